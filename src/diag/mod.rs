@@ -1,0 +1,104 @@
+//! Diagnostics: collecting them, ordering them, rendering them.
+//!
+//! Stage: shared. Each stage defines its own error enum deriving [`miette::Diagnostic`]
+//! with a stable code `insp::<stage>::<name>`, a label on the span at fault and a help
+//! line. Errors are plain data; this module renders them, either as miette's graphical
+//! report (for people) or as one JSON object per line (for editors).
+//!
+//! **Architecture Invariant:** a diagnostic's labels all lie in the file it is filed
+//! under; a related place in another file is named in the message or help instead.
+
+mod render;
+pub mod suggest;
+
+pub use render::{render_human, to_json, RenderOptions};
+
+use crate::source::FileId;
+use miette::Severity;
+
+/// One diagnostic, filed under the file its labels point into.
+pub struct Diagnostic {
+    /// The file the labels point into.
+    pub file: FileId,
+    /// The typed error.
+    pub inner: Box<dyn miette::Diagnostic + Send + Sync + 'static>,
+}
+
+impl Diagnostic {
+    /// The stable code, e.g. `insp::resolve::unknown_name`.
+    pub fn code(&self) -> String {
+        self.inner.code().map(|c| c.to_string()).unwrap_or_default()
+    }
+
+    /// Error unless the diagnostic says otherwise.
+    pub fn severity(&self) -> Severity {
+        self.inner.severity().unwrap_or(Severity::Error)
+    }
+
+    /// The message.
+    pub fn message(&self) -> String {
+        self.inner.to_string()
+    }
+
+    /// The byte offset of the first label, used to order diagnostics.
+    pub fn offset(&self) -> usize {
+        self.inner.labels().and_then(|mut l| l.next()).map_or(0, |l| l.offset())
+    }
+}
+
+impl std::fmt::Debug for Diagnostic {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {} (file {:?} @{})", self.code(), self.message(), self.file, self.offset())
+    }
+}
+
+/// The diagnostics of one run.
+#[derive(Debug, Default)]
+pub struct Diagnostics {
+    items: Vec<Diagnostic>,
+}
+
+impl Diagnostics {
+    /// An empty sink.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Files a diagnostic under `file`.
+    pub fn push(&mut self, file: FileId, err: impl miette::Diagnostic + Send + Sync + 'static) {
+        self.items.push(Diagnostic { file, inner: Box::new(err) });
+    }
+
+    /// Whether any error (not just warnings) was filed.
+    pub fn has_errors(&self) -> bool {
+        self.items.iter().any(|d| d.severity() == Severity::Error)
+    }
+
+    /// Number of errors.
+    pub fn error_count(&self) -> usize {
+        self.items.iter().filter(|d| d.severity() == Severity::Error).count()
+    }
+
+    /// Number of warnings.
+    pub fn warning_count(&self) -> usize {
+        self.items.iter().filter(|d| d.severity() == Severity::Warning).count()
+    }
+
+    /// All diagnostics in a stable order: by file, then position, then code.
+    pub fn sorted(mut self) -> Vec<Diagnostic> {
+        self.items.sort_by(|a, b| {
+            (a.file, a.offset(), a.code(), a.message()).cmp(&(b.file, b.offset(), b.code(), b.message()))
+        });
+        self.items
+    }
+
+    /// The diagnostics in the order they were filed.
+    pub fn iter(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.items.iter()
+    }
+
+    /// Moves every diagnostic of `other` into this sink.
+    pub fn extend(&mut self, other: Diagnostics) {
+        self.items.extend(other.items);
+    }
+}
