@@ -1,9 +1,42 @@
 //! inspc: a compiler for CMM inspection.
 //!
 //! `.insp` specs in, DMIS programs out. See `ARCHITECTURE.md` for the pipeline; each
-//! stage is a module with one documented entry point.
+//! stage is a module with one documented entry point:
+//! [`syntax::parse`] → [`load::load`] → [`resolve::resolve`] → [`model::Model`].
 #![warn(missing_docs)]
 
 pub mod diag;
+pub mod load;
+pub mod model;
+pub mod resolve;
 pub mod source;
 pub mod syntax;
+
+use std::path::PathBuf;
+
+/// The result of checking a spec: the model (meaningful only without errors), every
+/// diagnostic, and the sources they point into.
+pub struct Checked {
+    /// The resolved model.
+    pub model: model::Model,
+    /// Every diagnostic, in a stable order.
+    pub diagnostics: Vec<diag::Diagnostic>,
+    /// The files read.
+    pub sources: source::SourceMap,
+}
+
+impl Checked {
+    /// Whether any diagnostic is an error.
+    pub fn has_errors(&self) -> bool {
+        self.diagnostics.iter().any(|d| d.severity() == miette::Severity::Error)
+    }
+}
+
+/// Runs the front end (load, parse, resolve) over root files.
+pub fn check(world: &dyn source::World, roots: &[PathBuf]) -> Checked {
+    let mut sources = source::SourceMap::new();
+    let mut diags = diag::Diagnostics::new();
+    let program = load::load(world, roots, &mut sources, &mut diags);
+    let model = resolve::resolve(&program, &sources, world, &mut diags);
+    Checked { model, diagnostics: diags.sorted(), sources }
+}

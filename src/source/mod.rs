@@ -11,6 +11,7 @@
 mod world;
 
 pub use world::{FsWorld, MemoryWorld, World, WorldError};
+pub(crate) use world::normalize as normalize_path;
 
 use std::path::{Path, PathBuf};
 

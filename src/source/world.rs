@@ -3,19 +3,14 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// Why a file could not be read.
+/// Why a file could not be read: the system's reason.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum WorldError {
-    /// No such file, or it could not be opened; the text is the system's reason.
-    Unreadable(String),
-    /// The file is not UTF-8; the byte offset of the first bad byte.
-    NotUtf8(usize),
-}
+pub struct WorldError(pub String);
 
 /// Where source and data files come from.
 pub trait World {
-    /// The text of a file.
-    fn read(&self, path: &Path) -> Result<String, WorldError>;
+    /// The bytes of a file.
+    fn read(&self, path: &Path) -> Result<Vec<u8>, WorldError>;
     /// Whether a (data) file exists and is a regular file.
     fn exists(&self, path: &Path) -> bool;
     /// The canonical form of a path, so one file read under two spellings is one file.
@@ -29,9 +24,11 @@ pub trait World {
 pub struct FsWorld;
 
 impl World for FsWorld {
-    fn read(&self, path: &Path) -> Result<String, WorldError> {
-        let bytes = std::fs::read(path).map_err(|e| WorldError::Unreadable(e.to_string()))?;
-        String::from_utf8(bytes).map_err(|e| WorldError::NotUtf8(e.utf8_error().valid_up_to()))
+    fn read(&self, path: &Path) -> Result<Vec<u8>, WorldError> {
+        if path.is_dir() {
+            return Err(WorldError("is a directory".into()));
+        }
+        std::fs::read(path).map_err(|e| WorldError(e.to_string()))
     }
 
     fn exists(&self, path: &Path) -> bool {
@@ -63,12 +60,8 @@ impl MemoryWorld {
 }
 
 impl World for MemoryWorld {
-    fn read(&self, path: &Path) -> Result<String, WorldError> {
-        let bytes = self
-            .files
-            .get(&normalize(path))
-            .ok_or_else(|| WorldError::Unreadable("No such file or directory".into()))?;
-        String::from_utf8(bytes.clone()).map_err(|e| WorldError::NotUtf8(e.utf8_error().valid_up_to()))
+    fn read(&self, path: &Path) -> Result<Vec<u8>, WorldError> {
+        self.files.get(&normalize(path)).cloned().ok_or_else(|| WorldError("No such file or directory".into()))
     }
 
     fn exists(&self, path: &Path) -> bool {

@@ -299,8 +299,8 @@ pub enum PartStmt {
         what: NamedKind,
         /// The declared name.
         name: Ident,
-        /// The faces.
-        expr: FaceExpr,
+        /// The faces; `None` when nothing follows the name.
+        expr: Option<FaceExpr>,
         /// The statement.
         span: Span,
     },

@@ -278,7 +278,7 @@ impl L {
                     _ => NamedKind::Datum,
                 };
                 let name = self.ident(it.next().expect("name"));
-                let expr = self.face_expr(it.next().expect("face expression"))?;
+                let expr = it.next().map(|e| self.face_expr(e)).transpose()?;
                 PartStmt::Named { what, name, expr, span }
             }
             Rule::frame_stmt => {

@@ -1,0 +1,16 @@
+//! The standard library, embedded in the binary from `stdlib/`.
+
+/// Every standard module: its `use` name and its source.
+pub const STD_MODULES: &[(&str, &str)] = &[
+    ("std::heads", include_str!("../../stdlib/heads.insp")),
+    ("std::styli", include_str!("../../stdlib/styli.insp")),
+    ("std::probes", include_str!("../../stdlib/probes.insp")),
+    ("std::cmms", include_str!("../../stdlib/cmms.insp")),
+    ("std::hierarchies", include_str!("../../stdlib/hierarchies.insp")),
+    ("std::sampling", include_str!("../../stdlib/sampling.insp")),
+];
+
+/// The names of the standard modules.
+pub fn std_module_names() -> impl Iterator<Item = &'static str> + Clone {
+    STD_MODULES.iter().map(|(n, _)| *n)
+}

@@ -1,0 +1,407 @@
+//! The model: a resolved, typed, unit-normalised spec.
+//!
+//! Stage output of `resolve`, input of every later stage. Names are bound (references
+//! are indices into the model's vectors), quantities are converted to one internal unit
+//! — **millimetres for lengths, degrees for angles** (degrees keep head grids such as
+//! 7.5° exact in binary) — and directions are unit vectors in the part frame.
+//!
+//! **Architecture Invariant:** the model holds no spans except for diagnostics later
+//! stages may raise (planning failures point at the face or level at fault), and no
+//! `HashMap`: iteration order is declaration order everywhere.
+
+mod part;
+mod summary;
+
+pub use summary::fmt_num;
+
+pub use part::*;
+
+use crate::source::Span;
+
+/// A 3-vector in the part frame (mm for points, unit length for directions).
+pub type Vec3 = [f64; 3];
+
+macro_rules! ids {
+    ($($(#[$m:meta])* $name:ident),* $(,)?) => {$(
+        $(#[$m])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+        pub struct $name(pub usize);
+    )*};
+}
+
+ids! {
+    /// Index into [`Model::parts`].
+    PartId,
+    /// Index into [`Model::cmms`].
+    CmmId,
+    /// Index into [`Model::heads`].
+    HeadId,
+    /// Index into [`Model::probes`].
+    ProbeId,
+    /// Index into [`Model::styli`].
+    StylusId,
+    /// Index into [`Model::bodies`].
+    BodyId,
+    /// Index into [`Model::extensions`].
+    ExtensionId,
+    /// Index into [`Model::hierarchies`].
+    HierarchyId,
+    /// Index into [`Model::samplings`].
+    SamplingId,
+}
+
+/// Everything a run declared or imported, in declaration order.
+#[derive(Debug, Clone, Default)]
+pub struct Model {
+    /// Parts.
+    pub parts: Vec<Part>,
+    /// Machines.
+    pub cmms: Vec<Cmm>,
+    /// Probe heads.
+    pub heads: Vec<Head>,
+    /// Probe assemblies.
+    pub probes: Vec<Probe>,
+    /// Styli.
+    pub styli: Vec<Stylus>,
+    /// Probe bodies.
+    pub bodies: Vec<Body>,
+    /// Stylus extensions.
+    pub extensions: Vec<Extension>,
+    /// Constraint hierarchies.
+    pub hierarchies: Vec<Hierarchy>,
+    /// Sampling strategy sets.
+    pub samplings: Vec<Sampling>,
+    /// Plans declared in the root files (imported files' plans are not run).
+    pub plans: Vec<Plan>,
+}
+
+/// A coordinate measuring machine.
+#[derive(Debug, Clone)]
+pub struct Cmm {
+    /// Its name.
+    pub name: String,
+    /// The table's top, in machine z (mm).
+    pub table_z: f64,
+    /// The table's extent in x and y (mm), if given.
+    pub table_size: Option<[f64; 2]>,
+    /// The ram's radius (mm).
+    pub ram_radius: f64,
+    /// The ram's length below the bridge (mm).
+    pub ram_length: f64,
+    /// The head mounted on the ram.
+    pub head: HeadId,
+    /// The probes in its rack, by label.
+    pub probes: Vec<(String, ProbeId)>,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// How a head orients its probe.
+#[derive(Debug, Clone, PartialEq)]
+pub enum HeadKind {
+    /// The probe is aligned with the ram (a straight probe in Spitz's terms).
+    Fixed,
+    /// The probe indexes to A/B angles on a grid (a bent probe).
+    Indexable {
+        /// A (tilt) range in degrees, inclusive.
+        a: [f64; 2],
+        /// B (rotation) range in degrees, inclusive.
+        b: [f64; 2],
+        /// The indexing step in degrees; it divides both ranges.
+        step: f64,
+    },
+}
+
+/// A probe head.
+#[derive(Debug, Clone)]
+pub struct Head {
+    /// Its name.
+    pub name: String,
+    /// Fixed or indexable.
+    pub kind: HeadKind,
+    /// Envelope length from the ram face to the probe mount (mm).
+    pub length: f64,
+    /// Envelope diameter (mm).
+    pub diameter: f64,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+impl Head {
+    /// The A/B orientations of an indexable head (B = 180° folded onto −180°); empty for
+    /// a fixed head.
+    pub fn orientations(&self) -> Vec<(f64, f64)> {
+        let HeadKind::Indexable { a, b, step } = &self.kind else { return vec![] };
+        let steps = |r: &[f64; 2]| ((r[1] - r[0]) / step).round() as usize;
+        let full_turn = (b[1] - b[0] - 360.0).abs() < 1e-9;
+        let nb = steps(b) + usize::from(!full_turn);
+        (0..=steps(a)).flat_map(|i| (0..nb).map(move |j| (a[0] + i as f64 * step, b[0] + j as f64 * step))).collect()
+    }
+}
+
+/// A stylus: ball tip on a stem.
+#[derive(Debug, Clone)]
+pub struct Stylus {
+    /// Its name.
+    pub name: String,
+    /// Ball diameter (mm).
+    pub tip: f64,
+    /// Length from the mounting face to the ball centre (mm).
+    pub length: f64,
+    /// Stem diameter (mm).
+    pub stem: f64,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// A probe body (sensor), modelled as a cylinder.
+#[derive(Debug, Clone)]
+pub struct Body {
+    /// Its name.
+    pub name: String,
+    /// Diameter (mm).
+    pub diameter: f64,
+    /// Length (mm).
+    pub length: f64,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// A stylus extension, modelled as a cylinder.
+#[derive(Debug, Clone)]
+pub struct Extension {
+    /// Its name.
+    pub name: String,
+    /// Diameter (mm).
+    pub diameter: f64,
+    /// Length (mm).
+    pub length: f64,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// A probe assembly: body, extensions, stylus.
+#[derive(Debug, Clone)]
+pub struct Probe {
+    /// Its name.
+    pub name: String,
+    /// The body.
+    pub body: BodyId,
+    /// Extensions from the body outwards.
+    pub extensions: Vec<ExtensionId>,
+    /// The stylus.
+    pub stylus: StylusId,
+    /// Relative cost (1 = ordinary).
+    pub cost: f64,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// The variable a `same` constraint ties.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum SameVar {
+    /// `same_setup`
+    Setup,
+    /// `same_probe`
+    Probe,
+    /// `same_orient`
+    Orient,
+}
+
+/// The measurement group a `same` constraint applies to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Group {
+    /// `(T, F, *)`: the measurements of one feature under one tolerance.
+    TolFeature,
+    /// `(T, *)`: the measurements of one tolerance.
+    Tol,
+    /// `(*, *)`: all measurements.
+    All,
+}
+
+/// A soft level of a constraint hierarchy.
+#[derive(Debug, Clone)]
+pub struct Level {
+    /// Which variable.
+    pub var: SameVar,
+    /// Over which group.
+    pub group: Group,
+    /// Where it was written.
+    pub span: Span,
+}
+
+/// A constraint hierarchy: required approachability, then soft levels, most important
+/// first.
+#[derive(Debug, Clone)]
+pub struct Hierarchy {
+    /// Its name.
+    pub name: String,
+    /// The soft levels in order.
+    pub levels: Vec<Level>,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// A surface type, for sampling.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum SurfaceKind {
+    /// Planar face.
+    Plane,
+    /// Cylindrical face.
+    Cylinder,
+    /// Conical face.
+    Cone,
+    /// Spherical face.
+    Sphere,
+    /// Anything else.
+    Freeform,
+}
+
+impl SurfaceKind {
+    /// All kinds in order.
+    pub const ALL: [SurfaceKind; 5] = [Self::Plane, Self::Cylinder, Self::Cone, Self::Sphere, Self::Freeform];
+
+    /// The keyword.
+    pub fn keyword(self) -> &'static str {
+        match self {
+            Self::Plane => "plane",
+            Self::Cylinder => "cylinder",
+            Self::Cone => "cone",
+            Self::Sphere => "sphere",
+            Self::Freeform => "freeform",
+        }
+    }
+}
+
+/// How points are placed on a face.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SampleMethod {
+    /// Fan & Leu's rules: 4 points on a plane, 8 on a cylinder or cone.
+    FanLeu,
+    /// A uniform grid.
+    Uniform,
+    /// A Hammersley sequence.
+    Hammersley,
+}
+
+/// How far sample points stay from a face's boundary.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Inset {
+    /// A distance (mm).
+    Length(f64),
+    /// A fraction of the face's extent (0..0.5).
+    Fraction(f64),
+}
+
+/// A sampling strategy for one surface type or feature.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Strategy {
+    /// The method.
+    pub method: SampleMethod,
+    /// Number of points (the method's own rule when `None`).
+    pub points: Option<u32>,
+    /// Boundary inset (the method's own rule when `None`).
+    pub inset: Option<Inset>,
+}
+
+/// A set of strategies per surface type.
+#[derive(Debug, Clone)]
+pub struct Sampling {
+    /// Its name.
+    pub name: String,
+    /// Strategy per surface type; a type left out gets `uniform(points 9)`.
+    pub per_surface: Vec<(SurfaceKind, Strategy)>,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+impl Sampling {
+    /// The strategy for a surface type.
+    pub fn strategy(&self, kind: SurfaceKind) -> Strategy {
+        self.per_surface
+            .iter()
+            .find(|(k, _)| *k == kind)
+            .map(|(_, s)| s.clone())
+            .unwrap_or(Strategy { method: SampleMethod::Uniform, points: Some(9), inset: None })
+    }
+}
+
+/// A setup preference: the part orientation that puts `direction` (part frame) towards
+/// the ram.
+#[derive(Debug, Clone)]
+pub struct SetupPref {
+    /// Unit direction in the part frame.
+    pub direction: Vec3,
+    /// Weight for the weighted clustering (1 = strong); ignored when forbidden.
+    pub weight: f64,
+    /// Never use this setup.
+    pub forbidden: bool,
+    /// Where it was written.
+    pub span: Span,
+}
+
+/// A head orientation preference (indexable heads).
+#[derive(Debug, Clone)]
+pub struct OrientPref {
+    /// A angle (degrees).
+    pub a: f64,
+    /// B angle (degrees).
+    pub b: f64,
+    /// Weight (1 = strong).
+    pub weight: f64,
+    /// Never use this orientation.
+    pub forbidden: bool,
+    /// Where it was written.
+    pub span: Span,
+}
+
+/// A probe preference: a cost override or a ban.
+#[derive(Debug, Clone)]
+pub struct ProbePref {
+    /// The probe's label in the CMM's rack.
+    pub label: String,
+    /// Cost override.
+    pub cost: Option<f64>,
+    /// Never use this probe.
+    pub forbidden: bool,
+    /// Where it was written.
+    pub span: Span,
+}
+
+/// What a plan writes.
+#[derive(Debug, Clone, Default)]
+pub struct Outputs {
+    /// The DMIS program path, relative to the spec.
+    pub dmis: Option<String>,
+    /// The plan as JSON.
+    pub plan: Option<String>,
+    /// The measurement graph.
+    pub graph: Option<String>,
+}
+
+/// A plan: which part on which machine, and what a good plan is.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// Its name.
+    pub name: String,
+    /// The part.
+    pub part: PartId,
+    /// The machine.
+    pub cmm: CmmId,
+    /// The constraint hierarchy.
+    pub hierarchy: HierarchyId,
+    /// The sampling strategies.
+    pub sampling: SamplingId,
+    /// Per-feature strategy overrides.
+    pub overrides: Vec<(FeatureId, Strategy)>,
+    /// Setup preferences and bans.
+    pub setups: Vec<SetupPref>,
+    /// Orientation preferences and bans.
+    pub orientations: Vec<OrientPref>,
+    /// Probe costs and bans.
+    pub probes: Vec<ProbePref>,
+    /// Output files.
+    pub outputs: Outputs,
+    /// Where it was declared.
+    pub span: Span,
+}

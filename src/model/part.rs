@@ -1,0 +1,409 @@
+//! Parts: geometry source, faces, features, datums and tolerances.
+
+use super::Vec3;
+use crate::source::Span;
+
+/// Index into [`Part::features`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct FeatureId(pub usize);
+
+/// Index into [`Part::datums`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct DatumId(pub usize);
+
+/// Index into [`Part::ops`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct OpId(pub usize);
+
+/// A toleranced part.
+#[derive(Debug, Clone)]
+pub struct Part {
+    /// Its name.
+    pub name: String,
+    /// The unit its bare numbers were written in (mm per unit).
+    pub unit_mm: f64,
+    /// Where its geometry comes from.
+    pub geometry: Geometry,
+    /// Machining operations applied to the stock, in order.
+    pub ops: Vec<Op>,
+    /// Features (groups of faces to be measured).
+    pub features: Vec<Feature>,
+    /// Datums.
+    pub datums: Vec<Datum>,
+    /// Datum reference frames.
+    pub frames: Vec<Frame>,
+    /// Tolerances.
+    pub tolerances: Vec<Tolerance>,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// The geometry source.
+#[derive(Debug, Clone)]
+pub enum Geometry {
+    /// Stock, with `ops` applied.
+    Stock(Stock),
+    /// A mesh file.
+    Mesh {
+        /// The path as resolved against the spec's folder.
+        path: std::path::PathBuf,
+        /// mm per file unit.
+        unit_mm: f64,
+        /// Where the path was written.
+        span: Span,
+    },
+}
+
+/// A stock shape; boxes span `[0, x] × [0, y] × [0, z]`, cylinders stand on the origin
+/// along +z, spheres are centred on the origin.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Stock {
+    /// A box.
+    Box {
+        /// Extent (mm).
+        size: Vec3,
+    },
+    /// A cylinder along +z.
+    Cylinder {
+        /// Diameter (mm).
+        diameter: f64,
+        /// Height (mm).
+        height: f64,
+    },
+    /// A sphere.
+    Sphere {
+        /// Diameter (mm).
+        diameter: f64,
+    },
+}
+
+/// Where an operation sits.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Placement {
+    /// At a point (mm).
+    At(Vec3),
+    /// Where a ray from the stock's centre in this unit direction leaves the stock.
+    Radial(Vec3),
+}
+
+/// How deep a hole goes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Depth {
+    /// Through the part.
+    Through,
+    /// To this depth (mm).
+    Blind(f64),
+}
+
+/// A machining operation's shape.
+#[derive(Debug, Clone, PartialEq)]
+pub enum OpKind {
+    /// A drilled hole.
+    Hole {
+        /// Entry point.
+        at: Placement,
+        /// Drilling direction (into the material).
+        axis: Vec3,
+        /// Diameter (mm).
+        diameter: f64,
+        /// Depth.
+        depth: Depth,
+    },
+    /// A slot cut from `at` along a direction.
+    Slot {
+        /// Start of the slot's centre line on the surface.
+        at: Vec3,
+        /// Direction of the slot.
+        along: Vec3,
+        /// Direction into the material.
+        into: Vec3,
+        /// Width (mm).
+        width: f64,
+        /// Depth (mm).
+        depth: f64,
+        /// Length (mm), through the part when `None`.
+        length: Option<f64>,
+    },
+    /// A rectangular pocket centred on `at`.
+    Pocket {
+        /// Centre of the opening.
+        at: Vec3,
+        /// Direction of the pocket's length.
+        along: Vec3,
+        /// Direction into the material.
+        into: Vec3,
+        /// Length and width (mm).
+        size: [f64; 2],
+        /// Depth (mm).
+        depth: f64,
+        /// Corner radius (mm).
+        corner_radius: f64,
+    },
+    /// A step milled along an edge: one wall and one floor.
+    Step {
+        /// A point on the edge.
+        at: Vec3,
+        /// Direction of the edge.
+        along: Vec3,
+        /// Direction into the material.
+        into: Vec3,
+        /// Width removed from the edge (mm).
+        width: f64,
+        /// Depth (mm).
+        depth: f64,
+    },
+    /// A cylindrical boss (material added).
+    Boss {
+        /// Centre of its base.
+        at: Vec3,
+        /// Direction it grows in.
+        axis: Vec3,
+        /// Diameter (mm).
+        diameter: f64,
+        /// Height (mm).
+        height: f64,
+    },
+}
+
+/// Copies of an operation.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Pattern {
+    /// `count` copies, each `step` further.
+    Linear {
+        /// Number of copies.
+        count: u32,
+        /// Offset between copies (mm).
+        step: Vec3,
+    },
+    /// A grid of `nx × ny` copies along the part's x and y.
+    Grid {
+        /// Copies along x.
+        nx: u32,
+        /// Copies along y.
+        ny: u32,
+        /// Pitch along x and y (mm).
+        pitch: [f64; 2],
+    },
+    /// `count` copies rotated evenly about an axis through a centre.
+    Polar {
+        /// Number of copies.
+        count: u32,
+        /// Rotation axis.
+        axis: Vec3,
+        /// A point on the axis.
+        center: Vec3,
+    },
+}
+
+impl Pattern {
+    /// Number of instances.
+    pub fn count(&self) -> u32 {
+        match self {
+            Pattern::Linear { count, .. } | Pattern::Polar { count, .. } => *count,
+            Pattern::Grid { nx, ny, .. } => nx * ny,
+        }
+    }
+}
+
+/// A named machining operation.
+#[derive(Debug, Clone)]
+pub struct Op {
+    /// Its name.
+    pub name: String,
+    /// Material added (`add`) rather than removed (`cut`).
+    pub add: bool,
+    /// The shape.
+    pub kind: OpKind,
+    /// Copies, if patterned.
+    pub pattern: Option<Pattern>,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// Which faces of the stock or of an operation a reference names.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FaceSource {
+    /// The stock.
+    Stock,
+    /// An operation, optionally one instance of its pattern.
+    Op(OpId, Option<u32>),
+}
+
+/// A criterion picking faces of a mesh by their fitted surface.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Selector {
+    /// The surface type.
+    pub surface: Option<super::SurfaceKind>,
+    /// A plane's outward normal (unit).
+    pub normal: Option<Vec3>,
+    /// A cylinder's or cone's axis (unit, either sense).
+    pub axis: Option<Vec3>,
+    /// Radius (mm).
+    pub radius: Option<f64>,
+    /// Keep the face with the highest (`true`) or lowest centroid coordinate on an axis.
+    pub extreme: Option<(u8, bool)>,
+    /// Keep the face whose centroid is nearest this point (mm).
+    pub nearest: Option<Vec3>,
+}
+
+/// A reference to faces of the part geometry.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FaceRef {
+    /// A role of the stock or an operation: `stock.top`, `grid[2].wall`.
+    Role {
+        /// Whose face.
+        source: FaceSource,
+        /// The role: `top`, `wall`, `walls`, `floor`, …
+        role: String,
+        /// Where it was written.
+        span: Span,
+    },
+    /// A group of a mesh file.
+    Group(String, Span),
+    /// A segment of an unlabelled mesh.
+    Segment(u32, Span),
+    /// A selector over a mesh's faces.
+    Select(Selector, Span),
+}
+
+/// A feature: faces measured together.
+#[derive(Debug, Clone)]
+pub struct Feature {
+    /// Its name.
+    pub name: String,
+    /// Its faces (with repeats removed).
+    pub faces: Vec<FaceRef>,
+    /// Declared with `face` rather than `feature` (a named face reused in features).
+    pub is_face_alias: bool,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// A datum.
+#[derive(Debug, Clone)]
+pub struct Datum {
+    /// Its letter(s).
+    pub name: String,
+    /// The datum feature.
+    pub feature: FeatureId,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// Material condition modifiers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Material {
+    /// Maximum material condition, Ⓜ.
+    Mmc,
+    /// Least material condition, Ⓛ.
+    Lmc,
+    /// Regardless of feature size.
+    Rfs,
+}
+
+/// A datum in a tolerance's reference frame.
+#[derive(Debug, Clone)]
+pub struct DatumRef {
+    /// The datum.
+    pub datum: DatumId,
+    /// Its modifier.
+    pub modifier: Option<Material>,
+}
+
+/// A named datum reference frame.
+#[derive(Debug, Clone)]
+pub struct Frame {
+    /// Its name.
+    pub name: String,
+    /// Primary, secondary, tertiary.
+    pub refs: Vec<DatumRef>,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// Tolerance types a CMM checks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum TolKind {
+    /// ⏥
+    Flatness,
+    /// ⏤
+    Straightness,
+    /// ○
+    Circularity,
+    /// ⌭
+    Cylindricity,
+    /// ⌒
+    ProfileLine,
+    /// ⌓
+    ProfileSurface,
+    /// ⟂
+    Perpendicularity,
+    /// ∥
+    Parallelism,
+    /// ∠
+    Angularity,
+    /// ⌖
+    Position,
+    /// ◎ (concentricity)
+    Concentricity,
+    /// ◎ (coaxiality)
+    Coaxiality,
+    /// ⌯
+    Symmetry,
+    /// ↗
+    CircularRunout,
+    /// ⌰
+    TotalRunout,
+    /// Ø size
+    Diameter,
+    /// R size
+    Radius,
+    /// Width of a slot or tab.
+    Width,
+    /// Distance between features.
+    Distance,
+    /// Angle between features.
+    Angle,
+}
+
+/// A tolerance's value.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TolValue {
+    /// A geometric tolerance zone width (mm); `diameter` for a cylindrical zone (Ø).
+    Zone {
+        /// Width (mm).
+        width: f64,
+        /// Cylindrical zone.
+        diameter: bool,
+    },
+    /// A size with limits (mm, or degrees for `angle`).
+    Size {
+        /// Nominal.
+        nominal: f64,
+        /// Lower limit.
+        lower: f64,
+        /// Upper limit.
+        upper: f64,
+    },
+}
+
+/// A tolerance.
+#[derive(Debug, Clone)]
+pub struct Tolerance {
+    /// Its name.
+    pub name: String,
+    /// Its type.
+    pub kind: TolKind,
+    /// The toleranced features.
+    pub targets: Vec<FeatureId>,
+    /// Zone or limits.
+    pub value: TolValue,
+    /// Material condition of the toleranced feature.
+    pub modifier: Option<Material>,
+    /// The datum reference frame.
+    pub datums: Vec<DatumRef>,
+    /// Basic angle for angularity (degrees).
+    pub basic_angle: Option<f64>,
+    /// Where it was declared.
+    pub span: Span,
+}

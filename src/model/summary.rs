@@ -1,0 +1,211 @@
+//! A stable, readable text dump of the model, for golden tests and `inspc check --emit model`.
+
+use super::*;
+use std::fmt::Write;
+
+/// Formats a number the one way inspc prints numbers in reports: at most six decimals,
+/// trailing zeros trimmed, never `-0`.
+pub fn fmt_num(v: f64) -> String {
+    let s = format!("{v:.6}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.into() }
+}
+
+fn v3(v: &Vec3) -> String {
+    format!("({}, {}, {})", fmt_num(v[0]), fmt_num(v[1]), fmt_num(v[2]))
+}
+
+impl Model {
+    /// The model as indented text, in declaration order.
+    pub fn summary(&self) -> String {
+        let mut o = String::new();
+        for h in &self.heads {
+            let kind = match &h.kind {
+                HeadKind::Fixed => "fixed".to_string(),
+                HeadKind::Indexable { a, b, step } => format!(
+                    "indexable A {}..{} B {}..{} step {} ({} orientations)",
+                    fmt_num(a[0]), fmt_num(a[1]), fmt_num(b[0]), fmt_num(b[1]), fmt_num(*step), h.orientations().len()
+                ),
+            };
+            let _ = writeln!(o, "head {}: {kind}, envelope Ø{} × {}", h.name, fmt_num(h.diameter), fmt_num(h.length));
+        }
+        for s in &self.styli {
+            let _ = writeln!(o, "stylus {}: tip Ø{}, length {}, stem Ø{}", s.name, fmt_num(s.tip), fmt_num(s.length), fmt_num(s.stem));
+        }
+        for b in &self.bodies {
+            let _ = writeln!(o, "body {}: Ø{} × {}", b.name, fmt_num(b.diameter), fmt_num(b.length));
+        }
+        for e in &self.extensions {
+            let _ = writeln!(o, "extension {}: Ø{} × {}", e.name, fmt_num(e.diameter), fmt_num(e.length));
+        }
+        for p in &self.probes {
+            let ext: Vec<&str> = p.extensions.iter().map(|e| self.extensions[e.0].name.as_str()).collect();
+            let _ = writeln!(
+                o,
+                "probe {}: body {}, extensions [{}], stylus {}, cost {}",
+                p.name, self.bodies[p.body.0].name, ext.join(", "), self.styli[p.stylus.0].name, fmt_num(p.cost)
+            );
+        }
+        for c in &self.cmms {
+            let probes: Vec<String> = c.probes.iter().map(|(l, p)| format!("{l}: {}", self.probes[p.0].name)).collect();
+            let size = c.table_size.map_or(String::new(), |s| format!(" size {} × {}", fmt_num(s[0]), fmt_num(s[1])));
+            let _ = writeln!(
+                o,
+                "cmm {}: table z {}{size}, ram r {} l {}, head {}, probes [{}]",
+                c.name, fmt_num(c.table_z), fmt_num(c.ram_radius), fmt_num(c.ram_length), self.heads[c.head.0].name, probes.join(", ")
+            );
+        }
+        for h in &self.hierarchies {
+            let levels: Vec<String> = h.levels.iter().map(|l| crate::resolve::level_text(l.var, l.group)).collect();
+            let _ = writeln!(o, "hierarchy {}: required approachability > {}", h.name, levels.join(" > "));
+        }
+        for s in &self.samplings {
+            let per: Vec<String> = s.per_surface.iter().map(|(k, st)| format!("{} {}", k.keyword(), strategy_text(st))).collect();
+            let _ = writeln!(o, "sampling {}: {}", s.name, per.join(", "));
+        }
+        for p in &self.parts {
+            part_summary(&mut o, p);
+        }
+        for p in &self.plans {
+            let _ = writeln!(
+                o,
+                "plan {}: part {}, cmm {}, hierarchy {}, sampling {}",
+                p.name, self.parts[p.part.0].name, self.cmms[p.cmm.0].name, self.hierarchies[p.hierarchy.0].name, self.samplings[p.sampling.0].name
+            );
+            for s in &p.setups {
+                let verb = if s.forbidden { "forbid".to_string() } else { format!("prefer (weight {})", fmt_num(s.weight)) };
+                let _ = writeln!(o, "  {verb} setup {}", v3(&s.direction));
+            }
+            for s in &p.orientations {
+                let verb = if s.forbidden { "forbid".to_string() } else { format!("prefer (weight {})", fmt_num(s.weight)) };
+                let _ = writeln!(o, "  {verb} orientation A {} B {}", fmt_num(s.a), fmt_num(s.b));
+            }
+            for s in &p.probes {
+                let what = if s.forbidden { "forbid".to_string() } else { format!("cost {}", s.cost.map_or("-".into(), fmt_num)) };
+                let _ = writeln!(o, "  probe {}: {what}", s.label);
+            }
+            for (f, st) in &p.overrides {
+                let _ = writeln!(o, "  sample {} with {}", self.parts[p.part.0].features[f.0].name, strategy_text(st));
+            }
+        }
+        o
+    }
+}
+
+fn strategy_text(s: &Strategy) -> String {
+    let m = match s.method {
+        SampleMethod::FanLeu => "fan_leu",
+        SampleMethod::Uniform => "uniform",
+        SampleMethod::Hammersley => "hammersley",
+    };
+    let mut args = Vec::new();
+    if let Some(n) = s.points {
+        args.push(format!("points {n}"));
+    }
+    match s.inset {
+        Some(Inset::Length(l)) => args.push(format!("inset {} mm", fmt_num(l))),
+        Some(Inset::Fraction(f)) => args.push(format!("inset {} %", fmt_num(f * 100.0))),
+        None => {}
+    }
+    if args.is_empty() { m.to_string() } else { format!("{m}({})", args.join(", ")) }
+}
+
+fn part_summary(o: &mut String, p: &Part) {
+    let geometry = match &p.geometry {
+        Geometry::Stock(Stock::Box { size }) => format!("box {}", v3(size)),
+        Geometry::Stock(Stock::Cylinder { diameter, height }) => format!("cylinder Ø{} × {}", fmt_num(*diameter), fmt_num(*height)),
+        Geometry::Stock(Stock::Sphere { diameter }) => format!("sphere Ø{}", fmt_num(*diameter)),
+        Geometry::Mesh { path, unit_mm, .. } => {
+            let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            format!("mesh {name} (× {} mm)", fmt_num(*unit_mm))
+        }
+    };
+    let _ = writeln!(o, "part {}: {geometry}", p.name);
+    for op in &p.ops {
+        let verb = if op.add { "add" } else { "cut" };
+        let shape = match &op.kind {
+            OpKind::Hole { at, axis, diameter, depth } => {
+                let at = match at {
+                    Placement::At(p) => format!("at {}", v3(p)),
+                    Placement::Radial(d) => format!("radial {}", v3(d)),
+                };
+                let depth = match depth {
+                    Depth::Through => "through".to_string(),
+                    Depth::Blind(d) => format!("depth {}", fmt_num(*d)),
+                };
+                format!("hole {at} axis {} Ø{} {depth}", v3(axis), fmt_num(*diameter))
+            }
+            OpKind::Slot { at, along, into, width, depth, length } => format!(
+                "slot at {} along {} into {} width {} depth {}{}",
+                v3(at), v3(along), v3(into), fmt_num(*width), fmt_num(*depth), length.map_or(String::new(), |l| format!(" length {}", fmt_num(l)))
+            ),
+            OpKind::Pocket { at, along, into, size, depth, corner_radius } => format!(
+                "pocket at {} along {} into {} size {} × {} depth {} corner r {}",
+                v3(at), v3(along), v3(into), fmt_num(size[0]), fmt_num(size[1]), fmt_num(*depth), fmt_num(*corner_radius)
+            ),
+            OpKind::Step { at, along, into, width, depth } => format!("step at {} along {} into {} width {} depth {}", v3(at), v3(along), v3(into), fmt_num(*width), fmt_num(*depth)),
+            OpKind::Boss { at, axis, diameter, height } => format!("boss at {} axis {} Ø{} height {}", v3(at), v3(axis), fmt_num(*diameter), fmt_num(*height)),
+        };
+        let pattern = match &op.pattern {
+            None => String::new(),
+            Some(Pattern::Grid { nx, ny, pitch }) => format!(" × grid {nx}×{ny} pitch {} × {}", fmt_num(pitch[0]), fmt_num(pitch[1])),
+            Some(Pattern::Linear { count, step }) => format!(" × linear {count} step {}", v3(step)),
+            Some(Pattern::Polar { count, axis, center }) => format!(" × polar {count} about {} through {}", v3(axis), v3(center)),
+        };
+        let _ = writeln!(o, "  {verb} {}: {shape}{pattern}", op.name);
+    }
+    for f in &p.features {
+        let faces: Vec<String> = f.faces.iter().map(|r| face_text(p, r)).collect();
+        let what = if f.is_face_alias { "face" } else { "feature" };
+        let _ = writeln!(o, "  {what} {} = {}", f.name, faces.join(" + "));
+    }
+    for d in &p.datums {
+        let _ = writeln!(o, "  datum {} on {}", d.name, p.features[d.feature.0].name);
+    }
+    for f in &p.frames {
+        let _ = writeln!(o, "  frame {} = [{}]", f.name, datum_refs(p, &f.refs));
+    }
+    for t in &p.tolerances {
+        let targets: Vec<&str> = t.targets.iter().map(|f| p.features[f.0].name.as_str()).collect();
+        let value = match &t.value {
+            TolValue::Zone { width, diameter } => format!("{}{}", if *diameter { "Ø" } else { "" }, fmt_num(*width)),
+            TolValue::Size { nominal, lower, upper } => format!("{} [{}, {}]", fmt_num(*nominal), fmt_num(*lower), fmt_num(*upper)),
+        };
+        let m = match t.modifier {
+            Some(Material::Mmc) => " MMC",
+            Some(Material::Lmc) => " LMC",
+            Some(Material::Rfs) => " RFS",
+            None => "",
+        };
+        let datums = if t.datums.is_empty() { String::new() } else { format!(" | {}", datum_refs(p, &t.datums)) };
+        let basic = t.basic_angle.map_or(String::new(), |a| format!(" basic {}°", fmt_num(a)));
+        let kind = crate::resolve::tolerance_keyword(t.kind);
+        let _ = writeln!(o, "  tolerance {}: {kind}({}) {value}{m}{datums}{basic}", t.name, targets.join(", "));
+    }
+}
+
+fn datum_refs(p: &Part, refs: &[DatumRef]) -> String {
+    refs.iter()
+        .map(|r| {
+            let n = &p.datums[r.datum.0].name;
+            match r.modifier {
+                Some(Material::Mmc) => format!("{n}(MMC)"),
+                Some(Material::Lmc) => format!("{n}(LMC)"),
+                Some(Material::Rfs) => format!("{n}(RFS)"),
+                None => n.clone(),
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn face_text(p: &Part, r: &FaceRef) -> String {
+    match r {
+        FaceRef::Role { source: FaceSource::Stock, role, .. } => format!("stock.{role}"),
+        FaceRef::Role { source: FaceSource::Op(op, None), role, .. } => format!("{}.{role}", p.ops[op.0].name),
+        FaceRef::Role { source: FaceSource::Op(op, Some(i)), role, .. } => format!("{}[{i}].{role}", p.ops[op.0].name),
+        FaceRef::Group(g, _) => format!("group {g:?}"),
+        FaceRef::Segment(n, _) => format!("segment {n}"),
+        FaceRef::Select(s, _) => format!("select{s:?}"),
+    }
+}

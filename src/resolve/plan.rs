@@ -1,0 +1,161 @@
+//! Plans: which part, which machine, which hierarchy and sampling, and the preferences.
+
+use super::catalogue::strategy;
+use super::errors::ResolveError as E;
+use super::props::{describe, num, path_text, Cx, Dim, Props};
+use super::{Kind, Resolver};
+use crate::diag::suggest;
+use crate::load::ModuleId;
+use crate::model::*;
+use crate::syntax::ast::{self, PlanStmt, ValueKind};
+
+pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &ast::Plan, model: &Model) -> Option<Plan> {
+    let props: Vec<ast::Prop> = p.stmts.iter().filter_map(|s| if let PlanStmt::Prop(pr) = s { Some(pr.clone()) } else { None }).collect();
+    let mut pp = Props::new(cx, format!("plan `{}`", p.name.name), p.name.span, &props);
+    let part = pp.req(cx, "part", "f2").and_then(|v| r.lookup_value(cx, module, v, Kind::Part));
+    let cmm = pp.req(cx, "cmm", "lab").and_then(|v| r.lookup_value(cx, module, v, Kind::Cmm));
+    let hierarchy = match pp.get("hierarchy") {
+        Some(v) => r.lookup_value(cx, module, v, Kind::Hierarchy),
+        None => r.std_item("std::hierarchies", "efficient_accuracy", Kind::Hierarchy),
+    };
+    let sampling = match pp.get("sampling") {
+        Some(v) => r.lookup_value(cx, module, v, Kind::Sampling),
+        None => r.std_item("std::sampling", "fan_leu", Kind::Sampling),
+    };
+    let mut outputs = Outputs::default();
+    if let Some(v) = pp.get("output") {
+        match &v.kind {
+            ValueKind::Block(ops) => {
+                let mut o = Props::new(cx, "`output`", v.span, ops);
+                outputs.dmis = o.get("dmis").and_then(|x| cx.string(x)).map(|s| s.value.clone());
+                outputs.plan = o.get("plan").and_then(|x| cx.string(x)).map(|s| s.value.clone());
+                outputs.graph = o.get("graph").and_then(|x| cx.string(x)).map(|s| s.value.clone());
+                o.finish(cx);
+            }
+            _ => cx.mismatch(v, "a block `{ dmis \"out.dmi\" }`", ""),
+        }
+    }
+    pp.finish(cx);
+    let (part, cmm, hierarchy, sampling) = (part?, cmm?, hierarchy?, sampling?);
+    let the_part = &model.parts[part];
+    let the_cmm = &model.cmms[cmm];
+    let head = model.heads.get(the_cmm.head.0);
+
+    let mut plan = Plan {
+        name: p.name.name.clone(),
+        part: PartId(part),
+        cmm: CmmId(cmm),
+        hierarchy: HierarchyId(hierarchy),
+        sampling: SamplingId(sampling),
+        overrides: vec![],
+        setups: vec![],
+        orientations: vec![],
+        probes: vec![],
+        outputs,
+        span: p.name.span,
+    };
+    for s in &p.stmts {
+        match s {
+            PlanStmt::Prop(_) => {}
+            PlanStmt::Sample { feature, strategy: sv, .. } => {
+                let name = path_text(feature);
+                match the_part.features.iter().position(|f| f.name == name) {
+                    Some(i) => {
+                        if let Some(st) = strategy(cx, sv, None) {
+                            plan.overrides.push((FeatureId(i), st));
+                        }
+                    }
+                    None => {
+                        let help = suggest::help_for_unknown("feature", &name, the_part.features.iter().map(|f| f.name.as_str()));
+                        cx.err(E::UnknownName { span: feature.span, what: format!("feature of part `{}`", the_part.name), name, help });
+                    }
+                }
+            }
+            PlanStmt::Pref { forbid, kind, value, opts, span } => {
+                let mut o = Props::new(cx, format!("`{} {}`", if *forbid { "forbid" } else { "prefer" }, kind.name), *span, opts);
+                match kind.name.as_str() {
+                    "setup" => {
+                        let weight = if *forbid { None } else { o.get("weight").and_then(|v| cx.non_negative(v, "weight")) };
+                        if let Some(direction) = cx.direction(value) {
+                            plan.setups.push(SetupPref { direction, weight: weight.unwrap_or(1.0), forbidden: *forbid, span: *span });
+                        }
+                    }
+                    "orientation" => {
+                        let weight = if *forbid { None } else { o.get("weight").and_then(|v| cx.non_negative(v, "weight")) };
+                        if let (Some(ab), Some(head)) = (orientation(cx, value, head), head) {
+                            plan.orientations.push(OrientPref { a: ab.0, b: ab.1, weight: weight.unwrap_or(1.0), forbidden: *forbid, span: *span });
+                            let _ = head;
+                        }
+                    }
+                    "probe" => {
+                        let cost = if *forbid { None } else { o.get("cost").and_then(|v| cx.non_negative(v, "cost")) };
+                        if let Some(label) = cx.name(value) {
+                            if the_cmm.probes.iter().any(|(l, _)| *l == label.name) {
+                                plan.probes.push(ProbePref { label: label.name.clone(), cost, forbidden: *forbid, span: *span });
+                            } else {
+                                let help = suggest::help_for_unknown("probe", &label.name, the_cmm.probes.iter().map(|(l, _)| l.as_str()));
+                                cx.err(E::UnknownName { span: label.span, what: format!("probe of cmm `{}`", the_cmm.name), name: label.name.clone(), help });
+                            }
+                        }
+                    }
+                    other => {
+                        let help = suggest::help_for_unknown("preference", other, ["setup", "orientation", "probe"]);
+                        cx.err(E::UnknownName { span: kind.span, what: "preference".into(), name: other.into(), help });
+                    }
+                }
+                o.finish(cx);
+            }
+        }
+    }
+    Some(plan)
+}
+
+/// An `(A, B)` orientation checked against the head's range and grid.
+fn orientation(cx: &mut Cx, v: &ast::Value, head: Option<&Head>) -> Option<(f64, f64)> {
+    let ValueKind::Tuple(items) = &v.kind else {
+        cx.mismatch(v, "an orientation `(A, B)`", "write e.g. `(30 deg, 90 deg)`");
+        return None;
+    };
+    if items.len() != 2 {
+        cx.mismatch(v, "an orientation `(A, B)`", "write e.g. `(30 deg, 90 deg)`");
+        return None;
+    }
+    let a = cx.dim(&items[0], Dim::Angle);
+    let b = cx.dim(&items[1], Dim::Angle);
+    let (a, b) = (a?, b?);
+    let head = head?;
+    let HeadKind::Indexable { a: ar, b: br, step } = &head.kind else {
+        cx.err(E::FixedHead { span: v.span, head: head.name.clone() });
+        return None;
+    };
+    let mut ok = true;
+    for (axis, val, range, item) in [("A", a, ar, &items[0]), ("B", b, br, &items[1])] {
+        let rtxt = format!("{}°..{}°", num(range[0]), num(range[1]));
+        if val < range[0] - 1e-9 || val > range[1] + 1e-9 {
+            cx.err(E::AngleOutOfRange {
+                span: item.span,
+                axis: axis.into(),
+                value: num(val),
+                head: head.name.clone(),
+                help: format!("{} is {}; choose an angle within {rtxt}", axis, describe(item)),
+                range: rtxt,
+            });
+            ok = false;
+            continue;
+        }
+        let k = (val - range[0]) / step;
+        if (k - k.round()).abs() > 1e-9 {
+            let lo = range[0] + k.floor() * step;
+            cx.err(E::OffGrid {
+                span: item.span,
+                axis: axis.into(),
+                value: num(val),
+                head: head.name.clone(),
+                step: num(*step),
+                help: format!("the nearest positions are {}° and {}°", num(lo), num(lo + step)),
+            });
+            ok = false;
+        }
+    }
+    ok.then_some((a, b))
+}

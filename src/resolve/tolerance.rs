@@ -1,0 +1,278 @@
+//! Tolerances: one table of GD&T rules per type, and the checks it drives.
+
+use super::errors::ResolveError as E;
+use super::part::{check_unique_datums, datum_ref, material, Local, PartCx};
+use super::props::{describe, num, path_text, Cx, Dim};
+use crate::diag::suggest;
+use crate::model::*;
+use crate::source::Span;
+use crate::syntax::ast::{self, ValueKind};
+
+#[derive(Clone, Copy, PartialEq)]
+enum Datums {
+    Forbidden,
+    Optional,
+    Required,
+}
+
+/// The rules of one tolerance type.
+struct Rule {
+    name: &'static str,
+    kind: TolKind,
+    datums: Datums,
+    /// MMC/LMC allowed on the toleranced feature.
+    material: bool,
+    /// A cylindrical (Ø) zone allowed.
+    dia: bool,
+    /// Number of toleranced features (min, max).
+    targets: (usize, usize),
+    /// A size tolerance with limits of this dimension (geometric tolerances: `None`).
+    size: Option<Dim>,
+}
+
+const fn geo(name: &'static str, kind: TolKind, datums: Datums, material: bool, dia: bool) -> Rule {
+    Rule { name, kind, datums, material, dia, targets: (1, 1), size: None }
+}
+
+const fn size(name: &'static str, kind: TolKind, targets: (usize, usize), dim: Dim) -> Rule {
+    Rule { name, kind, datums: Datums::Forbidden, material: false, dia: false, targets, size: Some(dim) }
+}
+
+use Datums::*;
+use TolKind as K;
+
+/// ASME Y14.5-2009 rules, as a CMM program needs them.
+const RULES: &[Rule] = &[
+    geo("flatness", K::Flatness, Forbidden, false, false),
+    geo("straightness", K::Straightness, Forbidden, true, true),
+    geo("circularity", K::Circularity, Forbidden, false, false),
+    geo("cylindricity", K::Cylindricity, Forbidden, false, false),
+    geo("profile_line", K::ProfileLine, Optional, false, false),
+    geo("profile_surface", K::ProfileSurface, Optional, false, false),
+    geo("perpendicularity", K::Perpendicularity, Required, true, true),
+    geo("parallelism", K::Parallelism, Required, true, true),
+    geo("angularity", K::Angularity, Required, true, true),
+    geo("position", K::Position, Required, true, true),
+    geo("concentricity", K::Concentricity, Required, false, true),
+    geo("coaxiality", K::Coaxiality, Required, true, true),
+    geo("symmetry", K::Symmetry, Required, false, false),
+    geo("circular_runout", K::CircularRunout, Required, false, false),
+    geo("total_runout", K::TotalRunout, Required, false, false),
+    size("diameter", K::Diameter, (1, 1), Dim::Length),
+    size("radius", K::Radius, (1, 1), Dim::Length),
+    size("width", K::Width, (1, 1), Dim::Length),
+    size("distance", K::Distance, (1, 2), Dim::Length),
+    size("angle", K::Angle, (2, 2), Dim::Angle),
+];
+
+/// The keyword of a tolerance type.
+pub fn keyword(kind: TolKind) -> &'static str {
+    RULES.iter().find(|r| r.kind == kind).map_or("?", |r| r.name)
+}
+
+pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Call) -> Option<Tolerance> {
+    let callee = call.callee.as_ident();
+    let callee_name = callee.map_or_else(|| path_text(&call.callee), |i| i.name.clone());
+    let lookup = if callee_name == "roundness" { "circularity" } else { callee_name.as_str() };
+    let Some(rule) = RULES.iter().find(|r| r.name == lookup) else {
+        let help = suggest::help_for_unknown("tolerance type", &callee_name, RULES.iter().map(|r| r.name));
+        cx.err(E::UnknownName { span: call.callee.span, what: "tolerance type".into(), name: callee_name, help });
+        return None;
+    };
+    let what = rule.name.to_string();
+    let mut targets: Vec<(FeatureId, Span)> = Vec::new();
+    let mut value: Option<(TolValue, Span)> = None;
+    let mut modifier: Option<(Material, Span)> = None;
+    let mut datums: Vec<(DatumRef, Span)> = Vec::new();
+    let mut basic_angle = None;
+    let mut ok = true;
+
+    for a in &call.args {
+        match a {
+            ast::Arg::Named(k, v) if k.name == "dia" => {
+                if !rule.dia {
+                    cx.err(E::DiameterZone { span: k.span, kind: what.clone() });
+                    ok = false;
+                }
+                match zone(cx, v, &what) {
+                    Some(w) => value = Some((TolValue::Zone { width: w, diameter: true }, v.span)),
+                    None => ok = false,
+                }
+            }
+            ast::Arg::Named(k, v) if k.name == "basic" => {
+                if rule.kind != K::Angularity {
+                    cx.err(E::UnknownProperty { span: k.span, key: "basic".into(), item: what.clone(), help: "only angularity takes a basic angle".into() });
+                }
+                basic_angle = cx.angle(v);
+            }
+            ast::Arg::Named(k, _) => {
+                let help = suggest::help_for_unknown("argument", &k.name, ["dia", "basic"]);
+                cx.err(E::UnknownProperty { span: k.span, key: k.name.clone(), item: what.clone(), help });
+                ok = false;
+            }
+            ast::Arg::Positional(v) => match &v.kind {
+                ValueKind::Quantity(_) | ValueKind::Limits { .. } | ValueKind::Range(..) => {
+                    let val = if let Some(dim) = rule.size { size_limits(cx, v, dim) } else { zone(cx, v, &what).map(|w| TolValue::Zone { width: w, diameter: false }) };
+                    match val {
+                        Some(val) => value = Some((val, v.span)),
+                        None => ok = false,
+                    }
+                }
+                ValueKind::Path(p) if value.is_none() => match target(cx, pc, p) {
+                    Some(f) => targets.push((f, p.span)),
+                    None => ok = false,
+                },
+                ValueKind::Path(p) if p.as_ident().is_some_and(|i| matches!(i.name.as_str(), "MMC" | "LMC" | "RFS")) && datums.is_empty() => {
+                    let m = material(cx, p.as_ident()?)?;
+                    if !rule.material && m != Material::Rfs {
+                        cx.err(E::ModifierNotAllowed {
+                            span: p.span,
+                            kind: what.clone(),
+                            modifier: p.head().name.clone(),
+                            help: format!("{what} applies regardless of feature size; material modifiers belong on features of size under orientation, position or coaxiality"),
+                        });
+                        ok = false;
+                    }
+                    modifier = Some((m, p.span));
+                }
+                ValueKind::Path(p) if p.segs.len() == 1 && matches!(pc.names.get(&p.head().name), Some((Local::Frame(_), _))) => {
+                    let Some((Local::Frame(i), _)) = pc.names.get(&p.head().name) else { unreachable!() };
+                    match pc.part.frames.get(*i) {
+                        Some(f) => datums.extend(f.refs.iter().map(|r| (r.clone(), p.span))),
+                        None => ok = false,
+                    }
+                }
+                ValueKind::Path(_) | ValueKind::Call(_) => match datum_ref(cx, pc, v) {
+                    Some(d) => datums.push(d),
+                    None => ok = false,
+                },
+                _ => {
+                    cx.mismatch(v, "a feature, a value, a modifier or a datum", &format!("write e.g. `{}(feature, 0.05 mm, A)`", rule.name));
+                    ok = false;
+                }
+            },
+        }
+    }
+
+    let (min, max) = rule.targets;
+    if targets.len() < min || targets.len() > max {
+        let expected = if min == max { format!("{min} feature{}", if min == 1 { "" } else { "s" }) } else { format!("{min} or {max} features") };
+        cx.err(E::Arity {
+            span: targets.get(max).map_or(call.span, |t| t.1),
+            kind: what.clone(),
+            expected,
+            found: format!("{}", targets.len()),
+            help: format!("the toleranced feature{} come{} first: `{}(…)`", if max > 1 { "s" } else { "" }, if max > 1 { "" } else { "s" }, rule.name),
+        });
+        ok = false;
+    }
+    let Some((value, _)) = value else {
+        if ok {
+            let what_value = if rule.size.is_some() { "limits, e.g. `10 mm ± 0.05 mm`" } else { "a tolerance value, e.g. `0.05 mm`" };
+            cx.err(E::MissingArgument { span: call.span, kind: what.clone(), what: what_value.into(), help: format!("write `{}(feature, {})`", rule.name, if rule.size.is_some() { "10 mm ± 0.05 mm" } else { "0.05 mm" }) });
+        }
+        return None;
+    };
+    match rule.datums {
+        Forbidden => {
+            if let Some((_, span)) = datums.first() {
+                let help = if rule.size.is_some() { "sizes are checked without a datum frame".to_string() } else { format!("{what} is a form tolerance: it controls the feature on its own") };
+                cx.err(E::DatumsForbidden { span: *span, kind: what.clone(), help });
+                ok = false;
+            }
+        }
+        Required if datums.is_empty() => {
+            cx.err(E::DatumsRequired { span: call.span, kind: what.clone(), help: format!("{what} is measured relative to a datum: add one, e.g. `{}(feature, 0.05 mm, A)`", rule.name) });
+            ok = false;
+        }
+        _ => {}
+    }
+    if rule.kind == K::Angularity && basic_angle.is_none() && ok {
+        cx.err(E::MissingArgument { span: call.span, kind: what.clone(), what: "its basic angle".into(), help: "write `angularity(feature, 0.1 mm, A, basic 30 deg)`".into() });
+        ok = false;
+    }
+    check_unique_datums(cx, &pc.part, &datums, call.span);
+    for (d, span) in &datums {
+        let df = pc.part.datums[d.datum.0].feature;
+        if let Some((f, _)) = targets.iter().find(|(f, _)| *f == df) {
+            cx.err(E::DatumSelfReference { span: *span, datum: pc.part.datums[d.datum.0].name.clone(), feature: pc.part.features[f.0].name.clone() });
+            ok = false;
+        }
+    }
+    ok.then(|| Tolerance {
+        name: name.name.clone(),
+        kind: rule.kind,
+        targets: targets.into_iter().map(|t| t.0).collect(),
+        value,
+        modifier: modifier.map(|m| m.0),
+        datums: datums.into_iter().map(|d| d.0).collect(),
+        basic_angle,
+        span: name.span,
+    })
+}
+
+fn target(cx: &mut Cx, pc: &PartCx, p: &ast::Path) -> Option<FeatureId> {
+    let head = p.head();
+    match pc.names.get(&head.name) {
+        Some((Local::Feature(i), _)) if p.segs.len() == 1 => (*i < pc.part.features.len()).then_some(FeatureId(*i)),
+        Some((Local::Datum(i), _)) if p.segs.len() == 1 => pc.part.datums.get(*i).map(|d| d.feature),
+        Some((other, _)) => {
+            cx.err(E::WrongKind { span: p.span, name: path_text(p), expected: "a feature".into(), found: other.word(&pc.part), help: "tolerances apply to features: declare `feature name = faces` and name it here".into() });
+            None
+        }
+        None => {
+            let features = pc.names.iter().filter(|(_, (l, _))| matches!(l, Local::Feature(_))).map(|(n, _)| n.as_str());
+            let help = suggest::help_for_unknown("feature", &head.name, features);
+            cx.err(E::UnknownName { span: p.span, what: "feature".into(), name: path_text(p), help });
+            None
+        }
+    }
+}
+
+fn zone(cx: &mut Cx, v: &ast::Value, what: &str) -> Option<f64> {
+    match &v.kind {
+        ValueKind::Quantity(_) => {
+            let w = cx.length(v)?;
+            if w <= 0.0 {
+                cx.err(E::NonPositive { span: v.span, what: format!("the {what} tolerance"), value: describe(v), help: "a tolerance zone has a positive width".into() });
+                return None;
+            }
+            Some(w)
+        }
+        _ => {
+            cx.mismatch(v, "a tolerance zone width such as `0.05 mm`", "limits belong to size tolerances (`diameter`, `width`, `distance`, `angle`)");
+            None
+        }
+    }
+}
+
+fn size_limits(cx: &mut Cx, v: &ast::Value, dim: Dim) -> Option<TolValue> {
+    let (nominal, lower, upper) = match &v.kind {
+        ValueKind::Limits { nominal, plus, minus } => {
+            let n = cx.quantity(nominal, dim);
+            let p = cx.quantity(plus, dim);
+            let m = cx.quantity(minus, dim);
+            let (n, p, m) = (n?, p?, m?);
+            (n, n + m, n + p)
+        }
+        ValueKind::Range(lo, hi) => {
+            let lo = cx.quantity(lo, dim);
+            let hi = cx.quantity(hi, dim);
+            let (lo, hi) = (lo?, hi?);
+            ((lo + hi) / 2.0, lo, hi)
+        }
+        _ => {
+            cx.mismatch(v, "limits such as `10 mm ± 0.05 mm` or `9.95 mm .. 10.05 mm`", "a size tolerance gives its nominal and limits");
+            return None;
+        }
+    };
+    if lower >= upper {
+        cx.err(E::InvalidLimits { span: v.span, lower: num(lower), upper: num(upper) });
+        return None;
+    }
+    if nominal <= 0.0 && dim == Dim::Length {
+        cx.err(E::NonPositive { span: v.span, what: "the nominal size".into(), value: num(nominal), help: "sizes are positive".into() });
+        return None;
+    }
+    Some(TolValue::Size { nominal, lower, upper })
+}
