@@ -65,7 +65,8 @@ fn main() -> ExitCode {
                 }
             }
             if emit == Emit::Model && !checked.has_errors() {
-                let _ = write!(stdout, "{}", checked.model.summary());
+                let roots: Vec<_> = files.iter().filter_map(|f| checked.sources.find_path(&std::fs::canonicalize(f).unwrap_or_else(|_| f.clone()))).collect();
+                let _ = write!(stdout, "{}", checked.model.summary(&|file| roots.contains(&file)));
             }
             let errors = checked.diagnostics.iter().filter(|d| d.severity() == miette::Severity::Error).count();
             let warnings = checked.diagnostics.len() - errors;

@@ -119,7 +119,12 @@ pub enum LoadError {
 pub fn load(world: &dyn World, roots: &[PathBuf], sources: &mut SourceMap, diags: &mut Diagnostics) -> Program {
     let mut l = Loader { world, sources, diags, program: Program::default(), by_key: HashMap::new(), stack: Vec::new() };
     for root in roots {
-        l.load_file(root, None, true);
+        l.load_file(root, &root.to_string_lossy(), None, true);
+    }
+    // The standard library is always there: plans default to its hierarchy and
+    // sampling, and any item can be named by its full path `std::module::item`.
+    for name in std_module_names() {
+        l.load_std(name);
     }
     l.program
 }
@@ -137,14 +142,14 @@ struct Loader<'a> {
 
 impl Loader<'_> {
     /// Loads a user file; `from` is the `use` that named it and the importing file.
-    fn load_file(&mut self, path: &Path, from: Option<(FileId, Span)>, root: bool) -> Option<ModuleId> {
+    fn load_file(&mut self, path: &Path, shown: &str, from: Option<(FileId, Span)>, root: bool) -> Option<ModuleId> {
         let canonical = self.world.canonical(path);
         let key = canonical.to_string_lossy().into_owned();
         if let Some(&id) = self.by_key.get(&key) {
             self.program.modules[id.0].root |= root;
             return Some(id);
         }
-        let shown = path.to_string_lossy().into_owned();
+        let shown = shown.to_string();
         let bytes = match self.world.read(path) {
             Ok(b) => b,
             Err(e) => {
@@ -162,7 +167,8 @@ impl Loader<'_> {
         };
         let file = self.sources.add(shown.clone(), Some(canonical), text);
         if let Some(at) = bad {
-            self.diags.push(file, LoadError::NotUtf8 { span: Span::new(file, at, at + 1), path: shown });
+            // The lossy text holds U+FFFD (3 bytes) where the bad byte was.
+            self.diags.push(file, LoadError::NotUtf8 { span: Span::new(file, at, at + 3), path: shown });
             return None;
         }
         Some(self.add_module(key, file, None, root))
@@ -223,8 +229,11 @@ impl Loader<'_> {
     fn import(&mut self, file: FileId, u: &ast::Use) -> Option<ModuleId> {
         match &u.source {
             ast::UseSource::File(s) => {
-                let base = self.sources.get(file).dir().map(Path::to_path_buf).unwrap_or_default();
-                self.load_file(&base.join(&s.value), Some((file, s.span)), false)
+                let importer = self.sources.get(file);
+                let base = importer.dir().map(Path::to_path_buf).unwrap_or_default();
+                let shown_base = Path::new(&importer.name).parent().map(Path::to_path_buf).unwrap_or_default();
+                let shown = crate::source::normalize_path(&shown_base.join(&s.value)).to_string_lossy().into_owned();
+                self.load_file(&base.join(&s.value), &shown, Some((file, s.span)), false)
             }
             ast::UseSource::Module(segs) => {
                 let names: Vec<&str> = segs.iter().map(|s| s.name.as_str()).collect();

@@ -16,10 +16,14 @@ fn v3(v: &Vec3) -> String {
 }
 
 impl Model {
-    /// The model as indented text, in declaration order.
-    pub fn summary(&self) -> String {
+    /// The model as indented text, in declaration order: every part, CMM and plan, and
+    /// the catalogue items they use or that a file for which `shown` holds declares.
+    pub fn summary(&self, shown: &dyn Fn(crate::source::FileId) -> bool) -> String {
+        let used = self.used(shown);
+        let keep = |span: &crate::source::Span, kind: u8, index: usize| shown(span.file) || used.contains(&(kind, index));
         let mut o = String::new();
-        for h in &self.heads {
+        for (i, h) in self.heads.iter().enumerate().filter(|(i, h)| keep(&h.span, 0, *i)) {
+            let _ = i;
             let kind = match &h.kind {
                 HeadKind::Fixed => "fixed".to_string(),
                 HeadKind::Indexable { a, b, step } => format!(
@@ -29,16 +33,16 @@ impl Model {
             };
             let _ = writeln!(o, "head {}: {kind}, envelope Ø{} × {}", h.name, fmt_num(h.diameter), fmt_num(h.length));
         }
-        for s in &self.styli {
+        for s in self.styli.iter().enumerate().filter(|(i, x)| keep(&x.span, 1, *i)).map(|(_, x)| x) {
             let _ = writeln!(o, "stylus {}: tip Ø{}, length {}, stem Ø{}", s.name, fmt_num(s.tip), fmt_num(s.length), fmt_num(s.stem));
         }
-        for b in &self.bodies {
+        for b in self.bodies.iter().enumerate().filter(|(i, x)| keep(&x.span, 2, *i)).map(|(_, x)| x) {
             let _ = writeln!(o, "body {}: Ø{} × {}", b.name, fmt_num(b.diameter), fmt_num(b.length));
         }
-        for e in &self.extensions {
+        for e in self.extensions.iter().enumerate().filter(|(i, x)| keep(&x.span, 3, *i)).map(|(_, x)| x) {
             let _ = writeln!(o, "extension {}: Ø{} × {}", e.name, fmt_num(e.diameter), fmt_num(e.length));
         }
-        for p in &self.probes {
+        for p in self.probes.iter().enumerate().filter(|(i, x)| keep(&x.span, 4, *i)).map(|(_, x)| x) {
             let ext: Vec<&str> = p.extensions.iter().map(|e| self.extensions[e.0].name.as_str()).collect();
             let _ = writeln!(
                 o,
@@ -46,7 +50,7 @@ impl Model {
                 p.name, self.bodies[p.body.0].name, ext.join(", "), self.styli[p.stylus.0].name, fmt_num(p.cost)
             );
         }
-        for c in &self.cmms {
+        for c in self.cmms.iter().filter(|c| shown(c.span.file)) {
             let probes: Vec<String> = c.probes.iter().map(|(l, p)| format!("{l}: {}", self.probes[p.0].name)).collect();
             let size = c.table_size.map_or(String::new(), |s| format!(" size {} × {}", fmt_num(s[0]), fmt_num(s[1])));
             let _ = writeln!(
@@ -55,15 +59,15 @@ impl Model {
                 c.name, fmt_num(c.table_z), fmt_num(c.ram_radius), fmt_num(c.ram_length), self.heads[c.head.0].name, probes.join(", ")
             );
         }
-        for h in &self.hierarchies {
+        for h in self.hierarchies.iter().enumerate().filter(|(i, x)| keep(&x.span, 5, *i)).map(|(_, x)| x) {
             let levels: Vec<String> = h.levels.iter().map(|l| crate::resolve::level_text(l.var, l.group)).collect();
             let _ = writeln!(o, "hierarchy {}: required approachability > {}", h.name, levels.join(" > "));
         }
-        for s in &self.samplings {
+        for s in self.samplings.iter().enumerate().filter(|(i, x)| keep(&x.span, 6, *i)).map(|(_, x)| x) {
             let per: Vec<String> = s.per_surface.iter().map(|(k, st)| format!("{} {}", k.keyword(), strategy_text(st))).collect();
             let _ = writeln!(o, "sampling {}: {}", s.name, per.join(", "));
         }
-        for p in &self.parts {
+        for p in self.parts.iter().filter(|p| shown(p.span.file)) {
             part_summary(&mut o, p);
         }
         for p in &self.plans {
@@ -89,6 +93,32 @@ impl Model {
             }
         }
         o
+    }
+}
+
+impl Model {
+    /// Catalogue items used by the shown CMMs and plans, as (kind, index) pairs.
+    fn used(&self, shown: &dyn Fn(crate::source::FileId) -> bool) -> std::collections::BTreeSet<(u8, usize)> {
+        let mut used = std::collections::BTreeSet::new();
+        let mut cmms: Vec<usize> = self.cmms.iter().enumerate().filter(|(_, c)| shown(c.span.file)).map(|(i, _)| i).collect();
+        for p in &self.plans {
+            cmms.push(p.cmm.0);
+            used.insert((5, p.hierarchy.0));
+            used.insert((6, p.sampling.0));
+        }
+        let mut probes: Vec<usize> = self.probes.iter().enumerate().filter(|(_, p)| shown(p.span.file)).map(|(i, _)| i).collect();
+        for c in cmms {
+            used.insert((0, self.cmms[c].head.0));
+            probes.extend(self.cmms[c].probes.iter().map(|(_, p)| p.0));
+        }
+        for p in probes {
+            let probe = &self.probes[p];
+            used.insert((4, p));
+            used.insert((2, probe.body.0));
+            used.insert((1, probe.stylus.0));
+            used.extend(probe.extensions.iter().map(|e| (3, e.0)));
+        }
+        used
     }
 }
 

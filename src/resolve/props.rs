@@ -61,21 +61,9 @@ pub(crate) fn describe(v: &Value) -> String {
     }
 }
 
-/// The text of a path as written (segments joined by `.`).
+/// The text of a path as written.
 pub(crate) fn path_text(p: &ast::Path) -> String {
-    let mut s = String::new();
-    for seg in &p.segs {
-        match seg {
-            ast::PathSeg::Name(i) => {
-                if !s.is_empty() {
-                    s.push('.');
-                }
-                s.push_str(&i.name);
-            }
-            ast::PathSeg::Index(n, _) => s.push_str(&format!("[{n}]")),
-        }
-    }
-    s
+    p.text.clone()
 }
 
 /// The context values are converted in: where errors go and what a bare length means.
@@ -92,7 +80,17 @@ impl Cx<'_> {
     }
 
     pub fn mismatch(&mut self, v: &Value, expected: &str, help: &str) {
-        self.err(E::TypeMismatch { span: v.span, expected: expected.into(), found: describe(v), help: help.into() });
+        let help = if !help.is_empty() {
+            help.to_string()
+        } else {
+            match expected {
+                "a length" => "write a length such as `10 mm`".into(),
+                "an angle" => "write an angle such as `30 deg`".into(),
+                "a name" => "write a name, without quotes".into(),
+                _ => format!("write {expected} here"),
+            }
+        };
+        self.err(E::TypeMismatch { span: v.span, expected: expected.into(), found: describe(v), help });
     }
 
     /// Converts a quantity to the internal unit of `dim`.

@@ -156,6 +156,8 @@ pub enum PathSeg {
 pub struct Path {
     /// The segments; the first is always a name.
     pub segs: Vec<PathSeg>,
+    /// The path as written.
+    pub text: String,
     /// The whole path.
     pub span: Span,
 }

@@ -75,6 +75,7 @@ impl L {
 
     fn path(&self, p: P) -> R<Path> {
         let span = self.span(&p);
+        let text = p.as_str().to_string();
         let mut segs = Vec::new();
         for s in p.into_inner() {
             match s.as_rule() {
@@ -83,7 +84,7 @@ impl L {
                 r => unreachable!("path segment {r:?}"),
             }
         }
-        Ok(Path { segs, span })
+        Ok(Path { segs, text, span })
     }
 
     fn value(&self, p: P) -> R<Value> {

@@ -49,6 +49,16 @@ pub enum SyntaxError {
         /// The text.
         text: String,
     },
+    /// Brackets nested deeper than any spec needs (and than the parser's stack allows).
+    #[error("brackets nested more than {limit} deep")]
+    #[diagnostic(code(insp::syntax::too_deep), help("no spec needs this nesting; check for a missing closing bracket"))]
+    TooDeep {
+        /// The bracket past the limit.
+        #[label("too deep")]
+        span: Span,
+        /// The limit.
+        limit: usize,
+    },
     /// An unknown escape in a string.
     #[error("unknown escape `{text}` in a string")]
     #[diagnostic(code(insp::syntax::invalid_escape), help("strings know `\\\\`, `\\\"`, `\\n` and `\\t`"))]
@@ -67,7 +77,8 @@ impl SyntaxError {
         match self {
             SyntaxError::Unexpected { span, .. }
             | SyntaxError::InvalidNumber { span, .. }
-            | SyntaxError::InvalidEscape { span, .. } => *span,
+            | SyntaxError::InvalidEscape { span, .. }
+            | SyntaxError::TooDeep { span, .. } => *span,
         }
     }
 }
@@ -75,9 +86,53 @@ impl SyntaxError {
 /// Parses one file. The entry point of the syntax stage.
 pub fn parse(file: FileId, text: &str) -> Result<ast::File, SyntaxError> {
     use pest::Parser;
+    check_depth(file, text)?;
+    pest::set_error_detail(true);
     let mut pairs = InspParser::parse(Rule::file, text).map_err(|e| words::syntax_error(file, text, e))?;
     let root = pairs.next().expect("pest returns the `file` pair on success");
     lower::file(file, root)
+}
+
+/// How deep brackets may nest; pest recurses per level.
+const MAX_DEPTH: usize = 64;
+
+/// Rejects bracket nesting deeper than [`MAX_DEPTH`] before pest recurses into it.
+/// Strings and comments are skipped; unbalanced brackets are left to the parser.
+fn check_depth(file: FileId, text: &str) -> Result<(), SyntaxError> {
+    let bytes = text.as_bytes();
+    let (mut i, mut depth) = (0, 0usize);
+    while i < bytes.len() {
+        match bytes[i] {
+            b'"' => {
+                i += 1;
+                while i < bytes.len() && bytes[i] != b'"' && bytes[i] != b'\n' {
+                    i += if bytes[i] == b'\\' { 2 } else { 1 };
+                }
+            }
+            b'/' if bytes.get(i + 1) == Some(&b'/') => {
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            b'/' if bytes.get(i + 1) == Some(&b'*') => {
+                i += 2;
+                while i + 1 < bytes.len() && !(bytes[i] == b'*' && bytes[i + 1] == b'/') {
+                    i += 1;
+                }
+                i += 1;
+            }
+            b'(' | b'[' | b'{' => {
+                depth += 1;
+                if depth > MAX_DEPTH {
+                    return Err(SyntaxError::TooDeep { span: Span::new(file, i, i + 1), limit: MAX_DEPTH });
+                }
+            }
+            b')' | b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        i += 1;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

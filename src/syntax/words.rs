@@ -45,16 +45,16 @@ pub(crate) fn word(rule: Rule) -> Option<&'static str> {
         Rule::block => "`{`",
         Rule::prop => "a property (`name value`)",
         Rule::part_item => "a part",
-        Rule::part_stmt => "a part statement (`units`, `stock`, `mesh`, `cut`, `add`, `face`, `feature`, `datum`, `frame`, `tolerance`)",
-        Rule::units_stmt => "`units`",
-        Rule::stock_stmt => "`stock`",
-        Rule::mesh_stmt => "`mesh`",
-        Rule::cut_stmt => "`cut` or `add`",
-        Rule::face_stmt => "`face`",
-        Rule::feature_stmt => "`feature`",
-        Rule::datum_stmt => "`datum`",
-        Rule::frame_stmt => "`frame`",
-        Rule::tolerance_stmt => "`tolerance`",
+        Rule::part_stmt
+        | Rule::units_stmt
+        | Rule::stock_stmt
+        | Rule::mesh_stmt
+        | Rule::cut_stmt
+        | Rule::face_stmt
+        | Rule::feature_stmt
+        | Rule::datum_stmt
+        | Rule::frame_stmt
+        | Rule::tolerance_stmt => "a part statement (`units`, `stock`, `mesh`, `cut`, `add`, `face`, `feature`, `datum`, `frame`, `tolerance`)",
         Rule::face_expr | Rule::face_term => "a face (a name, `group \"…\"`, `segment N` or `select(…)`)",
         Rule::group_ref => "`group \"…\"`",
         Rule::segment_ref => "`segment N`",
@@ -93,12 +93,60 @@ pub(crate) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
         pest::error::InputLocation::Pos(p) => p,
         pest::error::InputLocation::Span((s, _)) => s,
     };
-    let mut expected: Vec<&str> = match &e.variant {
-        pest::error::ErrorVariant::ParsingError { positives, .. } => positives.iter().filter_map(|r| word(*r)).collect(),
+    let mut expected: Vec<String> = match &e.variant {
+        pest::error::ErrorVariant::ParsingError { positives, .. } => positives.iter().filter_map(|r| word(*r)).map(String::from).collect(),
         pest::error::ErrorVariant::CustomError { .. } => vec![],
     };
+    // Token-level attempts see literals (`=`, `)`, `,`) that rule positives miss, and
+    // the farthest position the parser reached.
+    let mut pos = pos;
+    if let Some(att) = e.parse_attempts() {
+        if att.max_position >= pos {
+            let mut words: Vec<String> = Vec::new();
+            // pest 2.9 does not re-export `ParseAttempt` and `ParsingToken`; their
+            // `Debug` forms (`Rule(name)`, `Sensitive { .. }`) are read instead.
+            for stack in att.call_stacks() {
+                let deepest = format!("{:?}", stack.deepest);
+                let rule = deepest
+                    .strip_prefix("Rule(")
+                    .and_then(|n| n.strip_suffix(')'))
+                    .and_then(|n| Rule::all_rules().iter().find(|r| format!("{r:?}") == n).copied());
+                if let Some(w) = rule.and_then(|r| word(r).or_else(|| stack.parent.and_then(word))) {
+                    words.push(w.to_string());
+                }
+            }
+            for t in att.expected_tokens() {
+                if !format!("{t:?}").starts_with("Sensitive") {
+                    continue;
+                }
+                let token = t.to_string();
+                // Whitespace, comments, optional suffixes of numbers and paths, and keywords
+                // (which the rule words already name) would only bury the real expectation.
+                let noise = matches!(token.as_str(), "\r" | " " | "\t" | "\u{feff}" | "//" | "/*" | "*/" | "%" | "+-" | "±" | "+" | "-" | ".." | "." | "::" | "[" | "e" | "E")
+                    || token.chars().all(|c| c.is_ascii_alphabetic() || c == '_');
+                if noise {
+                    continue;
+                }
+                words.push(if token == "\n" { "a new line".to_string() } else { format!("`{token}`") });
+            }
+            if !words.is_empty() {
+                pos = att.max_position;
+                expected = words;
+            }
+        }
+    }
+    // Continuations of a complete value (`10 mm` could go on as limits or a range) only
+    // matter when nothing else was expected.
+    let continuation = |w: &String| matches!(w.as_str(), "`±`" | "a range `a .. b`" | "a signed number such as `+0.1 mm`" | "a unit");
+    if expected.iter().any(|w| !continuation(w)) {
+        expected.retain(|w| !continuation(w));
+    }
     expected.sort_unstable();
     expected.dedup();
+    if expected.len() > 8 {
+        expected.truncate(7);
+        expected.push("…".into());
+    }
     let expected = match expected.as_slice() {
         [] => "something else".to_string(),
         [one] => one.to_string(),
@@ -107,7 +155,7 @@ pub(crate) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
     let (found, len) = found_at(text, pos);
     let help = if found == "end of file" {
         "the file ends in the middle of a statement: is a `}` or `)` missing?".to_string()
-    } else if expected.contains("a new line") {
+    } else if expected.contains("a new line") || expected.contains("`;`") {
         "statements end at a new line, `;` or `,`".to_string()
     } else {
         format!("write {expected} here")

@@ -1,0 +1,92 @@
+//! DIAGNOSTICS.md and the code stay in step: every code in `src/` is catalogued, every
+//! catalogued code exists, and every catalogue example reports its code.
+
+mod common;
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+struct Entry {
+    code: String,
+    bytes: Vec<u8>,
+}
+
+fn catalogue() -> Vec<Entry> {
+    let text = std::fs::read_to_string("DIAGNOSTICS.md").expect("DIAGNOSTICS.md is readable");
+    let mut out = Vec::new();
+    let mut lines = text.lines();
+    while let Some(line) = lines.next() {
+        let Some(rest) = line.strip_prefix("### `") else { continue };
+        let code = rest.split('`').next().unwrap().to_string();
+        let fence = lines.by_ref().find(|l| l.starts_with("```")).unwrap_or_else(|| panic!("{code} has no example"));
+        let raw = fence == "```insp-bytes";
+        let body: Vec<&str> = lines.by_ref().take_while(|l| !l.starts_with("```")).collect();
+        let body = body.join("\n") + "\n";
+        let bytes = if raw { unescape_bytes(&body) } else { body.into_bytes() };
+        out.push(Entry { code, bytes });
+    }
+    out
+}
+
+fn unescape_bytes(s: &str) -> Vec<u8> {
+    let mut out = Vec::new();
+    let b = s.as_bytes();
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'\\' && b.get(i + 1) == Some(&b'x') && i + 3 < b.len() {
+            out.push(u8::from_str_radix(&s[i + 2..i + 4], 16).expect("hex byte"));
+            i += 4;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    out
+}
+
+fn codes_in_source() -> BTreeSet<String> {
+    fn walk(dir: &Path, out: &mut BTreeSet<String>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                let text = std::fs::read_to_string(&p).unwrap();
+                for (i, _) in text.match_indices("code(insp::") {
+                    let rest = &text[i + 5..];
+                    out.insert(rest[..rest.find(')').unwrap()].to_string());
+                }
+            }
+        }
+    }
+    let mut out = BTreeSet::new();
+    walk(Path::new("src"), &mut out);
+    out
+}
+
+#[test]
+fn catalogue_and_code_list_the_same_codes() {
+    let documented: BTreeSet<String> = catalogue().into_iter().map(|e| e.code).collect();
+    let in_code = codes_in_source();
+    let undocumented: Vec<_> = in_code.difference(&documented).collect();
+    let stale: Vec<_> = documented.difference(&in_code).collect();
+    assert!(undocumented.is_empty(), "codes missing from DIAGNOSTICS.md: {undocumented:?}");
+    assert!(stale.is_empty(), "DIAGNOSTICS.md lists codes the source no longer has: {stale:?}");
+    assert!(in_code.len() >= 45, "expected the full set of codes, found {}", in_code.len());
+}
+
+#[test]
+fn every_catalogue_example_reports_its_code() {
+    let mut failures = Vec::new();
+    for e in catalogue() {
+        let diags = common::check_files(&[("example.insp", &e.bytes)]);
+        if !diags.iter().any(|d| d.code == e.code) {
+            failures.push(format!("{}: got {:?}", e.code, diags.iter().map(|d| &d.code).collect::<Vec<_>>()));
+        }
+        for d in &diags {
+            assert!(!d.help.is_empty(), "{} has no help line", d.code);
+            assert!(!d.span_text.is_empty() || d.code == "insp::load::unreadable" || d.code == "insp::syntax::unexpected", "{} has an empty label", d.code);
+        }
+    }
+    assert!(failures.is_empty(), "examples that do not report their code:\n{}", failures.join("\n"));
+}

@@ -1,0 +1,52 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use inspc::source::MemoryWorld;
+use std::path::PathBuf;
+
+/// One diagnostic, flattened for assertions.
+#[derive(Debug, Clone)]
+pub struct Flat {
+    pub code: String,
+    pub message: String,
+    pub help: String,
+    pub file: String,
+    /// The text under the first label.
+    pub span_text: String,
+    pub warning: bool,
+}
+
+/// Checks `files` (path, contents) in memory; the first file is the root.
+pub fn check_files(files: &[(&str, &[u8])]) -> Vec<Flat> {
+    let mut world = MemoryWorld::new();
+    for (p, c) in files {
+        world.insert(p, c.to_vec());
+    }
+    let checked = inspc::check(&world, &[PathBuf::from(files[0].0)]);
+    checked
+        .diagnostics
+        .iter()
+        .map(|d| {
+            let file = checked.sources.get(d.file);
+            let span_text = d
+                .inner
+                .labels()
+                .and_then(|mut l| l.next())
+                .map(|l| file.text.get(l.offset()..l.offset() + l.len()).unwrap_or("").to_string())
+                .unwrap_or_default();
+            Flat {
+                code: d.code(),
+                message: d.message(),
+                help: d.inner.help().map(|h| h.to_string()).unwrap_or_default(),
+                file: file.name.clone(),
+                span_text,
+                warning: d.severity() == miette::Severity::Warning,
+            }
+        })
+        .collect()
+}
+
+/// Checks one in-memory file named `main.insp`.
+pub fn check_src(src: &str) -> Vec<Flat> {
+    check_files(&[("main.insp", src.as_bytes())])
+}
