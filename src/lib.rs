@@ -23,12 +23,19 @@ pub struct Checked {
     pub diagnostics: Vec<diag::Diagnostic>,
     /// The files read.
     pub sources: source::SourceMap,
+    /// The files named as roots (that loaded).
+    pub roots: Vec<source::FileId>,
 }
 
 impl Checked {
     /// Whether any diagnostic is an error.
     pub fn has_errors(&self) -> bool {
         self.diagnostics.iter().any(|d| d.severity() == miette::Severity::Error)
+    }
+
+    /// The model as text, showing what the root files declare and use.
+    pub fn summary(&self) -> String {
+        self.model.summary(&|f| self.roots.contains(&f))
     }
 }
 
@@ -38,5 +45,6 @@ pub fn check(world: &dyn source::World, roots: &[PathBuf]) -> Checked {
     let mut diags = diag::Diagnostics::new();
     let program = load::load(world, roots, &mut sources, &mut diags);
     let model = resolve::resolve(&program, &sources, world, &mut diags);
-    Checked { model, diagnostics: diags.sorted(), sources }
+    let roots = program.modules.iter().filter(|m| m.root).map(|m| m.file).collect();
+    Checked { model, diagnostics: diags.sorted(), sources, roots }
 }

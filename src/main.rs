@@ -65,8 +65,7 @@ fn main() -> ExitCode {
                 }
             }
             if emit == Emit::Model && !checked.has_errors() {
-                let roots: Vec<_> = files.iter().filter_map(|f| checked.sources.find_path(&std::fs::canonicalize(f).unwrap_or_else(|_| f.clone()))).collect();
-                let _ = write!(stdout, "{}", checked.model.summary(&|file| roots.contains(&file)));
+                let _ = write!(stdout, "{}", checked.summary());
             }
             let errors = checked.diagnostics.iter().filter(|d| d.severity() == miette::Severity::Error).count();
             let warnings = checked.diagnostics.len() - errors;

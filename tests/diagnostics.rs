@@ -466,8 +466,10 @@ fn preferred_orientations_are_checked_against_the_head() {
 #[test]
 fn plan_references() {
     let d = check_src(&format!("{PLAN_HEAD}plan q {{ part p, cmm bridge_fixed\n prefer probe p9 cost 2\n sample topp with uniform(points 4)\n prefer sutup +z }}"));
-    expect(&d, "insp::resolve::unknown_name", "p9", "unknown probe of cmm `bridge_fixed` `p9`");
-    expect(&d, "insp::resolve::unknown_name", "topp", "unknown feature of part `p` `topp`");
+    expect(&d, "insp::resolve::unknown_name", "p9", "unknown probe `p9`");
+    assert!(d.iter().any(|x| x.help.starts_with("cmm `bridge_fixed` has no probe `p9`")), "{}", render(&d));
+    expect(&d, "insp::resolve::unknown_name", "topp", "unknown feature `topp`");
+    assert!(d.iter().any(|x| x.help == "part `p` has no feature `topp`; did you mean `top`?"), "{}", render(&d));
     expect(&d, "insp::resolve::unknown_name", "sutup", "unknown preference `sutup`");
     expect_src(&format!("{PLAN_HEAD}plan q {{ cmm bridge_fixed }}"), "insp::resolve::missing_property", "q", "plan `q` needs `part`");
 }

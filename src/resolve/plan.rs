@@ -2,7 +2,7 @@
 
 use super::catalogue::strategy;
 use super::errors::ResolveError as E;
-use super::props::{describe, num, path_text, Cx, Dim, Props};
+use super::props::{num, path_text, Cx, Dim, Props};
 use super::{Kind, Resolver};
 use crate::diag::suggest;
 use crate::load::ModuleId;
@@ -66,8 +66,8 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &ast::Plan, 
                         }
                     }
                     None => {
-                        let help = suggest::help_for_unknown("feature", &name, the_part.features.iter().map(|f| f.name.as_str()));
-                        cx.err(E::UnknownName { span: feature.span, what: format!("feature of part `{}`", the_part.name), name, help });
+                        let help = format!("part `{}` has no feature `{name}`; {}", the_part.name, suggest::help_for_unknown("feature", &name, the_part.features.iter().map(|f| f.name.as_str())));
+                        cx.err(E::UnknownName { span: feature.span, what: "feature".into(), name, help });
                     }
                 }
             }
@@ -93,8 +93,13 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &ast::Plan, 
                             if the_cmm.probes.iter().any(|(l, _)| *l == label.name) {
                                 plan.probes.push(ProbePref { label: label.name.clone(), cost, forbidden: *forbid, span: *span });
                             } else {
-                                let help = suggest::help_for_unknown("probe", &label.name, the_cmm.probes.iter().map(|(l, _)| l.as_str()));
-                                cx.err(E::UnknownName { span: label.span, what: format!("probe of cmm `{}`", the_cmm.name), name: label.name.clone(), help });
+                                let help = format!(
+                                    "cmm `{}` has no probe `{}`; {}",
+                                    the_cmm.name,
+                                    label.name,
+                                    suggest::help_for_unknown("probe", &label.name, the_cmm.probes.iter().map(|(l, _)| l.as_str()))
+                                );
+                                cx.err(E::UnknownName { span: label.span, what: "probe".into(), name: label.name.clone(), help });
                             }
                         }
                     }
@@ -137,7 +142,7 @@ fn orientation(cx: &mut Cx, v: &ast::Value, head: Option<&Head>) -> Option<(f64,
                 axis: axis.into(),
                 value: num(val),
                 head: head.name.clone(),
-                help: format!("{} is {}; choose an angle within {rtxt}", axis, describe(item)),
+                help: format!("choose {axis} within {rtxt}, a multiple of {}° from {}°", num(*step), num(range[0])),
                 range: rtxt,
             });
             ok = false;

@@ -86,10 +86,15 @@ pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Cal
     let mut datums: Vec<(DatumRef, Span)> = Vec::new();
     let mut basic_angle = None;
     let mut ok = true;
+    // Whether the value has been written (valid or not): targets come before it,
+    // modifiers and datums after.
+    let mut past_value = false;
+    let mut target_failed = false;
 
     for a in &call.args {
         match a {
             ast::Arg::Named(k, v) if k.name == "dia" => {
+                past_value = true;
                 if !rule.dia {
                     cx.err(E::DiameterZone { span: k.span, kind: what.clone() });
                     ok = false;
@@ -112,15 +117,19 @@ pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Cal
             }
             ast::Arg::Positional(v) => match &v.kind {
                 ValueKind::Quantity(_) | ValueKind::Limits { .. } | ValueKind::Range(..) => {
+                    past_value = true;
                     let val = if let Some(dim) = rule.size { size_limits(cx, v, dim) } else { zone(cx, v, &what).map(|w| TolValue::Zone { width: w, diameter: false }) };
                     match val {
                         Some(val) => value = Some((val, v.span)),
                         None => ok = false,
                     }
                 }
-                ValueKind::Path(p) if value.is_none() => match target(cx, pc, p) {
+                ValueKind::Path(p) if !past_value => match target(cx, pc, p) {
                     Some(f) => targets.push((f, p.span)),
-                    None => ok = false,
+                    None => {
+                        ok = false;
+                        target_failed = true;
+                    }
                 },
                 ValueKind::Path(p) if p.as_ident().is_some_and(|i| matches!(i.name.as_str(), "MMC" | "LMC" | "RFS")) && datums.is_empty() => {
                     let m = material(cx, p.as_ident()?)?;
@@ -155,7 +164,7 @@ pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Cal
     }
 
     let (min, max) = rule.targets;
-    if targets.len() < min || targets.len() > max {
+    if !target_failed && (targets.len() < min || targets.len() > max) {
         let expected = if min == max { format!("{min} feature{}", if min == 1 { "" } else { "s" }) } else { format!("{min} or {max} features") };
         cx.err(E::Arity {
             span: targets.get(max).map_or(call.span, |t| t.1),
@@ -213,6 +222,15 @@ pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Cal
 
 fn target(cx: &mut Cx, pc: &PartCx, p: &ast::Path) -> Option<FeatureId> {
     let head = p.head();
+    if p.segs.len() > 1 {
+        cx.err(E::TypeMismatch {
+            span: p.span,
+            expected: "a feature".into(),
+            found: format!("the face `{}`", path_text(p)),
+            help: format!("tolerances apply to features: declare `feature {}_f = {}` and name it here", head.name, path_text(p)),
+        });
+        return None;
+    }
     match pc.names.get(&head.name) {
         Some((Local::Feature(i), _)) if p.segs.len() == 1 => (*i < pc.part.features.len()).then_some(FeatureId(*i)),
         Some((Local::Datum(i), _)) if p.segs.len() == 1 => pc.part.datums.get(*i).map(|d| d.feature),

@@ -41,10 +41,10 @@ pub(crate) fn word(rule: Rule) -> Option<&'static str> {
         Rule::module_path => "a module path such as `std::probes`",
         Rule::use_select => "`*` or `{ names }`",
         Rule::glob => "`*`",
-        Rule::block_item => "an item",
+        // Whole items only ever fail part-way; what was expected there is named instead.
+        Rule::block_item | Rule::part_item | Rule::hierarchy_item | Rule::plan_item => return None,
         Rule::block => "`{`",
         Rule::prop => "a property (`name value`)",
-        Rule::part_item => "a part",
         Rule::part_stmt
         | Rule::units_stmt
         | Rule::stock_stmt
@@ -59,12 +59,10 @@ pub(crate) fn word(rule: Rule) -> Option<&'static str> {
         Rule::group_ref => "`group \"…\"`",
         Rule::segment_ref => "`segment N`",
         Rule::select_ref => "`select(…)`",
-        Rule::hierarchy_item => "a hierarchy",
         Rule::level => "a level (`required approachability` or `same_setup(T, *)`)",
         Rule::required_level => "`required approachability`",
         Rule::same_level => "a level such as `same_setup(T, *)`",
         Rule::group_part => "`T`, `F` or `*`",
-        Rule::plan_item => "a plan",
         Rule::plan_stmt => "a plan statement",
         Rule::pref_stmt => "`prefer` or `forbid`",
         Rule::sample_stmt => "`sample FEATURE with STRATEGY`",
