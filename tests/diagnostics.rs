@@ -219,6 +219,11 @@ fn pattern_instances_are_checked() {
 }
 
 #[test]
+fn huge_patterns_are_refused() {
+    expect_src(&part("cut hole g { at (5, 5, 20), axis -z, diameter 2, depth 5, pattern grid(1000, 1000, 1, 1) }"), "insp::resolve::out_of_range", "grid(1000, 1000, 1, 1)", "pattern of 1000000 instances");
+}
+
+#[test]
 fn features_cannot_use_features_declared_below() {
     expect_src(&part("feature a = b\nfeature b = stock.top"), "insp::resolve::unknown_name", "b", "declared above");
 }

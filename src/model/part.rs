@@ -200,7 +200,7 @@ impl Pattern {
     pub fn count(&self) -> u32 {
         match self {
             Pattern::Linear { count, .. } | Pattern::Polar { count, .. } => *count,
-            Pattern::Grid { nx, ny, .. } => nx * ny,
+            Pattern::Grid { nx, ny, .. } => nx.saturating_mul(*ny),
         }
     }
 }

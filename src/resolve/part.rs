@@ -401,10 +401,26 @@ fn operation(cx: &mut Cx, add: bool, kind: &ast::Ident, name: &ast::Ident, props
             OpKind::Boss { at: at?, axis: axis?, diameter: diameter?, height: height? }
         }
     };
-    let pattern = p.get("pattern").and_then(|v| pattern(cx, v));
+    let pattern = p.get("pattern").and_then(|v| {
+        let pat = pattern(cx, v)?;
+        if pat.count() > MAX_INSTANCES {
+            cx.err(E::OutOfRange {
+                span: v.span,
+                what: "pattern".into(),
+                value: format!("of {} instances", pat.count()),
+                range: format!("at most {MAX_INSTANCES}"),
+                help: "a CMM program measures each instance; split the pattern or check the counts".into(),
+            });
+            return None;
+        }
+        Some(pat)
+    });
     p.finish(cx);
     Some(Op { name: name.name.clone(), add, kind: op, pattern, span: name.span })
 }
+
+/// The most instances one pattern may have.
+const MAX_INSTANCES: u32 = 10_000;
 
 fn perpendicular(cx: &mut Cx, p: &mut Props, along: Option<Vec3>, into: Option<Vec3>) {
     if let (Some(a), Some(i)) = (along, into) {

@@ -87,8 +87,20 @@ impl SyntaxError {
 pub fn parse(file: FileId, text: &str) -> Result<ast::File, SyntaxError> {
     use pest::Parser;
     check_depth(file, text)?;
-    pest::set_error_detail(true);
-    let mut pairs = InspParser::parse(Rule::file, text).map_err(|e| words::syntax_error(file, text, e))?;
+    let mut pairs = match InspParser::parse(Rule::file, text) {
+        Ok(pairs) => pairs,
+        Err(_) => {
+            // Tracking every attempt is slow, so only a failed parse is run again with
+            // pest's error detail on (a process-wide flag, hence the lock: the error a
+            // file gets never depends on what other threads parse meanwhile).
+            static DETAIL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+            let _guard = DETAIL.lock().unwrap_or_else(|e| e.into_inner());
+            pest::set_error_detail(true);
+            let err = InspParser::parse(Rule::file, text).err();
+            pest::set_error_detail(false);
+            return Err(words::syntax_error(file, text, err.expect("a failed parse fails again")));
+        }
+    };
     let root = pairs.next().expect("pest returns the `file` pair on success");
     lower::file(file, root)
 }

@@ -1,0 +1,79 @@
+//! The `inspc` binary: exit codes and the JSON diagnostics contract.
+
+use std::process::Command;
+
+fn inspc(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_inspc")).args(args).env("NO_COLOR", "1").output().expect("inspc runs");
+    (out.status.code().unwrap_or(-1), String::from_utf8(out.stdout).unwrap(), String::from_utf8(out.stderr).unwrap())
+}
+
+fn temp_spec(name: &str, text: &str) -> String {
+    let dir = std::env::temp_dir().join(format!("inspc-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_string_lossy().into_owned()
+}
+
+#[test]
+fn check_clean_example_exits_zero() {
+    let (code, stdout, stderr) = inspc(&["check", "examples/f2.insp"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.is_empty());
+    assert!(stderr.contains("1 file checked, no errors"), "{stderr}");
+}
+
+#[test]
+fn check_reports_errors_and_exits_one() {
+    let bad = temp_spec("bad.insp", "stylus s { tip 0 mm, length 20 deg, stem 1 mmm }\n");
+    let (code, _, stderr) = inspc(&["check", &bad]);
+    assert_eq!(code, 1);
+    assert!(stderr.contains("insp::resolve::non_positive") && stderr.contains("help:"), "{stderr}");
+    assert!(stderr.contains("3 errors"), "{stderr}");
+}
+
+#[test]
+fn json_diagnostics_are_one_object_per_line() {
+    let bad = temp_spec("json.insp", "// é\nstylus s { tip 0 mm, length 20 deg, stem 1 mmm }\n");
+    let (code, stdout, stderr) = inspc(&["check", "--message-format", "json", &bad]);
+    assert_eq!(code, 1);
+    assert!(stderr.is_empty(), "json mode keeps stderr quiet: {stderr}");
+    let lines: Vec<serde_json::Value> = stdout.lines().map(|l| serde_json::from_str(l).expect("each line is JSON")).collect();
+    assert_eq!(lines.len(), 3);
+    for v in &lines {
+        for key in ["severity", "code", "message", "file", "line", "column", "end_line", "end_column", "labels", "help"] {
+            assert!(v.get(key).is_some(), "missing `{key}` in {v}");
+        }
+        assert_eq!(v["severity"], "error");
+        assert!(v["code"].as_str().unwrap().starts_with("insp::"));
+        assert!(v["labels"].as_array().unwrap().len() >= 1);
+    }
+    // `tip 0 mm`: line 2, column of `0` (1-based, in characters).
+    assert_eq!(lines[0]["line"], 2);
+    assert_eq!(lines[0]["column"], 16);
+    assert_eq!(lines[0]["end_column"], 20);
+    assert_eq!(lines[2]["code"], "insp::resolve::unknown_unit");
+    assert_eq!(lines[2]["help"], "did you mean `mm`?");
+}
+
+#[test]
+fn missing_file_is_a_diagnostic() {
+    let (code, stdout, _) = inspc(&["check", "--message-format", "json", "no/such/spec.insp"]);
+    assert_eq!(code, 1);
+    let v: serde_json::Value = serde_json::from_str(stdout.lines().next().unwrap()).unwrap();
+    assert_eq!(v["code"], "insp::load::unreadable");
+}
+
+#[test]
+fn emit_model_prints_the_resolved_spec() {
+    let (code, stdout, _) = inspc(&["check", "--emit", "model", "examples/f2.insp"]);
+    assert_eq!(code, 0);
+    assert!(stdout.contains("part f2: box (120, 60, 40)"), "{stdout}");
+    assert!(stdout.contains("tolerance T2: perpendicularity(small_slot) 0.02 | A"), "{stdout}");
+}
+
+#[test]
+fn usage_errors_exit_two() {
+    let (code, _, stderr) = inspc(&["check"]);
+    assert_eq!(code, 2, "{stderr}");
+}
