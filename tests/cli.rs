@@ -46,7 +46,7 @@ fn json_diagnostics_are_one_object_per_line() {
         }
         assert_eq!(v["severity"], "error");
         assert!(v["code"].as_str().unwrap().starts_with("insp::"));
-        assert!(v["labels"].as_array().unwrap().len() >= 1);
+        assert!(!v["labels"].as_array().unwrap().is_empty());
     }
     // `tip 0 mm`: line 2, column of `0` (1-based, in characters).
     assert_eq!(lines[0]["line"], 2);

@@ -20,8 +20,8 @@ fn insp_files(dir: &str) -> Vec<PathBuf> {
     out
 }
 
-fn assert_clean(path: &PathBuf) -> inspc::Checked {
-    let checked = inspc::check(&FsWorld, &[path.clone()]);
+fn assert_clean(path: &std::path::Path) -> inspc::Checked {
+    let checked = inspc::check(&FsWorld, &[path.to_path_buf()]);
     let rendered: Vec<String> = checked.diagnostics.iter().map(|d| format!("{}: {}", d.code(), d.message())).collect();
     assert!(rendered.is_empty(), "{} has diagnostics:\n{}", path.display(), rendered.join("\n"));
     checked

@@ -22,8 +22,7 @@ impl Model {
         let used = self.used(shown);
         let keep = |span: &crate::source::Span, kind: u8, index: usize| shown(span.file) || used.contains(&(kind, index));
         let mut o = String::new();
-        for (i, h) in self.heads.iter().enumerate().filter(|(i, h)| keep(&h.span, 0, *i)) {
-            let _ = i;
+        for h in self.heads.iter().enumerate().filter(|(i, x)| keep(&x.span, 0, *i)).map(|(_, x)| x) {
             let kind = match &h.kind {
                 HeadKind::Fixed => "fixed".to_string(),
                 HeadKind::Indexable { a, b, step } => format!(

@@ -180,8 +180,8 @@ fn cmm(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &mut Props, name: String,
         }
     }
     let (mut ram_radius, mut ram_length) = (1.0, 1.0);
-    match p.req(cx, "ram", "{ radius 35 mm, length 600 mm }") {
-        Some(v) => match &v.kind {
+    if let Some(v) = p.req(cx, "ram", "{ radius 35 mm, length 600 mm }") {
+        match &v.kind {
             ValueKind::Block(props) => {
                 let mut t = Props::new(cx, "the ram", v.span, props);
                 ram_radius = t.req(cx, "radius", "35 mm").and_then(|x| cx.positive(x, Dim::Length, "radius")).unwrap_or(1.0);
@@ -189,8 +189,7 @@ fn cmm(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &mut Props, name: String,
                 t.finish(cx);
             }
             _ => cx.mismatch(v, "a block `{ radius …, length … }`", ""),
-        },
-        None => {}
+        }
     }
     let head = p.req(cx, "head", "PH6").and_then(|v| r.lookup_value(cx, module, v, Kind::Head)).unwrap_or(0);
     let mut probes: Vec<(String, ProbeId)> = Vec::new();

@@ -271,7 +271,7 @@ impl<'a> Resolver<'a> {
         for d in &self.decls {
             let mut cx = Cx { diags, file: d.file, unit_mm: None };
             match (d.kind, d.item) {
-                (Kind::Part, ast::Item::Part(p)) => model.parts.push(part::lower(self, &mut cx, d.module, p)),
+                (Kind::Part, ast::Item::Part(p)) => model.parts.push(part::lower(self, &mut cx, p)),
                 (Kind::Hierarchy, ast::Item::Hierarchy(h)) => model.hierarchies.push(hierarchy::lower(&mut cx, h)),
                 (Kind::Plan, ast::Item::Plan(_)) => {}
                 (_, ast::Item::Block(b)) => catalogue::lower(self, &mut cx, d.module, d.kind, b, &mut model),

@@ -4,7 +4,6 @@ use super::errors::ResolveError as E;
 use super::props::{describe, path_text, Cx, Dim, Props, UNITS};
 use super::{tolerance, Resolver};
 use crate::diag::suggest;
-use crate::load::ModuleId;
 use crate::model::*;
 use crate::source::Span;
 use crate::syntax::ast::{self, NamedKind, PartStmt, PathSeg, ValueKind};
@@ -56,7 +55,7 @@ pub(super) struct PartCx<'p> {
     pub stmts: &'p [PartStmt],
 }
 
-pub(super) fn lower(r: &Resolver, cx: &mut Cx, _module: ModuleId, p: &ast::Part) -> Part {
+pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
     let mut part = Part {
         name: p.name.name.clone(),
         unit_mm: 1.0,
@@ -154,7 +153,7 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, _module: ModuleId, p: &ast::Part)
     for s in &p.stmts {
         if let PartStmt::Frame { name, refs, .. } = s {
             let refs = refs.iter().filter_map(|e| datum_ref(cx, &pc, &e.value)).collect::<Vec<_>>();
-            check_unique_datums(cx, &pc.part, &refs, name.span);
+            check_unique_datums(cx, &pc.part, &refs);
             pc.part.frames.push(Frame { name: name.name.clone(), refs: refs.into_iter().map(|(d, _)| d).collect(), span: name.span });
         }
     }
@@ -739,7 +738,7 @@ pub(super) fn material(cx: &mut Cx, i: &ast::Ident) -> Option<Material> {
     }
 }
 
-pub(super) fn check_unique_datums(cx: &mut Cx, part: &Part, refs: &[(DatumRef, Span)], _owner: Span) {
+pub(super) fn check_unique_datums(cx: &mut Cx, part: &Part, refs: &[(DatumRef, Span)]) {
     for (k, (r, span)) in refs.iter().enumerate() {
         if refs[..k].iter().any(|(o, _)| o.datum == r.datum) {
             cx.err(E::DuplicateDatum { span: *span, datum: part.datums[r.datum.0].name.clone() });

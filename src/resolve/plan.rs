@@ -82,9 +82,8 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &ast::Plan, 
                     }
                     "orientation" => {
                         let weight = if *forbid { None } else { o.get("weight").and_then(|v| cx.non_negative(v, "weight")) };
-                        if let (Some(ab), Some(head)) = (orientation(cx, value, head), head) {
-                            plan.orientations.push(OrientPref { a: ab.0, b: ab.1, weight: weight.unwrap_or(1.0), forbidden: *forbid, span: *span });
-                            let _ = head;
+                        if let Some((a, b)) = orientation(cx, value, head) {
+                            plan.orientations.push(OrientPref { a, b, weight: weight.unwrap_or(1.0), forbidden: *forbid, span: *span });
                         }
                     }
                     "probe" => {

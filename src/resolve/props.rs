@@ -219,7 +219,7 @@ impl Cx<'_> {
     /// A whole number ≥ 1.
     pub fn count(&mut self, v: &Value, what: &str) -> Option<u32> {
         let x = self.number(v)?;
-        if x.fract() != 0.0 || x < 1.0 || x > 1e6 {
+        if x.fract() != 0.0 || !(1.0..=1e6).contains(&x) {
             self.err(E::OutOfRange {
                 span: v.span,
                 what: format!("`{what}`"),

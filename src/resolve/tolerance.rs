@@ -200,7 +200,7 @@ pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Cal
         cx.err(E::MissingArgument { span: call.span, kind: what.clone(), what: "its basic angle".into(), help: "write `angularity(feature, 0.1 mm, A, basic 30 deg)`".into() });
         ok = false;
     }
-    check_unique_datums(cx, &pc.part, &datums, call.span);
+    check_unique_datums(cx, &pc.part, &datums);
     for (d, span) in &datums {
         let df = pc.part.datums[d.datum.0].feature;
         if let Some((f, _)) = targets.iter().find(|(f, _)| *f == df) {
