@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod diag;
+pub mod geometry;
 pub mod load;
 pub mod model;
 pub mod resolve;

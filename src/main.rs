@@ -30,8 +30,31 @@ enum Emit {
     Model,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum TableFormat {
+    /// A table for people.
+    Text,
+    /// One JSON array.
+    Json,
+}
+
 #[derive(Subcommand)]
 enum Command {
+    /// Lists the faces of a mesh (STL, OBJ) or of every part of a spec: id, surface type,
+    /// area, centroid, normal or axis and radius.
+    Faces {
+        /// A mesh file or an `.insp` spec.
+        file: PathBuf,
+        /// Segment the mesh even when it has groups.
+        #[arg(long)]
+        segment: bool,
+        /// The unit the mesh file is in.
+        #[arg(long, default_value = "mm")]
+        units: String,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = TableFormat::Text)]
+        format: TableFormat,
+    },
     /// Checks specs: parses, resolves names and units, checks values. Exits 1 on error.
     Check {
         /// The `.insp` files.
@@ -49,6 +72,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
+        Command::Faces { file, segment, units, format } => faces(&file, segment, &units, format),
         Command::Check { files, message_format, emit } => {
             let checked = inspc::check(&FsWorld, &files);
             let mut stdout = std::io::stdout().lock();
@@ -80,4 +104,77 @@ fn main() -> ExitCode {
             if errors > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS }
         }
     }
+}
+
+fn print_diagnostics(sources: &inspc::source::SourceMap, diags: &[inspc::diag::Diagnostic]) {
+    let opts = RenderOptions { width: 100, color: std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none() };
+    for d in diags {
+        eprint!("{}", render_human(sources, d, opts));
+    }
+}
+
+fn faces(file: &std::path::Path, segment: bool, units: &str, format: TableFormat) -> ExitCode {
+    use inspc::geometry;
+    let is_spec = file.extension().is_some_and(|e| e == "insp");
+    let mut listed: Vec<(String, geometry::PartGeometry)> = Vec::new();
+    if is_spec {
+        let checked = inspc::check(&FsWorld, &[file.to_path_buf()]);
+        print_diagnostics(&checked.sources, &checked.diagnostics);
+        if checked.has_errors() {
+            return ExitCode::from(1);
+        }
+        let mut diags = inspc::diag::Diagnostics::new();
+        for part in checked.model.parts.iter().filter(|p| checked.roots.contains(&p.span.file)) {
+            if let Some(g) = geometry::build(part, &FsWorld, part.span.file, &mut diags) {
+                listed.push((part.name.clone(), g));
+            }
+        }
+        let failed = diags.has_errors();
+        print_diagnostics(&checked.sources, &diags.sorted());
+        if failed {
+            return ExitCode::from(1);
+        }
+    } else {
+        let unit_mm = match units {
+            "mm" => 1.0,
+            "cm" => 10.0,
+            "m" => 1000.0,
+            "um" => 0.001,
+            "in" => 25.4,
+            other => {
+                eprintln!("inspc: unknown unit `{other}` (mm, cm, m, um, in)");
+                return ExitCode::from(2);
+            }
+        };
+        let raw = match geometry::read_mesh(&FsWorld, file, unit_mm) {
+            Ok(raw) => raw,
+            Err(e) => {
+                let mut sources = inspc::source::SourceMap::new();
+                let id = sources.add(file.to_string_lossy().into_owned(), None, file.to_string_lossy().into_owned());
+                let span = inspc::source::Span::new(id, 0, file.to_string_lossy().len());
+                let mut diags = inspc::diag::Diagnostics::new();
+                diags.push(id, e.at(span, file));
+                print_diagnostics(&sources, &diags.sorted());
+                return ExitCode::from(1);
+            }
+        };
+        if raw.open_edges + raw.nonmanifold_edges > 0 {
+            eprintln!("inspc: warning: {} open and {} non-manifold edges", raw.open_edges, raw.nonmanifold_edges);
+        }
+        let g = if raw.groups.len() > 1 && !segment { geometry::segment::from_groups(&raw) } else { geometry::segment::segment(&raw) };
+        listed.push((file.to_string_lossy().into_owned(), g));
+    }
+    let mut out = std::io::stdout().lock();
+    match format {
+        TableFormat::Json => {
+            let v: Vec<serde_json::Value> = listed.iter().map(|(name, g)| serde_json::json!({ "part": name, "faces": geometry::faces_json(g) })).collect();
+            let _ = writeln!(out, "{}", serde_json::Value::Array(v));
+        }
+        TableFormat::Text => {
+            for (name, g) in &listed {
+                let _ = write!(out, "{}", geometry::faces_table(name, g));
+            }
+        }
+    }
+    ExitCode::SUCCESS
 }

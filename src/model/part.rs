@@ -165,6 +165,19 @@ pub enum OpKind {
     },
 }
 
+impl OpKind {
+    /// The operation's name: `hole`, `slot`, `pocket`, `step`, `boss`.
+    pub fn word(&self) -> &'static str {
+        match self {
+            OpKind::Hole { .. } => "hole",
+            OpKind::Slot { .. } => "slot",
+            OpKind::Pocket { .. } => "pocket",
+            OpKind::Step { .. } => "step",
+            OpKind::Boss { .. } => "boss",
+        }
+    }
+}
+
 /// Copies of an operation.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Pattern {

@@ -25,23 +25,13 @@ impl Local {
     pub(super) fn word(self, part: &Part) -> String {
         match self {
             Local::Stock => "the stock".into(),
-            Local::Op(i) => format!("a {}", op_word(&part.ops[i].kind)),
+            Local::Op(i) => format!("a {}", part.ops[i].kind.word()),
             Local::Feature(i) if part.features[i].is_face_alias => "a face".into(),
             Local::Feature(_) => "a feature".into(),
             Local::Datum(_) => "a datum".into(),
             Local::Frame(_) => "a datum reference frame".into(),
             Local::Tolerance => "a tolerance".into(),
         }
-    }
-}
-
-pub(super) fn op_word(k: &OpKind) -> &'static str {
-    match k {
-        OpKind::Hole { .. } => "hole",
-        OpKind::Slot { .. } => "slot",
-        OpKind::Pocket { .. } => "pocket",
-        OpKind::Step { .. } => "step",
-        OpKind::Boss { .. } => "boss",
     }
 }
 
@@ -588,7 +578,7 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
     };
     let owner = match &source {
         FaceSource::Stock => "the stock".to_string(),
-        FaceSource::Op(OpId(i), _) => format!("{} `{}`", op_word(&pc.part.ops[*i].kind), pc.part.ops[*i].name),
+        FaceSource::Op(OpId(i), _) => format!("{} `{}`", pc.part.ops[*i].kind.word(), pc.part.ops[*i].name),
     };
     let known = roles(&pc.part, &source);
     match rest {

@@ -1,0 +1,125 @@
+//! The geometry stage's diagnostics.
+
+use crate::source::Span;
+
+/// A problem evaluating a part's geometry.
+#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[allow(missing_docs)]
+pub enum GeometryError {
+    #[error("cannot read mesh `{path}`: {reason}")]
+    #[diagnostic(code(insp::geometry::mesh_unreadable), help("check the path and that the file is a binary or ASCII STL, or an OBJ"))]
+    MeshUnreadable {
+        #[label("named here")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("mesh `{path}` is corrupt: {reason}")]
+    #[diagnostic(code(insp::geometry::mesh_corrupt), help("re-export the mesh from the CAD system; inspc needs a closed triangle mesh"))]
+    MeshCorrupt {
+        #[label("this mesh")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("mesh `{path}` is not closed: {reason}")]
+    #[diagnostic(code(insp::geometry::mesh_not_closed), help("accessibility needs a watertight solid: every edge shared by exactly two triangles; repair the mesh or re-export it"))]
+    MeshNotClosed {
+        #[label("this mesh")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("mesh `{path}` has {open} open and {nonmanifold} non-manifold edges")]
+    #[diagnostic(code(insp::geometry::mesh_defects), severity(Warning), help("the mesh is used as it is; collision checks near those edges may be off; repair or re-export it for a watertight solid"))]
+    MeshDefects {
+        #[label("this mesh")]
+        span: Span,
+        path: String,
+        open: usize,
+        nonmanifold: usize,
+    },
+    #[error("mesh `{path}` is too large: {reason}")]
+    #[diagnostic(code(insp::geometry::mesh_too_large), help("decimate the mesh; inspc accepts up to 2000000 triangles"))]
+    MeshTooLarge {
+        #[label("this mesh")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("the boolean operations of part `{part}` failed: {reason}")]
+    #[diagnostic(code(insp::geometry::boolean_failed), help("check that every operation overlaps the stock and that no two operations touch in a single edge or point"))]
+    BooleanFailed {
+        #[label("this part")]
+        span: Span,
+        part: String,
+        reason: String,
+    },
+    #[error("{what} `{name}` misses the part")]
+    #[diagnostic(code(insp::geometry::misses_part), help("move it onto the part: its position and direction are in the part frame (boxes span from the origin)"))]
+    MissesPart {
+        #[label("removes nothing")]
+        span: Span,
+        what: String,
+        name: String,
+    },
+    #[error("face `{face}` does not survive the booleans")]
+    #[diagnostic(code(insp::geometry::face_gone), help("a later operation removes it entirely; name a face that is still there"))]
+    FaceGone {
+        #[label("no triangle of the part lies on this face")]
+        span: Span,
+        face: String,
+    },
+    #[error("mesh has no group `{group}`")]
+    #[diagnostic(code(insp::geometry::unknown_group))]
+    UnknownGroup {
+        #[label("not in the mesh")]
+        span: Span,
+        group: String,
+        #[help]
+        help: String,
+    },
+    #[error("mesh has no segment {segment}")]
+    #[diagnostic(code(insp::geometry::unknown_segment))]
+    UnknownSegment {
+        #[label("no such segment")]
+        span: Span,
+        segment: u32,
+        #[help]
+        help: String,
+    },
+    #[error("no face matches this selector")]
+    #[diagnostic(code(insp::geometry::no_match))]
+    NoMatch {
+        #[label("matches nothing")]
+        span: Span,
+        #[help]
+        help: String,
+    },
+}
+
+/// A mesh-reading failure, located later at the spec's path.
+#[derive(Debug, Clone)]
+pub enum MeshError {
+    /// Could not read.
+    Unreadable(String),
+    /// Not a valid mesh.
+    Corrupt(String),
+    /// Not watertight.
+    NotClosed(String),
+    /// Over the size limit.
+    TooLarge(String),
+}
+
+impl MeshError {
+    /// The diagnostic, pointing at the spec's mesh path.
+    pub fn at(self, span: Span, path: &std::path::Path) -> GeometryError {
+        let path = path.to_string_lossy().into_owned();
+        match self {
+            MeshError::Unreadable(reason) => GeometryError::MeshUnreadable { span, path, reason },
+            MeshError::Corrupt(reason) => GeometryError::MeshCorrupt { span, path, reason },
+            MeshError::NotClosed(reason) => GeometryError::MeshNotClosed { span, path, reason },
+            MeshError::TooLarge(reason) => GeometryError::MeshTooLarge { span, path, reason },
+        }
+    }
+}

@@ -1,0 +1,329 @@
+//! Stage 4, geometry: a resolved part → a closed triangle mesh whose every triangle knows
+//! its named face, and every face its analytic surface.
+//!
+//! Constructive parts are built by boolean operations (boolmesh, a pure-Rust port of
+//! Manifold) on primitives whose faces carry exact surfaces; since boolmesh does not
+//! report which input face an output triangle came from, each output triangle is
+//! classified against the exact surfaces of the inputs (`csg.rs`). Mesh parts are read
+//! from STL or OBJ (`mesh_io.rs`); their faces come from OBJ groups or from segmentation
+//! (`segment.rs`), with surfaces fitted by least squares (`fit.rs`).
+//!
+//! **Architecture Invariant:** face numbering is deterministic: stock faces, then each
+//! operation's faces in declaration order, pattern instances in order; for meshes, the
+//! file's group order or the segmentation's seed order.
+
+mod csg;
+mod errors;
+pub mod fit;
+mod mesh_io;
+mod primitives;
+mod report;
+pub mod segment;
+mod select;
+
+pub use errors::GeometryError;
+pub use mesh_io::{read_mesh, RawMesh};
+pub use report::{describe, faces_json, faces_table};
+pub use select::resolve_faces;
+
+use crate::diag::Diagnostics;
+use crate::model::{self, Geometry as Source};
+use crate::source::{FileId, World};
+use nalgebra::{Point3, Vector3};
+
+/// A point in the part frame (mm).
+pub type P3 = Point3<f64>;
+/// A vector in the part frame.
+pub type V3 = Vector3<f64>;
+
+/// Geometric tolerance for "lies on a surface" (mm).
+pub const ON_SURFACE_MM: f64 = 1e-6;
+
+/// The analytic surface a face lies on.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Surface {
+    /// A plane through `origin`; `normal` is the solid's outward normal.
+    Plane {
+        /// A point on the plane.
+        origin: P3,
+        /// Outward unit normal.
+        normal: V3,
+    },
+    /// A cylinder around the line through `origin` along `axis`.
+    Cylinder {
+        /// A point on the axis.
+        origin: P3,
+        /// Unit axis.
+        axis: V3,
+        /// Radius (mm).
+        radius: f64,
+        /// The outward normal points away from the axis (a shaft) rather than toward it (a hole).
+        convex: bool,
+    },
+    /// A cone with `apex`, unit `axis` (from the apex into the cone) and half angle.
+    Cone {
+        /// The apex.
+        apex: P3,
+        /// Unit axis from the apex.
+        axis: V3,
+        /// Half angle (radians).
+        half_angle: f64,
+        /// The outward normal points away from the axis.
+        convex: bool,
+    },
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        center: P3,
+        /// Radius (mm).
+        radius: f64,
+        /// The outward normal points away from the centre.
+        convex: bool,
+    },
+    /// No analytic surface fits; the triangles are the geometry.
+    Freeform,
+}
+
+impl Surface {
+    /// The surface type.
+    pub fn kind(&self) -> model::SurfaceKind {
+        match self {
+            Surface::Plane { .. } => model::SurfaceKind::Plane,
+            Surface::Cylinder { .. } => model::SurfaceKind::Cylinder,
+            Surface::Cone { .. } => model::SurfaceKind::Cone,
+            Surface::Sphere { .. } => model::SurfaceKind::Sphere,
+            Surface::Freeform => model::SurfaceKind::Freeform,
+        }
+    }
+
+    /// Distance from a point to the surface (mm); `None` for free-form faces.
+    pub fn distance(&self, p: &P3) -> Option<f64> {
+        Some(match self {
+            Surface::Plane { origin, normal } => (p - origin).dot(normal).abs(),
+            Surface::Cylinder { origin, axis, radius, .. } => {
+                let d = p - origin;
+                ((d - axis * d.dot(axis)).norm() - radius).abs()
+            }
+            Surface::Cone { apex, axis, half_angle, .. } => {
+                let d = p - apex;
+                let h = d.dot(axis);
+                let r = (d - axis * h).norm();
+                // Distance to the cone's generator line in the (h, r) half-plane.
+                (r * half_angle.cos() - h * half_angle.sin()).abs()
+            }
+            Surface::Sphere { center, radius, .. } => ((p - center).norm() - radius).abs(),
+            Surface::Freeform => return None,
+        })
+    }
+
+    /// The solid's outward unit normal at (the projection of) `p`; `None` for free-form
+    /// faces or on an axis.
+    pub fn normal_at(&self, p: &P3) -> Option<V3> {
+        let flip = |v: V3, convex: bool| if convex { v } else { -v };
+        match self {
+            Surface::Plane { normal, .. } => Some(*normal),
+            Surface::Cylinder { origin, axis, convex, .. } => {
+                let d = p - origin;
+                let radial = d - axis * d.dot(axis);
+                radial.try_normalize(1e-12).map(|r| flip(r, *convex))
+            }
+            Surface::Cone { apex, axis, half_angle, convex } => {
+                let d = p - apex;
+                let radial = (d - axis * d.dot(axis)).try_normalize(1e-12)?;
+                let n = radial * half_angle.cos() - axis * half_angle.sin();
+                Some(flip(n, *convex))
+            }
+            Surface::Sphere { center, convex, .. } => (p - center).try_normalize(1e-12).map(|r| flip(r, *convex)),
+            Surface::Freeform => None,
+        }
+    }
+
+    /// The closest point of the surface to `p` (itself for free-form faces).
+    pub fn project(&self, p: &P3) -> P3 {
+        match self {
+            Surface::Plane { origin, normal } => p - normal * (p - origin).dot(normal),
+            Surface::Cylinder { origin, axis, radius, .. } => {
+                let d = p - origin;
+                let along = axis * d.dot(axis);
+                match (d - along).try_normalize(1e-12) {
+                    Some(r) => origin + along + r * *radius,
+                    None => *p,
+                }
+            }
+            Surface::Sphere { center, radius, .. } => match (p - center).try_normalize(1e-12) {
+                Some(r) => center + r * *radius,
+                None => *p,
+            },
+            Surface::Cone { apex, axis, half_angle, .. } => {
+                let d = p - apex;
+                let h = d.dot(axis);
+                let Some(radial) = (d - axis * h).try_normalize(1e-12) else { return *p };
+                let g = (axis * half_angle.cos() + radial * half_angle.sin()).normalize();
+                apex + g * d.dot(&g).max(0.0)
+            }
+            Surface::Freeform => *p,
+        }
+    }
+}
+
+/// Identifies a face of a [`PartGeometry`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct FaceId(pub usize);
+
+/// One face: a named, connected set of triangles on one surface.
+#[derive(Debug, Clone)]
+pub struct Face {
+    /// `stock.top`, `grid[3].wall`, `face_12` or `segment_4`.
+    pub name: String,
+    /// Its surface.
+    pub surface: Surface,
+    /// Indices into [`PartGeometry::triangles`].
+    pub triangles: Vec<u32>,
+    /// Area (mm²).
+    pub area: f64,
+    /// Area-weighted centroid.
+    pub centroid: P3,
+    /// For mesh faces: RMS distance of the vertices to the fitted surface (mm).
+    pub fit_rms: f64,
+}
+
+/// A part's evaluated geometry.
+#[derive(Debug, Clone)]
+pub struct PartGeometry {
+    /// Vertex positions (mm, part frame).
+    pub vertices: Vec<P3>,
+    /// Triangles, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+    /// The face of each triangle.
+    pub tri_face: Vec<u32>,
+    /// The faces.
+    pub faces: Vec<Face>,
+    /// For constructive parts, per face: whose face it is and the roles it answers to
+    /// (`walls`, `left_wall`, …); empty for mesh parts.
+    pub roles: Vec<(model::FaceSource, Vec<&'static str>)>,
+}
+
+impl PartGeometry {
+    /// Assembles faces from per-triangle face indices, computing areas and centroids.
+    pub(crate) fn new(vertices: Vec<P3>, triangles: Vec<[u32; 3]>, tri_face: Vec<u32>, specs: Vec<(String, Surface)>) -> Self {
+        let mut faces: Vec<Face> = specs
+            .into_iter()
+            .map(|(name, surface)| Face { name, surface, triangles: vec![], area: 0.0, centroid: P3::origin(), fit_rms: 0.0 })
+            .collect();
+        let mut sums = vec![V3::zeros(); faces.len()];
+        for (t, tri) in triangles.iter().enumerate() {
+            let f = tri_face[t] as usize;
+            let [a, b, c] = tri.map(|i| vertices[i as usize]);
+            let area = (b - a).cross(&(c - a)).norm() / 2.0;
+            faces[f].triangles.push(t as u32);
+            faces[f].area += area;
+            sums[f] += (a.coords + b.coords + c.coords) / 3.0 * area;
+        }
+        for (f, face) in faces.iter_mut().enumerate() {
+            if face.area > 0.0 {
+                face.centroid = P3::from(sums[f] / face.area);
+            }
+        }
+        PartGeometry { vertices, triangles, tri_face, faces, roles: Vec::new() }
+    }
+
+    /// The three corners of a triangle.
+    pub fn corners(&self, t: usize) -> [P3; 3] {
+        self.triangles[t].map(|i| self.vertices[i as usize])
+    }
+
+    /// The unit normal of a triangle (from its winding).
+    pub fn tri_normal(&self, t: usize) -> V3 {
+        let [a, b, c] = self.corners(t);
+        (b - a).cross(&(c - a)).try_normalize(0.0).unwrap_or_else(V3::zeros)
+    }
+
+    /// The axis-aligned bounds of all vertices.
+    pub fn bounds(&self) -> (P3, P3) {
+        let mut lo = P3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
+        let mut hi = P3::new(f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+        for v in &self.vertices {
+            lo = lo.inf(v);
+            hi = hi.sup(v);
+        }
+        (lo, hi)
+    }
+
+    /// Whether the mesh is closed: every edge is shared by exactly two triangles with
+    /// opposite orientations.
+    pub fn is_closed(&self) -> bool {
+        let mut edges: std::collections::HashMap<(u32, u32), i32> = std::collections::HashMap::new();
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *edges.entry((a.min(b), a.max(b))).or_default() += if a < b { 1 } else { -1 };
+            }
+        }
+        let mut counts: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *counts.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        edges.values().all(|v| *v == 0) && counts.values().all(|c| *c == 2)
+    }
+
+    /// The signed volume (mm³), positive for an outward-oriented closed mesh.
+    pub fn volume(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.vertices[i as usize].coords);
+                a.dot(&b.cross(&c)) / 6.0
+            })
+            .sum()
+    }
+
+    /// Whether a point is inside the solid (generalised winding number > 1/2).
+    pub fn contains(&self, p: &P3) -> bool {
+        let mut w = 0.0;
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| self.vertices[i as usize] - p);
+            let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
+            let num = a.dot(&b.cross(&c));
+            let den = la * lb * lc + a.dot(&b) * lc + b.dot(&c) * la + c.dot(&a) * lb;
+            w += 2.0 * num.atan2(den);
+        }
+        w / (4.0 * std::f64::consts::PI) > 0.5
+    }
+}
+
+/// Evaluates a part's geometry. The entry point of the geometry stage.
+///
+/// `file` is the spec file the part is declared in: diagnostics point at the part's
+/// declaration (or the mesh path) there.
+pub fn build(part: &model::Part, world: &dyn World, file: FileId, diags: &mut Diagnostics) -> Option<PartGeometry> {
+    match &part.geometry {
+        Source::Stock(stock) => csg::build(part, stock, file, diags),
+        Source::Mesh { path, unit_mm, span } => {
+            let raw = match read_mesh(world, path, *unit_mm) {
+                Ok(m) => m,
+                Err(e) => {
+                    diags.push(file, e.at(*span, path));
+                    return None;
+                }
+            };
+            if raw.open_edges + raw.nonmanifold_edges > 0 {
+                diags.push(file, GeometryError::MeshDefects {
+                    span: *span,
+                    path: path.to_string_lossy().into_owned(),
+                    open: raw.open_edges,
+                    nonmanifold: raw.nonmanifold_edges,
+                });
+            }
+            let uses_groups = part.features.iter().flat_map(|f| &f.faces).any(|r| matches!(r, model::FaceRef::Group(..)));
+            let geometry = if raw.groups.len() > 1 || (uses_groups && !raw.groups.is_empty()) {
+                segment::from_groups(&raw)
+            } else {
+                segment::segment(&raw)
+            };
+            Some(geometry)
+        }
+    }
+}
