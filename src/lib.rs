@@ -40,6 +40,37 @@ impl Checked {
     }
 }
 
+/// Runs the front end and then evaluates the geometry of every part the root files
+/// declare, resolving each feature's faces; geometry diagnostics join the front end's.
+/// A part whose geometry fails (or every part, when the front end failed) gets `None`.
+pub fn check_geometry(world: &dyn source::World, roots: &[PathBuf]) -> (Checked, Vec<Option<geometry::PartGeometry>>) {
+    let mut checked = check(world, roots);
+    let mut out = vec![None; checked.model.parts.len()];
+    if checked.has_errors() {
+        return (checked, out);
+    }
+    let mut diags = diag::Diagnostics::new();
+    for (k, part) in checked.model.parts.iter().enumerate() {
+        if !checked.roots.contains(&part.span.file) {
+            continue;
+        }
+        let Some(g) = geometry::build(part, world, part.span.file, &mut diags) else { continue };
+        for f in &part.features {
+            for r in &f.faces {
+                geometry::resolve_faces(&g, r, part.span.file, &mut diags);
+            }
+        }
+        out[k] = Some(g);
+    }
+    let mut all = diag::Diagnostics::new();
+    for d in std::mem::take(&mut checked.diagnostics) {
+        all.push_boxed(d);
+    }
+    all.extend(diags);
+    checked.diagnostics = all.sorted();
+    (checked, out)
+}
+
 /// Runs the front end (load, parse, resolve) over root files.
 pub fn check(world: &dyn source::World, roots: &[PathBuf]) -> Checked {
     let mut sources = source::SourceMap::new();

@@ -77,3 +77,59 @@ fn usage_errors_exit_two() {
     let (code, _, stderr) = inspc(&["check"]);
     assert_eq!(code, 2, "{stderr}");
 }
+
+fn type_counts(stdout: &str) -> std::collections::BTreeMap<String, usize> {
+    let v: serde_json::Value = serde_json::from_str(stdout).expect("faces --format json is JSON");
+    let mut counts = std::collections::BTreeMap::new();
+    for f in v[0]["faces"].as_array().unwrap() {
+        *counts.entry(f["type"].as_str().unwrap().to_string()).or_default() += 1;
+    }
+    counts
+}
+
+#[test]
+fn faces_of_the_nist_obj_groups_match_the_pmi_surface_types() {
+    // The PMI lists CTC 01 as 56 planes, 57 cylinders and 4 cones; FTC 08 as 82 planes,
+    // 134 cylinders, 20 spheres and 12 tori (free-form for inspc).
+    let (code, stdout, stderr) = inspc(&["faces", "--format", "json", "../shared/parts/nist_ctc_01_asme1_ap242-e1.obj"]);
+    assert_eq!(code, 0, "{stderr}");
+    let c = type_counts(&stdout);
+    assert_eq!((c["plane"], c["cylinder"], c["cone"]), (56, 57, 4), "{c:?}");
+    let (_, stdout, _) = inspc(&["faces", "--format", "json", "../shared/parts/nist_ftc_08_asme1_ap242-e1.obj"]);
+    let c = type_counts(&stdout);
+    assert_eq!((c["plane"], c["cylinder"], c["sphere"], c["freeform"]), (82, 134, 20, 12), "{c:?}");
+}
+
+#[test]
+fn faces_segments_the_nist_stl_files_into_sensible_types() {
+    for (mesh, min_faces) in [("nist_ctc_01_asme1_ap242-e1.stl", 90), ("nist_ftc_08_asme1_ap242-e1.stl", 200)] {
+        let (code, stdout, stderr) = inspc(&["faces", "--format", "json", &format!("../shared/parts/{mesh}")]);
+        assert_eq!(code, 0, "{stderr}");
+        let c = type_counts(&stdout);
+        let total: usize = c.values().sum();
+        assert!(total >= min_faces, "{mesh}: {c:?}");
+        // Planes and cylinders dominate; almost nothing is left free-form.
+        assert!(c["plane"] + c["cylinder"] > total * 2 / 3, "{mesh}: {c:?}");
+        assert!(c.get("freeform").copied().unwrap_or(0) * 20 < total, "{mesh}: {c:?}");
+    }
+    let (_, text, _) = inspc(&["faces", "../shared/parts/nist_ctc_01_asme1_ap242-e1.stl"]);
+    assert!(text.contains("segment_1 ") && text.contains("cylinder") && text.contains("(hole)"), "{text}");
+}
+
+#[test]
+fn faces_of_a_spec_name_the_constructive_faces() {
+    let (code, stdout, stderr) = inspc(&["faces", "examples/f2.insp"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.starts_with("f2: 12 faces"), "{stdout}");
+    assert!(stdout.contains("large.left_wall") && stdout.contains("small.floor"), "{stdout}");
+    let (code, stdout, _) = inspc(&["faces", "examples/swiss_block.insp"]);
+    assert_eq!(code, 0);
+    assert!(stdout.starts_with("swiss_block: 206 faces"), "{stdout}");
+}
+
+#[test]
+fn faces_of_a_missing_mesh_is_a_diagnostic() {
+    let (code, _, stderr) = inspc(&["faces", "no/such/part.stl"]);
+    assert_eq!(code, 1);
+    assert!(stderr.contains("insp::geometry::mesh_unreadable"), "{stderr}");
+}

@@ -242,9 +242,11 @@ fn mesh_and_stock_only_statements() {
     expect(&d, "insp::resolve::needs_stock", "cut hole h { at (0, 0, 0), axis -z, diameter 5, depth 5 }", "needs stock");
 }
 
+const TETRA_OBJ: &[u8] = b"g face_1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+
 #[test]
 fn mesh_files_are_found_relative_to_the_spec() {
-    let ok = check_files(&[("specs/main.insp", b"part p { units mm, mesh \"../meshes/p.obj\", feature f = group \"face_1\" }"), ("meshes/p.obj", b"v 0 0 0")]);
+    let ok = check_files(&[("specs/main.insp", b"part p { units mm, mesh \"../meshes/p.obj\", feature f = group \"face_1\" }"), ("meshes/p.obj", TETRA_OBJ)]);
     assert!(ok.is_empty(), "{}", render(&ok));
     expect_src("part p { units mm, mesh \"p.obj\" }", "insp::resolve::file_not_found", "\"p.obj\"", "mesh file `p.obj` not found");
     expect_src("part p { units mm, mesh \"p.iges\" }", "insp::resolve::mesh_format", "\"p.iges\"", "unsupported mesh format `.iges`");

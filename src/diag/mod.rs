@@ -69,6 +69,11 @@ impl Diagnostics {
         self.items.push(Diagnostic { file, inner: Box::new(err) });
     }
 
+    /// Files an already boxed diagnostic.
+    pub fn push_boxed(&mut self, d: Diagnostic) {
+        self.items.push(d);
+    }
+
     /// Whether any error (not just warnings) was filed.
     pub fn has_errors(&self) -> bool {
         self.items.iter().any(|d| d.severity() == Severity::Error)

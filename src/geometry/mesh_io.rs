@@ -44,9 +44,6 @@ pub fn read_mesh(world: &dyn World, path: &Path, unit_mm: f64) -> Result<RawMesh
 type Parsed = (Vec<[f64; 3]>, Vec<[usize; 3]>, Vec<u32>, Vec<String>);
 
 fn parse_stl(bytes: &[u8]) -> Result<Parsed, MeshError> {
-    // stl_io reads both forms; a binary file's header may start with "solid" too.
-    let mut cursor = std::io::Cursor::new(bytes);
-    let mesh = stl_io::read_stl(&mut cursor).map_err(|e| MeshError::Corrupt(format!("not a valid STL file ({e})")))?;
     if bytes.len() >= 84 && !bytes.starts_with(b"solid") {
         let declared = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
         if declared > MAX_TRIANGLES {
@@ -56,6 +53,9 @@ fn parse_stl(bytes: &[u8]) -> Result<Parsed, MeshError> {
             return Err(MeshError::Corrupt(format!("the file is truncated: {declared} triangles declared, room for {}", (bytes.len() - 84) / 50)));
         }
     }
+    // stl_io reads both forms; a binary file's header may start with "solid" too.
+    let mut cursor = std::io::Cursor::new(bytes);
+    let mesh = stl_io::read_stl(&mut cursor).map_err(|e| MeshError::Corrupt(format!("not a valid STL file ({e})")))?;
     let positions = mesh.vertices.iter().map(|v| [v[0] as f64, v[1] as f64, v[2] as f64]).collect();
     let faces: Vec<[usize; 3]> = mesh.faces.iter().map(|f| f.vertices).collect();
     let n = faces.len();

@@ -22,7 +22,7 @@ pub fn check_files(files: &[(&str, &[u8])]) -> Vec<Flat> {
     for (p, c) in files {
         world.insert(p, c.to_vec());
     }
-    let checked = inspc::check(&world, &[PathBuf::from(files[0].0)]);
+    let (checked, _) = inspc::check_geometry(&world, &[PathBuf::from(files[0].0)]);
     checked
         .diagnostics
         .iter()
