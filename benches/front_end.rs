@@ -39,3 +39,16 @@ fn stdlib_only(bencher: divan::Bencher) {
     let roots = [PathBuf::from("empty.insp")];
     bencher.bench(|| inspc::check(&world, divan::black_box(&roots)));
 }
+
+/// Geometry on top of the front end: booleans and face classification for constructive
+/// parts, reading and fitting for the NIST mesh (issue 3's budget: well under 100 ms
+/// for swiss_block).
+#[divan::bench(args = ["examples/swiss_block.insp", "examples/parts/swiss_sphere.insp", "tests/real/nist_ctc_01.insp"])]
+fn check_and_geometry(bencher: divan::Bencher, spec: &str) {
+    let roots = [PathBuf::from(spec)];
+    bencher.bench(|| {
+        let (c, g) = inspc::check_geometry(&FsWorld, divan::black_box(&roots));
+        assert!(!c.has_errors() && g.iter().any(Option::is_some));
+        g
+    });
+}
