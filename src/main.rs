@@ -135,16 +135,9 @@ fn faces(file: &std::path::Path, segment: bool, units: &str, format: TableFormat
             return ExitCode::from(1);
         }
     } else {
-        let unit_mm = match units {
-            "mm" => 1.0,
-            "cm" => 10.0,
-            "m" => 1000.0,
-            "um" => 0.001,
-            "in" => 25.4,
-            other => {
-                eprintln!("inspc: unknown unit `{other}` (mm, cm, m, um, in)");
-                return ExitCode::from(2);
-            }
+        let Some(unit_mm) = inspc::resolve::length_unit_mm(units) else {
+            eprintln!("inspc: unknown length unit `{units}` (mm, cm, m, um, in)");
+            return ExitCode::from(2);
         };
         let raw = match geometry::read_mesh(&FsWorld, file, unit_mm) {
             Ok(raw) => raw,

@@ -79,27 +79,12 @@ impl Diagnostics {
         self.items.iter().any(|d| d.severity() == Severity::Error)
     }
 
-    /// Number of errors.
-    pub fn error_count(&self) -> usize {
-        self.items.iter().filter(|d| d.severity() == Severity::Error).count()
-    }
-
-    /// Number of warnings.
-    pub fn warning_count(&self) -> usize {
-        self.items.iter().filter(|d| d.severity() == Severity::Warning).count()
-    }
-
     /// All diagnostics in a stable order: by file, then position, then code.
     pub fn sorted(mut self) -> Vec<Diagnostic> {
         self.items.sort_by(|a, b| {
             (a.file, a.offset(), a.code(), a.message()).cmp(&(b.file, b.offset(), b.code(), b.message()))
         });
         self.items
-    }
-
-    /// The diagnostics in the order they were filed.
-    pub fn iter(&self) -> impl Iterator<Item = &Diagnostic> {
-        self.items.iter()
     }
 
     /// Moves every diagnostic of `other` into this sink.

@@ -22,9 +22,10 @@ pub(crate) struct Spec {
     hi: P3,
 }
 
-/// One primitive to add or remove.
+/// One primitive to add or remove, with its bounds.
 struct Tool {
     prim: Prim,
+    bounds: (P3, P3),
     add: bool,
     op: usize,
 }
@@ -97,7 +98,7 @@ pub(super) fn build(part: &model::Part, stock: &Stock, file: FileId, diags: &mut
                         hi: hi + V3::repeat(grow),
                     });
             }
-            tools.push(Tool { prim, add: op.add, op: oi });
+            tools.push(Tool { bounds: (lo, hi), prim, add: op.add, op: oi });
         }
     }
 
@@ -107,7 +108,7 @@ pub(super) fn build(part: &model::Part, stock: &Stock, file: FileId, diags: &mut
     while i < tools.len() {
         let mut batch = vec![i];
         let mut j = i + 1;
-        while j < tools.len() && tools[j].add == tools[i].add && batch.iter().all(|&b| disjoint(&tools[b].prim, &tools[j].prim)) {
+        while j < tools.len() && tools[j].add == tools[i].add && batch.iter().all(|&b| disjoint(tools[b].bounds, tools[j].bounds)) {
             batch.push(j);
             j += 1;
         }
@@ -147,24 +148,38 @@ pub(super) fn build(part: &model::Part, stock: &Stock, file: FileId, diags: &mut
 /// The spec a triangle belongs to: every corner on its surface (within the tessellation
 /// tolerance for curved surfaces), its normal agreeing with the surface's, its centroid
 /// inside the spec's bounds. The best normal agreement wins; ties go to the first spec.
+/// A triangle that fits no spec (which the tolerances make rare) goes to the spec that
+/// is nearest and best aligned.
 fn classify(specs: &[Spec], corners: [P3; 3], g: P3, n: V3, plane_tol: f64, curved_tol: f64) -> usize {
-    let mut best: Option<(f64, usize)> = None;
-    let mut fallback: Option<(f64, usize)> = None;
-    for (k, s) in specs.iter().enumerate() {
-        let Some(sn) = s.surface.normal_at(&g) else { continue };
-        let agree = n.dot(&sn);
+    let fit = |s: &Spec| -> Option<(f64, f64)> {
+        let sn = s.surface.normal_at(&g)?;
         let dist = corners.iter().map(|c| s.surface.distance(c).unwrap_or(f64::INFINITY)).fold(0.0, f64::max);
-        let score = dist - agree;
-        if fallback.is_none_or(|(b, _)| score < b) {
-            fallback = Some((score, k));
+        Some((n.dot(&sn), dist))
+    };
+    let mut best: Option<(f64, usize)> = None;
+    for (k, s) in specs.iter().enumerate() {
+        // The bounds test is cheap and rules out almost every spec.
+        if !(0..3).all(|i| g[i] >= s.lo[i] && g[i] <= s.hi[i]) {
+            continue;
         }
-        let inside = (0..3).all(|i| g[i] >= s.lo[i] && g[i] <= s.hi[i]);
+        let Some((agree, dist)) = fit(s) else { continue };
         let (tol, min_agree) = if matches!(s.surface, Surface::Plane { .. }) { (plane_tol, 0.999) } else { (curved_tol, 0.7) };
-        if inside && dist <= tol && agree >= min_agree && best.is_none_or(|(b, _)| agree > b + 1e-9) {
+        if dist <= tol && agree >= min_agree && best.is_none_or(|(b, _)| agree > b + 1e-9) {
             best = Some((agree, k));
         }
     }
-    best.or(fallback).map_or(0, |(_, k)| k)
+    if let Some((_, k)) = best {
+        return k;
+    }
+    let mut fallback: Option<(f64, usize)> = None;
+    for (k, s) in specs.iter().enumerate() {
+        if let Some((agree, dist)) = fit(s) {
+            if fallback.is_none_or(|(b, _)| dist - agree < b) {
+                fallback = Some((dist - agree, k));
+            }
+        }
+    }
+    fallback.map_or(0, |(_, k)| k)
 }
 
 fn flip(s: Surface) -> Surface {
@@ -177,8 +192,7 @@ fn flip(s: Surface) -> Surface {
     }
 }
 
-fn disjoint(a: &Prim, b: &Prim) -> bool {
-    let ((alo, ahi), (blo, bhi)) = (a.bounds(), b.bounds());
+fn disjoint((alo, ahi): (P3, P3), (blo, bhi): (P3, P3)) -> bool {
     (0..3).any(|k| ahi[k] + 1e-6 < blo[k] || bhi[k] + 1e-6 < alo[k])
 }
 

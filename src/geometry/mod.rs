@@ -137,33 +137,6 @@ impl Surface {
             Surface::Freeform => None,
         }
     }
-
-    /// The closest point of the surface to `p` (itself for free-form faces).
-    pub fn project(&self, p: &P3) -> P3 {
-        match self {
-            Surface::Plane { origin, normal } => p - normal * (p - origin).dot(normal),
-            Surface::Cylinder { origin, axis, radius, .. } => {
-                let d = p - origin;
-                let along = axis * d.dot(axis);
-                match (d - along).try_normalize(1e-12) {
-                    Some(r) => origin + along + r * *radius,
-                    None => *p,
-                }
-            }
-            Surface::Sphere { center, radius, .. } => match (p - center).try_normalize(1e-12) {
-                Some(r) => center + r * *radius,
-                None => *p,
-            },
-            Surface::Cone { apex, axis, half_angle, .. } => {
-                let d = p - apex;
-                let h = d.dot(axis);
-                let Some(radial) = (d - axis * h).try_normalize(1e-12) else { return *p };
-                let g = (axis * half_angle.cos() + radial * half_angle.sin()).normalize();
-                apex + g * d.dot(&g).max(0.0)
-            }
-            Surface::Freeform => *p,
-        }
-    }
 }
 
 /// Identifies a face of a [`PartGeometry`].
@@ -227,17 +200,6 @@ impl PartGeometry {
         PartGeometry { vertices, triangles, tri_face, faces, roles: Vec::new() }
     }
 
-    /// The three corners of a triangle.
-    pub fn corners(&self, t: usize) -> [P3; 3] {
-        self.triangles[t].map(|i| self.vertices[i as usize])
-    }
-
-    /// The unit normal of a triangle (from its winding).
-    pub fn tri_normal(&self, t: usize) -> V3 {
-        let [a, b, c] = self.corners(t);
-        (b - a).cross(&(c - a)).try_normalize(0.0).unwrap_or_else(V3::zeros)
-    }
-
     /// The axis-aligned bounds of all vertices.
     pub fn bounds(&self) -> (P3, P3) {
         let mut lo = P3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
@@ -247,50 +209,6 @@ impl PartGeometry {
             hi = hi.sup(v);
         }
         (lo, hi)
-    }
-
-    /// Whether the mesh is closed: every edge is shared by exactly two triangles with
-    /// opposite orientations.
-    pub fn is_closed(&self) -> bool {
-        let mut edges: std::collections::HashMap<(u32, u32), i32> = std::collections::HashMap::new();
-        for t in &self.triangles {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                *edges.entry((a.min(b), a.max(b))).or_default() += if a < b { 1 } else { -1 };
-            }
-        }
-        let mut counts: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
-        for t in &self.triangles {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                *counts.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
-        }
-        edges.values().all(|v| *v == 0) && counts.values().all(|c| *c == 2)
-    }
-
-    /// The signed volume (mm³), positive for an outward-oriented closed mesh.
-    pub fn volume(&self) -> f64 {
-        self.triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| self.vertices[i as usize].coords);
-                a.dot(&b.cross(&c)) / 6.0
-            })
-            .sum()
-    }
-
-    /// Whether a point is inside the solid (generalised winding number > 1/2).
-    pub fn contains(&self, p: &P3) -> bool {
-        let mut w = 0.0;
-        for t in &self.triangles {
-            let [a, b, c] = t.map(|i| self.vertices[i as usize] - p);
-            let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
-            let num = a.dot(&b.cross(&c));
-            let den = la * lb * lc + a.dot(&b) * lc + b.dot(&c) * la + c.dot(&a) * lb;
-            w += 2.0 * num.atan2(den);
-        }
-        w / (4.0 * std::f64::consts::PI) > 0.5
     }
 }
 

@@ -20,6 +20,7 @@ mod tolerance;
 
 pub use errors::ResolveError;
 pub use hierarchy::level_text;
+pub use props::length_unit_mm;
 pub use tolerance::keyword as tolerance_keyword;
 
 use crate::diag::{suggest, Diagnostics};

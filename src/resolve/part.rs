@@ -159,8 +159,10 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
 }
 
 fn length_unit(cx: &mut Cx, u: &ast::Ident) -> Option<f64> {
+    if let Some(f) = super::props::length_unit_mm(&u.name) {
+        return Some(f);
+    }
     match UNITS.iter().find(|(n, _, _)| *n == u.name) {
-        Some((_, Dim::Length, f)) => Some(*f),
         Some(_) => {
             cx.err(E::UnitMismatch { span: u.span, expected: "a length unit".into(), found: "another unit".into(), unit: u.name.clone(), help: "part units are mm, cm, m, um or in".into() });
             None

@@ -39,6 +39,11 @@ pub(crate) const UNITS: &[(&str, Dim, f64)] = &[
 
 pub(crate) use crate::model::fmt_num as num;
 
+/// Millimetres per unit for a length unit name (`mm`, `in`, …).
+pub fn length_unit_mm(name: &str) -> Option<f64> {
+    UNITS.iter().find(|(n, d, _)| *n == name && *d == Dim::Length).map(|(_, _, f)| *f)
+}
+
 /// Describes a value's form for "found …" messages.
 pub(crate) fn describe(v: &Value) -> String {
     match &v.kind {

@@ -118,11 +118,6 @@ impl SourceMap {
         self.get(span.file).text.get(span.range()).unwrap_or("")
     }
 
-    /// The id of the file with this path, if loaded.
-    pub fn find_path(&self, path: &Path) -> Option<FileId> {
-        self.files.iter().position(|f| f.path.as_deref() == Some(path)).map(|i| FileId(i as u32))
-    }
-
     /// The id of the file with this display name, if loaded.
     pub fn find_name(&self, name: &str) -> Option<FileId> {
         self.files.iter().position(|f| f.name == name).map(|i| FileId(i as u32))

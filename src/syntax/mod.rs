@@ -71,18 +71,6 @@ pub enum SyntaxError {
     },
 }
 
-impl SyntaxError {
-    /// The span at fault.
-    pub fn span(&self) -> Span {
-        match self {
-            SyntaxError::Unexpected { span, .. }
-            | SyntaxError::InvalidNumber { span, .. }
-            | SyntaxError::InvalidEscape { span, .. }
-            | SyntaxError::TooDeep { span, .. } => *span,
-        }
-    }
-}
-
 /// Parses one file. The entry point of the syntax stage.
 pub fn parse(file: FileId, text: &str) -> Result<ast::File, SyntaxError> {
     use pest::Parser;
