@@ -78,6 +78,14 @@ fn usage_errors_exit_two() {
     assert_eq!(code, 2, "{stderr}");
 }
 
+/// The NIST meshes live in `../shared/parts/`, beside the repository, as CI has them.
+fn require_shared_parts() {
+    assert!(
+        std::path::Path::new("../shared/parts/nist_ctc_01_asme1_ap242-e1.obj").exists(),
+        "the NIST parts are expected in ../shared/parts/ beside the repository, as CI has them"
+    );
+}
+
 fn type_counts(stdout: &str) -> std::collections::BTreeMap<String, usize> {
     let v: serde_json::Value = serde_json::from_str(stdout).expect("faces --format json is JSON");
     let mut counts = std::collections::BTreeMap::new();
@@ -91,6 +99,7 @@ fn type_counts(stdout: &str) -> std::collections::BTreeMap<String, usize> {
 fn faces_of_the_nist_obj_groups_match_the_pmi_surface_types() {
     // The PMI lists CTC 01 as 56 planes, 57 cylinders and 4 cones; FTC 08 as 82 planes,
     // 134 cylinders, 20 spheres and 12 tori (free-form for inspc).
+    require_shared_parts();
     let (code, stdout, stderr) = inspc(&["faces", "--format", "json", "../shared/parts/nist_ctc_01_asme1_ap242-e1.obj"]);
     assert_eq!(code, 0, "{stderr}");
     let c = type_counts(&stdout);
@@ -102,6 +111,7 @@ fn faces_of_the_nist_obj_groups_match_the_pmi_surface_types() {
 
 #[test]
 fn faces_segments_the_nist_stl_files_into_sensible_types() {
+    require_shared_parts();
     for (mesh, min_faces) in [("nist_ctc_01_asme1_ap242-e1.stl", 90), ("nist_ftc_08_asme1_ap242-e1.stl", 200)] {
         let (code, stdout, stderr) = inspc(&["faces", "--format", "json", &format!("../shared/parts/{mesh}")]);
         assert_eq!(code, 0, "{stderr}");
