@@ -11,7 +11,11 @@ fn main() {
     divan::main();
 }
 
-const SPECS: [&str; 3] = ["examples/swiss_block.insp", "tests/real/nist_ctc_01.insp", "examples/parts/swiss_sphere.insp"];
+const SPECS: [&str; 3] = [
+    "examples/swiss_block.insp",
+    "tests/real/nist_ctc_01.insp",
+    "examples/parts/swiss_sphere.insp",
+];
 
 /// Baseline: the grammar alone on one file's text.
 #[divan::bench(args = SPECS)]

@@ -7,9 +7,11 @@
 
 pub mod diag;
 pub mod geometry;
+pub mod graph;
 pub mod load;
 pub mod model;
 pub mod resolve;
+pub mod sample;
 pub mod source;
 pub mod syntax;
 
@@ -31,7 +33,19 @@ pub struct Checked {
 impl Checked {
     /// Whether any diagnostic is an error.
     pub fn has_errors(&self) -> bool {
-        self.diagnostics.iter().any(|d| d.severity() == miette::Severity::Error)
+        self.diagnostics
+            .iter()
+            .any(|d| d.severity() == miette::Severity::Error)
+    }
+
+    /// Adds a later stage's diagnostics, keeping the stable order.
+    fn absorb(&mut self, later: diag::Diagnostics) {
+        let mut all = diag::Diagnostics::new();
+        for d in std::mem::take(&mut self.diagnostics) {
+            all.push_boxed(d);
+        }
+        all.extend(later);
+        self.diagnostics = all.sorted();
     }
 
     /// The model as text, showing what the root files declare and use.
@@ -40,10 +54,22 @@ impl Checked {
     }
 }
 
+/// A part's evaluated geometry and, per feature, the faces it names.
+#[derive(Debug, Clone)]
+pub struct PartData {
+    /// The geometry.
+    pub geometry: geometry::PartGeometry,
+    /// Per feature of the part, its faces.
+    pub feature_faces: Vec<Vec<geometry::FaceId>>,
+}
+
 /// Runs the front end and then evaluates the geometry of every part the root files
-/// declare, resolving each feature's faces; geometry diagnostics join the front end's.
+/// declare or their plans name, resolving each feature's faces; geometry diagnostics join the front end's.
 /// A part whose geometry fails (or every part, when the front end failed) gets `None`.
-pub fn check_geometry(world: &dyn source::World, roots: &[PathBuf]) -> (Checked, Vec<Option<geometry::PartGeometry>>) {
+pub fn check_geometry(
+    world: &dyn source::World,
+    roots: &[PathBuf],
+) -> (Checked, Vec<Option<PartData>>) {
     let mut checked = check(world, roots);
     let mut out = vec![None; checked.model.parts.len()];
     if checked.has_errors() {
@@ -51,24 +77,101 @@ pub fn check_geometry(world: &dyn source::World, roots: &[PathBuf]) -> (Checked,
     }
     let mut diags = diag::Diagnostics::new();
     for (k, part) in checked.model.parts.iter().enumerate() {
-        if !checked.roots.contains(&part.span.file) {
+        let planned = checked.model.plans.iter().any(|p| p.part.0 == k);
+        if !planned && !checked.roots.contains(&part.span.file) {
             continue;
         }
-        let Some(g) = geometry::build(part, world, part.span.file, &mut diags) else { continue };
-        for f in &part.features {
-            for r in &f.faces {
-                geometry::resolve_faces(&g, r, part.span.file, &mut diags);
-            }
-        }
-        out[k] = Some(g);
+        let Some(geometry) = geometry::build(part, world, part.span.file, &mut diags) else {
+            continue;
+        };
+        let feature_faces = part
+            .features
+            .iter()
+            .map(|f| {
+                let mut faces: Vec<geometry::FaceId> = Vec::new();
+                for r in &f.faces {
+                    for id in geometry::resolve_faces(&geometry, r, part.span.file, &mut diags) {
+                        if !faces.contains(&id) {
+                            faces.push(id);
+                        }
+                    }
+                }
+                faces
+            })
+            .collect();
+        out[k] = Some(PartData {
+            geometry,
+            feature_faces,
+        });
     }
-    let mut all = diag::Diagnostics::new();
-    for d in std::mem::take(&mut checked.diagnostics) {
-        all.push_boxed(d);
-    }
-    all.extend(diags);
-    checked.diagnostics = all.sorted();
+    checked.absorb(diags);
     (checked, out)
+}
+
+/// One measurement graph: for a plan of a root file, or for a root file's part that no
+/// plan there names (sampled with `std::sampling::fan_leu`).
+pub struct Graphed {
+    /// Index into [`model::Model::parts`].
+    pub part: usize,
+    /// The graph.
+    pub graph: graph::MeasurementGraph,
+}
+
+/// The margin fpoints keep from face edges for a plan: the largest tip radius of the
+/// plan's machine (1 mm without a plan).
+pub fn sampling_margin(model: &model::Model, plan: Option<&model::Plan>) -> f64 {
+    let Some(plan) = plan else { return 1.0 };
+    let cmm = &model.cmms[plan.cmm.0];
+    cmm.probes
+        .iter()
+        .map(|(_, p)| model.styli[model.probes[p.0].stylus.0].tip / 2.0)
+        .fold(0.0, f64::max)
+        .max(1e-3)
+}
+
+/// Runs [`check_geometry`], then builds the measurement graph of every plan in the root
+/// files, and of every root part no plan names. Sampling diagnostics join the others.
+pub fn measurement_graphs(
+    world: &dyn source::World,
+    roots: &[PathBuf],
+) -> (Checked, Vec<Option<PartData>>, Vec<Graphed>) {
+    let (mut checked, parts) = check_geometry(world, roots);
+    let mut out = Vec::new();
+    if checked.has_errors() {
+        return (checked, parts, out);
+    }
+    let model = &checked.model;
+    let mut diags = diag::Diagnostics::new();
+    let mut jobs: Vec<(usize, Option<&model::Plan>)> =
+        model.plans.iter().map(|p| (p.part.0, Some(p))).collect();
+    for (k, part) in model.parts.iter().enumerate() {
+        if checked.roots.contains(&part.span.file) && !jobs.iter().any(|(j, _)| *j == k) {
+            jobs.push((k, None));
+        }
+    }
+    for (k, plan) in jobs {
+        let Some(data) = &parts[k] else { continue };
+        let sampling = match plan.map(|p| p.sampling).or(model.default_sampling) {
+            Some(s) => &model.samplings[s.0],
+            None => continue,
+        };
+        let input = graph::Input {
+            part: &model.parts[k],
+            geometry: &data.geometry,
+            feature_faces: &data.feature_faces,
+            plan: plan.map(|p| p.name.as_str()),
+            sampling,
+            overrides: plan.map_or(&[][..], |p| &p.overrides),
+            margin: sampling_margin(model, plan),
+        };
+        let file = plan.map_or(model.parts[k].span.file, |p| p.span.file);
+        out.push(Graphed {
+            part: k,
+            graph: graph::build(&input, file, &mut diags),
+        });
+    }
+    checked.absorb(diags);
+    (checked, parts, out)
 }
 
 /// Runs the front end (load, parse, resolve) over root files.
@@ -77,6 +180,16 @@ pub fn check(world: &dyn source::World, roots: &[PathBuf]) -> Checked {
     let mut diags = diag::Diagnostics::new();
     let program = load::load(world, roots, &mut sources, &mut diags);
     let model = resolve::resolve(&program, &sources, world, &mut diags);
-    let roots = program.modules.iter().filter(|m| m.root).map(|m| m.file).collect();
-    Checked { model, diagnostics: diags.sorted(), sources, roots }
+    let roots = program
+        .modules
+        .iter()
+        .filter(|m| m.root)
+        .map(|m| m.file)
+        .collect();
+    Checked {
+        model,
+        diagnostics: diags.sorted(),
+        sources,
+        roots,
+    }
 }

@@ -8,7 +8,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "inspc", version, about = "Compiles .insp inspection specs into CMM programs")]
+#[command(
+    name = "inspc",
+    version,
+    about = "Compiles .insp inspection specs into CMM programs"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -38,8 +42,30 @@ enum TableFormat {
     Json,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum GraphFormat {
+    /// Graphviz DOT.
+    Dot,
+    /// A Mermaid flowchart.
+    Mermaid,
+    /// JSON with every fpoint's position and normal.
+    Json,
+}
+
 #[derive(Subcommand)]
 enum Command {
+    /// Prints the measurement graph (part → tolerance → feature → face → fpoint) of every
+    /// plan in the spec, or of its parts when it has no plan.
+    Graph {
+        /// The `.insp` spec.
+        file: PathBuf,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = GraphFormat::Dot)]
+        format: GraphFormat,
+        /// Draw every fpoint as a node (DOT and Mermaid); otherwise faces show counts.
+        #[arg(long)]
+        points: bool,
+    },
     /// Lists the faces of a mesh (STL, OBJ) or of every part of a spec: id, surface type,
     /// area, centroid, normal or axis and radius.
     Faces {
@@ -63,6 +89,9 @@ enum Command {
         /// How to print diagnostics.
         #[arg(long, value_enum, default_value_t = MessageFormat::Human)]
         message_format: MessageFormat,
+        /// Stop after the front end: skip geometry and sampling.
+        #[arg(long)]
+        front_end_only: bool,
         /// What to print besides diagnostics.
         #[arg(long, value_enum, default_value_t = Emit::Nothing)]
         emit: Emit,
@@ -72,12 +101,34 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Faces { file, segment, units, format } => faces(&file, segment, &units, format),
-        Command::Check { files, message_format, emit } => {
-            let checked = inspc::check(&FsWorld, &files);
+        Command::Faces {
+            file,
+            segment,
+            units,
+            format,
+        } => faces(&file, segment, &units, format),
+        Command::Graph {
+            file,
+            format,
+            points,
+        } => graph(&file, format, points),
+        Command::Check {
+            files,
+            message_format,
+            emit,
+            front_end_only,
+        } => {
+            let checked = if front_end_only {
+                inspc::check(&FsWorld, &files)
+            } else {
+                inspc::measurement_graphs(&FsWorld, &files).0
+            };
             let mut stdout = std::io::stdout().lock();
             let mut stderr = std::io::stderr().lock();
-            let opts = RenderOptions { width: 100, color: std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none() };
+            let opts = RenderOptions {
+                width: 100,
+                color: std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none(),
+            };
             for d in &checked.diagnostics {
                 match message_format {
                     MessageFormat::Json => {
@@ -91,26 +142,78 @@ fn main() -> ExitCode {
             if emit == Emit::Model && !checked.has_errors() {
                 let _ = write!(stdout, "{}", checked.summary());
             }
-            let errors = checked.diagnostics.iter().filter(|d| d.severity() == miette::Severity::Error).count();
+            let errors = checked
+                .diagnostics
+                .iter()
+                .filter(|d| d.severity() == miette::Severity::Error)
+                .count();
             let warnings = checked.diagnostics.len() - errors;
             if message_format == MessageFormat::Human {
-                let plural = |n: usize, w: &str| format!("{n} {w}{}", if n == 1 { "" } else { "s" });
+                let plural =
+                    |n: usize, w: &str| format!("{n} {w}{}", if n == 1 { "" } else { "s" });
                 let _ = if errors > 0 {
-                    writeln!(stderr, "inspc: {} and {} in {}", plural(errors, "error"), plural(warnings, "warning"), plural(files.len(), "file"))
+                    writeln!(
+                        stderr,
+                        "inspc: {} and {} in {}",
+                        plural(errors, "error"),
+                        plural(warnings, "warning"),
+                        plural(files.len(), "file")
+                    )
                 } else {
-                    writeln!(stderr, "inspc: {} checked, no errors ({})", plural(files.len(), "file"), plural(warnings, "warning"))
+                    writeln!(
+                        stderr,
+                        "inspc: {} checked, no errors ({})",
+                        plural(files.len(), "file"),
+                        plural(warnings, "warning")
+                    )
                 };
             }
-            if errors > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS }
+            if errors > 0 {
+                ExitCode::from(1)
+            } else {
+                ExitCode::SUCCESS
+            }
         }
     }
 }
 
 fn print_diagnostics(sources: &inspc::source::SourceMap, diags: &[inspc::diag::Diagnostic]) {
-    let opts = RenderOptions { width: 100, color: std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none() };
+    let opts = RenderOptions {
+        width: 100,
+        color: std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none(),
+    };
     for d in diags {
         eprint!("{}", render_human(sources, d, opts));
     }
+}
+
+fn graph(file: &std::path::Path, format: GraphFormat, points: bool) -> ExitCode {
+    let (checked, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[file.to_path_buf()]);
+    print_diagnostics(&checked.sources, &checked.diagnostics);
+    if checked.has_errors() {
+        return ExitCode::from(1);
+    }
+    let mut out = String::new();
+    let mut json = Vec::new();
+    for (k, g) in graphs.iter().enumerate() {
+        let part = &checked.model.parts[g.part];
+        let Some(data) = &parts[g.part] else { continue };
+        match format {
+            GraphFormat::Dot => out += &inspc::graph::dot(part, &data.geometry, &g.graph, points),
+            GraphFormat::Mermaid => {
+                if k > 0 {
+                    out.push('\n');
+                }
+                out += &inspc::graph::mermaid(part, &data.geometry, &g.graph, points);
+            }
+            GraphFormat::Json => json.push(inspc::graph::json(part, &data.geometry, &g.graph)),
+        }
+    }
+    if format == GraphFormat::Json {
+        out = serde_json::to_string_pretty(&json).unwrap_or_default() + "\n";
+    }
+    let _ = std::io::stdout().lock().write_all(out.as_bytes());
+    ExitCode::SUCCESS
 }
 
 fn faces(file: &std::path::Path, segment: bool, units: &str, format: TableFormat) -> ExitCode {
@@ -124,7 +227,12 @@ fn faces(file: &std::path::Path, segment: bool, units: &str, format: TableFormat
             return ExitCode::from(1);
         }
         let mut diags = inspc::diag::Diagnostics::new();
-        for part in checked.model.parts.iter().filter(|p| checked.roots.contains(&p.span.file)) {
+        for part in checked
+            .model
+            .parts
+            .iter()
+            .filter(|p| checked.roots.contains(&p.span.file))
+        {
             if let Some(g) = geometry::build(part, &FsWorld, part.span.file, &mut diags) {
                 listed.push((part.name.clone(), g));
             }
@@ -143,7 +251,11 @@ fn faces(file: &std::path::Path, segment: bool, units: &str, format: TableFormat
             Ok(raw) => raw,
             Err(e) => {
                 let mut sources = inspc::source::SourceMap::new();
-                let id = sources.add(file.to_string_lossy().into_owned(), None, file.to_string_lossy().into_owned());
+                let id = sources.add(
+                    file.to_string_lossy().into_owned(),
+                    None,
+                    file.to_string_lossy().into_owned(),
+                );
                 let span = inspc::source::Span::new(id, 0, file.to_string_lossy().len());
                 let mut diags = inspc::diag::Diagnostics::new();
                 diags.push(id, e.at(span, file));
@@ -152,9 +264,16 @@ fn faces(file: &std::path::Path, segment: bool, units: &str, format: TableFormat
             }
         };
         if raw.open_edges + raw.nonmanifold_edges > 0 {
-            eprintln!("inspc: warning: {} open and {} non-manifold edges", raw.open_edges, raw.nonmanifold_edges);
+            eprintln!(
+                "inspc: warning: {} open and {} non-manifold edges",
+                raw.open_edges, raw.nonmanifold_edges
+            );
         }
-        let g = if raw.groups.len() > 1 && !segment { geometry::segment::from_groups(&raw) } else { geometry::segment::segment(&raw) };
+        let g = if raw.groups.len() > 1 && !segment {
+            geometry::segment::from_groups(&raw)
+        } else {
+            geometry::segment::segment(&raw)
+        };
         listed.push((file.to_string_lossy().into_owned(), g));
     }
     let mut out = std::io::stdout().lock();

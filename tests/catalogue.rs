@@ -24,17 +24,33 @@ fn catalogue() -> Vec<Entry> {
     let mut out = Vec::new();
     let mut lines = text.lines();
     while let Some(line) = lines.next() {
-        let Some(rest) = line.strip_prefix("### `") else { continue };
+        let Some(rest) = line.strip_prefix("### `") else {
+            continue;
+        };
         let code = rest.split('`').next().unwrap().to_string();
         if NO_SPEC_EXAMPLE.iter().any(|(c, _)| *c == code) {
-            out.push(Entry { code, bytes: vec![], files: vec![] });
+            out.push(Entry {
+                code,
+                bytes: vec![],
+                files: vec![],
+            });
             continue;
         }
-        let fence = lines.by_ref().find(|l| l.starts_with("```")).unwrap_or_else(|| panic!("{code} has no example"));
+        let fence = lines
+            .by_ref()
+            .find(|l| l.starts_with("```"))
+            .unwrap_or_else(|| panic!("{code} has no example"));
         let raw = fence == "```insp-bytes";
-        let body: Vec<&str> = lines.by_ref().take_while(|l| !l.starts_with("```")).collect();
+        let body: Vec<&str> = lines
+            .by_ref()
+            .take_while(|l| !l.starts_with("```"))
+            .collect();
         let body = body.join("\n") + "\n";
-        let bytes = if raw { unescape_bytes(&body) } else { body.into_bytes() };
+        let bytes = if raw {
+            unescape_bytes(&body)
+        } else {
+            body.into_bytes()
+        };
         // Extra files follow as ```file NAME or ```file-bytes NAME blocks.
         let mut files = Vec::new();
         let mut peek = lines.clone();
@@ -42,11 +58,24 @@ fn catalogue() -> Vec<Entry> {
             if l.starts_with("### ") || l.starts_with("## ") {
                 break;
             }
-            if let Some(name) = l.strip_prefix("```file-bytes ").or_else(|| l.strip_prefix("```file ")) {
+            if let Some(name) = l
+                .strip_prefix("```file-bytes ")
+                .or_else(|| l.strip_prefix("```file "))
+            {
                 let raw = l.starts_with("```file-bytes ");
-                let body: Vec<&str> = peek.by_ref().take_while(|l| !l.starts_with("```")).collect();
+                let body: Vec<&str> = peek
+                    .by_ref()
+                    .take_while(|l| !l.starts_with("```"))
+                    .collect();
                 let body = body.join("\n") + "\n";
-                files.push((name.trim().to_string(), if raw { unescape_bytes(body.trim_end()) } else { body.into_bytes() }));
+                files.push((
+                    name.trim().to_string(),
+                    if raw {
+                        unescape_bytes(body.trim_end())
+                    } else {
+                        body.into_bytes()
+                    },
+                ));
             }
         }
         out.push(Entry { code, bytes, files });
@@ -96,9 +125,19 @@ fn catalogue_and_code_list_the_same_codes() {
     let in_code = codes_in_source();
     let undocumented: Vec<_> = in_code.difference(&documented).collect();
     let stale: Vec<_> = documented.difference(&in_code).collect();
-    assert!(undocumented.is_empty(), "codes missing from DIAGNOSTICS.md: {undocumented:?}");
-    assert!(stale.is_empty(), "DIAGNOSTICS.md lists codes the source no longer has: {stale:?}");
-    assert!(in_code.len() >= 45, "expected the full set of codes, found {}", in_code.len());
+    assert!(
+        undocumented.is_empty(),
+        "codes missing from DIAGNOSTICS.md: {undocumented:?}"
+    );
+    assert!(
+        stale.is_empty(),
+        "DIAGNOSTICS.md lists codes the source no longer has: {stale:?}"
+    );
+    assert!(
+        in_code.len() >= 45,
+        "expected the full set of codes, found {}",
+        in_code.len()
+    );
 }
 
 #[test]
@@ -112,12 +151,26 @@ fn every_catalogue_example_reports_its_code() {
         files.extend(e.files.iter().map(|(n, b)| (n.as_str(), b.as_slice())));
         let diags = common::check_files(&files);
         if !diags.iter().any(|d| d.code == e.code) {
-            failures.push(format!("{}: got {:?}", e.code, diags.iter().map(|d| &d.code).collect::<Vec<_>>()));
+            failures.push(format!(
+                "{}: got {:?}",
+                e.code,
+                diags.iter().map(|d| &d.code).collect::<Vec<_>>()
+            ));
         }
         for d in &diags {
             assert!(!d.help.is_empty(), "{} has no help line", d.code);
-            assert!(!d.span_text.is_empty() || d.code == "insp::load::unreadable" || d.code == "insp::syntax::unexpected", "{} has an empty label", d.code);
+            assert!(
+                !d.span_text.is_empty()
+                    || d.code == "insp::load::unreadable"
+                    || d.code == "insp::syntax::unexpected",
+                "{} has an empty label",
+                d.code
+            );
         }
     }
-    assert!(failures.is_empty(), "examples that do not report their code:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "examples that do not report their code:\n{}",
+        failures.join("\n")
+    );
 }

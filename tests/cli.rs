@@ -1,10 +1,20 @@
 //! The `inspc` binary: exit codes and the JSON diagnostics contract.
 
+mod common;
+
 use std::process::Command;
 
 fn inspc(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_inspc")).args(args).env("NO_COLOR", "1").output().expect("inspc runs");
-    (out.status.code().unwrap_or(-1), String::from_utf8(out.stdout).unwrap(), String::from_utf8(out.stderr).unwrap())
+    let out = Command::new(env!("CARGO_BIN_EXE_inspc"))
+        .args(args)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("inspc runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
 }
 
 fn temp_spec(name: &str, text: &str) -> String {
@@ -25,23 +35,46 @@ fn check_clean_example_exits_zero() {
 
 #[test]
 fn check_reports_errors_and_exits_one() {
-    let bad = temp_spec("bad.insp", "stylus s { tip 0 mm, length 20 deg, stem 1 mmm }\n");
+    let bad = temp_spec(
+        "bad.insp",
+        "stylus s { tip 0 mm, length 20 deg, stem 1 mmm }\n",
+    );
     let (code, _, stderr) = inspc(&["check", &bad]);
     assert_eq!(code, 1);
-    assert!(stderr.contains("insp::resolve::non_positive") && stderr.contains("help:"), "{stderr}");
+    assert!(
+        stderr.contains("insp::resolve::non_positive") && stderr.contains("help:"),
+        "{stderr}"
+    );
     assert!(stderr.contains("3 errors"), "{stderr}");
 }
 
 #[test]
 fn json_diagnostics_are_one_object_per_line() {
-    let bad = temp_spec("json.insp", "// é\nstylus s { tip 0 mm, length 20 deg, stem 1 mmm }\n");
+    let bad = temp_spec(
+        "json.insp",
+        "// é\nstylus s { tip 0 mm, length 20 deg, stem 1 mmm }\n",
+    );
     let (code, stdout, stderr) = inspc(&["check", "--message-format", "json", &bad]);
     assert_eq!(code, 1);
     assert!(stderr.is_empty(), "json mode keeps stderr quiet: {stderr}");
-    let lines: Vec<serde_json::Value> = stdout.lines().map(|l| serde_json::from_str(l).expect("each line is JSON")).collect();
+    let lines: Vec<serde_json::Value> = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("each line is JSON"))
+        .collect();
     assert_eq!(lines.len(), 3);
     for v in &lines {
-        for key in ["severity", "code", "message", "file", "line", "column", "end_line", "end_column", "labels", "help"] {
+        for key in [
+            "severity",
+            "code",
+            "message",
+            "file",
+            "line",
+            "column",
+            "end_line",
+            "end_column",
+            "labels",
+            "help",
+        ] {
             assert!(v.get(key).is_some(), "missing `{key}` in {v}");
         }
         assert_eq!(v["severity"], "error");
@@ -69,7 +102,10 @@ fn emit_model_prints_the_resolved_spec() {
     let (code, stdout, _) = inspc(&["check", "--emit", "model", "examples/f2.insp"]);
     assert_eq!(code, 0);
     assert!(stdout.contains("part f2: box (120, 60, 40)"), "{stdout}");
-    assert!(stdout.contains("tolerance T2: perpendicularity(small_slot) 0.02 | A"), "{stdout}");
+    assert!(
+        stdout.contains("tolerance T2: perpendicularity(small_slot) 0.02 | A"),
+        "{stdout}"
+    );
 }
 
 #[test]
@@ -79,18 +115,14 @@ fn usage_errors_exit_two() {
 }
 
 /// The NIST meshes live in `../shared/parts/`, beside the repository, as CI has them.
-fn require_shared_parts() {
-    assert!(
-        std::path::Path::new("../shared/parts/nist_ctc_01_asme1_ap242-e1.obj").exists(),
-        "the NIST parts are expected in ../shared/parts/ beside the repository, as CI has them"
-    );
-}
 
 fn type_counts(stdout: &str) -> std::collections::BTreeMap<String, usize> {
     let v: serde_json::Value = serde_json::from_str(stdout).expect("faces --format json is JSON");
     let mut counts = std::collections::BTreeMap::new();
     for f in v[0]["faces"].as_array().unwrap() {
-        *counts.entry(f["type"].as_str().unwrap().to_string()).or_default() += 1;
+        *counts
+            .entry(f["type"].as_str().unwrap().to_string())
+            .or_default() += 1;
     }
     counts
 }
@@ -99,31 +131,59 @@ fn type_counts(stdout: &str) -> std::collections::BTreeMap<String, usize> {
 fn faces_of_the_nist_obj_groups_match_the_pmi_surface_types() {
     // The PMI lists CTC 01 as 56 planes, 57 cylinders and 4 cones; FTC 08 as 82 planes,
     // 134 cylinders, 20 spheres and 12 tori (free-form for inspc).
-    require_shared_parts();
-    let (code, stdout, stderr) = inspc(&["faces", "--format", "json", "../shared/parts/nist_ctc_01_asme1_ap242-e1.obj"]);
+    common::require_shared_parts();
+    let (code, stdout, stderr) = inspc(&[
+        "faces",
+        "--format",
+        "json",
+        "../shared/parts/nist_ctc_01_asme1_ap242-e1.obj",
+    ]);
     assert_eq!(code, 0, "{stderr}");
     let c = type_counts(&stdout);
     assert_eq!((c["plane"], c["cylinder"], c["cone"]), (56, 57, 4), "{c:?}");
-    let (_, stdout, _) = inspc(&["faces", "--format", "json", "../shared/parts/nist_ftc_08_asme1_ap242-e1.obj"]);
+    let (_, stdout, _) = inspc(&[
+        "faces",
+        "--format",
+        "json",
+        "../shared/parts/nist_ftc_08_asme1_ap242-e1.obj",
+    ]);
     let c = type_counts(&stdout);
-    assert_eq!((c["plane"], c["cylinder"], c["sphere"], c["freeform"]), (82, 134, 20, 12), "{c:?}");
+    assert_eq!(
+        (c["plane"], c["cylinder"], c["sphere"], c["freeform"]),
+        (82, 134, 20, 12),
+        "{c:?}"
+    );
 }
 
 #[test]
 fn faces_segments_the_nist_stl_files_into_sensible_types() {
-    require_shared_parts();
-    for (mesh, min_faces) in [("nist_ctc_01_asme1_ap242-e1.stl", 90), ("nist_ftc_08_asme1_ap242-e1.stl", 200)] {
-        let (code, stdout, stderr) = inspc(&["faces", "--format", "json", &format!("../shared/parts/{mesh}")]);
+    common::require_shared_parts();
+    for (mesh, min_faces) in [
+        ("nist_ctc_01_asme1_ap242-e1.stl", 90),
+        ("nist_ftc_08_asme1_ap242-e1.stl", 200),
+    ] {
+        let (code, stdout, stderr) = inspc(&[
+            "faces",
+            "--format",
+            "json",
+            &format!("../shared/parts/{mesh}"),
+        ]);
         assert_eq!(code, 0, "{stderr}");
         let c = type_counts(&stdout);
         let total: usize = c.values().sum();
         assert!(total >= min_faces, "{mesh}: {c:?}");
         // Planes and cylinders dominate; almost nothing is left free-form.
         assert!(c["plane"] + c["cylinder"] > total * 2 / 3, "{mesh}: {c:?}");
-        assert!(c.get("freeform").copied().unwrap_or(0) * 20 < total, "{mesh}: {c:?}");
+        assert!(
+            c.get("freeform").copied().unwrap_or(0) * 20 < total,
+            "{mesh}: {c:?}"
+        );
     }
     let (_, text, _) = inspc(&["faces", "../shared/parts/nist_ctc_01_asme1_ap242-e1.stl"]);
-    assert!(text.contains("segment_1 ") && text.contains("cylinder") && text.contains("(hole)"), "{text}");
+    assert!(
+        text.contains("segment_1 ") && text.contains("cylinder") && text.contains("(hole)"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -131,7 +191,10 @@ fn faces_of_a_spec_name_the_constructive_faces() {
     let (code, stdout, stderr) = inspc(&["faces", "examples/f2.insp"]);
     assert_eq!(code, 0, "{stderr}");
     assert!(stdout.starts_with("f2: 12 faces"), "{stdout}");
-    assert!(stdout.contains("large.left_wall") && stdout.contains("small.floor"), "{stdout}");
+    assert!(
+        stdout.contains("large.left_wall") && stdout.contains("small.floor"),
+        "{stdout}"
+    );
     let (code, stdout, _) = inspc(&["faces", "examples/swiss_block.insp"]);
     assert_eq!(code, 0);
     assert!(stdout.starts_with("swiss_block: 206 faces"), "{stdout}");
@@ -141,5 +204,8 @@ fn faces_of_a_spec_name_the_constructive_faces() {
 fn faces_of_a_missing_mesh_is_a_diagnostic() {
     let (code, _, stderr) = inspc(&["faces", "no/such/part.stl"]);
     assert_eq!(code, 1);
-    assert!(stderr.contains("insp::geometry::mesh_unreadable"), "{stderr}");
+    assert!(
+        stderr.contains("insp::geometry::mesh_unreadable"),
+        "{stderr}"
+    );
 }

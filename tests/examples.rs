@@ -22,22 +22,50 @@ fn insp_files(dir: &str) -> Vec<PathBuf> {
 
 fn assert_clean(path: &std::path::Path) -> inspc::Checked {
     let checked = inspc::check(&FsWorld, &[path.to_path_buf()]);
-    let rendered: Vec<String> = checked.diagnostics.iter().map(|d| format!("{}: {}", d.code(), d.message())).collect();
-    assert!(rendered.is_empty(), "{} has diagnostics:\n{}", path.display(), rendered.join("\n"));
+    let rendered: Vec<String> = checked
+        .diagnostics
+        .iter()
+        .map(|d| format!("{}: {}", d.code(), d.message()))
+        .collect();
+    assert!(
+        rendered.is_empty(),
+        "{} has diagnostics:\n{}",
+        path.display(),
+        rendered.join("\n")
+    );
     checked
 }
 
 #[test]
 fn every_example_checks_clean_with_one_plan() {
     let files = insp_files("examples");
-    let top: Vec<&PathBuf> = files.iter().filter(|p| p.parent() == Some(std::path::Path::new("examples"))).collect();
-    for name in ["f2", "f3_fixed", "f3_indexed", "f4", "swiss_block", "swiss_sphere_fixed", "swiss_sphere_indexed"] {
-        assert!(top.iter().any(|p| p.file_stem().unwrap() == name), "examples/{name}.insp is missing");
+    let top: Vec<&PathBuf> = files
+        .iter()
+        .filter(|p| p.parent() == Some(std::path::Path::new("examples")))
+        .collect();
+    for name in [
+        "f2",
+        "f3_fixed",
+        "f3_indexed",
+        "f4",
+        "swiss_block",
+        "swiss_sphere_fixed",
+        "swiss_sphere_indexed",
+    ] {
+        assert!(
+            top.iter().any(|p| p.file_stem().unwrap() == name),
+            "examples/{name}.insp is missing"
+        );
     }
     for f in &files {
         let checked = assert_clean(f);
         let expected_plans = if top.contains(&f) { 1 } else { 0 };
-        assert_eq!(checked.model.plans.len(), expected_plans, "{} should declare {expected_plans} plan(s)", f.display());
+        assert_eq!(
+            checked.model.plans.len(),
+            expected_plans,
+            "{} should declare {expected_plans} plan(s)",
+            f.display()
+        );
     }
 }
 
@@ -47,11 +75,25 @@ fn every_stdlib_module_checks_clean() {
     let mut w = MemoryWorld::new();
     w.insert("empty.insp", "");
     let checked = inspc::check(&w, &["empty.insp".into()]);
-    let rendered: Vec<String> = checked.diagnostics.iter().map(|d| format!("{}: {}", d.code(), d.message())).collect();
-    assert!(rendered.is_empty(), "stdlib diagnostics:\n{}", rendered.join("\n"));
+    let rendered: Vec<String> = checked
+        .diagnostics
+        .iter()
+        .map(|d| format!("{}: {}", d.code(), d.message()))
+        .collect();
+    assert!(
+        rendered.is_empty(),
+        "stdlib diagnostics:\n{}",
+        rendered.join("\n")
+    );
     for (name, _) in inspc::load::STD_MODULES {
         let short = name.trim_start_matches("std::");
-        assert!(checked.sources.find_name(&format!("<std>/{short}.insp")).is_some(), "{name} was not loaded");
+        assert!(
+            checked
+                .sources
+                .find_name(&format!("<std>/{short}.insp"))
+                .is_some(),
+            "{name} was not loaded"
+        );
     }
     let m = &checked.model;
     assert_eq!(m.hierarchies.len(), 5);
@@ -66,9 +108,22 @@ fn every_stdlib_module_checks_clean() {
 #[test]
 fn the_nist_ctc_01_spec_checks_clean() {
     let mesh = PathBuf::from("../shared/parts/nist_ctc_01_asme1_ap242-e1.obj");
-    assert!(mesh.exists(), "the NIST parts are expected in ../shared/parts/ beside the repository, as CI has them");
+    assert!(
+        mesh.exists(),
+        "the NIST parts are expected in ../shared/parts/ beside the repository, as CI has them"
+    );
     let checked = assert_clean(&PathBuf::from("tests/real/nist_ctc_01.insp"));
     let part = &checked.model.parts[0];
-    assert_eq!(part.tolerances.len(), 12, "6 geometric tolerances and 6 toleranced sizes in the PMI");
-    assert_eq!(part.datums.iter().map(|d| d.name.as_str()).collect::<Vec<_>>(), ["A", "B", "C"]);
+    assert_eq!(
+        part.tolerances.len(),
+        12,
+        "6 geometric tolerances and 6 toleranced sizes in the PMI"
+    );
+    assert_eq!(
+        part.datums
+            .iter()
+            .map(|d| d.name.as_str())
+            .collect::<Vec<_>>(),
+        ["A", "B", "C"]
+    );
 }

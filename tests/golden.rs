@@ -11,8 +11,15 @@ enum Outcome {
 
 fn run(spec: &Path) -> Outcome {
     let checked = inspc::check(&FsWorld, &[spec.to_path_buf()]);
-    let opts = RenderOptions { width: 100, color: false };
-    let rendered: String = checked.diagnostics.iter().map(|d| render_human(&checked.sources, d, opts)).collect();
+    let opts = RenderOptions {
+        width: 100,
+        color: false,
+    };
+    let rendered: String = checked
+        .diagnostics
+        .iter()
+        .map(|d| render_human(&checked.sources, d, opts))
+        .collect();
     if checked.has_errors() {
         Outcome::Diagnostics(rendered)
     } else {
@@ -32,9 +39,17 @@ fn spec_of(case: &Path) -> PathBuf {
 #[test]
 fn golden_cases() {
     let bless = std::env::var_os("INSPC_BLESS").is_some();
-    let mut cases: Vec<PathBuf> = std::fs::read_dir("tests/golden").unwrap().map(|e| e.unwrap().path()).filter(|p| p.is_dir()).collect();
+    let mut cases: Vec<PathBuf> = std::fs::read_dir("tests/golden")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .collect();
     cases.sort();
-    assert!(cases.len() >= 15, "expected the golden cases, found {}", cases.len());
+    assert!(
+        cases.len() >= 15,
+        "expected the golden cases, found {}",
+        cases.len()
+    );
     let mut failures = Vec::new();
     for case in &cases {
         let name = case.file_name().unwrap().to_string_lossy().into_owned();
@@ -56,8 +71,14 @@ fn golden_cases() {
         }
         match std::fs::read_to_string(this) {
             Ok(expected) if expected == actual => {}
-            Ok(expected) => failures.push(format!("{name}: output differs from {}\n{}", this.display(), diff(&expected, &actual))),
-            Err(_) => failures.push(format!("{name}: no expectation; run `INSPC_BLESS=1 cargo test --test golden`")),
+            Ok(expected) => failures.push(format!(
+                "{name}: output differs from {}\n{}",
+                this.display(),
+                diff(&expected, &actual)
+            )),
+            Err(_) => failures.push(format!(
+                "{name}: no expectation; run `INSPC_BLESS=1 cargo test --test golden`"
+            )),
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
@@ -70,7 +91,12 @@ fn diff(expected: &str, actual: &str) -> String {
     for i in 0..e.len().max(a.len()) {
         let (x, y) = (e.get(i), a.get(i));
         if x != y {
-            out.push(format!("line {}:\n  - {}\n  + {}", i + 1, x.unwrap_or(&"<none>"), y.unwrap_or(&"<none>")));
+            out.push(format!(
+                "line {}:\n  - {}\n  + {}",
+                i + 1,
+                x.unwrap_or(&"<none>"),
+                y.unwrap_or(&"<none>")
+            ));
             if out.len() == 5 {
                 break;
             }

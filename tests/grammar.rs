@@ -41,33 +41,64 @@ fn use_forms() {
             Item::Use(u) => format!(
                 "{}{}",
                 match &u.source {
-                    UseSource::Module(s) => s.iter().map(|i| i.name.clone()).collect::<Vec<_>>().join("::"),
+                    UseSource::Module(s) => s
+                        .iter()
+                        .map(|i| i.name.clone())
+                        .collect::<Vec<_>>()
+                        .join("::"),
                     UseSource::File(s) => format!("\"{}\"", s.value),
                 },
                 match &u.select {
                     UseSelect::Implicit => String::new(),
                     UseSelect::Glob(_) => "::*".into(),
-                    UseSelect::Names(n) => format!("::{{{}}}", n.iter().map(|i| i.name.clone()).collect::<Vec<_>>().join(",")),
+                    UseSelect::Names(n) => format!(
+                        "::{{{}}}",
+                        n.iter()
+                            .map(|i| i.name.clone())
+                            .collect::<Vec<_>>()
+                            .join(",")
+                    ),
                 }
             ),
             _ => unreachable!(),
         })
         .collect();
-    assert_eq!(kinds, ["std::heads::PH6", "std::probes::{A,B}", "std::styli::*", "\"lib/lab.insp\"", "\"lib/x.insp\"::{c}"]);
+    assert_eq!(
+        kinds,
+        [
+            "std::heads::PH6",
+            "std::probes::{A,B}",
+            "std::styli::*",
+            "\"lib/lab.insp\"",
+            "\"lib/x.insp\"::{c}"
+        ]
+    );
 }
 
 #[test]
 fn quantities_limits_ranges_and_directions() {
-    assert!(matches!(first_prop_value("stylus s { tip 2.5 mm }"), ValueKind::Quantity(Quantity { value, unit: Some(u), .. }) if value == 2.5 && u.name == "mm"));
-    assert!(matches!(first_prop_value("stylus s { tip .5 }"), ValueKind::Quantity(Quantity { value, unit: None, .. }) if value == 0.5));
-    assert!(matches!(first_prop_value("stylus s { tip 1e-3 m }"), ValueKind::Quantity(Quantity { value, .. }) if value == 1e-3));
-    assert!(matches!(first_prop_value("stylus s { tip 20 % }"), ValueKind::Quantity(Quantity { unit: Some(u), .. }) if u.name == "%"));
+    assert!(
+        matches!(first_prop_value("stylus s { tip 2.5 mm }"), ValueKind::Quantity(Quantity { value, unit: Some(u), .. }) if value == 2.5 && u.name == "mm")
+    );
+    assert!(
+        matches!(first_prop_value("stylus s { tip .5 }"), ValueKind::Quantity(Quantity { value, unit: None, .. }) if value == 0.5)
+    );
+    assert!(
+        matches!(first_prop_value("stylus s { tip 1e-3 m }"), ValueKind::Quantity(Quantity { value, .. }) if value == 1e-3)
+    );
+    assert!(
+        matches!(first_prop_value("stylus s { tip 20 % }"), ValueKind::Quantity(Quantity { unit: Some(u), .. }) if u.name == "%")
+    );
     match first_prop_value("head h { a 0 deg .. 105 deg }") {
         ValueKind::Range(a, b) => assert_eq!((a.value, b.value), (0.0, 105.0)),
         v => panic!("{v:?}"),
     }
     match first_prop_value("head h { a 10 mm ± 0.1 mm }") {
-        ValueKind::Limits { nominal, plus, minus } => assert_eq!((nominal.value, plus.value, minus.value), (10.0, 0.1, -0.1)),
+        ValueKind::Limits {
+            nominal,
+            plus,
+            minus,
+        } => assert_eq!((nominal.value, plus.value, minus.value), (10.0, 0.1, -0.1)),
         v => panic!("{v:?}"),
     }
     match first_prop_value("head h { a 10 mm +- 0.1 mm }") {
@@ -78,8 +109,20 @@ fn quantities_limits_ranges_and_directions() {
         ValueKind::Limits { plus, minus, .. } => assert_eq!((plus.value, minus.value), (0.0, -0.2)),
         v => panic!("{v:?}"),
     }
-    assert!(matches!(first_prop_value("head h { a -z }"), ValueKind::Direction { axis: 2, negative: true }));
-    assert!(matches!(first_prop_value("head h { a +x }"), ValueKind::Direction { axis: 0, negative: false }));
+    assert!(matches!(
+        first_prop_value("head h { a -z }"),
+        ValueKind::Direction {
+            axis: 2,
+            negative: true
+        }
+    ));
+    assert!(matches!(
+        first_prop_value("head h { a +x }"),
+        ValueKind::Direction {
+            axis: 0,
+            negative: false
+        }
+    ));
     bad("head h { a +xy }");
 }
 
@@ -136,19 +179,31 @@ fn part_statements() {
     }"#);
     let Item::Part(p) = &f.items[0] else { panic!() };
     assert_eq!(p.stmts.len(), 11);
-    let PartStmt::Named { expr: Some(e), .. } = &p.stmts[6] else { panic!("{:?}", p.stmts[6]) };
+    let PartStmt::Named { expr: Some(e), .. } = &p.stmts[6] else {
+        panic!("{:?}", p.stmts[6])
+    };
     assert_eq!(e.terms.len(), 5);
     assert!(matches!(&e.terms[2], FaceTerm::Group(s) if s.value == "face_3"));
     assert!(matches!(&p.stmts[7], PartStmt::Named { expr: None, .. }));
-    let PartStmt::Tolerance { call, .. } = &p.stmts[10] else { panic!() };
+    let PartStmt::Tolerance { call, .. } = &p.stmts[10] else {
+        panic!()
+    };
     assert_eq!(call.args.len(), 5);
-    assert!(matches!(&call.args[4], Arg::Positional(Value { kind: ValueKind::Call(_), .. })));
+    assert!(matches!(
+        &call.args[4],
+        Arg::Positional(Value {
+            kind: ValueKind::Call(_),
+            ..
+        })
+    ));
 }
 
 #[test]
 fn hierarchies_and_plans() {
     let f = ok("hierarchy h {\n required approachability\n same_setup(T, F, *)\n same_orien(*, *)\n}\nplan q {\n part p\n prefer setup (0, 1, 1) weight 0.5\n forbid setup -z\n prefer orientation (30 deg, -90 deg)\n sample f with hammersley(points 5)\n output { dmis \"q.dmi\" }\n}");
-    let Item::Hierarchy(h) = &f.items[0] else { panic!() };
+    let Item::Hierarchy(h) = &f.items[0] else {
+        panic!()
+    };
     assert_eq!(h.levels.len(), 3);
     assert!(matches!(&h.levels[1], Level::Same { group, .. } if group.len() == 3));
     let Item::Plan(p) = &f.items[1] else { panic!() };
@@ -161,7 +216,9 @@ fn hierarchies_and_plans() {
 fn strings_unescape() {
     let f = ok(r#"part p { mesh "a\"b\\c\td.stl" }"#);
     let Item::Part(p) = &f.items[0] else { panic!() };
-    let PartStmt::Mesh { path, .. } = &p.stmts[0] else { panic!() };
+    let PartStmt::Mesh { path, .. } = &p.stmts[0] else {
+        panic!()
+    };
     assert_eq!(path.value, "a\"b\\c\td.stl");
 }
 

@@ -42,13 +42,23 @@ impl Diagnostic {
 
     /// The byte offset of the first label, used to order diagnostics.
     pub fn offset(&self) -> usize {
-        self.inner.labels().and_then(|mut l| l.next()).map_or(0, |l| l.offset())
+        self.inner
+            .labels()
+            .and_then(|mut l| l.next())
+            .map_or(0, |l| l.offset())
     }
 }
 
 impl std::fmt::Debug for Diagnostic {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}: {} (file {:?} @{})", self.code(), self.message(), self.file, self.offset())
+        write!(
+            f,
+            "{}: {} (file {:?} @{})",
+            self.code(),
+            self.message(),
+            self.file,
+            self.offset()
+        )
     }
 }
 
@@ -66,7 +76,10 @@ impl Diagnostics {
 
     /// Files a diagnostic under `file`.
     pub fn push(&mut self, file: FileId, err: impl miette::Diagnostic + Send + Sync + 'static) {
-        self.items.push(Diagnostic { file, inner: Box::new(err) });
+        self.items.push(Diagnostic {
+            file,
+            inner: Box::new(err),
+        });
     }
 
     /// Files an already boxed diagnostic.
@@ -82,7 +95,12 @@ impl Diagnostics {
     /// All diagnostics in a stable order: by file, then position, then code.
     pub fn sorted(mut self) -> Vec<Diagnostic> {
         self.items.sort_by(|a, b| {
-            (a.file, a.offset(), a.code(), a.message()).cmp(&(b.file, b.offset(), b.code(), b.message()))
+            (a.file, a.offset(), a.code(), a.message()).cmp(&(
+                b.file,
+                b.offset(),
+                b.code(),
+                b.message(),
+            ))
         });
         self.items
     }

@@ -17,16 +17,28 @@ pub struct RenderOptions {
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { width: 100, color: false }
+        RenderOptions {
+            width: 100,
+            color: false,
+        }
     }
 }
 
 /// Renders one diagnostic as miette's graphical report.
 pub fn render_human(map: &SourceMap, d: &Diagnostic, opts: RenderOptions) -> String {
     let file = map.get(d.file);
-    let located = Located { inner: d.inner.as_ref(), src: NamedSource::new(file.name.clone(), file.text.clone()) };
-    let theme = if opts.color { GraphicalTheme::unicode() } else { GraphicalTheme::unicode_nocolor() };
-    let handler = GraphicalReportHandler::new_themed(theme).with_width(opts.width).with_links(false);
+    let located = Located {
+        inner: d.inner.as_ref(),
+        src: NamedSource::new(file.name.clone(), file.text.clone()),
+    };
+    let theme = if opts.color {
+        GraphicalTheme::unicode()
+    } else {
+        GraphicalTheme::unicode_nocolor()
+    };
+    let handler = GraphicalReportHandler::new_themed(theme)
+        .with_width(opts.width)
+        .with_links(false);
     let mut out = String::new();
     if handler.render_report(&mut out, &located).is_err() {
         out = format!("{}: {}\n", d.code(), d.message());

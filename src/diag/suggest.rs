@@ -5,14 +5,21 @@
 /// Close enough means an edit distance of at most a third of the name's length
 /// (at least 1), or a case-insensitive match. Ties go to the first candidate, so the
 /// answer is deterministic given the candidates' order.
-pub fn did_you_mean<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<String> {
+pub fn did_you_mean<'a>(
+    name: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<String> {
     let limit = (name.chars().count() / 3).max(1);
     let mut best: Option<(usize, &str)> = None;
     for cand in candidates {
         if cand == name {
             continue;
         }
-        let d = if cand.eq_ignore_ascii_case(name) { 0 } else { edit_distance(name, cand) };
+        let d = if cand.eq_ignore_ascii_case(name) {
+            0
+        } else {
+            edit_distance(name, cand)
+        };
         if d <= limit && best.is_none_or(|(bd, _)| d < bd) {
             best = Some((d, cand));
         }
@@ -22,7 +29,11 @@ pub fn did_you_mean<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str
 
 /// A help line for an unknown name: the suggestion if there is one, otherwise the list of
 /// what is known (up to eight names).
-pub fn help_for_unknown<'a>(what: &str, name: &str, candidates: impl IntoIterator<Item = &'a str> + Clone) -> String {
+pub fn help_for_unknown<'a>(
+    what: &str,
+    name: &str,
+    candidates: impl IntoIterator<Item = &'a str> + Clone,
+) -> String {
     if let Some(s) = did_you_mean(name, candidates.clone()) {
         return format!("did you mean `{s}`?");
     }
@@ -31,7 +42,11 @@ pub fn help_for_unknown<'a>(what: &str, name: &str, candidates: impl IntoIterato
         return format!("no {what} is declared here");
     }
     let shown: Vec<String> = all.iter().take(8).map(|c| format!("`{c}`")).collect();
-    let more = if all.len() > 8 { format!(" and {} more", all.len() - 8) } else { String::new() };
+    let more = if all.len() > 8 {
+        format!(" and {} more", all.len() - 8)
+    } else {
+        String::new()
+    };
     format!("known {what}s: {}{more}", shown.join(", "))
 }
 
@@ -50,7 +65,9 @@ fn edit_distance(a: &str, b: &str) -> usize {
     for i in 1..=a.len() {
         for j in 1..=b.len() {
             let cost = usize::from(a[i - 1] != b[j - 1]);
-            let mut v = (d[i - 1][j] + 1).min(d[i][j - 1] + 1).min(d[i - 1][j - 1] + cost);
+            let mut v = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
             if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
                 v = v.min(d[i - 2][j - 2] + 1);
             }
@@ -66,7 +83,10 @@ mod tests {
 
     #[test]
     fn suggests_close_names_only() {
-        assert_eq!(did_you_mean("widht", ["width", "depth"]), Some("width".into()));
+        assert_eq!(
+            did_you_mean("widht", ["width", "depth"]),
+            Some("width".into())
+        );
         assert_eq!(did_you_mean("TP20", ["PH6", "PH10MQ"]), None);
         assert_eq!(did_you_mean("mM", ["mm", "cm"]), Some("mm".into()));
         assert_eq!(edit_distance("kitten", "sitting"), 3);

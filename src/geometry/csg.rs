@@ -3,13 +3,15 @@
 //! lies on.
 
 use super::errors::GeometryError as E;
-use super::primitives::{circle, prism, rectangle, rounded_rectangle, sphere, Frame, Prim, CHORD_MM};
+use super::primitives::{
+    circle, prism, rectangle, rounded_rectangle, sphere, Frame, Prim, CHORD_MM,
+};
 use super::{PartGeometry, Surface, P3, V3};
 use crate::diag::Diagnostics;
 use crate::model::{self, Depth, FaceSource, OpId, OpKind, Pattern, Placement, Stock};
 use crate::source::FileId;
 use boolmesh::prelude::{compute_boolean, Manifold, OpType};
-use nalgebra::{Isometry3, Translation3, UnitQuaternion, Unit};
+use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion};
 
 /// A named face before booleans: its surface, the roles it answers to, and where its
 /// triangles can be (bounds of the primitive face, slightly grown).
@@ -30,16 +32,37 @@ struct Tool {
     op: usize,
 }
 
-pub(super) fn build(part: &model::Part, stock: &Stock, file: FileId, diags: &mut Diagnostics) -> Option<PartGeometry> {
+pub(super) fn build(
+    part: &model::Part,
+    stock: &Stock,
+    file: FileId,
+    diags: &mut Diagnostics,
+) -> Option<PartGeometry> {
     let mut specs: Vec<Spec> = Vec::new();
     let (stock_prim, stock_roles): (Prim, Vec<&'static str>) = match stock {
         Stock::Box { size } => {
-            let f = Frame { o: P3::origin(), u: V3::x(), v: V3::y(), w: V3::z() };
-            (prism(&f, &rectangle(0.0, 0.0, size[0], size[1]), 0.0, size[2]), vec!["front", "right", "back", "left", "bottom", "top"])
+            let f = Frame {
+                o: P3::origin(),
+                u: V3::x(),
+                v: V3::y(),
+                w: V3::z(),
+            };
+            (
+                prism(&f, &rectangle(0.0, 0.0, size[0], size[1]), 0.0, size[2]),
+                vec!["front", "right", "back", "left", "bottom", "top"],
+            )
         }
         Stock::Cylinder { diameter, height } => {
-            let f = Frame { o: P3::origin(), u: V3::x(), v: V3::y(), w: V3::z() };
-            (prism(&f, &circle(diameter / 2.0), 0.0, *height), vec!["side", "bottom", "top"])
+            let f = Frame {
+                o: P3::origin(),
+                u: V3::x(),
+                v: V3::y(),
+                w: V3::z(),
+            };
+            (
+                prism(&f, &circle(diameter / 2.0), 0.0, *height),
+                vec!["side", "bottom", "top"],
+            )
         }
         Stock::Sphere { diameter } => (sphere(P3::origin(), diameter / 2.0), vec!["surface"]),
     };
@@ -63,10 +86,16 @@ pub(super) fn build(part: &model::Part, stock: &Stock, file: FileId, diags: &mut
     let center = P3::from((slo.coords + shi.coords) / 2.0);
     let mut tools: Vec<Tool> = Vec::new();
     for (oi, op) in part.ops.iter().enumerate() {
-        let Some((prim, roles)) = cutter(op, stock, center, ext, big) else { continue };
+        let Some((prim, roles)) = cutter(op, stock, center, ext, big) else {
+            continue;
+        };
         let instances: Vec<(Option<u32>, Isometry3<f64>)> = match &op.pattern {
             None => vec![(None, Isometry3::identity())],
-            Some(p) => pattern(p).into_iter().enumerate().map(|(i, m)| (Some(i as u32), m)).collect(),
+            Some(p) => pattern(p)
+                .into_iter()
+                .enumerate()
+                .map(|(i, m)| (Some(i as u32), m))
+                .collect(),
         };
         for (inst, m) in instances {
             let mut prim = prim.clone();
@@ -75,30 +104,42 @@ pub(super) fn build(part: &model::Part, stock: &Stock, file: FileId, diags: &mut
             if (0..3).any(|k| hi[k] < slo[k] || lo[k] > shi[k]) {
                 let what = op.kind.word();
                 let name = inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name));
-                diags.push(file, E::MissesPart { span: op.span, what: what.into(), name });
+                diags.push(
+                    file,
+                    E::MissesPart {
+                        span: op.span,
+                        what: what.into(),
+                        name,
+                    },
+                );
                 continue;
             }
             for (k, rs) in roles.iter().enumerate() {
-                    if rs.is_empty() {
-                        continue;
-                    }
-                    let (lo, hi) = prim.bounds_of_part(k as u32);
-                    let mut surface = prim.surfaces[k].clone();
-                    if !op.add {
-                        surface = flip(surface);
-                    }
-                    let base = inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name));
-                    let role_name = rs[0];
-                    specs.push(Spec {
-                        name: format!("{base}.{role_name}"),
-                        surface,
-                        source: FaceSource::Op(OpId(oi), inst),
-                        roles: rs.clone(),
-                        lo: lo - V3::repeat(grow),
-                        hi: hi + V3::repeat(grow),
-                    });
+                if rs.is_empty() {
+                    continue;
+                }
+                let (lo, hi) = prim.bounds_of_part(k as u32);
+                let mut surface = prim.surfaces[k].clone();
+                if !op.add {
+                    surface = flip(surface);
+                }
+                let base = inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name));
+                let role_name = rs[0];
+                specs.push(Spec {
+                    name: format!("{base}.{role_name}"),
+                    surface,
+                    source: FaceSource::Op(OpId(oi), inst),
+                    roles: rs.clone(),
+                    lo: lo - V3::repeat(grow),
+                    hi: hi + V3::repeat(grow),
+                });
             }
-            tools.push(Tool { bounds: (lo, hi), prim, add: op.add, op: oi });
+            tools.push(Tool {
+                bounds: (lo, hi),
+                prim,
+                add: op.add,
+                op: oi,
+            });
         }
     }
 
@@ -108,18 +149,34 @@ pub(super) fn build(part: &model::Part, stock: &Stock, file: FileId, diags: &mut
     while i < tools.len() {
         let mut batch = vec![i];
         let mut j = i + 1;
-        while j < tools.len() && tools[j].add == tools[i].add && batch.iter().all(|&b| disjoint(tools[b].bounds, tools[j].bounds)) {
+        while j < tools.len()
+            && tools[j].add == tools[i].add
+            && batch
+                .iter()
+                .all(|&b| disjoint(tools[b].bounds, tools[j].bounds))
+        {
             batch.push(j);
             j += 1;
         }
         let prims: Vec<&Prim> = batch.iter().map(|&b| &tools[b].prim).collect();
-        let op = if tools[i].add { OpType::Add } else { OpType::Subtract };
+        let op = if tools[i].add {
+            OpType::Add
+        } else {
+            OpType::Subtract
+        };
         let result = to_manifold(&prims).and_then(|cutter| compute_boolean(&current, &cutter, op));
         match result {
             Ok(m) => current = m,
             Err(reason) => {
                 let op = &part.ops[tools[i].op];
-                diags.push(file, E::BooleanFailed { span: op.span, part: part.name.clone(), reason });
+                diags.push(
+                    file,
+                    E::BooleanFailed {
+                        span: op.span,
+                        part: part.name.clone(),
+                        reason,
+                    },
+                );
                 return None;
             }
         }
@@ -127,7 +184,11 @@ pub(super) fn build(part: &model::Part, stock: &Stock, file: FileId, diags: &mut
     }
 
     let vertices: Vec<P3> = current.ps.iter().map(|p| P3::new(p.x, p.y, p.z)).collect();
-    let triangles: Vec<[u32; 3]> = current.hs.chunks(3).map(|h| [h[0].tail as u32, h[1].tail as u32, h[2].tail as u32]).collect();
+    let triangles: Vec<[u32; 3]> = current
+        .hs
+        .chunks(3)
+        .map(|h| [h[0].tail as u32, h[1].tail as u32, h[2].tail as u32])
+        .collect();
     let plane_tol = 1e-6 * diag.max(1.0) * 10.0;
     let curved_tol = 1.5 * CHORD_MM + plane_tol;
     let tri_face: Vec<u32> = triangles
@@ -135,11 +196,22 @@ pub(super) fn build(part: &model::Part, stock: &Stock, file: FileId, diags: &mut
         .map(|t| {
             let [a, b, c] = t.map(|i| vertices[i as usize]);
             let g = P3::from((a.coords + b.coords + c.coords) / 3.0);
-            let n = (b - a).cross(&(c - a)).try_normalize(0.0).unwrap_or_else(V3::zeros);
+            let n = (b - a)
+                .cross(&(c - a))
+                .try_normalize(0.0)
+                .unwrap_or_else(V3::zeros);
             classify(&specs, [a, b, c], g, n, plane_tol, curved_tol) as u32
         })
         .collect();
-    let geometry = PartGeometry::new(vertices, triangles, tri_face, specs.iter().map(|s| (s.name.clone(), s.surface.clone())).collect());
+    let geometry = PartGeometry::new(
+        vertices,
+        triangles,
+        tri_face,
+        specs
+            .iter()
+            .map(|s| (s.name.clone(), s.surface.clone()))
+            .collect(),
+    );
     let mut geometry = geometry;
     geometry.roles = specs.into_iter().map(|s| (s.source, s.roles)).collect();
     Some(geometry)
@@ -150,10 +222,20 @@ pub(super) fn build(part: &model::Part, stock: &Stock, file: FileId, diags: &mut
 /// inside the spec's bounds. The best normal agreement wins; ties go to the first spec.
 /// A triangle that fits no spec (which the tolerances make rare) goes to the spec that
 /// is nearest and best aligned.
-fn classify(specs: &[Spec], corners: [P3; 3], g: P3, n: V3, plane_tol: f64, curved_tol: f64) -> usize {
+fn classify(
+    specs: &[Spec],
+    corners: [P3; 3],
+    g: P3,
+    n: V3,
+    plane_tol: f64,
+    curved_tol: f64,
+) -> usize {
     let fit = |s: &Spec| -> Option<(f64, f64)> {
         let sn = s.surface.normal_at(&g)?;
-        let dist = corners.iter().map(|c| s.surface.distance(c).unwrap_or(f64::INFINITY)).fold(0.0, f64::max);
+        let dist = corners
+            .iter()
+            .map(|c| s.surface.distance(c).unwrap_or(f64::INFINITY))
+            .fold(0.0, f64::max);
         Some((n.dot(&sn), dist))
     };
     let mut best: Option<(f64, usize)> = None;
@@ -162,8 +244,14 @@ fn classify(specs: &[Spec], corners: [P3; 3], g: P3, n: V3, plane_tol: f64, curv
         if !(0..3).all(|i| g[i] >= s.lo[i] && g[i] <= s.hi[i]) {
             continue;
         }
-        let Some((agree, dist)) = fit(s) else { continue };
-        let (tol, min_agree) = if matches!(s.surface, Surface::Plane { .. }) { (plane_tol, 0.999) } else { (curved_tol, 0.7) };
+        let Some((agree, dist)) = fit(s) else {
+            continue;
+        };
+        let (tol, min_agree) = if matches!(s.surface, Surface::Plane { .. }) {
+            (plane_tol, 0.999)
+        } else {
+            (curved_tol, 0.7)
+        };
         if dist <= tol && agree >= min_agree && best.is_none_or(|(b, _)| agree > b + 1e-9) {
             best = Some((agree, k));
         }
@@ -184,10 +272,41 @@ fn classify(specs: &[Spec], corners: [P3; 3], g: P3, n: V3, plane_tol: f64, curv
 
 fn flip(s: Surface) -> Surface {
     match s {
-        Surface::Plane { origin, normal } => Surface::Plane { origin, normal: -normal },
-        Surface::Cylinder { origin, axis, radius, convex } => Surface::Cylinder { origin, axis, radius, convex: !convex },
-        Surface::Cone { apex, axis, half_angle, convex } => Surface::Cone { apex, axis, half_angle, convex: !convex },
-        Surface::Sphere { center, radius, convex } => Surface::Sphere { center, radius, convex: !convex },
+        Surface::Plane { origin, normal } => Surface::Plane {
+            origin,
+            normal: -normal,
+        },
+        Surface::Cylinder {
+            origin,
+            axis,
+            radius,
+            convex,
+        } => Surface::Cylinder {
+            origin,
+            axis,
+            radius,
+            convex: !convex,
+        },
+        Surface::Cone {
+            apex,
+            axis,
+            half_angle,
+            convex,
+        } => Surface::Cone {
+            apex,
+            axis,
+            half_angle,
+            convex: !convex,
+        },
+        Surface::Sphere {
+            center,
+            radius,
+            convex,
+        } => Surface::Sphere {
+            center,
+            radius,
+            convex: !convex,
+        },
         Surface::Freeform => Surface::Freeform,
     }
 }
@@ -220,13 +339,24 @@ fn radial_entry(stock: &Stock, center: P3, d: V3) -> P3 {
     match stock {
         Stock::Sphere { diameter } => P3::origin() + d * (diameter / 2.0),
         Stock::Box { size } => {
-            let t = (0..3).filter(|&k| d[k].abs() > 1e-12).map(|k| (size[k] / 2.0) / d[k].abs()).fold(f64::INFINITY, f64::min);
+            let t = (0..3)
+                .filter(|&k| d[k].abs() > 1e-12)
+                .map(|k| (size[k] / 2.0) / d[k].abs())
+                .fold(f64::INFINITY, f64::min);
             center + d * t
         }
         Stock::Cylinder { diameter, height } => {
             let radial = (d.x * d.x + d.y * d.y).sqrt();
-            let t_side = if radial > 1e-12 { diameter / 2.0 / radial } else { f64::INFINITY };
-            let t_cap = if d.z.abs() > 1e-12 { height / 2.0 / d.z.abs() } else { f64::INFINITY };
+            let t_side = if radial > 1e-12 {
+                diameter / 2.0 / radial
+            } else {
+                f64::INFINITY
+            };
+            let t_cap = if d.z.abs() > 1e-12 {
+                height / 2.0 / d.z.abs()
+            } else {
+                f64::INFINITY
+            };
             center + d * t_side.min(t_cap)
         }
     }
@@ -234,9 +364,20 @@ fn radial_entry(stock: &Stock, center: P3, d: V3) -> P3 {
 
 /// The primitive an operation adds or removes, and for each primitive part the roles
 /// its face answers to (empty: the part lies outside the finished solid).
-fn cutter(op: &model::Op, stock: &Stock, center: P3, ext: f64, big: f64) -> Option<(Prim, Vec<Vec<&'static str>>)> {
+fn cutter(
+    op: &model::Op,
+    stock: &Stock,
+    center: P3,
+    ext: f64,
+    big: f64,
+) -> Option<(Prim, Vec<Vec<&'static str>>)> {
     Some(match &op.kind {
-        OpKind::Hole { at, axis, diameter, depth } => {
+        OpKind::Hole {
+            at,
+            axis,
+            diameter,
+            depth,
+        } => {
             let entry = match at {
                 Placement::At(p) => P3::new(p[0], p[1], p[2]),
                 Placement::Radial(d) => radial_entry(stock, center, v3(d)),
@@ -246,18 +387,45 @@ fn cutter(op: &model::Op, stock: &Stock, center: P3, ext: f64, big: f64) -> Opti
                 Depth::Through => (big, vec![]),
                 Depth::Blind(d) => (*d, vec!["bottom"]),
             };
-            (prism(&f, &circle(diameter / 2.0), -ext, z1), vec![vec!["wall"], vec![], bottom])
+            (
+                prism(&f, &circle(diameter / 2.0), -ext, z1),
+                vec![vec!["wall"], vec![], bottom],
+            )
         }
-        OpKind::Slot { at, along, into, width, depth, length } => {
+        OpKind::Slot {
+            at,
+            along,
+            into,
+            width,
+            depth,
+            length,
+        } => {
             let f = Frame::from_uw(P3::new(at[0], at[1], at[2]), v3(along), v3(into));
             let (x0, x1, ends) = match length {
                 Some(l) => (0.0, *l, vec!["ends"]),
                 None => (-big, big, vec![]),
             };
             let prof = rectangle(x0, -width / 2.0, x1, width / 2.0);
-            (prism(&f, &prof, -ext, *depth), vec![vec!["left_wall", "walls"], ends.clone(), vec!["right_wall", "walls"], ends, vec![], vec!["floor"]])
+            (
+                prism(&f, &prof, -ext, *depth),
+                vec![
+                    vec!["left_wall", "walls"],
+                    ends.clone(),
+                    vec!["right_wall", "walls"],
+                    ends,
+                    vec![],
+                    vec!["floor"],
+                ],
+            )
         }
-        OpKind::Pocket { at, along, into, size, depth, corner_radius } => {
+        OpKind::Pocket {
+            at,
+            along,
+            into,
+            size,
+            depth,
+            corner_radius,
+        } => {
             let f = Frame::from_uw(P3::new(at[0], at[1], at[2]), v3(along), v3(into));
             let prof = rounded_rectangle(size[0], size[1], *corner_radius);
             let mut roles = vec![vec!["walls"]; prof.len()];
@@ -265,18 +433,35 @@ fn cutter(op: &model::Op, stock: &Stock, center: P3, ext: f64, big: f64) -> Opti
             roles.push(vec!["floor"]);
             (prism(&f, &prof, -ext, *depth), roles)
         }
-        OpKind::Step { at, along, into, width, depth } => {
+        OpKind::Step {
+            at,
+            along,
+            into,
+            width,
+            depth,
+        } => {
             let a = P3::new(at[0], at[1], at[2]);
             let mut f = Frame::from_uw(a, v3(along), v3(into));
             if (center - a).dot(&f.v) < 0.0 {
                 f = Frame::from_uw(a, -v3(along), v3(into));
             }
             let prof = rectangle(-big, -big, big, *width);
-            (prism(&f, &prof, -ext, *depth), vec![vec![], vec![], vec!["wall"], vec![], vec![], vec!["floor"]])
+            (
+                prism(&f, &prof, -ext, *depth),
+                vec![vec![], vec![], vec!["wall"], vec![], vec![], vec!["floor"]],
+            )
         }
-        OpKind::Boss { at, axis, diameter, height } => {
+        OpKind::Boss {
+            at,
+            axis,
+            diameter,
+            height,
+        } => {
             let f = Frame::along(P3::new(at[0], at[1], at[2]), v3(axis));
-            (prism(&f, &circle(diameter / 2.0), -ext, *height), vec![vec!["wall"], vec![], vec!["top"]])
+            (
+                prism(&f, &circle(diameter / 2.0), -ext, *height),
+                vec![vec!["wall"], vec![], vec!["top"]],
+            )
         }
     })
 }
@@ -284,16 +469,37 @@ fn cutter(op: &model::Op, stock: &Stock, center: P3, ext: f64, big: f64) -> Opti
 /// The rigid motion of each pattern instance.
 fn pattern(p: &Pattern) -> Vec<Isometry3<f64>> {
     match p {
-        Pattern::Linear { count, step } => (0..*count).map(|k| Isometry3::from_parts(Translation3::from(v3(step) * k as f64), UnitQuaternion::identity())).collect(),
-        Pattern::Grid { nx, ny, pitch } => (0..*ny)
-            .flat_map(|j| (0..*nx).map(move |i| Isometry3::from_parts(Translation3::new(i as f64 * pitch[0], j as f64 * pitch[1], 0.0), UnitQuaternion::identity())))
+        Pattern::Linear { count, step } => (0..*count)
+            .map(|k| {
+                Isometry3::from_parts(
+                    Translation3::from(v3(step) * k as f64),
+                    UnitQuaternion::identity(),
+                )
+            })
             .collect(),
-        Pattern::Polar { count, axis, center } => {
+        Pattern::Grid { nx, ny, pitch } => (0..*ny)
+            .flat_map(|j| {
+                (0..*nx).map(move |i| {
+                    Isometry3::from_parts(
+                        Translation3::new(i as f64 * pitch[0], j as f64 * pitch[1], 0.0),
+                        UnitQuaternion::identity(),
+                    )
+                })
+            })
+            .collect(),
+        Pattern::Polar {
+            count,
+            axis,
+            center,
+        } => {
             let c = v3(center);
             let ax = Unit::new_normalize(v3(axis));
             (0..*count)
                 .map(|k| {
-                    let r = UnitQuaternion::from_axis_angle(&ax, std::f64::consts::TAU * k as f64 / *count as f64);
+                    let r = UnitQuaternion::from_axis_angle(
+                        &ax,
+                        std::f64::consts::TAU * k as f64 / *count as f64,
+                    );
                     // Rotate about the axis through `center`: x ↦ c + R (x − c).
                     Isometry3::from_parts(Translation3::from(c - r * c), r)
                 })

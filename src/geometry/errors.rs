@@ -7,7 +7,10 @@ use crate::source::Span;
 #[allow(missing_docs)]
 pub enum GeometryError {
     #[error("cannot read mesh `{path}`: {reason}")]
-    #[diagnostic(code(insp::geometry::mesh_unreadable), help("check the path and that the file is a binary or ASCII STL, or an OBJ"))]
+    #[diagnostic(
+        code(insp::geometry::mesh_unreadable),
+        help("check the path and that the file is a binary or ASCII STL, or an OBJ")
+    )]
     MeshUnreadable {
         #[label("named here")]
         span: Span,
@@ -15,7 +18,10 @@ pub enum GeometryError {
         reason: String,
     },
     #[error("mesh `{path}` is corrupt: {reason}")]
-    #[diagnostic(code(insp::geometry::mesh_corrupt), help("re-export the mesh from the CAD system; inspc needs a closed triangle mesh"))]
+    #[diagnostic(
+        code(insp::geometry::mesh_corrupt),
+        help("re-export the mesh from the CAD system; inspc needs a closed triangle mesh")
+    )]
     MeshCorrupt {
         #[label("this mesh")]
         span: Span,
@@ -40,7 +46,10 @@ pub enum GeometryError {
         nonmanifold: usize,
     },
     #[error("mesh `{path}` is too large: {reason}")]
-    #[diagnostic(code(insp::geometry::mesh_too_large), help("decimate the mesh; inspc accepts up to 2000000 triangles"))]
+    #[diagnostic(
+        code(insp::geometry::mesh_too_large),
+        help("decimate the mesh; inspc accepts up to 2000000 triangles")
+    )]
     MeshTooLarge {
         #[label("this mesh")]
         span: Span,
@@ -64,7 +73,10 @@ pub enum GeometryError {
         name: String,
     },
     #[error("face `{face}` does not survive the booleans")]
-    #[diagnostic(code(insp::geometry::face_gone), help("a later operation removes it entirely; name a face that is still there"))]
+    #[diagnostic(
+        code(insp::geometry::face_gone),
+        help("a later operation removes it entirely; name a face that is still there")
+    )]
     FaceGone {
         #[label("no triangle of the part lies on this face")]
         span: Span,
@@ -114,7 +126,7 @@ pub enum MeshError {
 impl MeshError {
     /// The diagnostic, pointing at the spec's mesh path.
     pub fn at(self, span: Span, path: &std::path::Path) -> GeometryError {
-        let path = path.to_string_lossy().into_owned();
+        let path = shown_path(path);
         match self {
             MeshError::Unreadable(reason) => GeometryError::MeshUnreadable { span, path, reason },
             MeshError::Corrupt(reason) => GeometryError::MeshCorrupt { span, path, reason },
@@ -122,4 +134,13 @@ impl MeshError {
             MeshError::TooLarge(reason) => GeometryError::MeshTooLarge { span, path, reason },
         }
     }
+}
+
+/// How a mesh path appears in a message: its file name, so that messages read the same on
+/// every machine (the label points at the path as the spec wrote it).
+pub fn shown_path(path: &std::path::Path) -> String {
+    path.file_name()
+        .unwrap_or(path.as_os_str())
+        .to_string_lossy()
+        .into_owned()
 }

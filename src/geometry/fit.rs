@@ -28,7 +28,10 @@ pub struct Patch<'a> {
 }
 
 fn rms(points: &[P3], s: &Surface) -> f64 {
-    let sum: f64 = points.iter().map(|p| s.distance(p).unwrap_or(0.0).powi(2)).sum();
+    let sum: f64 = points
+        .iter()
+        .map(|p| s.distance(p).unwrap_or(0.0).powi(2))
+        .sum();
     (sum / points.len().max(1) as f64).sqrt()
 }
 
@@ -45,7 +48,9 @@ fn smallest_eigenvector(m: Matrix3<f64>) -> V3 {
 }
 
 fn mean_normal(p: &Patch) -> V3 {
-    p.normals.iter().fold(V3::zeros(), |s, (n, a, _)| s + n * *a)
+    p.normals
+        .iter()
+        .fold(V3::zeros(), |s, (n, a, _)| s + n * *a)
 }
 
 /// The best plane, its normal oriented like the triangles'.
@@ -59,8 +64,14 @@ pub fn plane(p: &Patch) -> Fit {
     if n.dot(&mean_normal(p)) < 0.0 {
         n = -n;
     }
-    let surface = Surface::Plane { origin: P3::from(c), normal: n };
-    Fit { rms: rms(p.points, &surface), surface }
+    let surface = Surface::Plane {
+        origin: P3::from(c),
+        normal: n,
+    };
+    Fit {
+        rms: rms(p.points, &surface),
+        surface,
+    }
 }
 
 /// The best cylinder or cone (whichever the radius along the axis says), or `None` when
@@ -121,30 +132,53 @@ pub fn cylinder_or_cone(p: &Patch) -> Option<Fit> {
         shr += h * r;
     }
     let var = shh - sh * sh / n;
-    let slope = if var > 1e-12 { (shr - sh * sr / n) / var } else { 0.0 };
+    let slope = if var > 1e-12 {
+        (shr - sh * sr / n) / var
+    } else {
+        0.0
+    };
     let r0 = (sr - slope * sh) / n;
-    let convex = p.normals.iter().map(|(nn, w, g)| {
-        let d = g - origin;
-        (d - axis * d.dot(&axis)).normalize().dot(nn) * w
-    }).sum::<f64>() > 0.0;
+    let convex = p
+        .normals
+        .iter()
+        .map(|(nn, w, g)| {
+            let d = g - origin;
+            (d - axis * d.dot(&axis)).normalize().dot(nn) * w
+        })
+        .sum::<f64>()
+        > 0.0;
     let surface = if slope.abs() < (0.25f64).to_radians().tan() {
-        Surface::Cylinder { origin, axis, radius: sr / n, convex }
+        Surface::Cylinder {
+            origin,
+            axis,
+            radius: sr / n,
+            convex,
+        }
     } else {
         let h_apex = -r0 / slope;
         let apex = origin + axis * h_apex;
         let dir = if slope > 0.0 { axis } else { -axis };
-        Surface::Cone { apex, axis: dir, half_angle: slope.abs().atan(), convex }
+        Surface::Cone {
+            apex,
+            axis: dir,
+            half_angle: slope.abs().atan(),
+            convex,
+        }
     };
     if !surface_finite(&surface) {
         return None;
     }
-    Some(Fit { rms: rms(p.points, &surface), surface })
+    Some(Fit {
+        rms: rms(p.points, &surface),
+        surface,
+    })
 }
 
 /// The best sphere.
 pub fn sphere(p: &Patch) -> Option<Fit> {
     // Centred first: far from the origin the normal equations lose all precision.
-    let mean = p.points.iter().fold(V3::zeros(), |s, q| s + q.coords) / p.points.len().max(1) as f64;
+    let mean =
+        p.points.iter().fold(V3::zeros(), |s, q| s + q.coords) / p.points.len().max(1) as f64;
     let mut ata = Matrix4::zeros();
     let mut atb = Vector4::zeros();
     for q in p.points {
@@ -160,19 +194,37 @@ pub fn sphere(p: &Patch) -> Option<Fit> {
     if r2 <= 0.0 {
         return None;
     }
-    let convex = p.normals.iter().map(|(n, w, g)| (g - center).normalize().dot(n) * w).sum::<f64>() > 0.0;
-    let surface = Surface::Sphere { center, radius: r2.sqrt(), convex };
+    let convex = p
+        .normals
+        .iter()
+        .map(|(n, w, g)| (g - center).normalize().dot(n) * w)
+        .sum::<f64>()
+        > 0.0;
+    let surface = Surface::Sphere {
+        center,
+        radius: r2.sqrt(),
+        convex,
+    };
     if !surface_finite(&surface) {
         return None;
     }
-    Some(Fit { rms: rms(p.points, &surface), surface })
+    Some(Fit {
+        rms: rms(p.points, &surface),
+        surface,
+    })
 }
 
 fn surface_finite(s: &Surface) -> bool {
     match s {
-        Surface::Cylinder { origin, radius, .. } => origin.coords.iter().all(|c| c.is_finite()) && radius.is_finite() && *radius < 1e7,
-        Surface::Cone { apex, half_angle, .. } => apex.coords.iter().all(|c| c.is_finite()) && half_angle.is_finite(),
-        Surface::Sphere { center, radius, .. } => center.coords.iter().all(|c| c.is_finite()) && radius.is_finite() && *radius < 1e7,
+        Surface::Cylinder { origin, radius, .. } => {
+            origin.coords.iter().all(|c| c.is_finite()) && radius.is_finite() && *radius < 1e7
+        }
+        Surface::Cone {
+            apex, half_angle, ..
+        } => apex.coords.iter().all(|c| c.is_finite()) && half_angle.is_finite(),
+        Surface::Sphere { center, radius, .. } => {
+            center.coords.iter().all(|c| c.is_finite()) && radius.is_finite() && *radius < 1e7
+        }
         _ => true,
     }
 }
@@ -183,7 +235,12 @@ fn surface_finite(s: &Surface) -> bool {
 fn normals_agree(p: &Patch, s: &Surface, max_deg: f64) -> bool {
     let cos = max_deg.to_radians().cos();
     let total: f64 = p.normals.iter().map(|(_, a, _)| a).sum();
-    let agreeing: f64 = p.normals.iter().filter(|(n, _, g)| s.normal_at(g).is_some_and(|sn| sn.dot(n) >= cos)).map(|(_, a, _)| a).sum();
+    let agreeing: f64 = p
+        .normals
+        .iter()
+        .filter(|(n, _, g)| s.normal_at(g).is_some_and(|sn| sn.dot(n) >= cos))
+        .map(|(_, a, _)| a)
+        .sum();
     agreeing >= 0.95 * total
 }
 
@@ -200,5 +257,8 @@ pub fn best(p: &Patch, tol: f64) -> Fit {
             return f;
         }
     }
-    Fit { surface: Surface::Freeform, rms: pl.rms }
+    Fit {
+        surface: Surface::Freeform,
+        rms: pl.rms,
+    }
 }

@@ -30,8 +30,15 @@ pub struct RawMesh {
 /// Reads a mesh file through the world, scaling by `unit_mm`.
 pub fn read_mesh(world: &dyn World, path: &Path, unit_mm: f64) -> Result<RawMesh, MeshError> {
     let bytes = world.read(path).map_err(|e| MeshError::Unreadable(e.0))?;
-    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
-    let (positions, faces, tri_group, groups) = if ext == "obj" { parse_obj(&bytes)? } else { parse_stl(&bytes)? };
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let (positions, faces, tri_group, groups) = if ext == "obj" {
+        parse_obj(&bytes)?
+    } else {
+        parse_stl(&bytes)?
+    };
     if faces.is_empty() {
         return Err(MeshError::Corrupt("it has no triangles".into()));
     }
@@ -47,23 +54,38 @@ fn parse_stl(bytes: &[u8]) -> Result<Parsed, MeshError> {
     if bytes.len() >= 84 && !bytes.starts_with(b"solid") {
         let declared = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
         if declared > MAX_TRIANGLES {
-            return Err(MeshError::TooLarge(format!("the header declares {declared} triangles")));
+            return Err(MeshError::TooLarge(format!(
+                "the header declares {declared} triangles"
+            )));
         }
         if bytes.len() < 84 + declared * 50 {
-            return Err(MeshError::Corrupt(format!("the file is truncated: {declared} triangles declared, room for {}", (bytes.len() - 84) / 50)));
+            return Err(MeshError::Corrupt(format!(
+                "the file is truncated: {declared} triangles declared, room for {}",
+                (bytes.len() - 84) / 50
+            )));
         }
     }
     // stl_io reads both forms; a binary file's header may start with "solid" too.
     let mut cursor = std::io::Cursor::new(bytes);
-    let mesh = stl_io::read_stl(&mut cursor).map_err(|e| MeshError::Corrupt(format!("not a valid STL file ({e})")))?;
-    let positions = mesh.vertices.iter().map(|v| [v[0] as f64, v[1] as f64, v[2] as f64]).collect();
+    let mesh = stl_io::read_stl(&mut cursor)
+        .map_err(|e| MeshError::Corrupt(format!("not a valid STL file ({e})")))?;
+    let positions = mesh
+        .vertices
+        .iter()
+        .map(|v| [v[0] as f64, v[1] as f64, v[2] as f64])
+        .collect();
     let faces: Vec<[usize; 3]> = mesh.faces.iter().map(|f| f.vertices).collect();
     let n = faces.len();
     Ok((positions, faces, vec![0; n], vec![]))
 }
 
 fn parse_obj(bytes: &[u8]) -> Result<Parsed, MeshError> {
-    let text = std::str::from_utf8(bytes).map_err(|e| MeshError::Corrupt(format!("not text: invalid UTF-8 at byte {}", e.valid_up_to())))?;
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        MeshError::Corrupt(format!(
+            "not text: invalid UTF-8 at byte {}",
+            e.valid_up_to()
+        ))
+    })?;
     let mut positions: Vec<[f64; 3]> = Vec::new();
     let mut faces = Vec::new();
     let mut tri_group = Vec::new();
@@ -76,14 +98,26 @@ fn parse_obj(bytes: &[u8]) -> Result<Parsed, MeshError> {
             Some("v") => {
                 let mut c = [0.0; 3];
                 for slot in &mut c {
-                    let tok = it.next().ok_or_else(|| MeshError::Corrupt(format!("line {ln}: a vertex needs three coordinates")))?;
-                    *slot = tok.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(|| MeshError::Corrupt(format!("line {ln}: `{tok}` is not a finite number")))?;
+                    let tok = it.next().ok_or_else(|| {
+                        MeshError::Corrupt(format!("line {ln}: a vertex needs three coordinates"))
+                    })?;
+                    *slot = tok
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|x| x.is_finite())
+                        .ok_or_else(|| {
+                            MeshError::Corrupt(format!("line {ln}: `{tok}` is not a finite number"))
+                        })?;
                 }
                 positions.push(c);
             }
             Some("g") | Some("o") => {
                 let name = it.collect::<Vec<_>>().join(" ");
-                let name = if name.is_empty() { "default".to_string() } else { name };
+                let name = if name.is_empty() {
+                    "default".to_string()
+                } else {
+                    name
+                };
                 current = Some(match groups.iter().position(|g| *g == name) {
                     Some(i) => i as u32,
                     None => {
@@ -96,15 +130,26 @@ fn parse_obj(bytes: &[u8]) -> Result<Parsed, MeshError> {
                 let mut idx = Vec::new();
                 for tok in it {
                     let first = tok.split('/').next().unwrap_or("");
-                    let i: i64 = first.parse().map_err(|_| MeshError::Corrupt(format!("line {ln}: `{tok}` is not a vertex index")))?;
-                    let resolved = if i > 0 { i - 1 } else { positions.len() as i64 + i };
+                    let i: i64 = first.parse().map_err(|_| {
+                        MeshError::Corrupt(format!("line {ln}: `{tok}` is not a vertex index"))
+                    })?;
+                    let resolved = if i > 0 {
+                        i - 1
+                    } else {
+                        positions.len() as i64 + i
+                    };
                     if resolved < 0 || resolved >= positions.len() as i64 {
-                        return Err(MeshError::Corrupt(format!("line {ln}: vertex index {i} is out of range (1 to {})", positions.len())));
+                        return Err(MeshError::Corrupt(format!(
+                            "line {ln}: vertex index {i} is out of range (1 to {})",
+                            positions.len()
+                        )));
                     }
                     idx.push(resolved as usize);
                 }
                 if idx.len() < 3 {
-                    return Err(MeshError::Corrupt(format!("line {ln}: a face needs at least three vertices")));
+                    return Err(MeshError::Corrupt(format!(
+                        "line {ln}: a face needs at least three vertices"
+                    )));
                 }
                 let g = *current.get_or_insert_with(|| {
                     groups.push("default".into());
@@ -115,7 +160,9 @@ fn parse_obj(bytes: &[u8]) -> Result<Parsed, MeshError> {
                     tri_group.push(g);
                 }
                 if faces.len() > MAX_TRIANGLES {
-                    return Err(MeshError::TooLarge(format!("more than {MAX_TRIANGLES} triangles")));
+                    return Err(MeshError::TooLarge(format!(
+                        "more than {MAX_TRIANGLES} triangles"
+                    )));
                 }
             }
             _ => {}
@@ -127,14 +174,22 @@ fn parse_obj(bytes: &[u8]) -> Result<Parsed, MeshError> {
 /// Merges coincident vertices (to 1e-6 mm), drops degenerate triangles and counts open
 /// and non-manifold edges; a mesh with more than a tenth of its edges defective is not
 /// a solid at all.
-fn weld(positions: Vec<[f64; 3]>, faces: Vec<[usize; 3]>, tri_group: Vec<u32>, groups: Vec<String>, unit_mm: f64) -> Result<RawMesh, MeshError> {
+fn weld(
+    positions: Vec<[f64; 3]>,
+    faces: Vec<[usize; 3]>,
+    tri_group: Vec<u32>,
+    groups: Vec<String>,
+    unit_mm: f64,
+) -> Result<RawMesh, MeshError> {
     let mut key_of: HashMap<[i64; 3], u32> = HashMap::new();
     let mut vertices = Vec::new();
     let mut remap = Vec::with_capacity(positions.len());
     for p in &positions {
         let q = p.map(|c| c * unit_mm);
         if q.iter().any(|c| !c.is_finite() || c.abs() > 1e9) {
-            return Err(MeshError::Corrupt("a vertex lies at infinity or beyond a kilometre".into()));
+            return Err(MeshError::Corrupt(
+                "a vertex lies at infinity or beyond a kilometre".into(),
+            ));
         }
         let key = q.map(|c| (c * 1e6).round() as i64);
         let id = *key_of.entry(key).or_insert_with(|| {
@@ -166,7 +221,17 @@ fn weld(positions: Vec<[f64; 3]>, faces: Vec<[usize; 3]>, tri_group: Vec<u32>, g
     let open_edges = uses.values().filter(|&&u| u == 1).count();
     let nonmanifold_edges = uses.values().filter(|&&u| u > 2).count();
     if (open_edges + nonmanifold_edges) * 10 > uses.len() {
-        return Err(MeshError::NotClosed(format!("{open_edges} open and {nonmanifold_edges} non-manifold edges of {}", uses.len())));
+        return Err(MeshError::NotClosed(format!(
+            "{open_edges} open and {nonmanifold_edges} non-manifold edges of {}",
+            uses.len()
+        )));
     }
-    Ok(RawMesh { vertices, triangles, tri_group: groups_of, groups, open_edges, nonmanifold_edges })
+    Ok(RawMesh {
+        vertices,
+        triangles,
+        tri_group: groups_of,
+        groups,
+        open_edges,
+        nonmanifold_edges,
+    })
 }

@@ -17,12 +17,14 @@ mod errors;
 pub mod fit;
 mod mesh_io;
 mod primitives;
+mod query;
 mod report;
 pub mod segment;
 mod select;
 
 pub use errors::GeometryError;
 pub use mesh_io::{read_mesh, RawMesh};
+pub use query::{line_triangle, segment_distance, FaceIndex};
 pub use report::{describe, faces_json, faces_table};
 pub use select::resolve_faces;
 
@@ -100,11 +102,21 @@ impl Surface {
     pub fn distance(&self, p: &P3) -> Option<f64> {
         Some(match self {
             Surface::Plane { origin, normal } => (p - origin).dot(normal).abs(),
-            Surface::Cylinder { origin, axis, radius, .. } => {
+            Surface::Cylinder {
+                origin,
+                axis,
+                radius,
+                ..
+            } => {
                 let d = p - origin;
                 ((d - axis * d.dot(axis)).norm() - radius).abs()
             }
-            Surface::Cone { apex, axis, half_angle, .. } => {
+            Surface::Cone {
+                apex,
+                axis,
+                half_angle,
+                ..
+            } => {
                 let d = p - apex;
                 let h = d.dot(axis);
                 let r = (d - axis * h).norm();
@@ -122,18 +134,30 @@ impl Surface {
         let flip = |v: V3, convex: bool| if convex { v } else { -v };
         match self {
             Surface::Plane { normal, .. } => Some(*normal),
-            Surface::Cylinder { origin, axis, convex, .. } => {
+            Surface::Cylinder {
+                origin,
+                axis,
+                convex,
+                ..
+            } => {
                 let d = p - origin;
                 let radial = d - axis * d.dot(axis);
                 radial.try_normalize(1e-12).map(|r| flip(r, *convex))
             }
-            Surface::Cone { apex, axis, half_angle, convex } => {
+            Surface::Cone {
+                apex,
+                axis,
+                half_angle,
+                convex,
+            } => {
                 let d = p - apex;
                 let radial = (d - axis * d.dot(axis)).try_normalize(1e-12)?;
                 let n = radial * half_angle.cos() - axis * half_angle.sin();
                 Some(flip(n, *convex))
             }
-            Surface::Sphere { center, convex, .. } => (p - center).try_normalize(1e-12).map(|r| flip(r, *convex)),
+            Surface::Sphere { center, convex, .. } => {
+                (p - center).try_normalize(1e-12).map(|r| flip(r, *convex))
+            }
             Surface::Freeform => None,
         }
     }
@@ -178,10 +202,22 @@ pub struct PartGeometry {
 
 impl PartGeometry {
     /// Assembles faces from per-triangle face indices, computing areas and centroids.
-    pub(crate) fn new(vertices: Vec<P3>, triangles: Vec<[u32; 3]>, tri_face: Vec<u32>, specs: Vec<(String, Surface)>) -> Self {
+    pub(crate) fn new(
+        vertices: Vec<P3>,
+        triangles: Vec<[u32; 3]>,
+        tri_face: Vec<u32>,
+        specs: Vec<(String, Surface)>,
+    ) -> Self {
         let mut faces: Vec<Face> = specs
             .into_iter()
-            .map(|(name, surface)| Face { name, surface, triangles: vec![], area: 0.0, centroid: P3::origin(), fit_rms: 0.0 })
+            .map(|(name, surface)| Face {
+                name,
+                surface,
+                triangles: vec![],
+                area: 0.0,
+                centroid: P3::origin(),
+                fit_rms: 0.0,
+            })
             .collect();
         let mut sums = vec![V3::zeros(); faces.len()];
         for (t, tri) in triangles.iter().enumerate() {
@@ -197,7 +233,13 @@ impl PartGeometry {
                 face.centroid = P3::from(sums[f] / face.area);
             }
         }
-        PartGeometry { vertices, triangles, tri_face, faces, roles: Vec::new() }
+        PartGeometry {
+            vertices,
+            triangles,
+            tri_face,
+            faces,
+            roles: Vec::new(),
+        }
     }
 
     /// The axis-aligned bounds of all vertices.
@@ -216,10 +258,19 @@ impl PartGeometry {
 ///
 /// `file` is the spec file the part is declared in: diagnostics point at the part's
 /// declaration (or the mesh path) there.
-pub fn build(part: &model::Part, world: &dyn World, file: FileId, diags: &mut Diagnostics) -> Option<PartGeometry> {
+pub fn build(
+    part: &model::Part,
+    world: &dyn World,
+    file: FileId,
+    diags: &mut Diagnostics,
+) -> Option<PartGeometry> {
     match &part.geometry {
         Source::Stock(stock) => csg::build(part, stock, file, diags),
-        Source::Mesh { path, unit_mm, span } => {
+        Source::Mesh {
+            path,
+            unit_mm,
+            span,
+        } => {
             let raw = match read_mesh(world, path, *unit_mm) {
                 Ok(m) => m,
                 Err(e) => {
@@ -228,14 +279,21 @@ pub fn build(part: &model::Part, world: &dyn World, file: FileId, diags: &mut Di
                 }
             };
             if raw.open_edges + raw.nonmanifold_edges > 0 {
-                diags.push(file, GeometryError::MeshDefects {
-                    span: *span,
-                    path: path.to_string_lossy().into_owned(),
-                    open: raw.open_edges,
-                    nonmanifold: raw.nonmanifold_edges,
-                });
+                diags.push(
+                    file,
+                    GeometryError::MeshDefects {
+                        span: *span,
+                        path: errors::shown_path(path),
+                        open: raw.open_edges,
+                        nonmanifold: raw.nonmanifold_edges,
+                    },
+                );
             }
-            let uses_groups = part.features.iter().flat_map(|f| &f.faces).any(|r| matches!(r, model::FaceRef::Group(..)));
+            let uses_groups = part
+                .features
+                .iter()
+                .flat_map(|f| &f.faces)
+                .any(|r| matches!(r, model::FaceRef::Group(..)));
             let geometry = if raw.groups.len() > 1 || (uses_groups && !raw.groups.is_empty()) {
                 segment::from_groups(&raw)
             } else {

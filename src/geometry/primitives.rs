@@ -40,7 +40,12 @@ impl Frame {
     pub fn from_uw(o: P3, u: V3, w: V3) -> Frame {
         let w = w.normalize();
         let u = (u - w * u.dot(&w)).normalize();
-        Frame { o, u, v: w.cross(&u), w }
+        Frame {
+            o,
+            u,
+            v: w.cross(&u),
+            w,
+        }
     }
 
     pub fn at(&self, x: f64, y: f64, z: f64) -> P3 {
@@ -51,13 +56,25 @@ impl Frame {
 /// A profile segment, counter-clockwise around the profile.
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Seg {
-    Line { a: [f64; 2] },
-    Arc { c: [f64; 2], r: f64, a0: f64, a1: f64 },
+    Line {
+        a: [f64; 2],
+    },
+    Arc {
+        c: [f64; 2],
+        r: f64,
+        a0: f64,
+        a1: f64,
+    },
 }
 
 /// A rectangle `[x0, x1] × [y0, y1]`: bottom, right, top, left edges in that order.
 pub(crate) fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Seg> {
-    vec![Seg::Line { a: [x0, y0] }, Seg::Line { a: [x1, y0] }, Seg::Line { a: [x1, y1] }, Seg::Line { a: [x0, y1] }]
+    vec![
+        Seg::Line { a: [x0, y0] },
+        Seg::Line { a: [x1, y0] },
+        Seg::Line { a: [x1, y1] },
+        Seg::Line { a: [x0, y1] },
+    ]
 }
 
 /// A rectangle centred on the origin with rounded corners: 4 lines (bottom, right, top,
@@ -70,19 +87,44 @@ pub(crate) fn rounded_rectangle(l: f64, w: f64, r: f64) -> Vec<Seg> {
     let r = r.min(hx).min(hy);
     vec![
         Seg::Line { a: [-hx + r, -hy] },
-        Seg::Arc { c: [hx - r, -hy + r], r, a0: -PI / 2.0, a1: 0.0 },
+        Seg::Arc {
+            c: [hx - r, -hy + r],
+            r,
+            a0: -PI / 2.0,
+            a1: 0.0,
+        },
         Seg::Line { a: [hx, -hy + r] },
-        Seg::Arc { c: [hx - r, hy - r], r, a0: 0.0, a1: PI / 2.0 },
+        Seg::Arc {
+            c: [hx - r, hy - r],
+            r,
+            a0: 0.0,
+            a1: PI / 2.0,
+        },
         Seg::Line { a: [hx - r, hy] },
-        Seg::Arc { c: [-hx + r, hy - r], r, a0: PI / 2.0, a1: PI },
+        Seg::Arc {
+            c: [-hx + r, hy - r],
+            r,
+            a0: PI / 2.0,
+            a1: PI,
+        },
         Seg::Line { a: [-hx, hy - r] },
-        Seg::Arc { c: [-hx + r, -hy + r], r, a0: PI, a1: 1.5 * PI },
+        Seg::Arc {
+            c: [-hx + r, -hy + r],
+            r,
+            a0: PI,
+            a1: 1.5 * PI,
+        },
     ]
 }
 
 /// A full circle.
 pub(crate) fn circle(r: f64) -> Vec<Seg> {
-    vec![Seg::Arc { c: [0.0, 0.0], r, a0: 0.0, a1: TAU }]
+    vec![Seg::Arc {
+        c: [0.0, 0.0],
+        r,
+        a0: 0.0,
+        a1: TAU,
+    }]
 }
 
 /// A triangulated primitive: `tri_part[t]` says which of the primitive's faces triangle
@@ -127,10 +169,41 @@ impl Prim {
         }
         for s in &mut self.surfaces {
             *s = match s.clone() {
-                Surface::Plane { origin, normal } => Surface::Plane { origin: m * origin, normal: m * normal },
-                Surface::Cylinder { origin, axis, radius, convex } => Surface::Cylinder { origin: m * origin, axis: m * axis, radius, convex },
-                Surface::Cone { apex, axis, half_angle, convex } => Surface::Cone { apex: m * apex, axis: m * axis, half_angle, convex },
-                Surface::Sphere { center, radius, convex } => Surface::Sphere { center: m * center, radius, convex },
+                Surface::Plane { origin, normal } => Surface::Plane {
+                    origin: m * origin,
+                    normal: m * normal,
+                },
+                Surface::Cylinder {
+                    origin,
+                    axis,
+                    radius,
+                    convex,
+                } => Surface::Cylinder {
+                    origin: m * origin,
+                    axis: m * axis,
+                    radius,
+                    convex,
+                },
+                Surface::Cone {
+                    apex,
+                    axis,
+                    half_angle,
+                    convex,
+                } => Surface::Cone {
+                    apex: m * apex,
+                    axis: m * axis,
+                    half_angle,
+                    convex,
+                },
+                Surface::Sphere {
+                    center,
+                    radius,
+                    convex,
+                } => Surface::Sphere {
+                    center: m * center,
+                    radius,
+                    convex,
+                },
                 Surface::Freeform => Surface::Freeform,
             };
         }
@@ -155,7 +228,10 @@ pub(crate) fn prism(f: &Frame, profile: &[Seg], z0: f64, z1: f64) -> Prim {
                 let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
                 let n2 = [dy, -dx];
                 let normal = (f.u * n2[0] + f.v * n2[1]).normalize();
-                surfaces.push(Surface::Plane { origin: f.at(a[0], a[1], 0.0), normal });
+                surfaces.push(Surface::Plane {
+                    origin: f.at(a[0], a[1], 0.0),
+                    normal,
+                });
             }
             Seg::Arc { c, r, a0, a1 } => {
                 let n = segments(r, a1 - a0);
@@ -163,20 +239,30 @@ pub(crate) fn prism(f: &Frame, profile: &[Seg], z0: f64, z1: f64) -> Prim {
                     let t = a0 + (a1 - a0) * i as f64 / n as f64;
                     ring.push(([c[0] + r * t.cos(), c[1] + r * t.sin()], k as u32));
                 }
-                surfaces.push(Surface::Cylinder { origin: f.at(c[0], c[1], 0.0), axis: f.w, radius: r, convex: true });
+                surfaces.push(Surface::Cylinder {
+                    origin: f.at(c[0], c[1], 0.0),
+                    axis: f.w,
+                    radius: r,
+                    convex: true,
+                });
             }
         }
     }
     let n = ring.len() as u32;
     let nseg = profile.len() as u32;
-    let mut p = Prim { surfaces, ..Prim::default() };
+    let mut p = Prim {
+        surfaces,
+        ..Prim::default()
+    };
     for &(q, _) in &ring {
         p.verts.push(f.at(q[0], q[1], z0));
     }
     for &(q, _) in &ring {
         p.verts.push(f.at(q[0], q[1], z1));
     }
-    let (cx, cy) = ring.iter().fold((0.0, 0.0), |s, (q, _)| (s.0 + q[0], s.1 + q[1]));
+    let (cx, cy) = ring
+        .iter()
+        .fold((0.0, 0.0), |s, (q, _)| (s.0 + q[0], s.1 + q[1]));
     let (cx, cy) = (cx / n as f64, cy / n as f64);
     p.verts.push(f.at(cx, cy, z0));
     p.verts.push(f.at(cx, cy, z1));
@@ -192,8 +278,14 @@ pub(crate) fn prism(f: &Frame, profile: &[Seg], z0: f64, z1: f64) -> Prim {
         p.tris.push([ct, n + i, n + j]);
         p.tri_part.push(nseg + 1);
     }
-    p.surfaces.push(Surface::Plane { origin: f.at(0.0, 0.0, z0), normal: -f.w });
-    p.surfaces.push(Surface::Plane { origin: f.at(0.0, 0.0, z1), normal: f.w });
+    p.surfaces.push(Surface::Plane {
+        origin: f.at(0.0, 0.0, z0),
+        normal: -f.w,
+    });
+    p.surfaces.push(Surface::Plane {
+        origin: f.at(0.0, 0.0, z1),
+        normal: f.w,
+    });
     p
 }
 
@@ -201,13 +293,27 @@ pub(crate) fn prism(f: &Frame, profile: &[Seg], z0: f64, z1: f64) -> Prim {
 pub(crate) fn sphere(center: P3, r: f64) -> Prim {
     let nlon = segments(r, TAU).max(16);
     let nlat = (nlon / 2).max(8);
-    let mut p = Prim { surfaces: vec![Surface::Sphere { center, radius: r, convex: true }], ..Prim::default() };
+    let mut p = Prim {
+        surfaces: vec![Surface::Sphere {
+            center,
+            radius: r,
+            convex: true,
+        }],
+        ..Prim::default()
+    };
     p.verts.push(center + V3::new(0.0, 0.0, -r));
     for i in 1..nlat {
         let th = PI * i as f64 / nlat as f64 - PI / 2.0;
         for j in 0..nlon {
             let ph = TAU * j as f64 / nlon as f64;
-            p.verts.push(center + V3::new(r * th.cos() * ph.cos(), r * th.cos() * ph.sin(), r * th.sin()));
+            p.verts.push(
+                center
+                    + V3::new(
+                        r * th.cos() * ph.cos(),
+                        r * th.cos() * ph.sin(),
+                        r * th.sin(),
+                    ),
+            );
         }
     }
     p.verts.push(center + V3::new(0.0, 0.0, r));
@@ -219,8 +325,10 @@ pub(crate) fn sphere(center: P3, r: f64) -> Prim {
     }
     for i in 1..nlat - 1 {
         for j in 0..nlon {
-            p.tris.push([ring(i, j), ring(i, j + 1), ring(i + 1, j + 1)]);
-            p.tris.push([ring(i, j), ring(i + 1, j + 1), ring(i + 1, j)]);
+            p.tris
+                .push([ring(i, j), ring(i, j + 1), ring(i + 1, j + 1)]);
+            p.tris
+                .push([ring(i, j), ring(i + 1, j + 1), ring(i + 1, j)]);
         }
     }
     p.tri_part = vec![0; p.tris.len()];

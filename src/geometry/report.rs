@@ -16,17 +16,42 @@ fn vec3(v: &V3) -> String {
 pub fn describe(s: &Surface) -> String {
     match s {
         Surface::Plane { normal, .. } => format!("normal {}", vec3(normal)),
-        Surface::Cylinder { origin, axis, radius, convex } => {
-            format!("axis {} through {} r {}{}", vec3(axis), vec3(&origin.coords), r(*radius), if *convex { "" } else { " (hole)" })
+        Surface::Cylinder {
+            origin,
+            axis,
+            radius,
+            convex,
+        } => {
+            format!(
+                "axis {} through {} r {}{}",
+                vec3(axis),
+                vec3(&origin.coords),
+                r(*radius),
+                if *convex { "" } else { " (hole)" }
+            )
         }
-        Surface::Cone { apex, axis, half_angle, convex } => format!(
+        Surface::Cone {
+            apex,
+            axis,
+            half_angle,
+            convex,
+        } => format!(
             "axis {} apex {} half-angle {}°{}",
             vec3(axis),
             vec3(&apex.coords),
             r(half_angle.to_degrees()),
             if *convex { "" } else { " (inner)" }
         ),
-        Surface::Sphere { center, radius, convex } => format!("centre {} r {}{}", vec3(&center.coords), r(*radius), if *convex { "" } else { " (inner)" }),
+        Surface::Sphere {
+            center,
+            radius,
+            convex,
+        } => format!(
+            "centre {} r {}{}",
+            vec3(&center.coords),
+            r(*radius),
+            if *convex { "" } else { " (inner)" }
+        ),
         Surface::Freeform => String::new(),
     }
 }
@@ -35,8 +60,17 @@ pub fn describe(s: &Surface) -> String {
 pub fn faces_table(title: &str, g: &PartGeometry) -> String {
     let mut o = String::new();
     let live = g.faces.iter().filter(|f| f.area > 0.0).count();
-    let _ = writeln!(o, "{title}: {live} faces, {} triangles, {} vertices", g.triangles.len(), g.vertices.len());
-    let _ = writeln!(o, "{:>4}  {:<20} {:<9} {:>12}  {:<28} surface", "id", "name", "type", "area mm²", "centroid");
+    let _ = writeln!(
+        o,
+        "{title}: {live} faces, {} triangles, {} vertices",
+        g.triangles.len(),
+        g.vertices.len()
+    );
+    let _ = writeln!(
+        o,
+        "{:>4}  {:<20} {:<9} {:>12}  {:<28} surface",
+        "id", "name", "type", "area mm²", "centroid"
+    );
     for (k, f) in g.faces.iter().enumerate().filter(|(_, f)| f.area > 0.0) {
         let _ = writeln!(
             o,

@@ -20,7 +20,11 @@ fn tri_normal(m: &RawMesh, t: usize) -> (V3, f64, P3) {
     let [a, b, c] = m.triangles[t].map(|i| m.vertices[i as usize]);
     let cr = (b - a).cross(&(c - a));
     let area = cr.norm() / 2.0;
-    (cr.try_normalize(0.0).unwrap_or_else(V3::zeros), area, P3::from((a.coords + b.coords + c.coords) / 3.0))
+    (
+        cr.try_normalize(0.0).unwrap_or_else(V3::zeros),
+        area,
+        P3::from((a.coords + b.coords + c.coords) / 3.0),
+    )
 }
 
 /// Fits one face's surface from its triangles.
@@ -35,7 +39,13 @@ fn fit_face(m: &RawMesh, tris: &[u32], normals: &[(V3, f64, P3)], tol: f64) -> f
         }
     }
     let ns: Vec<(V3, f64, P3)> = tris.iter().map(|&t| normals[t as usize]).collect();
-    fit::best(&Patch { points: &points, normals: &ns }, tol)
+    fit::best(
+        &Patch {
+            points: &points,
+            normals: &ns,
+        },
+        tol,
+    )
 }
 
 fn fit_tolerance(m: &RawMesh) -> f64 {
@@ -47,7 +57,12 @@ fn fit_tolerance(m: &RawMesh) -> f64 {
     0.01 + 1e-4 * (hi - lo).norm()
 }
 
-fn assemble(m: &RawMesh, regions: Vec<Vec<u32>>, names: Vec<String>, normals: &[(V3, f64, P3)]) -> PartGeometry {
+fn assemble(
+    m: &RawMesh,
+    regions: Vec<Vec<u32>>,
+    names: Vec<String>,
+    normals: &[(V3, f64, P3)],
+) -> PartGeometry {
     let tol = fit_tolerance(m);
     let mut tri_face = vec![0u32; m.triangles.len()];
     let mut specs = Vec::new();
@@ -74,7 +89,11 @@ pub fn from_groups(m: &RawMesh) -> PartGeometry {
     for (t, &g) in m.tri_group.iter().enumerate() {
         regions[g as usize].push(t as u32);
     }
-    let names = if m.groups.is_empty() { vec!["mesh".to_string()] } else { m.groups.clone() };
+    let names = if m.groups.is_empty() {
+        vec!["mesh".to_string()]
+    } else {
+        m.groups.clone()
+    };
     assemble(m, regions, names, &normals)
 }
 
@@ -88,7 +107,10 @@ pub fn segment(m: &RawMesh) -> PartGeometry {
     for (t, tri) in m.triangles.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            edge_tris.entry((a.min(b), a.max(b))).or_default().push(t as u32);
+            edge_tris
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push(t as u32);
         }
     }
     // Neighbours of each triangle across manifold edges, with the edge length.
@@ -103,7 +125,14 @@ pub fn segment(m: &RawMesh) -> PartGeometry {
             nbrs[ts[1] as usize].push((ts[0], len));
         }
     }
-    let angle = |a: u32, b: u32| normals[a as usize].0.dot(&normals[b as usize].0).clamp(-1.0, 1.0).acos().to_degrees();
+    let angle = |a: u32, b: u32| {
+        normals[a as usize]
+            .0
+            .dot(&normals[b as usize].0)
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees()
+    };
 
     // 1. Flat patches.
     let mut flat = vec![u32::MAX; nt];
@@ -143,7 +172,9 @@ pub fn segment(m: &RawMesh) -> PartGeometry {
             }
         }
     }
-    let facet: Vec<bool> = (0..np).map(|p| border[p] > 0.0 && gentle[p] > 0.5 * border[p]).collect();
+    let facet: Vec<bool> = (0..np)
+        .map(|p| border[p] > 0.0 && gentle[p] > 0.5 * border[p])
+        .collect();
     // 3. Curved regions: facets joined across gentle creases.
     let mut region = vec![u32::MAX; np];
     let mut regions: Vec<Vec<u32>> = Vec::new();
@@ -171,7 +202,12 @@ pub fn segment(m: &RawMesh) -> PartGeometry {
                 }
             }
         }
-        regions.push(group.iter().flat_map(|&q| patches[q].iter().copied()).collect());
+        regions.push(
+            group
+                .iter()
+                .flat_map(|&q| patches[q].iter().copied())
+                .collect(),
+        );
     }
     // 4. Fit. A curved region no single surface fits (two tangent fillets, say) is split
     // by growing sub-regions facet by facet while one surface still fits them.
@@ -183,8 +219,12 @@ pub fn segment(m: &RawMesh) -> PartGeometry {
     let mut faces: Vec<Vec<u32>> = Vec::new();
     for (id, tris) in regions.into_iter().enumerate() {
         let members = &members_of[id];
-        if members.len() > 1 && matches!(fit_face(m, &tris, &normals, tol).surface, Surface::Freeform) {
-            faces.extend(grow_by_fit(m, members, &patches, &flat, &nbrs, &normals, tol));
+        if members.len() > 1
+            && matches!(fit_face(m, &tris, &normals, tol).surface, Surface::Freeform)
+        {
+            faces.extend(grow_by_fit(
+                m, members, &patches, &flat, &nbrs, &normals, tol,
+            ));
         } else {
             let mut t = tris;
             t.sort_unstable();
@@ -216,7 +256,11 @@ fn grow_by_fit(
         loop {
             let candidate = tris
                 .iter()
-                .flat_map(|&t| nbrs[t as usize].iter().map(|&(n, _)| flat[n as usize] as usize))
+                .flat_map(|&t| {
+                    nbrs[t as usize]
+                        .iter()
+                        .map(|&(n, _)| flat[n as usize] as usize)
+                })
                 .filter(|p| left.contains(p) && !rejected.contains(p))
                 .min();
             let Some(p) = candidate else { break };

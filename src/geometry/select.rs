@@ -10,7 +10,12 @@ use crate::source::FileId;
 const SELECT_DEG: f64 = 5.0;
 
 /// The faces a reference names, in face order; reports references that name nothing.
-pub fn resolve_faces(g: &PartGeometry, r: &FaceRef, file: FileId, diags: &mut Diagnostics) -> Vec<FaceId> {
+pub fn resolve_faces(
+    g: &PartGeometry,
+    r: &FaceRef,
+    file: FileId,
+    diags: &mut Diagnostics,
+) -> Vec<FaceId> {
     let alive = |k: usize| g.faces[k].area > 0.0;
     match r {
         FaceRef::Role { source, role, span } => {
@@ -25,34 +30,74 @@ pub fn resolve_faces(g: &PartGeometry, r: &FaceRef, file: FileId, diags: &mut Di
                     })
                 })
                 .collect();
-            let live: Vec<FaceId> = matching.iter().copied().filter(|&k| alive(k)).map(FaceId).collect();
+            let live: Vec<FaceId> = matching
+                .iter()
+                .copied()
+                .filter(|&k| alive(k))
+                .map(FaceId)
+                .collect();
             if live.is_empty() {
-                let face = matching.first().map_or_else(|| role.clone(), |&k| g.faces[k].name.clone());
+                let face = matching
+                    .first()
+                    .map_or_else(|| role.clone(), |&k| g.faces[k].name.clone());
                 diags.push(file, E::FaceGone { span: *span, face });
             }
             live
         }
         FaceRef::Group(name, span) => {
-            let found: Vec<FaceId> = (0..g.faces.len()).filter(|&k| g.faces[k].name == *name && alive(k)).map(FaceId).collect();
+            let found: Vec<FaceId> = (0..g.faces.len())
+                .filter(|&k| g.faces[k].name == *name && alive(k))
+                .map(FaceId)
+                .collect();
             if found.is_empty() {
-                let help = suggest::help_for_unknown("group", name, g.faces.iter().map(|f| f.name.as_str()));
-                diags.push(file, E::UnknownGroup { span: *span, group: name.clone(), help });
+                let help = suggest::help_for_unknown(
+                    "group",
+                    name,
+                    g.faces.iter().map(|f| f.name.as_str()),
+                );
+                diags.push(
+                    file,
+                    E::UnknownGroup {
+                        span: *span,
+                        group: name.clone(),
+                        help,
+                    },
+                );
             }
             found
         }
         FaceRef::Segment(n, span) => {
             let name = format!("segment_{n}");
-            let found: Vec<FaceId> = (0..g.faces.len()).filter(|&k| g.faces[k].name == name).map(FaceId).collect();
+            let found: Vec<FaceId> = (0..g.faces.len())
+                .filter(|&k| g.faces[k].name == name)
+                .map(FaceId)
+                .collect();
             if found.is_empty() {
-                let help = format!("the mesh has {} segments, numbered from 1; `inspc faces MESH` lists them", g.faces.len());
-                diags.push(file, E::UnknownSegment { span: *span, segment: *n, help });
+                let help = format!(
+                    "the mesh has {} segments, numbered from 1; `inspc faces MESH` lists them",
+                    g.faces.len()
+                );
+                diags.push(
+                    file,
+                    E::UnknownSegment {
+                        span: *span,
+                        segment: *n,
+                        help,
+                    },
+                );
             }
             found
         }
         FaceRef::Select(sel, span) => {
             let found = select(g, sel);
             if found.is_empty() {
-                diags.push(file, E::NoMatch { span: *span, help: "relax a criterion, or list the faces with `inspc faces MESH`".into() });
+                diags.push(
+                    file,
+                    E::NoMatch {
+                        span: *span,
+                        help: "relax a criterion, or list the faces with `inspc faces MESH`".into(),
+                    },
+                );
             }
             found
         }
@@ -79,7 +124,8 @@ fn select(g: &PartGeometry, s: &Selector) -> Vec<FaceId> {
             }
             if let Some(a) = s.axis {
                 match &f.surface {
-                    Surface::Cylinder { axis, .. } | Surface::Cone { axis, .. } if axis.dot(&v(&a)).abs() >= cos => {}
+                    Surface::Cylinder { axis, .. } | Surface::Cone { axis, .. }
+                        if axis.dot(&v(&a)).abs() >= cos => {}
                     _ => return false,
                 }
             }
@@ -97,12 +143,28 @@ fn select(g: &PartGeometry, s: &Selector) -> Vec<FaceId> {
         .collect();
     if let Some((axis, highest)) = s.extreme {
         let key = |k: &usize| g.faces[*k].centroid[axis as usize];
-        let best = if highest { hits.iter().copied().max_by(|a, b| key(a).total_cmp(&key(b))) } else { hits.iter().copied().min_by(|a, b| key(a).total_cmp(&key(b))) };
+        let best = if highest {
+            hits.iter()
+                .copied()
+                .max_by(|a, b| key(a).total_cmp(&key(b)))
+        } else {
+            hits.iter()
+                .copied()
+                .min_by(|a, b| key(a).total_cmp(&key(b)))
+        };
         hits = best.into_iter().collect();
     }
     if let Some(p) = s.nearest {
         let p = super::P3::new(p[0], p[1], p[2]);
-        hits = hits.into_iter().min_by(|a, b| (g.faces[*a].centroid - p).norm().total_cmp(&(g.faces[*b].centroid - p).norm())).into_iter().collect();
+        hits = hits
+            .into_iter()
+            .min_by(|a, b| {
+                (g.faces[*a].centroid - p)
+                    .norm()
+                    .total_cmp(&(g.faces[*b].centroid - p).norm())
+            })
+            .into_iter()
+            .collect();
     }
     hits.into_iter().map(FaceId).collect()
 }

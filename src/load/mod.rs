@@ -48,7 +48,10 @@ pub struct Program {
 impl Program {
     /// The module of a standard-library name such as `std::hierarchies`, if loaded.
     pub fn std_module(&self, name: &str) -> Option<ModuleId> {
-        self.modules.iter().position(|m| m.std_name.as_deref() == Some(name)).map(ModuleId)
+        self.modules
+            .iter()
+            .position(|m| m.std_name.as_deref() == Some(name))
+            .map(ModuleId)
     }
 }
 
@@ -57,7 +60,10 @@ impl Program {
 pub enum LoadError {
     /// A file could not be read.
     #[error("cannot read `{path}`: {reason}")]
-    #[diagnostic(code(insp::load::unreadable), help("check the path; relative imports are resolved against the importing file's folder"))]
+    #[diagnostic(
+        code(insp::load::unreadable),
+        help("check the path; relative imports are resolved against the importing file's folder")
+    )]
     Unreadable {
         /// The `use` or mesh path that named it, if any.
         #[label("imported here")]
@@ -105,7 +111,10 @@ pub enum LoadError {
     },
     /// Files that import each other.
     #[error("import cycle: {cycle}")]
-    #[diagnostic(code(insp::load::import_cycle), help("move what both files need into a third file that imports neither"))]
+    #[diagnostic(
+        code(insp::load::import_cycle),
+        help("move what both files need into a third file that imports neither")
+    )]
     ImportCycle {
         /// The `use` that closes the cycle.
         #[label("this import closes the cycle")]
@@ -116,8 +125,20 @@ pub enum LoadError {
 }
 
 /// Loads the root files and everything they import. The entry point of the load stage.
-pub fn load(world: &dyn World, roots: &[PathBuf], sources: &mut SourceMap, diags: &mut Diagnostics) -> Program {
-    let mut l = Loader { world, sources, diags, program: Program::default(), by_key: HashMap::new(), stack: Vec::new() };
+pub fn load(
+    world: &dyn World,
+    roots: &[PathBuf],
+    sources: &mut SourceMap,
+    diags: &mut Diagnostics,
+) -> Program {
+    let mut l = Loader {
+        world,
+        sources,
+        diags,
+        program: Program::default(),
+        by_key: HashMap::new(),
+        stack: Vec::new(),
+    };
     for root in roots {
         l.load_file(root, &root.to_string_lossy(), None, true);
     }
@@ -142,7 +163,13 @@ struct Loader<'a> {
 
 impl Loader<'_> {
     /// Loads a user file; `from` is the `use` that named it and the importing file.
-    fn load_file(&mut self, path: &Path, shown: &str, from: Option<(FileId, Span)>, root: bool) -> Option<ModuleId> {
+    fn load_file(
+        &mut self,
+        path: &Path,
+        shown: &str,
+        from: Option<(FileId, Span)>,
+        root: bool,
+    ) -> Option<ModuleId> {
         let canonical = self.world.canonical(path);
         let key = canonical.to_string_lossy().into_owned();
         if let Some(&id) = self.by_key.get(&key) {
@@ -153,8 +180,21 @@ impl Loader<'_> {
         let bytes = match self.world.read(path) {
             Ok(b) => b,
             Err(e) => {
-                let file = from.map_or_else(|| self.sources.add(shown.clone(), Some(canonical.clone()), String::new()), |f| f.0);
-                self.diags.push(file, LoadError::Unreadable { span: from.map(|f| f.1), path: shown, reason: e.0 });
+                let file = from.map_or_else(
+                    || {
+                        self.sources
+                            .add(shown.clone(), Some(canonical.clone()), String::new())
+                    },
+                    |f| f.0,
+                );
+                self.diags.push(
+                    file,
+                    LoadError::Unreadable {
+                        span: from.map(|f| f.1),
+                        path: shown,
+                        reason: e.0,
+                    },
+                );
                 return None;
             }
         };
@@ -168,7 +208,13 @@ impl Loader<'_> {
         let file = self.sources.add(shown.clone(), Some(canonical), text);
         if let Some(at) = bad {
             // The lossy text holds U+FFFD (3 bytes) where the bad byte was.
-            self.diags.push(file, LoadError::NotUtf8 { span: Span::new(file, at, at + 3), path: shown });
+            self.diags.push(
+                file,
+                LoadError::NotUtf8 {
+                    span: Span::new(file, at, at + 3),
+                    path: shown,
+                },
+            );
             return None;
         }
         Some(self.add_module(key, file, None, root))
@@ -180,11 +226,19 @@ impl Loader<'_> {
         }
         let (_, text) = STD_MODULES.iter().find(|(n, _)| *n == name)?;
         let short = name.trim_start_matches("std::");
-        let file = self.sources.add(format!("<std>/{short}.insp"), None, text.to_string());
+        let file = self
+            .sources
+            .add(format!("<std>/{short}.insp"), None, text.to_string());
         Some(self.add_module(name.to_string(), file, Some(name.to_string()), false))
     }
 
-    fn add_module(&mut self, key: String, file: FileId, std_name: Option<String>, root: bool) -> ModuleId {
+    fn add_module(
+        &mut self,
+        key: String,
+        file: FileId,
+        std_name: Option<String>,
+        root: bool,
+    ) -> ModuleId {
         let ast = match syntax::parse(file, &self.sources.get(file).text) {
             Ok(ast) => ast,
             Err(e) => {
@@ -193,7 +247,13 @@ impl Loader<'_> {
             }
         };
         let id = ModuleId(self.program.modules.len());
-        self.program.modules.push(Module { file, ast, imports: Vec::new(), std_name, root });
+        self.program.modules.push(Module {
+            file,
+            ast,
+            imports: Vec::new(),
+            std_name,
+            root,
+        });
         self.by_key.insert(key, id);
         self.stack.push(id);
         let uses: Vec<(usize, ast::Use)> = self.program.modules[id.0]
@@ -209,9 +269,18 @@ impl Loader<'_> {
         for (index, u) in uses {
             if let Some(target) = self.import(file, &u) {
                 if let Some(pos) = self.stack.iter().position(|&m| m == target) {
-                    let mut names: Vec<String> = self.stack[pos..].iter().map(|m| self.module_name(*m)).collect();
+                    let mut names: Vec<String> = self.stack[pos..]
+                        .iter()
+                        .map(|m| self.module_name(*m))
+                        .collect();
                     names.push(self.module_name(target));
-                    self.diags.push(file, LoadError::ImportCycle { span: u.span, cycle: names.join(" → ") });
+                    self.diags.push(
+                        file,
+                        LoadError::ImportCycle {
+                            span: u.span,
+                            cycle: names.join(" → "),
+                        },
+                    );
                     continue;
                 }
                 self.program.modules[id.0].imports.push((index, target));
@@ -223,7 +292,9 @@ impl Loader<'_> {
 
     fn module_name(&self, id: ModuleId) -> String {
         let m = &self.program.modules[id.0];
-        m.std_name.clone().unwrap_or_else(|| self.sources.get(m.file).name.clone())
+        m.std_name
+            .clone()
+            .unwrap_or_else(|| self.sources.get(m.file).name.clone())
     }
 
     fn import(&mut self, file: FileId, u: &ast::Use) -> Option<ModuleId> {
@@ -231,8 +302,13 @@ impl Loader<'_> {
             ast::UseSource::File(s) => {
                 let importer = self.sources.get(file);
                 let base = importer.dir().map(Path::to_path_buf).unwrap_or_default();
-                let shown_base = Path::new(&importer.name).parent().map(Path::to_path_buf).unwrap_or_default();
-                let shown = crate::source::normalize_path(&shown_base.join(&s.value)).to_string_lossy().into_owned();
+                let shown_base = Path::new(&importer.name)
+                    .parent()
+                    .map(Path::to_path_buf)
+                    .unwrap_or_default();
+                let shown = crate::source::normalize_path(&shown_base.join(&s.value))
+                    .to_string_lossy()
+                    .into_owned();
                 self.load_file(&base.join(&s.value), &shown, Some((file, s.span)), false)
             }
             ast::UseSource::Module(segs) => {
@@ -243,7 +319,9 @@ impl Loader<'_> {
                 };
                 let module = names[..module_len].join("::");
                 let span = segs[0].span.join(segs[module_len.max(1) - 1].span);
-                if matches!(u.select, ast::UseSelect::Implicit) && STD_MODULES.iter().any(|(n, _)| *n == names.join("::")) {
+                if matches!(u.select, ast::UseSelect::Implicit)
+                    && STD_MODULES.iter().any(|(n, _)| *n == names.join("::"))
+                {
                     let full = names.join("::");
                     self.diags.push(file, LoadError::ModuleImport {
                         span: u.span,
@@ -262,7 +340,14 @@ impl Loader<'_> {
                                 std_module_names().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
                             ),
                         };
-                        self.diags.push(file, LoadError::UnknownModule { span, name: module, help });
+                        self.diags.push(
+                            file,
+                            LoadError::UnknownModule {
+                                span,
+                                name: module,
+                                help,
+                            },
+                        );
                         None
                     }
                 }

@@ -6,7 +6,10 @@ pub const STD_MODULES: &[(&str, &str)] = &[
     ("std::styli", include_str!("../../stdlib/styli.insp")),
     ("std::probes", include_str!("../../stdlib/probes.insp")),
     ("std::cmms", include_str!("../../stdlib/cmms.insp")),
-    ("std::hierarchies", include_str!("../../stdlib/hierarchies.insp")),
+    (
+        "std::hierarchies",
+        include_str!("../../stdlib/hierarchies.insp"),
+    ),
     ("std::sampling", include_str!("../../stdlib/sampling.insp")),
 ];
 

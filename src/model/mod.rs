@@ -73,6 +73,9 @@ pub struct Model {
     pub samplings: Vec<Sampling>,
     /// Plans declared in the root files (imported files' plans are not run).
     pub plans: Vec<Plan>,
+    /// `std::sampling::fan_leu`, the sampling of a plan that names none and of a part
+    /// sampled without a plan.
+    pub default_sampling: Option<SamplingId>,
 }
 
 /// A coordinate measuring machine.
@@ -131,11 +134,15 @@ impl Head {
     /// The A/B orientations of an indexable head (B = 180° folded onto −180°); empty for
     /// a fixed head.
     pub fn orientations(&self) -> Vec<(f64, f64)> {
-        let HeadKind::Indexable { a, b, step } = &self.kind else { return vec![] };
+        let HeadKind::Indexable { a, b, step } = &self.kind else {
+            return vec![];
+        };
         let steps = |r: &[f64; 2]| ((r[1] - r[0]) / step).round() as usize;
         let full_turn = (b[1] - b[0] - 360.0).abs() < 1e-9;
         let nb = steps(b) + usize::from(!full_turn);
-        (0..=steps(a)).flat_map(|i| (0..nb).map(move |j| (a[0] + i as f64 * step, b[0] + j as f64 * step))).collect()
+        (0..=steps(a))
+            .flat_map(|i| (0..nb).map(move |j| (a[0] + i as f64 * step, b[0] + j as f64 * step)))
+            .collect()
     }
 }
 
@@ -259,7 +266,13 @@ pub enum SurfaceKind {
 
 impl SurfaceKind {
     /// All kinds in order.
-    pub const ALL: [SurfaceKind; 5] = [Self::Plane, Self::Cylinder, Self::Cone, Self::Sphere, Self::Freeform];
+    pub const ALL: [SurfaceKind; 5] = [
+        Self::Plane,
+        Self::Cylinder,
+        Self::Cone,
+        Self::Sphere,
+        Self::Freeform,
+    ];
 
     /// The keyword.
     pub fn keyword(self) -> &'static str {
@@ -322,7 +335,11 @@ impl Sampling {
             .iter()
             .find(|(k, _)| *k == kind)
             .map(|(_, s)| s.clone())
-            .unwrap_or(Strategy { method: SampleMethod::Uniform, points: Some(9), inset: None })
+            .unwrap_or(Strategy {
+                method: SampleMethod::Uniform,
+                points: Some(9),
+                inset: None,
+            })
     }
 }
 

@@ -8,7 +8,11 @@ use std::fmt::Write;
 pub fn fmt_num(v: f64) -> String {
     let s = format!("{v:.6}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" { "0".into() } else { s.into() }
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
+    }
 }
 
 fn v3(v: &Vec3) -> String {
@@ -20,50 +24,156 @@ impl Model {
     /// the catalogue items they use or that a file for which `shown` holds declares.
     pub fn summary(&self, shown: &dyn Fn(crate::source::FileId) -> bool) -> String {
         let used = self.used(shown);
-        let keep = |span: &crate::source::Span, kind: u8, index: usize| shown(span.file) || used.contains(&(kind, index));
+        let keep = |span: &crate::source::Span, kind: u8, index: usize| {
+            shown(span.file) || used.contains(&(kind, index))
+        };
         let mut o = String::new();
-        for h in self.heads.iter().enumerate().filter(|(i, x)| keep(&x.span, 0, *i)).map(|(_, x)| x) {
+        for h in self
+            .heads
+            .iter()
+            .enumerate()
+            .filter(|(i, x)| keep(&x.span, 0, *i))
+            .map(|(_, x)| x)
+        {
             let kind = match &h.kind {
                 HeadKind::Fixed => "fixed".to_string(),
                 HeadKind::Indexable { a, b, step } => format!(
                     "indexable A {}..{} B {}..{} step {} ({} orientations)",
-                    fmt_num(a[0]), fmt_num(a[1]), fmt_num(b[0]), fmt_num(b[1]), fmt_num(*step), h.orientations().len()
+                    fmt_num(a[0]),
+                    fmt_num(a[1]),
+                    fmt_num(b[0]),
+                    fmt_num(b[1]),
+                    fmt_num(*step),
+                    h.orientations().len()
                 ),
             };
-            let _ = writeln!(o, "head {}: {kind}, envelope Ø{} × {}", h.name, fmt_num(h.diameter), fmt_num(h.length));
+            let _ = writeln!(
+                o,
+                "head {}: {kind}, envelope Ø{} × {}",
+                h.name,
+                fmt_num(h.diameter),
+                fmt_num(h.length)
+            );
         }
-        for s in self.styli.iter().enumerate().filter(|(i, x)| keep(&x.span, 1, *i)).map(|(_, x)| x) {
-            let _ = writeln!(o, "stylus {}: tip Ø{}, length {}, stem Ø{}", s.name, fmt_num(s.tip), fmt_num(s.length), fmt_num(s.stem));
+        for s in self
+            .styli
+            .iter()
+            .enumerate()
+            .filter(|(i, x)| keep(&x.span, 1, *i))
+            .map(|(_, x)| x)
+        {
+            let _ = writeln!(
+                o,
+                "stylus {}: tip Ø{}, length {}, stem Ø{}",
+                s.name,
+                fmt_num(s.tip),
+                fmt_num(s.length),
+                fmt_num(s.stem)
+            );
         }
-        for b in self.bodies.iter().enumerate().filter(|(i, x)| keep(&x.span, 2, *i)).map(|(_, x)| x) {
-            let _ = writeln!(o, "body {}: Ø{} × {}", b.name, fmt_num(b.diameter), fmt_num(b.length));
+        for b in self
+            .bodies
+            .iter()
+            .enumerate()
+            .filter(|(i, x)| keep(&x.span, 2, *i))
+            .map(|(_, x)| x)
+        {
+            let _ = writeln!(
+                o,
+                "body {}: Ø{} × {}",
+                b.name,
+                fmt_num(b.diameter),
+                fmt_num(b.length)
+            );
         }
-        for e in self.extensions.iter().enumerate().filter(|(i, x)| keep(&x.span, 3, *i)).map(|(_, x)| x) {
-            let _ = writeln!(o, "extension {}: Ø{} × {}", e.name, fmt_num(e.diameter), fmt_num(e.length));
+        for e in self
+            .extensions
+            .iter()
+            .enumerate()
+            .filter(|(i, x)| keep(&x.span, 3, *i))
+            .map(|(_, x)| x)
+        {
+            let _ = writeln!(
+                o,
+                "extension {}: Ø{} × {}",
+                e.name,
+                fmt_num(e.diameter),
+                fmt_num(e.length)
+            );
         }
-        for p in self.probes.iter().enumerate().filter(|(i, x)| keep(&x.span, 4, *i)).map(|(_, x)| x) {
-            let ext: Vec<&str> = p.extensions.iter().map(|e| self.extensions[e.0].name.as_str()).collect();
+        for p in self
+            .probes
+            .iter()
+            .enumerate()
+            .filter(|(i, x)| keep(&x.span, 4, *i))
+            .map(|(_, x)| x)
+        {
+            let ext: Vec<&str> = p
+                .extensions
+                .iter()
+                .map(|e| self.extensions[e.0].name.as_str())
+                .collect();
             let _ = writeln!(
                 o,
                 "probe {}: body {}, extensions [{}], stylus {}, cost {}",
-                p.name, self.bodies[p.body.0].name, ext.join(", "), self.styli[p.stylus.0].name, fmt_num(p.cost)
+                p.name,
+                self.bodies[p.body.0].name,
+                ext.join(", "),
+                self.styli[p.stylus.0].name,
+                fmt_num(p.cost)
             );
         }
         for c in self.cmms.iter().filter(|c| shown(c.span.file)) {
-            let probes: Vec<String> = c.probes.iter().map(|(l, p)| format!("{l}: {}", self.probes[p.0].name)).collect();
-            let size = c.table_size.map_or(String::new(), |s| format!(" size {} × {}", fmt_num(s[0]), fmt_num(s[1])));
+            let probes: Vec<String> = c
+                .probes
+                .iter()
+                .map(|(l, p)| format!("{l}: {}", self.probes[p.0].name))
+                .collect();
+            let size = c.table_size.map_or(String::new(), |s| {
+                format!(" size {} × {}", fmt_num(s[0]), fmt_num(s[1]))
+            });
             let _ = writeln!(
                 o,
                 "cmm {}: table z {}{size}, ram r {} l {}, head {}, probes [{}]",
-                c.name, fmt_num(c.table_z), fmt_num(c.ram_radius), fmt_num(c.ram_length), self.heads[c.head.0].name, probes.join(", ")
+                c.name,
+                fmt_num(c.table_z),
+                fmt_num(c.ram_radius),
+                fmt_num(c.ram_length),
+                self.heads[c.head.0].name,
+                probes.join(", ")
             );
         }
-        for h in self.hierarchies.iter().enumerate().filter(|(i, x)| keep(&x.span, 5, *i)).map(|(_, x)| x) {
-            let levels: Vec<String> = h.levels.iter().map(|l| crate::resolve::level_text(l.var, l.group)).collect();
-            let _ = writeln!(o, "hierarchy {}: required approachability > {}", h.name, levels.join(" > "));
+        for h in self
+            .hierarchies
+            .iter()
+            .enumerate()
+            .filter(|(i, x)| keep(&x.span, 5, *i))
+            .map(|(_, x)| x)
+        {
+            let levels: Vec<String> = h
+                .levels
+                .iter()
+                .map(|l| crate::resolve::level_text(l.var, l.group))
+                .collect();
+            let _ = writeln!(
+                o,
+                "hierarchy {}: required approachability > {}",
+                h.name,
+                levels.join(" > ")
+            );
         }
-        for s in self.samplings.iter().enumerate().filter(|(i, x)| keep(&x.span, 6, *i)).map(|(_, x)| x) {
-            let per: Vec<String> = s.per_surface.iter().map(|(k, st)| format!("{} {}", k.keyword(), strategy_text(st))).collect();
+        for s in self
+            .samplings
+            .iter()
+            .enumerate()
+            .filter(|(i, x)| keep(&x.span, 6, *i))
+            .map(|(_, x)| x)
+        {
+            let per: Vec<String> = s
+                .per_surface
+                .iter()
+                .map(|(k, st)| format!("{} {}", k.keyword(), strategy_text(st)))
+                .collect();
             let _ = writeln!(o, "sampling {}: {}", s.name, per.join(", "));
         }
         for p in self.parts.iter().filter(|p| shown(p.span.file)) {
@@ -73,22 +183,48 @@ impl Model {
             let _ = writeln!(
                 o,
                 "plan {}: part {}, cmm {}, hierarchy {}, sampling {}",
-                p.name, self.parts[p.part.0].name, self.cmms[p.cmm.0].name, self.hierarchies[p.hierarchy.0].name, self.samplings[p.sampling.0].name
+                p.name,
+                self.parts[p.part.0].name,
+                self.cmms[p.cmm.0].name,
+                self.hierarchies[p.hierarchy.0].name,
+                self.samplings[p.sampling.0].name
             );
             for s in &p.setups {
-                let verb = if s.forbidden { "forbid".to_string() } else { format!("prefer (weight {})", fmt_num(s.weight)) };
+                let verb = if s.forbidden {
+                    "forbid".to_string()
+                } else {
+                    format!("prefer (weight {})", fmt_num(s.weight))
+                };
                 let _ = writeln!(o, "  {verb} setup {}", v3(&s.direction));
             }
             for s in &p.orientations {
-                let verb = if s.forbidden { "forbid".to_string() } else { format!("prefer (weight {})", fmt_num(s.weight)) };
-                let _ = writeln!(o, "  {verb} orientation A {} B {}", fmt_num(s.a), fmt_num(s.b));
+                let verb = if s.forbidden {
+                    "forbid".to_string()
+                } else {
+                    format!("prefer (weight {})", fmt_num(s.weight))
+                };
+                let _ = writeln!(
+                    o,
+                    "  {verb} orientation A {} B {}",
+                    fmt_num(s.a),
+                    fmt_num(s.b)
+                );
             }
             for s in &p.probes {
-                let what = if s.forbidden { "forbid".to_string() } else { format!("cost {}", s.cost.map_or("-".into(), fmt_num)) };
+                let what = if s.forbidden {
+                    "forbid".to_string()
+                } else {
+                    format!("cost {}", s.cost.map_or("-".into(), fmt_num))
+                };
                 let _ = writeln!(o, "  probe {}: {what}", s.label);
             }
             for (f, st) in &p.overrides {
-                let _ = writeln!(o, "  sample {} with {}", self.parts[p.part.0].features[f.0].name, strategy_text(st));
+                let _ = writeln!(
+                    o,
+                    "  sample {} with {}",
+                    self.parts[p.part.0].features[f.0].name,
+                    strategy_text(st)
+                );
             }
         }
         o
@@ -97,15 +233,30 @@ impl Model {
 
 impl Model {
     /// Catalogue items used by the shown CMMs and plans, as (kind, index) pairs.
-    fn used(&self, shown: &dyn Fn(crate::source::FileId) -> bool) -> std::collections::BTreeSet<(u8, usize)> {
+    fn used(
+        &self,
+        shown: &dyn Fn(crate::source::FileId) -> bool,
+    ) -> std::collections::BTreeSet<(u8, usize)> {
         let mut used = std::collections::BTreeSet::new();
-        let mut cmms: Vec<usize> = self.cmms.iter().enumerate().filter(|(_, c)| shown(c.span.file)).map(|(i, _)| i).collect();
+        let mut cmms: Vec<usize> = self
+            .cmms
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| shown(c.span.file))
+            .map(|(i, _)| i)
+            .collect();
         for p in &self.plans {
             cmms.push(p.cmm.0);
             used.insert((5, p.hierarchy.0));
             used.insert((6, p.sampling.0));
         }
-        let mut probes: Vec<usize> = self.probes.iter().enumerate().filter(|(_, p)| shown(p.span.file)).map(|(i, _)| i).collect();
+        let mut probes: Vec<usize> = self
+            .probes
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| shown(p.span.file))
+            .map(|(i, _)| i)
+            .collect();
         for c in cmms {
             used.insert((0, self.cmms[c].head.0));
             probes.extend(self.cmms[c].probes.iter().map(|(_, p)| p.0));
@@ -136,16 +287,25 @@ fn strategy_text(s: &Strategy) -> String {
         Some(Inset::Fraction(f)) => args.push(format!("inset {} %", fmt_num(f * 100.0))),
         None => {}
     }
-    if args.is_empty() { m.to_string() } else { format!("{m}({})", args.join(", ")) }
+    if args.is_empty() {
+        m.to_string()
+    } else {
+        format!("{m}({})", args.join(", "))
+    }
 }
 
 fn part_summary(o: &mut String, p: &Part) {
     let geometry = match &p.geometry {
         Geometry::Stock(Stock::Box { size }) => format!("box {}", v3(size)),
-        Geometry::Stock(Stock::Cylinder { diameter, height }) => format!("cylinder Ø{} × {}", fmt_num(*diameter), fmt_num(*height)),
+        Geometry::Stock(Stock::Cylinder { diameter, height }) => {
+            format!("cylinder Ø{} × {}", fmt_num(*diameter), fmt_num(*height))
+        }
         Geometry::Stock(Stock::Sphere { diameter }) => format!("sphere Ø{}", fmt_num(*diameter)),
         Geometry::Mesh { path, unit_mm, .. } => {
-            let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
             format!("mesh {name} (× {} mm)", fmt_num(*unit_mm))
         }
     };
@@ -153,7 +313,12 @@ fn part_summary(o: &mut String, p: &Part) {
     for op in &p.ops {
         let verb = if op.add { "add" } else { "cut" };
         let shape = match &op.kind {
-            OpKind::Hole { at, axis, diameter, depth } => {
+            OpKind::Hole {
+                at,
+                axis,
+                diameter,
+                depth,
+            } => {
                 let at = match at {
                     Placement::At(p) => format!("at {}", v3(p)),
                     Placement::Radial(d) => format!("radial {}", v3(d)),
@@ -162,24 +327,85 @@ fn part_summary(o: &mut String, p: &Part) {
                     Depth::Through => "through".to_string(),
                     Depth::Blind(d) => format!("depth {}", fmt_num(*d)),
                 };
-                format!("hole {at} axis {} Ø{} {depth}", v3(axis), fmt_num(*diameter))
+                format!(
+                    "hole {at} axis {} Ø{} {depth}",
+                    v3(axis),
+                    fmt_num(*diameter)
+                )
             }
-            OpKind::Slot { at, along, into, width, depth, length } => format!(
+            OpKind::Slot {
+                at,
+                along,
+                into,
+                width,
+                depth,
+                length,
+            } => format!(
                 "slot at {} along {} into {} width {} depth {}{}",
-                v3(at), v3(along), v3(into), fmt_num(*width), fmt_num(*depth), length.map_or(String::new(), |l| format!(" length {}", fmt_num(l)))
+                v3(at),
+                v3(along),
+                v3(into),
+                fmt_num(*width),
+                fmt_num(*depth),
+                length.map_or(String::new(), |l| format!(" length {}", fmt_num(l)))
             ),
-            OpKind::Pocket { at, along, into, size, depth, corner_radius } => format!(
+            OpKind::Pocket {
+                at,
+                along,
+                into,
+                size,
+                depth,
+                corner_radius,
+            } => format!(
                 "pocket at {} along {} into {} size {} × {} depth {} corner r {}",
-                v3(at), v3(along), v3(into), fmt_num(size[0]), fmt_num(size[1]), fmt_num(*depth), fmt_num(*corner_radius)
+                v3(at),
+                v3(along),
+                v3(into),
+                fmt_num(size[0]),
+                fmt_num(size[1]),
+                fmt_num(*depth),
+                fmt_num(*corner_radius)
             ),
-            OpKind::Step { at, along, into, width, depth } => format!("step at {} along {} into {} width {} depth {}", v3(at), v3(along), v3(into), fmt_num(*width), fmt_num(*depth)),
-            OpKind::Boss { at, axis, diameter, height } => format!("boss at {} axis {} Ø{} height {}", v3(at), v3(axis), fmt_num(*diameter), fmt_num(*height)),
+            OpKind::Step {
+                at,
+                along,
+                into,
+                width,
+                depth,
+            } => format!(
+                "step at {} along {} into {} width {} depth {}",
+                v3(at),
+                v3(along),
+                v3(into),
+                fmt_num(*width),
+                fmt_num(*depth)
+            ),
+            OpKind::Boss {
+                at,
+                axis,
+                diameter,
+                height,
+            } => format!(
+                "boss at {} axis {} Ø{} height {}",
+                v3(at),
+                v3(axis),
+                fmt_num(*diameter),
+                fmt_num(*height)
+            ),
         };
         let pattern = match &op.pattern {
             None => String::new(),
-            Some(Pattern::Grid { nx, ny, pitch }) => format!(" × grid {nx}×{ny} pitch {} × {}", fmt_num(pitch[0]), fmt_num(pitch[1])),
+            Some(Pattern::Grid { nx, ny, pitch }) => format!(
+                " × grid {nx}×{ny} pitch {} × {}",
+                fmt_num(pitch[0]),
+                fmt_num(pitch[1])
+            ),
             Some(Pattern::Linear { count, step }) => format!(" × linear {count} step {}", v3(step)),
-            Some(Pattern::Polar { count, axis, center }) => format!(" × polar {count} about {} through {}", v3(axis), v3(center)),
+            Some(Pattern::Polar {
+                count,
+                axis,
+                center,
+            }) => format!(" × polar {count} about {} through {}", v3(axis), v3(center)),
         };
         let _ = writeln!(o, "  {verb} {}: {shape}{pattern}", op.name);
     }
@@ -195,10 +421,25 @@ fn part_summary(o: &mut String, p: &Part) {
         let _ = writeln!(o, "  frame {} = [{}]", f.name, datum_refs(p, &f.refs));
     }
     for t in &p.tolerances {
-        let targets: Vec<&str> = t.targets.iter().map(|f| p.features[f.0].name.as_str()).collect();
+        let targets: Vec<&str> = t
+            .targets
+            .iter()
+            .map(|f| p.features[f.0].name.as_str())
+            .collect();
         let value = match &t.value {
-            TolValue::Zone { width, diameter } => format!("{}{}", if *diameter { "Ø" } else { "" }, fmt_num(*width)),
-            TolValue::Size { nominal, lower, upper } => format!("{} [{}, {}]", fmt_num(*nominal), fmt_num(*lower), fmt_num(*upper)),
+            TolValue::Zone { width, diameter } => {
+                format!("{}{}", if *diameter { "Ø" } else { "" }, fmt_num(*width))
+            }
+            TolValue::Size {
+                nominal,
+                lower,
+                upper,
+            } => format!(
+                "{} [{}, {}]",
+                fmt_num(*nominal),
+                fmt_num(*lower),
+                fmt_num(*upper)
+            ),
         };
         let m = match t.modifier {
             Some(Material::Mmc) => " MMC",
@@ -206,10 +447,21 @@ fn part_summary(o: &mut String, p: &Part) {
             Some(Material::Rfs) => " RFS",
             None => "",
         };
-        let datums = if t.datums.is_empty() { String::new() } else { format!(" | {}", datum_refs(p, &t.datums)) };
-        let basic = t.basic_angle.map_or(String::new(), |a| format!(" basic {}°", fmt_num(a)));
+        let datums = if t.datums.is_empty() {
+            String::new()
+        } else {
+            format!(" | {}", datum_refs(p, &t.datums))
+        };
+        let basic = t
+            .basic_angle
+            .map_or(String::new(), |a| format!(" basic {}°", fmt_num(a)));
         let kind = crate::resolve::tolerance_keyword(t.kind);
-        let _ = writeln!(o, "  tolerance {}: {kind}({}) {value}{m}{datums}{basic}", t.name, targets.join(", "));
+        let _ = writeln!(
+            o,
+            "  tolerance {}: {kind}({}) {value}{m}{datums}{basic}",
+            t.name,
+            targets.join(", ")
+        );
     }
 }
 
@@ -230,9 +482,21 @@ fn datum_refs(p: &Part, refs: &[DatumRef]) -> String {
 
 fn face_text(p: &Part, r: &FaceRef) -> String {
     match r {
-        FaceRef::Role { source: FaceSource::Stock, role, .. } => format!("stock.{role}"),
-        FaceRef::Role { source: FaceSource::Op(op, None), role, .. } => format!("{}.{role}", p.ops[op.0].name),
-        FaceRef::Role { source: FaceSource::Op(op, Some(i)), role, .. } => format!("{}[{i}].{role}", p.ops[op.0].name),
+        FaceRef::Role {
+            source: FaceSource::Stock,
+            role,
+            ..
+        } => format!("stock.{role}"),
+        FaceRef::Role {
+            source: FaceSource::Op(op, None),
+            role,
+            ..
+        } => format!("{}.{role}", p.ops[op.0].name),
+        FaceRef::Role {
+            source: FaceSource::Op(op, Some(i)),
+            role,
+            ..
+        } => format!("{}[{i}].{role}", p.ops[op.0].name),
         FaceRef::Group(g, _) => format!("group {g:?}"),
         FaceRef::Segment(n, _) => format!("segment {n}"),
         FaceRef::Select(s, _) => format!("select{s:?}"),

@@ -10,7 +10,14 @@ use crate::syntax::ast::{self, ValueKind};
 
 /// Lowers one property item and pushes it onto the model (always exactly one entry, so
 /// indices stay aligned with declarations even after errors).
-pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, kind: Kind, b: &ast::BlockItem, model: &mut Model) {
+pub(super) fn lower(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    kind: Kind,
+    b: &ast::BlockItem,
+    model: &mut Model,
+) {
     let name = b.name.name.clone();
     let span = b.name.span;
     let item = format!("{} `{name}`", kind.noun());
@@ -21,31 +28,72 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, kind: Kind, b: 
             model.heads.push(head);
         }
         Kind::Stylus => {
-            let tip = p.req(cx, "tip", "2 mm").and_then(|v| cx.positive(v, Dim::Length, "tip")).unwrap_or(1.0);
-            let length = p.req(cx, "length", "20 mm").and_then(|v| cx.positive(v, Dim::Length, "length")).unwrap_or(1.0);
+            let tip = p
+                .req(cx, "tip", "2 mm")
+                .and_then(|v| cx.positive(v, Dim::Length, "tip"))
+                .unwrap_or(1.0);
+            let length = p
+                .req(cx, "length", "20 mm")
+                .and_then(|v| cx.positive(v, Dim::Length, "length"))
+                .unwrap_or(1.0);
             let stem_v = p.req(cx, "stem", "1.5 mm");
-            let stem = stem_v.and_then(|v| cx.positive(v, Dim::Length, "stem")).unwrap_or(0.5);
+            let stem = stem_v
+                .and_then(|v| cx.positive(v, Dim::Length, "stem"))
+                .unwrap_or(0.5);
             if let Some(v) = stem_v {
                 if stem >= tip {
-                    cx.err(E::StemThickerThanTip { span: v.span, name: name.clone(), stem: num(stem), tip: num(tip) });
+                    cx.err(E::StemThickerThanTip {
+                        span: v.span,
+                        name: name.clone(),
+                        stem: num(stem),
+                        tip: num(tip),
+                    });
                 }
             }
             describe_only(cx, &mut p);
-            model.styli.push(Stylus { name, tip, length, stem, span });
+            model.styli.push(Stylus {
+                name,
+                tip,
+                length,
+                stem,
+                span,
+            });
         }
         Kind::Body | Kind::Extension => {
-            let diameter = p.req(cx, "diameter", "13.2 mm").and_then(|v| cx.positive(v, Dim::Length, "diameter")).unwrap_or(1.0);
-            let length = p.req(cx, "length", "30 mm").and_then(|v| cx.positive(v, Dim::Length, "length")).unwrap_or(1.0);
+            let diameter = p
+                .req(cx, "diameter", "13.2 mm")
+                .and_then(|v| cx.positive(v, Dim::Length, "diameter"))
+                .unwrap_or(1.0);
+            let length = p
+                .req(cx, "length", "30 mm")
+                .and_then(|v| cx.positive(v, Dim::Length, "length"))
+                .unwrap_or(1.0);
             describe_only(cx, &mut p);
             if kind == Kind::Body {
-                model.bodies.push(Body { name, diameter, length, span });
+                model.bodies.push(Body {
+                    name,
+                    diameter,
+                    length,
+                    span,
+                });
             } else {
-                model.extensions.push(Extension { name, diameter, length, span });
+                model.extensions.push(Extension {
+                    name,
+                    diameter,
+                    length,
+                    span,
+                });
             }
         }
         Kind::Probe => {
-            let body = p.req(cx, "body", "TP20_SF").and_then(|v| r.lookup_value(cx, module, v, Kind::Body)).unwrap_or(0);
-            let stylus = p.req(cx, "stylus", "M2_D2_L20").and_then(|v| r.lookup_value(cx, module, v, Kind::Stylus)).unwrap_or(0);
+            let body = p
+                .req(cx, "body", "TP20_SF")
+                .and_then(|v| r.lookup_value(cx, module, v, Kind::Body))
+                .unwrap_or(0);
+            let stylus = p
+                .req(cx, "stylus", "M2_D2_L20")
+                .and_then(|v| r.lookup_value(cx, module, v, Kind::Stylus))
+                .unwrap_or(0);
             let mut extensions = Vec::new();
             if let Some(v) = p.get("extensions") {
                 match &v.kind {
@@ -59,9 +107,19 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, kind: Kind, b: 
                     _ => cx.mismatch(v, "a list of extensions", "write `extensions [PEM20]`"),
                 }
             }
-            let cost = p.get("cost").and_then(|v| cx.non_negative(v, "cost")).unwrap_or(1.0);
+            let cost = p
+                .get("cost")
+                .and_then(|v| cx.non_negative(v, "cost"))
+                .unwrap_or(1.0);
             describe_only(cx, &mut p);
-            model.probes.push(Probe { name, body: BodyId(body), extensions, stylus: StylusId(stylus), cost, span });
+            model.probes.push(Probe {
+                name,
+                body: BodyId(body),
+                extensions,
+                stylus: StylusId(stylus),
+                cost,
+                span,
+            });
         }
         Kind::Cmm => {
             let cmm = cmm(r, cx, module, &mut p, name, span);
@@ -76,7 +134,11 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, kind: Kind, b: 
                     }
                 }
             }
-            model.samplings.push(Sampling { name, per_surface, span });
+            model.samplings.push(Sampling {
+                name,
+                per_surface,
+                span,
+            });
         }
         Kind::Part | Kind::Hierarchy | Kind::Plan => unreachable!("not a property item"),
     }
@@ -93,15 +155,27 @@ fn describe_only(cx: &mut Cx, p: &mut Props) {
 }
 
 fn head(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Head {
-    let length = p.req(cx, "length", "50 mm").and_then(|v| cx.positive(v, Dim::Length, "length")).unwrap_or(1.0);
-    let diameter = p.req(cx, "diameter", "25 mm").and_then(|v| cx.positive(v, Dim::Length, "diameter")).unwrap_or(1.0);
+    let length = p
+        .req(cx, "length", "50 mm")
+        .and_then(|v| cx.positive(v, Dim::Length, "length"))
+        .unwrap_or(1.0);
+    let diameter = p
+        .req(cx, "diameter", "25 mm")
+        .and_then(|v| cx.positive(v, Dim::Length, "diameter"))
+        .unwrap_or(1.0);
     describe_only(cx, p);
     let kind_v = p.req(cx, "kind", "fixed");
-    let kind_name = kind_v.and_then(|v| cx.name(v)).map(|i| (i.name.as_str(), i.span));
+    let kind_name = kind_v
+        .and_then(|v| cx.name(v))
+        .map(|i| (i.name.as_str(), i.span));
     let kind = match kind_name {
         Some(("indexable", _)) => {
-            let a = p.req(cx, "a", "0 deg .. 105 deg").and_then(|v| angle_range(cx, v, "a", [0.0, 180.0]));
-            let b = p.req(cx, "b", "-180 deg .. 180 deg").and_then(|v| angle_range(cx, v, "b", [-360.0, 360.0]));
+            let a = p
+                .req(cx, "a", "0 deg .. 105 deg")
+                .and_then(|v| angle_range(cx, v, "a", [0.0, 180.0]));
+            let b = p
+                .req(cx, "b", "-180 deg .. 180 deg")
+                .and_then(|v| angle_range(cx, v, "b", [-360.0, 360.0]));
             let step_v = p.req(cx, "step", "7.5 deg");
             let step = step_v.and_then(|v| cx.positive(v, Dim::Angle, "step"));
             if let (Some(step), Some(v)) = (step, step_v) {
@@ -122,22 +196,41 @@ fn head(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> 
             }
             match (a, b, step) {
                 (Some(a), Some(b), Some(step)) => HeadKind::Indexable { a, b, step },
-                _ => HeadKind::Indexable { a: [0.0, 0.0], b: [0.0, 0.0], step: 1.0 },
+                _ => HeadKind::Indexable {
+                    a: [0.0, 0.0],
+                    b: [0.0, 0.0],
+                    step: 1.0,
+                },
             }
         }
         Some(("fixed", _)) | None => HeadKind::Fixed,
         Some((other, s)) => {
             let help = suggest::help_for_unknown("head kind", other, ["fixed", "indexable"]);
-            cx.err(E::UnknownName { span: s, what: "head kind".into(), name: other.into(), help });
+            cx.err(E::UnknownName {
+                span: s,
+                what: "head kind".into(),
+                name: other.into(),
+                help,
+            });
             HeadKind::Fixed
         }
     };
-    Head { name, kind, length, diameter, span }
+    Head {
+        name,
+        kind,
+        length,
+        diameter,
+        span,
+    }
 }
 
 fn angle_range(cx: &mut Cx, v: &ast::Value, axis: &str, limits: [f64; 2]) -> Option<[f64; 2]> {
     let ValueKind::Range(lo, hi) = &v.kind else {
-        cx.mismatch(v, "an angle range", &format!("write `{axis} 0 deg .. 105 deg`"));
+        cx.mismatch(
+            v,
+            "an angle range",
+            &format!("write `{axis} 0 deg .. 105 deg`"),
+        );
         return None;
     };
     let lo = cx.quantity(lo, Dim::Angle);
@@ -148,7 +241,11 @@ fn angle_range(cx: &mut Cx, v: &ast::Value, axis: &str, limits: [f64; 2]) -> Opt
             span: v.span,
             what: format!("`{axis}` range"),
             value: format!("{}°..{}°", num(lo), num(hi)),
-            range: format!("it must run upwards within {}°..{}°", num(limits[0]), num(limits[1])),
+            range: format!(
+                "it must run upwards within {}°..{}°",
+                num(limits[0]),
+                num(limits[1])
+            ),
             help: "give the head's mechanical limits from its data sheet".into(),
         });
         return None;
@@ -156,7 +253,14 @@ fn angle_range(cx: &mut Cx, v: &ast::Value, axis: &str, limits: [f64; 2]) -> Opt
     Some([lo, hi])
 }
 
-fn cmm(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &mut Props, name: String, span: crate::source::Span) -> Cmm {
+fn cmm(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    p: &mut Props,
+    name: String,
+    span: crate::source::Span,
+) -> Cmm {
     let mut table_z = 0.0;
     let mut table_size = None;
     if let Some(v) = p.get("table") {
@@ -168,7 +272,12 @@ fn cmm(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &mut Props, name: String,
             if let Some(s) = t.get("size") {
                 if let Some(size) = cx.lengths::<2>(s) {
                     if size.iter().any(|x| *x <= 0.0) {
-                        cx.err(E::NonPositive { span: s.span, what: "the table size".into(), value: describe(s), help: "give the table's length and width".into() });
+                        cx.err(E::NonPositive {
+                            span: s.span,
+                            what: "the table size".into(),
+                            value: describe(s),
+                            help: "give the table's length and width".into(),
+                        });
                     } else {
                         table_size = Some(size);
                     }
@@ -184,29 +293,48 @@ fn cmm(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &mut Props, name: String,
         match &v.kind {
             ValueKind::Block(props) => {
                 let mut t = Props::new(cx, "the ram", v.span, props);
-                ram_radius = t.req(cx, "radius", "35 mm").and_then(|x| cx.positive(x, Dim::Length, "radius")).unwrap_or(1.0);
-                ram_length = t.req(cx, "length", "600 mm").and_then(|x| cx.positive(x, Dim::Length, "length")).unwrap_or(1.0);
+                ram_radius = t
+                    .req(cx, "radius", "35 mm")
+                    .and_then(|x| cx.positive(x, Dim::Length, "radius"))
+                    .unwrap_or(1.0);
+                ram_length = t
+                    .req(cx, "length", "600 mm")
+                    .and_then(|x| cx.positive(x, Dim::Length, "length"))
+                    .unwrap_or(1.0);
                 t.finish(cx);
             }
             _ => cx.mismatch(v, "a block `{ radius …, length … }`", ""),
         }
     }
-    let head = p.req(cx, "head", "PH6").and_then(|v| r.lookup_value(cx, module, v, Kind::Head)).unwrap_or(0);
+    let head = p
+        .req(cx, "head", "PH6")
+        .and_then(|v| r.lookup_value(cx, module, v, Kind::Head))
+        .unwrap_or(0);
     let mut probes: Vec<(String, ProbeId)> = Vec::new();
     if let Some(v) = p.req(cx, "probes", "[p1: TP20_D2_L20]") {
         match &v.kind {
             ValueKind::List(entries) if !entries.is_empty() => {
                 for e in entries {
-                    let Some(id) = r.lookup_value(cx, module, &e.value, Kind::Probe) else { continue };
+                    let Some(id) = r.lookup_value(cx, module, &e.value, Kind::Probe) else {
+                        continue;
+                    };
                     let (label, lspan) = match &e.label {
                         Some(l) => (l.name.clone(), l.span),
-                        None => (match &e.value.kind {
-                            ValueKind::Path(path) => super::props::path_text(path),
-                            _ => String::new(),
-                        }, e.value.span),
+                        None => (
+                            match &e.value.kind {
+                                ValueKind::Path(path) => super::props::path_text(path),
+                                _ => String::new(),
+                            },
+                            e.value.span,
+                        ),
                     };
                     if probes.iter().any(|(l, _)| *l == label) {
-                        cx.err(E::DuplicateName { span: lspan, first: None, name: label, help: "each probe in the rack needs its own label".into() });
+                        cx.err(E::DuplicateName {
+                            span: lspan,
+                            first: None,
+                            name: label,
+                            help: "each probe in the rack needs its own label".into(),
+                        });
                         continue;
                     }
                     probes.push((label, ProbeId(id)));
@@ -221,17 +349,34 @@ fn cmm(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &mut Props, name: String,
             _ => cx.mismatch(v, "a list of probes", "write `probes [p1: TP20_D2_L20]`"),
         }
     }
-    Cmm { name, table_z, table_size, ram_radius, ram_length, head: HeadId(head), probes, span }
+    Cmm {
+        name,
+        table_z,
+        table_size,
+        ram_radius,
+        ram_length,
+        head: HeadId(head),
+        probes,
+        span,
+    }
 }
 
 /// A sampling strategy: `fan_leu`, `uniform(points 9, inset 1 mm)`, `hammersley(points 16)`.
 /// `surface` is the surface type it is for, when known.
-pub(super) fn strategy(cx: &mut Cx, v: &ast::Value, surface: Option<SurfaceKind>) -> Option<Strategy> {
+pub(super) fn strategy(
+    cx: &mut Cx,
+    v: &ast::Value,
+    surface: Option<SurfaceKind>,
+) -> Option<Strategy> {
     let (callee, args): (&ast::Ident, &[ast::Arg]) = match &v.kind {
         ValueKind::Path(p) if p.as_ident().is_some() => (p.as_ident()?, &[]),
         ValueKind::Call(c) if c.callee.as_ident().is_some() => (c.callee.as_ident()?, &c.args),
         _ => {
-            cx.mismatch(v, "a sampling method", "write `fan_leu`, `uniform(points 9)` or `hammersley(points 16)`");
+            cx.mismatch(
+                v,
+                "a sampling method",
+                "write `fan_leu`, `uniform(points 9)` or `hammersley(points 16)`",
+            );
             return None;
         }
     };
@@ -240,12 +385,23 @@ pub(super) fn strategy(cx: &mut Cx, v: &ast::Value, surface: Option<SurfaceKind>
         "uniform" => SampleMethod::Uniform,
         "hammersley" => SampleMethod::Hammersley,
         other => {
-            let help = suggest::help_for_unknown("sampling method", other, ["fan_leu", "uniform", "hammersley"]);
-            cx.err(E::UnknownName { span: callee.span, what: "sampling method".into(), name: other.into(), help });
+            let help = suggest::help_for_unknown(
+                "sampling method",
+                other,
+                ["fan_leu", "uniform", "hammersley"],
+            );
+            cx.err(E::UnknownName {
+                span: callee.span,
+                what: "sampling method".into(),
+                name: other.into(),
+                help,
+            });
             return None;
         }
     };
-    if method == SampleMethod::FanLeu && matches!(surface, Some(SurfaceKind::Sphere | SurfaceKind::Freeform)) {
+    if method == SampleMethod::FanLeu
+        && matches!(surface, Some(SurfaceKind::Sphere | SurfaceKind::Freeform))
+    {
         cx.err(E::OutOfRange {
             span: callee.span,
             what: "Fan & Leu sampling".into(),
@@ -263,12 +419,24 @@ pub(super) fn strategy(cx: &mut Cx, v: &ast::Value, surface: Option<SurfaceKind>
             ast::Arg::Named(k, val) if k.name == "inset" => inset = inset_value(cx, val),
             ast::Arg::Named(k, _) => {
                 let help = suggest::help_for_unknown("option", &k.name, ["points", "inset"]);
-                cx.err(E::UnknownProperty { span: k.span, key: k.name.clone(), item: "a sampling method".into(), help });
+                cx.err(E::UnknownProperty {
+                    span: k.span,
+                    key: k.name.clone(),
+                    item: "a sampling method".into(),
+                    help,
+                });
             }
-            ast::Arg::Positional(val) => cx.mismatch(val, "a named option", "write `points 9` or `inset 1 mm`"),
+            ast::Arg::Positional(val) => {
+                cx.mismatch(val, "a named option", "write `points 9` or `inset 1 mm`")
+            }
         }
     }
-    if method != SampleMethod::FanLeu && points.is_none() && !args.iter().any(|a| matches!(a, ast::Arg::Named(k, _) if k.name == "points")) {
+    if method != SampleMethod::FanLeu
+        && points.is_none()
+        && !args
+            .iter()
+            .any(|a| matches!(a, ast::Arg::Named(k, _) if k.name == "points"))
+    {
         cx.err(E::MissingArgument {
             span: v.span,
             kind: format!("`{}`", callee.name),
@@ -277,7 +445,11 @@ pub(super) fn strategy(cx: &mut Cx, v: &ast::Value, surface: Option<SurfaceKind>
         });
         return None;
     }
-    Some(Strategy { method, points, inset })
+    Some(Strategy {
+        method,
+        points,
+        inset,
+    })
 }
 
 fn inset_value(cx: &mut Cx, v: &ast::Value) -> Option<Inset> {
@@ -288,14 +460,26 @@ fn inset_value(cx: &mut Cx, v: &ast::Value) -> Option<Inset> {
     if q.unit.as_ref().is_some_and(|u| u.name == "%") {
         let f = cx.quantity(q, Dim::Ratio)?;
         if !(0.0..0.5).contains(&f) {
-            cx.err(E::OutOfRange { span: v.span, what: "`inset`".into(), value: describe(v), range: "a percentage from 0 % to below 50 %".into(), help: "the inset is taken from each side".into() });
+            cx.err(E::OutOfRange {
+                span: v.span,
+                what: "`inset`".into(),
+                value: describe(v),
+                range: "a percentage from 0 % to below 50 %".into(),
+                help: "the inset is taken from each side".into(),
+            });
             return None;
         }
         return Some(Inset::Fraction(f));
     }
     let x = cx.length(v)?;
     if x < 0.0 {
-        cx.err(E::OutOfRange { span: v.span, what: "`inset`".into(), value: describe(v), range: "it cannot be negative".into(), help: "give a distance from the face's boundary".into() });
+        cx.err(E::OutOfRange {
+            span: v.span,
+            what: "`inset`".into(),
+            value: describe(v),
+            range: "it cannot be negative".into(),
+            help: "give a distance from the face's boundary".into(),
+        });
         return None;
     }
     Some(Inset::Length(x))
@@ -303,7 +487,13 @@ fn inset_value(cx: &mut Cx, v: &ast::Value) -> Option<Inset> {
 
 impl Resolver<'_> {
     /// Looks up a value that must be a name of the given kind.
-    pub(super) fn lookup_value(&self, cx: &mut Cx, module: ModuleId, v: &ast::Value, kind: Kind) -> Option<usize> {
+    pub(super) fn lookup_value(
+        &self,
+        cx: &mut Cx,
+        module: ModuleId,
+        v: &ast::Value,
+        kind: Kind,
+    ) -> Option<usize> {
         match &v.kind {
             ValueKind::Path(p) => self.lookup(cx, module, p, kind),
             _ => {

@@ -189,7 +189,10 @@ pub enum ResolveError {
         help: String,
     },
     #[error("tolerance on `{feature}` refers to datum `{datum}`, which is that same feature")]
-    #[diagnostic(code(insp::resolve::datum_self_reference), help("a feature cannot be controlled relative to itself: refer to another datum"))]
+    #[diagnostic(
+        code(insp::resolve::datum_self_reference),
+        help("a feature cannot be controlled relative to itself: refer to another datum")
+    )]
     DatumSelfReference {
         #[label("`{datum}` is `{feature}`")]
         span: Span,
@@ -197,7 +200,10 @@ pub enum ResolveError {
         feature: String,
     },
     #[error("datum `{datum}` appears twice in the reference frame")]
-    #[diagnostic(code(insp::resolve::duplicate_datum), help("each datum appears once: primary, secondary, tertiary"))]
+    #[diagnostic(
+        code(insp::resolve::duplicate_datum),
+        help("each datum appears once: primary, secondary, tertiary")
+    )]
     DuplicateDatum {
         #[label("again")]
         span: Span,
@@ -225,7 +231,10 @@ pub enum ResolveError {
         help: String,
     },
     #[error("{kind} has no diameter (Ø) zone")]
-    #[diagnostic(code(insp::resolve::diameter_zone), help("write the zone width without `dia`"))]
+    #[diagnostic(
+        code(insp::resolve::diameter_zone),
+        help("write the zone width without `dia`")
+    )]
     DiameterZone {
         #[label("`dia` not allowed here")]
         span: Span,
@@ -250,7 +259,10 @@ pub enum ResolveError {
         upper: String,
     },
     #[error("feature `{name}` has no faces")]
-    #[diagnostic(code(insp::resolve::empty_feature), help("list its faces: `feature {name} = stock.top + slot.walls`"))]
+    #[diagnostic(
+        code(insp::resolve::empty_feature),
+        help("list its faces: `feature {name} = stock.top + slot.walls`")
+    )]
     EmptyFeature {
         #[label("no faces")]
         span: Span,
@@ -283,14 +295,20 @@ pub enum ResolveError {
         what: String,
     },
     #[error("part `{part}` has no geometry")]
-    #[diagnostic(code(insp::resolve::no_geometry), help("add `stock box(…)` (or `cylinder`, `sphere`) or `mesh \"file.stl\"`"))]
+    #[diagnostic(
+        code(insp::resolve::no_geometry),
+        help("add `stock box(…)` (or `cylinder`, `sphere`) or `mesh \"file.stl\"`")
+    )]
     NoGeometry {
         #[label("no `stock` or `mesh`")]
         span: Span,
         part: String,
     },
     #[error("part `{part}` has two geometry sources")]
-    #[diagnostic(code(insp::resolve::duplicate_geometry), help("a part is either one stock with operations or one mesh"))]
+    #[diagnostic(
+        code(insp::resolve::duplicate_geometry),
+        help("a part is either one stock with operations or one mesh")
+    )]
     DuplicateGeometry {
         #[label("second source")]
         span: Span,
@@ -299,14 +317,20 @@ pub enum ResolveError {
         part: String,
     },
     #[error("mesh file `{path}` not found")]
-    #[diagnostic(code(insp::resolve::file_not_found), help("paths are relative to the folder of the spec that names them"))]
+    #[diagnostic(
+        code(insp::resolve::file_not_found),
+        help("paths are relative to the folder of the spec that names them")
+    )]
     FileNotFound {
         #[label("no such file")]
         span: Span,
         path: String,
     },
     #[error("unsupported mesh format `{ext}`")]
-    #[diagnostic(code(insp::resolve::mesh_format), help("inspc reads STL (binary or ASCII) and OBJ files"))]
+    #[diagnostic(
+        code(insp::resolve::mesh_format),
+        help("inspc reads STL (binary or ASCII) and OBJ files")
+    )]
     MeshFormat {
         #[label("not .stl or .obj")]
         span: Span,
@@ -342,7 +366,10 @@ pub enum ResolveError {
         help: String,
     },
     #[error("level `{level}` appears twice")]
-    #[diagnostic(code(insp::resolve::duplicate_level), help("a level counts its violations once; remove the repeat"))]
+    #[diagnostic(
+        code(insp::resolve::duplicate_level),
+        help("a level counts its violations once; remove the repeat")
+    )]
     DuplicateLevel {
         #[label("repeated")]
         span: Span,
@@ -358,7 +385,10 @@ pub enum ResolveError {
         group: String,
     },
     #[error("a direction cannot be the zero vector")]
-    #[diagnostic(code(insp::resolve::zero_vector), help("give a direction such as `+z` or `(0, 1, 1)`"))]
+    #[diagnostic(
+        code(insp::resolve::zero_vector),
+        help("give a direction such as `+z` or `(0, 1, 1)`")
+    )]
     ZeroVector {
         #[label("zero length")]
         span: Span,
@@ -373,7 +403,11 @@ pub enum ResolveError {
         tip: String,
     },
     #[error("datum name `{name}` is not a datum letter")]
-    #[diagnostic(code(insp::resolve::datum_letter), severity(Warning), help("ASME Y14.5 names datums with capital letters, not I, O or Q (`A`, `B`, … `AA`)"))]
+    #[diagnostic(
+        code(insp::resolve::datum_letter),
+        severity(Warning),
+        help("ASME Y14.5 names datums with capital letters, not I, O or Q (`A`, `B`, … `AA`)")
+    )]
     DatumLetter {
         #[label("not a datum letter")]
         span: Span,

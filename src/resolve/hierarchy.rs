@@ -28,8 +28,17 @@ pub(super) fn lower(cx: &mut Cx, h: &ast::Hierarchy) -> Hierarchy {
         match l {
             ast::Level::Required(c, span) => {
                 if c.name != "approachability" {
-                    let help = suggest::help_for_unknown("required constraint", &c.name, ["approachability"]);
-                    cx.err(E::UnknownName { span: c.span, what: "required constraint".into(), name: c.name.clone(), help });
+                    let help = suggest::help_for_unknown(
+                        "required constraint",
+                        &c.name,
+                        ["approachability"],
+                    );
+                    cx.err(E::UnknownName {
+                        span: c.span,
+                        what: "required constraint".into(),
+                        name: c.name.clone(),
+                        help,
+                    });
                 } else if k != 0 || saw_required {
                     cx.err(E::HierarchyOrder {
                         span: *span,
@@ -40,15 +49,28 @@ pub(super) fn lower(cx: &mut Cx, h: &ast::Hierarchy) -> Hierarchy {
                 }
                 saw_required = true;
             }
-            ast::Level::Same { constraint, group, span } => {
+            ast::Level::Same {
+                constraint,
+                group,
+                span,
+            } => {
                 let var = match constraint.name.as_str() {
                     "same_setup" => SameVar::Setup,
                     "same_probe" => SameVar::Probe,
                     // Spitz spells it both ways.
                     "same_orient" | "same_orien" => SameVar::Orient,
                     other => {
-                        let help = suggest::help_for_unknown("constraint", other, ["same_setup", "same_probe", "same_orient"]);
-                        cx.err(E::UnknownName { span: constraint.span, what: "constraint".into(), name: other.into(), help });
+                        let help = suggest::help_for_unknown(
+                            "constraint",
+                            other,
+                            ["same_setup", "same_probe", "same_orient"],
+                        );
+                        cx.err(E::UnknownName {
+                            span: constraint.span,
+                            what: "constraint".into(),
+                            name: other.into(),
+                            help,
+                        });
                         continue;
                     }
                 };
@@ -59,12 +81,19 @@ pub(super) fn lower(cx: &mut Cx, h: &ast::Hierarchy) -> Hierarchy {
                     ["*", "*"] | ["*", "*", "*"] | ["*"] => Group::All,
                     _ => {
                         let gspan = group[0].span.join(group[group.len() - 1].span);
-                        cx.err(E::UnknownGroup { span: gspan, group: text.join(", ") });
+                        cx.err(E::UnknownGroup {
+                            span: gspan,
+                            group: text.join(", "),
+                        });
                         continue;
                     }
                 };
                 if let Some(first) = levels.iter().find(|o| o.var == var && o.group == grp) {
-                    cx.err(E::DuplicateLevel { span: *span, first: first.span, level: level_text(var, grp) });
+                    cx.err(E::DuplicateLevel {
+                        span: *span,
+                        first: first.span,
+                        level: level_text(var, grp),
+                    });
                     continue;
                 }
                 // The solver fixes setups, then probes, then orientations: a level on a
@@ -78,12 +107,23 @@ pub(super) fn lower(cx: &mut Cx, h: &ast::Hierarchy) -> Hierarchy {
                     });
                     continue;
                 }
-                levels.push(Level { var, group: grp, span: *span });
+                levels.push(Level {
+                    var,
+                    group: grp,
+                    span: *span,
+                });
             }
         }
     }
     if !saw_required {
-        cx.err(E::HierarchyRequired { span: h.name.span, name: h.name.name.clone() });
+        cx.err(E::HierarchyRequired {
+            span: h.name.span,
+            name: h.name.name.clone(),
+        });
     }
-    Hierarchy { name: h.name.name.clone(), levels, span: h.name.span }
+    Hierarchy {
+        name: h.name.name.clone(),
+        levels,
+        span: h.name.span,
+    }
 }

@@ -64,7 +64,9 @@ impl Kind {
     }
 
     fn noun(self) -> &'static str {
-        self.word().trim_start_matches("an ").trim_start_matches("a ")
+        self.word()
+            .trim_start_matches("an ")
+            .trim_start_matches("a ")
     }
 }
 
@@ -93,11 +95,26 @@ pub(crate) struct Resolver<'a> {
 }
 
 /// Resolves a loaded program. The entry point of the resolve stage.
-pub fn resolve(program: &Program, sources: &SourceMap, world: &dyn World, diags: &mut Diagnostics) -> Model {
-    let mut r = Resolver { program, sources, world, decls: Vec::new(), scopes: Vec::new() };
+pub fn resolve(
+    program: &Program,
+    sources: &SourceMap,
+    world: &dyn World,
+    diags: &mut Diagnostics,
+) -> Model {
+    let mut r = Resolver {
+        program,
+        sources,
+        world,
+        decls: Vec::new(),
+        scopes: Vec::new(),
+    };
     r.declare(diags);
     r.import(diags);
-    r.lower(diags)
+    let mut model = r.lower(diags);
+    model.default_sampling = r
+        .std_item("std::sampling", "fan_leu", Kind::Sampling)
+        .map(crate::model::SamplingId);
+    model
 }
 
 impl<'a> Resolver<'a> {
@@ -131,17 +148,27 @@ impl<'a> Resolver<'a> {
                     ),
                 };
                 if let Some(&first) = scope.get(&name.name) {
-                    diags.push(module.file, E::DuplicateName {
-                        span: name.span,
-                        first: Some(self.decls[first].name.span),
-                        name: name.name.clone(),
-                        help: "rename one of them".into(),
-                    });
+                    diags.push(
+                        module.file,
+                        E::DuplicateName {
+                            span: name.span,
+                            first: Some(self.decls[first].name.span),
+                            name: name.name.clone(),
+                            help: "rename one of them".into(),
+                        },
+                    );
                     continue;
                 }
                 let count = counts.entry(kind).or_default();
                 scope.insert(name.name.clone(), self.decls.len());
-                self.decls.push(Decl { module: ModuleId(mi), file: module.file, kind, index: *count, name, item });
+                self.decls.push(Decl {
+                    module: ModuleId(mi),
+                    file: module.file,
+                    kind,
+                    index: *count,
+                    name,
+                    item,
+                });
                 *count += 1;
             }
             self.scopes.push(scope);
@@ -152,11 +179,15 @@ impl<'a> Resolver<'a> {
     fn import(&mut self, diags: &mut Diagnostics) {
         for (mi, module) in self.program.modules.iter().enumerate() {
             for &(item_index, target) in &module.imports {
-                let ast::Item::Use(u) = &module.ast.items[item_index] else { continue };
+                let ast::Item::Use(u) = &module.ast.items[item_index] else {
+                    continue;
+                };
                 let exported: Vec<(String, usize)> = self.own_items(target);
                 let wanted: Vec<&ast::Ident> = match (&u.select, &u.source) {
                     (ast::UseSelect::Names(names), _) => names.iter().collect(),
-                    (ast::UseSelect::Implicit, ast::UseSource::Module(segs)) => segs.last().into_iter().collect(),
+                    (ast::UseSelect::Implicit, ast::UseSource::Module(segs)) => {
+                        segs.last().into_iter().collect()
+                    }
                     _ => {
                         // A glob: own declarations shadow glob imports silently.
                         for (name, d) in exported {
@@ -168,18 +199,38 @@ impl<'a> Resolver<'a> {
                 for ident in wanted {
                     let Some(&(_, d)) = exported.iter().find(|(n, _)| *n == ident.name) else {
                         let module_name = self.module_name(target);
-                        let help = match suggest::did_you_mean(&ident.name, exported.iter().map(|(n, _)| n.as_str())) {
-                            Some(s) => format!("`{module_name}` has no `{}`; did you mean `{s}`?", ident.name),
-                            None => format!("`{module_name}` has no `{}`; its {}", ident.name, suggest::help_for_unknown("item", &ident.name, exported.iter().map(|(n, _)| n.as_str())).trim_start_matches("known ")),
+                        let help = match suggest::did_you_mean(
+                            &ident.name,
+                            exported.iter().map(|(n, _)| n.as_str()),
+                        ) {
+                            Some(s) => format!(
+                                "`{module_name}` has no `{}`; did you mean `{s}`?",
+                                ident.name
+                            ),
+                            None => format!(
+                                "`{module_name}` has no `{}`; its {}",
+                                ident.name,
+                                suggest::help_for_unknown(
+                                    "item",
+                                    &ident.name,
+                                    exported.iter().map(|(n, _)| n.as_str())
+                                )
+                                .trim_start_matches("known ")
+                            ),
                         };
-                        diags.push(module.file, E::UnknownName {
-                            span: ident.span,
-                            what: "item".into(),
-                            name: ident.name.clone(),
-                            help,
-                        });
+                        diags.push(
+                            module.file,
+                            E::UnknownName {
+                                span: ident.span,
+                                what: "item".into(),
+                                name: ident.name.clone(),
+                                help,
+                            },
+                        );
                         // Poison the name so its uses do not report it again.
-                        self.scopes[mi].entry(ident.name.clone()).or_insert(POISONED);
+                        self.scopes[mi]
+                            .entry(ident.name.clone())
+                            .or_insert(POISONED);
                         continue;
                     };
                     match self.scopes[mi].get(&ident.name) {
@@ -202,17 +253,30 @@ impl<'a> Resolver<'a> {
     }
 
     fn own_items(&self, module: ModuleId) -> Vec<(String, usize)> {
-        self.decls.iter().enumerate().filter(|(_, d)| d.module == module).map(|(i, d)| (d.name.name.clone(), i)).collect()
+        self.decls
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| d.module == module)
+            .map(|(i, d)| (d.name.name.clone(), i))
+            .collect()
     }
 
     fn module_name(&self, id: ModuleId) -> String {
         let m = &self.program.modules[id.0];
-        m.std_name.clone().unwrap_or_else(|| self.sources.get(m.file).name.clone())
+        m.std_name
+            .clone()
+            .unwrap_or_else(|| self.sources.get(m.file).name.clone())
     }
 
     /// Looks up a name of an expected kind in a module's scope; `std::x::y` paths reach
     /// the standard library directly.
-    pub(crate) fn lookup(&self, cx: &mut Cx, module: ModuleId, path: &ast::Path, kind: Kind) -> Option<usize> {
+    pub(crate) fn lookup(
+        &self,
+        cx: &mut Cx,
+        module: ModuleId,
+        path: &ast::Path,
+        kind: Kind,
+    ) -> Option<usize> {
         let names: Vec<&ast::Ident> = path
             .segs
             .iter()
@@ -221,17 +285,25 @@ impl<'a> Resolver<'a> {
                 ast::PathSeg::Index(..) => None,
             })
             .collect();
-        let found = if names.len() == 1 && self.scopes[module.0].get(&names[0].name) == Some(&POISONED) {
-            return None;
-        } else if names.len() > 1 && names[0].name == "std" {
-            let module_name = names[..names.len() - 1].iter().map(|i| i.name.as_str()).collect::<Vec<_>>().join("::");
-            let last = names[names.len() - 1];
-            self.program.std_module(&module_name).and_then(|m| self.own_items(m).into_iter().find(|(n, _)| *n == last.name)).map(|(_, d)| d)
-        } else if names.len() == 1 && path.segs.len() == 1 {
-            self.scopes[module.0].get(&names[0].name).copied()
-        } else {
-            None
-        };
+        let found =
+            if names.len() == 1 && self.scopes[module.0].get(&names[0].name) == Some(&POISONED) {
+                return None;
+            } else if names.len() > 1 && names[0].name == "std" {
+                let module_name = names[..names.len() - 1]
+                    .iter()
+                    .map(|i| i.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join("::");
+                let last = names[names.len() - 1];
+                self.program
+                    .std_module(&module_name)
+                    .and_then(|m| self.own_items(m).into_iter().find(|(n, _)| *n == last.name))
+                    .map(|(_, d)| d)
+            } else if names.len() == 1 && path.segs.len() == 1 {
+                self.scopes[module.0].get(&names[0].name).copied()
+            } else {
+                None
+            };
         let Some(d) = found else {
             let candidates: Vec<&str> = self.scopes[module.0]
                 .iter()
@@ -239,11 +311,17 @@ impl<'a> Resolver<'a> {
                 .map(|(n, _)| n.as_str())
                 .collect();
             let name = props::path_text(path);
-            let mut help = suggest::help_for_unknown(kind.noun(), &name, candidates.iter().copied());
+            let mut help =
+                suggest::help_for_unknown(kind.noun(), &name, candidates.iter().copied());
             if candidates.is_empty() {
                 help = format!("no {} is declared or imported here; import one with `use std::…::{{{name}}}` or declare it", kind.noun());
             }
-            cx.err(E::UnknownName { span: path.span, what: kind.noun().into(), name, help });
+            cx.err(E::UnknownName {
+                span: path.span,
+                what: kind.noun().into(),
+                name,
+                help,
+            });
             return None;
         };
         let decl = &self.decls[d];
@@ -263,26 +341,41 @@ impl<'a> Resolver<'a> {
     /// The declaration of a standard item, used for plan defaults.
     pub(crate) fn std_item(&self, module: &str, name: &str, kind: Kind) -> Option<usize> {
         let m = self.program.std_module(module)?;
-        self.decls.iter().find(|d| d.module == m && d.kind == kind && d.name.name == name).map(|d| d.index)
+        self.decls
+            .iter()
+            .find(|d| d.module == m && d.kind == kind && d.name.name == name)
+            .map(|d| d.index)
     }
 
     /// Lowers every declaration, in declaration order per kind.
     fn lower(&self, diags: &mut Diagnostics) -> Model {
         let mut model = Model::default();
         for d in &self.decls {
-            let mut cx = Cx { diags, file: d.file, unit_mm: None };
+            let mut cx = Cx {
+                diags,
+                file: d.file,
+                unit_mm: None,
+            };
             match (d.kind, d.item) {
                 (Kind::Part, ast::Item::Part(p)) => model.parts.push(part::lower(self, &mut cx, p)),
-                (Kind::Hierarchy, ast::Item::Hierarchy(h)) => model.hierarchies.push(hierarchy::lower(&mut cx, h)),
+                (Kind::Hierarchy, ast::Item::Hierarchy(h)) => {
+                    model.hierarchies.push(hierarchy::lower(&mut cx, h))
+                }
                 (Kind::Plan, ast::Item::Plan(_)) => {}
-                (_, ast::Item::Block(b)) => catalogue::lower(self, &mut cx, d.module, d.kind, b, &mut model),
+                (_, ast::Item::Block(b)) => {
+                    catalogue::lower(self, &mut cx, d.module, d.kind, b, &mut model)
+                }
                 _ => unreachable!("declaration kinds match their items"),
             }
         }
         // Plans last: their checks read the CMMs, heads and parts they name.
         for d in self.decls.iter().filter(|d| d.kind == Kind::Plan) {
             let ast::Item::Plan(p) = d.item else { continue };
-            let mut cx = Cx { diags, file: d.file, unit_mm: None };
+            let mut cx = Cx {
+                diags,
+                file: d.file,
+                unit_mm: None,
+            };
             if let Some(plan) = plan::lower(self, &mut cx, d.module, p, &model) {
                 model.plans.push(plan);
             }
@@ -290,4 +383,3 @@ impl<'a> Resolver<'a> {
         model
     }
 }
-

@@ -58,7 +58,17 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
         span: p.name.span,
     };
     // Units first: they give bare numbers their meaning.
-    let units: Vec<&ast::Ident> = p.stmts.iter().filter_map(|s| if let PartStmt::Units(u) = s { Some(u) } else { None }).collect();
+    let units: Vec<&ast::Ident> = p
+        .stmts
+        .iter()
+        .filter_map(|s| {
+            if let PartStmt::Units(u) = s {
+                Some(u)
+            } else {
+                None
+            }
+        })
+        .collect();
     match units.as_slice() {
         [] => cx.err(E::MissingProperty {
             span: p.name.span,
@@ -87,7 +97,11 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
             _ => continue,
         };
         if let Some(first) = source_span {
-            cx.err(E::DuplicateGeometry { span, first, part: part.name.clone() });
+            cx.err(E::DuplicateGeometry {
+                span,
+                first,
+                part: part.name.clone(),
+            });
             continue;
         }
         source_span = Some(span);
@@ -97,24 +111,47 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
         }
     }
     if source_span.is_none() {
-        cx.err(E::NoGeometry { span: p.name.span, part: part.name.clone() });
+        cx.err(E::NoGeometry {
+            span: p.name.span,
+            part: part.name.clone(),
+        });
     }
     let is_mesh = source_span.is_some() && !have_stock;
 
     // Declare every local name so references can say what a name is.
-    let mut pc = PartCx { part, names: BTreeMap::new(), lowered_features: 0, stmts: &p.stmts };
+    let mut pc = PartCx {
+        part,
+        names: BTreeMap::new(),
+        lowered_features: 0,
+        stmts: &p.stmts,
+    };
     declare_locals(cx, &mut pc);
 
     for s in &p.stmts {
-        if let PartStmt::Cut { add, kind, name, props, span } = s {
+        if let PartStmt::Cut {
+            add,
+            kind,
+            name,
+            props,
+            span,
+        } = s
+        {
             if is_mesh {
-                cx.err(E::NeedsStock { span: *span, what: format!("`{}` {}", if *add { "add" } else { "cut" }, kind.name) });
+                cx.err(E::NeedsStock {
+                    span: *span,
+                    what: format!("`{}` {}", if *add { "add" } else { "cut" }, kind.name),
+                });
             }
             let op = operation(cx, *add, kind, name, props);
             pc.part.ops.push(op.unwrap_or(Op {
                 name: name.name.clone(),
                 add: *add,
-                kind: OpKind::Boss { at: [0.0; 3], axis: [0.0, 0.0, 1.0], diameter: 1.0, height: 1.0 },
+                kind: OpKind::Boss {
+                    at: [0.0; 3],
+                    axis: [0.0, 0.0, 1.0],
+                    diameter: 1.0,
+                    height: 1.0,
+                },
                 pattern: None,
                 span: name.span,
             }));
@@ -123,18 +160,36 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
 
     for s in &p.stmts {
         match s {
-            PartStmt::Named { what: what @ (NamedKind::Face | NamedKind::Feature), name, expr, .. } => {
+            PartStmt::Named {
+                what: what @ (NamedKind::Face | NamedKind::Feature),
+                name,
+                expr,
+                ..
+            } => {
                 let faces = match expr {
                     Some(e) => face_expr(cx, &pc, e, is_mesh),
                     None => vec![],
                 };
                 if faces.is_empty() && expr.is_none() {
-                    cx.err(E::EmptyFeature { span: name.span, name: name.name.clone() });
+                    cx.err(E::EmptyFeature {
+                        span: name.span,
+                        name: name.name.clone(),
+                    });
                 }
-                pc.part.features.push(Feature { name: name.name.clone(), faces, is_face_alias: *what == NamedKind::Face, span: name.span });
+                pc.part.features.push(Feature {
+                    name: name.name.clone(),
+                    faces,
+                    is_face_alias: *what == NamedKind::Face,
+                    span: name.span,
+                });
                 pc.lowered_features += 1;
             }
-            PartStmt::Named { what: NamedKind::Datum, name, expr, span } => {
+            PartStmt::Named {
+                what: NamedKind::Datum,
+                name,
+                expr,
+                span,
+            } => {
                 datum(cx, &mut pc, name, expr.as_ref(), *span, is_mesh);
             }
             _ => {}
@@ -142,9 +197,16 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
     }
     for s in &p.stmts {
         if let PartStmt::Frame { name, refs, .. } = s {
-            let refs = refs.iter().filter_map(|e| datum_ref(cx, &pc, &e.value)).collect::<Vec<_>>();
+            let refs = refs
+                .iter()
+                .filter_map(|e| datum_ref(cx, &pc, &e.value))
+                .collect::<Vec<_>>();
             check_unique_datums(cx, &pc.part, &refs);
-            pc.part.frames.push(Frame { name: name.name.clone(), refs: refs.into_iter().map(|(d, _)| d).collect(), span: name.span });
+            pc.part.frames.push(Frame {
+                name: name.name.clone(),
+                refs: refs.into_iter().map(|(d, _)| d).collect(),
+                span: name.span,
+            });
         }
     }
     for s in &p.stmts {
@@ -164,13 +226,26 @@ fn length_unit(cx: &mut Cx, u: &ast::Ident) -> Option<f64> {
     }
     match UNITS.iter().find(|(n, _, _)| *n == u.name) {
         Some(_) => {
-            cx.err(E::UnitMismatch { span: u.span, expected: "a length unit".into(), found: "another unit".into(), unit: u.name.clone(), help: "part units are mm, cm, m, um or in".into() });
+            cx.err(E::UnitMismatch {
+                span: u.span,
+                expected: "a length unit".into(),
+                found: "another unit".into(),
+                unit: u.name.clone(),
+                help: "part units are mm, cm, m, um or in".into(),
+            });
             None
         }
         None => {
-            let lengths = UNITS.iter().filter(|(_, d, _)| *d == Dim::Length).map(|(n, _, _)| *n);
+            let lengths = UNITS
+                .iter()
+                .filter(|(_, d, _)| *d == Dim::Length)
+                .map(|(n, _, _)| *n);
             let help = suggest::help_for_unknown("unit", &u.name, lengths);
-            cx.err(E::UnknownUnit { span: u.span, unit: u.name.clone(), help });
+            cx.err(E::UnknownUnit {
+                span: u.span,
+                unit: u.name.clone(),
+                help,
+            });
             None
         }
     }
@@ -184,11 +259,19 @@ fn declare_locals(cx: &mut Cx, pc: &mut PartCx) {
                 counts[0] += 1;
                 (name, Local::Op(counts[0] - 1))
             }
-            PartStmt::Named { what: NamedKind::Face | NamedKind::Feature, name, .. } => {
+            PartStmt::Named {
+                what: NamedKind::Face | NamedKind::Feature,
+                name,
+                ..
+            } => {
                 counts[1] += 1;
                 (name, Local::Feature(counts[1] - 1))
             }
-            PartStmt::Named { what: NamedKind::Datum, name, .. } => {
+            PartStmt::Named {
+                what: NamedKind::Datum,
+                name,
+                ..
+            } => {
                 counts[2] += 1;
                 (name, Local::Datum(counts[2] - 1))
             }
@@ -200,7 +283,12 @@ fn declare_locals(cx: &mut Cx, pc: &mut PartCx) {
             _ => continue,
         };
         if name.name == "stock" {
-            cx.err(E::DuplicateName { span: name.span, first: None, name: "stock".into(), help: "`stock` names the part's stock; choose another name".into() });
+            cx.err(E::DuplicateName {
+                span: name.span,
+                first: None,
+                name: "stock".into(),
+                help: "`stock` names the part's stock; choose another name".into(),
+            });
             continue;
         }
         if let Some((_, first)) = pc.names.get(&name.name) {
@@ -209,11 +297,17 @@ fn declare_locals(cx: &mut Cx, pc: &mut PartCx) {
         }
         pc.names.insert(name.name.clone(), (local, name.span));
     }
-    pc.names.insert("stock".into(), (Local::Stock, Span::new(cx.file, 0, 0)));
+    pc.names
+        .insert("stock".into(), (Local::Stock, Span::new(cx.file, 0, 0)));
 }
 
 /// Positional or named arguments of a call, by parameter order.
-fn call_args<'c>(cx: &mut Cx, call: &'c ast::Call, params: &[&'static str], what: &str) -> Vec<Option<&'c ast::Value>> {
+fn call_args<'c>(
+    cx: &mut Cx,
+    call: &'c ast::Call,
+    params: &[&'static str],
+    what: &str,
+) -> Vec<Option<&'c ast::Value>> {
     let mut out: Vec<Option<&ast::Value>> = vec![None; params.len()];
     let mut next = 0;
     for a in &call.args {
@@ -235,15 +329,26 @@ fn call_args<'c>(cx: &mut Cx, call: &'c ast::Call, params: &[&'static str], what
             ast::Arg::Named(k, v) => match params.iter().position(|p| *p == k.name) {
                 Some(i) => out[i] = Some(v),
                 None => {
-                    let help = suggest::help_for_unknown("argument", &k.name, params.iter().copied());
-                    cx.err(E::UnknownProperty { span: k.span, key: k.name.clone(), item: what.into(), help });
+                    let help =
+                        suggest::help_for_unknown("argument", &k.name, params.iter().copied());
+                    cx.err(E::UnknownProperty {
+                        span: k.span,
+                        key: k.name.clone(),
+                        item: what.into(),
+                        help,
+                    });
                 }
             },
         }
     }
     for (i, p) in params.iter().enumerate() {
         if out[i].is_none() {
-            cx.err(E::MissingArgument { span: call.span, kind: what.into(), what: format!("`{p}`"), help: format!("write `{}({})`", path_text(&call.callee), params.join(", ")) });
+            cx.err(E::MissingArgument {
+                span: call.span,
+                kind: what.into(),
+                what: format!("`{p}`"),
+                help: format!("write `{}({})`", path_text(&call.callee), params.join(", ")),
+            });
         }
     }
     out
@@ -251,10 +356,18 @@ fn call_args<'c>(cx: &mut Cx, call: &'c ast::Call, params: &[&'static str], what
 
 fn stock(cx: &mut Cx, call: &ast::Call) -> Option<Geometry> {
     let Some(shape) = call.callee.as_ident() else {
-        cx.err(E::UnknownName { span: call.callee.span, what: "stock shape".into(), name: path_text(&call.callee), help: "stock is `box(x, y, z)`, `cylinder(diameter, height)` or `sphere(diameter)`".into() });
+        cx.err(E::UnknownName {
+            span: call.callee.span,
+            what: "stock shape".into(),
+            name: path_text(&call.callee),
+            help: "stock is `box(x, y, z)`, `cylinder(diameter, height)` or `sphere(diameter)`"
+                .into(),
+        });
         return None;
     };
-    let pos = |cx: &mut Cx, v: Option<&ast::Value>, what: &str| v.and_then(|v| cx.positive(v, Dim::Length, what));
+    let pos = |cx: &mut Cx, v: Option<&ast::Value>, what: &str| {
+        v.and_then(|v| cx.positive(v, Dim::Length, what))
+    };
     let s = match shape.name.as_str() {
         "box" => {
             let a = call_args(cx, call, &["x", "y", "z"], "a box");
@@ -264,43 +377,97 @@ fn stock(cx: &mut Cx, call: &ast::Call) -> Option<Geometry> {
         "cylinder" => {
             let a = call_args(cx, call, &["diameter", "height"], "a cylinder");
             let (d, h) = (pos(cx, a[0], "diameter"), pos(cx, a[1], "height"));
-            Stock::Cylinder { diameter: d?, height: h? }
+            Stock::Cylinder {
+                diameter: d?,
+                height: h?,
+            }
         }
         "sphere" => {
             let a = call_args(cx, call, &["diameter"], "a sphere");
-            Stock::Sphere { diameter: pos(cx, a[0], "diameter")? }
+            Stock::Sphere {
+                diameter: pos(cx, a[0], "diameter")?,
+            }
         }
         other => {
-            let help = suggest::help_for_unknown("stock shape", other, ["box", "cylinder", "sphere"]);
-            cx.err(E::UnknownName { span: shape.span, what: "stock shape".into(), name: other.into(), help });
+            let help =
+                suggest::help_for_unknown("stock shape", other, ["box", "cylinder", "sphere"]);
+            cx.err(E::UnknownName {
+                span: shape.span,
+                what: "stock shape".into(),
+                name: other.into(),
+                help,
+            });
             return None;
         }
     };
     Some(Geometry::Stock(s))
 }
 
-fn mesh(r: &Resolver, cx: &mut Cx, path: &ast::Str, props: &[ast::Prop], part_unit: f64) -> Option<Geometry> {
+fn mesh(
+    r: &Resolver,
+    cx: &mut Cx,
+    path: &ast::Str,
+    props: &[ast::Prop],
+    part_unit: f64,
+) -> Option<Geometry> {
     let mut p = Props::new(cx, "a mesh", path.span, props);
-    let unit_mm = p.get("units").and_then(|v| cx.name(v).cloned()).and_then(|u| length_unit(cx, &u)).unwrap_or(part_unit);
+    let unit_mm = p
+        .get("units")
+        .and_then(|v| cx.name(v).cloned())
+        .and_then(|u| length_unit(cx, &u))
+        .unwrap_or(part_unit);
     p.finish(cx);
-    let ext = std::path::Path::new(&path.value).extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    let ext = std::path::Path::new(&path.value)
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
     if ext != "stl" && ext != "obj" {
-        cx.err(E::MeshFormat { span: path.span, ext: if ext.is_empty() { "(none)".into() } else { format!(".{ext}") } });
+        cx.err(E::MeshFormat {
+            span: path.span,
+            ext: if ext.is_empty() {
+                "(none)".into()
+            } else {
+                format!(".{ext}")
+            },
+        });
         return None;
     }
-    let base = r.sources.get(cx.file).dir().map(|d| d.to_path_buf()).unwrap_or_default();
+    let base = r
+        .sources
+        .get(cx.file)
+        .dir()
+        .map(|d| d.to_path_buf())
+        .unwrap_or_default();
     let full = crate::source::normalize_path(&base.join(&path.value));
     if !r.world.exists(&full) {
-        cx.err(E::FileNotFound { span: path.span, path: path.value.clone() });
+        cx.err(E::FileNotFound {
+            span: path.span,
+            path: path.value.clone(),
+        });
     }
-    Some(Geometry::Mesh { path: full, unit_mm, span: path.span })
+    Some(Geometry::Mesh {
+        path: full,
+        unit_mm,
+        span: path.span,
+    })
 }
 
-fn operation(cx: &mut Cx, add: bool, kind: &ast::Ident, name: &ast::Ident, props: &[ast::Prop]) -> Option<Op> {
+fn operation(
+    cx: &mut Cx,
+    add: bool,
+    kind: &ast::Ident,
+    name: &ast::Ident,
+    props: &[ast::Prop],
+) -> Option<Op> {
     const KINDS: [&str; 5] = ["hole", "slot", "pocket", "step", "boss"];
     if !KINDS.contains(&kind.name.as_str()) {
         let help = suggest::help_for_unknown("machining feature", &kind.name, KINDS);
-        cx.err(E::UnknownName { span: kind.span, what: "machining feature".into(), name: kind.name.clone(), help });
+        cx.err(E::UnknownName {
+            span: kind.span,
+            what: "machining feature".into(),
+            name: kind.name.clone(),
+            help,
+        });
         return None;
     }
     let adds = kind.name == "boss";
@@ -309,20 +476,36 @@ fn operation(cx: &mut Cx, add: bool, kind: &ast::Ident, name: &ast::Ident, props
         cx.err(E::WrongOperation {
             span: kind.span,
             kind: format!("a {}", kind.name),
-            op: if adds { "adds material, it cannot be written".into() } else { "removes material, it cannot be written".into() },
+            op: if adds {
+                "adds material, it cannot be written".into()
+            } else {
+                "removes material, it cannot be written".into()
+            },
             verb: verb.into(),
             fix: format!("{fix} {}", kind.name),
             help: format!("write `{fix} {} {} {{ … }}`", kind.name, name.name),
         });
     }
-    let mut p = Props::new(cx, format!("{} `{}`", kind.name, name.name), name.span, props);
-    let dir = |cx: &mut Cx, p: &mut Props, key: &'static str, default: Option<Vec3>| match p.get(key) {
-        Some(v) => cx.direction(v),
-        None if default.is_some() => default,
-        None => p.req(cx, key, "+x").and_then(|v| cx.direction(v)),
+    let mut p = Props::new(
+        cx,
+        format!("{} `{}`", kind.name, name.name),
+        name.span,
+        props,
+    );
+    let dir =
+        |cx: &mut Cx, p: &mut Props, key: &'static str, default: Option<Vec3>| match p.get(key) {
+            Some(v) => cx.direction(v),
+            None if default.is_some() => default,
+            None => p.req(cx, key, "+x").and_then(|v| cx.direction(v)),
+        };
+    let point = |cx: &mut Cx, p: &mut Props| {
+        p.req(cx, "at", "(10, 10, 40)")
+            .and_then(|v| cx.lengths::<3>(v))
     };
-    let point = |cx: &mut Cx, p: &mut Props| p.req(cx, "at", "(10, 10, 40)").and_then(|v| cx.lengths::<3>(v));
-    let positive = |cx: &mut Cx, p: &mut Props, key: &'static str| p.req(cx, key, "10").and_then(|v| cx.positive(v, Dim::Length, key));
+    let positive = |cx: &mut Cx, p: &mut Props, key: &'static str| {
+        p.req(cx, key, "10")
+            .and_then(|v| cx.positive(v, Dim::Length, key))
+    };
     let op = match kind.name.as_str() {
         "hole" => {
             let radial = p.get("radial").and_then(|v| cx.direction(v));
@@ -330,7 +513,11 @@ fn operation(cx: &mut Cx, add: bool, kind: &ast::Ident, name: &ast::Ident, props
                 (Some(v), None) => cx.lengths::<3>(v).map(Placement::At),
                 (None, Some(d)) => Some(Placement::Radial(d)),
                 (Some(v), Some(_)) => {
-                    cx.err(E::DuplicateGeometry { span: v.span, first: p.get("radial").map_or(v.span, |r| r.span), part: name.name.clone() });
+                    cx.err(E::DuplicateGeometry {
+                        span: v.span,
+                        first: p.get("radial").map_or(v.span, |r| r.span),
+                        part: name.name.clone(),
+                    });
                     None
                 }
                 (None, None) => p.req(cx, "at", "(10, 10, 40)").and(None),
@@ -341,11 +528,18 @@ fn operation(cx: &mut Cx, add: bool, kind: &ast::Ident, name: &ast::Ident, props
             };
             let diameter = positive(cx, &mut p, "diameter");
             let depth = match p.req(cx, "depth", "20 mm or `depth through`") {
-                Some(v) if matches!(&v.kind, ValueKind::Path(pp) if pp.as_ident().is_some_and(|i| i.name == "through")) => Some(Depth::Through),
+                Some(v) if matches!(&v.kind, ValueKind::Path(pp) if pp.as_ident().is_some_and(|i| i.name == "through")) => {
+                    Some(Depth::Through)
+                }
                 Some(v) => cx.positive(v, Dim::Length, "depth").map(Depth::Blind),
                 None => None,
             };
-            OpKind::Hole { at: at?, axis: axis?, diameter: diameter?, depth: depth? }
+            OpKind::Hole {
+                at: at?,
+                axis: axis?,
+                diameter: diameter?,
+                depth: depth?,
+            }
         }
         "slot" | "step" => {
             let at = point(cx, &mut p);
@@ -359,9 +553,22 @@ fn operation(cx: &mut Cx, add: bool, kind: &ast::Ident, name: &ast::Ident, props
                     Some(v) => Some(cx.positive(v, Dim::Length, "length")?),
                     None => None,
                 };
-                OpKind::Slot { at: at?, along: along?, into: into?, width: width?, depth: depth?, length }
+                OpKind::Slot {
+                    at: at?,
+                    along: along?,
+                    into: into?,
+                    width: width?,
+                    depth: depth?,
+                    length,
+                }
             } else {
-                OpKind::Step { at: at?, along: along?, into: into?, width: width?, depth: depth? }
+                OpKind::Step {
+                    at: at?,
+                    along: along?,
+                    into: into?,
+                    width: width?,
+                    depth: depth?,
+                }
             }
         }
         "pocket" => {
@@ -372,7 +579,12 @@ fn operation(cx: &mut Cx, add: bool, kind: &ast::Ident, name: &ast::Ident, props
             let size = p.req(cx, "size", "(40, 20)").and_then(|v| {
                 let s = cx.lengths::<2>(v)?;
                 if s.iter().any(|x| *x <= 0.0) {
-                    cx.err(E::NonPositive { span: v.span, what: "`size`".into(), value: describe(v), help: "a pocket's length and width are positive".into() });
+                    cx.err(E::NonPositive {
+                        span: v.span,
+                        what: "`size`".into(),
+                        value: describe(v),
+                        help: "a pocket's length and width are positive".into(),
+                    });
                     return None;
                 }
                 Some(s)
@@ -382,14 +594,26 @@ fn operation(cx: &mut Cx, add: bool, kind: &ast::Ident, name: &ast::Ident, props
                 Some(v) => cx.length(v).filter(|x| *x >= 0.0),
                 None => Some(0.0),
             };
-            OpKind::Pocket { at: at?, along: along?, into: into?, size: size?, depth: depth?, corner_radius: corner_radius? }
+            OpKind::Pocket {
+                at: at?,
+                along: along?,
+                into: into?,
+                size: size?,
+                depth: depth?,
+                corner_radius: corner_radius?,
+            }
         }
         _ => {
             let at = point(cx, &mut p);
             let axis = dir(cx, &mut p, "axis", Some([0.0, 0.0, 1.0]));
             let diameter = positive(cx, &mut p, "diameter");
             let height = positive(cx, &mut p, "height");
-            OpKind::Boss { at: at?, axis: axis?, diameter: diameter?, height: height? }
+            OpKind::Boss {
+                at: at?,
+                axis: axis?,
+                diameter: diameter?,
+                height: height?,
+            }
         }
     };
     let pattern = p.get("pattern").and_then(|v| {
@@ -400,14 +624,21 @@ fn operation(cx: &mut Cx, add: bool, kind: &ast::Ident, name: &ast::Ident, props
                 what: "pattern".into(),
                 value: format!("of {} instances", pat.count()),
                 range: format!("at most {MAX_INSTANCES}"),
-                help: "a CMM program measures each instance; split the pattern or check the counts".into(),
+                help: "a CMM program measures each instance; split the pattern or check the counts"
+                    .into(),
             });
             return None;
         }
         Some(pat)
     });
     p.finish(cx);
-    Some(Op { name: name.name.clone(), add, kind: op, pattern, span: name.span })
+    Some(Op {
+        name: name.name.clone(),
+        add,
+        kind: op,
+        pattern,
+        span: name.span,
+    })
 }
 
 /// The most instances one pattern may have.
@@ -436,32 +667,57 @@ fn pattern(cx: &mut Cx, v: &ast::Value) -> Option<Pattern> {
         cx.mismatch(v, "a pattern", "write `grid(nx, ny, pitch_x, pitch_y)`, `linear(count, (dx, dy, dz))` or `polar(count, axis, (cx, cy, cz))`");
         return None;
     };
-    let name = call.callee.as_ident().map(|i| i.name.as_str()).unwrap_or("");
+    let name = call
+        .callee
+        .as_ident()
+        .map(|i| i.name.as_str())
+        .unwrap_or("");
     match name {
         "grid" => {
-            let a = call_args(cx, call, &["nx", "ny", "pitch_x", "pitch_y"], "a grid pattern");
+            let a = call_args(
+                cx,
+                call,
+                &["nx", "ny", "pitch_x", "pitch_y"],
+                "a grid pattern",
+            );
             let nx = a[0].and_then(|v| cx.count(v, "nx"));
             let ny = a[1].and_then(|v| cx.count(v, "ny"));
             let px = a[2].and_then(|v| cx.positive(v, Dim::Length, "pitch_x"));
             let py = a[3].and_then(|v| cx.positive(v, Dim::Length, "pitch_y"));
-            Some(Pattern::Grid { nx: nx?, ny: ny?, pitch: [px?, py?] })
+            Some(Pattern::Grid {
+                nx: nx?,
+                ny: ny?,
+                pitch: [px?, py?],
+            })
         }
         "linear" => {
             let a = call_args(cx, call, &["count", "step"], "a linear pattern");
             let count = a[0].and_then(|v| cx.count(v, "count"));
             let step = a[1].and_then(|v| cx.lengths::<3>(v));
-            Some(Pattern::Linear { count: count?, step: step? })
+            Some(Pattern::Linear {
+                count: count?,
+                step: step?,
+            })
         }
         "polar" => {
             let a = call_args(cx, call, &["count", "axis", "center"], "a polar pattern");
             let count = a[0].and_then(|v| cx.count(v, "count"));
             let axis = a[1].and_then(|v| cx.direction(v));
             let center = a[2].and_then(|v| cx.lengths::<3>(v));
-            Some(Pattern::Polar { count: count?, axis: axis?, center: center? })
+            Some(Pattern::Polar {
+                count: count?,
+                axis: axis?,
+                center: center?,
+            })
         }
         other => {
             let help = suggest::help_for_unknown("pattern", other, ["grid", "linear", "polar"]);
-            cx.err(E::UnknownName { span: call.callee.span, what: "pattern".into(), name: path_text(&call.callee), help });
+            cx.err(E::UnknownName {
+                span: call.callee.span,
+                what: "pattern".into(),
+                name: path_text(&call.callee),
+                help,
+            });
             None
         }
     }
@@ -471,15 +727,22 @@ fn pattern(cx: &mut Cx, v: &ast::Value) -> Option<Pattern> {
 fn roles(part: &Part, source: &FaceSource) -> Vec<&'static str> {
     match source {
         FaceSource::Stock => match &part.geometry {
-            Geometry::Stock(Stock::Box { .. }) => vec!["top", "bottom", "left", "right", "front", "back"],
+            Geometry::Stock(Stock::Box { .. }) => {
+                vec!["top", "bottom", "left", "right", "front", "back"]
+            }
             Geometry::Stock(Stock::Cylinder { .. }) => vec!["top", "bottom", "side"],
             Geometry::Stock(Stock::Sphere { .. }) => vec!["surface"],
             Geometry::Mesh { .. } => vec![],
         },
         FaceSource::Op(OpId(i), _) => match &part.ops[*i].kind {
-            OpKind::Hole { depth: Depth::Through, .. } => vec!["wall"],
+            OpKind::Hole {
+                depth: Depth::Through,
+                ..
+            } => vec!["wall"],
             OpKind::Hole { .. } => vec!["wall", "bottom"],
-            OpKind::Slot { length: Some(_), .. } => vec!["walls", "left_wall", "right_wall", "floor", "ends"],
+            OpKind::Slot {
+                length: Some(_), ..
+            } => vec!["walls", "left_wall", "right_wall", "floor", "ends"],
             OpKind::Slot { .. } => vec!["walls", "left_wall", "right_wall", "floor"],
             OpKind::Pocket { .. } => vec!["walls", "floor"],
             OpKind::Step { .. } => vec!["wall", "floor"],
@@ -502,7 +765,18 @@ fn face_expr(cx: &mut Cx, pc: &PartCx, e: &ast::FaceExpr, is_mesh: bool) -> Vec<
 
 fn same_face(a: &FaceRef, b: &FaceRef) -> bool {
     match (a, b) {
-        (FaceRef::Role { source: s1, role: r1, .. }, FaceRef::Role { source: s2, role: r2, .. }) => s1 == s2 && r1 == r2,
+        (
+            FaceRef::Role {
+                source: s1,
+                role: r1,
+                ..
+            },
+            FaceRef::Role {
+                source: s2,
+                role: r2,
+                ..
+            },
+        ) => s1 == s2 && r1 == r2,
         (FaceRef::Group(a, _), FaceRef::Group(b, _)) => a == b,
         (FaceRef::Segment(a, _), FaceRef::Segment(b, _)) => a == b,
         _ => false,
@@ -512,7 +786,11 @@ fn same_face(a: &FaceRef, b: &FaceRef) -> bool {
 fn face_term(cx: &mut Cx, pc: &PartCx, t: &ast::FaceTerm, is_mesh: bool) -> Vec<FaceRef> {
     let needs_mesh = |cx: &mut Cx, span: Span, what: &str| {
         if !is_mesh {
-            cx.err(E::NeedsMesh { span, what: what.into(), help: "on a stock part, name faces by role: `stock.top`, `slot1.walls`".into() });
+            cx.err(E::NeedsMesh {
+                span,
+                what: what.into(),
+                help: "on a stock part, name faces by role: `stock.top`, `slot1.walls`".into(),
+            });
             false
         } else {
             true
@@ -520,16 +798,26 @@ fn face_term(cx: &mut Cx, pc: &PartCx, t: &ast::FaceTerm, is_mesh: bool) -> Vec<
     };
     match t {
         ast::FaceTerm::Group(s) => {
-            if needs_mesh(cx, s.span, "`group`") { vec![FaceRef::Group(s.value.clone(), s.span)] } else { vec![] }
+            if needs_mesh(cx, s.span, "`group`") {
+                vec![FaceRef::Group(s.value.clone(), s.span)]
+            } else {
+                vec![]
+            }
         }
         ast::FaceTerm::Segment(n, span) => {
-            if needs_mesh(cx, *span, "`segment`") { vec![FaceRef::Segment(*n, *span)] } else { vec![] }
+            if needs_mesh(cx, *span, "`segment`") {
+                vec![FaceRef::Segment(*n, *span)]
+            } else {
+                vec![]
+            }
         }
         ast::FaceTerm::Select(args, span) => {
             if !needs_mesh(cx, *span, "`select`") {
                 return vec![];
             }
-            selector(cx, args, *span).map(|s| vec![FaceRef::Select(s, *span)]).unwrap_or_default()
+            selector(cx, args, *span)
+                .map(|s| vec![FaceRef::Select(s, *span)])
+                .unwrap_or_default()
         }
         ast::FaceTerm::Path(path) => path_faces(cx, pc, path),
     }
@@ -538,9 +826,19 @@ fn face_term(cx: &mut Cx, pc: &PartCx, t: &ast::FaceTerm, is_mesh: bool) -> Vec<
 fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
     let head = path.head();
     let Some(&(local, _)) = pc.names.get(&head.name) else {
-        let candidates: Vec<&str> = pc.names.iter().filter(|(_, (l, _))| matches!(l, Local::Feature(_) | Local::Op(_) | Local::Stock)).map(|(n, _)| n.as_str()).collect();
+        let candidates: Vec<&str> = pc
+            .names
+            .iter()
+            .filter(|(_, (l, _))| matches!(l, Local::Feature(_) | Local::Op(_) | Local::Stock))
+            .map(|(n, _)| n.as_str())
+            .collect();
         let help = suggest::help_for_unknown("face or feature", &head.name, candidates);
-        cx.err(E::UnknownName { span: head.span, what: "face or feature".into(), name: head.name.clone(), help });
+        cx.err(E::UnknownName {
+            span: head.span,
+            what: "face or feature".into(),
+            name: head.name.clone(),
+            help,
+        });
         return vec![];
     };
     let (source, rest) = match (local, &path.segs[1..]) {
@@ -550,23 +848,42 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
                     span: head.span,
                     what: "face or feature declared above".into(),
                     name: head.name.clone(),
-                    help: format!("`{}` is declared further down; declare it before it is used", head.name),
+                    help: format!(
+                        "`{}` is declared further down; declare it before it is used",
+                        head.name
+                    ),
                 });
                 return vec![];
             }
             return pc.part.features[i].faces.clone();
         }
-        (Local::Datum(i), []) if i < pc.part.datums.len() => return pc.part.features[pc.part.datums[i].feature.0].faces.clone(),
+        (Local::Datum(i), []) if i < pc.part.datums.len() => {
+            return pc.part.features[pc.part.datums[i].feature.0].faces.clone()
+        }
         (Local::Stock, rest) => (FaceSource::Stock, rest),
         (Local::Op(i), [PathSeg::Index(n, ispan), rest @ ..]) => {
             let count = pc.part.ops[i].pattern.as_ref().map(Pattern::count);
             match count {
                 None => {
-                    cx.err(E::TypeMismatch { span: *ispan, expected: "no index".into(), found: format!("`[{n}]`"), help: format!("`{}` is not a pattern; only patterned operations have instances", head.name) });
+                    cx.err(E::TypeMismatch {
+                        span: *ispan,
+                        expected: "no index".into(),
+                        found: format!("`[{n}]`"),
+                        help: format!(
+                            "`{}` is not a pattern; only patterned operations have instances",
+                            head.name
+                        ),
+                    });
                     return vec![];
                 }
                 Some(c) if *n >= c => {
-                    cx.err(E::OutOfRange { span: *ispan, what: "instance".into(), value: n.to_string(), range: format!("`{}` has instances 0 to {}", head.name, c - 1), help: "instances are numbered from 0, row by row".into() });
+                    cx.err(E::OutOfRange {
+                        span: *ispan,
+                        what: "instance".into(),
+                        value: n.to_string(),
+                        range: format!("`{}` has instances 0 to {}", head.name, c - 1),
+                        help: "instances are numbered from 0, row by row".into(),
+                    });
                     return vec![];
                 }
                 Some(_) => (FaceSource::Op(OpId(i), Some(*n)), rest),
@@ -574,30 +891,58 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
         }
         (Local::Op(i), rest) => (FaceSource::Op(OpId(i), None), rest),
         (other, _) => {
-            cx.err(E::WrongKind { span: path.span, name: path_text(path), expected: "a face or feature".into(), found: other.word(&pc.part), help: "name faces and features here".into() });
+            cx.err(E::WrongKind {
+                span: path.span,
+                name: path_text(path),
+                expected: "a face or feature".into(),
+                found: other.word(&pc.part),
+                help: "name faces and features here".into(),
+            });
             return vec![];
         }
     };
     let owner = match &source {
         FaceSource::Stock => "the stock".to_string(),
-        FaceSource::Op(OpId(i), _) => format!("{} `{}`", pc.part.ops[*i].kind.word(), pc.part.ops[*i].name),
+        FaceSource::Op(OpId(i), _) => {
+            format!("{} `{}`", pc.part.ops[*i].kind.word(), pc.part.ops[*i].name)
+        }
     };
     let known = roles(&pc.part, &source);
     match rest {
         [PathSeg::Name(role)] => {
             if !known.contains(&role.name.as_str()) {
                 let mut help = suggest::help_for_unknown("face", &role.name, known.iter().copied());
-                if role.name == "bottom" && matches!(&source, FaceSource::Op(OpId(i), _) if matches!(pc.part.ops[*i].kind, OpKind::Hole { depth: Depth::Through, .. })) {
+                if role.name == "bottom"
+                    && matches!(&source, FaceSource::Op(OpId(i), _) if matches!(pc.part.ops[*i].kind, OpKind::Hole { depth: Depth::Through, .. }))
+                {
                     help = "a through hole has no bottom".into();
                 }
-                cx.err(E::UnknownFace { span: role.span, owner, role: role.name.clone(), help });
+                cx.err(E::UnknownFace {
+                    span: role.span,
+                    owner,
+                    role: role.name.clone(),
+                    help,
+                });
                 return vec![];
             }
-            vec![FaceRef::Role { source, role: role.name.clone(), span: path.span }]
+            vec![FaceRef::Role {
+                source,
+                role: role.name.clone(),
+                span: path.span,
+            }]
         }
         _ => {
-            let roles = known.iter().map(|r| format!("`{}.{r}`", head.name)).collect::<Vec<_>>().join(", ");
-            cx.err(E::TypeMismatch { span: path.span, expected: "a face".into(), found: format!("{owner} as a whole"), help: format!("name one of its faces: {roles}") });
+            let roles = known
+                .iter()
+                .map(|r| format!("`{}.{r}`", head.name))
+                .collect::<Vec<_>>()
+                .join(", ");
+            cx.err(E::TypeMismatch {
+                span: path.span,
+                expected: "a face".into(),
+                found: format!("{owner} as a whole"),
+                help: format!("name one of its faces: {roles}"),
+            });
             vec![]
         }
     }
@@ -611,8 +956,17 @@ fn selector(cx: &mut Cx, args: &[ast::Arg], span: Span) -> Option<Selector> {
                 Some((n, nspan)) => match SurfaceKind::ALL.iter().find(|k| k.keyword() == n) {
                     Some(k) => s.surface = Some(*k),
                     None => {
-                        let help = suggest::help_for_unknown("surface type", &n, SurfaceKind::ALL.iter().map(|k| k.keyword()));
-                        cx.err(E::UnknownName { span: nspan, what: "surface type".into(), name: n, help });
+                        let help = suggest::help_for_unknown(
+                            "surface type",
+                            &n,
+                            SurfaceKind::ALL.iter().map(|k| k.keyword()),
+                        );
+                        cx.err(E::UnknownName {
+                            span: nspan,
+                            what: "surface type".into(),
+                            name: n,
+                            help,
+                        });
                     }
                 },
                 None => return None,
@@ -631,28 +985,60 @@ fn selector(cx: &mut Cx, args: &[ast::Arg], span: Span) -> Option<Selector> {
                     s.extreme = Some((ai as u8, k.name == "highest"));
                 }
                 other => {
-                    let help = suggest::help_for_unknown("criterion", other, ["normal", "axis", "radius", "highest", "lowest", "nearest"]);
-                    cx.err(E::UnknownProperty { span: k.span, key: other.into(), item: "`select`".into(), help });
+                    let help = suggest::help_for_unknown(
+                        "criterion",
+                        other,
+                        ["normal", "axis", "radius", "highest", "lowest", "nearest"],
+                    );
+                    cx.err(E::UnknownProperty {
+                        span: k.span,
+                        key: other.into(),
+                        item: "`select`".into(),
+                        help,
+                    });
                 }
             },
         }
     }
     if s == Selector::default() {
-        cx.err(E::MissingArgument { span, kind: "`select`".into(), what: "a criterion".into(), help: "e.g. `select(plane, normal +z, highest z)`".into() });
+        cx.err(E::MissingArgument {
+            span,
+            kind: "`select`".into(),
+            what: "a criterion".into(),
+            help: "e.g. `select(plane, normal +z, highest z)`".into(),
+        });
         return None;
     }
     Some(s)
 }
 
-fn datum(cx: &mut Cx, pc: &mut PartCx, name: &ast::Ident, expr: Option<&ast::FaceExpr>, span: Span, is_mesh: bool) {
+fn datum(
+    cx: &mut Cx,
+    pc: &mut PartCx,
+    name: &ast::Ident,
+    expr: Option<&ast::FaceExpr>,
+    span: Span,
+    is_mesh: bool,
+) {
     let letters_ok = !name.name.is_empty()
         && name.name.len() <= 2
-        && name.name.chars().all(|c| c.is_ascii_uppercase() && !matches!(c, 'I' | 'O' | 'Q'));
+        && name
+            .name
+            .chars()
+            .all(|c| c.is_ascii_uppercase() && !matches!(c, 'I' | 'O' | 'Q'));
     if !letters_ok {
-        cx.err(E::DatumLetter { span: name.span, name: name.name.clone() });
+        cx.err(E::DatumLetter {
+            span: name.span,
+            name: name.name.clone(),
+        });
     }
     let Some(expr) = expr else {
-        cx.err(E::MissingArgument { span, kind: format!("datum `{}`", name.name), what: "a datum feature".into(), help: format!("write `datum {} = top`", name.name) });
+        cx.err(E::MissingArgument {
+            span,
+            kind: format!("datum `{}`", name.name),
+            what: "a datum feature".into(),
+            help: format!("write `datum {} = top`", name.name),
+        });
         return;
     };
     // A single name of a feature is that feature; anything else becomes a feature of its own.
@@ -670,11 +1056,20 @@ fn datum(cx: &mut Cx, pc: &mut PartCx, name: &ast::Ident, expr: Option<&ast::Fac
             if faces.is_empty() {
                 return;
             }
-            pc.part.features.push(Feature { name: name.name.clone(), faces, is_face_alias: false, span: name.span });
+            pc.part.features.push(Feature {
+                name: name.name.clone(),
+                faces,
+                is_face_alias: false,
+                span: name.span,
+            });
             FeatureId(pc.part.features.len() - 1)
         }
     };
-    pc.part.datums.push(Datum { name: name.name.clone(), feature, span: name.span });
+    pc.part.datums.push(Datum {
+        name: name.name.clone(),
+        feature,
+        span: name.span,
+    });
 }
 
 /// A datum reference `A` or `A(MMC)`; the span is for duplicate reports.
@@ -702,16 +1097,37 @@ pub(super) fn datum_ref(cx: &mut Cx, pc: &PartCx, v: &ast::Value) -> Option<(Dat
             if *i >= pc.part.datums.len() {
                 return None; // the datum itself failed to resolve and was reported
             }
-            Some((DatumRef { datum: DatumId(*i), modifier }, path.span))
+            Some((
+                DatumRef {
+                    datum: DatumId(*i),
+                    modifier,
+                },
+                path.span,
+            ))
         }
         Some((other, _)) => {
-            cx.err(E::WrongKind { span: path.span, name: path_text(path), expected: "a datum".into(), found: other.word(&pc.part), help: "declare it with `datum A = feature` first".into() });
+            cx.err(E::WrongKind {
+                span: path.span,
+                name: path_text(path),
+                expected: "a datum".into(),
+                found: other.word(&pc.part),
+                help: "declare it with `datum A = feature` first".into(),
+            });
             None
         }
         None => {
-            let datums = pc.names.iter().filter(|(_, (l, _))| matches!(l, Local::Datum(_))).map(|(n, _)| n.as_str());
+            let datums = pc
+                .names
+                .iter()
+                .filter(|(_, (l, _))| matches!(l, Local::Datum(_)))
+                .map(|(n, _)| n.as_str());
             let help = suggest::help_for_unknown("datum", &head.name, datums);
-            cx.err(E::UnknownName { span: path.span, what: "datum".into(), name: path_text(path), help });
+            cx.err(E::UnknownName {
+                span: path.span,
+                what: "datum".into(),
+                name: path_text(path),
+                help,
+            });
             None
         }
     }
@@ -724,7 +1140,12 @@ pub(super) fn material(cx: &mut Cx, i: &ast::Ident) -> Option<Material> {
         "RFS" => Some(Material::Rfs),
         other => {
             let help = suggest::help_for_unknown("modifier", other, ["MMC", "LMC", "RFS"]);
-            cx.err(E::UnknownName { span: i.span, what: "material modifier".into(), name: other.into(), help });
+            cx.err(E::UnknownName {
+                span: i.span,
+                what: "material modifier".into(),
+                name: other.into(),
+                help,
+            });
             None
         }
     }
@@ -733,7 +1154,10 @@ pub(super) fn material(cx: &mut Cx, i: &ast::Ident) -> Option<Material> {
 pub(super) fn check_unique_datums(cx: &mut Cx, part: &Part, refs: &[(DatumRef, Span)]) {
     for (k, (r, span)) in refs.iter().enumerate() {
         if refs[..k].iter().any(|(o, _)| o.datum == r.datum) {
-            cx.err(E::DuplicateDatum { span: *span, datum: part.datums[r.datum.0].name.clone() });
+            cx.err(E::DuplicateDatum {
+                span: *span,
+                datum: part.datums[r.datum.0].name.clone(),
+            });
         }
     }
 }

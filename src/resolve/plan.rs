@@ -9,11 +9,31 @@ use crate::load::ModuleId;
 use crate::model::*;
 use crate::syntax::ast::{self, PlanStmt, ValueKind};
 
-pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &ast::Plan, model: &Model) -> Option<Plan> {
-    let props: Vec<ast::Prop> = p.stmts.iter().filter_map(|s| if let PlanStmt::Prop(pr) = s { Some(pr.clone()) } else { None }).collect();
+pub(super) fn lower(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    p: &ast::Plan,
+    model: &Model,
+) -> Option<Plan> {
+    let props: Vec<ast::Prop> = p
+        .stmts
+        .iter()
+        .filter_map(|s| {
+            if let PlanStmt::Prop(pr) = s {
+                Some(pr.clone())
+            } else {
+                None
+            }
+        })
+        .collect();
     let mut pp = Props::new(cx, format!("plan `{}`", p.name.name), p.name.span, &props);
-    let part = pp.req(cx, "part", "f2").and_then(|v| r.lookup_value(cx, module, v, Kind::Part));
-    let cmm = pp.req(cx, "cmm", "lab").and_then(|v| r.lookup_value(cx, module, v, Kind::Cmm));
+    let part = pp
+        .req(cx, "part", "f2")
+        .and_then(|v| r.lookup_value(cx, module, v, Kind::Part));
+    let cmm = pp
+        .req(cx, "cmm", "lab")
+        .and_then(|v| r.lookup_value(cx, module, v, Kind::Cmm));
     let hierarchy = match pp.get("hierarchy") {
         Some(v) => r.lookup_value(cx, module, v, Kind::Hierarchy),
         None => r.std_item("std::hierarchies", "efficient_accuracy", Kind::Hierarchy),
@@ -27,9 +47,18 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &ast::Plan, 
         match &v.kind {
             ValueKind::Block(ops) => {
                 let mut o = Props::new(cx, "`output`", v.span, ops);
-                outputs.dmis = o.get("dmis").and_then(|x| cx.string(x)).map(|s| s.value.clone());
-                outputs.plan = o.get("plan").and_then(|x| cx.string(x)).map(|s| s.value.clone());
-                outputs.graph = o.get("graph").and_then(|x| cx.string(x)).map(|s| s.value.clone());
+                outputs.dmis = o
+                    .get("dmis")
+                    .and_then(|x| cx.string(x))
+                    .map(|s| s.value.clone());
+                outputs.plan = o
+                    .get("plan")
+                    .and_then(|x| cx.string(x))
+                    .map(|s| s.value.clone());
+                outputs.graph = o
+                    .get("graph")
+                    .and_then(|x| cx.string(x))
+                    .map(|s| s.value.clone());
                 o.finish(cx);
             }
             _ => cx.mismatch(v, "a block `{ dmis \"out.dmi\" }`", ""),
@@ -57,7 +86,11 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &ast::Plan, 
     for s in &p.stmts {
         match s {
             PlanStmt::Prop(_) => {}
-            PlanStmt::Sample { feature, strategy: sv, .. } => {
+            PlanStmt::Sample {
+                feature,
+                strategy: sv,
+                ..
+            } => {
                 let name = path_text(feature);
                 match the_part.features.iter().position(|f| f.name == name) {
                     Some(i) => {
@@ -66,45 +99,119 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &ast::Plan, 
                         }
                     }
                     None => {
-                        let help = format!("part `{}` has no feature `{name}`; {}", the_part.name, suggest::help_for_unknown("feature", &name, the_part.features.iter().map(|f| f.name.as_str())));
-                        cx.err(E::UnknownName { span: feature.span, what: "feature".into(), name, help });
+                        let help = format!(
+                            "part `{}` has no feature `{name}`; {}",
+                            the_part.name,
+                            suggest::help_for_unknown(
+                                "feature",
+                                &name,
+                                the_part.features.iter().map(|f| f.name.as_str())
+                            )
+                        );
+                        cx.err(E::UnknownName {
+                            span: feature.span,
+                            what: "feature".into(),
+                            name,
+                            help,
+                        });
                     }
                 }
             }
-            PlanStmt::Pref { forbid, kind, value, opts, span } => {
-                let mut o = Props::new(cx, format!("`{} {}`", if *forbid { "forbid" } else { "prefer" }, kind.name), *span, opts);
+            PlanStmt::Pref {
+                forbid,
+                kind,
+                value,
+                opts,
+                span,
+            } => {
+                let mut o = Props::new(
+                    cx,
+                    format!(
+                        "`{} {}`",
+                        if *forbid { "forbid" } else { "prefer" },
+                        kind.name
+                    ),
+                    *span,
+                    opts,
+                );
                 match kind.name.as_str() {
                     "setup" => {
-                        let weight = if *forbid { None } else { o.get("weight").and_then(|v| cx.non_negative(v, "weight")) };
+                        let weight = if *forbid {
+                            None
+                        } else {
+                            o.get("weight").and_then(|v| cx.non_negative(v, "weight"))
+                        };
                         if let Some(direction) = cx.direction(value) {
-                            plan.setups.push(SetupPref { direction, weight: weight.unwrap_or(1.0), forbidden: *forbid, span: *span });
+                            plan.setups.push(SetupPref {
+                                direction,
+                                weight: weight.unwrap_or(1.0),
+                                forbidden: *forbid,
+                                span: *span,
+                            });
                         }
                     }
                     "orientation" => {
-                        let weight = if *forbid { None } else { o.get("weight").and_then(|v| cx.non_negative(v, "weight")) };
+                        let weight = if *forbid {
+                            None
+                        } else {
+                            o.get("weight").and_then(|v| cx.non_negative(v, "weight"))
+                        };
                         if let Some((a, b)) = orientation(cx, value, head) {
-                            plan.orientations.push(OrientPref { a, b, weight: weight.unwrap_or(1.0), forbidden: *forbid, span: *span });
+                            plan.orientations.push(OrientPref {
+                                a,
+                                b,
+                                weight: weight.unwrap_or(1.0),
+                                forbidden: *forbid,
+                                span: *span,
+                            });
                         }
                     }
                     "probe" => {
-                        let cost = if *forbid { None } else { o.get("cost").and_then(|v| cx.non_negative(v, "cost")) };
+                        let cost = if *forbid {
+                            None
+                        } else {
+                            o.get("cost").and_then(|v| cx.non_negative(v, "cost"))
+                        };
                         if let Some(label) = cx.name(value) {
                             if the_cmm.probes.iter().any(|(l, _)| *l == label.name) {
-                                plan.probes.push(ProbePref { label: label.name.clone(), cost, forbidden: *forbid, span: *span });
+                                plan.probes.push(ProbePref {
+                                    label: label.name.clone(),
+                                    cost,
+                                    forbidden: *forbid,
+                                    span: *span,
+                                });
                             } else {
                                 let help = format!(
                                     "cmm `{}` has no probe `{}`; {}",
                                     the_cmm.name,
                                     label.name,
-                                    suggest::help_for_unknown("probe", &label.name, the_cmm.probes.iter().map(|(l, _)| l.as_str()))
+                                    suggest::help_for_unknown(
+                                        "probe",
+                                        &label.name,
+                                        the_cmm.probes.iter().map(|(l, _)| l.as_str())
+                                    )
                                 );
-                                cx.err(E::UnknownName { span: label.span, what: "probe".into(), name: label.name.clone(), help });
+                                cx.err(E::UnknownName {
+                                    span: label.span,
+                                    what: "probe".into(),
+                                    name: label.name.clone(),
+                                    help,
+                                });
                             }
                         }
                     }
                     other => {
-                        let help = suggest::help_for_unknown("preference", other, ["setup", "orientation", "probe"]);
-                        cx.err(E::UnknownName { span: kind.span, what: "preference".into(), name: other.into(), help });
+                        let help = suggest::help_for_unknown(
+                            "preference",
+                            other,
+                            ["setup", "orientation", "probe"],
+                        );
+                        cx.err(E::UnknownName {
+                            span: kind.span,
+                            what: "preference".into(),
+                            name: other.into(),
+                            help,
+                        });
                     }
                 }
                 o.finish(cx);
@@ -117,11 +224,19 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, module: ModuleId, p: &ast::Plan, 
 /// An `(A, B)` orientation checked against the head's range and grid.
 fn orientation(cx: &mut Cx, v: &ast::Value, head: Option<&Head>) -> Option<(f64, f64)> {
     let ValueKind::Tuple(items) = &v.kind else {
-        cx.mismatch(v, "an orientation `(A, B)`", "write e.g. `(30 deg, 90 deg)`");
+        cx.mismatch(
+            v,
+            "an orientation `(A, B)`",
+            "write e.g. `(30 deg, 90 deg)`",
+        );
         return None;
     };
     if items.len() != 2 {
-        cx.mismatch(v, "an orientation `(A, B)`", "write e.g. `(30 deg, 90 deg)`");
+        cx.mismatch(
+            v,
+            "an orientation `(A, B)`",
+            "write e.g. `(30 deg, 90 deg)`",
+        );
         return None;
     }
     let a = cx.dim(&items[0], Dim::Angle);
@@ -129,7 +244,10 @@ fn orientation(cx: &mut Cx, v: &ast::Value, head: Option<&Head>) -> Option<(f64,
     let (a, b) = (a?, b?);
     let head = head?;
     let HeadKind::Indexable { a: ar, b: br, step } = &head.kind else {
-        cx.err(E::FixedHead { span: v.span, head: head.name.clone() });
+        cx.err(E::FixedHead {
+            span: v.span,
+            head: head.name.clone(),
+        });
         return None;
     };
     let mut ok = true;
@@ -141,7 +259,11 @@ fn orientation(cx: &mut Cx, v: &ast::Value, head: Option<&Head>) -> Option<(f64,
                 axis: axis.into(),
                 value: num(val),
                 head: head.name.clone(),
-                help: format!("choose {axis} within {rtxt}, a multiple of {}° from {}°", num(*step), num(range[0])),
+                help: format!(
+                    "choose {axis} within {rtxt}, a multiple of {}° from {}°",
+                    num(*step),
+                    num(range[0])
+                ),
                 range: rtxt,
             });
             ok = false;
@@ -156,7 +278,11 @@ fn orientation(cx: &mut Cx, v: &ast::Value, head: Option<&Head>) -> Option<(f64,
                 value: num(val),
                 head: head.name.clone(),
                 step: num(*step),
-                help: format!("the nearest positions are {}° and {}°", num(lo), num(lo + step)),
+                help: format!(
+                    "the nearest positions are {}° and {}°",
+                    num(lo),
+                    num(lo + step)
+                ),
             });
             ok = false;
         }

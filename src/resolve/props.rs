@@ -41,7 +41,10 @@ pub(crate) use crate::model::fmt_num as num;
 
 /// Millimetres per unit for a length unit name (`mm`, `in`, …).
 pub fn length_unit_mm(name: &str) -> Option<f64> {
-    UNITS.iter().find(|(n, d, _)| *n == name && *d == Dim::Length).map(|(_, _, f)| *f)
+    UNITS
+        .iter()
+        .find(|(n, d, _)| *n == name && *d == Dim::Length)
+        .map(|(_, _, f)| *f)
 }
 
 /// Describes a value's form for "found …" messages.
@@ -95,7 +98,12 @@ impl Cx<'_> {
                 _ => format!("write {expected} here"),
             }
         };
-        self.err(E::TypeMismatch { span: v.span, expected: expected.into(), found: describe(v), help });
+        self.err(E::TypeMismatch {
+            span: v.span,
+            expected: expected.into(),
+            found: describe(v),
+            help,
+        });
     }
 
     /// Converts a quantity to the internal unit of `dim`.
@@ -114,7 +122,11 @@ impl Cx<'_> {
                     Dim::Length => ("mm, cm, m, um or in", "mm"),
                     _ => ("deg or rad", "deg"),
                 };
-                let hint = if dim == Dim::Length { "; inside a part, bare numbers take the part's `units`" } else { "" };
+                let hint = if dim == Dim::Length {
+                    "; inside a part, bare numbers take the part's `units`"
+                } else {
+                    ""
+                };
                 self.err(E::MissingUnit {
                     span: q.span,
                     value: num(q.value),
@@ -125,8 +137,16 @@ impl Cx<'_> {
             }
             Some(u) => match UNITS.iter().find(|(n, _, _)| *n == u.name) {
                 None => {
-                    let help = suggest::help_for_unknown("unit", &u.name, UNITS.iter().map(|(n, _, _)| *n));
-                    self.err(E::UnknownUnit { span: u.span, unit: u.name.clone(), help });
+                    let help = suggest::help_for_unknown(
+                        "unit",
+                        &u.name,
+                        UNITS.iter().map(|(n, _, _)| *n),
+                    );
+                    self.err(E::UnknownUnit {
+                        span: u.span,
+                        unit: u.name.clone(),
+                        help,
+                    });
                     None
                 }
                 Some((_, d, f)) if *d == dim => Some(q.value * f),
@@ -187,12 +207,18 @@ impl Cx<'_> {
     /// A plain number (weights, costs, scales).
     pub fn number(&mut self, v: &Value) -> Option<f64> {
         match &v.kind {
-            ValueKind::Quantity(Quantity { value, unit: None, .. }) => Some(*value),
+            ValueKind::Quantity(Quantity {
+                value, unit: None, ..
+            }) => Some(*value),
             ValueKind::Quantity(Quantity { unit: Some(u), .. }) => {
                 self.err(E::UnitMismatch {
                     span: v.span,
                     expected: "a plain number".into(),
-                    found: UNITS.iter().find(|(n, _, _)| *n == u.name).map_or("a quantity", |(_, d, _)| d.word()).into(),
+                    found: UNITS
+                        .iter()
+                        .find(|(n, _, _)| *n == u.name)
+                        .map_or("a quantity", |(_, d, _)| d.word())
+                        .into(),
                     unit: u.name.clone(),
                     help: "weights and costs have no unit".into(),
                 });
@@ -253,7 +279,11 @@ impl Cx<'_> {
                 d
             }
             _ => {
-                self.mismatch(v, "a direction", "write `+x`, `-z` or a vector such as `(0, 1, 1)`");
+                self.mismatch(
+                    v,
+                    "a direction",
+                    "write `+x`, `-z` or a vector such as `(0, 1, 1)`",
+                );
                 return None;
             }
         };
@@ -280,7 +310,11 @@ impl Cx<'_> {
                 ok.then_some(out)
             }
             _ => {
-                let expected = if N == 3 { "a point `(x, y, z)`".to_string() } else { format!("a tuple of {N} lengths") };
+                let expected = if N == 3 {
+                    "a point `(x, y, z)`".to_string()
+                } else {
+                    format!("a tuple of {N} lengths")
+                };
                 self.mismatch(v, &expected, "");
                 None
             }
@@ -324,17 +358,29 @@ impl<'a> Props<'a> {
         let mut kept: Vec<&'a ast::Prop> = Vec::new();
         for p in props {
             match kept.iter().find(|k| k.key.name == p.key.name) {
-                Some(first) => cx.err(E::DuplicateProperty { span: p.key.span, first: first.key.span, key: p.key.name.clone() }),
+                Some(first) => cx.err(E::DuplicateProperty {
+                    span: p.key.span,
+                    first: first.key.span,
+                    key: p.key.name.clone(),
+                }),
                 None => kept.push(p),
             }
         }
-        Props { item: item.into(), owner, props: kept, asked: Vec::new() }
+        Props {
+            item: item.into(),
+            owner,
+            props: kept,
+            asked: Vec::new(),
+        }
     }
 
     /// The value of an optional property.
     pub fn get(&mut self, key: &'static str) -> Option<&'a Value> {
         self.asked.push(key);
-        self.props.iter().find(|p| p.key.name == key).map(|p| &p.value)
+        self.props
+            .iter()
+            .find(|p| p.key.name == key)
+            .map(|p| &p.value)
     }
 
     /// The value of a required property, reporting it missing.
@@ -355,8 +401,14 @@ impl<'a> Props<'a> {
     pub fn finish(self, cx: &mut Cx) {
         for p in &self.props {
             if !self.asked.contains(&p.key.name.as_str()) {
-                let help = suggest::help_for_unknown("property", &p.key.name, self.asked.iter().copied());
-                cx.err(E::UnknownProperty { span: p.key.span, key: p.key.name.clone(), item: self.item.clone(), help });
+                let help =
+                    suggest::help_for_unknown("property", &p.key.name, self.asked.iter().copied());
+                cx.err(E::UnknownProperty {
+                    span: p.key.span,
+                    key: p.key.name.clone(),
+                    item: self.item.clone(),
+                    help,
+                });
             }
         }
     }

@@ -31,11 +31,27 @@ struct Rule {
 }
 
 const fn geo(name: &'static str, kind: TolKind, datums: Datums, material: bool, dia: bool) -> Rule {
-    Rule { name, kind, datums, material, dia, targets: (1, 1), size: None }
+    Rule {
+        name,
+        kind,
+        datums,
+        material,
+        dia,
+        targets: (1, 1),
+        size: None,
+    }
 }
 
 const fn size(name: &'static str, kind: TolKind, targets: (usize, usize), dim: Dim) -> Rule {
-    Rule { name, kind, datums: Datums::Forbidden, material: false, dia: false, targets, size: Some(dim) }
+    Rule {
+        name,
+        kind,
+        datums: Datums::Forbidden,
+        material: false,
+        dia: false,
+        targets,
+        size: Some(dim),
+    }
 }
 
 use Datums::*;
@@ -49,7 +65,13 @@ const RULES: &[Rule] = &[
     geo("cylindricity", K::Cylindricity, Forbidden, false, false),
     geo("profile_line", K::ProfileLine, Optional, false, false),
     geo("profile_surface", K::ProfileSurface, Optional, false, false),
-    geo("perpendicularity", K::Perpendicularity, Required, true, true),
+    geo(
+        "perpendicularity",
+        K::Perpendicularity,
+        Required,
+        true,
+        true,
+    ),
     geo("parallelism", K::Parallelism, Required, true, true),
     geo("angularity", K::Angularity, Required, true, true),
     geo("position", K::Position, Required, true, true),
@@ -67,16 +89,34 @@ const RULES: &[Rule] = &[
 
 /// The keyword of a tolerance type.
 pub fn keyword(kind: TolKind) -> &'static str {
-    RULES.iter().find(|r| r.kind == kind).map_or("?", |r| r.name)
+    RULES
+        .iter()
+        .find(|r| r.kind == kind)
+        .map_or("?", |r| r.name)
 }
 
-pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Call) -> Option<Tolerance> {
+pub(super) fn lower(
+    cx: &mut Cx,
+    pc: &PartCx,
+    name: &ast::Ident,
+    call: &ast::Call,
+) -> Option<Tolerance> {
     let callee = call.callee.as_ident();
     let callee_name = callee.map_or_else(|| path_text(&call.callee), |i| i.name.clone());
-    let lookup = if callee_name == "roundness" { "circularity" } else { callee_name.as_str() };
+    let lookup = if callee_name == "roundness" {
+        "circularity"
+    } else {
+        callee_name.as_str()
+    };
     let Some(rule) = RULES.iter().find(|r| r.name == lookup) else {
-        let help = suggest::help_for_unknown("tolerance type", &callee_name, RULES.iter().map(|r| r.name));
-        cx.err(E::UnknownName { span: call.callee.span, what: "tolerance type".into(), name: callee_name, help });
+        let help =
+            suggest::help_for_unknown("tolerance type", &callee_name, RULES.iter().map(|r| r.name));
+        cx.err(E::UnknownName {
+            span: call.callee.span,
+            what: "tolerance type".into(),
+            name: callee_name,
+            help,
+        });
         return None;
     };
     let what = rule.name.to_string();
@@ -96,29 +136,57 @@ pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Cal
             ast::Arg::Named(k, v) if k.name == "dia" => {
                 past_value = true;
                 if !rule.dia {
-                    cx.err(E::DiameterZone { span: k.span, kind: what.clone() });
+                    cx.err(E::DiameterZone {
+                        span: k.span,
+                        kind: what.clone(),
+                    });
                     ok = false;
                 }
                 match zone(cx, v, &what) {
-                    Some(w) => value = Some((TolValue::Zone { width: w, diameter: true }, v.span)),
+                    Some(w) => {
+                        value = Some((
+                            TolValue::Zone {
+                                width: w,
+                                diameter: true,
+                            },
+                            v.span,
+                        ))
+                    }
                     None => ok = false,
                 }
             }
             ast::Arg::Named(k, v) if k.name == "basic" => {
                 if rule.kind != K::Angularity {
-                    cx.err(E::UnknownProperty { span: k.span, key: "basic".into(), item: what.clone(), help: "only angularity takes a basic angle".into() });
+                    cx.err(E::UnknownProperty {
+                        span: k.span,
+                        key: "basic".into(),
+                        item: what.clone(),
+                        help: "only angularity takes a basic angle".into(),
+                    });
                 }
                 basic_angle = cx.angle(v);
             }
             ast::Arg::Named(k, _) => {
                 let help = suggest::help_for_unknown("argument", &k.name, ["dia", "basic"]);
-                cx.err(E::UnknownProperty { span: k.span, key: k.name.clone(), item: what.clone(), help });
+                cx.err(E::UnknownProperty {
+                    span: k.span,
+                    key: k.name.clone(),
+                    item: what.clone(),
+                    help,
+                });
                 ok = false;
             }
             ast::Arg::Positional(v) => match &v.kind {
                 ValueKind::Quantity(_) | ValueKind::Limits { .. } | ValueKind::Range(..) => {
                     past_value = true;
-                    let val = if let Some(dim) = rule.size { size_limits(cx, v, dim) } else { zone(cx, v, &what).map(|w| TolValue::Zone { width: w, diameter: false }) };
+                    let val = if let Some(dim) = rule.size {
+                        size_limits(cx, v, dim)
+                    } else {
+                        zone(cx, v, &what).map(|w| TolValue::Zone {
+                            width: w,
+                            diameter: false,
+                        })
+                    };
                     match val {
                         Some(val) => value = Some((val, v.span)),
                         None => ok = false,
@@ -131,7 +199,11 @@ pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Cal
                         target_failed = true;
                     }
                 },
-                ValueKind::Path(p) if p.as_ident().is_some_and(|i| matches!(i.name.as_str(), "MMC" | "LMC" | "RFS")) && datums.is_empty() => {
+                ValueKind::Path(p)
+                    if p.as_ident()
+                        .is_some_and(|i| matches!(i.name.as_str(), "MMC" | "LMC" | "RFS"))
+                        && datums.is_empty() =>
+                {
                     let m = material(cx, p.as_ident()?)?;
                     if !rule.material && m != Material::Rfs {
                         cx.err(E::ModifierNotAllowed {
@@ -144,8 +216,13 @@ pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Cal
                     }
                     modifier = Some((m, p.span));
                 }
-                ValueKind::Path(p) if p.segs.len() == 1 && matches!(pc.names.get(&p.head().name), Some((Local::Frame(_), _))) => {
-                    let Some((Local::Frame(i), _)) = pc.names.get(&p.head().name) else { unreachable!() };
+                ValueKind::Path(p)
+                    if p.segs.len() == 1
+                        && matches!(pc.names.get(&p.head().name), Some((Local::Frame(_), _))) =>
+                {
+                    let Some((Local::Frame(i), _)) = pc.names.get(&p.head().name) else {
+                        unreachable!()
+                    };
                     match pc.part.frames.get(*i) {
                         Some(f) => datums.extend(f.refs.iter().map(|r| (r.clone(), p.span))),
                         None => ok = false,
@@ -156,7 +233,11 @@ pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Cal
                     None => ok = false,
                 },
                 _ => {
-                    cx.mismatch(v, "a feature, a value, a modifier or a datum", &format!("write e.g. `{}(feature, 0.05 mm, A)`", rule.name));
+                    cx.mismatch(
+                        v,
+                        "a feature, a value, a modifier or a datum",
+                        &format!("write e.g. `{}(feature, 0.05 mm, A)`", rule.name),
+                    );
                     ok = false;
                 }
             },
@@ -165,28 +246,62 @@ pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Cal
 
     let (min, max) = rule.targets;
     if !target_failed && (targets.len() < min || targets.len() > max) {
-        let expected = if min == max { format!("{min} feature{}", if min == 1 { "" } else { "s" }) } else { format!("{min} or {max} features") };
+        let expected = if min == max {
+            format!("{min} feature{}", if min == 1 { "" } else { "s" })
+        } else {
+            format!("{min} or {max} features")
+        };
         cx.err(E::Arity {
             span: targets.get(max).map_or(call.span, |t| t.1),
             kind: what.clone(),
             expected,
             found: format!("{}", targets.len()),
-            help: format!("the toleranced feature{} come{} first: `{}(…)`", if max > 1 { "s" } else { "" }, if max > 1 { "" } else { "s" }, rule.name),
+            help: format!(
+                "the toleranced feature{} come{} first: `{}(…)`",
+                if max > 1 { "s" } else { "" },
+                if max > 1 { "" } else { "s" },
+                rule.name
+            ),
         });
         ok = false;
     }
     let Some((value, _)) = value else {
         if ok {
-            let what_value = if rule.size.is_some() { "limits, e.g. `10 mm ± 0.05 mm`" } else { "a tolerance value, e.g. `0.05 mm`" };
-            cx.err(E::MissingArgument { span: call.span, kind: what.clone(), what: what_value.into(), help: format!("write `{}(feature, {})`", rule.name, if rule.size.is_some() { "10 mm ± 0.05 mm" } else { "0.05 mm" }) });
+            let what_value = if rule.size.is_some() {
+                "limits, e.g. `10 mm ± 0.05 mm`"
+            } else {
+                "a tolerance value, e.g. `0.05 mm`"
+            };
+            cx.err(E::MissingArgument {
+                span: call.span,
+                kind: what.clone(),
+                what: what_value.into(),
+                help: format!(
+                    "write `{}(feature, {})`",
+                    rule.name,
+                    if rule.size.is_some() {
+                        "10 mm ± 0.05 mm"
+                    } else {
+                        "0.05 mm"
+                    }
+                ),
+            });
         }
         return None;
     };
     match rule.datums {
         Forbidden => {
             if let Some((_, span)) = datums.first() {
-                let help = if rule.size.is_some() { "sizes are checked without a datum frame".to_string() } else { format!("{what} is a form tolerance: it controls the feature on its own") };
-                cx.err(E::DatumsForbidden { span: *span, kind: what.clone(), help });
+                let help = if rule.size.is_some() {
+                    "sizes are checked without a datum frame".to_string()
+                } else {
+                    format!("{what} is a form tolerance: it controls the feature on its own")
+                };
+                cx.err(E::DatumsForbidden {
+                    span: *span,
+                    kind: what.clone(),
+                    help,
+                });
                 ok = false;
             }
         }
@@ -197,14 +312,23 @@ pub(super) fn lower(cx: &mut Cx, pc: &PartCx, name: &ast::Ident, call: &ast::Cal
         _ => {}
     }
     if rule.kind == K::Angularity && basic_angle.is_none() && ok {
-        cx.err(E::MissingArgument { span: call.span, kind: what.clone(), what: "its basic angle".into(), help: "write `angularity(feature, 0.1 mm, A, basic 30 deg)`".into() });
+        cx.err(E::MissingArgument {
+            span: call.span,
+            kind: what.clone(),
+            what: "its basic angle".into(),
+            help: "write `angularity(feature, 0.1 mm, A, basic 30 deg)`".into(),
+        });
         ok = false;
     }
     check_unique_datums(cx, &pc.part, &datums);
     for (d, span) in &datums {
         let df = pc.part.datums[d.datum.0].feature;
         if let Some((f, _)) = targets.iter().find(|(f, _)| *f == df) {
-            cx.err(E::DatumSelfReference { span: *span, datum: pc.part.datums[d.datum.0].name.clone(), feature: pc.part.features[f.0].name.clone() });
+            cx.err(E::DatumSelfReference {
+                span: *span,
+                datum: pc.part.datums[d.datum.0].name.clone(),
+                feature: pc.part.features[f.0].name.clone(),
+            });
             ok = false;
         }
     }
@@ -227,21 +351,46 @@ fn target(cx: &mut Cx, pc: &PartCx, p: &ast::Path) -> Option<FeatureId> {
             span: p.span,
             expected: "a feature".into(),
             found: format!("the face `{}`", path_text(p)),
-            help: format!("tolerances apply to features: declare `feature {}_f = {}` and name it here", head.name, path_text(p)),
+            help: format!(
+                "tolerances apply to features: declare `feature {}_f = {}` and name it here",
+                head.name,
+                path_text(p)
+            ),
         });
         return None;
     }
     match pc.names.get(&head.name) {
-        Some((Local::Feature(i), _)) if p.segs.len() == 1 => (*i < pc.part.features.len()).then_some(FeatureId(*i)),
-        Some((Local::Datum(i), _)) if p.segs.len() == 1 => pc.part.datums.get(*i).map(|d| d.feature),
+        Some((Local::Feature(i), _)) if p.segs.len() == 1 => {
+            (*i < pc.part.features.len()).then_some(FeatureId(*i))
+        }
+        Some((Local::Datum(i), _)) if p.segs.len() == 1 => {
+            pc.part.datums.get(*i).map(|d| d.feature)
+        }
         Some((other, _)) => {
-            cx.err(E::WrongKind { span: p.span, name: path_text(p), expected: "a feature".into(), found: other.word(&pc.part), help: "tolerances apply to features: declare `feature name = faces` and name it here".into() });
+            cx.err(E::WrongKind {
+                span: p.span,
+                name: path_text(p),
+                expected: "a feature".into(),
+                found: other.word(&pc.part),
+                help:
+                    "tolerances apply to features: declare `feature name = faces` and name it here"
+                        .into(),
+            });
             None
         }
         None => {
-            let features = pc.names.iter().filter(|(_, (l, _))| matches!(l, Local::Feature(_))).map(|(n, _)| n.as_str());
+            let features = pc
+                .names
+                .iter()
+                .filter(|(_, (l, _))| matches!(l, Local::Feature(_)))
+                .map(|(n, _)| n.as_str());
             let help = suggest::help_for_unknown("feature", &head.name, features);
-            cx.err(E::UnknownName { span: p.span, what: "feature".into(), name: path_text(p), help });
+            cx.err(E::UnknownName {
+                span: p.span,
+                what: "feature".into(),
+                name: path_text(p),
+                help,
+            });
             None
         }
     }
@@ -252,13 +401,22 @@ fn zone(cx: &mut Cx, v: &ast::Value, what: &str) -> Option<f64> {
         ValueKind::Quantity(_) => {
             let w = cx.length(v)?;
             if w <= 0.0 {
-                cx.err(E::NonPositive { span: v.span, what: format!("the {what} tolerance"), value: describe(v), help: "a tolerance zone has a positive width".into() });
+                cx.err(E::NonPositive {
+                    span: v.span,
+                    what: format!("the {what} tolerance"),
+                    value: describe(v),
+                    help: "a tolerance zone has a positive width".into(),
+                });
                 return None;
             }
             Some(w)
         }
         _ => {
-            cx.mismatch(v, "a tolerance zone width such as `0.05 mm`", "limits belong to size tolerances (`diameter`, `width`, `distance`, `angle`)");
+            cx.mismatch(
+                v,
+                "a tolerance zone width such as `0.05 mm`",
+                "limits belong to size tolerances (`diameter`, `width`, `distance`, `angle`)",
+            );
             None
         }
     }
@@ -266,7 +424,11 @@ fn zone(cx: &mut Cx, v: &ast::Value, what: &str) -> Option<f64> {
 
 fn size_limits(cx: &mut Cx, v: &ast::Value, dim: Dim) -> Option<TolValue> {
     let (nominal, lower, upper) = match &v.kind {
-        ValueKind::Limits { nominal, plus, minus } => {
+        ValueKind::Limits {
+            nominal,
+            plus,
+            minus,
+        } => {
             let n = cx.quantity(nominal, dim);
             let p = cx.quantity(plus, dim);
             let m = cx.quantity(minus, dim);
@@ -280,17 +442,34 @@ fn size_limits(cx: &mut Cx, v: &ast::Value, dim: Dim) -> Option<TolValue> {
             ((lo + hi) / 2.0, lo, hi)
         }
         _ => {
-            cx.mismatch(v, "limits such as `10 mm ± 0.05 mm` or `9.95 mm .. 10.05 mm`", "a size tolerance gives its nominal and limits");
+            cx.mismatch(
+                v,
+                "limits such as `10 mm ± 0.05 mm` or `9.95 mm .. 10.05 mm`",
+                "a size tolerance gives its nominal and limits",
+            );
             return None;
         }
     };
     if lower >= upper {
-        cx.err(E::InvalidLimits { span: v.span, lower: num(lower), upper: num(upper) });
+        cx.err(E::InvalidLimits {
+            span: v.span,
+            lower: num(lower),
+            upper: num(upper),
+        });
         return None;
     }
     if nominal <= 0.0 && dim == Dim::Length {
-        cx.err(E::NonPositive { span: v.span, what: "the nominal size".into(), value: num(nominal), help: "sizes are positive".into() });
+        cx.err(E::NonPositive {
+            span: v.span,
+            what: "the nominal size".into(),
+            value: num(nominal),
+            help: "sizes are positive".into(),
+        });
         return None;
     }
-    Some(TolValue::Size { nominal, lower, upper })
+    Some(TolValue::Size {
+        nominal,
+        lower,
+        upper,
+    })
 }

@@ -61,7 +61,10 @@ impl MemoryWorld {
 
 impl World for MemoryWorld {
     fn read(&self, path: &Path) -> Result<Vec<u8>, WorldError> {
-        self.files.get(&normalize(path)).cloned().ok_or_else(|| WorldError("No such file or directory".into()))
+        self.files
+            .get(&normalize(path))
+            .cloned()
+            .ok_or_else(|| WorldError("No such file or directory".into()))
     }
 
     fn exists(&self, path: &Path) -> bool {

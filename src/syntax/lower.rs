@@ -22,7 +22,10 @@ impl L {
     }
 
     fn ident(&self, p: P) -> Ident {
-        Ident { name: p.as_str().to_string(), span: self.span(&p) }
+        Ident {
+            name: p.as_str().to_string(),
+            span: self.span(&p),
+        }
     }
 
     fn string(&self, p: P) -> R<Str> {
@@ -44,7 +47,10 @@ impl L {
                 Some((j, other)) => {
                     let start = inner.as_span().start() + i;
                     let end = inner.as_span().start() + j + other.len_utf8();
-                    return Err(SyntaxError::InvalidEscape { span: Span::new(self.file, start, end), text: format!("\\{other}") });
+                    return Err(SyntaxError::InvalidEscape {
+                        span: Span::new(self.file, start, end),
+                        text: format!("\\{other}"),
+                    });
                 }
                 None => value.push('\\'),
             }
@@ -56,12 +62,20 @@ impl L {
         let text = p.as_str();
         match text.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
-            _ => Err(SyntaxError::InvalidNumber { span: self.span(p), text: text.to_string() }),
+            _ => Err(SyntaxError::InvalidNumber {
+                span: self.span(p),
+                text: text.to_string(),
+            }),
         }
     }
 
     fn integer(&self, p: &P) -> R<u32> {
-        p.as_str().parse::<u32>().map_err(|_| SyntaxError::InvalidNumber { span: self.span(p), text: p.as_str().to_string() })
+        p.as_str()
+            .parse::<u32>()
+            .map_err(|_| SyntaxError::InvalidNumber {
+                span: self.span(p),
+                text: p.as_str().to_string(),
+            })
     }
 
     fn quantity(&self, p: P) -> R<Quantity> {
@@ -89,7 +103,11 @@ impl L {
 
     fn value(&self, p: P) -> R<Value> {
         let span = self.span(&p);
-        let inner = if p.as_rule() == Rule::value { p.into_inner().next().expect("value has one child") } else { p };
+        let inner = if p.as_rule() == Rule::value {
+            p.into_inner().next().expect("value has one child")
+        } else {
+            p
+        };
         let kind = match inner.as_rule() {
             Rule::quantity => ValueKind::Quantity(self.quantity(inner)?),
             Rule::limits => {
@@ -98,14 +116,25 @@ impl L {
                 let second = it.next().expect("limits has a second part");
                 if second.as_rule() == Rule::pm {
                     let plus = self.quantity(it.next().expect("deviation"))?;
-                    let minus = Quantity { value: -plus.value, ..plus.clone() };
-                    ValueKind::Limits { nominal, plus, minus }
+                    let minus = Quantity {
+                        value: -plus.value,
+                        ..plus.clone()
+                    };
+                    ValueKind::Limits {
+                        nominal,
+                        plus,
+                        minus,
+                    }
                 } else {
                     let a = self.quantity(second)?;
                     let b = self.quantity(it.next().expect("second deviation"))?;
                     // Written in either order: the larger is the upper deviation.
                     let (plus, minus) = if a.value >= b.value { (a, b) } else { (b, a) };
-                    ValueKind::Limits { nominal, plus, minus }
+                    ValueKind::Limits {
+                        nominal,
+                        plus,
+                        minus,
+                    }
                 }
             }
             Rule::range => {
@@ -121,10 +150,18 @@ impl L {
                     "y" => 1,
                     _ => 2,
                 };
-                ValueKind::Direction { axis, negative: s.starts_with('-') }
+                ValueKind::Direction {
+                    axis,
+                    negative: s.starts_with('-'),
+                }
             }
             Rule::string => ValueKind::Str(self.string(inner)?),
-            Rule::tuple => ValueKind::Tuple(inner.into_inner().map(|v| self.value(v)).collect::<R<_>>()?),
+            Rule::tuple => ValueKind::Tuple(
+                inner
+                    .into_inner()
+                    .map(|v| self.value(v))
+                    .collect::<R<_>>()?,
+            ),
             Rule::list => ValueKind::List(self.list(inner)?),
             Rule::block => ValueKind::Block(self.props(inner.into_inner())?),
             Rule::call => ValueKind::Call(self.call(inner)?),
@@ -142,9 +179,15 @@ impl L {
                 if first.as_rule() == Rule::list_label {
                     let label = self.ident(first.into_inner().next().expect("label name"));
                     let value = self.value(it.next().expect("labelled value"))?;
-                    Ok(ListEntry { label: Some(label), value })
+                    Ok(ListEntry {
+                        label: Some(label),
+                        value,
+                    })
                 } else {
-                    Ok(ListEntry { label: None, value: self.value(first)? })
+                    Ok(ListEntry {
+                        label: None,
+                        value: self.value(first)?,
+                    })
                 }
             })
             .collect()
@@ -170,7 +213,11 @@ impl L {
         let span = self.span(&p);
         let mut it = p.into_inner();
         let callee = self.path(it.next().expect("callee"))?;
-        Ok(Call { callee, args: self.args(it)?, span })
+        Ok(Call {
+            callee,
+            args: self.args(it)?,
+            span,
+        })
     }
 
     fn props(&self, pairs: Pairs<Rule>) -> R<Vec<Prop>> {
@@ -203,7 +250,12 @@ impl L {
                 };
                 let name = self.ident(it.next().expect("name"));
                 let props = self.props(it.next().expect("block").into_inner())?;
-                Item::Block(BlockItem { kind, name, props, span })
+                Item::Block(BlockItem {
+                    kind,
+                    name,
+                    props,
+                    span,
+                })
             }
             Rule::part_item => Item::Part(self.part(p, span)?),
             Rule::hierarchy_item => {
@@ -238,7 +290,11 @@ impl L {
                 }
             }
         };
-        Ok(Use { source, select, span })
+        Ok(Use {
+            source,
+            select,
+            span,
+        })
     }
 
     fn part(&self, p: P, span: Span) -> R<Part> {
@@ -270,7 +326,13 @@ impl L {
                 let kind = self.ident(it.next().expect("cut kind"));
                 let name = self.ident(it.next().expect("cut name"));
                 let props = self.props(it.next().expect("block").into_inner())?;
-                PartStmt::Cut { add, kind, name, props, span }
+                PartStmt::Cut {
+                    add,
+                    kind,
+                    name,
+                    props,
+                    span,
+                }
             }
             Rule::face_stmt | Rule::feature_stmt | Rule::datum_stmt => {
                 let what = match rule {
@@ -280,7 +342,12 @@ impl L {
                 };
                 let name = self.ident(it.next().expect("name"));
                 let expr = it.next().map(|e| self.face_expr(e)).transpose()?;
-                PartStmt::Named { what, name, expr, span }
+                PartStmt::Named {
+                    what,
+                    name,
+                    expr,
+                    span,
+                }
             }
             Rule::frame_stmt => {
                 let name = self.ident(it.next().expect("name"));
@@ -303,8 +370,13 @@ impl L {
             let tspan = self.span(&t);
             terms.push(match t.as_rule() {
                 Rule::path => FaceTerm::Path(self.path(t)?),
-                Rule::group_ref => FaceTerm::Group(self.string(t.into_inner().nth(1).expect("group name"))?),
-                Rule::segment_ref => FaceTerm::Segment(self.integer(&t.into_inner().nth(1).expect("segment id"))?, tspan),
+                Rule::group_ref => {
+                    FaceTerm::Group(self.string(t.into_inner().nth(1).expect("group name"))?)
+                }
+                Rule::segment_ref => FaceTerm::Segment(
+                    self.integer(&t.into_inner().nth(1).expect("segment id"))?,
+                    tspan,
+                ),
                 Rule::select_ref => {
                     let mut it = t.into_inner();
                     it.next();
@@ -327,8 +399,17 @@ impl L {
             }
             _ => {
                 let constraint = self.ident(it.next().expect("constraint"));
-                let group = it.map(|g| Ident { name: g.as_str().to_string(), span: self.span(&g) }).collect();
-                Level::Same { constraint, group, span }
+                let group = it
+                    .map(|g| Ident {
+                        name: g.as_str().to_string(),
+                        span: self.span(&g),
+                    })
+                    .collect();
+                Level::Same {
+                    constraint,
+                    group,
+                    span,
+                }
             }
         }
     }
@@ -352,9 +433,19 @@ impl L {
                         let key = self.ident(k);
                         let v = self.value(si.next().expect("option value"))?;
                         let pspan = key.span.join(v.span);
-                        opts.push(Prop { key, value: v, span: pspan });
+                        opts.push(Prop {
+                            key,
+                            value: v,
+                            span: pspan,
+                        });
                     }
-                    PlanStmt::Pref { forbid, kind, value, opts, span: sspan }
+                    PlanStmt::Pref {
+                        forbid,
+                        kind,
+                        value,
+                        opts,
+                        span: sspan,
+                    }
                 }
                 Rule::sample_stmt => {
                     let mut si = s.into_inner();
@@ -362,7 +453,11 @@ impl L {
                     let feature = self.path(si.next().expect("feature"))?;
                     si.next();
                     let strategy = self.value(si.next().expect("strategy"))?;
-                    PlanStmt::Sample { feature, strategy, span: sspan }
+                    PlanStmt::Sample {
+                        feature,
+                        strategy,
+                        span: sspan,
+                    }
                 }
                 r => unreachable!("plan statement {r:?}"),
             });

@@ -41,7 +41,10 @@ pub enum SyntaxError {
     },
     /// A number that does not fit.
     #[error("invalid number `{text}`")]
-    #[diagnostic(code(insp::syntax::invalid_number), help("numbers must be finite; indices must be whole numbers below 4294967296"))]
+    #[diagnostic(
+        code(insp::syntax::invalid_number),
+        help("numbers must be finite; indices must be whole numbers below 4294967296")
+    )]
     InvalidNumber {
         /// Where.
         #[label("not a usable number")]
@@ -51,7 +54,10 @@ pub enum SyntaxError {
     },
     /// Brackets nested deeper than any spec needs (and than the parser's stack allows).
     #[error("brackets nested more than {limit} deep")]
-    #[diagnostic(code(insp::syntax::too_deep), help("no spec needs this nesting; check for a missing closing bracket"))]
+    #[diagnostic(
+        code(insp::syntax::too_deep),
+        help("no spec needs this nesting; check for a missing closing bracket")
+    )]
     TooDeep {
         /// The bracket past the limit.
         #[label("too deep")]
@@ -61,7 +67,10 @@ pub enum SyntaxError {
     },
     /// An unknown escape in a string.
     #[error("unknown escape `{text}` in a string")]
-    #[diagnostic(code(insp::syntax::invalid_escape), help("strings know `\\\\`, `\\\"`, `\\n` and `\\t`"))]
+    #[diagnostic(
+        code(insp::syntax::invalid_escape),
+        help("strings know `\\\\`, `\\\"`, `\\n` and `\\t`")
+    )]
     InvalidEscape {
         /// Where.
         #[label("unknown escape")]
@@ -86,10 +95,16 @@ pub fn parse(file: FileId, text: &str) -> Result<ast::File, SyntaxError> {
             pest::set_error_detail(true);
             let err = InspParser::parse(Rule::file, text).err();
             pest::set_error_detail(false);
-            return Err(words::syntax_error(file, text, err.expect("a failed parse fails again")));
+            return Err(words::syntax_error(
+                file,
+                text,
+                err.expect("a failed parse fails again"),
+            ));
         }
     };
-    let root = pairs.next().expect("pest returns the `file` pair on success");
+    let root = pairs
+        .next()
+        .expect("pest returns the `file` pair on success");
     lower::file(file, root)
 }
 
@@ -124,7 +139,10 @@ fn check_depth(file: FileId, text: &str) -> Result<(), SyntaxError> {
             b'(' | b'[' | b'{' => {
                 depth += 1;
                 if depth > MAX_DEPTH {
-                    return Err(SyntaxError::TooDeep { span: Span::new(file, i, i + 1), limit: MAX_DEPTH });
+                    return Err(SyntaxError::TooDeep {
+                        span: Span::new(file, i, i + 1),
+                        limit: MAX_DEPTH,
+                    });
                 }
             }
             b')' | b']' | b'}' => depth = depth.saturating_sub(1),
@@ -148,7 +166,11 @@ mod tests {
 
     #[test]
     fn errors_name_words() {
-        let e = parse(FileId(0), "part p { units mm\n stock box(1, 2, 3)\n tolerance T = }").unwrap_err();
+        let e = parse(
+            FileId(0),
+            "part p { units mm\n stock box(1, 2, 3)\n tolerance T = }",
+        )
+        .unwrap_err();
         let msg = e.to_string();
         assert!(msg.contains("expected a name, found `}`"), "{msg}");
         assert!(!msg.contains("Rule") && !msg.contains('_'), "{msg}");

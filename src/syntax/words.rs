@@ -92,7 +92,11 @@ pub(crate) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
         pest::error::InputLocation::Span((s, _)) => s,
     };
     let mut expected: Vec<String> = match &e.variant {
-        pest::error::ErrorVariant::ParsingError { positives, .. } => positives.iter().filter_map(|r| word(*r)).map(String::from).collect(),
+        pest::error::ErrorVariant::ParsingError { positives, .. } => positives
+            .iter()
+            .filter_map(|r| word(*r))
+            .map(String::from)
+            .collect(),
         pest::error::ErrorVariant::CustomError { .. } => vec![],
     };
     // Token-level attempts see literals (`=`, `)`, `,`) that rule positives miss, and
@@ -108,8 +112,14 @@ pub(crate) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
                 let rule = deepest
                     .strip_prefix("Rule(")
                     .and_then(|n| n.strip_suffix(')'))
-                    .and_then(|n| Rule::all_rules().iter().find(|r| format!("{r:?}") == n).copied());
-                if let Some(w) = rule.and_then(|r| word(r).or_else(|| stack.parent.and_then(word))) {
+                    .and_then(|n| {
+                        Rule::all_rules()
+                            .iter()
+                            .find(|r| format!("{r:?}") == n)
+                            .copied()
+                    });
+                if let Some(w) = rule.and_then(|r| word(r).or_else(|| stack.parent.and_then(word)))
+                {
                     words.push(w.to_string());
                 }
             }
@@ -120,12 +130,34 @@ pub(crate) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
                 let token = t.to_string();
                 // Whitespace, comments, optional suffixes of numbers and paths, and keywords
                 // (which the rule words already name) would only bury the real expectation.
-                let noise = matches!(token.as_str(), "\r" | " " | "\t" | "\u{feff}" | "//" | "/*" | "*/" | "%" | "+-" | "±" | "+" | "-" | ".." | "." | "::" | "[" | "e" | "E")
-                    || token.chars().all(|c| c.is_ascii_alphabetic() || c == '_');
+                let noise = matches!(
+                    token.as_str(),
+                    "\r" | " "
+                        | "\t"
+                        | "\u{feff}"
+                        | "//"
+                        | "/*"
+                        | "*/"
+                        | "%"
+                        | "+-"
+                        | "±"
+                        | "+"
+                        | "-"
+                        | ".."
+                        | "."
+                        | "::"
+                        | "["
+                        | "e"
+                        | "E"
+                ) || token.chars().all(|c| c.is_ascii_alphabetic() || c == '_');
                 if noise {
                     continue;
                 }
-                words.push(if token == "\n" { "a new line".to_string() } else { format!("`{token}`") });
+                words.push(if token == "\n" {
+                    "a new line".to_string()
+                } else {
+                    format!("`{token}`")
+                });
             }
             if !words.is_empty() {
                 pos = att.max_position;
@@ -135,7 +167,12 @@ pub(crate) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
     }
     // Continuations of a complete value (`10 mm` could go on as limits or a range) only
     // matter when nothing else was expected.
-    let continuation = |w: &String| matches!(w.as_str(), "`±`" | "a range `a .. b`" | "a signed number such as `+0.1 mm`" | "a unit");
+    let continuation = |w: &String| {
+        matches!(
+            w.as_str(),
+            "`±`" | "a range `a .. b`" | "a signed number such as `+0.1 mm`" | "a unit"
+        )
+    };
     if expected.iter().any(|w| !continuation(w)) {
         expected.retain(|w| !continuation(w));
     }
@@ -158,7 +195,12 @@ pub(crate) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
     } else {
         format!("write {expected} here")
     };
-    SyntaxError::Unexpected { span: Span::new(file, pos, pos + len), expected, found, help }
+    SyntaxError::Unexpected {
+        span: Span::new(file, pos, pos + len),
+        expected,
+        found,
+        help,
+    }
 }
 
 /// What sits at `pos`, in words, and its length in bytes.
@@ -170,7 +212,11 @@ fn found_at(text: &str, pos: usize) -> (String, usize) {
     if c == '\n' || c == '\r' {
         return ("end of line".into(), 0);
     }
-    let word_len = |pred: fn(char) -> bool| rest.char_indices().find(|&(_, ch)| !pred(ch)).map_or(rest.len(), |(i, _)| i);
+    let word_len = |pred: fn(char) -> bool| {
+        rest.char_indices()
+            .find(|&(_, ch)| !pred(ch))
+            .map_or(rest.len(), |(i, _)| i)
+    };
     let len = if c.is_alphanumeric() || c == '_' {
         word_len(|ch| ch.is_alphanumeric() || ch == '_' || ch == '.')
     } else {

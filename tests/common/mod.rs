@@ -22,7 +22,7 @@ pub fn check_files(files: &[(&str, &[u8])]) -> Vec<Flat> {
     for (p, c) in files {
         world.insert(p, c.to_vec());
     }
-    let (checked, _) = inspc::check_geometry(&world, &[PathBuf::from(files[0].0)]);
+    let (checked, _, _) = inspc::measurement_graphs(&world, &[PathBuf::from(files[0].0)]);
     checked
         .diagnostics
         .iter()
@@ -32,7 +32,12 @@ pub fn check_files(files: &[(&str, &[u8])]) -> Vec<Flat> {
                 .inner
                 .labels()
                 .and_then(|mut l| l.next())
-                .map(|l| file.text.get(l.offset()..l.offset() + l.len()).unwrap_or("").to_string())
+                .map(|l| {
+                    file.text
+                        .get(l.offset()..l.offset() + l.len())
+                        .unwrap_or("")
+                        .to_string()
+                })
                 .unwrap_or_default();
             Flat {
                 code: d.code(),
@@ -49,4 +54,12 @@ pub fn check_files(files: &[(&str, &[u8])]) -> Vec<Flat> {
 /// Checks one in-memory file named `main.insp`.
 pub fn check_src(src: &str) -> Vec<Flat> {
     check_files(&[("main.insp", src.as_bytes())])
+}
+
+/// The NIST parts are expected in ../shared/parts/ beside the repository, as CI has them.
+pub fn require_shared_parts() {
+    assert!(
+        std::path::Path::new("../shared/parts/nist_ctc_01_asme1_ap242-e1.obj").exists(),
+        "the NIST parts are expected in ../shared/parts/ beside the repository, as CI has them"
+    );
 }

@@ -1,0 +1,22 @@
+//! The graph stage's diagnostics.
+
+use crate::source::Span;
+
+/// A problem building the measurement graph.
+#[derive(Debug, thiserror::Error, miette::Diagnostic)]
+#[allow(missing_docs)]
+pub enum GraphError {
+    #[error("face `{face}` of feature `{feature}` gets no measuring point")]
+    #[diagnostic(
+        code(insp::graph::no_points),
+        severity(Warning),
+        help("no candidate point lies inside the face and {margin} mm (the largest tip radius, at most a fifth of the face) from its edges; lower the sampling inset or drop the face from the feature")
+    )]
+    NoPoints {
+        #[label("this feature")]
+        span: Span,
+        face: String,
+        feature: String,
+        margin: String,
+    },
+}

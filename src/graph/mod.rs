@@ -1,0 +1,289 @@
+//! Stage 6, the measurement graph (seed ch. 3.2, figs. 3.2 and 3.29): part → tolerance →
+//! feature → face → fpoint, the structure the planner clusters.
+//!
+//! A tolerance's children are the features it tolerances and the features of the datums
+//! it refers to. Features no tolerance names hang from the part, so that they are still
+//! measured. A face shared by two features is one node with two parents. Datum features
+//! are marked with their letters, and a planar datum face the part can rest on — its
+//! plane supports the whole part — is marked `on_table` (ch. 3.6.2): the planner may put
+//! it on the table instead of probing it.
+//!
+//! **Architecture Invariant:** node order is deterministic: the part, then tolerances in
+//! declaration order with their features as first named, then the remaining features,
+//! then faces as their features first list them, then each face's fpoints.
+
+mod errors;
+mod render;
+
+pub use errors::GraphError;
+pub use render::{dot, json, mermaid};
+
+use crate::diag::Diagnostics;
+use crate::geometry::{FaceId, PartGeometry, Surface};
+use crate::model::{FeatureId, Part, Sampling, Strategy};
+use crate::sample::{Fpoint, Sampler};
+use crate::source::FileId;
+use petgraph::graph::{DiGraph, NodeIndex};
+use std::collections::HashMap;
+
+/// A node of the measurement graph.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Node {
+    /// The part, the root.
+    Part,
+    /// A tolerance, by index into [`Part::tolerances`].
+    Tolerance(usize),
+    /// A feature, with the letters of the datums it carries.
+    Feature {
+        /// The feature.
+        feature: FeatureId,
+        /// Datum letters it is the feature of.
+        datums: Vec<String>,
+    },
+    /// A face of the geometry.
+    Face {
+        /// The face.
+        face: FaceId,
+        /// A planar datum face whose plane supports the part: it can rest on the table.
+        on_table: bool,
+    },
+    /// A measuring point, by index into [`MeasurementGraph::fpoints`].
+    Point(usize),
+}
+
+/// Why an edge exists.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Edge {
+    /// Part → tolerance.
+    Tolerance,
+    /// Tolerance → a feature it tolerances (or part → an untoleranced feature).
+    Target,
+    /// Tolerance → the feature of one of its datums.
+    Datum,
+    /// Feature → face.
+    Face,
+    /// Face → fpoint.
+    Point,
+}
+
+/// The measurement graph of one part under one sampling.
+#[derive(Debug, Clone)]
+pub struct MeasurementGraph {
+    /// The plan it was built for, if any.
+    pub plan: Option<String>,
+    /// The sampling's name.
+    pub sampling: String,
+    /// The graph.
+    pub graph: DiGraph<Node, Edge>,
+    /// The part node.
+    pub root: NodeIndex,
+    /// Every measuring point, in node order.
+    pub fpoints: Vec<Fpoint>,
+    /// The distance points keep from face boundaries (mm).
+    pub margin: f64,
+}
+
+impl MeasurementGraph {
+    /// The nodes of a kind, in order.
+    pub fn nodes(&self) -> impl Iterator<Item = (NodeIndex, &Node)> {
+        self.graph.node_indices().map(move |i| (i, &self.graph[i]))
+    }
+
+    /// The children of a node, in insertion order.
+    pub fn children(&self, n: NodeIndex) -> Vec<(NodeIndex, Edge)> {
+        let mut out: Vec<(NodeIndex, Edge)> = self
+            .graph
+            .edges(n)
+            .map(|e| (petgraph::visit::EdgeRef::target(&e), *e.weight()))
+            .collect();
+        out.sort_by_key(|(i, _)| *i);
+        out
+    }
+
+    /// Counts: tolerances, features, faces, fpoints.
+    pub fn counts(&self) -> [usize; 4] {
+        let mut c = [0; 4];
+        for (_, n) in self.nodes() {
+            match n {
+                Node::Part => {}
+                Node::Tolerance(_) => c[0] += 1,
+                Node::Feature { .. } => c[1] += 1,
+                Node::Face { .. } => c[2] += 1,
+                Node::Point(_) => c[3] += 1,
+            }
+        }
+        c
+    }
+}
+
+/// What building a graph needs.
+pub struct Input<'a> {
+    /// The part.
+    pub part: &'a Part,
+    /// Its geometry.
+    pub geometry: &'a PartGeometry,
+    /// Per feature, its faces.
+    pub feature_faces: &'a [Vec<FaceId>],
+    /// The plan's name, if any.
+    pub plan: Option<&'a str>,
+    /// The sampling.
+    pub sampling: &'a Sampling,
+    /// Per-feature strategies.
+    pub overrides: &'a [(FeatureId, Strategy)],
+    /// The distance points keep from face boundaries (mm).
+    pub margin: f64,
+}
+
+/// Builds the measurement graph of a part, sampling every face. The entry point of the
+/// graph stage. Faces that get no measuring point are reported as warnings at the
+/// feature that names them.
+pub fn build(input: &Input, file: FileId, diags: &mut Diagnostics) -> MeasurementGraph {
+    let part = input.part;
+    let mut graph = DiGraph::new();
+    let root = graph.add_node(Node::Part);
+    let mut datums_of: HashMap<FeatureId, Vec<String>> = HashMap::new();
+    for d in &part.datums {
+        datums_of.entry(d.feature).or_default().push(d.name.clone());
+    }
+    let mut feature_nodes: Vec<(FeatureId, NodeIndex)> = Vec::new();
+    let mut feature_node = |graph: &mut DiGraph<Node, Edge>, f: FeatureId| -> NodeIndex {
+        if let Some(&(_, n)) = feature_nodes.iter().find(|(g, _)| *g == f) {
+            return n;
+        }
+        let n = graph.add_node(Node::Feature {
+            feature: f,
+            datums: datums_of.get(&f).cloned().unwrap_or_default(),
+        });
+        feature_nodes.push((f, n));
+        n
+    };
+    for (k, t) in part.tolerances.iter().enumerate() {
+        let tn = graph.add_node(Node::Tolerance(k));
+        graph.add_edge(root, tn, Edge::Tolerance);
+        for &f in &t.targets {
+            let fnode = feature_node(&mut graph, f);
+            graph.update_edge(tn, fnode, Edge::Target);
+        }
+        for r in &t.datums {
+            let f = part.datums[r.datum.0].feature;
+            let fnode = feature_node(&mut graph, f);
+            if graph.find_edge(tn, fnode).is_none() {
+                graph.add_edge(tn, fnode, Edge::Datum);
+            }
+        }
+    }
+    for (k, f) in part.features.iter().enumerate() {
+        let id = FeatureId(k);
+        let named = graph
+            .node_weights()
+            .any(|n| matches!(n, Node::Feature { feature, .. } if *feature == id));
+        // Face aliases (`face top = …`) only name a face for use in features.
+        if !named && !(f.is_face_alias && datums_of.get(&id).is_none()) {
+            let fnode = feature_node(&mut graph, id);
+            graph.add_edge(root, fnode, Edge::Target);
+        }
+    }
+    let feature_nodes: Vec<(FeatureId, NodeIndex)> = graph
+        .node_indices()
+        .filter_map(|i| match &graph[i] {
+            Node::Feature { feature, .. } => Some((*feature, i)),
+            _ => None,
+        })
+        .collect();
+
+    let g = input.geometry;
+    let mut face_nodes: Vec<(FaceId, NodeIndex, FeatureId)> = Vec::new();
+    for &(f, fnode) in &feature_nodes {
+        let datum = datums_of.contains_key(&f);
+        for &face in &input.feature_faces[f.0] {
+            let node = match face_nodes.iter().find(|(x, _, _)| *x == face) {
+                Some(&(_, n, _)) => {
+                    if datum && on_table(g, face) {
+                        graph[n] = Node::Face {
+                            face,
+                            on_table: true,
+                        };
+                    }
+                    n
+                }
+                None => {
+                    let n = graph.add_node(Node::Face {
+                        face,
+                        on_table: datum && on_table(g, face),
+                    });
+                    face_nodes.push((face, n, f));
+                    n
+                }
+            };
+            graph.update_edge(fnode, node, Edge::Face);
+        }
+    }
+
+    let sampler = Sampler::new(g, input.margin);
+    let mut fpoints = Vec::new();
+    for &(face, fnode, first_feature) in &face_nodes {
+        let strategy = strategy_for(input, face, &feature_nodes);
+        let points = sampler.sample(face, &strategy);
+        if points.is_empty() {
+            let feature = &part.features[first_feature.0];
+            diags.push(
+                file,
+                GraphError::NoPoints {
+                    span: feature.span,
+                    face: g.faces[face.0].name.clone(),
+                    feature: feature.name.clone(),
+                    margin: crate::model::fmt_num(input.margin),
+                },
+            );
+        }
+        for p in points {
+            let pn = graph.add_node(Node::Point(fpoints.len()));
+            graph.add_edge(fnode, pn, Edge::Point);
+            fpoints.push(p);
+        }
+    }
+    MeasurementGraph {
+        plan: input.plan.map(str::to_owned),
+        sampling: input.sampling.name.clone(),
+        graph,
+        root,
+        fpoints,
+        margin: input.margin,
+    }
+}
+
+/// The strategy for a face: the override of the first feature (in declaration order)
+/// that has one and lists the face, else the sampling's strategy for its surface type.
+fn strategy_for(input: &Input, face: FaceId, features: &[(FeatureId, NodeIndex)]) -> Strategy {
+    let mut owners: Vec<FeatureId> = features
+        .iter()
+        .map(|(f, _)| *f)
+        .filter(|f| input.feature_faces[f.0].contains(&face))
+        .collect();
+    owners.sort();
+    owners
+        .iter()
+        .find_map(|f| {
+            input
+                .overrides
+                .iter()
+                .find(|(o, _)| o == f)
+                .map(|(_, s)| s.clone())
+        })
+        .unwrap_or_else(|| {
+            input
+                .sampling
+                .strategy(input.geometry.faces[face.0].surface.kind())
+        })
+}
+
+/// Whether a planar face's plane supports the whole part: no vertex lies outside it.
+pub fn on_table(g: &PartGeometry, face: FaceId) -> bool {
+    let f = &g.faces[face.0];
+    let Surface::Plane { origin, normal } = f.surface else {
+        return false;
+    };
+    let (lo, hi) = g.bounds();
+    let tol = 1e-6 * (1.0 + (hi - lo).norm()) + 3.0 * f.fit_rms;
+    g.vertices.iter().all(|v| (v - origin).dot(&normal) <= tol)
+}

@@ -1,0 +1,400 @@
+//! Stage 5, sampling: measuring points (the seed's fpoints) on each face, by the plan's
+//! strategy.
+//!
+//! Points lie on the face's exact surface, found through a [`Chart`] of the face's
+//! parameters; a candidate counts only if the line along its normal crosses one of the
+//! face's triangles (it is inside the face's boundary, not in a hole) and it keeps
+//! [`Sampler::margin`] from that boundary. Strategies:
+//!
+//! - **Fan & Leu** (1998): a plane gets 4 points inset by a fifth of each side of its
+//!   minimum-area rectangle; past an aspect ratio of 4, points 2 and 4 move inward by a
+//!   quarter of the inner rectangle's length. A cylinder or cone gets 4 points on each of
+//!   two circles at h₁ = r + (H − 2r)/5 and h₂ = r + 4(H − 2r)/5, r being the margin. A
+//!   point that falls outside the face or into a hole moves by the diagonal or normal
+//!   zig-zag search until it is inside. Spheres and free-form faces, which the rules do
+//!   not cover, get Hammersley points (9 and 16).
+//! - **Uniform**: a grid of about `points` points, its outer rows at the inset.
+//! - **Hammersley** (Zhao et al. 2011): `x = i/N, y = Φ₂(i)`, area-uniform on the face.
+//!
+//! Where a grid or sequence loses points to holes, a denser one is drawn and `points` of
+//! its accepted points are kept, evenly by index. Free-form faces are sampled on their
+//! triangles, by area.
+//!
+//! **Architecture Invariant:** sampling is a pure function of the geometry, the face,
+//! the strategy and the margin; the same inputs give the same points in the same order.
+
+mod chart;
+
+pub use chart::{perpendicular_basis, Chart};
+
+use crate::geometry::{FaceId, FaceIndex, PartGeometry, Surface, P3, V3};
+use crate::model::{Inset, SampleMethod, Strategy};
+
+/// A measuring point: where the stylus tip touches the face.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fpoint {
+    /// The face it lies on.
+    pub face: FaceId,
+    /// The contact point, on the face's exact surface (mm, part frame).
+    pub position: P3,
+    /// The outward unit normal of the solid there.
+    pub normal: V3,
+}
+
+impl Fpoint {
+    /// The centre of a tip of radius `r` touching the point: p + r·n, the point whose
+    /// accessibility the tip's is (seed ch. 2.4).
+    pub fn tip_centre(&self, r: f64) -> P3 {
+        self.position + self.normal * r
+    }
+}
+
+/// Samples the faces of one geometry.
+pub struct Sampler<'a> {
+    g: &'a PartGeometry,
+    index: FaceIndex,
+    /// The distance points keep from a face's boundary (mm): the largest tip radius the
+    /// plan's machine carries, so that every probe's tip fits; Fan & Leu's `r`.
+    pub margin: f64,
+}
+
+/// How many search steps span a face in each parameter.
+const STEPS: f64 = 20.0;
+
+impl<'a> Sampler<'a> {
+    /// A sampler for a geometry, keeping `margin` from face boundaries.
+    pub fn new(g: &'a PartGeometry, margin: f64) -> Sampler<'a> {
+        Sampler {
+            g,
+            index: FaceIndex::new(g),
+            margin,
+        }
+    }
+
+    /// The measuring points of one face. The entry point of the sampling stage. Faces too
+    /// small to keep the margin get fewer points, possibly none.
+    pub fn sample(&self, face: FaceId, strategy: &Strategy) -> Vec<Fpoint> {
+        let f = &self.g.faces[face.0];
+        if f.area <= 0.0 {
+            return Vec::new();
+        }
+        let Some(chart) = Chart::of(self.g, face) else {
+            let n = strategy.points.unwrap_or(16) as usize;
+            return self.freeform(face, strategy.method, n);
+        };
+        let (eu, ev) = chart.extent_mm();
+        let margin = self.margin.min(0.2 * eu.min(ev));
+        let place = Place {
+            s: self,
+            chart: &chart,
+            face,
+            margin,
+        };
+        match (strategy.method, &f.surface) {
+            (SampleMethod::FanLeu, Surface::Plane { .. }) => place.fan_leu_plane(strategy.inset),
+            (SampleMethod::FanLeu, Surface::Cylinder { .. } | Surface::Cone { .. }) => {
+                place.fan_leu_round(strategy.points.map_or(4, |n| n.div_ceil(2).max(1)) as usize)
+            }
+            (SampleMethod::FanLeu, _) => place.pool(
+                SampleMethod::Hammersley,
+                strategy.points.unwrap_or(9) as usize,
+                None,
+            ),
+            (SampleMethod::Uniform, _) => place.pool(
+                SampleMethod::Uniform,
+                strategy.points.unwrap_or(9) as usize,
+                Some(strategy.inset.unwrap_or(Inset::Fraction(0.1))),
+            ),
+            (SampleMethod::Hammersley, _) => place.pool(
+                SampleMethod::Hammersley,
+                strategy.points.unwrap_or(12) as usize,
+                strategy.inset,
+            ),
+        }
+    }
+
+    /// Points on a free-form face's triangles, chosen by area.
+    fn freeform(&self, face: FaceId, method: SampleMethod, n: usize) -> Vec<Fpoint> {
+        let g = self.g;
+        let f = &g.faces[face.0];
+        let margin = self.margin.min(0.1 * f.area.sqrt());
+        let mut cdf = Vec::with_capacity(f.triangles.len());
+        let mut total = 0.0;
+        for &t in &f.triangles {
+            let [a, b, c] = g.triangles[t as usize].map(|i| g.vertices[i as usize]);
+            total += (b - a).cross(&(c - a)).norm() / 2.0;
+            cdf.push(total);
+        }
+        let mut best = Vec::new();
+        for m in [1, 2, 4, 8] {
+            let count = n * m;
+            let mut got = Vec::new();
+            for i in 0..count {
+                let s = (i as f64 + 0.5) / count as f64 * total;
+                let k = cdf.partition_point(|&c| c < s).min(cdf.len() - 1);
+                let [a, b, c] =
+                    g.triangles[f.triangles[k] as usize].map(|i| g.vertices[i as usize]);
+                let (mut x, mut y) = match method {
+                    SampleMethod::Uniform => (1.0 / 3.0, 1.0 / 3.0),
+                    _ => (radical_inverse(i as u32, 2), radical_inverse(i as u32, 3)),
+                };
+                if x + y > 1.0 {
+                    (x, y) = (1.0 - x, 1.0 - y);
+                }
+                let p = a + (b - a) * x + (c - a) * y;
+                let Some(normal) = (b - a).cross(&(c - a)).try_normalize(0.0) else {
+                    continue;
+                };
+                if self.index.boundary_distance(g, face, &p) >= margin {
+                    got.push(Fpoint {
+                        face,
+                        position: p,
+                        normal,
+                    });
+                }
+            }
+            let enough = got.len() >= n;
+            best = got;
+            if enough {
+                break;
+            }
+        }
+        pick_evenly(best, n)
+    }
+}
+
+/// Placing points on one analytic face.
+struct Place<'s, 'a> {
+    s: &'s Sampler<'a>,
+    chart: &'s Chart,
+    face: FaceId,
+    margin: f64,
+}
+
+impl Place<'_, '_> {
+    /// The point at (u, v), if it is on the face, keeps the margin, and is not within
+    /// `min_sep` of a point already taken.
+    fn accept(&self, u: f64, v: f64, taken: &[Fpoint], min_sep: f64) -> Option<Fpoint> {
+        let (position, normal) = self.chart.eval(u, v);
+        if taken
+            .iter()
+            .any(|f| (f.position - position).norm() < min_sep)
+        {
+            return None;
+        }
+        let g = self.s.g;
+        if !g.face_covers(self.face, &position, &normal, self.chart.cover_tolerance()) {
+            return None;
+        }
+        if self.s.index.boundary_distance(g, self.face, &position) < self.margin {
+            return None;
+        }
+        Some(Fpoint {
+            face: self.face,
+            position,
+            normal,
+        })
+    }
+
+    fn steps(&self) -> (f64, f64) {
+        let c = self.chart;
+        ((c.u.1 - c.u.0) / STEPS, (c.v.1 - c.v.0) / STEPS)
+    }
+
+    fn min_sep(&self) -> f64 {
+        let (eu, ev) = self.chart.extent_mm();
+        0.5 * eu.min(ev) / STEPS
+    }
+
+    /// Fan & Leu's zig-zag search from (u0, v0): step towards the middle of the face —
+    /// diagonally from a corner, along the normal from an edge — and at the k-th step try
+    /// offsets 0, +1, −1, …, ±k across that direction; the first acceptable point wins.
+    fn search(&self, u0: f64, v0: f64, taken: &[Fpoint]) -> Option<Fpoint> {
+        let c = self.chart;
+        let (du, dv) = self.steps();
+        let min_sep = self.min_sep();
+        let toward = |x: f64, (lo, hi): (f64, f64), step: f64| {
+            let mid = (lo + hi) / 2.0;
+            if (mid - x).abs() <= step / 2.0 {
+                0.0
+            } else {
+                (mid - x).signum()
+            }
+        };
+        let mut d = (
+            if c.periodic_u {
+                0.0
+            } else {
+                toward(u0, c.u, du)
+            },
+            toward(v0, c.v, dv),
+        );
+        if d == (0.0, 0.0) {
+            d = (1.0, 0.0);
+        }
+        let t = (-d.1, d.0);
+        let limit = 2 * STEPS as i32;
+        for k in 0..=limit {
+            for j in (0..=k).flat_map(|j| if j == 0 { vec![0] } else { vec![j, -j] }) {
+                let (k, j) = (k as f64, j as f64);
+                let mut u = u0 + (k * d.0 + j * t.0) * du;
+                let v = v0 + (k * d.1 + j * t.1) * dv;
+                if c.periodic_u {
+                    u = c.u.0 + (u - c.u.0).rem_euclid(c.u.1 - c.u.0);
+                } else if u < c.u.0 || u > c.u.1 {
+                    continue;
+                }
+                if v < c.v.0 || v > c.v.1 {
+                    continue;
+                }
+                if let Some(p) = self.accept(u, v, taken, min_sep) {
+                    return Some(p);
+                }
+            }
+        }
+        None
+    }
+
+    /// Places points at parameter positions, each moved by the zig-zag search if needed.
+    fn place_all(&self, targets: &[(f64, f64)]) -> Vec<Fpoint> {
+        let mut taken = Vec::new();
+        for &(u, v) in targets {
+            if let Some(p) = self.search(u, v, &taken) {
+                taken.push(p);
+            }
+        }
+        taken
+    }
+
+    fn fan_leu_plane(&self, inset: Option<Inset>) -> Vec<Fpoint> {
+        let c = self.chart;
+        let (l, w) = (c.u.1 - c.u.0, c.v.1 - c.v.0);
+        let (fu, fv) = match inset {
+            None => (0.2, 0.2),
+            Some(Inset::Fraction(f)) => (f, f),
+            Some(Inset::Length(mm)) => ((mm / l.max(1e-12)).min(0.5), (mm / w.max(1e-12)).min(0.5)),
+        };
+        let (a, b) = (fu, 1.0 - fu);
+        // Slender faces: points 2 and 4 move inward by two eighths of the inner length.
+        let shift = if l > 4.0 * w {
+            2.0 * (b - a) / 8.0
+        } else {
+            0.0
+        };
+        let at = |x: f64, y: f64| (c.u.0 + x * l, c.v.0 + y * w);
+        self.place_all(&[
+            at(a, fv),
+            at(b - shift, fv),
+            at(b, 1.0 - fv),
+            at(a + shift, 1.0 - fv),
+        ])
+    }
+
+    fn fan_leu_round(&self, per_circle: usize) -> Vec<Fpoint> {
+        let c = self.chart;
+        let h = c.v.1 - c.v.0;
+        let (_, sv) = c.scale();
+        let r = (self.margin / sv).min(h / 4.0);
+        let heights = [
+            c.v.0 + r + (h - 2.0 * r) / 5.0,
+            c.v.0 + r + 4.0 * (h - 2.0 * r) / 5.0,
+        ];
+        let span = c.u.1 - c.u.0;
+        let mut targets = Vec::new();
+        for v in heights {
+            for k in 0..per_circle {
+                let f = if c.periodic_u {
+                    k as f64 / per_circle as f64
+                } else {
+                    (k as f64 + 0.5) / per_circle as f64
+                };
+                targets.push((c.u.0 + f * span, v));
+            }
+        }
+        self.place_all(&targets)
+    }
+
+    /// Uniform grids or Hammersley sequences, denser until `n` points are accepted.
+    fn pool(&self, method: SampleMethod, n: usize, inset: Option<Inset>) -> Vec<Fpoint> {
+        let c = self.chart;
+        let (eu, ev) = c.extent_mm();
+        let frac = |extent: f64| match inset {
+            None => 0.0,
+            Some(Inset::Fraction(f)) => f.min(0.49),
+            Some(Inset::Length(mm)) => (mm / extent.max(1e-12)).min(0.49),
+        };
+        let (iu, iv) = (if c.periodic_u { 0.0 } else { frac(eu) }, frac(ev));
+        let u_at = |s: f64| c.u.0 + (iu + s * (1.0 - 2.0 * iu)) * (c.u.1 - c.u.0);
+        let v_at = |t: f64| c.v_by_area(iv + t * (1.0 - 2.0 * iv));
+        let mut best = Vec::new();
+        for m in [1, 2, 4, 8] {
+            let count = n * m;
+            let params: Vec<(f64, f64)> = match method {
+                SampleMethod::Uniform => {
+                    let aspect = (eu / ev.max(1e-12)).clamp(1e-3, 1e3);
+                    let nu = ((count as f64 * aspect).sqrt().round() as usize).clamp(1, count);
+                    let nv = count.div_ceil(nu);
+                    let at = |i: usize, n: usize, periodic: bool| match (n, periodic) {
+                        (_, true) => i as f64 / n as f64,
+                        (1, false) => 0.5,
+                        _ => i as f64 / (n - 1) as f64,
+                    };
+                    (0..nv)
+                        .flat_map(|j| (0..nu).map(move |i| (i, j)))
+                        .map(|(i, j)| (u_at(at(i, nu, c.periodic_u)), v_at(at(j, nv, false))))
+                        .collect()
+                }
+                _ => (0..count)
+                    .map(|i| {
+                        (
+                            u_at((i as f64 + 0.5) / count as f64),
+                            v_at(radical_inverse(i as u32, 2)),
+                        )
+                    })
+                    .collect(),
+            };
+            let got: Vec<Fpoint> = params
+                .into_iter()
+                .filter_map(|(u, v)| self.accept(u, v, &[], 0.0))
+                .collect();
+            let enough = got.len() >= n;
+            best = got;
+            if enough {
+                break;
+            }
+        }
+        pick_evenly(best, n)
+    }
+}
+
+/// `n` of the points, evenly spread by index; all of them if there are no more than `n`.
+fn pick_evenly(points: Vec<Fpoint>, n: usize) -> Vec<Fpoint> {
+    if points.len() <= n {
+        return points;
+    }
+    let len = points.len();
+    (0..n).map(|k| points[k * len / n].clone()).collect()
+}
+
+/// The van der Corput radical inverse of `i` in `base`: its digits mirrored after the
+/// point, a low-discrepancy sequence in [0, 1).
+pub fn radical_inverse(mut i: u32, base: u32) -> f64 {
+    let (mut inv, mut f) = (0.0, 1.0 / base as f64);
+    while i > 0 {
+        inv += (i % base) as f64 * f;
+        i /= base;
+        f /= base as f64;
+    }
+    inv
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn radical_inverse_base_2() {
+        let xs: Vec<f64> = (0..5).map(|i| radical_inverse(i, 2)).collect();
+        assert_eq!(xs, vec![0.0, 0.5, 0.25, 0.75, 0.125]);
+    }
+}
