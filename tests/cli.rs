@@ -114,8 +114,6 @@ fn usage_errors_exit_two() {
     assert_eq!(code, 2, "{stderr}");
 }
 
-/// The NIST meshes live in `../shared/parts/`, beside the repository, as CI has them.
-
 fn type_counts(stdout: &str) -> std::collections::BTreeMap<String, usize> {
     let v: serde_json::Value = serde_json::from_str(stdout).expect("faces --format json is JSON");
     let mut counts = std::collections::BTreeMap::new();

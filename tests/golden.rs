@@ -4,6 +4,9 @@ use inspc::diag::{render_human, RenderOptions};
 use inspc::source::FsWorld;
 use std::path::{Path, PathBuf};
 
+mod common;
+use common::diff;
+
 enum Outcome {
     Model(String),
     Diagnostics(String),
@@ -82,25 +85,4 @@ fn golden_cases() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
-}
-
-/// The first differing lines, enough to see what changed.
-fn diff(expected: &str, actual: &str) -> String {
-    let (e, a): (Vec<&str>, Vec<&str>) = (expected.lines().collect(), actual.lines().collect());
-    let mut out = Vec::new();
-    for i in 0..e.len().max(a.len()) {
-        let (x, y) = (e.get(i), a.get(i));
-        if x != y {
-            out.push(format!(
-                "line {}:\n  - {}\n  + {}",
-                i + 1,
-                x.unwrap_or(&"<none>"),
-                y.unwrap_or(&"<none>")
-            ));
-            if out.len() == 5 {
-                break;
-            }
-        }
-    }
-    out.join("\n")
 }

@@ -178,7 +178,8 @@ pub fn build(input: &Input, file: FileId, diags: &mut Diagnostics) -> Measuremen
             .node_weights()
             .any(|n| matches!(n, Node::Feature { feature, .. } if *feature == id));
         // Face aliases (`face top = …`) only name a face for use in features.
-        if !named && !(f.is_face_alias && datums_of.get(&id).is_none()) {
+        let alias_only = f.is_face_alias && !datums_of.contains_key(&id);
+        if !named && !alias_only {
             let fnode = feature_node(&mut graph, id);
             graph.add_edge(root, fnode, Edge::Target);
         }

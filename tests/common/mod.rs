@@ -63,3 +63,24 @@ pub fn require_shared_parts() {
         "the NIST parts are expected in ../shared/parts/ beside the repository, as CI has them"
     );
 }
+
+/// The first differing lines, enough to see what changed.
+pub fn diff(expected: &str, actual: &str) -> String {
+    let (e, a): (Vec<&str>, Vec<&str>) = (expected.lines().collect(), actual.lines().collect());
+    let mut out = Vec::new();
+    for i in 0..e.len().max(a.len()) {
+        let (x, y) = (e.get(i), a.get(i));
+        if x != y {
+            out.push(format!(
+                "line {}:\n  - {}\n  + {}",
+                i + 1,
+                x.unwrap_or(&"<none>"),
+                y.unwrap_or(&"<none>")
+            ));
+            if out.len() == 5 {
+                break;
+            }
+        }
+    }
+    out.join("\n")
+}
