@@ -1,6 +1,7 @@
 //! Front-end speed: parsing alone against the whole check (load, parse every module
 //! including the stdlib, resolve), on the largest example, the real NIST spec and an
-//! empty spec (the cost of the always-loaded standard library).
+//! empty spec (the cost of the always-loaded standard library); then geometry, and
+//! geometry with sampling and the measurement graph, on top.
 //!
 //! Run with `cargo bench --bench front_end`.
 
@@ -47,12 +48,26 @@ fn stdlib_only(bencher: divan::Bencher) {
 /// Geometry on top of the front end: booleans and face classification for constructive
 /// parts, reading and fitting for the NIST mesh (issue 3's budget: well under 100 ms
 /// for swiss_block).
-#[divan::bench(args = ["examples/swiss_block.insp", "examples/parts/swiss_sphere.insp", "tests/real/nist_ctc_01.insp"])]
+#[divan::bench(args = PARTS)]
 fn check_and_geometry(bencher: divan::Bencher, spec: &str) {
     let roots = [PathBuf::from(spec)];
     bencher.bench(|| {
         let (c, g) = inspc::check_geometry(&FsWorld, divan::black_box(&roots));
         assert!(!c.has_errors() && g.iter().any(Option::is_some));
         g
+    });
+}
+
+const PARTS: [&str; 4] = ["examples/swiss_block.insp", "examples/swiss_sphere_fixed.insp", "tests/real/nist_ctc_01.insp", "tests/real/nist_ftc_08.insp"];
+
+/// Everything up to the measurement graph: front end, geometry, fpoint sampling and the
+/// graph, as `inspc graph` runs it (issue 3's budget: well under 100 ms for swiss_block).
+#[divan::bench(args = PARTS)]
+fn check_geometry_and_graph(bencher: divan::Bencher, spec: &str) {
+    let roots = [PathBuf::from(spec)];
+    bencher.bench(|| {
+        let (c, _, graphs) = inspc::measurement_graphs(&FsWorld, divan::black_box(&roots));
+        assert!(!c.has_errors() && !graphs.is_empty());
+        graphs
     });
 }

@@ -84,7 +84,7 @@ pub fn check_geometry(
         let Some(geometry) = geometry::build(part, world, part.span.file, &mut diags) else {
             continue;
         };
-        let feature_faces = part
+        let feature_faces: Vec<Vec<geometry::FaceId>> = part
             .features
             .iter()
             .map(|f| {
@@ -99,6 +99,7 @@ pub fn check_geometry(
                 faces
             })
             .collect();
+        graph::check_surfaces(part, &geometry, &feature_faces, part.span.file, &mut diags);
         out[k] = Some(PartData {
             geometry,
             feature_faces,

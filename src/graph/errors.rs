@@ -19,4 +19,16 @@ pub enum GraphError {
         feature: String,
         margin: String,
     },
+    #[error("{tolerance} needs {needs} faces, but face `{face}` of feature `{feature}` is {found}")]
+    #[diagnostic(code(insp::graph::wrong_surface), help("{help}"))]
+    WrongSurface {
+        #[label("this tolerance")]
+        span: Span,
+        tolerance: String,
+        needs: String,
+        face: String,
+        feature: String,
+        found: String,
+        help: String,
+    },
 }

@@ -20,7 +20,7 @@ pub use render::{dot, json, mermaid};
 
 use crate::diag::Diagnostics;
 use crate::geometry::{FaceId, PartGeometry, Surface};
-use crate::model::{FeatureId, Part, Sampling, Strategy};
+use crate::model::{FeatureId, Part, Sampling, Strategy, SurfaceKind, TolKind};
 use crate::sample::{Fpoint, Sampler};
 use crate::source::FileId;
 use petgraph::graph::{DiGraph, NodeIndex};
@@ -276,6 +276,50 @@ fn strategy_for(input: &Input, face: FaceId, features: &[(FeatureId, NodeIndex)]
                 .sampling
                 .strategy(input.geometry.faces[face.0].surface.kind())
         })
+}
+
+/// The surface types a tolerance kind applies to; `None` for kinds that apply to any.
+fn surfaces_for(kind: TolKind) -> Option<&'static [SurfaceKind]> {
+    use SurfaceKind::*;
+    match kind {
+        TolKind::Flatness => Some(&[Plane]),
+        TolKind::Cylindricity => Some(&[Cylinder]),
+        TolKind::Circularity => Some(&[Cylinder, Cone, Sphere]),
+        TolKind::Diameter | TolKind::Radius => Some(&[Cylinder, Cone, Sphere]),
+        TolKind::Concentricity | TolKind::Coaxiality => Some(&[Cylinder, Cone, Sphere]),
+        _ => None,
+    }
+}
+
+/// Reports tolerances on faces of the wrong surface type: flatness on a cylinder,
+/// cylindricity or a diameter on a plane. Free-form faces pass: a mesh patch no surface
+/// fits may still be what the drawing calls it.
+pub fn check_surfaces(part: &Part, g: &PartGeometry, feature_faces: &[Vec<FaceId>], file: FileId, diags: &mut Diagnostics) {
+    for t in &part.tolerances {
+        let Some(allowed) = surfaces_for(t.kind) else { continue };
+        let wrong = t.targets.iter().find_map(|f| {
+            feature_faces[f.0].iter().map(|&face| (f, face)).find(|&(_, face)| {
+                let k = g.faces[face.0].surface.kind();
+                k != SurfaceKind::Freeform && !allowed.contains(&k)
+            })
+        });
+        let Some((f, face)) = wrong else { continue };
+        let names: Vec<&str> = allowed.iter().map(|k| k.keyword()).collect();
+        let needs = match names.as_slice() {
+            [one] => one.to_string(),
+            [init @ .., last] => format!("{} or {last}", init.join(", ")),
+            [] => String::new(),
+        };
+        diags.push(file, GraphError::WrongSurface {
+            span: t.span,
+            tolerance: crate::resolve::tolerance_keyword(t.kind).to_string(),
+            needs,
+            face: g.faces[face.0].name.clone(),
+            feature: part.features[f.0].name.clone(),
+            found: format!("a {}", g.faces[face.0].surface.kind().keyword()),
+            help: "check the feature's faces (`inspc faces` lists their types), or choose a tolerance that fits them".into(),
+        });
+    }
 }
 
 /// Whether a planar face's plane supports the whole part: no vertex lies outside it.
