@@ -58,7 +58,12 @@ fn check_and_geometry(bencher: divan::Bencher, spec: &str) {
     });
 }
 
-const PARTS: [&str; 4] = ["examples/swiss_block.insp", "examples/swiss_sphere_fixed.insp", "tests/real/nist_ctc_01.insp", "tests/real/nist_ftc_08.insp"];
+const PARTS: [&str; 4] = [
+    "examples/swiss_block.insp",
+    "examples/swiss_sphere_fixed.insp",
+    "tests/real/nist_ctc_01.insp",
+    "tests/real/nist_ftc_08.insp",
+];
 
 /// Everything up to the measurement graph: front end, geometry, fpoint sampling and the
 /// graph, as `inspc graph` runs it (issue 3's budget: well under 100 ms for swiss_block).

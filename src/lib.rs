@@ -5,6 +5,7 @@
 //! [`syntax::parse`] → [`load::load`] → [`resolve::resolve`] → [`model::Model`].
 #![warn(missing_docs)]
 
+pub mod access;
 pub mod diag;
 pub mod geometry;
 pub mod graph;

@@ -212,17 +212,30 @@ fn faces_of_a_missing_mesh_is_a_diagnostic() {
 fn graph_prints_dot_mermaid_and_json() {
     let (code, dot, stderr) = inspc(&["graph", "examples/f2.insp"]);
     assert_eq!(code, 0, "{stderr}");
-    assert!(dot.starts_with("digraph \"f2\" {") && dot.trim_end().ends_with('}'), "{dot}");
-    assert!(dot.contains("stock.top\\nplane · 4 points\\ncan rest on the table"), "{dot}");
+    assert!(
+        dot.starts_with("digraph \"f2\" {") && dot.trim_end().ends_with('}'),
+        "{dot}"
+    );
+    assert!(
+        dot.contains("stock.top\\nplane · 4 points\\ncan rest on the table"),
+        "{dot}"
+    );
     assert!(dot.contains("[style=dashed, label=\"datum\"]"), "{dot}");
 
     let (code, with_points, _) = inspc(&["graph", "examples/f2.insp", "--points"]);
     assert_eq!(code, 0);
-    assert_eq!(with_points.matches("shape=point").count(), 20, "{with_points}");
+    assert_eq!(
+        with_points.matches("shape=point").count(),
+        20,
+        "{with_points}"
+    );
 
     let (code, mermaid, _) = inspc(&["graph", "examples/f2.insp", "--format", "mermaid"]);
     assert_eq!(code, 0);
-    assert!(mermaid.starts_with("flowchart TD\n") && mermaid.contains("-. datum .->"), "{mermaid}");
+    assert!(
+        mermaid.starts_with("flowchart TD\n") && mermaid.contains("-. datum .->"),
+        "{mermaid}"
+    );
 
     let (code, json, _) = inspc(&["graph", "examples/swiss_block.insp", "--format", "json"]);
     assert_eq!(code, 0);
@@ -230,7 +243,12 @@ fn graph_prints_dot_mermaid_and_json() {
     let g = &v[0];
     assert_eq!(g["plan"], "swiss_block_plan");
     assert_eq!(g["counts"]["faces"], 101);
-    let points: usize = g["faces"].as_array().unwrap().iter().map(|f| f["points"].as_array().unwrap().len()).sum();
+    let points: usize = g["faces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["points"].as_array().unwrap().len())
+        .sum();
     assert_eq!(g["counts"]["fpoints"], points);
     assert_eq!(g["faces"][0]["points"][0]["n"].as_array().unwrap().len(), 3);
 }
@@ -238,19 +256,35 @@ fn graph_prints_dot_mermaid_and_json() {
 #[test]
 fn graph_of_both_nist_parts() {
     common::require_shared_parts();
-    for (spec, tolerances) in [("tests/real/nist_ctc_01.insp", 12), ("tests/real/nist_ftc_08.insp", 42)] {
+    for (spec, tolerances) in [
+        ("tests/real/nist_ctc_01.insp", 12),
+        ("tests/real/nist_ftc_08.insp", 42),
+    ] {
         let (code, json, stderr) = inspc(&["graph", spec, "--format", "json"]);
         assert_eq!(code, 0, "{spec}: {stderr}");
         let v: serde_json::Value = serde_json::from_str(&json).unwrap();
         assert_eq!(v[0]["counts"]["tolerances"], tolerances, "{spec}");
-        assert!(v[0]["faces"].as_array().unwrap().iter().all(|f| !f["points"].as_array().unwrap().is_empty()), "{spec}: a face without points");
+        assert!(
+            v[0]["faces"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|f| !f["points"].as_array().unwrap().is_empty()),
+            "{spec}: a face without points"
+        );
     }
 }
 
 #[test]
 fn graph_of_a_bad_spec_exits_one() {
-    let spec = temp_spec("bad_graph.insp", "part p { units mm, stock box(10, 10, 10), feature f = stock.tpo }\n");
+    let spec = temp_spec(
+        "bad_graph.insp",
+        "part p { units mm, stock box(10, 10, 10), feature f = stock.tpo }\n",
+    );
     let (code, out, stderr) = inspc(&["graph", &spec]);
     assert_eq!(code, 1, "{stderr}");
-    assert!(out.is_empty() && stderr.contains("insp::resolve::"), "{stderr}");
+    assert!(
+        out.is_empty() && stderr.contains("insp::resolve::"),
+        "{stderr}"
+    );
 }

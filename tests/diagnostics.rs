@@ -989,14 +989,32 @@ fn tolerance_on_the_wrong_surface_type() {
         "{BLOCK}    cut hole bore {{ at (25, 20, 20), axis -z, diameter 10, depth through }}\n    feature hole = bore.wall\n    feature top = stock.top\n    tolerance cyl = cylindricity(top, 0.01 mm)\n    tolerance ok = cylindricity(hole, 0.01 mm)\n}}\n"
     );
     let diags = check_src(&src);
-    expect(&diags, "insp::graph::wrong_surface", "cyl", "face `stock.top` of feature `top` is a plane");
-    assert_eq!(diags.iter().filter(|d| d.code == "insp::graph::wrong_surface").count(), 1, "{}", render(&diags));
+    expect(
+        &diags,
+        "insp::graph::wrong_surface",
+        "cyl",
+        "face `stock.top` of feature `top` is a plane",
+    );
+    assert_eq!(
+        diags
+            .iter()
+            .filter(|d| d.code == "insp::graph::wrong_surface")
+            .count(),
+        1,
+        "{}",
+        render(&diags)
+    );
 }
 
 #[test]
 fn face_with_no_room_for_points() {
     let src = "use std::heads::PH6\nuse std::probes::TP20_D2_L20\npart p {\n    units mm\n    stock box(100, 100, 20)\n    cut hole bore { at (50, 50, 20), axis -z, diameter 40, depth through }\n    feature top = stock.top\n}\ncmm lab { table { z 0 mm }, ram { radius 35 mm, length 600 mm }, head PH6, probes [p1: TP20_D2_L20] }\nplan q { part p, cmm lab, sample top with uniform(points 4, inset 45 %) }\n";
     let diags = check_src(src);
-    expect(&diags, "insp::graph::no_points", "top", "face `stock.top` of feature `top` gets no measuring point");
+    expect(
+        &diags,
+        "insp::graph::no_points",
+        "top",
+        "face `stock.top` of feature `top` gets no measuring point",
+    );
     assert!(diags.iter().all(|d| d.warning), "{}", render(&diags));
 }

@@ -140,6 +140,10 @@ fn the_nist_ftc_08_spec_checks_clean() {
     );
     let checked = assert_clean(&PathBuf::from("tests/real/nist_ftc_08.insp"));
     let part = &checked.model.parts[0];
-    assert_eq!(part.tolerances.len(), 42, "33 geometric tolerances and 9 toleranced sizes in the PMI");
+    assert_eq!(
+        part.tolerances.len(),
+        42,
+        "33 geometric tolerances and 9 toleranced sizes in the PMI"
+    );
     assert_eq!(part.datums.len(), 11, "datums A to L without I");
 }

@@ -32,20 +32,41 @@ fn block() -> impl Strategy<Value = Block> {
         let hole = move |depth_max: f64| (4.0f64..12.0, prop::option::of(3.0f64..depth_max));
         (
             prop::collection::vec(prop::option::of(hole(h - 4.0)), cells),
-            prop::collection::vec(prop::option::of((4.0f64..8.0, 3.0f64..(w / 2.0 - 10.0))), cells),
+            prop::collection::vec(
+                prop::option::of((4.0f64..8.0, 3.0f64..(w / 2.0 - 10.0))),
+                cells,
+            ),
         )
             .prop_map(move |(top, front)| {
                 let top = top
                     .into_iter()
                     .enumerate()
-                    .filter_map(|(i, o)| o.map(|(d, depth)| Hole { x: 15.0 + 30.0 * i as f64, y: w * 0.75, d, depth }))
+                    .filter_map(|(i, o)| {
+                        o.map(|(d, depth)| Hole {
+                            x: 15.0 + 30.0 * i as f64,
+                            y: w * 0.75,
+                            d,
+                            depth,
+                        })
+                    })
                     .collect();
                 let front = front
                     .into_iter()
                     .enumerate()
-                    .filter_map(|(i, o)| o.map(|(d, depth)| Hole { x: 15.0 + 30.0 * i as f64, y: h / 2.0, d, depth: Some(depth) }))
+                    .filter_map(|(i, o)| {
+                        o.map(|(d, depth)| Hole {
+                            x: 15.0 + 30.0 * i as f64,
+                            y: h / 2.0,
+                            d,
+                            depth: Some(depth),
+                        })
+                    })
                     .collect();
-                Block { size: [l, w, h], top, front }
+                Block {
+                    size: [l, w, h],
+                    top,
+                    front,
+                }
             })
     })
 }
@@ -56,20 +77,39 @@ fn spec(b: &Block) -> String {
     let mut features = vec!["stock.top".to_string()];
     for (k, t) in b.top.iter().enumerate() {
         let depth = t.depth.map_or("through".into(), |d| d.to_string());
-        let _ = writeln!(s, " cut hole t{k} {{ at ({}, {}, {h}), axis -z, diameter {}, depth {depth} }}", t.x, t.y, t.d);
+        let _ = writeln!(
+            s,
+            " cut hole t{k} {{ at ({}, {}, {h}), axis -z, diameter {}, depth {depth} }}",
+            t.x, t.y, t.d
+        );
         features.push(format!("t{k}.wall"));
     }
     for (k, f) in b.front.iter().enumerate() {
-        let _ = writeln!(s, " cut hole f{k} {{ at ({}, 0, {}), axis +y, diameter {}, depth {} }}", f.x, f.y, f.d, f.depth.unwrap());
+        let _ = writeln!(
+            s,
+            " cut hole f{k} {{ at ({}, 0, {}), axis +y, diameter {}, depth {} }}",
+            f.x,
+            f.y,
+            f.d,
+            f.depth.unwrap()
+        );
         features.push(format!("f{k}.wall"));
     }
-    let _ = writeln!(s, " feature all = {}\n datum A = stock.bottom\n}}", features.join(" + "));
+    let _ = writeln!(
+        s,
+        " feature all = {}\n datum A = stock.bottom\n}}",
+        features.join(" + ")
+    );
     s + "cmm lab { table { z 0 mm }, ram { radius 35 mm, length 600 mm }, head PH6, probes [p1: TP20_D2_L20] }\n\
          plan q { part p, cmm lab, sampling std::sampling::fan_leu }\n"
 }
 
 fn area(g: &PartGeometry, name: &str) -> f64 {
-    g.faces.iter().filter(|f| f.name == name).map(|f| f.area).sum()
+    g.faces
+        .iter()
+        .filter(|f| f.name == name)
+        .map(|f| f.area)
+        .sum()
 }
 
 fn close(a: f64, b: f64, rel: f64) -> bool {

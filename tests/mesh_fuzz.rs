@@ -22,8 +22,19 @@ fn segment_and_sample(raw: &RawMesh) {
     for g in [segment::segment(raw), segment::from_groups(raw)] {
         let sampler = Sampler::new(&g, 1.0);
         for f in 0..g.faces.len() {
-            for method in [SampleMethod::FanLeu, SampleMethod::Uniform, SampleMethod::Hammersley] {
-                let _ = sampler.sample(FaceId(f), &Sampling { method, points: Some(5), inset: None });
+            for method in [
+                SampleMethod::FanLeu,
+                SampleMethod::Uniform,
+                SampleMethod::Hammersley,
+            ] {
+                let _ = sampler.sample(
+                    FaceId(f),
+                    &Sampling {
+                        method,
+                        points: Some(5),
+                        inset: None,
+                    },
+                );
             }
         }
     }
@@ -55,9 +66,19 @@ fn cube_obj() -> String {
     for v in 0..8 {
         s += &format!("v {} {} {}\n", v & 1, (v >> 1) & 1, (v >> 2) & 1);
     }
-    let quads = [[1, 3, 4, 2], [5, 6, 8, 7], [1, 2, 6, 5], [3, 7, 8, 4], [1, 5, 7, 3], [2, 4, 8, 6]];
+    let quads = [
+        [1, 3, 4, 2],
+        [5, 6, 8, 7],
+        [1, 2, 6, 5],
+        [3, 7, 8, 4],
+        [1, 5, 7, 3],
+        [2, 4, 8, 6],
+    ];
     for (k, q) in quads.iter().enumerate() {
-        s += &format!("g side_{k}\nf {} {} {}\nf {} {} {}\n", q[0], q[1], q[2], q[0], q[2], q[3]);
+        s += &format!(
+            "g side_{k}\nf {} {} {}\nf {} {} {}\n",
+            q[0], q[1], q[2], q[0], q[2], q[3]
+        );
     }
     s
 }

@@ -19,7 +19,9 @@ pub enum GraphError {
         feature: String,
         margin: String,
     },
-    #[error("{tolerance} needs {needs} faces, but face `{face}` of feature `{feature}` is {found}")]
+    #[error(
+        "{tolerance} needs {needs} faces, but face `{face}` of feature `{feature}` is {found}"
+    )]
     #[diagnostic(code(insp::graph::wrong_surface), help("{help}"))]
     WrongSurface {
         #[label("this tolerance")]

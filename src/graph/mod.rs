@@ -294,14 +294,25 @@ fn surfaces_for(kind: TolKind) -> Option<&'static [SurfaceKind]> {
 /// Reports tolerances on faces of the wrong surface type: flatness on a cylinder,
 /// cylindricity or a diameter on a plane. Free-form faces pass: a mesh patch no surface
 /// fits may still be what the drawing calls it.
-pub fn check_surfaces(part: &Part, g: &PartGeometry, feature_faces: &[Vec<FaceId>], file: FileId, diags: &mut Diagnostics) {
+pub fn check_surfaces(
+    part: &Part,
+    g: &PartGeometry,
+    feature_faces: &[Vec<FaceId>],
+    file: FileId,
+    diags: &mut Diagnostics,
+) {
     for t in &part.tolerances {
-        let Some(allowed) = surfaces_for(t.kind) else { continue };
+        let Some(allowed) = surfaces_for(t.kind) else {
+            continue;
+        };
         let wrong = t.targets.iter().find_map(|f| {
-            feature_faces[f.0].iter().map(|&face| (f, face)).find(|&(_, face)| {
-                let k = g.faces[face.0].surface.kind();
-                k != SurfaceKind::Freeform && !allowed.contains(&k)
-            })
+            feature_faces[f.0]
+                .iter()
+                .map(|&face| (f, face))
+                .find(|&(_, face)| {
+                    let k = g.faces[face.0].surface.kind();
+                    k != SurfaceKind::Freeform && !allowed.contains(&k)
+                })
         });
         let Some((f, face)) = wrong else { continue };
         let names: Vec<&str> = allowed.iter().map(|k| k.keyword()).collect();

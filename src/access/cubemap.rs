@@ -1,0 +1,392 @@
+//! Direction cones as cube maps (seed ch. 2.3 and 4.3.4): six N × N bitmaps on the faces
+//! of the cube around the origin, one bit per pixel, plus one bit per *preferred
+//! direction* — an exact direction such as +z that would otherwise fall on a pixel corner
+//! and could not be chosen exactly.
+//!
+//! Cube face `f` has major axis `a = f / 2` and sign `s = +1` for even `f`; its pixel
+//! (i, j) covers u ∈ [2i/N − 1, 2(i+1)/N − 1] and likewise v for j, where the direction is
+//! `s·e_a + u·e_(a+1) + v·e_(a+2)` (axes modulo 3). So face 4 is +z with u along x and
+//! v along y.
+
+use crate::geometry::V3;
+use std::sync::Arc;
+
+/// A set of directions: pixels of a cube map, and preferred directions.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CubeMap {
+    n: u32,
+    /// The preferred directions every map of a computation shares.
+    extra: Arc<[[u64; 3]]>,
+    /// 6·N² pixel bits, then one bit per preferred direction.
+    bits: Vec<u64>,
+}
+
+/// A pixel: cube face (0..6), column i and row j.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Pixel {
+    /// Cube face: 0 +x, 1 −x, 2 +y, 3 −y, 4 +z, 5 −z.
+    pub face: u8,
+    /// Column (along u).
+    pub i: u32,
+    /// Row (along v).
+    pub j: u32,
+}
+
+/// An element of a cube map: a pixel or the k-th preferred direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Cell {
+    /// A pixel.
+    Pixel(Pixel),
+    /// A preferred direction, by index.
+    Preferred(usize),
+}
+
+fn key(d: &V3) -> [u64; 3] {
+    let n = d.normalize();
+    [n.x, n.y, n.z].map(|c| (c + 0.0).to_bits())
+}
+
+/// The major axis and sign of a direction, and its (u, v) on that cube face.
+pub fn face_uv(d: &V3) -> (u8, f64, f64) {
+    let a = d.iamax();
+    let s = d[a];
+    let face = (2 * a + usize::from(s < 0.0)) as u8;
+    let w = s.abs();
+    (face, d[(a + 1) % 3] / w, d[(a + 2) % 3] / w)
+}
+
+/// The direction through (u, v) of a cube face (not normalised).
+pub fn face_dir(face: u8, u: f64, v: f64) -> V3 {
+    let a = (face / 2) as usize;
+    let s = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
+    let mut d = V3::zeros();
+    d[a] = s;
+    d[(a + 1) % 3] = u;
+    d[(a + 2) % 3] = v;
+    d
+}
+
+impl CubeMap {
+    /// The empty cone at resolution `n` with the given preferred directions.
+    pub fn empty(n: u32, preferred: &[V3]) -> CubeMap {
+        let extra: Arc<[[u64; 3]]> = preferred.iter().map(key).collect();
+        let len = 6 * (n as usize) * (n as usize) + extra.len();
+        CubeMap {
+            n,
+            extra,
+            bits: vec![0; len.div_ceil(64)],
+        }
+    }
+
+    /// The full cone (every direction) at resolution `n`.
+    pub fn full(n: u32, preferred: &[V3]) -> CubeMap {
+        let mut c = CubeMap::empty(n, preferred);
+        c.bits.iter_mut().for_each(|w| *w = !0);
+        c.trim();
+        c
+    }
+
+    /// A map with no bits set and the same resolution and preferred directions.
+    pub fn empty_like(&self) -> CubeMap {
+        CubeMap {
+            n: self.n,
+            extra: self.extra.clone(),
+            bits: vec![0; self.bits.len()],
+        }
+    }
+
+    /// Resolution N (pixels per cube-face side).
+    pub fn n(&self) -> u32 {
+        self.n
+    }
+
+    /// The number of preferred directions.
+    pub fn preferred_len(&self) -> usize {
+        self.extra.len()
+    }
+
+    /// The k-th preferred direction (unit).
+    pub fn preferred(&self, k: usize) -> V3 {
+        let [x, y, z] = self.extra[k].map(f64::from_bits);
+        V3::new(x, y, z)
+    }
+
+    fn len(&self) -> usize {
+        6 * (self.n as usize) * (self.n as usize) + self.extra.len()
+    }
+
+    /// Clears the unused bits past the end, so counts and equality are exact.
+    fn trim(&mut self) {
+        let len = self.len();
+        if !len.is_multiple_of(64) {
+            if let Some(last) = self.bits.last_mut() {
+                *last &= (1u64 << (len % 64)) - 1;
+            }
+        }
+    }
+
+    /// The bit index of a cell.
+    pub fn index(&self, c: Cell) -> usize {
+        let n = self.n as usize;
+        match c {
+            Cell::Pixel(p) => (p.face as usize * n + p.j as usize) * n + p.i as usize,
+            Cell::Preferred(k) => 6 * n * n + k,
+        }
+    }
+
+    /// The cell of a bit index.
+    pub fn cell(&self, index: usize) -> Cell {
+        let n = self.n as usize;
+        if index >= 6 * n * n {
+            return Cell::Preferred(index - 6 * n * n);
+        }
+        Cell::Pixel(Pixel {
+            face: (index / (n * n)) as u8,
+            j: ((index / n) % n) as u32,
+            i: (index % n) as u32,
+        })
+    }
+
+    /// Whether a cell is in the cone.
+    pub fn get(&self, c: Cell) -> bool {
+        let k = self.index(c);
+        self.bits[k / 64] >> (k % 64) & 1 == 1
+    }
+
+    /// Adds or removes a cell.
+    pub fn set(&mut self, c: Cell, on: bool) {
+        let k = self.index(c);
+        if on {
+            self.bits[k / 64] |= 1 << (k % 64);
+        } else {
+            self.bits[k / 64] &= !(1 << (k % 64));
+        }
+    }
+
+    /// The pixel a direction falls in.
+    pub fn pixel_of(&self, d: &V3) -> Pixel {
+        let (face, u, v) = face_uv(d);
+        let at = |x: f64| {
+            (((x + 1.0) / 2.0 * self.n as f64).floor() as i64).clamp(0, self.n as i64 - 1) as u32
+        };
+        Pixel {
+            face,
+            i: at(u),
+            j: at(v),
+        }
+    }
+
+    /// The cell of a direction: its preferred-direction bit if it is one, else its pixel.
+    pub fn cell_of(&self, d: &V3) -> Cell {
+        let k = key(d);
+        match self.extra.iter().position(|e| *e == k) {
+            Some(i) => Cell::Preferred(i),
+            None => Cell::Pixel(self.pixel_of(d)),
+        }
+    }
+
+    /// Whether a direction is in the cone (sampled at its cell).
+    pub fn contains(&self, d: &V3) -> bool {
+        self.get(self.cell_of(d))
+    }
+
+    /// The unit direction of a cell: the pixel centre, or the preferred direction.
+    pub fn direction(&self, c: Cell) -> V3 {
+        match c {
+            Cell::Pixel(p) => {
+                let at = |k: u32| (2.0 * (k as f64 + 0.5)) / self.n as f64 - 1.0;
+                face_dir(p.face, at(p.i), at(p.j)).normalize()
+            }
+            Cell::Preferred(k) => self.preferred(k),
+        }
+    }
+
+    /// Whether no direction is in the cone.
+    pub fn is_empty(&self) -> bool {
+        self.bits.iter().all(|&w| w == 0)
+    }
+
+    /// The number of cells in the cone.
+    pub fn count(&self) -> usize {
+        self.bits.iter().map(|w| w.count_ones() as usize).sum()
+    }
+
+    /// The cells in the cone, in index order (faces, rows, columns, then preferred).
+    pub fn cells(&self) -> impl Iterator<Item = Cell> + '_ {
+        self.bits.iter().enumerate().flat_map(move |(w, &word)| {
+            let mut rest = word;
+            std::iter::from_fn(move || {
+                if rest == 0 {
+                    return None;
+                }
+                let b = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                Some(w * 64 + b)
+            })
+            .map(move |k| self.cell(k))
+        })
+    }
+
+    fn same_shape(&self, o: &CubeMap) {
+        assert!(
+            self.n == o.n && self.extra == o.extra,
+            "cube maps of different resolution or preferred directions"
+        );
+    }
+
+    /// In place: keep only directions also in `o`.
+    pub fn and_assign(&mut self, o: &CubeMap) {
+        self.same_shape(o);
+        self.bits.iter_mut().zip(&o.bits).for_each(|(a, b)| *a &= b);
+    }
+
+    /// In place: add the directions of `o`.
+    pub fn or_assign(&mut self, o: &CubeMap) {
+        self.same_shape(o);
+        self.bits.iter_mut().zip(&o.bits).for_each(|(a, b)| *a |= b);
+    }
+
+    /// In place: remove the directions of `o`.
+    pub fn and_not_assign(&mut self, o: &CubeMap) {
+        self.same_shape(o);
+        self.bits
+            .iter_mut()
+            .zip(&o.bits)
+            .for_each(|(a, b)| *a &= !b);
+    }
+
+    /// The intersection.
+    pub fn and(&self, o: &CubeMap) -> CubeMap {
+        let mut c = self.clone();
+        c.and_assign(o);
+        c
+    }
+
+    /// The union.
+    pub fn or(&self, o: &CubeMap) -> CubeMap {
+        let mut c = self.clone();
+        c.or_assign(o);
+        c
+    }
+
+    /// The complement.
+    pub fn not(&self) -> CubeMap {
+        let mut c = self.clone();
+        c.bits.iter_mut().for_each(|w| *w = !*w);
+        c.trim();
+        c
+    }
+
+    /// The pixels next to a pixel (8-neighbourhood), across cube edges too.
+    pub fn neighbours(&self, p: Pixel) -> Vec<Pixel> {
+        let n = self.n as f64;
+        let mut out = Vec::with_capacity(8);
+        for dj in -1i32..=1 {
+            for di in -1i32..=1 {
+                if (di, dj) == (0, 0) {
+                    continue;
+                }
+                let (i, j) = (p.i as i64 + di as i64, p.j as i64 + dj as i64);
+                let q = if (0..self.n as i64).contains(&i) && (0..self.n as i64).contains(&j) {
+                    Pixel {
+                        face: p.face,
+                        i: i as u32,
+                        j: j as u32,
+                    }
+                } else {
+                    // Off the face: the pixel the neighbour's centre direction falls in.
+                    let at = |k: i64| (2.0 * (k as f64 + 0.5)) / n - 1.0;
+                    self.pixel_of(&face_dir(p.face, at(i), at(j)))
+                };
+                if q != p && !out.contains(&q) {
+                    out.push(q);
+                }
+            }
+        }
+        out
+    }
+
+    /// The cone grown by one pixel: every pixel next to one in the cone joins it (the
+    /// pessimistic step of ch. 4.3.4 when the cone is a set of blocked directions).
+    /// Preferred directions join when their pixel or a neighbour of it is in the cone.
+    pub fn grow(&self) -> CubeMap {
+        let mut out = self.clone();
+        for c in self.cells() {
+            if let Cell::Pixel(p) = c {
+                for q in self.neighbours(p) {
+                    out.set(Cell::Pixel(q), true);
+                }
+            }
+        }
+        for k in 0..self.extra.len() {
+            let p = self.pixel_of(&self.preferred(k));
+            if out.get(Cell::Pixel(p)) {
+                out.set(Cell::Preferred(k), true);
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn directions_round_trip_through_their_pixels() {
+        let c = CubeMap::empty(16, &[]);
+        for k in 0..c.len() {
+            let cell = c.cell(k);
+            assert_eq!(c.index(cell), k);
+            assert_eq!(c.cell_of(&c.direction(cell)), cell);
+        }
+    }
+
+    #[test]
+    fn full_empty_not_and_count() {
+        let prefs = [V3::z(), -V3::x()];
+        let full = CubeMap::full(8, &prefs);
+        assert_eq!(full.count(), 6 * 64 + 2);
+        assert!(full.not().is_empty());
+        let mut half = CubeMap::empty(8, &prefs);
+        for cell in full
+            .cells()
+            .filter(|c| matches!(c, Cell::Pixel(p) if p.face % 2 == 0))
+        {
+            half.set(cell, true);
+        }
+        assert_eq!(half.count(), 3 * 64);
+        assert_eq!(half.or(&half.not()), full);
+        assert!(half.and(&half.not()).is_empty());
+        assert!(half.contains(&V3::new(1.0, 0.2, 0.1)) && !half.contains(&V3::new(-1.0, 0.2, 0.1)));
+    }
+
+    #[test]
+    fn preferred_directions_are_exact() {
+        let mut c = CubeMap::empty(4, &[V3::z()]);
+        assert_eq!(c.cell_of(&V3::new(0.0, 0.0, 2.0)), Cell::Preferred(0));
+        c.set(Cell::Preferred(0), true);
+        assert!(c.contains(&V3::z()));
+        // +z is a pixel corner; the pixels around it are not in the cone.
+        assert!(!c.contains(&V3::new(1e-3, 1e-3, 1.0)));
+    }
+
+    #[test]
+    fn growing_crosses_cube_edges() {
+        let mut c = CubeMap::empty(8, &[]);
+        // The +z pixel at the +x edge.
+        let p = Pixel {
+            face: 4,
+            i: 7,
+            j: 3,
+        };
+        c.set(Cell::Pixel(p), true);
+        let g = c.grow();
+        assert_eq!(g.count(), 9);
+        assert!(
+            g.cells()
+                .any(|c| matches!(c, Cell::Pixel(q) if q.face == 0)),
+            "no +x pixel after growing"
+        );
+    }
+}
