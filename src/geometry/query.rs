@@ -15,17 +15,7 @@ pub struct FaceIndex {
 impl FaceIndex {
     /// Indexes a geometry's faces.
     pub fn new(g: &PartGeometry) -> FaceIndex {
-        let mut edges: HashMap<(u32, u32), Vec<u32>> =
-            HashMap::with_capacity(g.triangles.len() * 2);
-        for (t, tri) in g.triangles.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                edges
-                    .entry((a.min(b), a.max(b)))
-                    .or_default()
-                    .push(t as u32);
-            }
-        }
+        let edges = edge_triangles(&g.triangles);
         let mut boundary = vec![Vec::new(); g.faces.len()];
         for (t, tri) in g.triangles.iter().enumerate() {
             let f = g.tri_face[t];
@@ -48,6 +38,21 @@ impl FaceIndex {
             .map(|&[a, b]| segment_distance(p, &g.vertices[a as usize], &g.vertices[b as usize]))
             .fold(f64::INFINITY, f64::min)
     }
+}
+
+/// Each undirected edge (smaller vertex index first) → the triangles using it, in order.
+pub fn edge_triangles(triangles: &[[u32; 3]]) -> HashMap<(u32, u32), Vec<u32>> {
+    let mut edges: HashMap<(u32, u32), Vec<u32>> = HashMap::with_capacity(triangles.len() * 2);
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            edges
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push(t as u32);
+        }
+    }
+    edges
 }
 
 /// Distance from a point to a segment.

@@ -9,7 +9,6 @@
 
 use super::fit::{self, Patch};
 use super::{PartGeometry, RawMesh, Surface, P3, V3};
-use std::collections::HashMap;
 
 /// Normals within this angle are one flat patch (degrees).
 pub const FLAT_DEG: f64 = 0.5;
@@ -103,16 +102,7 @@ pub fn segment(m: &RawMesh) -> PartGeometry {
     let nt = m.triangles.len();
     let normals: Vec<_> = (0..nt).map(|t| tri_normal(m, t)).collect();
     // Edge → triangles.
-    let mut edge_tris: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
-    for (t, tri) in m.triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            edge_tris
-                .entry((a.min(b), a.max(b)))
-                .or_default()
-                .push(t as u32);
-        }
-    }
+    let edge_tris = super::query::edge_triangles(&m.triangles);
     // Neighbours of each triangle across manifold edges, with the edge length.
     let mut nbrs: Vec<Vec<(u32, f64)>> = vec![Vec::new(); nt];
     let mut keys: Vec<&(u32, u32)> = edge_tris.keys().collect();

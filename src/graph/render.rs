@@ -2,7 +2,7 @@
 
 use super::{Edge, MeasurementGraph, Node};
 use crate::geometry::PartGeometry;
-use crate::model::{fmt_num, Part, TolValue};
+use crate::model::{fmt_num, Part};
 use petgraph::graph::NodeIndex;
 use std::fmt::Write;
 
@@ -13,21 +13,7 @@ fn round6(v: f64) -> f64 {
 
 fn tolerance_text(part: &Part, k: usize) -> (String, String) {
     let t = &part.tolerances[k];
-    let value = match &t.value {
-        TolValue::Zone { width, diameter } => {
-            format!("{}{}", if *diameter { "Ø" } else { "" }, fmt_num(*width))
-        }
-        TolValue::Size {
-            nominal,
-            lower,
-            upper,
-        } => format!(
-            "{} [{}, {}]",
-            fmt_num(*nominal),
-            fmt_num(*lower),
-            fmt_num(*upper)
-        ),
-    };
+    let value = t.value.text();
     let kind = crate::resolve::tolerance_keyword(t.kind);
     let datums: Vec<&str> = t
         .datums

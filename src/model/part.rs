@@ -400,6 +400,28 @@ pub enum TolValue {
     },
 }
 
+impl TolValue {
+    /// The value as reports print it: `Ø0.1` for a zone, `10 [9.9, 10.1]` for a size.
+    pub fn text(&self) -> String {
+        use super::fmt_num;
+        match self {
+            TolValue::Zone { width, diameter } => {
+                format!("{}{}", if *diameter { "Ø" } else { "" }, fmt_num(*width))
+            }
+            TolValue::Size {
+                nominal,
+                lower,
+                upper,
+            } => format!(
+                "{} [{}, {}]",
+                fmt_num(*nominal),
+                fmt_num(*lower),
+                fmt_num(*upper)
+            ),
+        }
+    }
+}
+
 /// A tolerance.
 #[derive(Debug, Clone)]
 pub struct Tolerance {

@@ -426,21 +426,7 @@ fn part_summary(o: &mut String, p: &Part) {
             .iter()
             .map(|f| p.features[f.0].name.as_str())
             .collect();
-        let value = match &t.value {
-            TolValue::Zone { width, diameter } => {
-                format!("{}{}", if *diameter { "Ø" } else { "" }, fmt_num(*width))
-            }
-            TolValue::Size {
-                nominal,
-                lower,
-                upper,
-            } => format!(
-                "{} [{}, {}]",
-                fmt_num(*nominal),
-                fmt_num(*lower),
-                fmt_num(*upper)
-            ),
-        };
+        let value = t.value.text();
         let m = match t.modifier {
             Some(Material::Mmc) => " MMC",
             Some(Material::Lmc) => " LMC",
