@@ -166,10 +166,9 @@ pub fn measurement_graphs(
             overrides: plan.map_or(&[][..], |p| &p.overrides),
             margin: sampling_margin(model, plan),
         };
-        let file = plan.map_or(model.parts[k].span.file, |p| p.span.file);
         out.push(Graphed {
             part: k,
-            graph: graph::build(&input, file, &mut diags),
+            graph: graph::build(&input, &mut diags),
         });
     }
     checked.absorb(diags);

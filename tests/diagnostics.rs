@@ -1018,3 +1018,21 @@ fn face_with_no_room_for_points() {
     );
     assert!(diags.iter().all(|d| d.warning), "{}", render(&diags));
 }
+
+#[test]
+fn no_points_in_an_imported_part_points_into_the_part_file() {
+    let part: &[u8] = b"part p {\n    units mm\n    stock box(100, 100, 20)\n    cut hole bore { at (50, 50, 20), axis -z, diameter 40, depth through }\n    feature top = stock.top\n}\n";
+    let main: &[u8] = b"use \"part.insp\"\nuse std::heads::PH6\nuse std::probes::TP20_D2_L20\ncmm lab { table { z 0 mm }, ram { radius 35 mm, length 600 mm }, head PH6, probes [p1: TP20_D2_L20] }\nplan q { part p, cmm lab, sample top with uniform(points 4, inset 45 %) }\n";
+    let diags = check_files(&[("main.insp", main), ("part.insp", part)]);
+    expect(
+        &diags,
+        "insp::graph::no_points",
+        "top",
+        "gets no measuring point",
+    );
+    let d = diags
+        .iter()
+        .find(|d| d.code == "insp::graph::no_points")
+        .unwrap();
+    assert!(d.file.ends_with("part.insp"), "filed under {}", d.file);
+}

@@ -137,7 +137,7 @@ pub struct Input<'a> {
 /// Builds the measurement graph of a part, sampling every face. The entry point of the
 /// graph stage. Faces that get no measuring point are reported as warnings at the
 /// feature that names them.
-pub fn build(input: &Input, file: FileId, diags: &mut Diagnostics) -> MeasurementGraph {
+pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
     let part = input.part;
     let mut graph = DiGraph::new();
     let root = graph.add_node(Node::Part);
@@ -228,7 +228,7 @@ pub fn build(input: &Input, file: FileId, diags: &mut Diagnostics) -> Measuremen
         if points.is_empty() {
             let feature = &part.features[first_feature.0];
             diags.push(
-                file,
+                feature.span.file,
                 GraphError::NoPoints {
                     span: feature.span,
                     face: g.faces[face.0].name.clone(),
