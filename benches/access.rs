@@ -1,11 +1,14 @@
-//! Accessibility speed: the half-line GAC by the conservative CPU rasterizer against the
-//! plain baseline of one exact ray per pixel centre (every triangle tested, no
-//! acceleration), in the same run, at N = 32 and 64, at an fpoint's tip centre.
+//! Accessibility speed: cones per fpoint for the bare half-line, the grown half-line
+//! (the plan's first stylus, ρ = stem radius, reaching to infinity) and the ram (its
+//! cylinder from the head up), by the CPU backend, each beside the plain baseline of one
+//! parry ray cast per pixel centre (parry's own BVH), in the same run, at N = 32 and 64,
+//! on swiss_block and the NIST CTC 01 mesh. Each iteration computes the cones of 16
+//! fpoints spread over the part; divide by 16 for one cone.
 //!
 //! Run with `cargo bench --bench access`.
 
-use inspc::access::{gac_halfline, triangles_of, Cell, CubeMap};
-use inspc::geometry::{line_triangle, P3};
+use inspc::access::{Backend, Cell, Component, Cpu, CubeMap, End, ProbeShape, Scene};
+use inspc::geometry::P3;
 use inspc::source::FsWorld;
 use std::path::PathBuf;
 
@@ -20,23 +23,67 @@ const CASES: [(&str, u32); 4] = [
     ("tests/real/nist_ctc_01.insp", 64),
 ];
 
-/// The triangles and a tip centre (the middle fpoint, r = 1 mm) of a spec.
-fn scene(spec: &str) -> (Vec<[P3; 3]>, P3) {
-    let (_, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[PathBuf::from(spec)]);
+const POINTS: usize = 16;
+
+/// The scene, 16 tip centres spread over the fpoints, and the plan's first probe.
+fn scene(spec: &str) -> (Scene, Vec<P3>, ProbeShape) {
+    let (checked, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[PathBuf::from(spec)]);
     let g = &parts[graphs[0].part].as_ref().unwrap().geometry;
-    let f = &graphs[0].graph.fpoints[graphs[0].graph.fpoints.len() / 2];
-    (triangles_of(g), f.tip_centre(1.0))
+    let model = &checked.model;
+    let probe = ProbeShape::of_cmm(model, &model.cmms[model.plans[0].cmm.0]).remove(0);
+    let fp = &graphs[0].graph.fpoints;
+    let pts = (0..POINTS)
+        .map(|k| fp[k * fp.len() / POINTS].tip_centre(probe.tip_radius))
+        .collect();
+    (Scene::of_part(g), pts, probe)
+}
+
+fn component(kind: &str, probe: &ProbeShape) -> Component {
+    match kind {
+        "halfline" => Component::half_line(),
+        "grown" => Component {
+            name: "grown".into(),
+            a: 0.0,
+            b: f64::INFINITY,
+            radius: probe.first[0].radius,
+            end: End::Round,
+        },
+        _ => probe.straight().last().unwrap().clone(),
+    }
+}
+
+fn run(bencher: divan::Bencher, (spec, n): (&str, u32), kind: &str) {
+    let (scene, pts, probe) = scene(spec);
+    let comp = component(kind, &probe);
+    bencher.bench(|| {
+        pts.iter()
+            .map(|p| {
+                Cpu.blocked(&scene, divan::black_box(p), &comp, n, &[])
+                    .count()
+            })
+            .sum::<usize>()
+    });
 }
 
 #[divan::bench(args = CASES)]
-fn halfline_raster(bencher: divan::Bencher, (spec, n): (&str, u32)) {
-    let (tris, p) = scene(spec);
-    bencher.bench(|| gac_halfline(divan::black_box(&p), &tris, n, &[]));
+fn halfline(bencher: divan::Bencher, case: (&str, u32)) {
+    run(bencher, case, "halfline");
 }
 
 #[divan::bench(args = CASES)]
-fn halfline_ray_per_pixel_baseline(bencher: divan::Bencher, (spec, n): (&str, u32)) {
-    let (tris, p) = scene(spec);
+fn grown(bencher: divan::Bencher, case: (&str, u32)) {
+    run(bencher, case, "grown");
+}
+
+#[divan::bench(args = CASES)]
+fn ram(bencher: divan::Bencher, case: (&str, u32)) {
+    run(bencher, case, "ram");
+}
+
+/// The baseline: one parry ray cast per pixel centre.
+#[divan::bench(args = CASES)]
+fn parry_ray_per_pixel(bencher: divan::Bencher, (spec, n): (&str, u32)) {
+    let (scene, pts, _) = scene(spec);
     let dirs: Vec<_> = {
         let c = CubeMap::full(n, &[]);
         c.cells()
@@ -45,13 +92,14 @@ fn halfline_ray_per_pixel_baseline(bencher: divan::Bencher, (spec, n): (&str, u3
             .collect()
     };
     bencher.bench(|| {
-        let mut out = CubeMap::empty(n, &[]);
-        for (cell, d) in &dirs {
-            let free = !tris
-                .iter()
-                .any(|t| line_triangle(&p, d, &t[0], &t[1], &t[2]).is_some_and(|s| s > 1e-9));
-            out.set(*cell, free);
-        }
-        out
+        pts.iter()
+            .map(|p| {
+                let mut out = CubeMap::empty(n, &[]);
+                for (cell, d) in &dirs {
+                    out.set(*cell, scene.cast_ray(p, d, f64::MAX).is_some());
+                }
+                out.count()
+            })
+            .sum::<usize>()
     });
 }

@@ -81,6 +81,28 @@ enum Command {
         #[arg(long, value_enum, default_value_t = TableFormat::Text)]
         format: TableFormat,
     },
+    /// Computes the accessibility cones of one fpoint under one probe: prints how much of
+    /// the sphere each probe component leaves free and draws the probe's cone as an
+    /// unfolded cube map (binary PGM).
+    Cones {
+        /// The `.insp` spec.
+        file: PathBuf,
+        /// A face, by the name `inspc faces` gives it; all fpoints when absent.
+        #[arg(long)]
+        face: Option<String>,
+        /// Which fpoint of the face (or of the part), from 0.
+        #[arg(long, default_value_t = 0)]
+        point: usize,
+        /// A probe label of the plan's machine; its first probe when absent.
+        #[arg(long)]
+        probe: Option<String>,
+        /// Cube-map resolution (pixels per cube-face side).
+        #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(2..=256))]
+        resolution: u32,
+        /// Where to write the image.
+        #[arg(short, long, default_value = "cone.pgm")]
+        output: PathBuf,
+    },
     /// Checks specs: parses, resolves names and units, checks values. Exits 1 on error.
     Check {
         /// The `.insp` files.
@@ -112,6 +134,22 @@ fn main() -> ExitCode {
             format,
             points,
         } => graph(&file, format, points),
+        Command::Cones {
+            file,
+            face,
+            point,
+            probe,
+            resolution,
+            output,
+        } => {
+            let req = inspc::access::ConeRequest {
+                face,
+                point,
+                probe,
+                n: resolution,
+            };
+            cones(&file, &req, &output)
+        }
         Command::Check {
             files,
             message_format,
@@ -185,6 +223,47 @@ fn print_diagnostics(sources: &inspc::source::SourceMap, diags: &[inspc::diag::D
     for d in diags {
         eprint!("{}", render_human(sources, d, opts));
     }
+}
+
+fn cones(
+    file: &std::path::Path,
+    req: &inspc::access::ConeRequest,
+    output: &std::path::Path,
+) -> ExitCode {
+    let (checked, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[file.to_path_buf()]);
+    print_diagnostics(&checked.sources, &checked.diagnostics);
+    if checked.has_errors() {
+        return ExitCode::from(1);
+    }
+    let mut diags = inspc::diag::Diagnostics::new();
+    let report = inspc::access::cone_report(&checked, &parts, &graphs, req, &mut diags);
+    print_diagnostics(&checked.sources, &diags.sorted());
+    let Some(report) = report else {
+        return ExitCode::from(1);
+    };
+    if let Err(e) = write_atomically(output, &report.pgm) {
+        eprintln!("inspc: cannot write {}: {e}", output.display());
+        return ExitCode::from(1);
+    }
+    print!("{}", report.text);
+    println!(
+        "wrote {} (unfolded cube, +z in the middle: free white, blocked black)",
+        output.display()
+    );
+    ExitCode::SUCCESS
+}
+
+/// Writes a file whole or not at all: a temporary beside it, then a rename.
+fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.inspc-tmp"));
+    std::fs::write(&tmp, bytes)?;
+    std::fs::rename(&tmp, path).inspect_err(|_| {
+        let _ = std::fs::remove_file(&tmp);
+    })
 }
 
 fn graph(file: &std::path::Path, format: GraphFormat, points: bool) -> ExitCode {

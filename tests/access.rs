@@ -1,80 +1,238 @@
-//! The half-line GAC against brute force: one exact ray per pixel centre, at tip centres
-//! of fpoints of every example and both NIST parts. The rasterizer must never call a
-//! direction free that the exact ray finds blocked; agreement is reported.
+//! Cones against brute force with parry, at fpoints of every example and both NIST parts:
+//! one exact ray per pixel centre for the half-line, one exact capsule or cylinder
+//! intersection test per pixel centre for the grown abstractions (stylus, ram). The
+//! grown cones must never call a blocked direction free; the half-line cone must agree
+//! with the rays on ≥ 99 % of pixels and never call a blocked one free either.
 
 mod common;
 
-use inspc::access::{gac_halfline, triangles_of, Cell, CubeMap};
-use inspc::geometry::line_triangle;
+use inspc::access::{
+    cones, gac_halfline, Backend, Cell, Component, ConeOptions, Cpu, CubeMap, End, ProbeShape,
+    Scene,
+};
+use inspc::geometry::{P3, V3};
 use inspc::source::FsWorld;
+use parry3d_f64::math::Isometry;
+use parry3d_f64::na::{Translation3, UnitQuaternion};
+use parry3d_f64::query::intersection_test;
+use parry3d_f64::shape::{Capsule, Cylinder};
 use std::path::PathBuf;
 
-fn exact_blocked(
-    p: &inspc::geometry::P3,
-    tris: &[[inspc::geometry::P3; 3]],
-    d: &inspc::geometry::V3,
-) -> bool {
-    tris.iter()
-        .any(|t| line_triangle(p, d, &t[0], &t[1], &t[2]).is_some_and(|s| s > 1e-9))
+const EXAMPLES: [&str; 7] = [
+    "examples/f2.insp",
+    "examples/f3_fixed.insp",
+    "examples/f3_indexed.insp",
+    "examples/f4.insp",
+    "examples/swiss_block.insp",
+    "examples/swiss_sphere_fixed.insp",
+    "examples/swiss_sphere_indexed.insp",
+];
+const NIST: [&str; 2] = ["tests/real/nist_ctc_01.insp", "tests/real/nist_ftc_08.insp"];
+
+struct Case {
+    scene: Scene,
+    /// (tip centre, fpoint index) at pseudo-random fpoints.
+    points: Vec<P3>,
+    probes: Vec<ProbeShape>,
 }
 
-/// (pixels compared, pixels that agree) over sampled fpoints of a spec.
-fn verify(spec: &str, n: u32, every: usize) -> (usize, usize) {
+/// The scene, `count` pseudo-random tip centres (r = 1 mm) and the plan's probes.
+fn case(spec: &str, count: usize, seed: u64) -> Case {
     let (checked, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[PathBuf::from(spec)]);
     assert!(!checked.has_errors(), "{spec}");
-    let (mut total, mut agree) = (0usize, 0usize);
-    for gr in &graphs {
-        let g = &parts[gr.part].as_ref().unwrap().geometry;
-        let tris = triangles_of(g);
-        for f in gr.graph.fpoints.iter().step_by(every) {
-            let p = f.tip_centre(1.0);
-            let gac = gac_halfline(&p, &tris, n, &[]);
-            let probe = CubeMap::full(n, &[]);
-            for cell in probe.cells() {
-                let Cell::Pixel(_) = cell else { continue };
-                let d = probe.direction(cell);
-                let blocked = exact_blocked(&p, &tris, &d);
-                assert!(
-                    !(blocked && gac.get(cell)),
-                    "{spec}: direction {d:?} is blocked at {p:?} but reported free"
-                );
-                total += 1;
-                agree += usize::from(blocked != gac.get(cell)); // blocked ⇔ not free
-            }
+    let gr = &graphs[0];
+    let g = &parts[gr.part].as_ref().unwrap().geometry;
+    let scene = Scene::of_part(g);
+    let fp = &gr.graph.fpoints;
+    let mut state = seed;
+    let points = (0..count)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            fp[(state >> 33) as usize % fp.len()].tip_centre(1.0)
+        })
+        .collect();
+    let model = &checked.model;
+    let probes = model
+        .plans
+        .first()
+        .map(|p| ProbeShape::of_cmm(model, &model.cmms[p.cmm.0]))
+        .unwrap_or_default();
+    Case {
+        scene,
+        points,
+        probes,
+    }
+}
+
+fn every_direction(n: u32) -> Vec<(Cell, V3)> {
+    let c = CubeMap::full(n, &inspc::access::axes());
+    c.cells().map(|cell| (cell, c.direction(cell))).collect()
+}
+
+/// Whether the component, along `d` from `p`, meets the part (parry, exact up to its
+/// tolerances). The ram's infinite end is cut well past the part.
+fn exact_blocked(scene: &Scene, p: &P3, d: &V3, comp: &Component) -> bool {
+    let mesh = scene.mesh().unwrap();
+    let b = comp.b.min(comp.a + 4.0 * scene.size + 10.0);
+    if comp.radius == 0.0 {
+        return scene
+            .cast_ray(&(p + d * comp.a), d, b - comp.a)
+            .is_some_and(|t| t > 1e-9);
+    }
+    let id = Isometry::identity();
+    match comp.end {
+        End::Round => {
+            let cap = Capsule::new(p + d * comp.a, p + d * b, comp.radius);
+            intersection_test(&id, &cap, &id, mesh).unwrap()
         }
+        End::Flat => {
+            let half = (b - comp.a) / 2.0;
+            let cyl = Cylinder::new(half, comp.radius);
+            let rot = UnitQuaternion::rotation_between(&V3::y(), d).unwrap_or_else(|| {
+                UnitQuaternion::from_axis_angle(&V3::x_axis(), std::f64::consts::PI)
+            });
+            let centre = p + d * (comp.a + half);
+            let pos = Isometry::from_parts(Translation3::from(centre.coords), rot);
+            intersection_test(&pos, &cyl, &id, mesh).unwrap()
+        }
+    }
+}
+
+/// Compares one component's cone with the exact test at every pixel centre and preferred
+/// direction: (cells, agreeing cells); panics on a blocked direction reported free.
+fn compare(scene: &Scene, p: &P3, comp: &Component, n: u32, what: &str) -> (usize, usize) {
+    let blocked = Cpu.blocked(scene, p, comp, n, &inspc::access::axes());
+    let (mut total, mut agree) = (0, 0);
+    for (cell, d) in every_direction(n) {
+        let exact = exact_blocked(scene, p, &d, comp);
+        assert!(
+            !exact || blocked.get(cell),
+            "{what}: {} blocks {d:?} at {p:?}, reported free",
+            comp.name
+        );
+        total += 1;
+        agree += usize::from(exact == blocked.get(cell));
     }
     (total, agree)
 }
 
-#[test]
-fn halfline_gac_is_conservative_on_the_examples() {
-    for (spec, every) in [
-        ("examples/f2.insp", 3),
-        ("examples/f4.insp", 3),
-        ("examples/swiss_block.insp", 61),
-    ] {
-        let (total, agree) = verify(spec, 32, every);
-        let ratio = agree as f64 / total as f64;
+fn verify_halfline(spec: &str, count: usize, n: u32) {
+    let c = case(spec, count, 17);
+    let (mut total, mut agree) = (0, 0);
+    for p in &c.points {
+        let (t, a) = compare(&c.scene, p, &Component::half_line(), n, spec);
+        total += t;
+        agree += a;
+    }
+    let ratio = agree as f64 / total as f64;
+    eprintln!(
+        "{spec}: half-line {agree}/{total} cells agree ({:.3} %)",
+        100.0 * ratio
+    );
+    assert!(ratio >= 0.99, "{spec}: only {:.3} % agree", 100.0 * ratio);
+}
+
+/// The stylus and the ram of the plan's first probe, each on its own, and the bare
+/// half-line grown by 1 mm.
+fn verify_grown(spec: &str, count: usize, n: u32) {
+    let c = case(spec, count, 29);
+    let probe = &c.probes[0];
+    let mut comps = vec![probe.first[0].clone()];
+    comps.push(Component {
+        name: "grown half-line".into(),
+        a: 0.0,
+        b: f64::INFINITY,
+        radius: 0.8,
+        end: End::Round,
+    });
+    if !probe.bent {
+        comps.push(probe.second[1].clone());
+    }
+    for comp in &comps {
+        let (mut total, mut agree) = (0, 0);
+        for p in &c.points {
+            let (t, a) = compare(&c.scene, p, comp, n, spec);
+            if std::env::var("INSPC_DEBUG").is_ok() {
+                eprintln!("  {p:?} dist {:.3}: {a}/{t}", c.scene.distance(p));
+            }
+            total += t;
+            agree += a;
+        }
         eprintln!(
-            "{spec}: {agree}/{total} pixels agree ({:.2} %)",
-            100.0 * ratio
-        );
-        assert!(
-            ratio > 0.95,
-            "{spec}: only {:.2} % of pixels agree",
-            100.0 * ratio
+            "{spec}: {} {agree}/{total} cells agree ({:.2} %)",
+            comp.name,
+            100.0 * agree as f64 / total as f64
         );
     }
 }
 
 #[test]
-fn halfline_gac_is_conservative_on_nist_ctc_01() {
+fn halfline_cones_match_exact_rays_on_the_examples() {
+    for spec in EXAMPLES {
+        verify_halfline(spec, 6, 32);
+    }
+}
+
+#[test]
+fn halfline_cones_match_exact_rays_on_the_nist_parts() {
     common::require_shared_parts();
-    let (total, agree) = verify("tests/real/nist_ctc_01.insp", 32, 19);
-    let ratio = agree as f64 / total as f64;
-    eprintln!(
-        "nist_ctc_01: {agree}/{total} pixels agree ({:.2} %)",
-        100.0 * ratio
+    for spec in NIST {
+        verify_halfline(spec, 6, 32);
+    }
+    verify_halfline(NIST[0], 2, 64);
+}
+
+#[test]
+fn grown_cones_are_pessimistic_on_the_examples() {
+    for spec in EXAMPLES {
+        verify_grown(spec, 3, 32);
+    }
+}
+
+#[test]
+fn grown_cones_are_pessimistic_on_the_nist_parts() {
+    common::require_shared_parts();
+    for spec in NIST {
+        verify_grown(spec, 3, 32);
+    }
+}
+
+#[test]
+fn halfline_gac_is_the_complement_of_its_blocked_map() {
+    let c = case("examples/f4.insp", 1, 3);
+    let gac = gac_halfline(&c.scene, &c.points[0], 32, &[]);
+    let blocked = Cpu.blocked(&c.scene, &c.points[0], &Component::half_line(), 32, &[]);
+    assert_eq!(gac, blocked.not());
+    assert!(!gac.is_empty() && gac.count() < 6 * 32 * 32);
+}
+
+#[test]
+fn cones_are_the_same_for_any_thread_count() {
+    let (checked, parts, graphs) =
+        inspc::measurement_graphs(&FsWorld, &[PathBuf::from("examples/f3_indexed.insp")]);
+    let gr = &graphs[0];
+    let scene = Scene::of_part(&parts[gr.part].as_ref().unwrap().geometry);
+    let model = &checked.model;
+    let probes = ProbeShape::of_cmm(model, &model.cmms[model.plans[0].cmm.0]);
+    let opts = ConeOptions {
+        n: 32,
+        d2_samples: 4,
+        ..ConeOptions::default()
+    };
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| cones(&Cpu, &scene, &gr.graph.fpoints, &probes[0], &opts))
+    };
+    let one = run(1);
+    assert_eq!(one, run(3));
+    assert!(
+        one.iter().all(|c| c.d2.is_some()),
+        "an indexable head gives D2 cones"
     );
-    assert!(ratio > 0.95, "only {:.2} % agree", 100.0 * ratio);
+    assert!(one.iter().any(|c| !c.approach.is_empty()));
 }

@@ -17,6 +17,10 @@ struct Entry {
 const NO_SPEC_EXAMPLE: &[(&str, &str)] = &[
     ("insp::geometry::boolean_failed", "a guard: inspc's primitives are closed and manifold and boolmesh accepts them all"),
     ("insp::geometry::mesh_unreadable", "a spec's mesh is checked to exist first; `inspc faces` on a missing file reports it (tests/cli.rs)"),
+    ("insp::access::unknown_face", "a command-line request; tests/cli.rs"),
+    ("insp::access::no_point", "a command-line request; tests/cli.rs"),
+    ("insp::access::unknown_probe", "a command-line request; tests/cli.rs"),
+    ("insp::access::no_machine", "a command-line request; tests/cli.rs"),
 ];
 
 fn catalogue() -> Vec<Entry> {

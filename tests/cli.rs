@@ -288,3 +288,96 @@ fn graph_of_a_bad_spec_exits_one() {
         "{stderr}"
     );
 }
+
+#[test]
+fn cones_prints_a_summary_and_draws_the_cone() {
+    let dir = std::env::temp_dir().join(format!("inspc-cones-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("cone.pgm");
+    let (code, stdout, stderr) = inspc(&[
+        "cones",
+        "examples/f4.insp",
+        "--face",
+        "small.wall",
+        "--point",
+        "2",
+        "--probe",
+        "small",
+        "-n",
+        "32",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    for needle in [
+        "face small.wall (cylinder)",
+        "probe small",
+        "stylus",
+        "body",
+        "D2 (setup directions)",
+        "wrote",
+    ] {
+        assert!(stdout.contains(needle), "no `{needle}` in:\n{stdout}");
+    }
+    let bytes = std::fs::read(&out).unwrap();
+    assert!(bytes.starts_with(b"P5\n128 96\n255\n"));
+    assert_eq!(bytes.len(), "P5\n128 96\n255\n".len() + 128 * 96);
+    // Deep in the small hole few directions are free, but the exact hole axis is.
+    assert!(stdout.contains("axes in the cone: +x"), "{stdout}");
+    let (code, stdout, stderr) = inspc(&[
+        "cones",
+        "examples/f4.insp",
+        "--face",
+        "stock.top",
+        "-n",
+        "32",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let axes = stdout
+        .lines()
+        .find(|l| l.contains("axes in the cone"))
+        .unwrap();
+    assert!(axes.ends_with("+z") && !axes.contains("-z"), "{stdout}");
+    let bytes = std::fs::read(&out).unwrap();
+    // On the top, the upper half of the sphere is largely free.
+    let px = &bytes["P5\n128 96\n255\n".len()..];
+    let white = px.iter().filter(|&&b| b == 255).count();
+    let black = px.iter().filter(|&&b| b == 0).count();
+    assert!(white > 0 && black > white, "{white} free, {black} blocked");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn cones_of_unknown_names_are_diagnostics() {
+    for (args, code) in [
+        (&["--face", "nope"][..], "insp::access::unknown_face"),
+        (&["--probe", "zz"][..], "insp::access::unknown_probe"),
+        (
+            &["--face", "small.wall", "--point", "99"][..],
+            "insp::access::no_point",
+        ),
+    ] {
+        let mut all = vec!["cones", "examples/f4.insp"];
+        all.extend_from_slice(args);
+        all.extend_from_slice(&["-o", "/nonexistent-dir/never.pgm"]);
+        let (status, _, stderr) = inspc(&all);
+        assert_eq!(status, 1);
+        assert!(stderr.contains(code), "{args:?}: {stderr}");
+    }
+    let spec = temp_spec(
+        "cones_no_machine.insp",
+        "part p {\n    units mm\n    stock box(10, 10, 10)\n    feature top = stock.top\n}\n",
+    );
+    let (status, _, stderr) = inspc(&[
+        "cones",
+        &spec,
+        "--probe",
+        "p1",
+        "-o",
+        "/nonexistent-dir/x.pgm",
+    ]);
+    assert_eq!(status, 1);
+    assert!(stderr.contains("insp::access::no_machine"), "{stderr}");
+}

@@ -176,10 +176,11 @@ impl CubeMap {
         }
     }
 
-    /// The cell of a direction: its preferred-direction bit if it is one, else its pixel.
+    /// The cell of a direction: its preferred-direction bit if it is one (to within
+    /// 1e-9 rad, so a head's A = 90°, B = 0° is +x despite rounding), else its pixel.
     pub fn cell_of(&self, d: &V3) -> Cell {
-        let k = key(d);
-        match self.extra.iter().position(|e| *e == k) {
+        let u = d.normalize();
+        match (0..self.extra.len()).find(|&k| (self.preferred(k) - u).norm() < 1e-9) {
             Some(i) => Cell::Preferred(i),
             None => Cell::Pixel(self.pixel_of(d)),
         }
@@ -308,8 +309,60 @@ impl CubeMap {
 
     /// The cone grown by one pixel: every pixel next to one in the cone joins it (the
     /// pessimistic step of ch. 4.3.4 when the cone is a set of blocked directions).
-    /// Preferred directions join when their pixel or a neighbour of it is in the cone.
+    /// Preferred directions join when their pixel is in the grown cone.
     pub fn grow(&self) -> CubeMap {
+        let n = self.n as usize;
+        if n > 64 {
+            return self.grow_slow();
+        }
+        let mut out = self.clone();
+        let mask = row_mask(n);
+        let table = EdgeTable::of(self.n);
+        for face in 0..6u8 {
+            let rows: Vec<u64> = (0..n).map(|j| self.row(face, j)).collect();
+            let wide: Vec<u64> = rows.iter().map(|&r| (r | r << 1 | r >> 1) & mask).collect();
+            for j in 0..n {
+                let mut g = wide[j];
+                if j > 0 {
+                    g |= wide[j - 1];
+                }
+                if j + 1 < n {
+                    g |= wide[j + 1];
+                }
+                out.or_row(face, j, g);
+            }
+            // Pixels on the face's border reach across cube edges.
+            for (j, &r) in rows.iter().enumerate() {
+                let border = if j == 0 || j == n - 1 {
+                    r
+                } else {
+                    r & (1 | 1 << (n - 1))
+                };
+                let mut rest = border;
+                while rest != 0 {
+                    let i = rest.trailing_zeros() as usize;
+                    rest &= rest - 1;
+                    let pixel = (face as usize * n + j) * n + i;
+                    for &q in table.across(pixel) {
+                        out.bits[q as usize / 64] |= 1 << (q % 64);
+                    }
+                }
+            }
+        }
+        out.settle_preferred();
+        out
+    }
+
+    /// [`CubeMap::grow`] `k` times.
+    pub fn grown(&self, k: u32) -> CubeMap {
+        let mut c = self.clone();
+        for _ in 0..k {
+            c = c.grow();
+        }
+        c
+    }
+
+    fn grow_slow(&self) -> CubeMap {
         let mut out = self.clone();
         for c in self.cells() {
             if let Cell::Pixel(p) = c {
@@ -318,13 +371,169 @@ impl CubeMap {
                 }
             }
         }
+        out.settle_preferred();
+        out
+    }
+
+    /// Preferred directions whose pixel is in the cone join it.
+    fn settle_preferred(&mut self) {
         for k in 0..self.extra.len() {
             let p = self.pixel_of(&self.preferred(k));
-            if out.get(Cell::Pixel(p)) {
-                out.set(Cell::Preferred(k), true);
+            if self.get(Cell::Pixel(p)) {
+                self.set(Cell::Preferred(k), true);
+            }
+        }
+    }
+
+    /// Row `j` of a face as bits (bit i = column i); N ≤ 64.
+    pub(crate) fn row(&self, face: u8, j: usize) -> u64 {
+        let n = self.n as usize;
+        let start = (face as usize * n + j) * n;
+        let (w, b) = (start / 64, start % 64);
+        let mut r = self.bits[w] >> b;
+        if b + n > 64 {
+            r |= self.bits[w + 1] << (64 - b);
+        }
+        r & row_mask(n)
+    }
+
+    /// Adds the bits of `r` to row `j` of a face; N ≤ 64.
+    pub(crate) fn or_row(&mut self, face: u8, j: usize, r: u64) {
+        let n = self.n as usize;
+        let r = r & row_mask(n);
+        let start = (face as usize * n + j) * n;
+        let (w, b) = (start / 64, start % 64);
+        self.bits[w] |= r << b;
+        if b + n > 64 {
+            self.bits[w + 1] |= r >> (64 - b);
+        }
+    }
+
+    /// Adds pixels i0..=i1 of row `j` of a face.
+    pub fn set_span(&mut self, face: u8, j: u32, i0: u32, i1: u32) {
+        if i0 > i1 {
+            return;
+        }
+        let n = self.n as usize;
+        let start = (face as usize * n + j as usize) * n;
+        let (mut k, end) = (start + i0 as usize, start + i1 as usize + 1);
+        while k < end {
+            let (w, b) = (k / 64, k % 64);
+            let len = (64 - b).min(end - k);
+            self.bits[w] |= row_mask(len) << b;
+            k += len;
+        }
+    }
+
+    /// Adds every preferred direction.
+    pub fn fill_preferred(&mut self) {
+        for k in 0..self.extra.len() {
+            self.set(Cell::Preferred(k), true);
+        }
+    }
+
+    /// Every pixel whose closed cell holds the direction: one inside a pixel, up to four
+    /// on pixel edges and corners, across cube edges too.
+    pub fn pixels_holding(&self, d: &V3) -> Vec<Pixel> {
+        let n = self.n as f64;
+        let mut out = Vec::new();
+        for face in 0..6u8 {
+            let a = (face / 2) as usize;
+            let s = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
+            let w = s * d[a];
+            if w <= 0.0 {
+                continue;
+            }
+            let (u, v) = (d[(a + 1) % 3] / w, d[(a + 2) % 3] / w);
+            let tol = 1e-9;
+            if u.abs() > 1.0 + tol || v.abs() > 1.0 + tol {
+                continue;
+            }
+            let range = |x: f64| {
+                let y = (x + 1.0) / 2.0 * n;
+                let lo = ((y - tol).floor().max(0.0) as u32).min(self.n - 1);
+                let hi = ((y + tol).floor().max(0.0) as u32).min(self.n - 1);
+                lo..=hi
+            };
+            for j in range(v) {
+                for i in range(u) {
+                    let p = Pixel { face, i, j };
+                    if !out.contains(&p) {
+                        out.push(p);
+                    }
+                }
             }
         }
         out
+    }
+
+    /// Adds every pixel.
+    pub fn fill_pixels(&mut self) {
+        let pixels = 6 * (self.n as usize) * (self.n as usize);
+        for f in 0..6 {
+            for j in 0..self.n {
+                self.set_span(f, j, 0, self.n - 1);
+            }
+        }
+        debug_assert!(self.count() >= pixels);
+    }
+}
+
+/// Per border pixel, its neighbours on other cube faces (bit indices), computed once per
+/// resolution.
+struct EdgeTable {
+    /// Border pixel index → range in `list`.
+    start: std::collections::HashMap<u32, (u32, u32)>,
+    list: Vec<u32>,
+}
+
+impl EdgeTable {
+    fn of(n: u32) -> Arc<EdgeTable> {
+        use std::collections::HashMap;
+        use std::sync::{Mutex, OnceLock};
+        static TABLES: OnceLock<Mutex<HashMap<u32, Arc<EdgeTable>>>> = OnceLock::new();
+        let tables = TABLES.get_or_init(|| Mutex::new(HashMap::new()));
+        if let Some(t) = tables.lock().unwrap_or_else(|e| e.into_inner()).get(&n) {
+            return t.clone();
+        }
+        let map = CubeMap::empty(n, &[]);
+        let (mut start, mut list) = (HashMap::new(), Vec::new());
+        for face in 0..6u8 {
+            for j in 0..n {
+                for i in 0..n {
+                    if i != 0 && j != 0 && i != n - 1 && j != n - 1 {
+                        continue;
+                    }
+                    let p = Pixel { face, i, j };
+                    let from = list.len() as u32;
+                    for q in map.neighbours(p).into_iter().filter(|q| q.face != face) {
+                        list.push(map.index(Cell::Pixel(q)) as u32);
+                    }
+                    start.insert(map.index(Cell::Pixel(p)) as u32, (from, list.len() as u32));
+                }
+            }
+        }
+        let t = Arc::new(EdgeTable { start, list });
+        tables
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .insert(n, t.clone());
+        t
+    }
+
+    fn across(&self, pixel: usize) -> &[u32] {
+        match self.start.get(&(pixel as u32)) {
+            Some(&(a, b)) => &self.list[a as usize..b as usize],
+            None => &[],
+        }
+    }
+}
+
+fn row_mask(n: usize) -> u64 {
+    if n >= 64 {
+        !0
+    } else {
+        (1u64 << n) - 1
     }
 }
 
@@ -388,5 +597,42 @@ mod tests {
                 .any(|c| matches!(c, Cell::Pixel(q) if q.face == 0)),
             "no +x pixel after growing"
         );
+    }
+
+    #[test]
+    fn fast_growth_matches_the_neighbour_definition() {
+        for n in [5u32, 8, 32, 64] {
+            let mut c = CubeMap::empty(n, &[V3::z()]);
+            let mut k = 7usize;
+            for idx in 0..6 * (n as usize) * (n as usize) {
+                k = k
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                if k >> 60 == 0 {
+                    c.set(c.cell(idx), true);
+                }
+            }
+            assert_eq!(c.grow(), c.grow_slow(), "n = {n}");
+        }
+    }
+
+    #[test]
+    fn spans_set_exactly_their_pixels() {
+        for n in [5u32, 32, 64] {
+            let mut c = CubeMap::empty(n, &[]);
+            c.set_span(3, 2, 1, n - 2);
+            assert_eq!(c.count(), n as usize - 2);
+            assert!(c.get(Cell::Pixel(Pixel {
+                face: 3,
+                i: 1,
+                j: 2
+            })));
+            assert!(!c.get(Cell::Pixel(Pixel {
+                face: 3,
+                i: 0,
+                j: 2
+            })));
+            assert_eq!(c.row(3, 2), ((1u64 << (n - 1)) - 1) & !1);
+        }
     }
 }

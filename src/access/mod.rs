@@ -1,21 +1,74 @@
 //! Stage 7, accessibility (seed ch. 2, paper 001): for a point near the part, the
 //! directions from which a probe can reach it, as cube-map cones.
 //!
-//! Built so far: the cube map ([`CubeMap`]) with its set operations, growing and
-//! preferred directions; the conservative CPU rasterizer for the half-line GAC
-//! ([`gac_halfline`]); and the map between an indexable head's A/B grid and directions.
-//! Grown half-lines, the ram, bent probes and the wgpu backend follow (issue 4).
+//! The entry point is [`point_cones`] (one fpoint, one probe) and [`cones`] (many, in
+//! parallel). The pieces:
+//! - [`CubeMap`]: six N × N bitmaps plus exact preferred directions, with set operations
+//!   and growing;
+//! - [`Scene`]: the obstacle (part, and table once a setup is known);
+//! - [`ProbeShape`]: the spec's probe as tip ball plus [`Component`]s (stylus and
+//!   extensions as capsules, body, head and ram as cylinders);
+//! - [`Backend`]: computes one component's blocked directions; [`Cpu`] is the software
+//!   rasterizer, and the GPU backend will implement the same trait;
+//! - the seed's family: the half-line GAC, grown and truncated half-lines (any
+//!   component), D1, D2 (weak GAC over dD1), D1′ for a chosen second-component
+//!   direction, feature cones as intersections, approach/retract cones.
 //!
-//! **Architecture Invariant:** a direction the obstacle blocks is never reported
-//! accessible: the rasterizer marks every pixel a triangle's shadow touches.
+//! **Architecture Invariant:** for components of non-zero radius a direction the
+//! obstacle blocks is never reported accessible; the bare half-line is exact at pixel
+//! centres.
 
+mod cpu;
 mod cubemap;
+mod errors;
+mod heightmap;
+mod probe;
 mod raster;
+mod report;
+mod scene;
 
+pub use cpu::pixels_for;
 pub use cubemap::{face_dir, face_uv, Cell, CubeMap, Pixel};
-pub use raster::{blocked_halfline, shadow_triangle};
+pub use errors::AccessError;
+pub use probe::{Component, End, ProbeShape};
+pub use raster::{shadow_polygon, Coverage};
+pub use report::{cone_report, pgm, ConeReport, ConeRequest};
+pub use scene::{point_triangle_distance, Scene, Tri};
 
 use crate::geometry::{PartGeometry, P3, V3};
+use crate::sample::Fpoint;
+use rayon::prelude::*;
+
+/// Computes the directions one probe component is blocked in. The CPU rasterizer
+/// implements it; a GPU backend renders the same shadows.
+pub trait Backend: Sync {
+    /// The directions in which `comp`, with its axis starting at `from`, meets the scene.
+    fn blocked(
+        &self,
+        scene: &Scene,
+        from: &P3,
+        comp: &Component,
+        n: u32,
+        preferred: &[V3],
+    ) -> CubeMap;
+}
+
+/// The software backend.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Cpu;
+
+impl Backend for Cpu {
+    fn blocked(
+        &self,
+        scene: &Scene,
+        from: &P3,
+        comp: &Component,
+        n: u32,
+        preferred: &[V3],
+    ) -> CubeMap {
+        cpu::blocked(scene, from, comp, n, preferred)
+    }
+}
 
 /// The part's triangles as corner points.
 pub fn triangles_of(g: &PartGeometry) -> Vec<[P3; 3]> {
@@ -26,10 +79,198 @@ pub fn triangles_of(g: &PartGeometry) -> Vec<[P3; 3]> {
 }
 
 /// The global accessibility cone of a half-line at `p`: the directions d for which the
-/// ray p + t·d, t > 0, misses every triangle (seed ch. 2.3). `p` should be off the
-/// surface, such as a tip centre p + r·n.
-pub fn gac_halfline(p: &P3, triangles: &[[P3; 3]], n: u32, preferred: &[V3]) -> CubeMap {
-    blocked_halfline(p, triangles, n, preferred).not()
+/// ray p + t·d, t > 0, misses every triangle (seed ch. 2.3), sampled at pixel centres.
+/// `p` should be off the surface, such as a tip centre p + r·n.
+pub fn gac_halfline(scene: &Scene, p: &P3, n: u32, preferred: &[V3]) -> CubeMap {
+    Cpu.blocked(scene, p, &Component::half_line(), n, preferred)
+        .not()
+}
+
+/// The directions from which all of `comps`, stacked along one axis from `from`, miss
+/// the scene: the intersection of their cones (a straight probe, ch. 2.4).
+pub fn gac(
+    backend: &dyn Backend,
+    scene: &Scene,
+    from: &P3,
+    comps: &[Component],
+    n: u32,
+    preferred: &[V3],
+) -> CubeMap {
+    let mut blocked = CubeMap::empty(n, preferred);
+    for c in comps {
+        blocked.or_assign(&backend.blocked(scene, from, c, n, preferred));
+    }
+    blocked.not()
+}
+
+/// Whether the tip ball of radius `r` centred at `c` stays clear of the scene, up to
+/// the mesh's chordal error (a tenth of the radius).
+pub fn tip_fits(scene: &Scene, c: &P3, r: f64) -> bool {
+    scene.distance(c) >= 0.9 * r
+}
+
+/// What to compute for a point.
+#[derive(Debug, Clone)]
+pub struct ConeOptions {
+    /// Cube-map resolution N.
+    pub n: u32,
+    /// Preferred directions (exact axes and the like), shared by every cone.
+    pub preferred: Vec<V3>,
+    /// The retract distance along the normal (mm): approach cones hold at the contact
+    /// and at the retract point.
+    pub retract: f64,
+    /// How many points of dD1 the weak GAC D2 samples.
+    pub d2_samples: usize,
+}
+
+impl Default for ConeOptions {
+    fn default() -> Self {
+        ConeOptions {
+            n: 64,
+            preferred: axes(),
+            retract: 2.0,
+            d2_samples: 16,
+        }
+    }
+}
+
+/// The six axis directions, the usual preferred directions.
+pub fn axes() -> Vec<V3> {
+    vec![V3::x(), -V3::x(), V3::y(), -V3::y(), V3::z(), -V3::z()]
+}
+
+/// The cones of one fpoint under one probe.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointCones {
+    /// Whether the tip ball fits at the point.
+    pub tip_fits: bool,
+    /// Straight probe: the probe directions that clear every component at the contact and
+    /// at the retract point. Bent probe: D1 at both (the first component's cone).
+    pub approach: CubeMap,
+    /// Bent probe only: D2, the second component's directions (the setup's vertical)
+    /// from which at least one point of dD1 is reachable.
+    pub d2: Option<CubeMap>,
+}
+
+/// The cones of one fpoint under one probe. A tip that does not fit gives empty cones.
+pub fn point_cones(
+    backend: &dyn Backend,
+    scene: &Scene,
+    f: &Fpoint,
+    probe: &ProbeShape,
+    opts: &ConeOptions,
+) -> PointCones {
+    let (n, pref) = (opts.n, &opts.preferred[..]);
+    let c = f.tip_centre(probe.tip_radius);
+    if !tip_fits(scene, &c, probe.tip_radius) {
+        return PointCones {
+            tip_fits: false,
+            approach: CubeMap::empty(n, pref),
+            d2: probe.bent.then(|| CubeMap::empty(n, pref)),
+        };
+    }
+    let retract = c + f.normal * opts.retract;
+    let comps = if probe.bent {
+        probe.first.clone()
+    } else {
+        probe.straight()
+    };
+    let mut approach = gac(backend, scene, &c, &comps, n, pref);
+    if !approach.is_empty() && opts.retract > 0.0 {
+        approach.and_assign(&gac(backend, scene, &retract, &comps, n, pref));
+    }
+    let d2 = probe
+        .bent
+        .then(|| d2(backend, scene, &c, probe, &approach, opts.d2_samples));
+    PointCones {
+        tip_fits: true,
+        approach,
+        d2,
+    }
+}
+
+/// D1 (ch. 2.5.1): the first component's cone, the truncated (0, d) family.
+pub fn d1(
+    backend: &dyn Backend,
+    scene: &Scene,
+    c: &P3,
+    probe: &ProbeShape,
+    n: u32,
+    pref: &[V3],
+) -> CubeMap {
+    gac(backend, scene, c, &probe.first, n, pref)
+}
+
+/// D2 (ch. 2.5.2): the weak GAC of dD1, the union of the second component's cones at up
+/// to `samples` points c + d·u, u spread evenly over D1's cells (a lower bound).
+pub fn d2(
+    backend: &dyn Backend,
+    scene: &Scene,
+    c: &P3,
+    probe: &ProbeShape,
+    d1: &CubeMap,
+    samples: usize,
+) -> CubeMap {
+    let mut out = d1.empty_like();
+    let cells: Vec<Cell> = d1.cells().collect();
+    if cells.is_empty() || samples == 0 {
+        return out;
+    }
+    let step = cells.len().div_ceil(samples).max(1);
+    let prefs: Vec<V3> = (0..d1.preferred_len()).map(|k| d1.preferred(k)).collect();
+    for cell in cells.iter().skip(step / 2).step_by(step) {
+        let x = c + d1.direction(*cell) * probe.reach();
+        out.or_assign(&gac(backend, scene, &x, &probe.second, d1.n(), &prefs));
+    }
+    out
+}
+
+/// D1′ (ch. 2.5.3): the directions of D1 whose articulation point c + d·u lets the second
+/// component, pointing along `v2`, clear the scene — read off an orthographic depth map
+/// along `v2`, as the seed does.
+pub fn d1_prime(scene: &Scene, c: &P3, probe: &ProbeShape, d1: &CubeMap, v2: &V3) -> CubeMap {
+    let radius = probe.second.iter().map(|s| s.radius).fold(0.0, f64::max);
+    let depth = heightmap::HeightMap::new(scene, c, probe.reach() + radius, v2, radius);
+    let mut out = d1.empty_like();
+    for cell in d1.cells() {
+        let x = c + d1.direction(cell) * probe.reach();
+        if depth.clear(&x) {
+            out.set(cell, true);
+        }
+    }
+    out
+}
+
+/// A feature's cone: the intersection of its points' cones (ch. 2.3).
+pub fn feature_cone<'a>(cones: impl IntoIterator<Item = &'a CubeMap>) -> Option<CubeMap> {
+    let mut it = cones.into_iter();
+    let mut acc = it.next()?.clone();
+    for c in it {
+        acc.and_assign(c);
+    }
+    Some(acc)
+}
+
+/// [`point_cones`] for many fpoints, in parallel; the result is in the fpoints' order and
+/// the same for any number of threads.
+pub fn cones(
+    backend: &dyn Backend,
+    scene: &Scene,
+    fpoints: &[Fpoint],
+    probe: &ProbeShape,
+    opts: &ConeOptions,
+) -> Vec<PointCones> {
+    fpoints
+        .par_iter()
+        .map(|f| point_cones(backend, scene, f, probe, opts))
+        .collect()
+}
+
+/// A unit vector perpendicular to `d`.
+pub(crate) fn perpendicular(d: &V3) -> V3 {
+    let d = d.normalize();
+    let helper = if d.x.abs() < 0.9 { V3::x() } else { V3::y() };
+    d.cross(&helper).normalize()
 }
 
 /// The probe direction of an indexable head at angles A (tilt from vertical) and B
@@ -89,7 +330,7 @@ mod tests {
             P3::new(1.0, -1.0, 1.0),
             P3::new(0.0, 1.0, 1.0),
         ]];
-        let gac = gac_halfline(&P3::origin(), &tri, 32, &[V3::z()]);
+        let gac = gac_halfline(&Scene::of_triangles(&tri), &P3::origin(), 32, &[V3::z()]);
         assert!(!gac.contains(&V3::z()));
         assert!(!gac.contains(&V3::new(0.0, -0.9, 1.0)));
         assert!(gac.contains(&V3::new(0.0, 0.0, -1.0)));

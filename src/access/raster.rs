@@ -1,135 +1,227 @@
-//! The CPU backend: projects obstacle triangles onto the cube around a point and marks,
-//! conservatively, every pixel their shadow touches.
+//! The CPU rasterizer: projects obstacle polygons onto the cube around a point and marks
+//! the pixels of their shadows.
 //!
-//! Central projection maps a triangle's straight edges to straight lines on each cube
-//! face, so its shadow on a face is a convex polygon: the triangle clipped by the face's
-//! pyramid (|u| ≤ w, |v| ≤ w), divided by w. Each pixel row takes the polygon clipped to
-//! the row's strip and marks from its least to its greatest u: every pixel the shadow
-//! touches, so a blocked direction is never reported free.
+//! Central projection maps a polygon's straight edges to straight lines on each cube
+//! face, so a convex polygon's shadow on a face is a convex polygon: the polygon clipped
+//! by the face's pyramid (|u| ≤ w, |v| ≤ w), divided by w. A polygon whose corners all
+//! lie inside one face's pyramid needs no clipping (the pyramid is convex); that is the
+//! common case and the fast path.
+//!
+//! Two coverage rules ([`Coverage`]): `Centres` marks a pixel when its centre direction is
+//! in the shadow (within a hair, so rays through shared edges and corners are caught by
+//! both neighbours) — the cone then samples the exact GAC at pixel centres. `Cells` marks
+//! every pixel whose cell the shadow touches, so a blocked direction anywhere in a pixel
+//! blocks the pixel; the pessimistic abstractions grow from it.
 
-use super::cubemap::{Cell, CubeMap, Pixel};
-use crate::geometry::{P3, V3};
+use super::cubemap::CubeMap;
+use crate::geometry::V3;
 
-/// Marks in `out` every direction d for which the ray `p + t·d`, t > 0, may meet the
-/// triangle `tri`.
-pub fn shadow_triangle(out: &mut CubeMap, p: &P3, tri: &[P3; 3]) {
-    let q = tri.map(|v| v - p);
-    for face in 0..6u8 {
-        let a = (face / 2) as usize;
-        let s = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
-        let (ua, va) = ((a + 1) % 3, (a + 2) % 3);
-        // (u, v, w) per vertex in the face's frame.
-        let pts: Vec<[f64; 3]> = q.iter().map(|x| [x[ua], x[va], s * x[a]]).collect();
-        // Quick reject: all vertices outside one side of the pyramid.
-        let planes: [fn(&[f64; 3]) -> f64; 4] = [
-            |x| x[2] - x[0],
-            |x| x[2] + x[0],
-            |x| x[2] - x[1],
-            |x| x[2] + x[1],
-        ];
-        if planes.iter().any(|f| pts.iter().all(|x| f(x) < 0.0)) {
-            continue;
+/// Which pixels a shadow marks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Coverage {
+    /// Pixels whose centre direction is in the shadow.
+    Centres,
+    /// Pixels whose cell the shadow touches.
+    Cells,
+}
+
+/// Slack in cube-face coordinates: a pixel centre this close to a shadow counts as in it.
+const HAIR: f64 = 1e-9;
+
+/// A small convex polygon in a cube face's frame (u, v, w).
+#[derive(Clone, Copy)]
+struct Poly {
+    pts: [[f64; 3]; 16],
+    len: usize,
+}
+
+impl Poly {
+    fn new() -> Poly {
+        Poly {
+            pts: [[0.0; 3]; 16],
+            len: 0,
         }
-        let mut poly = pts;
-        for f in planes {
-            poly = clip(&poly, f);
-            if poly.is_empty() {
+    }
+
+    fn push(&mut self, p: [f64; 3]) {
+        if self.len < self.pts.len() {
+            self.pts[self.len] = p;
+            self.len += 1;
+        }
+    }
+
+    /// Sutherland–Hodgman: the part where `f ≥ 0`.
+    fn clip(&self, f: impl Fn(&[f64; 3]) -> f64) -> Poly {
+        let mut out = Poly::new();
+        for k in 0..self.len {
+            let (a, b) = (&self.pts[k], &self.pts[(k + 1) % self.len]);
+            let (fa, fb) = (f(a), f(b));
+            if fa >= 0.0 {
+                out.push(*a);
+            }
+            if (fa >= 0.0) != (fb >= 0.0) {
+                let t = fa / (fa - fb);
+                out.push([
+                    a[0] + t * (b[0] - a[0]),
+                    a[1] + t * (b[1] - a[1]),
+                    a[2] + t * (b[2] - a[2]),
+                ]);
+            }
+        }
+        out
+    }
+}
+
+/// The cube face a direction falls in (ties to the lower axis).
+fn face_of(x: &V3) -> u8 {
+    let (ax, ay, az) = (x.x.abs(), x.y.abs(), x.z.abs());
+    let a = if ax >= ay && ax >= az {
+        0
+    } else if ay >= az {
+        1
+    } else {
+        2
+    };
+    (2 * a + usize::from(x[a] < 0.0)) as u8
+}
+
+/// (u, v, w) of a direction in a face's frame.
+#[inline]
+fn in_frame(face: u8, x: &V3) -> [f64; 3] {
+    let a = (face / 2) as usize;
+    let s = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
+    [x[(a + 1) % 3], x[(a + 2) % 3], s * x[a]]
+}
+
+/// Marks in `out` the shadow, seen from the origin, of the convex planar polygon with
+/// corners `q` (relative to the viewpoint, at most 12).
+pub fn shadow_polygon(out: &mut CubeMap, q: &[V3], cov: Coverage) {
+    debug_assert!(q.len() >= 3 && q.len() <= 12);
+    // Fast path: every corner strictly inside one face's pyramid.
+    let f0 = face_of(&q[0]);
+    if q[1..].iter().all(|x| face_of(x) == f0) {
+        let mut flat = [(0.0, 0.0); 12];
+        let mut ok = true;
+        for (k, x) in q.iter().enumerate() {
+            let [u, v, w] = in_frame(f0, x);
+            if w <= 0.0 {
+                ok = false;
                 break;
             }
+            flat[k] = (u / w, v / w);
         }
-        if poly.is_empty() {
+        if ok {
+            raster_convex(out, f0, &flat[..q.len()], cov);
+            return;
+        }
+    }
+    let scale = q.iter().map(|x| x.norm()).fold(0.0, f64::max);
+    for face in 0..6u8 {
+        let mut poly = Poly::new();
+        for x in q {
+            poly.push(in_frame(face, x));
+        }
+        let pts = &poly.pts[..poly.len];
+        // Quick reject: every corner outside one side of the pyramid.
+        if pts.iter().all(|x| x[2] < x[0])
+            || pts.iter().all(|x| x[2] < -x[0])
+            || pts.iter().all(|x| x[2] < x[1])
+            || pts.iter().all(|x| x[2] < -x[1])
+        {
             continue;
         }
-        let scale = q.iter().map(|x| x.norm()).fold(0.0, f64::max);
-        if poly.iter().any(|x| x[2] <= 1e-12 * scale.max(1e-300)) {
-            // The triangle passes through the point: block the whole face.
-            mark_rect(out, face, 0, out.n() - 1, 0, out.n() - 1);
+        let poly = poly
+            .clip(|x| x[2] - x[0])
+            .clip(|x| x[2] + x[0])
+            .clip(|x| x[2] - x[1])
+            .clip(|x| x[2] + x[1]);
+        if poly.len == 0 {
             continue;
         }
-        let flat: Vec<(f64, f64)> = poly.iter().map(|x| (x[0] / x[2], x[1] / x[2])).collect();
-        raster_convex(out, face, &flat);
-    }
-}
-
-/// Sutherland–Hodgman: the part of a convex polygon where `f ≥ 0`.
-fn clip(poly: &[[f64; 3]], f: fn(&[f64; 3]) -> f64) -> Vec<[f64; 3]> {
-    let mut out = Vec::with_capacity(poly.len() + 1);
-    for k in 0..poly.len() {
-        let (a, b) = (&poly[k], &poly[(k + 1) % poly.len()]);
-        let (fa, fb) = (f(a), f(b));
-        if fa >= 0.0 {
-            out.push(*a);
-        }
-        if (fa >= 0.0) != (fb >= 0.0) {
-            let t = fa / (fa - fb);
-            out.push([
-                a[0] + t * (b[0] - a[0]),
-                a[1] + t * (b[1] - a[1]),
-                a[2] + t * (b[2] - a[2]),
-            ]);
-        }
-    }
-    out
-}
-
-fn mark_rect(out: &mut CubeMap, face: u8, i0: u32, i1: u32, j0: u32, j1: u32) {
-    for j in j0..=j1 {
-        for i in i0..=i1 {
-            out.set(Cell::Pixel(Pixel { face, i, j }), true);
-        }
-    }
-}
-
-/// Marks every pixel of a cube face that a convex polygon in (u, v) ∈ [−1, 1]² touches.
-fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)]) {
-    let n = out.n();
-    let h = 2.0 / n as f64;
-    let cell = |x: f64| (((x + 1.0) / h).floor() as i64).clamp(0, n as i64 - 1) as u32;
-    let (vmin, vmax) = poly
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(p.1), hi.max(p.1))
-        });
-    let (j0, j1) = (cell(vmin), cell(vmax));
-    for j in j0..=j1 {
-        let (lo, hi) = (-1.0 + j as f64 * h, -1.0 + (j + 1) as f64 * h);
-        // The polygon's u extent over the strip lo ≤ v ≤ hi: at vertices inside the strip
-        // and where edges cross its borders.
-        let (mut umin, mut umax) = (f64::INFINITY, f64::NEG_INFINITY);
-        for k in 0..poly.len() {
-            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
-            if a.1 >= lo && a.1 <= hi {
-                umin = umin.min(a.0);
-                umax = umax.max(a.0);
+        let pts = &poly.pts[..poly.len];
+        if pts.iter().any(|x| x[2] <= 1e-12 * scale.max(1e-300)) {
+            // The polygon passes through the viewpoint: it blocks the whole face.
+            for j in 0..out.n() {
+                out.set_span(face, j, 0, out.n() - 1);
             }
-            for border in [lo, hi] {
-                if (a.1 - border) * (b.1 - border) < 0.0 {
-                    let t = (border - a.1) / (b.1 - a.1);
-                    let u = a.0 + t * (b.0 - a.0);
-                    umin = umin.min(u);
-                    umax = umax.max(u);
+            continue;
+        }
+        let mut flat = [(0.0, 0.0); 16];
+        for (k, x) in pts.iter().enumerate() {
+            flat[k] = (x[0] / x[2], x[1] / x[2]);
+        }
+        raster_convex(out, face, &flat[..poly.len], cov);
+    }
+}
+
+/// Marks the pixels of a cube face that a convex polygon in (u, v) ∈ [−1, 1]² covers.
+fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage) {
+    let n = out.n() as i64;
+    let h = 2.0 / n as f64;
+    let (mut vmin, mut vmax) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in poly {
+        vmin = vmin.min(p.1);
+        vmax = vmax.max(p.1);
+    }
+    let clampi = |k: i64| k.clamp(0, n - 1);
+    match cov {
+        Coverage::Cells => {
+            let cell = |x: f64| clampi(((x + 1.0) / h).floor() as i64);
+            for j in cell(vmin)..=cell(vmax) {
+                let (lo, hi) = (-1.0 + j as f64 * h, -1.0 + (j + 1) as f64 * h);
+                // The polygon's u extent over the strip lo ≤ v ≤ hi: at corners inside the
+                // strip and where edges cross its borders.
+                let (mut umin, mut umax) = (f64::INFINITY, f64::NEG_INFINITY);
+                for k in 0..poly.len() {
+                    let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+                    if a.1 >= lo && a.1 <= hi {
+                        umin = umin.min(a.0);
+                        umax = umax.max(a.0);
+                    }
+                    for border in [lo, hi] {
+                        if (a.1 - border) * (b.1 - border) < 0.0 {
+                            let t = (border - a.1) / (b.1 - a.1);
+                            let u = a.0 + t * (b.0 - a.0);
+                            umin = umin.min(u);
+                            umax = umax.max(u);
+                        }
+                    }
+                }
+                if umin <= umax {
+                    out.set_span(face, j as u32, cell(umin) as u32, cell(umax) as u32);
                 }
             }
         }
-        if umin <= umax {
-            mark_rect(out, face, cell(umin), cell(umax), j, j);
+        Coverage::Centres => {
+            // Rows whose centre line is within a hair of the polygon.
+            let j0 = ((vmin - HAIR + 1.0) / h - 0.5).ceil() as i64;
+            let j1 = ((vmax + HAIR + 1.0) / h - 0.5).floor() as i64;
+            for j in j0.max(0)..=j1.min(n - 1) {
+                let v = (-1.0 + (j as f64 + 0.5) * h).clamp(vmin, vmax);
+                let (mut umin, mut umax) = (f64::INFINITY, f64::NEG_INFINITY);
+                for k in 0..poly.len() {
+                    let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+                    if (a.1 <= v && v <= b.1) || (b.1 <= v && v <= a.1) {
+                        let u = if a.1 == b.1 {
+                            umin = umin.min(a.0.min(b.0));
+                            umax = umax.max(a.0.max(b.0));
+                            continue;
+                        } else {
+                            a.0 + (v - a.1) / (b.1 - a.1) * (b.0 - a.0)
+                        };
+                        umin = umin.min(u);
+                        umax = umax.max(u);
+                    }
+                }
+                if umin > umax {
+                    continue;
+                }
+                let i0 = ((umin - HAIR + 1.0) / h - 0.5).ceil() as i64;
+                let i1 = ((umax + HAIR + 1.0) / h - 0.5).floor() as i64;
+                if i0 <= i1 && i1 >= 0 && i0 < n {
+                    out.set_span(face, j as u32, clampi(i0) as u32, clampi(i1) as u32);
+                }
+            }
         }
     }
-}
-
-/// The directions blocked for a half-line from `p` by any of the triangles.
-pub fn blocked_halfline(p: &P3, triangles: &[[P3; 3]], n: u32, preferred: &[V3]) -> CubeMap {
-    let mut out = CubeMap::empty(n, preferred);
-    for t in triangles {
-        shadow_triangle(&mut out, p, t);
-    }
-    // Preferred directions are tested exactly.
-    for k in 0..out.preferred_len() {
-        let d = out.preferred(k);
-        let hit = triangles.iter().any(|t| {
-            crate::geometry::line_triangle(p, &d, &t[0], &t[1], &t[2]).is_some_and(|s| s > 0.0)
-        });
-        out.set(Cell::Preferred(k), hit);
-    }
-    out
 }

@@ -24,7 +24,7 @@ mod select;
 
 pub use errors::GeometryError;
 pub use mesh_io::{read_mesh, RawMesh};
-pub use query::{line_triangle, segment_distance, FaceIndex};
+pub use query::{edge_triangles, line_triangle, segment_distance, FaceIndex};
 pub use report::{describe, faces_json, faces_table};
 pub use select::resolve_faces;
 

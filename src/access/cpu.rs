@@ -1,0 +1,238 @@
+//! The CPU backend: the blocked directions of one probe component, by projecting the
+//! obstacle onto the cube in software.
+//!
+//! Per triangle, cheapest test first:
+//! - **distance**: a triangle entirely nearer than the component's nearest point or
+//!   farther than its farthest cannot touch it (bounding spheres, then the exact distance);
+//! - **facing**: for a component that starts at the viewpoint, a triangle of a closed
+//!   solid facing away from it is skipped — a half-line entering the solid, or a grown one
+//!   first touching it, does so through a triangle that faces the viewpoint (proof in
+//!   ARCHITECTURE.md);
+//! - **shadow**: a bare half-line marks the triangle's shadow at pixel centres; a
+//!   component of radius ρ marks every pixel its shadow touches and dilates it by
+//!   asin(ρ / distance), rounded up to whole pixels, in bands so each band grows once;
+//!   near triangles, whose dilation would be many pixels, are grown in space instead: the
+//!   shadow of a prism that holds the triangle swept by a ball of radius ρ.
+
+use super::cubemap::CubeMap;
+use super::probe::Component;
+use super::raster::{shadow_polygon, Coverage};
+use super::scene::{point_triangle_distance, Scene, Tri};
+use crate::geometry::{P3, V3};
+
+/// Past this many pixels of dilation a triangle is grown in space, as a prism.
+const PRISM_PIXELS: u32 = 3;
+
+/// How many times a triangle straddling a component's nearest distance is split.
+const MAX_SPLIT: u32 = 4;
+
+/// The least angle (rad) between directions in pixels k + 1 apart, over k: one pixel
+/// step along a cube face is at least 0.408 · 2/N rad (at the cube's corners).
+const MIN_STEP: f64 = 0.408 * 2.0;
+
+/// How many whole-pixel growths cover a dilation by `alpha` rad at resolution `n`.
+pub fn pixels_for(alpha: f64, n: u32) -> u32 {
+    (alpha * n as f64 / MIN_STEP * 1.02).ceil().max(1.0) as u32
+}
+
+/// Marks the directions in which `comp`, placed with its axis from `from`, meets the
+/// scene.
+pub fn blocked(scene: &Scene, from: &P3, comp: &Component, n: u32, preferred: &[V3]) -> CubeMap {
+    let mut base = CubeMap::empty(n, preferred);
+    let r = comp.radius;
+    let (near, far) = (comp.near(), comp.far());
+    let from_tip = comp.a == 0.0;
+    let mut bands: Vec<Option<CubeMap>> = Vec::new();
+    let mut candidates: Vec<&Tri> = Vec::new();
+    let mut q = [V3::zeros(); 12];
+    for t in &scene.tris {
+        let dc = (t.centre - from).norm();
+        if dc - t.radius > far || dc + t.radius < near {
+            continue;
+        }
+        let h = t.normal.dot(&(from - t.v[0]));
+        if from_tip && t.closed && h < 0.0 {
+            continue;
+        }
+        let exact = || point_triangle_distance(from, &t.v);
+        if r == 0.0 {
+            // Bare (possibly truncated) half-line: the shadow, sampled at pixel centres.
+            if dc - t.radius < near || dc + t.radius > far {
+                let d = exact();
+                if d > far {
+                    continue;
+                }
+            }
+            for (k, v) in t.v.iter().enumerate() {
+                q[k] = v - from;
+            }
+            shadow_polygon(&mut base, &q[..3], Coverage::Centres);
+            candidates.push(t);
+            continue;
+        }
+        let lower = dc - t.radius;
+        let dmin = if lower > 20.0 * r { lower } else { exact() };
+        if dmin > far {
+            continue;
+        }
+        if from_tip && dmin.max(near) > r {
+            let k = pixels_for((r / dmin.max(near)).asin(), n);
+            if k > PRISM_PIXELS && t.normal != V3::zeros() && prism_shadow(&mut base, from, t, r, h)
+            {
+                continue;
+            }
+        }
+        if !grown_shadow(&mut base, &mut bands, from, comp, t.v, dmin, 0) {
+            base.fill_pixels();
+            base.fill_preferred();
+            return base;
+        }
+    }
+    // ∪ₖ growₖ(bandₖ), growing each accumulated band once per step (Horner's scheme).
+    let mut acc: Option<CubeMap> = None;
+    for band in bands.into_iter().rev() {
+        let mut m = match acc.take() {
+            Some(a) => a.grow(),
+            None => CubeMap::empty(n, preferred),
+        };
+        if let Some(b) = band {
+            m.or_assign(&b);
+        }
+        acc = Some(m);
+    }
+    if let Some(a) = acc {
+        base.or_assign(&a.grow());
+    }
+    // Preferred directions.
+    for k in 0..base.preferred_len() {
+        let d = base.preferred(k);
+        let hit = if r == 0.0 {
+            candidates.iter().any(|t| {
+                crate::geometry::line_triangle(from, &d, &t.v[0], &t.v[1], &t.v[2])
+                    .is_some_and(|s| s > 0.0 && s >= near && s <= far)
+            })
+        } else {
+            // Blocked unless a pixel holding the direction is free: the pixel maps mark
+            // every pixel their blocked region touches.
+            base.pixels_holding(&d)
+                .iter()
+                .all(|p| base.get(super::Cell::Pixel(*p)))
+        };
+        base.set(super::Cell::Preferred(k), hit);
+    }
+    base
+}
+
+/// Marks the shadow of the triangle `v` (at distance `dmin`) dilated for a component of
+/// radius ρ, in the band of its dilation. A triangle that reaches inside the component's
+/// nearest distance is split, up to `MAX_SPLIT` times, and the pieces wholly inside are
+/// dropped. False when the component meets the triangle in every direction.
+fn grown_shadow(
+    base: &mut CubeMap,
+    bands: &mut Vec<Option<CubeMap>>,
+    from: &P3,
+    comp: &Component,
+    v: [P3; 3],
+    dmin: f64,
+    depth: u32,
+) -> bool {
+    let (r, near, n) = (comp.radius, comp.near(), base.n());
+    let reach = v.iter().map(|p| (p - from).norm()).fold(0.0, f64::max);
+    if reach < near {
+        return true;
+    }
+    if dmin < near && depth < MAX_SPLIT {
+        let m = [0, 1, 2].map(|k| P3::from((v[k].coords + v[(k + 1) % 3].coords) / 2.0));
+        let parts = [
+            [v[0], m[0], m[2]],
+            [m[0], v[1], m[1]],
+            [m[2], m[1], v[2]],
+            [m[0], m[1], m[2]],
+        ];
+        return parts.into_iter().all(|part| {
+            let d = point_triangle_distance(from, &part);
+            d > comp.far() || grown_shadow(base, bands, from, comp, part, d, depth + 1)
+        });
+    }
+    let Some(alpha) = dilation(r, near, dmin, reach) else {
+        return false;
+    };
+    let k = pixels_for(alpha, n);
+    if k as usize > 2 * n as usize {
+        return false;
+    }
+    let q = v.map(|p| p - from);
+    if bands.len() < k as usize {
+        bands.resize(k as usize, None);
+    }
+    let band = bands[k as usize - 1].get_or_insert_with(|| base.empty_like());
+    shadow_polygon(band, &q, Coverage::Cells);
+    true
+}
+
+/// The largest angle between the axis of a component of radius `r` whose points all lie
+/// at least `near` along its axis and a direction to an obstacle point it touches, for
+/// obstacle points between `dmin` and `dmax` away; None when it touches whatever its
+/// direction. A point at distance D and angle θ is inside only if D·sin θ ≤ r and
+/// D·cos θ ≥ near: θ ≤ min(asin(r/D), acos(near/D)), which peaks at atan(r/near).
+fn dilation(r: f64, near: f64, dmin: f64, dmax: f64) -> Option<f64> {
+    if near <= 0.0 {
+        return (dmin > r).then(|| (r / dmin).asin());
+    }
+    let turn = near.hypot(r);
+    Some(if dmax <= turn {
+        (near / dmax).min(1.0).acos()
+    } else if dmin >= turn {
+        (r / dmin).asin()
+    } else {
+        (r / near).atan()
+    })
+}
+
+/// Marks the shadow of a prism that holds the triangle swept by a ball of radius `r`:
+/// its cross-section is the triangle offset by `r` in its plane with bevelled corners
+/// (six sides), and it reaches `r` to either side of the plane. Only the faces that face
+/// the viewpoint are drawn; they hide the rest. False, drawing nothing, when the
+/// viewpoint is inside the prism.
+fn prism_shadow(out: &mut CubeMap, from: &P3, t: &Tri, r: f64, h: f64) -> bool {
+    let nn = t.normal;
+    let mut hex = [V3::zeros(); 6];
+    for i in 0..3 {
+        let (prev, v, next) = (t.v[(i + 2) % 3], t.v[i], t.v[(i + 1) % 3]);
+        let t_in = (v - prev).normalize();
+        let t_out = (next - v).normalize();
+        let m_in = t_in.cross(&nn);
+        let m_out = t_out.cross(&nn);
+        let b = (m_in + m_out).normalize();
+        let lam_in = r * (1.0 - b.dot(&m_in)) / b.dot(&t_in);
+        let lam_out = r * (1.0 - b.dot(&m_out)) / b.dot(&-t_out);
+        hex[2 * i] = (v - from) + m_in * r + t_in * lam_in;
+        hex[2 * i + 1] = (v - from) + m_out * r - t_out * lam_out;
+    }
+    if hex.iter().any(|p| !p.iter().all(|x| x.is_finite())) {
+        return false;
+    }
+    // The viewpoint is the origin here: a side faces it when m·(0 − p) > 0.
+    let facing: Vec<bool> = (0..6)
+        .map(|k| {
+            let side = hex[(k + 1) % 6] - hex[k];
+            side.norm_squared() > 1e-24 && side.cross(&nn).dot(&-hex[k]) > 0.0
+        })
+        .collect();
+    let above = h.abs() > r;
+    if !above && !facing.iter().any(|&f| f) {
+        return false;
+    }
+    let up = nn * (r * if h >= 0.0 { 1.0 } else { -1.0 });
+    if above {
+        let near: Vec<V3> = hex.iter().map(|p| p + up).collect();
+        shadow_polygon(out, &near, Coverage::Cells);
+    }
+    for k in 0..6 {
+        if facing[k] {
+            let (p, q) = (hex[k], hex[(k + 1) % 6]);
+            shadow_polygon(out, &[p + up, q + up, q - up, p - up], Coverage::Cells);
+        }
+    }
+    true
+}

@@ -1,0 +1,159 @@
+//! An orthographic depth map along a direction (seed ch. 2.5.3, after Spyridi): per
+//! texel of a plane perpendicular to `v`, the highest the obstacle reaches along `v`,
+//! dilated by a radius. A cylinder of that radius standing on a point x and reaching to
+//! infinity along `v` clears the obstacle iff the dilated height under x is below x.
+
+use super::scene::Scene;
+use crate::geometry::{P3, V3};
+
+/// Texels per side.
+const M: usize = 96;
+
+pub(crate) struct HeightMap {
+    origin: P3,
+    e1: V3,
+    e2: V3,
+    v: V3,
+    half: f64,
+    texel: f64,
+    /// Dilated heights, row-major; −∞ where nothing is.
+    h: Vec<f64>,
+}
+
+impl HeightMap {
+    /// The map around `centre`, covering `half` mm to each side, along `v`, dilated by
+    /// `radius`.
+    pub(crate) fn new(scene: &Scene, centre: &P3, half: f64, v: &V3, radius: f64) -> HeightMap {
+        let v = v.normalize();
+        let e1 = super::perpendicular(&v);
+        let e2 = v.cross(&e1);
+        let texel = 2.0 * half / M as f64;
+        let mut raw = vec![f64::NEG_INFINITY; M * M];
+        let to_uv = |p: &P3| {
+            let d = p - centre;
+            (
+                (d.dot(&e1) + half) / texel,
+                (d.dot(&e2) + half) / texel,
+                d.dot(&v),
+            )
+        };
+        for t in &scene.tris {
+            let q = t.v.map(|p| to_uv(&p));
+            let (umin, umax) = (
+                q[0].0.min(q[1].0).min(q[2].0),
+                q[0].0.max(q[1].0).max(q[2].0),
+            );
+            let (vmin, vmax) = (
+                q[0].1.min(q[1].1).min(q[2].1),
+                q[0].1.max(q[1].1).max(q[2].1),
+            );
+            if umax < 0.0 || vmax < 0.0 || umin > M as f64 || vmin > M as f64 {
+                continue;
+            }
+            let hmax = q[0].2.max(q[1].2).max(q[2].2);
+            let hmin = q[0].2.min(q[1].2).min(q[2].2);
+            // Height over the plane as a function of (u, v), when the triangle is not
+            // seen edge-on; otherwise its highest corner.
+            let (a, b) = (
+                (q[1].0 - q[0].0, q[1].1 - q[0].1),
+                (q[2].0 - q[0].0, q[2].1 - q[0].1),
+            );
+            let det = a.0 * b.1 - a.1 * b.0;
+            let plane = (det.abs() > 1e-9).then(|| {
+                let (dh1, dh2) = (q[1].2 - q[0].2, q[2].2 - q[0].2);
+                let gu = (dh1 * b.1 - dh2 * a.1) / det;
+                let gv = (dh2 * a.0 - dh1 * b.0) / det;
+                (gu, gv)
+            });
+            let clampi = |x: f64| (x.floor().max(0.0) as usize).min(M - 1);
+            for j in clampi(vmin)..=clampi(vmax) {
+                for i in clampi(umin)..=clampi(umax) {
+                    if !touches(&q, i as f64, j as f64) {
+                        continue;
+                    }
+                    let top = match plane {
+                        Some((gu, gv)) => {
+                            let at =
+                                |x: f64, y: f64| q[0].2 + gu * (x - q[0].0) + gv * (y - q[0].1);
+                            let corners = [
+                                at(i as f64, j as f64),
+                                at(i as f64 + 1.0, j as f64),
+                                at(i as f64, j as f64 + 1.0),
+                                at(i as f64 + 1.0, j as f64 + 1.0),
+                            ];
+                            corners
+                                .iter()
+                                .fold(f64::NEG_INFINITY, |m, &x| m.max(x))
+                                .clamp(hmin, hmax)
+                        }
+                        None => hmax,
+                    };
+                    let cell = &mut raw[j * M + i];
+                    *cell = cell.max(top);
+                }
+            }
+        }
+        // Dilate by the radius plus a texel diagonal, over a disc of texels.
+        let k = ((radius / texel) + std::f64::consts::SQRT_2).ceil() as i64;
+        let mut h = vec![f64::NEG_INFINITY; M * M];
+        for j in 0..M as i64 {
+            for dj in -k..=k {
+                let jj = j + dj;
+                if jj < 0 || jj >= M as i64 {
+                    continue;
+                }
+                let w = ((k * k - dj * dj) as f64).sqrt().floor() as i64;
+                for i in 0..M as i64 {
+                    let (lo, hi) = ((i - w).max(0), (i + w).min(M as i64 - 1));
+                    let row = &raw[jj as usize * M..jj as usize * M + M];
+                    let m = row[lo as usize..=hi as usize]
+                        .iter()
+                        .fold(f64::NEG_INFINITY, |m, &x| m.max(x));
+                    let cell = &mut h[j as usize * M + i as usize];
+                    *cell = cell.max(m);
+                }
+            }
+        }
+        HeightMap {
+            origin: *centre,
+            e1,
+            e2,
+            v,
+            half,
+            texel,
+            h,
+        }
+    }
+
+    /// Whether the dilated obstacle stays below `x` along the map's direction.
+    pub(crate) fn clear(&self, x: &P3) -> bool {
+        let d = x - self.origin;
+        let (u, w) = (
+            (d.dot(&self.e1) + self.half) / self.texel,
+            (d.dot(&self.e2) + self.half) / self.texel,
+        );
+        if u < 0.0 || w < 0.0 || u >= M as f64 || w >= M as f64 {
+            return false;
+        }
+        self.h[w as usize * M + u as usize] < d.dot(&self.v)
+    }
+}
+
+/// Whether the triangle's projection (texel units) touches texel (i, j): separating axes
+/// of the texel square and the triangle's edges.
+fn touches(q: &[(f64, f64, f64); 3], i: f64, j: f64) -> bool {
+    let corners = [(i, j), (i + 1.0, j), (i, j + 1.0), (i + 1.0, j + 1.0)];
+    for k in 0..3 {
+        let (a, b, c) = (q[k], q[(k + 1) % 3], q[(k + 2) % 3]);
+        let (ex, ey) = (b.0 - a.0, b.1 - a.1);
+        let side = |p: (f64, f64)| ex * (p.1 - a.1) - ey * (p.0 - a.0);
+        let s = side((c.0, c.1));
+        if s == 0.0 {
+            return true; // degenerate in projection: keep (conservative)
+        }
+        if corners.iter().all(|&p| side(p) * s < 0.0) {
+            return false;
+        }
+    }
+    true
+}

@@ -1,0 +1,278 @@
+//! `inspc cones`: the cones of one fpoint under one probe, as a summary and as an
+//! unfolded cube-map image.
+
+use super::errors::AccessError;
+use super::*;
+use crate::diag::Diagnostics;
+use crate::model::fmt_num;
+use std::fmt::Write;
+
+/// Which fpoint, which probe, what resolution.
+#[derive(Debug, Clone)]
+pub struct ConeRequest {
+    /// A face name (as `inspc faces` lists them); all fpoints when absent.
+    pub face: Option<String>,
+    /// Which of the selected fpoints, from 0.
+    pub point: usize,
+    /// A probe label of the plan's machine; its first probe when absent.
+    pub probe: Option<String>,
+    /// Cube-map resolution.
+    pub n: u32,
+}
+
+/// What `inspc cones` prints and draws.
+#[derive(Debug, Clone)]
+pub struct ConeReport {
+    /// The summary for people.
+    pub text: String,
+    /// The drawn cone (the probe's, or the half-line's without a machine) as a binary
+    /// PGM: an unfolded cube, a cross of 4 × 3 faces centred on +z.
+    pub pgm: Vec<u8>,
+}
+
+/// Computes the cones the request names on the first measurement graph, or files a
+/// diagnostic saying what does not exist.
+pub fn cone_report(
+    checked: &crate::Checked,
+    parts: &[Option<crate::PartData>],
+    graphs: &[crate::Graphed],
+    req: &ConeRequest,
+    diags: &mut Diagnostics,
+) -> Option<ConeReport> {
+    let model = &checked.model;
+    let gr = graphs.first()?;
+    let part = &model.parts[gr.part];
+    let g = &parts[gr.part].as_ref()?.geometry;
+    let file = part.span.file;
+    let chosen: Vec<&Fpoint> = match &req.face {
+        Some(name) => {
+            let Some(face) = g.faces.iter().position(|f| &f.name == name) else {
+                let mut known: Vec<&str> = g.faces.iter().map(|f| f.name.as_str()).collect();
+                known.truncate(12);
+                diags.push(
+                    file,
+                    AccessError::UnknownFace {
+                        span: part.span,
+                        face: name.clone(),
+                        part: part.name.clone(),
+                        known: known.join(", "),
+                    },
+                );
+                return None;
+            };
+            gr.graph
+                .fpoints
+                .iter()
+                .filter(|f| f.face.0 == face)
+                .collect()
+        }
+        None => gr.graph.fpoints.iter().collect(),
+    };
+    let Some(f) = chosen.get(req.point) else {
+        diags.push(
+            file,
+            AccessError::NoPoint {
+                span: part.span,
+                face: req.face.clone().unwrap_or_else(|| "the part".into()),
+                index: req.point,
+                count: chosen.len(),
+            },
+        );
+        return None;
+    };
+    let plan = gr
+        .graph
+        .plan
+        .as_ref()
+        .and_then(|name| model.plans.iter().find(|p| &p.name == name));
+    let probe = match plan {
+        Some(plan) => {
+            let cmm = &model.cmms[plan.cmm.0];
+            let shapes = ProbeShape::of_cmm(model, cmm);
+            let found = match &req.probe {
+                Some(label) => shapes.into_iter().find(|s| &s.name == label),
+                None => shapes.into_iter().next(),
+            };
+            if found.is_none() {
+                diags.push(
+                    plan.span.file,
+                    AccessError::UnknownProbe {
+                        span: cmm.span,
+                        probe: req.probe.clone().unwrap_or_default(),
+                        cmm: cmm.name.clone(),
+                        known: cmm
+                            .probes
+                            .iter()
+                            .map(|(l, _)| l.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                    },
+                );
+                return None;
+            }
+            found
+        }
+        None if req.probe.is_some() => {
+            diags.push(
+                file,
+                AccessError::NoMachine {
+                    span: part.span,
+                    part: part.name.clone(),
+                },
+            );
+            return None;
+        }
+        None => None,
+    };
+    let scene = Scene::of_part(g);
+    let n = req.n;
+    let prefs = axes();
+    let total = 6 * (n as usize) * (n as usize) + prefs.len();
+    let pct = |c: &CubeMap| format!("{:5.1} %", 100.0 * c.count() as f64 / total as f64);
+    let v = |x: &V3| format!("({}, {}, {})", fmt_num(x.x), fmt_num(x.y), fmt_num(x.z));
+    let p3 = |x: &P3| v(&x.coords);
+    let mut text = String::new();
+    let face = &g.faces[f.face.0];
+    let _ = writeln!(
+        text,
+        "fpoint {} of {} on face {} ({}): at {}, normal {}",
+        req.point,
+        chosen.len(),
+        face.name,
+        face.surface.kind().keyword(),
+        p3(&f.position),
+        v(&f.normal)
+    );
+    let _ = writeln!(
+        text,
+        "part {}: {} triangles, {}",
+        part.name,
+        scene.tris.len(),
+        if scene.closed {
+            "closed"
+        } else {
+            "open (no back-face culling)"
+        }
+    );
+    let _ = writeln!(
+        text,
+        "cube map N = {n}: {total} cells (pixels and 6 axes); free share:"
+    );
+    let r = probe.as_ref().map_or(1.0, |p| p.tip_radius);
+    let c = f.tip_centre(r);
+    let half = gac_halfline(&scene, &c, n, &prefs);
+    let _ = writeln!(text, "  half-line at the tip centre      {}", pct(&half));
+    let drawn = match &probe {
+        None => half,
+        Some(probe) => {
+            let head = if probe.bent {
+                "indexable head"
+            } else {
+                "fixed head"
+            };
+            let _ = writeln!(
+                text,
+                "probe {}: tip radius {} mm, reach {} mm, {head}",
+                probe.name,
+                fmt_num(probe.tip_radius),
+                fmt_num(probe.reach())
+            );
+            if !tip_fits(&scene, &c, probe.tip_radius) {
+                let _ = writeln!(
+                    text,
+                    "  the tip does not fit: the part is {} mm from its centre",
+                    fmt_num(scene.distance(&c))
+                );
+            }
+            let comps = if probe.bent {
+                probe.first.clone()
+            } else {
+                probe.straight()
+            };
+            for comp in &comps {
+                let cone = gac(&Cpu, &scene, &c, std::slice::from_ref(comp), n, &prefs);
+                let _ = writeln!(
+                    text,
+                    "  {:<32} {}",
+                    format!("{} (r {} mm)", comp.name, fmt_num(comp.radius)),
+                    pct(&cone)
+                );
+            }
+            let opts = ConeOptions {
+                n,
+                preferred: prefs.clone(),
+                ..ConeOptions::default()
+            };
+            let cones = point_cones(&Cpu, &scene, f, probe, &opts);
+            let what = if probe.bent {
+                "D1, approach and retract"
+            } else {
+                "probe, approach and retract"
+            };
+            let _ = writeln!(text, "  {what:<32} {}", pct(&cones.approach));
+            let axes_free: Vec<&str> = ["+x", "-x", "+y", "-y", "+z", "-z"]
+                .into_iter()
+                .enumerate()
+                .filter(|(k, _)| cones.approach.get(Cell::Preferred(*k)))
+                .map(|(_, s)| s)
+                .collect();
+            let _ = writeln!(
+                text,
+                "  axes in the cone: {}",
+                if axes_free.is_empty() {
+                    "none".to_string()
+                } else {
+                    axes_free.join(" ")
+                }
+            );
+            if let Some(d2) = &cones.d2 {
+                let _ = writeln!(text, "  D2 (setup directions)           {}", pct(d2));
+                let cmm = &model.cmms[plan.map(|p| p.cmm.0).unwrap_or(0)];
+                let grid = model.heads[cmm.head.0].orientations();
+                let inside = orientations_in(&cones.approach, &grid);
+                let _ = writeln!(
+                    text,
+                    "  head orientations in D1: {} of {}",
+                    inside.len(),
+                    grid.len()
+                );
+            }
+            cones.approach
+        }
+    };
+    Some(ConeReport {
+        text,
+        pgm: pgm(&drawn),
+    })
+}
+
+/// The cone as a binary PGM: free white, blocked black, the unused corners of the cross
+/// grey. Tiles (column, row): +y (1, 0); −x (0, 1), +z (1, 1), +x (2, 1), −z (3, 1);
+/// −y (1, 2). Seen from outside with +z up front, x to the right and y up the image.
+pub fn pgm(cone: &CubeMap) -> Vec<u8> {
+    let n = cone.n() as usize;
+    let (w, h) = (4 * n, 3 * n);
+    let mut out = format!("P5\n{w} {h}\n255\n").into_bytes();
+    for row in 0..h {
+        for col in 0..w {
+            let (tx, ty) = (col / n, row / n);
+            let s = 2.0 * ((col % n) as f64 + 0.5) / n as f64 - 1.0;
+            let t = 1.0 - 2.0 * ((row % n) as f64 + 0.5) / n as f64;
+            let d = match (tx, ty) {
+                (1, 1) => Some(V3::new(s, t, 1.0)),
+                (2, 1) => Some(V3::new(1.0, t, -s)),
+                (0, 1) => Some(V3::new(-1.0, t, s)),
+                (3, 1) => Some(V3::new(-s, t, -1.0)),
+                (1, 0) => Some(V3::new(s, 1.0, -t)),
+                (1, 2) => Some(V3::new(s, -1.0, t)),
+                _ => None,
+            };
+            out.push(match d {
+                Some(d) if cone.get(Cell::Pixel(cone.pixel_of(&d))) => 255,
+                Some(_) => 0,
+                None => 128,
+            });
+        }
+    }
+    out
+}

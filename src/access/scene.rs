@@ -1,0 +1,194 @@
+//! The obstacle a cone is computed against: the part's triangles (and the table, once a
+//! setup places one), with what culling needs, and a parry mesh for exact queries.
+
+use crate::geometry::{PartGeometry, P3, V3};
+use parry3d_f64::math::Isometry;
+use parry3d_f64::query::{PointQuery, Ray, RayCast};
+use parry3d_f64::shape::TriMesh;
+
+/// One obstacle triangle.
+#[derive(Debug, Clone)]
+pub struct Tri {
+    /// Corners, counter-clockwise seen from outside.
+    pub v: [P3; 3],
+    /// Outward unit normal; zero for a degenerate triangle.
+    pub normal: V3,
+    /// Centre and radius of a sphere around it.
+    pub centre: P3,
+    /// Radius of that sphere.
+    pub radius: f64,
+    /// Whether it bounds a closed solid, so that it can be culled when facing away.
+    pub closed: bool,
+}
+
+/// The obstacle.
+pub struct Scene {
+    /// Its triangles.
+    pub tris: Vec<Tri>,
+    /// Whether the part's mesh is closed (every edge shared by exactly two triangles).
+    pub closed: bool,
+    /// The diagonal of its bounds (mm).
+    pub size: f64,
+    mesh: Option<TriMesh>,
+}
+
+impl Scene {
+    /// The part as obstacle.
+    pub fn of_part(g: &PartGeometry) -> Scene {
+        let edges = crate::geometry::edge_triangles(&g.triangles);
+        let closed = edges.values().all(|users| users.len() == 2);
+        let tris = g
+            .triangles
+            .iter()
+            .map(|t| make_tri(t.map(|i| g.vertices[i as usize]), closed))
+            .collect();
+        Scene::new(tris, closed)
+    }
+
+    /// A scene of free triangles (nothing is culled), as for tests.
+    pub fn of_triangles(tris: &[[P3; 3]]) -> Scene {
+        Scene::new(tris.iter().map(|&t| make_tri(t, false)).collect(), false)
+    }
+
+    fn new(tris: Vec<Tri>, closed: bool) -> Scene {
+        let (mut lo, mut hi) = (P3::origin(), P3::origin());
+        for (k, t) in tris.iter().flat_map(|t| t.v.iter()).enumerate() {
+            if k == 0 {
+                (lo, hi) = (*t, *t);
+            }
+            lo = lo.inf(t);
+            hi = hi.sup(t);
+        }
+        let vertices: Vec<P3> = tris.iter().flat_map(|t| t.v).collect();
+        let indices: Vec<[u32; 3]> = (0..tris.len() as u32)
+            .map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
+            .collect();
+        let mesh = if tris.is_empty() {
+            None
+        } else {
+            TriMesh::new(vertices, indices).ok()
+        };
+        Scene {
+            tris,
+            closed,
+            size: (hi - lo).norm(),
+            mesh,
+        }
+    }
+
+    /// The scene with a table under the part: the plane through `point` with upward
+    /// normal `up`, a square reaching well past the part. Its triangles are never culled.
+    pub fn with_table(&self, point: &P3, up: &V3) -> Scene {
+        let up = up.normalize();
+        let e1 = super::perpendicular(&up);
+        let e2 = up.cross(&e1);
+        let s = 4.0 * self.size.max(1.0);
+        let c = |a: f64, b: f64| point + e1 * (a * s) + e2 * (b * s);
+        let (p00, p10, p11, p01) = (c(-1.0, -1.0), c(1.0, -1.0), c(1.0, 1.0), c(-1.0, 1.0));
+        let mut tris = self.tris.clone();
+        tris.push(make_tri([p00, p10, p11], false));
+        tris.push(make_tri([p00, p11, p01], false));
+        for t in &mut tris {
+            t.closed = t.closed && self.closed;
+        }
+        Scene::new(tris, self.closed)
+    }
+
+    /// The first hit of the ray `from + t·d` (t > 0, `d` unit), if within `max`.
+    pub fn cast_ray(&self, from: &P3, d: &V3, max: f64) -> Option<f64> {
+        let mesh = self.mesh.as_ref()?;
+        mesh.cast_ray(&Isometry::identity(), &Ray::new(*from, *d), max, false)
+    }
+
+    /// Distance from a point to the nearest triangle.
+    pub fn distance(&self, p: &P3) -> f64 {
+        match &self.mesh {
+            Some(m) => m.distance_to_point(&Isometry::identity(), p, false),
+            None => f64::INFINITY,
+        }
+    }
+
+    /// The parry mesh, for exact shape queries.
+    pub fn mesh(&self) -> Option<&TriMesh> {
+        self.mesh.as_ref()
+    }
+}
+
+fn make_tri(v: [P3; 3], closed: bool) -> Tri {
+    let n = (v[1] - v[0]).cross(&(v[2] - v[0]));
+    let len = n.norm();
+    let scale = (v[1] - v[0])
+        .norm_squared()
+        .max((v[2] - v[0]).norm_squared());
+    let normal = if len > 1e-12 * scale && len > 0.0 {
+        n / len
+    } else {
+        V3::zeros()
+    };
+    let centre = P3::from((v[0].coords + v[1].coords + v[2].coords) / 3.0);
+    let radius = v.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max);
+    Tri {
+        v,
+        normal,
+        centre,
+        radius,
+        closed,
+    }
+}
+
+/// Distance from `p` to the triangle (Ericson, Real-Time Collision Detection 5.1.5).
+pub fn point_triangle_distance(p: &P3, t: &[P3; 3]) -> f64 {
+    let [a, b, c] = t;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return ap.norm();
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return bp.norm();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (p - (a + ab * v)).norm();
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return cp.norm();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (p - (a + ac * w)).norm();
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (p - (b + (c - b) * w)).norm();
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    (p - (a + ab * v + ac * w)).norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn point_triangle_distances() {
+        let t = [
+            P3::new(0.0, 0.0, 0.0),
+            P3::new(2.0, 0.0, 0.0),
+            P3::new(0.0, 2.0, 0.0),
+        ];
+        let d = |x, y, z| point_triangle_distance(&P3::new(x, y, z), &t);
+        assert!((d(0.5, 0.5, 3.0) - 3.0).abs() < 1e-12);
+        assert!((d(-1.0, -1.0, 0.0) - 2f64.sqrt()).abs() < 1e-12);
+        assert!((d(1.0, -2.0, 0.0) - 2.0).abs() < 1e-12);
+        assert!((d(2.0, 2.0, 0.0) - 2f64.sqrt()).abs() < 1e-12);
+    }
+}
