@@ -3,7 +3,8 @@
 //! cylinder from the head up), by the CPU backend, each beside the plain baseline of one
 //! parry ray cast per pixel centre (parry's own BVH), in the same run, at N = 32 and 64,
 //! on swiss_block and the NIST CTC 01 mesh. Each iteration computes the cones of 16
-//! fpoints spread over the part; divide by 16 for one cone.
+//! fpoints spread over the part; divide by 16 for one cone. `grown_exact_boundary` adds
+//! the exact refinement of the grown cone's boundary.
 //!
 //! Run with `cargo bench --bench access`.
 
@@ -78,6 +79,23 @@ fn grown(bencher: divan::Bencher, case: (&str, u32)) {
 #[divan::bench(args = CASES)]
 fn ram(bencher: divan::Bencher, case: (&str, u32)) {
     run(bencher, case, "ram");
+}
+
+/// The grown half-line with its boundary refined by exact parry capsule tests (opt-in and
+/// slow: a few samples only).
+#[divan::bench(args = CASES, sample_count = 3, sample_size = 1)]
+fn grown_exact_boundary(bencher: divan::Bencher, (spec, n): (&str, u32)) {
+    let (scene, pts, probe) = scene(spec);
+    let comp = component("grown", &probe);
+    bencher.bench(|| {
+        pts.iter()
+            .map(|p| {
+                let mut b = Cpu.blocked(&scene, divan::black_box(p), &comp, n, &[]);
+                inspc::access::refine(&scene, p, &comp, &mut b);
+                b.count()
+            })
+            .sum::<usize>()
+    });
 }
 
 /// The baseline: one parry ray cast per pixel centre.

@@ -36,13 +36,21 @@ struct Case {
     probes: Vec<ProbeShape>,
 }
 
-/// The scene, `count` pseudo-random tip centres (r = 1 mm) and the plan's probes.
+/// The scene, `count` pseudo-random tip centres (for the first probe's tip, 1 mm
+/// without a plan) and the plan's probes.
 fn case(spec: &str, count: usize, seed: u64) -> Case {
     let (checked, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[PathBuf::from(spec)]);
     assert!(!checked.has_errors(), "{spec}");
     let gr = &graphs[0];
     let g = &parts[gr.part].as_ref().unwrap().geometry;
     let scene = Scene::of_part(g);
+    let model = &checked.model;
+    let probes = model
+        .plans
+        .first()
+        .map(|p| ProbeShape::of_cmm(model, &model.cmms[p.cmm.0]))
+        .unwrap_or_default();
+    let r = probes.first().map_or(1.0, |p| p.tip_radius);
     let fp = &gr.graph.fpoints;
     let mut state = seed;
     let points = (0..count)
@@ -50,15 +58,9 @@ fn case(spec: &str, count: usize, seed: u64) -> Case {
             state = state
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
-            fp[(state >> 33) as usize % fp.len()].tip_centre(1.0)
+            fp[(state >> 33) as usize % fp.len()].tip_centre(r)
         })
         .collect();
-    let model = &checked.model;
-    let probes = model
-        .plans
-        .first()
-        .map(|p| ProbeShape::of_cmm(model, &model.cmms[p.cmm.0]))
-        .unwrap_or_default();
     Case {
         scene,
         points,
@@ -103,7 +105,21 @@ fn exact_blocked(scene: &Scene, p: &P3, d: &V3, comp: &Component) -> bool {
 /// Compares one component's cone with the exact test at every pixel centre and preferred
 /// direction: (cells, agreeing cells); panics on a blocked direction reported free.
 fn compare(scene: &Scene, p: &P3, comp: &Component, n: u32, what: &str) -> (usize, usize) {
-    let blocked = Cpu.blocked(scene, p, comp, n, &inspc::access::axes());
+    compare_map(scene, p, comp, n, what, false)
+}
+
+fn compare_map(
+    scene: &Scene,
+    p: &P3,
+    comp: &Component,
+    n: u32,
+    what: &str,
+    refined: bool,
+) -> (usize, usize) {
+    let mut blocked = Cpu.blocked(scene, p, comp, n, &inspc::access::axes());
+    if refined {
+        inspc::access::refine(scene, p, comp, &mut blocked);
+    }
     let (mut total, mut agree) = (0, 0);
     for (cell, d) in every_direction(n) {
         let exact = exact_blocked(scene, p, &d, comp);
@@ -134,12 +150,17 @@ fn verify_halfline(spec: &str, count: usize, n: u32) {
     assert!(ratio >= 0.99, "{spec}: only {:.3} % agree", 100.0 * ratio);
 }
 
-/// The stylus and the ram of the plan's first probe, each on its own, and the bare
-/// half-line grown by 1 mm.
+/// Every component of the plan's first probe (as mounted: the whole chain for a fixed
+/// head, the first component for an indexable one), each on its own, and a bare
+/// half-line grown by 0.8 mm.
 fn verify_grown(spec: &str, count: usize, n: u32) {
     let c = case(spec, count, 29);
     let probe = &c.probes[0];
-    let mut comps = vec![probe.first[0].clone()];
+    let mut comps = if probe.bent {
+        probe.first.clone()
+    } else {
+        probe.straight()
+    };
     comps.push(Component {
         name: "grown half-line".into(),
         a: 0.0,
@@ -147,25 +168,30 @@ fn verify_grown(spec: &str, count: usize, n: u32) {
         radius: 0.8,
         end: End::Round,
     });
-    if !probe.bent {
-        comps.push(probe.second[1].clone());
-    }
+    let (mut all, mut all_agree) = (0, 0);
     for comp in &comps {
-        let (mut total, mut agree) = (0, 0);
+        let (mut total, mut agree, mut refined) = (0, 0, 0);
         for p in &c.points {
             let (t, a) = compare(&c.scene, p, comp, n, spec);
-            if std::env::var("INSPC_DEBUG").is_ok() {
-                eprintln!("  {p:?} dist {:.3}: {a}/{t}", c.scene.distance(p));
-            }
             total += t;
             agree += a;
+            refined += compare_map(&c.scene, p, comp, n, spec, true).1;
         }
         eprintln!(
-            "{spec}: {} {agree}/{total} cells agree ({:.2} %)",
+            "{spec}: {} {agree}/{total} cells agree ({:.2} %), refined {:.2} %",
             comp.name,
-            100.0 * agree as f64 / total as f64
+            100.0 * agree as f64 / total as f64,
+            100.0 * refined as f64 / total as f64
         );
+        all += total;
+        all_agree += refined;
     }
+    let ratio = all_agree as f64 / all as f64;
+    assert!(
+        ratio >= 0.99,
+        "{spec}: refined cones agree on {:.2} %",
+        100.0 * ratio
+    );
 }
 
 #[test]
@@ -235,4 +261,120 @@ fn cones_are_the_same_for_any_thread_count() {
         "an indexable head gives D2 cones"
     );
     assert!(one.iter().any(|c| !c.approach.is_empty()));
+}
+
+/// D1′ for the vertical: every direction it keeps lets a cylinder of the head's and ram's
+/// largest radius stand on the articulation point and clear the part (parry), and it
+/// keeps most of the directions that do.
+#[test]
+fn d1_prime_is_pessimistic() {
+    use inspc::access::{d1, d1_prime};
+    let c = case("examples/f3_indexed.insp", 4, 5);
+    let probe = &c.probes[0];
+    assert!(probe.bent);
+    let radius = probe.second.iter().map(|s| s.radius).fold(0.0, f64::max);
+    let up = V3::z();
+    let stand = Component {
+        name: "second".into(),
+        a: 0.0,
+        b: f64::INFINITY,
+        radius,
+        end: End::Flat,
+    };
+    let (mut kept, mut free) = (0, 0);
+    for p in &c.points {
+        let first = d1(&Cpu, &c.scene, p, probe, 32, &[]);
+        let prime = d1_prime(&c.scene, p, probe, &first, &up);
+        assert_eq!(prime.and(&first), prime, "D1′ ⊆ D1");
+        for cell in first.cells() {
+            let x = p + first.direction(cell) * probe.reach();
+            let clear = !exact_blocked(&c.scene, &x, &up, &stand);
+            assert!(
+                clear || !prime.get(cell),
+                "D1′ keeps {cell:?} at {p:?}, but the head hits"
+            );
+            free += usize::from(clear);
+            kept += usize::from(prime.get(cell));
+        }
+    }
+    eprintln!("D1′ keeps {kept} of {free} directions that clear");
+    assert!(kept > 0 && kept * 10 >= free * 7, "{kept} of {free}");
+}
+
+/// Approach cones hold at the retract point too; a feature's cone is the intersection of
+/// its points'; D2 is empty exactly when D1 is.
+#[test]
+fn approach_feature_and_d2_cones() {
+    use inspc::access::{feature_cone, gac, point_cones};
+    let (checked, parts, graphs) =
+        inspc::measurement_graphs(&FsWorld, &[PathBuf::from("examples/f3_fixed.insp")]);
+    let gr = &graphs[0];
+    let scene = Scene::of_part(&parts[gr.part].as_ref().unwrap().geometry);
+    let model = &checked.model;
+    let probe = ProbeShape::of_cmm(model, &model.cmms[model.plans[0].cmm.0]).remove(0);
+    assert!(!probe.bent);
+    let opts = ConeOptions {
+        n: 32,
+        ..ConeOptions::default()
+    };
+    let face = gr.graph.fpoints[0].face;
+    let pts: Vec<_> = gr.graph.fpoints.iter().filter(|f| f.face == face).collect();
+    let mut each = Vec::new();
+    for f in &pts {
+        let cones = point_cones(&Cpu, &scene, f, &probe, &opts);
+        assert!(cones.tip_fits && cones.d2.is_none());
+        let at_contact = gac(
+            &Cpu,
+            &scene,
+            &f.tip_centre(probe.tip_radius),
+            &probe.straight(),
+            32,
+            &opts.preferred,
+        );
+        assert_eq!(cones.approach.and(&at_contact), cones.approach);
+        each.push(cones.approach);
+    }
+    let feature = feature_cone(&each).unwrap();
+    for c in &each {
+        assert_eq!(feature.and(c), feature);
+    }
+    assert!(feature_cone(std::iter::empty::<&CubeMap>()).is_none());
+
+    let (checked, parts, graphs) =
+        inspc::measurement_graphs(&FsWorld, &[PathBuf::from("examples/f3_indexed.insp")]);
+    let gr = &graphs[0];
+    let scene = Scene::of_part(&parts[gr.part].as_ref().unwrap().geometry);
+    let model = &checked.model;
+    let probe = ProbeShape::of_cmm(model, &model.cmms[model.plans[0].cmm.0]).remove(0);
+    for f in gr.graph.fpoints.iter().step_by(5) {
+        let cones = point_cones(&Cpu, &scene, f, &probe, &opts);
+        let d2 = cones.d2.unwrap();
+        assert_eq!(cones.approach.is_empty(), d2.is_empty());
+        // With an indexable head the part can stand upright: +z is a setup direction.
+        if !d2.is_empty() {
+            assert!(d2.contains(&V3::z()), "{:?}", f.position);
+        }
+    }
+}
+
+/// A table under the part blocks the directions that pass beneath it.
+#[test]
+fn the_table_blocks_directions_under_the_part() {
+    let (_, parts, graphs) =
+        inspc::measurement_graphs(&FsWorld, &[PathBuf::from("examples/f2.insp")]);
+    let gr = &graphs[0];
+    let g = &parts[gr.part].as_ref().unwrap().geometry;
+    let scene = Scene::of_part(g);
+    let table = scene.with_table(&g.bounds().0, &V3::z());
+    // Beside the +x side, half-way up: looking outwards and steeply down misses the part
+    // but hits the table.
+    let (lo, hi) = g.bounds();
+    let c = P3::new(hi.x + 1.0, (lo.y + hi.y) / 2.0, (lo.z + hi.z) / 2.0);
+    let down = V3::new(0.3, 0.0, -1.0).normalize();
+    let without = gac_halfline(&scene, &c, 32, &[]);
+    let with = gac_halfline(&table, &c, 32, &[]);
+    assert!(without.contains(&down));
+    assert!(!with.contains(&down));
+    assert_eq!(with.and(&without), with);
+    assert!(with.contains(&V3::new(1.0, 0.0, 0.2)));
 }

@@ -21,6 +21,7 @@
 mod cpu;
 mod cubemap;
 mod errors;
+mod exact;
 mod heightmap;
 mod probe;
 mod raster;
@@ -30,6 +31,7 @@ mod scene;
 pub use cpu::pixels_for;
 pub use cubemap::{face_dir, face_uv, Cell, CubeMap, Pixel};
 pub use errors::AccessError;
+pub use exact::{component_hits, refine};
 pub use probe::{Component, End, ProbeShape};
 pub use raster::{shadow_polygon, Coverage};
 pub use report::{cone_report, pgm, ConeReport, ConeRequest};
@@ -96,9 +98,27 @@ pub fn gac(
     n: u32,
     preferred: &[V3],
 ) -> CubeMap {
+    gac_with(backend, scene, from, comps, n, preferred, false)
+}
+
+/// [`gac`], optionally with each component's cone [`refine`]d by exact tests at its
+/// boundary.
+pub fn gac_with(
+    backend: &dyn Backend,
+    scene: &Scene,
+    from: &P3,
+    comps: &[Component],
+    n: u32,
+    preferred: &[V3],
+    exact: bool,
+) -> CubeMap {
     let mut blocked = CubeMap::empty(n, preferred);
     for c in comps {
-        blocked.or_assign(&backend.blocked(scene, from, c, n, preferred));
+        let mut b = backend.blocked(scene, from, c, n, preferred);
+        if exact && c.radius > 0.0 {
+            refine(scene, from, c, &mut b);
+        }
+        blocked.or_assign(&b);
     }
     blocked.not()
 }
@@ -121,6 +141,9 @@ pub struct ConeOptions {
     pub retract: f64,
     /// How many points of dD1 the weak GAC D2 samples.
     pub d2_samples: usize,
+    /// Refine the grown components' cones with exact parry tests at their boundaries
+    /// ([`refine`]): slower, and exact at the pixel centres it reaches.
+    pub exact_boundary: bool,
 }
 
 impl Default for ConeOptions {
@@ -130,6 +153,7 @@ impl Default for ConeOptions {
             preferred: axes(),
             retract: 2.0,
             d2_samples: 16,
+            exact_boundary: false,
         }
     }
 }
@@ -175,9 +199,10 @@ pub fn point_cones(
     } else {
         probe.straight()
     };
-    let mut approach = gac(backend, scene, &c, &comps, n, pref);
+    let exact = opts.exact_boundary;
+    let mut approach = gac_with(backend, scene, &c, &comps, n, pref, exact);
     if !approach.is_empty() && opts.retract > 0.0 {
-        approach.and_assign(&gac(backend, scene, &retract, &comps, n, pref));
+        approach.and_assign(&gac_with(backend, scene, &retract, &comps, n, pref, exact));
     }
     let d2 = probe
         .bent
