@@ -106,7 +106,9 @@ pub fn blocked(scene: &Scene, from: &P3, comp: &Component, n: u32, preferred: &[
     // Preferred directions.
     for k in 0..base.preferred_len() {
         let d = base.preferred(k);
-        let hit = if r == 0.0 {
+        let hit = if r == 0.0 && near == 0.0 {
+            scene.cast_ray(from, &d, far).is_some_and(|t| t > 0.0)
+        } else if r == 0.0 {
             candidates.iter().any(|t| {
                 crate::geometry::line_triangle(from, &d, &t.v[0], &t.v[1], &t.v[2])
                     .is_some_and(|s| s > 0.0 && s >= near && s <= far)
@@ -141,7 +143,12 @@ fn grown_shadow(
     if reach < near {
         return true;
     }
-    if dmin < near && depth < MAX_SPLIT {
+    // Splitting pays only for triangles large beside the distance they straddle.
+    let size = (v[1] - v[0])
+        .norm()
+        .max((v[2] - v[1]).norm())
+        .max((v[0] - v[2]).norm());
+    if dmin < near && depth < MAX_SPLIT && size > 0.1 * near {
         let m = [0, 1, 2].map(|k| P3::from((v[k].coords + v[(k + 1) % 3].coords) / 2.0));
         let parts = [
             [v[0], m[0], m[2]],

@@ -207,6 +207,11 @@ impl CubeMap {
         self.bits.iter().all(|&w| w == 0)
     }
 
+    /// Whether every direction is in the cone.
+    pub fn is_full(&self) -> bool {
+        self.count() == self.len()
+    }
+
     /// The number of cells in the cone.
     pub fn count(&self) -> usize {
         self.bits.iter().map(|w| w.count_ones() as usize).sum()
@@ -482,8 +487,8 @@ impl CubeMap {
 /// Per border pixel, its neighbours on other cube faces (bit indices), computed once per
 /// resolution.
 struct EdgeTable {
-    /// Border pixel index → range in `list`.
-    start: std::collections::HashMap<u32, (u32, u32)>,
+    /// Pixel index → range in `list` (empty inside a face).
+    start: Vec<(u32, u32)>,
     list: Vec<u32>,
 }
 
@@ -497,7 +502,7 @@ impl EdgeTable {
             return t.clone();
         }
         let map = CubeMap::empty(n, &[]);
-        let (mut start, mut list) = (HashMap::new(), Vec::new());
+        let (mut start, mut list) = (vec![(0, 0); 6 * (n as usize) * (n as usize)], Vec::new());
         for face in 0..6u8 {
             for j in 0..n {
                 for i in 0..n {
@@ -509,7 +514,7 @@ impl EdgeTable {
                     for q in map.neighbours(p).into_iter().filter(|q| q.face != face) {
                         list.push(map.index(Cell::Pixel(q)) as u32);
                     }
-                    start.insert(map.index(Cell::Pixel(p)) as u32, (from, list.len() as u32));
+                    start[map.index(Cell::Pixel(p))] = (from, list.len() as u32);
                 }
             }
         }
@@ -522,10 +527,8 @@ impl EdgeTable {
     }
 
     fn across(&self, pixel: usize) -> &[u32] {
-        match self.start.get(&(pixel as u32)) {
-            Some(&(a, b)) => &self.list[a as usize..b as usize],
-            None => &[],
-        }
+        let (a, b) = self.start[pixel];
+        &self.list[a as usize..b as usize]
     }
 }
 

@@ -119,6 +119,9 @@ pub fn gac_with(
             refine(scene, from, c, &mut b);
         }
         blocked.or_assign(&b);
+        if blocked.is_full() {
+            break;
+        }
     }
     blocked.not()
 }
