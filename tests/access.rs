@@ -7,15 +7,11 @@
 mod common;
 
 use inspc::access::{
-    cones, gac_halfline, Backend, Cell, Component, ConeOptions, Cpu, CubeMap, End, ProbeShape,
-    Scene,
+    component_hits, cones, gac_halfline, Backend, Cell, Component, ConeOptions, Cpu, CubeMap, End,
+    ProbeShape, Scene,
 };
 use inspc::geometry::{P3, V3};
 use inspc::source::FsWorld;
-use parry3d_f64::math::Isometry;
-use parry3d_f64::na::{Translation3, UnitQuaternion};
-use parry3d_f64::query::intersection_test;
-use parry3d_f64::shape::{Capsule, Cylinder};
 use std::path::PathBuf;
 
 const EXAMPLES: [&str; 7] = [
@@ -73,35 +69,6 @@ fn every_direction(n: u32) -> Vec<(Cell, V3)> {
     c.cells().map(|cell| (cell, c.direction(cell))).collect()
 }
 
-/// Whether the component, along `d` from `p`, meets the part (parry, exact up to its
-/// tolerances). The ram's infinite end is cut well past the part.
-fn exact_blocked(scene: &Scene, p: &P3, d: &V3, comp: &Component) -> bool {
-    let mesh = scene.mesh().unwrap();
-    let b = comp.b.min(comp.a + 4.0 * scene.size + 10.0);
-    if comp.radius == 0.0 {
-        return scene
-            .cast_ray(&(p + d * comp.a), d, b - comp.a)
-            .is_some_and(|t| t > 1e-9);
-    }
-    let id = Isometry::identity();
-    match comp.end {
-        End::Round => {
-            let cap = Capsule::new(p + d * comp.a, p + d * b, comp.radius);
-            intersection_test(&id, &cap, &id, mesh).unwrap()
-        }
-        End::Flat => {
-            let half = (b - comp.a) / 2.0;
-            let cyl = Cylinder::new(half, comp.radius);
-            let rot = UnitQuaternion::rotation_between(&V3::y(), d).unwrap_or_else(|| {
-                UnitQuaternion::from_axis_angle(&V3::x_axis(), std::f64::consts::PI)
-            });
-            let centre = p + d * (comp.a + half);
-            let pos = Isometry::from_parts(Translation3::from(centre.coords), rot);
-            intersection_test(&pos, &cyl, &id, mesh).unwrap()
-        }
-    }
-}
-
 /// Compares one component's cone with the exact test at every pixel centre and preferred
 /// direction: (cells, agreeing cells); panics on a blocked direction reported free.
 fn compare(scene: &Scene, p: &P3, comp: &Component, n: u32, what: &str) -> (usize, usize) {
@@ -122,7 +89,7 @@ fn compare_map(
     }
     let (mut total, mut agree) = (0, 0);
     for (cell, d) in every_direction(n) {
-        let exact = exact_blocked(scene, p, &d, comp);
+        let exact = component_hits(scene, p, &d, comp);
         assert!(
             !exact || blocked.get(cell),
             "{what}: {} blocks {d:?} at {p:?}, reported free",
@@ -288,7 +255,7 @@ fn d1_prime_is_pessimistic() {
         assert_eq!(prime.and(&first), prime, "D1′ ⊆ D1");
         for cell in first.cells() {
             let x = p + first.direction(cell) * probe.reach();
-            let clear = !exact_blocked(&c.scene, &x, &up, &stand);
+            let clear = !component_hits(&c.scene, &x, &up, &stand);
             assert!(
                 clear || !prime.get(cell),
                 "D1′ keeps {cell:?} at {p:?}, but the head hits"

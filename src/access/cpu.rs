@@ -67,7 +67,9 @@ pub fn blocked(scene: &Scene, from: &P3, comp: &Component, n: u32, preferred: &[
                 q[k] = v - from;
             }
             shadow_polygon(&mut base, &q[..3], Coverage::Centres);
-            candidates.push(t);
+            if near > 0.0 {
+                candidates.push(t);
+            }
             continue;
         }
         let lower = dc - t.radius;

@@ -25,8 +25,7 @@ impl HeightMap {
     /// `radius`.
     pub(crate) fn new(scene: &Scene, centre: &P3, half: f64, v: &V3, radius: f64) -> HeightMap {
         let v = v.normalize();
-        let e1 = super::perpendicular(&v);
-        let e2 = v.cross(&e1);
+        let (e1, e2) = crate::sample::perpendicular_basis(&v);
         let texel = 2.0 * half / M as f64;
         let mut raw = vec![f64::NEG_INFINITY; M * M];
         let to_uv = |p: &P3| {

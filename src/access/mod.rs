@@ -294,13 +294,6 @@ pub fn cones(
         .collect()
 }
 
-/// A unit vector perpendicular to `d`.
-pub(crate) fn perpendicular(d: &V3) -> V3 {
-    let d = d.normalize();
-    let helper = if d.x.abs() < 0.9 { V3::x() } else { V3::y() };
-    d.cross(&helper).normalize()
-}
-
 /// The probe direction of an indexable head at angles A (tilt from vertical) and B
 /// (rotation about vertical), in degrees: the unit vector from the stylus tip towards the
 /// head, in the machine frame. A = 0 hangs the stylus straight down, so the probe

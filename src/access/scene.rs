@@ -80,17 +80,13 @@ impl Scene {
     /// normal `up`, a square reaching well past the part. Its triangles are never culled.
     pub fn with_table(&self, point: &P3, up: &V3) -> Scene {
         let up = up.normalize();
-        let e1 = super::perpendicular(&up);
-        let e2 = up.cross(&e1);
+        let (e1, e2) = crate::sample::perpendicular_basis(&up);
         let s = 4.0 * self.size.max(1.0);
         let c = |a: f64, b: f64| point + e1 * (a * s) + e2 * (b * s);
         let (p00, p10, p11, p01) = (c(-1.0, -1.0), c(1.0, -1.0), c(1.0, 1.0), c(-1.0, 1.0));
         let mut tris = self.tris.clone();
         tris.push(make_tri([p00, p10, p11], false));
         tris.push(make_tri([p00, p11, p01], false));
-        for t in &mut tris {
-            t.closed = t.closed && self.closed;
-        }
         Scene::new(tris, self.closed)
     }
 
