@@ -11,6 +11,7 @@ pub mod geometry;
 pub mod graph;
 pub mod load;
 pub mod model;
+pub mod plan;
 pub mod resolve;
 pub mod sample;
 pub mod source;
@@ -173,6 +174,58 @@ pub fn measurement_graphs(
     }
     checked.absorb(diags);
     (checked, parts, out)
+}
+
+/// One plan's result.
+pub struct Planned {
+    /// The plan, by index into [`model::Model::plans`].
+    pub plan: usize,
+    /// The HLIP, when planning succeeded.
+    pub hlip: Option<plan::Hlip>,
+}
+
+/// Runs [`measurement_graphs`], then plans every plan of the root files. Parts the root
+/// files declare that no plan names are an error: there is no machine to plan for.
+/// Planning diagnostics join the others.
+pub fn plans(
+    world: &dyn source::World,
+    roots: &[PathBuf],
+    opts: &plan::PlanOptions,
+) -> (Checked, Vec<Option<PartData>>, Vec<Graphed>, Vec<Planned>) {
+    let (mut checked, parts, graphs) = measurement_graphs(world, roots);
+    let mut out = Vec::new();
+    if checked.has_errors() {
+        return (checked, parts, graphs, out);
+    }
+    let mut diags = diag::Diagnostics::new();
+    let model = &checked.model;
+    for g in &graphs {
+        let Some(name) = &g.graph.plan else {
+            let part = &model.parts[g.part];
+            diags.push(
+                part.span.file,
+                plan::PlanError::NoPlan {
+                    span: part.span,
+                    part: part.name.clone(),
+                },
+            );
+            continue;
+        };
+        let Some(k) = model.plans.iter().position(|p| &p.name == name) else {
+            continue;
+        };
+        let Some(data) = &parts[g.part] else { continue };
+        let input = plan::Input {
+            model,
+            plan: &model.plans[k],
+            geometry: &data.geometry,
+            graph: &g.graph,
+        };
+        let hlip = plan::plan(&input, opts, &mut diags);
+        out.push(Planned { plan: k, hlip });
+    }
+    checked.absorb(diags);
+    (checked, parts, graphs, out)
 }
 
 /// Runs the front end (load, parse, resolve) over root files.

@@ -103,6 +103,18 @@ enum Command {
         #[arg(short, long, default_value = "cone.pgm")]
         output: PathBuf,
     },
+    /// Plans every plan of a spec: setups, probes, orientations and what each inspects
+    /// (the high-level inspection plan).
+    Plan {
+        /// The `.insp` spec.
+        file: PathBuf,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = TableFormat::Text)]
+        format: TableFormat,
+        /// Cube-map resolution of the accessibility cones.
+        #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(8..=256))]
+        resolution: u32,
+    },
     /// Checks specs: parses, resolves names and units, checks values. Exits 1 on error.
     Check {
         /// The `.insp` files.
@@ -150,6 +162,11 @@ fn main() -> ExitCode {
             };
             cones(&file, &req, &output)
         }
+        Command::Plan {
+            file,
+            format,
+            resolution,
+        } => plan(&file, format, resolution),
         Command::Check {
             files,
             message_format,
@@ -250,6 +267,38 @@ fn cones(
         "wrote {} (unfolded cube, +z in the middle: free white, blocked black)",
         output.display()
     );
+    ExitCode::SUCCESS
+}
+
+fn plan(file: &std::path::Path, format: TableFormat, n: u32) -> ExitCode {
+    let opts = inspc::plan::PlanOptions {
+        n,
+        ..Default::default()
+    };
+    let start = std::time::Instant::now();
+    let (checked, _, _, planned) = inspc::plans(&FsWorld, &[file.to_path_buf()], &opts);
+    print_diagnostics(&checked.sources, &checked.diagnostics);
+    if checked.has_errors() {
+        return ExitCode::from(1);
+    }
+    let hlips: Vec<&inspc::plan::Hlip> = planned.iter().filter_map(|p| p.hlip.as_ref()).collect();
+    match format {
+        TableFormat::Text => {
+            for h in &hlips {
+                print!("{}", inspc::plan::text(h));
+            }
+            eprintln!("inspc: planned in {:.2} s", start.elapsed().as_secs_f64());
+        }
+        TableFormat::Json => {
+            let all: Vec<serde_json::Value> = hlips.iter().map(|h| inspc::plan::json(h)).collect();
+            let v = if all.len() == 1 {
+                all.into_iter().next().unwrap_or_default()
+            } else {
+                serde_json::Value::Array(all)
+            };
+            println!("{}", serde_json::to_string_pretty(&v).unwrap_or_default());
+        }
+    }
     ExitCode::SUCCESS
 }
 

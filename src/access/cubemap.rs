@@ -202,6 +202,12 @@ impl CubeMap {
         }
     }
 
+    /// The raw bits: 6·N² pixels then the preferred directions, 64 to a word, in
+    /// [`CubeMap::index`] order. For set algorithms that work on any bitset.
+    pub fn words(&self) -> &[u64] {
+        &self.bits
+    }
+
     /// Whether no direction is in the cone.
     pub fn is_empty(&self) -> bool {
         self.bits.iter().all(|&w| w == 0)

@@ -269,6 +269,36 @@ pub fn d1_prime(scene: &Scene, c: &P3, probe: &ProbeShape, d1: &CubeMap, v2: &V3
     out
 }
 
+/// The depth map the second component of a bent probe is tested against in one setup
+/// (ch. 2.5.3): the part seen along `v2`, dilated by the head's and ram's radius, wide
+/// enough for any articulation point within `reach` of the part. One map serves every
+/// fpoint of the setup.
+pub struct SecondMap(heightmap::HeightMap);
+
+impl SecondMap {
+    /// The map for second components of radius `radius` along `v2`.
+    pub fn new(scene: &Scene, v2: &V3, radius: f64, reach: f64) -> SecondMap {
+        let mut lo = P3::new(f64::MAX, f64::MAX, f64::MAX);
+        let mut hi = P3::new(f64::MIN, f64::MIN, f64::MIN);
+        for v in scene.tris.iter().flat_map(|t| t.v.iter()) {
+            lo = lo.inf(v);
+            hi = hi.sup(v);
+        }
+        let centre = if lo.x <= hi.x {
+            nalgebra::center(&lo, &hi)
+        } else {
+            P3::origin()
+        };
+        let half = scene.size / 2.0 + reach + radius + 1.0;
+        SecondMap(heightmap::HeightMap::new(scene, &centre, half, v2, radius))
+    }
+
+    /// Whether the second component standing on articulation point `x` clears the part.
+    pub fn clear(&self, x: &P3) -> bool {
+        self.0.clear(x)
+    }
+}
+
 /// A feature's cone: the intersection of its points' cones (ch. 2.3).
 pub fn feature_cone<'a>(cones: impl IntoIterator<Item = &'a CubeMap>) -> Option<CubeMap> {
     let mut it = cones.into_iter();

@@ -1,0 +1,683 @@
+//! The knowledge base (seed ch. 3.3.5 and 4.1): per fpoint and probe, the domain of
+//! allowable configurations, refined lazily as generate-and-test finds out more.
+//!
+//! A setup is the direction of the part frame that points up, towards the ram. For a
+//! fixed head the domain of (fpoint, probe) is one cone of setups; for an indexable head
+//! it is the pair (D1, D2): probe directions and setups, with D1′ — the A/B grid
+//! orientations that work in a chosen setup — computed on demand and cached.
+//!
+//! Knowledge starts cheap: the bare half-line cone from the tip centre (and, for bent
+//! probes, D2 over-approximated by tilting D1 as far as the head's A range allows). When
+//! validation rejects a configuration, the point's domain is replaced by the whole
+//! probe's cones (every component at contact and retract point, and the weak GAC D2),
+//! and the rejected configuration is removed.
+
+use super::cluster::{Bits, Set};
+use crate::access::{self, tip_fits, Cell, ConeOptions, CubeMap, ProbeShape, Scene, SecondMap};
+use crate::geometry::{FaceId, Surface, P3, V3};
+use crate::model::{HeadKind, Model, Plan};
+use crate::sample::Fpoint;
+use nalgebra::{Rotation3, Unit};
+use rayon::prelude::*;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// The share of the tip radius the mesh may come closer than the radius (chordal error).
+pub(crate) const TIP_CLEARANCE: f64 = 0.9;
+
+/// The machine as the planner sees it.
+pub(crate) struct Machine {
+    /// Probe shapes in rack order.
+    pub probes: Vec<ProbeShape>,
+    /// Probe costs (plan overrides applied).
+    pub costs: Vec<f64>,
+    /// Probes the plan allows.
+    pub allowed: Vec<bool>,
+    /// Whether the head indexes.
+    pub bent: bool,
+    /// The head's A/B grid (degrees); one (0, 0) for a fixed head.
+    pub grid: Vec<(f64, f64)>,
+    /// The grid orientations the plan allows.
+    pub grid_allowed: Bits,
+    /// Preference weights of grid orientations (0.5 when unspecified).
+    pub grid_weight: Vec<f64>,
+    /// The largest A (degrees).
+    pub a_max: f64,
+}
+
+impl Machine {
+    pub(crate) fn new(model: &Model, plan: &Plan) -> Machine {
+        let cmm = &model.cmms[plan.cmm.0];
+        let head = &model.heads[cmm.head.0];
+        let probes = ProbeShape::of_cmm(model, cmm);
+        let mut costs: Vec<f64> = cmm
+            .probes
+            .iter()
+            .map(|(_, p)| model.probes[p.0].cost)
+            .collect();
+        let mut allowed = vec![true; probes.len()];
+        for pref in &plan.probes {
+            if let Some(k) = cmm.probes.iter().position(|(l, _)| *l == pref.label) {
+                if pref.forbidden {
+                    allowed[k] = false;
+                }
+                if let Some(c) = pref.cost {
+                    costs[k] = c;
+                }
+            }
+        }
+        let (bent, a_max) = match head.kind {
+            HeadKind::Fixed => (false, 0.0),
+            HeadKind::Indexable { a, .. } => (true, a[1]),
+        };
+        let grid = if bent {
+            head.orientations()
+        } else {
+            vec![(0.0, 0.0)]
+        };
+        let mut grid_allowed = Bits::full(grid.len());
+        let mut grid_weight = vec![0.5; grid.len()];
+        for o in &plan.orientations {
+            for (k, g) in grid.iter().enumerate() {
+                let same = (g.0 - o.a).abs() < 1e-6
+                    && ((g.1 - o.b).rem_euclid(360.0) < 1e-6
+                        || (g.1 - o.b).rem_euclid(360.0) > 360.0 - 1e-6
+                        || g.0.abs() < 1e-9 && o.a.abs() < 1e-9);
+                if same {
+                    if o.forbidden {
+                        grid_allowed.remove(k);
+                    } else {
+                        grid_weight[k] = o.weight;
+                    }
+                }
+            }
+        }
+        Machine {
+            probes,
+            costs,
+            allowed,
+            bent,
+            grid,
+            grid_allowed,
+            grid_weight,
+            a_max,
+        }
+    }
+}
+
+/// How much is known about one (fpoint, probe).
+#[derive(Debug, Clone)]
+pub(crate) struct Dom {
+    /// The tip fits at the contact and at the retract point.
+    pub tip: bool,
+    /// Setups: the straight probe's cone, or D2 for a bent probe.
+    pub setup: CubeMap,
+    /// D1, for a bent probe.
+    pub d1: Option<CubeMap>,
+    /// Whether the whole probe's cones replaced the half-line approximation.
+    pub full: bool,
+}
+
+/// Putting a planar datum face on the table (ch. 3.6.2).
+#[derive(Debug, Clone)]
+pub(crate) struct TableAlt {
+    /// The datum face.
+    pub face: FaceId,
+    /// The setup that rests it on the table: minus its outward normal.
+    pub up: V3,
+    /// That setup's cell index in the cube maps.
+    pub cell: usize,
+    /// The table points standing in for the face: indices into [`Knowledge::points`].
+    pub points: Vec<usize>,
+    /// False once validation found the table points unreachable.
+    pub alive: bool,
+}
+
+/// The planner's knowledge base.
+pub(crate) struct Knowledge {
+    /// Cube-map options (resolution, preferred directions, retract distance).
+    pub opts: ConeOptions,
+    /// The part as obstacle.
+    pub scene: Scene,
+    /// The graph's fpoints, then the table points.
+    pub points: Vec<Fpoint>,
+    /// How many of `points` come from the graph.
+    pub graph_points: usize,
+    /// Per point and probe.
+    pub dom: Vec<Vec<Dom>>,
+    /// Setups the plan forbids.
+    pub forbidden: CubeMap,
+    /// Preference weight per cube-map cell index (0.5 when unspecified).
+    pub setup_weight: BTreeMap<usize, f64>,
+    /// Setup preferences in declaration order: (cell index, weight).
+    pub setup_prefs: Vec<(usize, f64)>,
+    /// Datum faces that may rest on the table.
+    pub tables: Vec<TableAlt>,
+    /// D1′ on the grid per (point, probe, setup cell).
+    d1p: BTreeMap<(usize, usize, usize), Bits>,
+    /// The second component's depth map per setup cell.
+    second: BTreeMap<usize, SecondMap>,
+    /// How many times the whole probe's cones were computed.
+    pub acquired: usize,
+}
+
+/// The rotation taking the part frame to the machine frame of setup `up` (up ↦ +z).
+pub(crate) fn frame(up: &V3) -> Rotation3<f64> {
+    Rotation3::rotation_between(up, &V3::z()).unwrap_or_else(|| {
+        Rotation3::from_axis_angle(&Unit::new_normalize(V3::x()), std::f64::consts::PI)
+    })
+}
+
+/// The probe direction (tip towards head, part frame) of grid orientation (A, B) in setup
+/// `up`.
+pub(crate) fn orientation_dir(up: &V3, a: f64, b: f64) -> V3 {
+    frame(up).inverse() * access::head_direction(a, b)
+}
+
+/// The height of the table under the part in setup `up`: the lowest vertex along `up`.
+pub(crate) fn table_height(scene: &Scene, up: &V3) -> f64 {
+    scene
+        .tris
+        .iter()
+        .flat_map(|t| t.v.iter())
+        .map(|v| v.coords.dot(up))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The lowest point along `up` of a component whose axis runs from `from` along unit `d`
+/// over [a, b].
+pub(crate) fn lowest(comp: &access::Component, from: &P3, d: &V3, up: &V3) -> f64 {
+    let b = if comp.b.is_finite() { comp.b } else { comp.a };
+    let h = |t: f64| (from + d * t).coords.dot(up);
+    let ends = h(comp.a).min(h(b));
+    let side = match comp.end {
+        access::End::Round => comp.radius,
+        access::End::Flat => comp.radius * (1.0 - d.dot(up).powi(2)).max(0.0).sqrt(),
+    };
+    ends - side
+}
+
+/// Whether a bent probe at tip centre `c`, along `o`, with the head above its
+/// articulation point, keeps off the table at height `t0` in setup `up`.
+pub(crate) fn above_table(probe: &ProbeShape, c: &P3, o: &V3, up: &V3, t0: f64) -> bool {
+    const MARGIN: f64 = 0.5;
+    let art = c + o * probe.reach();
+    probe
+        .first
+        .iter()
+        .all(|comp| lowest(comp, c, o, up) >= t0 + MARGIN)
+        && probe
+            .second
+            .iter()
+            .all(|comp| lowest(comp, &art, up, up) >= t0 + MARGIN)
+}
+
+/// The cells within `angle` radians of `axis`, in the shape of `like`.
+pub(crate) fn cone_around(like: &CubeMap, axis: &V3, angle: f64) -> CubeMap {
+    let mut out = like.empty_like();
+    let cos = angle.min(std::f64::consts::PI).cos();
+    let total = 6 * (like.n() as usize).pow(2) + like.preferred_len();
+    let axis = axis.normalize();
+    for k in 0..total {
+        let cell = like.cell(k);
+        if like.direction(cell).dot(&axis) >= cos - 1e-12 {
+            out.set(cell, true);
+        }
+    }
+    out
+}
+
+impl Knowledge {
+    /// The initial knowledge: half-line cones at every fpoint for every probe, table
+    /// alternatives for datum faces that can rest on the table.
+    pub(crate) fn new(
+        model: &Model,
+        plan: &Plan,
+        machine: &Machine,
+        geometry: &crate::geometry::PartGeometry,
+        fpoints: &[Fpoint],
+        table_faces: &[FaceId],
+        opts: ConeOptions,
+    ) -> Knowledge {
+        let _ = model;
+        let scene = Scene::of_part(geometry);
+        // Preferred directions: the axes, the plan's setups, the table setups, then
+        // feature axes and plane normals — a probe often fits a hole only along its
+        // axis (at most MAX_FACE_DIRECTIONS of those).
+        let mut pref = opts.preferred.clone();
+        fn add(pref: &mut Vec<V3>, d: V3) -> bool {
+            let d = d.normalize();
+            let new = !pref.iter().any(|p| (p - d).norm() < 1e-9);
+            if new {
+                pref.push(d);
+            }
+            new
+        }
+        for s in &plan.setups {
+            add(&mut pref, V3::from(s.direction));
+        }
+        let mut table_dirs = Vec::new();
+        for &f in table_faces {
+            if let Surface::Plane { normal, .. } = geometry.faces[f.0].surface {
+                add(&mut pref, -normal);
+                table_dirs.push((f, -normal));
+            }
+        }
+        let mut face_dirs = 0;
+        let mut seen: BTreeSet<usize> = BTreeSet::new();
+        for f in fpoints {
+            if face_dirs >= MAX_FACE_DIRECTIONS || !seen.insert(f.face.0) {
+                continue;
+            }
+            let dirs = match geometry.faces[f.face.0].surface {
+                Surface::Plane { normal, .. } => vec![normal],
+                Surface::Cylinder { axis, .. } | Surface::Cone { axis, .. } => vec![axis, -axis],
+                _ => vec![],
+            };
+            for d in dirs {
+                face_dirs += usize::from(add(&mut pref, d));
+            }
+        }
+        let opts = ConeOptions {
+            preferred: pref.clone(),
+            ..opts
+        };
+        let empty = CubeMap::empty(opts.n, &pref);
+        let mut forbidden = empty.clone();
+        let mut setup_weight = BTreeMap::new();
+        let mut setup_prefs = Vec::new();
+        for s in &plan.setups {
+            let d = V3::from(s.direction).normalize();
+            let cell = empty.index(empty.cell_of(&d));
+            if s.forbidden {
+                forbidden.or_assign(&cone_around(&empty, &d, FORBID_ANGLE.to_radians()));
+            } else {
+                setup_weight.insert(cell, s.weight);
+                setup_prefs.push((cell, s.weight));
+            }
+        }
+        let mut points = fpoints.to_vec();
+        let mut tables = Vec::new();
+        for (face, up) in table_dirs {
+            let pts = table_points(&scene, geometry, face, &up, machine);
+            let first = points.len();
+            points.extend(pts.iter().map(|&position| Fpoint {
+                face,
+                position,
+                normal: up,
+            }));
+            tables.push(TableAlt {
+                face,
+                up,
+                cell: empty.index(empty.cell_of(&up)),
+                points: (first..points.len()).collect(),
+                alive: true,
+            });
+        }
+        let graph_points = fpoints.len();
+        let dom: Vec<Vec<Dom>> = fpoints
+            .par_iter()
+            .map(|f| {
+                machine
+                    .probes
+                    .iter()
+                    .map(|p| initial(&scene, f, p, machine, &opts))
+                    .collect()
+            })
+            .collect();
+        Knowledge {
+            opts,
+            scene,
+            points,
+            graph_points,
+            dom,
+            forbidden,
+            setup_weight,
+            setup_prefs,
+            tables,
+            d1p: BTreeMap::new(),
+            second: BTreeMap::new(),
+            acquired: 0,
+        }
+    }
+
+    /// An empty cube map of the knowledge's shape.
+    pub(crate) fn empty_cone(&self) -> CubeMap {
+        CubeMap::empty(self.opts.n, &self.opts.preferred)
+    }
+
+    /// The table alternative a table point belongs to.
+    pub(crate) fn table_of(&self, point: usize) -> Option<&TableAlt> {
+        self.tables.iter().find(|t| t.points.contains(&point))
+    }
+
+    /// The setups from which some allowed probe reaches graph fpoint `f`.
+    pub(crate) fn setups(&self, f: usize, machine: &Machine) -> CubeMap {
+        let mut out = self.empty_cone();
+        for (p, d) in self.dom[f].iter().enumerate() {
+            if machine.allowed[p] && d.tip {
+                out.or_assign(&d.setup);
+            }
+        }
+        out.and_not_assign(&self.forbidden);
+        out
+    }
+
+    /// The allowed probes that reach graph fpoint `f` in setup cell `s`.
+    pub(crate) fn probes(&self, f: usize, s: usize, machine: &Machine) -> Bits {
+        Bits::of(
+            machine.probes.len(),
+            (0..machine.probes.len()).filter(|&p| {
+                machine.allowed[p] && self.dom[f][p].tip && Set::has(&self.dom[f][p].setup, s)
+            }),
+        )
+    }
+
+    /// The grid orientations from which probe `p` reaches point `f` in setup `up` (cell
+    /// `s`): D1′ on the A/B grid, kept off the table. Table points take every orientation
+    /// that keeps the probe off the table. Fixed heads have the one orientation.
+    pub(crate) fn orientations(
+        &mut self,
+        f: usize,
+        p: usize,
+        s: usize,
+        up: &V3,
+        machine: &Machine,
+    ) -> Bits {
+        if !machine.bent {
+            return Bits::full(1);
+        }
+        if let Some(b) = self.d1p.get(&(f, p, s)) {
+            return b.clone();
+        }
+        let probe = &machine.probes[p];
+        let point = &self.points[f];
+        let c = point.tip_centre(probe.tip_radius);
+        let t0 = table_height(&self.scene, up);
+        let dirs: Vec<V3> = machine
+            .grid
+            .iter()
+            .map(|&(a, b)| orientation_dir(up, a, b))
+            .collect();
+        let table = f >= self.graph_points;
+        let d1 = self.dom.get(f).and_then(|d| d[p].d1.clone());
+        let candidates: Vec<usize> = (0..dirs.len())
+            .filter(|&k| {
+                Set::has(&machine.grid_allowed, k)
+                    && (table || d1.as_ref().is_some_and(|d1| d1.contains(&dirs[k])))
+                    && above_table(probe, &c, &dirs[k], up, t0)
+                    && (!table || dirs[k].dot(&point.normal) > 0.2)
+            })
+            .collect();
+        let clear: Vec<bool> = if candidates.is_empty() {
+            vec![]
+        } else {
+            let map = self.second.entry(s).or_insert_with(|| {
+                let radius = machine
+                    .probes
+                    .iter()
+                    .flat_map(|p| p.second.iter().map(|c| c.radius))
+                    .fold(0.0, f64::max);
+                let reach = machine.probes.iter().map(|p| p.reach()).fold(0.0, f64::max);
+                SecondMap::new(&self.scene, up, radius, reach + 2.0 * self.opts.retract)
+            });
+            candidates
+                .iter()
+                .map(|&k| map.clear(&(c + dirs[k] * probe.reach())))
+                .collect()
+        };
+        let out = Bits::of(
+            machine.grid.len(),
+            candidates
+                .iter()
+                .zip(clear)
+                .filter(|(_, ok)| *ok)
+                .map(|(&k, _)| k),
+        );
+        self.d1p.insert((f, p, s), out.clone());
+        out
+    }
+
+    /// Learns that probe `p` cannot reach point `f` from setup cell `s` (and, for a bent
+    /// probe, orientation `o`): the first time, the point's half-line domain is replaced
+    /// by the whole probe's cones; the configuration is then removed.
+    pub(crate) fn reject(
+        &mut self,
+        f: usize,
+        p: usize,
+        s: usize,
+        o: Option<usize>,
+        machine: &Machine,
+    ) {
+        if f >= self.graph_points {
+            if let Some(t) = self.tables.iter_mut().find(|t| t.points.contains(&f)) {
+                t.alive = false;
+            }
+            return;
+        }
+        if !self.dom[f][p].full {
+            self.acquire(f, p, machine);
+            return;
+        }
+        if let (Some(o), Some(b)) = (o, self.d1p.get_mut(&(f, p, s))) {
+            b.remove(o);
+            if !b.is_empty() {
+                return;
+            }
+        }
+        let dom = &mut self.dom[f][p];
+        let cell = dom.setup.cell(s);
+        if machine.bent {
+            // No orientation works in this setup: nor, most likely, in setups close by.
+            let dir = dom.setup.direction(cell);
+            let cap = cone_around(&dom.setup, &dir, REJECT_CAP.to_radians());
+            dom.setup.and_not_assign(&cap);
+            dom.setup.set(cell, false);
+        } else if dom.setup.get(cell) {
+            // Rejected although the whole probe's cone holds it: its pixel is on the
+            // boundary. Drop it and its neighbours.
+            dom.setup.set(cell, false);
+            if let Cell::Pixel(px) = cell {
+                for nb in dom.setup.neighbours(px) {
+                    dom.setup.set(Cell::Pixel(nb), false);
+                }
+            }
+        }
+    }
+
+    /// Replaces the half-line knowledge of (f, p) by the whole probe's cones.
+    pub(crate) fn acquire(&mut self, f: usize, p: usize, machine: &Machine) {
+        self.acquire_many(&[(f, p)], machine);
+    }
+
+    /// Acquires the whole probe's cones for many (point, probe) pairs at once, in
+    /// parallel; the result does not depend on the thread count.
+    pub(crate) fn acquire_many(&mut self, pairs: &[(usize, usize)], machine: &Machine) {
+        let todo: Vec<(usize, usize)> = pairs
+            .iter()
+            .copied()
+            .filter(|&(f, p)| f < self.graph_points && !self.dom[f][p].full)
+            .collect();
+        // D2 is not sampled (the weak GAC costs 16 second-component cones): the cap over
+        // the new D1 bounds it, and D1′ in each chosen setup is the exact test.
+        let opts = ConeOptions {
+            d2_samples: 0,
+            ..self.opts.clone()
+        };
+        let computed: Vec<access::PointCones> = todo
+            .par_iter()
+            .map(|&(f, p)| {
+                access::point_cones(
+                    &access::Cpu,
+                    &self.scene,
+                    &self.points[f],
+                    &machine.probes[p],
+                    &opts,
+                )
+            })
+            .collect();
+        // Preferred directions the half-line allowed and the rasterized probe did not:
+        // its grown pixels err on the blocked side, so test them exactly.
+        let exact: Vec<Vec<usize>> = todo
+            .par_iter()
+            .zip(&computed)
+            .map(|(&(f, p), cones)| {
+                if machine.bent || !cones.tip_fits {
+                    return vec![];
+                }
+                let old = &self.dom[f][p].setup;
+                let base = 6 * (old.n() as usize).pow(2);
+                (0..old.preferred_len())
+                    .filter(|&j| {
+                        let cell = Cell::Preferred(j);
+                        old.get(cell) && !cones.approach.get(cell) && !self.forbidden.get(cell)
+                    })
+                    .filter(|&j| {
+                        let up = old.preferred(j);
+                        let pip = super::validate::Pip {
+                            point: f,
+                            probe: p,
+                            setup: base + j,
+                            orient: 0,
+                        };
+                        super::validate::check(
+                            self,
+                            machine,
+                            &pip,
+                            &up,
+                            table_height(&self.scene, &up),
+                        )
+                        .is_none()
+                    })
+                    .collect()
+            })
+            .collect();
+        for ((&(f, p), mut cones), exact) in todo.iter().zip(computed).zip(exact) {
+            if self.dom[f][p].full {
+                continue;
+            }
+            for j in exact {
+                cones.approach.set(Cell::Preferred(j), true);
+            }
+            let dom = &mut self.dom[f][p];
+            dom.full = true;
+            dom.tip &= cones.tip_fits;
+            match &mut dom.d1 {
+                Some(d1) => {
+                    d1.and_assign(&cones.approach);
+                    dom.setup.and_assign(&d2_cap(d1, machine.a_max));
+                }
+                None => dom.setup.and_assign(&cones.approach),
+            }
+            self.acquired += 1;
+            self.d1p.retain(|&(ff, pp, _), _| !(ff == f && pp == p));
+        }
+    }
+}
+
+/// The most face axes and normals added as exact directions.
+const MAX_FACE_DIRECTIONS: usize = 48;
+
+/// How far around a forbidden setup direction the setups are forbidden (degrees).
+pub(crate) const FORBID_ANGLE: f64 = 10.0;
+
+/// The first knowledge of (fpoint, probe): tip fit at contact and retract point, the
+/// half-line cone; for a bent probe D1 = that cone and D2 every setup within the head's
+/// A range of it.
+fn initial(
+    scene: &Scene,
+    f: &Fpoint,
+    probe: &ProbeShape,
+    machine: &Machine,
+    opts: &ConeOptions,
+) -> Dom {
+    let (n, pref) = (opts.n, &opts.preferred[..]);
+    let c = f.tip_centre(probe.tip_radius);
+    let r = probe.tip_radius;
+    let tip = tip_fits(scene, &c, r) && tip_fits(scene, &(c + f.normal * opts.retract), r);
+    if !tip {
+        let e = CubeMap::empty(n, pref);
+        return Dom {
+            tip,
+            setup: e.clone(),
+            d1: machine.bent.then_some(e),
+            full: true,
+        };
+    }
+    let half = access::gac_halfline(scene, &c, n, pref);
+    if !machine.bent {
+        return Dom {
+            tip,
+            setup: half,
+            d1: None,
+            full: false,
+        };
+    }
+    let d2 = d2_cap(&half, machine.a_max);
+    Dom {
+        tip,
+        setup: d2,
+        d1: Some(half),
+        full: false,
+    }
+}
+
+/// An over-approximation of D2: every setup within the head's A range (`a_max`
+/// degrees) of some direction of D1 — the cap around D1's mean axis, widened by D1's
+/// angular radius and a pixel.
+fn d2_cap(d1: &CubeMap, a_max: f64) -> CubeMap {
+    let dirs: Vec<V3> = d1.cells().map(|c| d1.direction(c)).collect();
+    let sum: V3 = dirs.iter().sum();
+    if dirs.is_empty() {
+        return d1.empty_like();
+    }
+    if sum.norm() < 1e-9 {
+        return d1.not().or(d1);
+    }
+    let m = sum.normalize();
+    let rho = dirs
+        .iter()
+        .map(|d| d.dot(&m).clamp(-1.0, 1.0).acos())
+        .fold(0.0, f64::max);
+    let pixel = 2.0 / d1.n() as f64;
+    cone_around(d1, &m, a_max.to_radians() + rho + pixel)
+}
+
+/// How far around a setup in which a bent probe found no orientation the setups are
+/// dropped too (degrees).
+const REJECT_CAP: f64 = 5.0;
+
+/// Points on the table around the part resting on datum face `face`: four points beyond
+/// the corners of the part's footprint, far enough out that the probe body clears it.
+fn table_points(
+    scene: &Scene,
+    g: &crate::geometry::PartGeometry,
+    face: FaceId,
+    up: &V3,
+    machine: &Machine,
+) -> Vec<P3> {
+    let crate::geometry::Surface::Plane { origin, .. } = g.faces[face.0].surface else {
+        return vec![];
+    };
+    let (e1, e2) = crate::sample::perpendicular_basis(up);
+    let (mut u0, mut u1, mut v0, mut v1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for v in scene.tris.iter().flat_map(|t| t.v.iter()) {
+        let d = v - origin;
+        let (u, w) = (d.dot(&e1), d.dot(&e2));
+        (u0, u1, v0, v1) = (u0.min(u), u1.max(u), v0.min(w), v1.max(w));
+    }
+    let body = machine
+        .probes
+        .iter()
+        .flat_map(|p| p.first.iter().map(|c| c.radius))
+        .fold(0.0, f64::max);
+    let off = 5.0 + body;
+    [
+        (u0 - off, v0 - off),
+        (u1 + off, v0 - off),
+        (u1 + off, v1 + off),
+        (u0 - off, v1 + off),
+    ]
+    .iter()
+    .map(|&(u, w)| origin + e1 * u + e2 * w)
+    .collect()
+}
