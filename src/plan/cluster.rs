@@ -334,6 +334,7 @@ pub fn min_hitting_set<S: Set>(w: &[&S], budget: usize) -> (usize, bool) {
     let mut best = greedy;
     let mut nodes = 0usize;
     let mut complete = true;
+    #[allow(clippy::too_many_arguments)]
     fn search(
         covered: &Bits,
         depth: usize,

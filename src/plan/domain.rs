@@ -122,8 +122,6 @@ pub(crate) struct Dom {
 pub(crate) struct TableAlt {
     /// The datum face.
     pub face: FaceId,
-    /// The setup that rests it on the table: minus its outward normal.
-    pub up: V3,
     /// That setup's cell index in the cube maps.
     pub cell: usize,
     /// The table points standing in for the face: indices into [`Knowledge::points`].
@@ -307,7 +305,6 @@ impl Knowledge {
             }));
             tables.push(TableAlt {
                 face,
-                up,
                 cell: empty.index(empty.cell_of(&up)),
                 points: (first..points.len()).collect(),
                 alive: true,
@@ -343,11 +340,6 @@ impl Knowledge {
     /// An empty cube map of the knowledge's shape.
     pub(crate) fn empty_cone(&self) -> CubeMap {
         CubeMap::empty(self.opts.n, &self.opts.preferred)
-    }
-
-    /// The table alternative a table point belongs to.
-    pub(crate) fn table_of(&self, point: usize) -> Option<&TableAlt> {
-        self.tables.iter().find(|t| t.points.contains(&point))
     }
 
     /// The setups from which some allowed probe reaches graph fpoint `f`.
@@ -500,7 +492,7 @@ impl Knowledge {
         // D2 is not sampled (the weak GAC costs 16 second-component cones): the cap over
         // the new D1 bounds it, and D1′ in each chosen setup is the exact test.
         let opts = ConeOptions {
-            d2_samples: 0,
+            d2_samples: D2_SAMPLES,
             ..self.opts.clone()
         };
         let computed: Vec<access::PointCones> = todo
@@ -561,12 +553,13 @@ impl Knowledge {
             let dom = &mut self.dom[f][p];
             dom.full = true;
             dom.tip &= cones.tip_fits;
-            match &mut dom.d1 {
-                Some(d1) => {
+            match (&mut dom.d1, cones.d2) {
+                (Some(d1), Some(d2)) => {
                     d1.and_assign(&cones.approach);
                     dom.setup.and_assign(&d2_cap(d1, machine.a_max));
+                    dom.setup.and_assign(&d2);
                 }
-                None => dom.setup.and_assign(&cones.approach),
+                _ => dom.setup.and_assign(&cones.approach),
             }
             self.acquired += 1;
             self.d1p.retain(|&(ff, pp, _), _| !(ff == f && pp == p));
@@ -641,6 +634,10 @@ fn d2_cap(d1: &CubeMap, a_max: f64) -> CubeMap {
     let pixel = 2.0 / d1.n() as f64;
     cone_around(d1, &m, a_max.to_radians() + rho + pixel)
 }
+
+/// How many articulation points the weak GAC D2 samples when a bent probe's knowledge
+/// is acquired (the seed's 16 cost more than they add here).
+const D2_SAMPLES: usize = 6;
 
 /// How far around a setup in which a bent probe found no orientation the setups are
 /// dropped too (degrees).

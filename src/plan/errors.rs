@@ -9,7 +9,7 @@ pub enum PlanError {
     #[error("face `{face}` of feature `{feature}` cannot be inspected: {why}")]
     #[diagnostic(code(insp::plan::uninspectable_face), help("{help}"))]
     UninspectableFace {
-        #[label("`{face}` is declared here")]
+        #[label("`{face}` is part of this feature")]
         span: Span,
         face: String,
         feature: String,

@@ -340,15 +340,6 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
                     validated.insert(p);
                 }
                 Some(w) => {
-                    if std::env::var_os("INSPC_DEBUG").is_some() {
-                        let d = k.empty_cone().direction(k.empty_cone().cell(p.setup));
-                        eprintln!(
-                            "iter {iteration} invalid {:?} up {:?} full {} hits {w}",
-                            p,
-                            d,
-                            p.point < k.graph_points && k.dom[p.point][p.probe].full
-                        );
-                    }
                     last = format!(
                         "probe {} at a point of {} hits {}",
                         machine.probes[p.probe].name,
@@ -418,12 +409,18 @@ fn learn(k: &mut Knowledge, m: &Machine, mut fails: Vec<(usize, usize, usize, Op
         .iter()
         .map(|&(f, p, _, _)| f >= k.graph_points || k.dom[f][p].full)
         .collect();
-    let pairs: Vec<(usize, usize)> = fails
-        .iter()
-        .zip(&full)
-        .filter(|(_, full)| !**full)
-        .map(|(&(f, p, _, _), _)| (f, p))
-        .collect();
+    // Neighbours on a face fail together and are clustered together (ch. 4.2): better
+    // knowledge of a few of them usually moves the whole face, so acquire at most
+    // ACQUIRE_PER_FACE points per face and probe in a round.
+    let mut per_face: BTreeMap<(usize, usize), usize> = BTreeMap::new();
+    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    for (&(f, p, _, _), &full) in fails.iter().zip(&full) {
+        let n = per_face.entry((k.points[f].face.0, p)).or_default();
+        if !full && *n < ACQUIRE_PER_FACE && !pairs.contains(&(f, p)) {
+            *n += 1;
+            pairs.push((f, p));
+        }
+    }
     k.acquire_many(&pairs, m);
     for (&(f, p, s, o), full) in fails.iter().zip(full) {
         if full {
@@ -431,6 +428,9 @@ fn learn(k: &mut Knowledge, m: &Machine, mut fails: Vec<(usize, usize, usize, Op
         }
     }
 }
+
+/// How many points per face and probe get the whole probe's cones in one round.
+const ACQUIRE_PER_FACE: usize = 2;
 
 /// The fpoints of a face, by index.
 fn face_points(g: &MeasurementGraph, face: FaceId) -> Vec<usize> {
@@ -668,7 +668,9 @@ fn build(
     let geo = input.geometry;
     let hierarchy = &model.hierarchies[input.plan.hierarchy.0];
     // Group branches by setup (first appearance), then probe, then orientation.
-    let mut setups: Vec<(usize, V3, Vec<(usize, Vec<(usize, Vec<&Inst>)>)>)> = Vec::new();
+    // (setup, up, [(probe, [(orientation, trees)])])
+    type Probes<'a> = Vec<(usize, Vec<(usize, Vec<&'a Inst>)>)>;
+    let mut setups: Vec<(usize, V3, Probes)> = Vec::new();
     for b in branches {
         let si = match setups.iter().position(|s| s.0 == b.setup) {
             Some(i) => i,
@@ -857,14 +859,13 @@ fn build(
     }
 }
 
+/// A face visit: (tolerance, feature, face, on the table, points).
+type Visit<'a> =
+    dyn FnMut(Option<usize>, Option<crate::model::FeatureId>, FaceId, bool, &[usize]) + 'a;
+
 /// Walks an instance tree, calling `f(tolerance, feature, face, table, points)` for every
 /// face or table visit.
-fn collect(
-    i: &Inst,
-    tol: Option<usize>,
-    feat: Option<crate::model::FeatureId>,
-    f: &mut dyn FnMut(Option<usize>, Option<crate::model::FeatureId>, FaceId, bool, &[usize]),
-) {
+fn collect(i: &Inst, tol: Option<usize>, feat: Option<crate::model::FeatureId>, f: &mut Visit) {
     match &i.kind {
         Kind::Tol(t) => i
             .children

@@ -297,6 +297,63 @@ fn pick_setup(mu: &CubeMap, k: &Knowledge) -> usize {
     first.map_or(0, |c| mu.index(c))
 }
 
+/// For a bent probe, a setup of the cluster is only as good as the orientations it
+/// leaves: among a few candidates (the usual pick, the axes, and cells spread over the
+/// underlying set) take the one under which most of the cluster's points keep an
+/// orientation for some probe.
+fn pick_bent_setup(mu: &CubeMap, sub: &Inst, k: &mut Knowledge, m: &Machine) -> usize {
+    let mut cands = vec![pick_setup(mu, k)];
+    for d in [V3::z(), -V3::z(), V3::x(), -V3::x(), V3::y(), -V3::y()] {
+        let cell = mu.index(mu.cell_of(&d));
+        if Set::has(mu, cell) {
+            cands.push(cell);
+        }
+    }
+    let cells: Vec<Cell> = mu.cells().collect();
+    let step = cells.len().div_ceil(BENT_SETUP_SAMPLES).max(1);
+    cands.extend(
+        cells
+            .iter()
+            .skip(step / 2)
+            .step_by(step)
+            .map(|&c| mu.index(c)),
+    );
+    let mut seen = BTreeSet::new();
+    cands.retain(|c| seen.insert(*c));
+    if cands.len() == 1 {
+        return cands[0];
+    }
+    let mut pts = Vec::new();
+    leaves(sub, &mut pts);
+    pts.sort_unstable();
+    pts.dedup();
+    let shape = k.empty_cone();
+    let mut best = (0usize, cands[0]);
+    for &s in &cands {
+        let up = shape.direction(shape.cell(s));
+        let mut ok = 0;
+        for &f in &pts {
+            let probes = k.probes(f, s, m);
+            if probes
+                .ones()
+                .any(|p| !k.orientations(f, p, s, &up, m).is_empty())
+            {
+                ok += 1;
+            }
+        }
+        if ok > best.0 {
+            best = (ok, s);
+        }
+        if ok == pts.len() {
+            break;
+        }
+    }
+    best.1
+}
+
+/// How many cells of a cluster's underlying set a bent probe's setup pick tries.
+const BENT_SETUP_SAMPLES: usize = 8;
+
 /// Picks the cheapest probe, the lowest rack index on a tie.
 fn pick_probe(mu: &Bits, m: &Machine) -> usize {
     mu.ones()
@@ -364,9 +421,13 @@ pub(crate) fn solve(
     );
     let mut by_setup: Vec<(usize, Inst)> = Vec::new();
     for (j, cl) in tree.clusters.iter().enumerate() {
-        let s = pick_setup(&cl.set, k);
-        let sub = rest_on_table(&extract(root, &tree, &[j as u32]), s, k);
-        by_setup.push((s, sub));
+        let sub = extract(root, &tree, &[j as u32]);
+        let s = if m.bent {
+            pick_bent_setup(&cl.set, &sub, k, m)
+        } else {
+            pick_setup(&cl.set, k)
+        };
+        by_setup.push((s, rest_on_table(&sub, s, k)));
     }
     // 2. Probes, 3. orientations.
     let mut out = Vec::new();
@@ -506,8 +567,9 @@ pub(crate) fn violations(branches: &[Branch], m: &Machine, h: &Hierarchy) -> Vec
     h.levels
         .iter()
         .map(|l| {
-            let mut groups: BTreeMap<(Option<usize>, Option<FeatureId>), BTreeMap<Vec<i64>, u64>> =
-                BTreeMap::new();
+            // Per group (tolerance, feature), the count of each value.
+            type Counts = BTreeMap<Vec<i64>, u64>;
+            let mut groups: BTreeMap<(Option<usize>, Option<FeatureId>), Counts> = BTreeMap::new();
             for x in &all {
                 let g = match l.group {
                     Group::All => (None, None),

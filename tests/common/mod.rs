@@ -18,11 +18,26 @@ pub struct Flat {
 
 /// Checks `files` (path, contents) in memory; the first file is the root.
 pub fn check_files(files: &[(&str, &[u8])]) -> Vec<Flat> {
+    run_files(files, false)
+}
+
+/// [`check_files`] through the planner too.
+#[allow(dead_code)]
+pub fn plan_files(files: &[(&str, &[u8])]) -> Vec<Flat> {
+    run_files(files, true)
+}
+
+fn run_files(files: &[(&str, &[u8])], plan: bool) -> Vec<Flat> {
     let mut world = MemoryWorld::new();
     for (p, c) in files {
         world.insert(p, c.to_vec());
     }
-    let (checked, _, _) = inspc::measurement_graphs(&world, &[PathBuf::from(files[0].0)]);
+    let roots = [PathBuf::from(files[0].0)];
+    let checked = if plan {
+        inspc::plans(&world, &roots, &inspc::plan::PlanOptions::default()).0
+    } else {
+        inspc::measurement_graphs(&world, &roots).0
+    };
     checked
         .diagnostics
         .iter()
