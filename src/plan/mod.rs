@@ -351,6 +351,11 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
             }
         }
         if invalid.is_empty() {
+            debug_assert!(
+                audit(&mut k, &machine, &best.1).is_empty(),
+                "{:?}",
+                audit(&mut k, &machine, &best.1)
+            );
             return Some(build(
                 input,
                 &k,
@@ -374,6 +379,35 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
     );
     let _ = part;
     None
+}
+
+/// The configurations of a plan that lie outside their point's domain (there should be
+/// none): setup in the point's setups (or its table alternative), probe among those
+/// reaching it there, orientation in D1′.
+fn audit(k: &mut Knowledge, m: &Machine, branches: &[Branch]) -> Vec<String> {
+    let mut out = Vec::new();
+    for b in branches {
+        let mut pts = Vec::new();
+        solve::leaves(&b.tree, &mut pts);
+        for f in pts {
+            let ok = if f >= k.graph_points {
+                k.tables
+                    .iter()
+                    .any(|t| t.points.contains(&f) && t.cell == b.setup && t.alive)
+            } else {
+                cluster::Set::has(&k.setups(f, m), b.setup)
+                    && cluster::Set::has(&k.probes(f, b.setup, m), b.probe)
+            };
+            let o_ok = cluster::Set::has(&k.orientations(f, b.probe, b.setup, &b.up, m), b.orient);
+            if !ok || !o_ok {
+                out.push(format!(
+                    "point {f}: setup {} probe {} orientation {}",
+                    b.setup, b.probe, b.orient
+                ));
+            }
+        }
+    }
+    out
 }
 
 /// What makes one plan better than another: the hierarchy's violations level by level,
