@@ -228,7 +228,6 @@ impl Knowledge {
     /// The initial knowledge: half-line cones at every fpoint for every probe, table
     /// alternatives for datum faces that can rest on the table.
     pub(crate) fn new(
-        model: &Model,
         plan: &Plan,
         machine: &Machine,
         geometry: &crate::geometry::PartGeometry,
@@ -236,7 +235,6 @@ impl Knowledge {
         table_faces: &[FaceId],
         opts: ConeOptions,
     ) -> Knowledge {
-        let _ = model;
         let scene = Scene::of_part(geometry);
         // Preferred directions: the axes, the plan's setups, the table setups, then
         // feature axes and plane normals — a probe often fits a hole only along its

@@ -208,7 +208,6 @@ fn min_points(kind: SurfaceKind) -> usize {
 /// a search that does not settle, are reported in `diags` and give `None`.
 pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Option<Hlip> {
     let (model, plan, g) = (input.model, input.plan, input.graph);
-    let part = &model.parts[plan.part.0];
     let hierarchy = &model.hierarchies[plan.hierarchy.0];
     let machine = Machine::new(model, plan);
     // Datum faces that can rest on the table.
@@ -237,7 +236,6 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
         ..Default::default()
     };
     let mut k = Knowledge::new(
-        model,
         plan,
         &machine,
         input.geometry,
@@ -377,7 +375,6 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
             last,
         },
     );
-    let _ = part;
     None
 }
 
