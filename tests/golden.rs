@@ -5,7 +5,7 @@ use inspc::source::FsWorld;
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::diff;
+use common::{diff, spec_of};
 
 enum Outcome {
     Model(String),
@@ -27,15 +27,6 @@ fn run(spec: &Path) -> Outcome {
         Outcome::Diagnostics(rendered)
     } else {
         Outcome::Model(checked.summary() + &rendered)
-    }
-}
-
-fn spec_of(case: &Path) -> PathBuf {
-    let source = case.join("source.txt");
-    if source.exists() {
-        PathBuf::from(std::fs::read_to_string(&source).unwrap().trim())
-    } else {
-        case.join("main.insp")
     }
 }
 

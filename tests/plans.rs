@@ -9,16 +9,7 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::diff;
-
-fn spec_of(case: &Path) -> PathBuf {
-    let source = case.join("source.txt");
-    if source.exists() {
-        PathBuf::from(std::fs::read_to_string(&source).unwrap().trim())
-    } else {
-        case.join("main.insp")
-    }
-}
+use common::{diff, spec_of};
 
 /// Plans a spec: the HLIPs, or the rendered diagnostics.
 fn plan(spec: &Path) -> Result<Vec<Hlip>, String> {

@@ -66,6 +66,21 @@ pub fn face_dir(face: u8, u: f64, v: f64) -> V3 {
     d
 }
 
+/// The indices of the set bits of a word slice (64 to a word), ascending.
+pub fn ones(words: &[u64]) -> impl Iterator<Item = usize> + '_ {
+    words.iter().enumerate().flat_map(|(w, &word)| {
+        let mut rest = word;
+        std::iter::from_fn(move || {
+            if rest == 0 {
+                return None;
+            }
+            let b = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            Some(w * 64 + b)
+        })
+    })
+}
+
 impl CubeMap {
     /// The empty cone at resolution `n` with the given preferred directions.
     pub fn empty(n: u32, preferred: &[V3]) -> CubeMap {
@@ -225,18 +240,7 @@ impl CubeMap {
 
     /// The cells in the cone, in index order (faces, rows, columns, then preferred).
     pub fn cells(&self) -> impl Iterator<Item = Cell> + '_ {
-        self.bits.iter().enumerate().flat_map(move |(w, &word)| {
-            let mut rest = word;
-            std::iter::from_fn(move || {
-                if rest == 0 {
-                    return None;
-                }
-                let b = rest.trailing_zeros() as usize;
-                rest &= rest - 1;
-                Some(w * 64 + b)
-            })
-            .map(move |k| self.cell(k))
-        })
+        ones(&self.bits).map(move |k| self.cell(k))
     }
 
     fn same_shape(&self, o: &CubeMap) {

@@ -29,7 +29,7 @@ mod report;
 mod scene;
 
 pub use cpu::pixels_for;
-pub use cubemap::{face_dir, face_uv, Cell, CubeMap, Pixel};
+pub use cubemap::{face_dir, face_uv, ones, Cell, CubeMap, Pixel};
 pub use errors::AccessError;
 pub use exact::{component_hits, refine};
 pub use probe::{Component, End, ProbeShape};

@@ -4,6 +4,7 @@
 //! The sets are bitsets — cube-map cones for setups, probe sets, A/B-grid orientation
 //! sets — behind [`Set`], so one implementation serves every variable.
 
+pub use crate::access::ones;
 use crate::access::CubeMap;
 
 /// A set the solver clusters: a bitset over a fixed universe.
@@ -78,6 +79,19 @@ impl Bits {
         self.words[e / 64] &= !(1 << (e % 64));
     }
 
+    /// The union.
+    pub fn or(&self, o: &Bits) -> Bits {
+        Bits {
+            len: self.len,
+            words: self
+                .words
+                .iter()
+                .zip(&o.words)
+                .map(|(a, b)| a | b)
+                .collect(),
+        }
+    }
+
     /// The elements, ascending.
     pub fn ones(&self) -> impl Iterator<Item = usize> + '_ {
         ones(&self.words)
@@ -99,21 +113,6 @@ impl Set for Bits {
     fn words(&self) -> &[u64] {
         &self.words
     }
-}
-
-/// The set bits of a word slice, ascending.
-pub fn ones(words: &[u64]) -> impl Iterator<Item = usize> + '_ {
-    words.iter().enumerate().flat_map(|(w, &word)| {
-        let mut rest = word;
-        std::iter::from_fn(move || {
-            if rest == 0 {
-                return None;
-            }
-            let b = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            Some(w * 64 + b)
-        })
-    })
 }
 
 /// A cluster: members (indices into the clustered collection) and their underlying set.
@@ -307,25 +306,9 @@ pub fn min_hitting_set<S: Set>(w: &[&S], budget: usize) -> (usize, bool) {
     while covered.count() < n {
         let best = keep
             .iter()
-            .max_by_key(|c| {
-                let new = c
-                    .words
-                    .iter()
-                    .zip(&covered.words)
-                    .map(|(a, b)| (a & !b).count_ones())
-                    .sum::<u32>();
-                new
-            })
+            .max_by_key(|c| c.or(&covered).count())
             .expect("every set is non-empty");
-        covered = Bits {
-            len: n,
-            words: covered
-                .words
-                .iter()
-                .zip(&best.words)
-                .map(|(a, b)| a | b)
-                .collect(),
-        };
+        covered = covered.or(best);
         greedy += 1;
     }
     if greedy == lower {
@@ -358,16 +341,16 @@ pub fn min_hitting_set<S: Set>(w: &[&S], budget: usize) -> (usize, bool) {
             return;
         }
         for c in keep.iter().filter(|c| c.has(first)) {
-            let next = Bits {
-                len: n,
-                words: covered
-                    .words
-                    .iter()
-                    .zip(&c.words)
-                    .map(|(a, b)| a | b)
-                    .collect(),
-            };
-            search(&next, depth + 1, n, keep, best, nodes, budget, complete);
+            search(
+                &covered.or(c),
+                depth + 1,
+                n,
+                keep,
+                best,
+                nodes,
+                budget,
+                complete,
+            );
             if !*complete {
                 return;
             }

@@ -154,6 +154,8 @@ pub(crate) struct Knowledge {
     d1p: BTreeMap<(usize, usize, usize), Bits>,
     /// The second component's depth map per setup cell.
     second: BTreeMap<usize, SecondMap>,
+    /// The table's height per setup cell.
+    heights: BTreeMap<usize, f64>,
     /// How many times the whole probe's cones were computed.
     pub acquired: usize,
 }
@@ -331,6 +333,7 @@ impl Knowledge {
             tables,
             d1p: BTreeMap::new(),
             second: BTreeMap::new(),
+            heights: BTreeMap::new(),
             acquired: 0,
         }
     }
@@ -338,6 +341,22 @@ impl Knowledge {
     /// An empty cube map of the knowledge's shape.
     pub(crate) fn empty_cone(&self) -> CubeMap {
         CubeMap::empty(self.opts.n, &self.opts.preferred)
+    }
+
+    /// The up direction of setup cell `s`.
+    pub(crate) fn setup_dir(&self, s: usize) -> V3 {
+        let shape = &self.forbidden;
+        shape.direction(shape.cell(s))
+    }
+
+    /// The table's height under the part in setup cell `s` (cached).
+    pub(crate) fn table_height(&mut self, s: usize) -> f64 {
+        if let Some(&h) = self.heights.get(&s) {
+            return h;
+        }
+        let h = table_height(&self.scene, &self.setup_dir(s));
+        self.heights.insert(s, h);
+        h
     }
 
     /// The setups from which some allowed probe reaches graph fpoint `f`.
@@ -379,14 +398,15 @@ impl Knowledge {
         if let Some(b) = self.d1p.get(&(f, p, s)) {
             return b.clone();
         }
+        let t0 = self.table_height(s);
         let probe = &machine.probes[p];
         let point = &self.points[f];
         let c = point.tip_centre(probe.tip_radius);
-        let t0 = table_height(&self.scene, up);
+        let to_part = frame(up).inverse();
         let dirs: Vec<V3> = machine
             .grid
             .iter()
-            .map(|&(a, b)| orientation_dir(up, a, b))
+            .map(|&(a, b)| to_part * access::head_direction(a, b))
             .collect();
         let table = f >= self.graph_points;
         let d1 = self.dom.get(f).and_then(|d| d[p].d1.clone());

@@ -325,7 +325,7 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
         pips.retain(|(p, _)| !validated.contains(p));
         let heights: BTreeMap<usize, f64> = pips
             .iter()
-            .map(|(p, up)| (p.setup, domain::table_height(&k.scene, up)))
+            .map(|(p, _)| (p.setup, k.table_height(p.setup)))
             .collect();
         let checked: Vec<(Pip, Option<String>)> = pips
             .par_iter()
@@ -670,18 +670,9 @@ fn blocking(k: &Knowledge, m: &Machine, p: usize, f: usize) -> (usize, String) {
     )
 }
 
-/// The direction deepest inside a cone.
+/// The direction deepest inside a cone (+z when it is empty).
 fn deepest(c: &crate::access::CubeMap) -> V3 {
-    let mut cur = c.clone();
-    loop {
-        let e = cur.and(&cur.not().grow().not());
-        if e.is_empty() {
-            break;
-        }
-        cur = e;
-    }
-    let first = cur.cells().next();
-    first.map_or(V3::z(), |cell| cur.direction(cell))
+    solve::deepest(c).map_or(V3::z(), |cell| c.direction(cell))
 }
 
 /// Assembles the HLIP tree from the branches.

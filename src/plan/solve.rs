@@ -209,6 +209,14 @@ pub(crate) fn leaves(inst: &Inst, out: &mut Vec<usize>) {
     }
 }
 
+/// The leaves of a tree with their table alternatives, in order.
+fn leaf_kinds(inst: &Inst, out: &mut Vec<(usize, Option<usize>)>) {
+    match inst.kind {
+        Kind::Point { point, table } => out.push((point, table)),
+        _ => inst.children.iter().for_each(|c| leaf_kinds(c, out)),
+    }
+}
+
 /// Replaces datum faces by the table where the setup rests them on it.
 fn rest_on_table(inst: &Inst, setup: usize, k: &Knowledge) -> Inst {
     if let Kind::Face {
@@ -285,6 +293,12 @@ fn pick_setup(mu: &CubeMap, k: &Knowledge) -> usize {
     if let Some(t) = k.tables.iter().find(|t| Set::has(mu, t.cell)) {
         return t.cell;
     }
+    deepest(mu).map_or(0, |c| mu.index(c))
+}
+
+/// The cell deepest inside a cone: the first left by eroding it until one more erosion
+/// would empty it.
+pub(crate) fn deepest(mu: &CubeMap) -> Option<Cell> {
     let mut cur = mu.clone();
     loop {
         let eroded = cur.and(&cur.not().grow().not());
@@ -293,8 +307,8 @@ fn pick_setup(mu: &CubeMap, k: &Knowledge) -> usize {
         }
         cur = eroded;
     }
-    let first = cur.cells().next().or_else(|| mu.cells().next());
-    first.map_or(0, |c| mu.index(c))
+    let first = cur.cells().next();
+    first
 }
 
 /// For a bent probe, a setup of the cluster is only as good as the orientations it
@@ -327,10 +341,9 @@ fn pick_bent_setup(mu: &CubeMap, sub: &Inst, k: &mut Knowledge, m: &Machine) -> 
     leaves(sub, &mut pts);
     pts.sort_unstable();
     pts.dedup();
-    let shape = k.empty_cone();
     let mut best = (0usize, cands[0]);
     for &s in &cands {
-        let up = shape.direction(shape.cell(s));
+        let up = k.setup_dir(s);
         let mut ok = 0;
         for &f in &pts {
             let probes = k.probes(f, s, m);
@@ -384,29 +397,19 @@ pub(crate) fn solve(
     strategy: Strategy,
 ) -> Result<Vec<Branch>, Vec<Failure>> {
     // 1. Setups.
+    let mut pts = Vec::new();
+    leaf_kinds(root, &mut pts);
     let mut setup_sets: BTreeMap<(usize, Option<usize>), CubeMap> = BTreeMap::new();
-    let collect = |inst: &Inst, out: &mut BTreeMap<(usize, Option<usize>), CubeMap>| {
-        fn rec(
-            i: &Inst,
-            k: &Knowledge,
-            m: &Machine,
-            out: &mut BTreeMap<(usize, Option<usize>), CubeMap>,
-        ) {
-            if let Kind::Point { point, table } = i.kind {
-                out.entry((point, table)).or_insert_with(|| {
-                    let mut s = k.setups(point, m);
-                    if let Some(t) = table {
-                        let c = s.cell(k.tables[t].cell);
-                        s.set(c, true);
-                    }
-                    s
-                });
+    for key in pts {
+        setup_sets.entry(key).or_insert_with(|| {
+            let mut s = k.setups(key.0, m);
+            if let Some(t) = key.1 {
+                let c = s.cell(k.tables[t].cell);
+                s.set(c, true);
             }
-            i.children.iter().for_each(|c| rec(c, k, m, out));
-        }
-        rec(inst, k, m, out)
-    };
-    collect(root, &mut setup_sets);
+            s
+        });
+    }
     let sw = |e: usize| k.setup_weight.get(&e).copied().unwrap_or(0.5);
     let leaf_setup = |i: &Inst| match i.kind {
         Kind::Point { point, table } => setup_sets[&(point, table)].clone(),
@@ -434,7 +437,7 @@ pub(crate) fn solve(
     let mut failures = Vec::new();
     let pw = |p: usize| 1.0 / m.costs.get(p).copied().unwrap_or(1.0).max(1e-3);
     for (s, sub) in by_setup {
-        let upd = k.empty_cone().direction(k.empty_cone().cell(s));
+        let upd = k.setup_dir(s);
         let mut probe_sets: BTreeMap<usize, Bits> = BTreeMap::new();
         let mut pts = Vec::new();
         leaves(&sub, &mut pts);

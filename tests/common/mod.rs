@@ -99,3 +99,14 @@ pub fn diff(expected: &str, actual: &str) -> String {
     }
     out.join("\n")
 }
+
+/// The spec of a golden case folder: the path in its `source.txt`, else its `main.insp`.
+#[allow(dead_code)]
+pub fn spec_of(case: &std::path::Path) -> PathBuf {
+    let source = case.join("source.txt");
+    if source.exists() {
+        PathBuf::from(std::fs::read_to_string(&source).unwrap().trim())
+    } else {
+        case.join("main.insp")
+    }
+}
