@@ -7,10 +7,12 @@
 
 pub mod access;
 pub mod diag;
+pub mod dmis;
 pub mod geometry;
 pub mod graph;
 pub mod load;
 pub mod model;
+pub mod path;
 pub mod plan;
 pub mod resolve;
 pub mod sample;
@@ -73,9 +75,15 @@ pub fn check_geometry(
     roots: &[PathBuf],
 ) -> (Checked, Vec<Option<PartData>>) {
     let mut checked = check(world, roots);
+    let parts = geometry_of(world, &mut checked);
+    (checked, parts)
+}
+
+/// The geometry stage over a checked spec (see [`check_geometry`]).
+fn geometry_of(world: &dyn source::World, checked: &mut Checked) -> Vec<Option<PartData>> {
     let mut out = vec![None; checked.model.parts.len()];
     if checked.has_errors() {
-        return (checked, out);
+        return out;
     }
     let mut diags = diag::Diagnostics::new();
     for (k, part) in checked.model.parts.iter().enumerate() {
@@ -108,7 +116,7 @@ pub fn check_geometry(
         });
     }
     checked.absorb(diags);
-    (checked, out)
+    out
 }
 
 /// One measurement graph: for a plan of a root file, or for a root file's part that no
@@ -139,9 +147,15 @@ pub fn measurement_graphs(
     roots: &[PathBuf],
 ) -> (Checked, Vec<Option<PartData>>, Vec<Graphed>) {
     let (mut checked, parts) = check_geometry(world, roots);
+    let graphs = graphs_of(&mut checked, &parts);
+    (checked, parts, graphs)
+}
+
+/// The sampling and graph stage over a spec with geometry (see [`measurement_graphs`]).
+fn graphs_of(checked: &mut Checked, parts: &[Option<PartData>]) -> Vec<Graphed> {
     let mut out = Vec::new();
     if checked.has_errors() {
-        return (checked, parts, out);
+        return out;
     }
     let model = &checked.model;
     let mut diags = diag::Diagnostics::new();
@@ -173,7 +187,7 @@ pub fn measurement_graphs(
         });
     }
     checked.absorb(diags);
-    (checked, parts, out)
+    out
 }
 
 /// One plan's result.
@@ -193,13 +207,24 @@ pub fn plans(
     opts: &plan::PlanOptions,
 ) -> (Checked, Vec<Option<PartData>>, Vec<Graphed>, Vec<Planned>) {
     let (mut checked, parts, graphs) = measurement_graphs(world, roots);
+    let out = plans_of(&mut checked, &parts, &graphs, opts);
+    (checked, parts, graphs, out)
+}
+
+/// The planning stage over the measurement graphs (see [`plans`]).
+fn plans_of(
+    checked: &mut Checked,
+    parts: &[Option<PartData>],
+    graphs: &[Graphed],
+    opts: &plan::PlanOptions,
+) -> Vec<Planned> {
     let mut out = Vec::new();
     if checked.has_errors() {
-        return (checked, parts, graphs, out);
+        return out;
     }
     let mut diags = diag::Diagnostics::new();
     let model = &checked.model;
-    for g in &graphs {
+    for g in graphs {
         let Some(name) = &g.graph.plan else {
             let part = &model.parts[g.part];
             diags.push(
@@ -225,7 +250,116 @@ pub fn plans(
         out.push(Planned { plan: k, hlip });
     }
     checked.absorb(diags);
-    (checked, parts, graphs, out)
+    out
+}
+
+/// One plan built: its HLIP, its paths and its DMIS program.
+pub struct Built {
+    /// The plan, by index into [`model::Model::plans`].
+    pub plan: usize,
+    /// The high-level plan.
+    pub hlip: plan::Hlip,
+    /// Its moves.
+    pub llip: path::Llip,
+    /// The DMIS program.
+    pub dmis: String,
+}
+
+/// Where a build's time went, stage by stage.
+#[derive(Debug, Clone, Default)]
+pub struct Timings {
+    /// (stage, seconds), in pipeline order.
+    pub stages: Vec<(&'static str, f64)>,
+}
+
+/// Reports a build's progress: (what, done, total).
+pub type Progress<'a> = &'a (dyn Fn(&str, usize, usize) + Sync);
+
+/// The whole pipeline: front end, geometry, graphs, plans, paths and DMIS. `Built` holds
+/// every plan that got through; the caller writes nothing unless `Checked` has no errors.
+pub fn build(
+    world: &dyn source::World,
+    roots: &[PathBuf],
+    opts: &plan::PlanOptions,
+    progress: Progress,
+) -> (Checked, Vec<Built>, Timings) {
+    let mut t = Timings::default();
+    let mut clock = std::time::Instant::now();
+    let mut lap = |t: &mut Timings, stage: &'static str| {
+        t.stages.push((stage, clock.elapsed().as_secs_f64()));
+        clock = std::time::Instant::now();
+    };
+    progress("front end", 0, 1);
+    let mut checked = check(world, roots);
+    lap(&mut t, "front end");
+    progress("geometry", 0, 1);
+    let parts = geometry_of(world, &mut checked);
+    lap(&mut t, "geometry");
+    progress("measurement graph", 0, 1);
+    let graphs = graphs_of(&mut checked, &parts);
+    lap(&mut t, "graph");
+    progress("planning", 0, 1);
+    let planned = plans_of(&mut checked, &parts, &graphs, opts);
+    lap(&mut t, "plan");
+    let mut out = Vec::new();
+    if checked.has_errors() {
+        return (checked, out, t);
+    }
+    let mut diags = diag::Diagnostics::new();
+    let mut paths = Vec::new();
+    for p in planned {
+        let Some(hlip) = p.hlip else { continue };
+        let plan = &checked.model.plans[p.plan];
+        let Some(g) = graphs
+            .iter()
+            .find(|g| g.graph.plan.as_deref() == Some(&plan.name))
+        else {
+            continue;
+        };
+        let Some(data) = &parts[g.part] else { continue };
+        let input = plan::Input {
+            model: &checked.model,
+            plan,
+            geometry: &data.geometry,
+            graph: &g.graph,
+        };
+        let report = |done: usize, total: usize| progress("paths", done, total);
+        if let Some(llip) = path::plan(&input, &hlip, &report, &mut diags) {
+            paths.push((p.plan, g.part, hlip, llip));
+        }
+    }
+    checked.absorb(diags);
+    lap(&mut t, "paths");
+    if checked.has_errors() {
+        return (checked, out, t);
+    }
+    progress("dmis", 0, 1);
+    for (k, part, hlip, llip) in paths {
+        let Some(data) = &parts[part] else { continue };
+        let dmis = dmis::write(&dmis::Input {
+            model: &checked.model,
+            plan: &checked.model.plans[k],
+            geometry: &data.geometry,
+            hlip: &hlip,
+            llip: &llip,
+            source: checked
+                .sources
+                .get(checked.model.plans[k].span.file)
+                .path
+                .as_deref()
+                .and_then(|p| p.file_name())
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+        });
+        out.push(Built {
+            plan: k,
+            hlip,
+            llip,
+            dmis,
+        });
+    }
+    lap(&mut t, "dmis");
+    (checked, out, t)
 }
 
 /// Runs the front end (load, parse, resolve) over root files.

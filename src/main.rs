@@ -115,6 +115,28 @@ enum Command {
         #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(8..=256))]
         resolution: u32,
     },
+    /// Builds a spec into a DMIS program: plans, paths, program. Writes nothing unless
+    /// every plan succeeds.
+    Build {
+        /// The `.insp` spec.
+        file: PathBuf,
+        /// Where to write the program (default: the plan's `output { dmis }`, else
+        /// `<spec>.dmi` beside the spec).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Also write the plan with its paths as JSON.
+        #[arg(long)]
+        plan_json: Option<PathBuf>,
+        /// Cube-map resolution of the accessibility cones.
+        #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(8..=256))]
+        resolution: u32,
+    },
+    /// Reads a DMIS program and checks it as a controller would: line lengths, labels,
+    /// names defined before use, MEAS blocks.
+    Dmis {
+        /// The `.dmi` file.
+        file: PathBuf,
+    },
     /// Checks specs: parses, resolves names and units, checks values. Exits 1 on error.
     Check {
         /// The `.insp` files.
@@ -167,6 +189,13 @@ fn main() -> ExitCode {
             format,
             resolution,
         } => plan(&file, format, resolution),
+        Command::Build {
+            file,
+            output,
+            plan_json,
+            resolution,
+        } => build(&file, output, plan_json, resolution),
+        Command::Dmis { file } => read_dmis(&file),
         Command::Check {
             files,
             message_format,
@@ -300,6 +329,149 @@ fn plan(file: &std::path::Path, format: TableFormat, n: u32) -> ExitCode {
         }
     }
     ExitCode::SUCCESS
+}
+
+/// `inspc build`: the whole pipeline, then every output written atomically.
+fn build(
+    file: &std::path::Path,
+    output: Option<PathBuf>,
+    plan_json: Option<PathBuf>,
+    n: u32,
+) -> ExitCode {
+    let opts = inspc::plan::PlanOptions {
+        n,
+        ..Default::default()
+    };
+    let start = std::time::Instant::now();
+    let bar = indicatif::ProgressBar::new_spinner();
+    if std::io::stderr().is_terminal() {
+        bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    } else {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    let report = |what: &str, done: usize, total: usize| {
+        if total > 1 {
+            bar.set_message(format!("{what} {done}/{total}"));
+        } else {
+            bar.set_message(what.to_string());
+        }
+    };
+    let (checked, built, timings) = inspc::build(&FsWorld, &[file.to_path_buf()], &opts, &report);
+    bar.finish_and_clear();
+    print_diagnostics(&checked.sources, &checked.diagnostics);
+    if checked.has_errors() {
+        eprintln!("inspc: nothing written");
+        return ExitCode::from(1);
+    }
+    if built.is_empty() {
+        eprintln!("inspc: {} has no plan to build", file.display());
+        return ExitCode::from(1);
+    }
+    if built.len() > 1 && (output.is_some() || plan_json.is_some()) {
+        eprintln!(
+            "inspc: {} holds {} plans; -o and --plan-json name one file, so leave them out and each plan writes its own",
+            file.display(),
+            built.len()
+        );
+        return ExitCode::from(2);
+    }
+    // Every file is decided before any is written.
+    let dir = file.parent().unwrap_or(std::path::Path::new(""));
+    let stem = file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "program".into());
+    let mut writes: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    for b in &built {
+        let plan = &checked.model.plans[b.plan];
+        let dmi = output.clone().unwrap_or_else(|| match &plan.outputs.dmis {
+            Some(p) => dir.join(p),
+            None if built.len() == 1 => dir.join(format!("{stem}.dmi")),
+            None => dir.join(format!("{stem}_{}.dmi", plan.name)),
+        });
+        writes.push((dmi, b.dmis.clone().into_bytes()));
+        let json = plan_json
+            .clone()
+            .or_else(|| plan.outputs.plan.as_ref().map(|p| dir.join(p)));
+        if let Some(j) = json {
+            let v = inspc::path::json(&b.hlip, &b.llip);
+            let text = serde_json::to_string_pretty(&v).unwrap_or_default() + "\n";
+            writes.push((j, text.into_bytes()));
+        }
+    }
+    for (path, bytes) in &writes {
+        if let Err(e) = write_atomically(path, bytes) {
+            eprintln!("inspc: cannot write {}: {e}", path.display());
+            return ExitCode::from(1);
+        }
+    }
+    for b in &built {
+        let h = &b.hlip;
+        let l = &b.llip;
+        let s = &h.summary;
+        println!(
+            "plan {}: {} setups, {} probes, {} orientations, {} features, {} touches",
+            h.plan, s.setups, s.probes_used, s.orientations, s.features, l.summary.touches
+        );
+        println!(
+            "  path {:.1} m in {} groups ({} roadmap nodes added, {} moves checked)",
+            l.summary.length / 1000.0,
+            l.summary.groups,
+            l.summary.added_nodes,
+            l.summary.checks
+        );
+    }
+    let stages: Vec<String> = timings
+        .stages
+        .iter()
+        .map(|(s, t)| format!("{s} {t:.2} s"))
+        .collect();
+    println!("  time: {}", stages.join(", "));
+    for (path, bytes) in &writes {
+        println!("wrote {} ({} bytes)", path.display(), bytes.len());
+    }
+    eprintln!("inspc: built in {:.2} s", start.elapsed().as_secs_f64());
+    ExitCode::SUCCESS
+}
+
+/// `inspc dmis`: reads a program and reports what a controller would reject.
+fn read_dmis(file: &std::path::Path) -> ExitCode {
+    let text = match std::fs::read(file) {
+        Ok(b) => String::from_utf8_lossy(&b).into_owned(),
+        Err(e) => {
+            eprintln!("inspc: cannot read {}: {e}", file.display());
+            return ExitCode::from(1);
+        }
+    };
+    match inspc::dmis::read(&file.display().to_string(), &text) {
+        Ok(p) => {
+            let count = |m: &str| p.commands(m).count();
+            println!(
+                "{}: {} statements, {} sensors, {} features, {} tolerances, {} MEAS blocks, {} touches, {} moves",
+                file.display(),
+                p.statements.len(),
+                count("SNSDEF"),
+                count("FEAT"),
+                count("TOL"),
+                count("MEAS"),
+                count("PTMEAS"),
+                count("GOTO")
+            );
+            ExitCode::SUCCESS
+        }
+        Err(errors) => {
+            let handler = miette::GraphicalReportHandler::new_themed(
+                miette::GraphicalTheme::unicode_nocolor(),
+            );
+            for e in &errors {
+                let mut out = String::new();
+                let _ = handler.render_report(&mut out, e);
+                eprint!("{out}");
+            }
+            eprintln!("inspc: {} problems in {}", errors.len(), file.display());
+            ExitCode::from(1)
+        }
+    }
 }
 
 /// Writes a file whole or not at all: a temporary beside it, then a rename.

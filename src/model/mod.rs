@@ -396,6 +396,32 @@ pub struct Outputs {
     pub graph: Option<String>,
 }
 
+/// How the probe moves around a touch and between groups (mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Motion {
+    /// Distance before the nominal point where the touch move starts (DMIS `APPRCH`).
+    pub prehit: f64,
+    /// Distance the probe backs off along the normal after a touch (DMIS `RETRCT`).
+    pub retract: f64,
+    /// How far past the nominal point the touch move searches (DMIS `SEARCH`).
+    pub search: f64,
+    /// Height above the part's top of the clearance plane between groups (DMIS `CLRSRF`).
+    pub clearance: f64,
+}
+
+impl Default for Motion {
+    /// Defaults for a TP20 on a touch-trigger head: 2 mm pre-hit and retract (the
+    /// module's pre-travel is well under 1 mm), 4 mm search, 20 mm clearance.
+    fn default() -> Self {
+        Motion {
+            prehit: 2.0,
+            retract: 2.0,
+            search: 4.0,
+            clearance: 20.0,
+        }
+    }
+}
+
 /// A plan: which part on which machine, and what a good plan is.
 #[derive(Debug, Clone)]
 pub struct Plan {
@@ -419,6 +445,8 @@ pub struct Plan {
     pub probes: Vec<ProbePref>,
     /// Output files.
     pub outputs: Outputs,
+    /// Approach, retract and clearance distances.
+    pub motion: Motion,
     /// Where it was declared.
     pub span: Span,
 }

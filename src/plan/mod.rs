@@ -20,6 +20,7 @@ mod render;
 mod solve;
 mod validate;
 
+pub(crate) use domain::lowest;
 pub use errors::PlanError;
 pub use render::{json, text};
 
@@ -41,8 +42,6 @@ pub struct PlanOptions {
     pub n: u32,
     /// The most generate-and-test rounds before giving up.
     pub max_iterations: usize,
-    /// Retract (and prehit) distance along the normal (mm).
-    pub retract: f64,
     /// Search nodes for the exact minimum number of setups.
     pub exact_budget: usize,
 }
@@ -52,7 +51,6 @@ impl Default for PlanOptions {
         PlanOptions {
             n: 64,
             max_iterations: 40,
-            retract: 2.0,
             exact_budget: 200_000,
         }
     }
@@ -232,7 +230,8 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
     }
     let cone_opts = crate::access::ConeOptions {
         n: opts.n,
-        retract: opts.retract,
+        // The approach validated is the longer of the pre-hit and retract moves.
+        retract: input.plan.motion.prehit.max(input.plan.motion.retract),
         ..Default::default()
     };
     let mut k = Knowledge::new(

@@ -64,6 +64,26 @@ pub(super) fn lower(
             _ => cx.mismatch(v, "a block `{ dmis \"out.dmi\" }`", ""),
         }
     }
+    let mut motion = Motion::default();
+    if let Some(v) = pp.get("motion") {
+        match &v.kind {
+            ValueKind::Block(ops) => {
+                let mut o = Props::new(cx, "`motion`", v.span, ops);
+                for (key, slot) in [
+                    ("prehit", &mut motion.prehit),
+                    ("retract", &mut motion.retract),
+                    ("search", &mut motion.search),
+                    ("clearance", &mut motion.clearance),
+                ] {
+                    if let Some(x) = o.get(key).and_then(|x| cx.positive(x, Dim::Length, key)) {
+                        *slot = x;
+                    }
+                }
+                o.finish(cx);
+            }
+            _ => cx.mismatch(v, "a block `{ prehit 2 mm, retract 2 mm }`", ""),
+        }
+    }
     pp.finish(cx);
     let (part, cmm, hierarchy, sampling) = (part?, cmm?, hierarchy?, sampling?);
     let the_part = &model.parts[part];
@@ -81,6 +101,7 @@ pub(super) fn lower(
         orientations: vec![],
         probes: vec![],
         outputs,
+        motion,
         span: p.name.span,
     };
     for s in &p.stmts {

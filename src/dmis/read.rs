@@ -1,0 +1,428 @@
+//! A reader for the DMIS we write: statements with their labels and parameters, and the
+//! checks a controller would make before running a program — line length, legal and
+//! unique labels, names defined before use, `MEAS` blocks with as many touches as they
+//! announce and nothing but moves inside, `DMISMN` first and `ENDFIL` last.
+
+use super::text::{is_label, split_params, LINE_MAX};
+use miette::{Diagnostic, NamedSource, SourceSpan};
+use std::collections::{BTreeMap, BTreeSet};
+use thiserror::Error;
+
+/// One statement.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Statement {
+    /// `$$ text`.
+    Comment(String),
+    /// `[KIND(label)=]MAJOR[/params]`.
+    Command {
+        /// `F`, `S`, `T`, `DAT`, `D` and the label.
+        label: Option<(String, String)>,
+        /// `FEAT`, `GOTO`, `PTMEAS`, ….
+        major: String,
+        /// The parameters, as written.
+        params: Vec<String>,
+        /// Byte offset of the statement in the text.
+        at: usize,
+    },
+}
+
+/// A program read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Program {
+    /// Its statements in order.
+    pub statements: Vec<Statement>,
+}
+
+impl Program {
+    /// The commands with a given major word.
+    pub fn commands<'a>(&'a self, major: &'a str) -> impl Iterator<Item = &'a [String]> + 'a {
+        self.statements.iter().filter_map(move |s| match s {
+            Statement::Command {
+                major: m, params, ..
+            } if m == major => Some(&params[..]),
+            _ => None,
+        })
+    }
+
+    /// The text again, through the writer's line rules: byte-identical to what inspc
+    /// wrote.
+    pub fn to_text(&self) -> String {
+        let mut out = String::new();
+        for s in &self.statements {
+            match s {
+                Statement::Comment(c) => {
+                    out.push_str("$$ ");
+                    out.push_str(c);
+                    out.push('\n');
+                }
+                Statement::Command {
+                    label,
+                    major,
+                    params,
+                    ..
+                } => {
+                    let mut t = String::new();
+                    if let Some((k, l)) = label {
+                        t.push_str(&format!("{k}({l})="));
+                    }
+                    t.push_str(major);
+                    if !params.is_empty() {
+                        t.push('/');
+                        t.push_str(&params.join(","));
+                    }
+                    for line in super::text::wrap(&t) {
+                        out.push_str(&line);
+                        out.push('\n');
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// What is wrong with a DMIS program.
+#[derive(Debug, Error, Diagnostic)]
+#[allow(missing_docs)]
+pub enum DmisError {
+    #[error("line {line} is {len} characters long; DMIS lines hold at most {LINE_MAX}")]
+    #[diagnostic(
+        code(insp::dmis::long_line),
+        help("break the statement after a comma and end the line with `$`")
+    )]
+    LongLine {
+        #[source_code]
+        src: NamedSource<String>,
+        #[label("this line")]
+        span: SourceSpan,
+        line: usize,
+        len: usize,
+    },
+    #[error("`{text}` is not a DMIS statement")]
+    #[diagnostic(
+        code(insp::dmis::syntax),
+        help("statements read `[KIND(label)=]MAJOR/param,param,…`, comments start with `$$`")
+    )]
+    Syntax {
+        #[source_code]
+        src: NamedSource<String>,
+        #[label("here")]
+        span: SourceSpan,
+        text: String,
+    },
+    #[error("`{label}` is not a legal label")]
+    #[diagnostic(
+        code(insp::dmis::bad_label),
+        help("labels are 1 to 16 characters: an upper-case letter, then letters, digits or `_`")
+    )]
+    BadLabel {
+        #[source_code]
+        src: NamedSource<String>,
+        #[label("this label")]
+        span: SourceSpan,
+        label: String,
+    },
+    #[error("{kind}({label}) is defined twice")]
+    #[diagnostic(
+        code(insp::dmis::duplicate_label),
+        help("every feature, sensor and tolerance needs a label of its own")
+    )]
+    Duplicate {
+        #[source_code]
+        src: NamedSource<String>,
+        #[label("defined again here")]
+        span: SourceSpan,
+        kind: String,
+        label: String,
+    },
+    #[error("{kind}({label}) is used but never defined")]
+    #[diagnostic(
+        code(insp::dmis::undefined),
+        help("define it with `{kind}({label})=…` before this statement")
+    )]
+    Undefined {
+        #[source_code]
+        src: NamedSource<String>,
+        #[label("used here")]
+        span: SourceSpan,
+        kind: String,
+        label: String,
+    },
+    #[error("{what}")]
+    #[diagnostic(code(insp::dmis::structure), help("{help}"))]
+    Structure {
+        #[source_code]
+        src: NamedSource<String>,
+        #[label("here")]
+        span: SourceSpan,
+        what: String,
+        help: String,
+    },
+}
+
+/// Statements that may appear between `MEAS` and `ENDMES`.
+const IN_MEAS: &[&str] = &["GOTO", "PTMEAS"];
+
+/// Parses and checks a program; every problem found, in text order.
+pub fn read(name: &str, text: &str) -> Result<Program, Vec<DmisError>> {
+    let src = || NamedSource::new(name, text.to_string());
+    let mut errors = Vec::new();
+    let mut statements = Vec::new();
+    // Physical lines → logical statements.
+    let mut offset = 0;
+    let mut pending: Option<(usize, String)> = None;
+    for (k, line) in text.split_inclusive('\n').enumerate() {
+        let at = offset;
+        offset += line.len();
+        let line = line.trim_end_matches('\n').trim_end_matches('\r');
+        if line.chars().count() > LINE_MAX {
+            errors.push(DmisError::LongLine {
+                src: src(),
+                span: (at, line.len()).into(),
+                line: k + 1,
+                len: line.chars().count(),
+            });
+        }
+        if pending.is_none() {
+            if let Some(c) = line.strip_prefix("$$") {
+                statements.push(Statement::Comment(
+                    c.strip_prefix(' ').unwrap_or(c).to_string(),
+                ));
+                continue;
+            }
+            if line.trim().is_empty() {
+                continue;
+            }
+        }
+        let (start, mut acc) = pending.take().unwrap_or((at, String::new()));
+        if let Some(body) = line.strip_suffix('$') {
+            acc.push_str(body);
+            pending = Some((start, acc));
+            continue;
+        }
+        acc.push_str(line);
+        match parse(&acc, start) {
+            Some(s) => statements.push(s),
+            None => errors.push(DmisError::Syntax {
+                src: src(),
+                span: (start, acc.len().min(text.len() - start)).into(),
+                text: acc.chars().take(40).collect(),
+            }),
+        }
+    }
+    if let Some((start, acc)) = pending {
+        errors.push(DmisError::Syntax {
+            src: src(),
+            span: (start, 0).into(),
+            text: acc.chars().take(40).collect(),
+        });
+    }
+    check(&statements, text, &src, &mut errors);
+    if errors.is_empty() {
+        Ok(Program { statements })
+    } else {
+        Err(errors)
+    }
+}
+
+/// One logical statement.
+fn parse(s: &str, at: usize) -> Option<Statement> {
+    let (label, rest) = match s.split_once('=') {
+        Some((l, r)) if l.ends_with(')') && !l.contains('\'') => {
+            let (kind, name) = l.trim_end_matches(')').split_once('(')?;
+            (Some((kind.to_string(), name.to_string())), r)
+        }
+        _ => (None, s),
+    };
+    let (major, params) = match rest.split_once('/') {
+        Some((m, p)) => (m, split_params(p).into_iter().map(String::from).collect()),
+        None => (rest, vec![]),
+    };
+    if major.is_empty() || !major.bytes().all(|c| c.is_ascii_uppercase()) {
+        return None;
+    }
+    Some(Statement::Command {
+        label,
+        major: major.to_string(),
+        params,
+        at,
+    })
+}
+
+/// The `KIND(label)` references in a parameter list.
+fn refs(params: &[String]) -> Vec<(String, String)> {
+    params
+        .iter()
+        .filter_map(|p| {
+            let (k, rest) = p.split_once('(')?;
+            let l = rest.strip_suffix(')')?;
+            (!k.is_empty() && k.bytes().all(|c| c.is_ascii_uppercase()))
+                .then(|| (k.to_string(), l.to_string()))
+        })
+        .collect()
+}
+
+fn check(
+    statements: &[Statement],
+    text: &str,
+    src: &dyn Fn() -> NamedSource<String>,
+    errors: &mut Vec<DmisError>,
+) {
+    let span = |at: usize| -> SourceSpan {
+        let end = text[at..].find('\n').map_or(text.len(), |e| at + e);
+        (at, end - at).into()
+    };
+    let commands: Vec<(&Option<(String, String)>, &str, &[String], usize)> = statements
+        .iter()
+        .filter_map(|s| match s {
+            Statement::Command {
+                label,
+                major,
+                params,
+                at,
+            } => Some((label, major.as_str(), &params[..], *at)),
+            _ => None,
+        })
+        .collect();
+    let structure = |at: usize, what: &str, help: &str| DmisError::Structure {
+        src: src(),
+        span: span(at),
+        what: what.into(),
+        help: help.into(),
+    };
+    match commands.first() {
+        Some((_, "DMISMN", _, _)) => {}
+        Some((_, _, _, at)) => errors.push(structure(
+            *at,
+            "the program does not start with DMISMN",
+            "start with `DMISMN/'name',05.3`",
+        )),
+        None => errors.push(structure(
+            0,
+            "the program is empty",
+            "start with `DMISMN/'name',05.3` and end with `ENDFIL`",
+        )),
+    }
+    if let Some((_, m, _, at)) = commands.last() {
+        if *m != "ENDFIL" {
+            errors.push(structure(
+                *at,
+                "the program does not end with ENDFIL",
+                "end the program with `ENDFIL`",
+            ));
+        }
+    }
+    // Definitions (any position: a tolerance may name a datum defined later).
+    let mut defined: BTreeMap<(String, String), usize> = BTreeMap::new();
+    for (label, major, _, at) in &commands {
+        let Some((kind, l)) = label else { continue };
+        if !is_label(l) {
+            errors.push(DmisError::BadLabel {
+                src: src(),
+                span: span(*at),
+                label: l.clone(),
+            });
+        }
+        // Datums are redefined each time their feature is measured again.
+        let key = (kind.clone(), l.clone());
+        if defined.contains_key(&key) && *major != "DATDEF" {
+            errors.push(DmisError::Duplicate {
+                src: src(),
+                span: span(*at),
+                kind: kind.clone(),
+                label: l.clone(),
+            });
+        }
+        defined.entry(key).or_insert(*at);
+    }
+    let mut measured: BTreeSet<String> = BTreeSet::new();
+    let mut meas: Option<(usize, usize, usize)> = None; // (at, announced, touches)
+    for (_, major, params, at) in &commands {
+        // References: F/FA to features, S to sensors, TA/T to tolerances, DAT to datums.
+        for (k, l) in refs(params) {
+            let kind = match k.as_str() {
+                "F" | "FA" => "F",
+                "TA" | "T" => "T",
+                other => other,
+            };
+            let ok = match kind {
+                "F" if k == "FA" => measured.contains(&l),
+                _ => defined.contains_key(&(kind.to_string(), l.clone())),
+            };
+            let ok = ok && (kind != "F" || defined.contains_key(&("F".to_string(), l.clone())));
+            if !ok {
+                errors.push(DmisError::Undefined {
+                    src: src(),
+                    span: span(*at),
+                    kind: k.clone(),
+                    label: l,
+                });
+            }
+        }
+        match (*major, &mut meas) {
+            ("MEAS", None) => {
+                let n = params.last().and_then(|n| n.parse::<usize>().ok());
+                match n {
+                    Some(n) => meas = Some((*at, n, 0)),
+                    None => errors.push(structure(
+                        *at,
+                        "MEAS without a point count",
+                        "write `MEAS/type,F(label),n`",
+                    )),
+                }
+                if let Some((_, l)) = refs(params).first() {
+                    measured.insert(l.clone());
+                }
+            }
+            ("MEAS", Some(_)) => errors.push(structure(
+                *at,
+                "MEAS inside a MEAS block",
+                "close the block with ENDMES first",
+            )),
+            ("PTMEAS", Some(m)) => m.2 += 1,
+            ("ENDMES", Some((start, n, got))) => {
+                if n != got {
+                    errors.push(structure(
+                        *start,
+                        &format!("MEAS announces {n} points but takes {got}"),
+                        "make the count match the PTMEAS statements",
+                    ));
+                }
+                meas = None;
+            }
+            ("ENDMES", None) => errors.push(structure(
+                *at,
+                "ENDMES without MEAS",
+                "open the block with MEAS",
+            )),
+            (m, Some(_)) if !IN_MEAS.contains(&m) => errors.push(structure(
+                *at,
+                &format!("{m} inside a MEAS block"),
+                "only GOTO and PTMEAS belong between MEAS and ENDMES",
+            )),
+            ("PTMEAS", None) => errors.push(structure(
+                *at,
+                "PTMEAS outside a MEAS block",
+                "put touches between MEAS and ENDMES",
+            )),
+            _ => {}
+        }
+        if matches!(*major, "GOTO" | "PTMEAS") {
+            let nums = params.iter().filter(|p| *p != "CART");
+            if nums.clone().any(|p| p.parse::<f64>().is_err()) {
+                errors.push(structure(
+                    *at,
+                    &format!("{major} with a parameter that is not a number"),
+                    "coordinates are plain decimal numbers",
+                ));
+            }
+        }
+    }
+    if let Some((at, _, _)) = meas {
+        errors.push(structure(
+            at,
+            "MEAS block without ENDMES",
+            "close the block with ENDMES",
+        ));
+    }
+}

@@ -1,0 +1,273 @@
+//! The manual alignment of a setup (seed ch. 5.6): after the operator places the part,
+//! the program cannot know where it is, so the operator touches a few points by hand —
+//! 3 on a primary plane, 2 on a secondary, 1 on a tertiary (3-2-1) — and `DATSET` builds
+//! the part's frame from them. Features are chosen among those the setup inspects:
+//! datum features first in datum order, then the largest faces; a plane qualifies when
+//! its normal is a part axis, a cylinder when its axis is, so that every feature maps
+//! onto `XDIR`/`YDIR`/`ZDIR` and `XORIG`/`YORIG`/`ZORIG`. A cylinder on the primary's
+//! axis (a bore in the primary face) can stand in for the secondary's origins, a sphere
+//! gives all three. Whatever the features leave free is named in [`Alignment::missing`]
+//! and becomes an operator instruction.
+
+use super::{Hlip, SetupPath};
+use crate::geometry::{Surface, P3, V3};
+use crate::plan::Input;
+
+/// A setup's alignment.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Alignment {
+    /// The features touched by hand, in order.
+    pub steps: Vec<AlignStep>,
+    /// After `DATSET`, the origin shifts that restore the part frame: (axis, value).
+    pub trans: Vec<(char, f64)>,
+    /// What the features leave free, in words (empty for a full 3-2-1).
+    pub missing: Vec<String>,
+}
+
+/// One feature of the alignment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AlignStep {
+    /// The group (index into [`SetupPath::groups`]) whose sensor touches it.
+    pub group: usize,
+    /// The block in that group.
+    pub block: usize,
+    /// Points touched (indices into [`Hlip::points`]).
+    pub points: Vec<usize>,
+    /// What it fixes: `ZDIR`, `-XDIR`, `YORIG`, ….
+    pub keywords: Vec<String>,
+}
+
+const AXES: [char; 3] = ['X', 'Y', 'Z'];
+
+/// The part axis a unit vector lies along, and its sign.
+fn axis_of(v: &V3) -> Option<(usize, bool)> {
+    (0..3)
+        .find(|&k| v[k].abs() > 1.0 - 1e-9)
+        .map(|k| (k, v[k] > 0.0))
+}
+
+fn dir_word(k: usize, positive: bool) -> String {
+    format!("{}{}DIR", if positive { "" } else { "-" }, AXES[k])
+}
+
+fn orig_word(k: usize) -> String {
+    format!("{}ORIG", AXES[k])
+}
+
+/// A candidate feature: its surface as the alignment sees it.
+enum Shape {
+    Plane {
+        axis: usize,
+        positive: bool,
+        at: f64,
+    },
+    Cylinder {
+        axis: usize,
+        positive: bool,
+        at: P3,
+    },
+    Sphere {
+        at: P3,
+    },
+}
+
+impl Shape {
+    /// The feature's nominal coordinate along axis `k` (where its origin lands).
+    fn at(&self, k: usize) -> f64 {
+        match self {
+            Shape::Plane { at, .. } => *at,
+            Shape::Cylinder { at, .. } | Shape::Sphere { at } => at[k],
+        }
+    }
+}
+
+/// Chooses the alignment of one setup from its groups' blocks.
+pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
+    let part = &input.model.parts[input.plan.part.0];
+    let geometry = input.geometry;
+    let face = |name: &str| geometry.faces.iter().find(|f| f.name == name);
+    // Candidates: (rank, -area, group, block, shape, points in tour order).
+    let mut cands = Vec::new();
+    for (gi, g) in sp.groups.iter().enumerate() {
+        for (bi, b) in g.blocks.iter().enumerate() {
+            let points: Vec<usize> = b.touches.iter().map(|t| t.point).collect();
+            let Some(&first) = points.first() else {
+                continue;
+            };
+            let f = face(&b.face);
+            let shape = if b.table {
+                let p = &hlip.points[first];
+                axis_of(&V3::from(p.normal)).map(|(axis, positive)| Shape::Plane {
+                    axis,
+                    positive,
+                    at: p.position[axis],
+                })
+            } else {
+                match f.map(|f| &f.surface) {
+                    Some(Surface::Plane { origin, normal }) => {
+                        axis_of(normal).map(|(axis, positive)| Shape::Plane {
+                            axis,
+                            positive,
+                            at: origin[axis],
+                        })
+                    }
+                    Some(Surface::Cylinder { origin, axis, .. }) => {
+                        axis_of(axis).map(|(k, positive)| Shape::Cylinder {
+                            axis: k,
+                            positive,
+                            at: *origin,
+                        })
+                    }
+                    Some(Surface::Sphere { center, .. }) => Some(Shape::Sphere { at: *center }),
+                    _ => None,
+                }
+            };
+            let Some(shape) = shape else { continue };
+            let rank = b
+                .datum
+                .as_ref()
+                .and_then(|d| part.datums.iter().position(|x| &x.name == d))
+                .unwrap_or(usize::MAX);
+            let area = f.map_or(0.0, |f| f.area);
+            cands.push((rank, -area, gi, bi, shape, points));
+        }
+    }
+    // Datum rank first, then area, then order.
+    cands.sort_by(|a, b| {
+        a.0.cmp(&b.0)
+            .then(a.1.total_cmp(&b.1))
+            .then((a.2, a.3).cmp(&(b.2, b.3)))
+    });
+
+    let mut out = Alignment::default();
+    let mut dirs: Vec<usize> = Vec::new();
+    let mut origins = [false; 3];
+    let mut used = vec![false; cands.len()];
+    let spread = |pts: &[usize], n: usize| -> Option<Vec<usize>> {
+        if pts.len() < n {
+            return None;
+        }
+        let pos = |k: usize| P3::from(hlip.points[k].position);
+        let mut chosen = vec![pts[0]];
+        while chosen.len() < n {
+            let next = pts
+                .iter()
+                .filter(|k| !chosen.contains(k))
+                .max_by(|&&a, &&b| {
+                    let d = |x: usize| {
+                        chosen
+                            .iter()
+                            .map(|&c| (pos(x) - pos(c)).norm())
+                            .fold(f64::INFINITY, f64::min)
+                    };
+                    d(a).total_cmp(&d(b)).then(b.cmp(&a))
+                })?;
+            chosen.push(*next);
+        }
+        Some(chosen)
+    };
+    // Primary, secondary, tertiary: three passes over the candidates.
+    for stage in 0..3 {
+        for (ci, (_, _, gi, bi, shape, pts)) in cands.iter().enumerate() {
+            if used[ci] {
+                continue;
+            }
+            let free = |skip: Option<usize>| -> Vec<usize> {
+                (0..3).filter(|&k| Some(k) != skip && !origins[k]).collect()
+            };
+            // (keywords, points needed, origins fixed, direction fixed)
+            let (keywords, n, fixed, dir): (Vec<String>, usize, Vec<usize>, Option<usize>) =
+                match (stage, shape) {
+                    (0, Shape::Plane { axis, positive, .. }) => (
+                        vec![dir_word(*axis, *positive), orig_word(*axis)],
+                        3,
+                        vec![*axis],
+                        Some(*axis),
+                    ),
+                    (1, Shape::Plane { axis, positive, .. })
+                        if !dirs.contains(axis) && dirs.len() == 1 =>
+                    {
+                        (
+                            vec![dir_word(*axis, *positive), orig_word(*axis)],
+                            2,
+                            vec![*axis],
+                            Some(*axis),
+                        )
+                    }
+                    (2, Shape::Plane { axis, .. }) if !origins[*axis] && dirs.len() == 2 => {
+                        (vec![orig_word(*axis)], 1, vec![*axis], None)
+                    }
+                    (1, Shape::Cylinder { axis, .. }) if dirs == [*axis] => {
+                        let o = free(Some(*axis));
+                        (o.iter().map(|&k| orig_word(k)).collect(), 4, o, None)
+                    }
+                    (2, Shape::Sphere { .. }) => {
+                        let o = free(None);
+                        (o.iter().map(|&k| orig_word(k)).collect(), 4, o, None)
+                    }
+                    _ => continue,
+                };
+            if keywords.is_empty() {
+                continue;
+            }
+            let Some(points) = spread(pts, n) else {
+                continue;
+            };
+            used[ci] = true;
+            dirs.extend(dir);
+            for k in fixed {
+                origins[k] = true;
+                out.trans.push((AXES[k], shape.at(k)));
+            }
+            out.steps.push(AlignStep {
+                group: *gi,
+                block: *bi,
+                points,
+                keywords,
+            });
+            break;
+        }
+    }
+    // A primary cylinder or a lone sphere when no plane qualifies.
+    if out.steps.is_empty() {
+        for (gi, bi, shape, pts) in cands.iter().map(|c| (c.2, c.3, &c.4, &c.5)) {
+            let (keywords, fixed): (Vec<String>, Vec<usize>) = match shape {
+                Shape::Cylinder { axis, positive, .. } => {
+                    let o: Vec<usize> = (0..3).filter(|k| k != axis).collect();
+                    let mut w = vec![dir_word(*axis, *positive)];
+                    w.extend(o.iter().map(|&k| orig_word(k)));
+                    dirs.push(*axis);
+                    (w, o)
+                }
+                Shape::Sphere { .. } => ((0..3).map(orig_word).collect(), (0..3).collect()),
+                Shape::Plane { .. } => continue,
+            };
+            let Some(points) = spread(pts, 4.min(pts.len()).max(1)) else {
+                continue;
+            };
+            for k in fixed {
+                origins[k] = true;
+                out.trans.push((AXES[k], shape.at(k)));
+            }
+            out.steps.push(AlignStep {
+                group: gi,
+                block: bi,
+                points,
+                keywords,
+            });
+            break;
+        }
+    }
+    if dirs.is_empty() {
+        out.missing.push("the part's orientation".into());
+    } else if dirs.len() == 1 {
+        out.missing
+            .push(format!("the rotation about {}", AXES[dirs[0]]));
+    }
+    for k in 0..3 {
+        if !origins[k] {
+            out.missing.push(format!("the {} origin", AXES[k]));
+        }
+    }
+    out
+}

@@ -1,0 +1,619 @@
+//! Stage 9, paths (seed ch. 5): HLIP → low-level inspection plan (LLIP). The HLIP tree
+//! is linearised into groups — one per (setup, probe, orientation) — and each group gets
+//! a collision-free tour of its points:
+//!
+//! - every point is touched from its *stand-off*, the tip centre `max(prehit, retract)`
+//!   out along the surface normal; the planner validated that approach, so it is not
+//!   checked again (ch. 5.4.1);
+//! - stand-offs are joined by a roadmap ([`roadmap`]) built with the CMM local planner
+//!   and enhanced until connected; every segment is checked with parry ([`sweep`]);
+//! - the visiting order is a tour over the roadmap's shortest paths ([`tour`]), one
+//!   block of points per feature face (a DMIS `MEAS` block), datum features first;
+//! - a group starts and ends on the clearance plane above the part, and moves between
+//!   groups run along it, high enough for the head to index.
+//!
+//! Each setup also gets its manual 3-2-1 alignment ([`align`], ch. 5.6). The entry point
+//! is [`plan`]; a move that cannot be made collision-free is `insp::path::no_path`.
+//!
+//! **Architecture Invariant:** the result is a function of the input alone: the roadmap
+//! links nodes in index order and collects parallel checks in input order, random
+//! enhancement nodes come from a fixed seed, and ties go to the lower index.
+
+pub mod align;
+mod errors;
+mod render;
+mod roadmap;
+mod sweep;
+pub mod tour;
+
+pub use align::Alignment;
+pub use errors::PathError;
+pub use render::json;
+pub use sweep::Pose;
+
+use crate::access::{ProbeShape, Scene};
+use crate::diag::Diagnostics;
+use crate::geometry::{P3, V3};
+use crate::model::Motion;
+use crate::plan::{Hlip, Input};
+use rayon::prelude::*;
+use roadmap::Roadmap;
+use std::collections::BTreeMap;
+
+/// The low-level inspection plan: every move of the program.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Llip {
+    /// Approach, retract, search and clearance distances.
+    pub motion: Motion,
+    /// The setups, in HLIP order.
+    pub setups: Vec<SetupPath>,
+    /// Counts.
+    pub summary: PathSummary,
+}
+
+/// One setup's moves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SetupPath {
+    /// Index into [`Hlip::setups`].
+    pub setup: usize,
+    /// The manual alignment after the operator places the part.
+    pub alignment: Alignment,
+    /// The groups, datum groups first.
+    pub groups: Vec<GroupPath>,
+}
+
+/// One (probe, orientation) group: its entry, blocks of touches, and exit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GroupPath {
+    /// The probe's label in the rack.
+    pub probe: String,
+    /// Head angle A (degrees).
+    pub a: f64,
+    /// Head angle B (degrees).
+    pub b: f64,
+    /// The probe direction, tip to head, part frame.
+    pub direction: [f64; 3],
+    /// Positions from the clearance plane down to the first stand-off (tip centre).
+    pub entry: Vec<[f64; 3]>,
+    /// The touches, one block per feature face.
+    pub blocks: Vec<BlockPath>,
+    /// Positions from the last stand-off up to the clearance plane.
+    pub exit: Vec<[f64; 3]>,
+    /// The tolerances whose features this group completes, in HLIP order.
+    pub records: Vec<String>,
+    /// Travel in this group, touches included (mm).
+    pub length: f64,
+}
+
+/// The touches on one face (a DMIS `MEAS` block).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockPath {
+    /// The feature.
+    pub feature: String,
+    /// The face (or the datum face the table stands in for).
+    pub face: String,
+    /// Whether the table is probed instead of the face.
+    pub table: bool,
+    /// The datum letter when the feature is a datum feature.
+    pub datum: Option<String>,
+    /// The touches in order.
+    pub touches: Vec<Touch>,
+}
+
+/// One touch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Touch {
+    /// Index into [`Hlip::points`].
+    pub point: usize,
+    /// Positions passed on the way from the previous stand-off, before this one.
+    pub via: Vec<[f64; 3]>,
+    /// The stand-off: where the touch starts and ends.
+    pub standoff: [f64; 3],
+}
+
+/// The LLIP in numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathSummary {
+    /// Groups.
+    pub groups: usize,
+    /// Touches.
+    pub touches: usize,
+    /// Total travel (mm): moves and touches.
+    pub length: f64,
+    /// Roadmap nodes the enhancement step added.
+    pub added_nodes: usize,
+    /// Move segments checked with parry.
+    pub checks: usize,
+}
+
+/// Everything a group needs while it is planned.
+struct GroupIn<'a> {
+    setup: usize,
+    probe: &'a ProbeShape,
+    label: String,
+    a: f64,
+    b: f64,
+    dir: V3,
+    up: V3,
+    table: f64,
+    height: f64,
+    blocks: Vec<BlockPath>,
+    records: Vec<String>,
+    has_datum: bool,
+}
+
+/// A group's planned moves, before the moves between groups are joined.
+struct GroupOut {
+    entry: Vec<P3>,
+    blocks: Vec<BlockPath>,
+    exit: Vec<P3>,
+    added: usize,
+    checks: usize,
+}
+
+/// Plans every move of `hlip`. `None` after pushing diagnostics when some move cannot
+/// be made collision-free.
+pub fn plan(
+    input: &Input,
+    hlip: &Hlip,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    diags: &mut Diagnostics,
+) -> Option<Llip> {
+    let model = input.model;
+    let plan = input.plan;
+    let motion = plan.motion;
+    let part = &model.parts[plan.part.0];
+    let cmm = &model.cmms[plan.cmm.0];
+    let probes = ProbeShape::of_cmm(model, cmm);
+    let scene = Scene::of_part(input.geometry);
+    let vertices = &input.geometry.vertices;
+    let datum_of: BTreeMap<&str, (usize, &str)> = part
+        .datums
+        .iter()
+        .enumerate()
+        .map(|(k, d)| {
+            (
+                part.features[d.feature.0].name.as_str(),
+                (k, d.name.as_str()),
+            )
+        })
+        .collect();
+    let standoff = motion.prehit.max(motion.retract);
+
+    // Linearise the HLIP into groups, datum groups first within a setup.
+    let mut groups: Vec<GroupIn> = Vec::new();
+    for (si, s) in hlip.setups.iter().enumerate() {
+        let up = V3::from(s.up);
+        let table = vertices
+            .iter()
+            .map(|v| v.coords.dot(&up))
+            .fold(f64::INFINITY, f64::min);
+        let top = vertices
+            .iter()
+            .map(|v| v.coords.dot(&up))
+            .fold(f64::NEG_INFINITY, f64::max);
+        let mut setup_groups = Vec::new();
+        for p in &s.probes {
+            let Some(probe) = probes.iter().find(|x| x.name == p.probe) else {
+                continue;
+            };
+            for o in &p.orients {
+                let dir = V3::from(o.direction);
+                let lift = if probe.bent {
+                    probe.reach() * (1.0 - dir.dot(&up))
+                } else {
+                    0.0
+                };
+                let mut blocks = Vec::new();
+                let mut records = Vec::new();
+                for i in &o.inspections {
+                    for f in &i.faces {
+                        blocks.push(BlockPath {
+                            feature: i.feature.clone(),
+                            face: f.face.clone(),
+                            table: f.table,
+                            datum: datum_of.get(i.feature.as_str()).map(|d| d.1.to_string()),
+                            touches: f
+                                .points
+                                .iter()
+                                .map(|&k| Touch {
+                                    point: k,
+                                    via: vec![],
+                                    standoff: [0.0; 3],
+                                })
+                                .collect(),
+                        });
+                    }
+                    for r in &i.records {
+                        if !records.contains(r) {
+                            records.push(r.clone());
+                        }
+                    }
+                }
+                let has_datum = blocks.iter().any(|b| b.datum.is_some());
+                setup_groups.push(GroupIn {
+                    setup: si,
+                    probe,
+                    label: p.probe.clone(),
+                    a: o.a,
+                    b: o.b,
+                    dir,
+                    up,
+                    table,
+                    height: top + motion.clearance + lift,
+                    blocks,
+                    records,
+                    has_datum,
+                });
+            }
+        }
+        // Datum groups first, keeping each probe's orientations together.
+        let probe_has_datum =
+            |label: &str, gs: &[GroupIn]| gs.iter().any(|g| g.label == label && g.has_datum);
+        let keys: Vec<(bool, bool)> = setup_groups
+            .iter()
+            .map(|g| (!probe_has_datum(&g.label, &setup_groups), !g.has_datum))
+            .collect();
+        let mut idx: Vec<usize> = (0..setup_groups.len()).collect();
+        idx.sort_by_key(|&k| keys[k]);
+        let mut taken: Vec<Option<GroupIn>> = setup_groups.into_iter().map(Some).collect();
+        for k in idx {
+            if let Some(g) = taken[k].take() {
+                groups.push(g);
+            }
+        }
+    }
+
+    let total = groups.len();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let results: Vec<Result<GroupOut, PathError>> = groups
+        .par_iter()
+        .map(|g| {
+            let r = plan_group(input, hlip, &scene, g, standoff, &datum_of);
+            progress(
+                done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+                total,
+            );
+            r
+        })
+        .collect();
+
+    let mut failed = false;
+    let mut outs = Vec::new();
+    for r in results {
+        match r {
+            Ok(o) => outs.push(o),
+            Err(e) => {
+                failed = true;
+                diags.push(part.span.file, e);
+            }
+        }
+    }
+    if failed {
+        return None;
+    }
+
+    // Join the groups: moves between them run on the clearance plane.
+    let mut setups: Vec<SetupPath> = Vec::new();
+    let (mut added, mut checks, mut length, mut touches) = (0, 0, 0.0, 0);
+    let mut prev: Option<(usize, P3)> = None;
+    for (g, o) in groups.iter().zip(outs) {
+        added += o.added;
+        checks += o.checks;
+        let mut entry = o.entry;
+        if let Some((s, at)) = prev {
+            if s == g.setup {
+                // Across from above the previous group's exit, at this group's height.
+                let across = at + g.up * (g.height - at.coords.dot(&g.up));
+                let pose = Pose::new(&scene, g.probe, g.dir, g.up, g.table);
+                checks += 1;
+                if let Err(blocker) = pose.segment(&across, &entry[0]) {
+                    let b = &o.blocks[0];
+                    diags.push(part.span.file, no_path(input, b, g, blocker));
+                    return None;
+                }
+                entry.insert(0, across);
+            }
+        }
+        let exit_end = o.exit.last().copied().unwrap_or(entry[0]);
+        prev = Some((g.setup, exit_end));
+        let mut glen = polyline(&entry) + polyline(&o.exit);
+        let mut at = P3::from(o.exit.first().map_or([0.0; 3], |_| [0.0; 3]));
+        let mut first = true;
+        for b in &o.blocks {
+            for t in &b.touches {
+                let s = P3::from(t.standoff);
+                if !first {
+                    let mut pts = vec![at];
+                    pts.extend(t.via.iter().map(|&v| P3::from(v)));
+                    pts.push(s);
+                    glen += polyline(&pts);
+                }
+                first = false;
+                glen += 2.0 * standoff;
+                at = s;
+                touches += 1;
+            }
+        }
+        length += glen;
+        let gp = GroupPath {
+            probe: g.label.clone(),
+            a: g.a,
+            b: g.b,
+            direction: g.dir.into(),
+            entry: entry.iter().map(|p| p.coords.into()).collect(),
+            blocks: o.blocks,
+            exit: o.exit.iter().map(|p| p.coords.into()).collect(),
+            records: g.records.clone(),
+            length: glen,
+        };
+        match setups.last_mut() {
+            Some(sp) if sp.setup == g.setup => sp.groups.push(gp),
+            _ => setups.push(SetupPath {
+                setup: g.setup,
+                alignment: Alignment::default(),
+                groups: vec![gp],
+            }),
+        }
+    }
+    for sp in &mut setups {
+        sp.alignment = align::align(input, hlip, sp);
+    }
+    Some(Llip {
+        motion,
+        summary: PathSummary {
+            groups: total,
+            touches,
+            length,
+            added_nodes: added,
+            checks,
+        },
+        setups,
+    })
+}
+
+/// The length of a polyline.
+fn polyline(pts: &[P3]) -> f64 {
+    pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+}
+
+/// The diagnostic for a block no move reaches.
+fn no_path(input: &Input, b: &BlockPath, g: &GroupIn, blocker: String) -> PathError {
+    let part = &input.model.parts[input.plan.part.0];
+    let feature = part.features.iter().find(|f| f.name == b.feature);
+    PathError::NoPath {
+        span: feature.map_or(part.span, |f| f.span),
+        face: b.face.clone(),
+        feature: b.feature.clone(),
+        probe: g.label.clone(),
+        orient: if g.probe.bent {
+            format!(
+                " at A{} B{}",
+                crate::model::fmt_num(g.a),
+                crate::model::fmt_num(g.b)
+            )
+        } else {
+            String::new()
+        },
+        blocker,
+    }
+}
+
+/// Plans one group: roadmap, tour, entry and exit.
+fn plan_group(
+    input: &Input,
+    hlip: &Hlip,
+    scene: &Scene,
+    g: &GroupIn,
+    standoff: f64,
+    datum_of: &BTreeMap<&str, (usize, &str)>,
+) -> Result<GroupOut, PathError> {
+    let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table);
+    let r = g.probe.tip_radius;
+    // Goals: every touch's stand-off, block by block.
+    let mut goals = Vec::new();
+    let mut owner = Vec::new();
+    for (bi, b) in g.blocks.iter().enumerate() {
+        for (ti, t) in b.touches.iter().enumerate() {
+            let p = &hlip.points[t.point];
+            let n = V3::from(p.normal);
+            goals.push(P3::from(p.position) + n * (r + standoff));
+            owner.push((bi, ti));
+        }
+    }
+    let geometry = input.geometry;
+    let face_ids: BTreeMap<&str, usize> = geometry
+        .faces
+        .iter()
+        .enumerate()
+        .map(|(k, f)| (f.name.as_str(), k))
+        .collect();
+    let face_points = |goal: usize| -> Vec<P3> {
+        let (bi, _) = owner[goal];
+        let b = &g.blocks[bi];
+        if b.table {
+            return vec![];
+        }
+        let Some(&f) = face_ids.get(b.face.as_str()) else {
+            return vec![];
+        };
+        let tris = &geometry.faces[f].triangles;
+        let stride = tris.len().div_ceil(24).max(1);
+        tris.iter()
+            .step_by(stride)
+            .filter_map(|&t| {
+                let [a, b2, c] =
+                    geometry.triangles[t as usize].map(|i| geometry.vertices[i as usize]);
+                let n = (b2 - a).cross(&(c - a));
+                (n.norm() > 1e-12).then(|| {
+                    P3::from((a.coords + b2.coords + c.coords) / 3.0)
+                        + n.normalize() * (r + standoff)
+                })
+            })
+            .collect()
+    };
+    let mut map = Roadmap::new(&pose, goals.clone(), g.dir, vertices_of(input), g.height);
+    let added = map.build(face_points).map_err(|d| {
+        let (bi, _) = owner[d.goal];
+        no_path(input, &g.blocks[bi], g, d.blocker)
+    })?;
+    let paths = map.shortest_paths();
+    // The way up from each goal to the clearance plane.
+    let lifts: Vec<Option<Vec<P3>>> = goals.par_iter().map(|x| lift(&pose, x, g)).collect();
+    let mut checks = map.checks + goals.len() * 3;
+    let lift_len = |k: usize| {
+        lifts[k].as_ref().map_or(f64::INFINITY, |w| {
+            let mut pts = vec![goals[k]];
+            pts.extend(w.iter().copied());
+            polyline(&pts)
+        })
+    };
+    // Goals of each block.
+    let mut of_block: Vec<Vec<usize>> = vec![vec![]; g.blocks.len()];
+    for (k, &(bi, _)) in owner.iter().enumerate() {
+        of_block[bi].push(k);
+    }
+    // Block order: datum blocks first (in datum order), then a tour over the rest.
+    let rank = |bi: usize| {
+        g.blocks[bi]
+            .datum
+            .as_ref()
+            .and_then(|_| datum_of.get(g.blocks[bi].feature.as_str()).map(|d| d.0))
+    };
+    let mut datum_blocks: Vec<usize> = (0..g.blocks.len()).filter(|&b| rank(b).is_some()).collect();
+    datum_blocks.sort_by_key(|&b| (rank(b), b));
+    let rest: Vec<usize> = (0..g.blocks.len()).filter(|&b| rank(b).is_none()).collect();
+    let dist_from = |cur: Option<usize>, k: usize| match cur {
+        None => lift_len(k),
+        Some(c) => paths.d(c, k),
+    };
+    let mut order: Vec<(usize, Vec<usize>)> = Vec::new();
+    let mut cur: Option<usize> = None;
+    let visit = |bi: usize, cur: &mut Option<usize>, order: &mut Vec<(usize, Vec<usize>)>| {
+        let ks = &of_block[bi];
+        let m = tour::Matrix::new(
+            ks.len(),
+            |i, j| paths.d(ks[i], ks[j]),
+            ks.iter().map(|&k| dist_from(*cur, k)).collect(),
+        );
+        let seq: Vec<usize> = tour::solve(&m).into_iter().map(|i| ks[i]).collect();
+        *cur = seq.last().copied().or(*cur);
+        order.push((bi, seq));
+    };
+    for &bi in &datum_blocks {
+        visit(bi, &mut cur, &mut order);
+    }
+    if !rest.is_empty() {
+        let near = |a: usize, b: usize| {
+            of_block[a]
+                .iter()
+                .flat_map(|&x| of_block[b].iter().map(move |&y| (x, y)))
+                .map(|(x, y)| paths.d(x, y))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let m = tour::Matrix::new(
+            rest.len(),
+            |i, j| near(rest[i], rest[j]),
+            rest.iter()
+                .map(|&b| {
+                    of_block[b]
+                        .iter()
+                        .map(|&k| dist_from(cur, k))
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .collect(),
+        );
+        for i in tour::solve(&m) {
+            visit(rest[i], &mut cur, &mut order);
+        }
+    }
+    // Unreachable distances mean the goals are not all connected (cannot happen after
+    // a successful build) or no lift exists at all.
+    let first = order
+        .first()
+        .and_then(|(_, s)| s.first())
+        .copied()
+        .unwrap_or(0);
+    let Some(entry_up) = lifts[first].clone() else {
+        let (bi, _) = owner[first];
+        return Err(no_path(
+            input,
+            &g.blocks[bi],
+            g,
+            "the way up to the clearance plane".into(),
+        ));
+    };
+    let mut entry: Vec<P3> = entry_up.into_iter().rev().collect();
+    entry.push(goals[first]);
+    let last = cur.unwrap_or(first);
+    let exit_goal = (0..goals.len())
+        .filter(|&k| lifts[k].is_some())
+        .min_by(|&a, &b| {
+            (paths.d(last, a) + lift_len(a))
+                .total_cmp(&(paths.d(last, b) + lift_len(b)))
+                .then(a.cmp(&b))
+        })
+        .unwrap_or(first);
+    let mut exit = paths.path(&map, last, exit_goal);
+    exit.extend(lifts[exit_goal].clone().unwrap_or_default());
+    // The blocks in tour order with their moves.
+    let mut blocks = Vec::new();
+    let mut prev: Option<usize> = None;
+    for (bi, seq) in order {
+        let mut b = g.blocks[bi].clone();
+        b.touches = seq
+            .iter()
+            .map(|&k| {
+                let (_, ti) = owner[k];
+                let mut via: Vec<[f64; 3]> = match prev {
+                    Some(p) => paths
+                        .path(&map, p, k)
+                        .iter()
+                        .map(|x| x.coords.into())
+                        .collect(),
+                    None => vec![],
+                };
+                via.pop();
+                prev = Some(k);
+                Touch {
+                    point: g.blocks[bi].touches[ti].point,
+                    via,
+                    standoff: goals[k].coords.into(),
+                }
+            })
+            .collect();
+        blocks.push(b);
+    }
+    checks += 0;
+    Ok(GroupOut {
+        entry,
+        blocks,
+        exit,
+        added,
+        checks,
+    })
+}
+
+/// The part's vertices.
+fn vertices_of<'a>(input: &Input<'a>) -> &'a [P3] {
+    &input.geometry.vertices
+}
+
+/// The way from stand-off `x` up to the clearance plane: straight up the ram axis, or
+/// first up the probe axis; the waypoints after `x`, or `None` when every way is blocked.
+fn lift(pose: &Pose, x: &P3, g: &GroupIn) -> Option<Vec<P3>> {
+    let raise = |y: &P3| y + g.up * (g.height - y.coords.dot(&g.up)).max(0.0);
+    let mut tries: Vec<Vec<P3>> = vec![vec![raise(x)]];
+    for h in [5.0, 20.0, 60.0] {
+        let y = x + g.dir * h;
+        tries.push(vec![y, raise(&y)]);
+    }
+    tries.into_iter().find(|w| {
+        let mut at = *x;
+        w.iter().all(|y| {
+            let ok = pose.segment(&at, y).is_ok();
+            at = *y;
+            ok
+        })
+    })
+}

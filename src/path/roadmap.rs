@@ -1,0 +1,447 @@
+//! The roadmap of one group (seed ch. 5.3–5.4): nodes are the goals (each point's
+//! stand-off position, where the touch starts and ends) and whatever the enhancement
+//! step adds; edges are paths of the CMM local planner, every segment checked by
+//! [`Pose::segment`].
+//!
+//! The local planner tries, in order (ch. 5.4.2): the straight segment; up the probe
+//! axis, across, down; up the probe axis, then up the ram axis to the clearance height,
+//! across, and back down both. The enhancement step (ch. 5.4.3) adds, while goals are in
+//! more than one component: goals lifted along the probe and ram axes, points on the
+//! faces of the goals left out, then random points (a fixed seed). Shortest paths between
+//! goals come from Dijkstra on the result (the all-pairs step of ch. 5.3.2).
+
+use super::sweep::Pose;
+use crate::geometry::{P3, V3};
+use rayon::prelude::*;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// Neighbours each new node is connected to.
+const K: usize = 8;
+
+/// How a local path between two nodes runs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Route {
+    /// The straight segment.
+    Straight,
+    /// Up the probe axis by `h`, across, down.
+    Probe(f64),
+    /// Up the probe axis by `h`, up the ram axis to the clearance height, across, down.
+    ProbeRam(f64),
+}
+
+/// An edge.
+#[derive(Debug, Clone, Copy)]
+struct Edge {
+    to: usize,
+    length: f64,
+    route: Route,
+}
+
+/// The roadmap of one group.
+pub struct Roadmap<'a> {
+    pose: &'a Pose<'a>,
+    /// Node positions (tip centre, part frame); the first `goals` are the goals.
+    pub nodes: Vec<P3>,
+    goals: usize,
+    adj: Vec<Vec<Edge>>,
+    dir: V3,
+    up: V3,
+    /// The tip-centre height along `up` of the clearance plane.
+    pub height: f64,
+    /// How far the part reaches along the probe axis.
+    top_dir: f64,
+    /// Segments checked.
+    pub checks: usize,
+}
+
+/// Why goals could not be connected: the first goal left out and what blocked it.
+#[derive(Debug, Clone)]
+pub struct Disconnected {
+    /// The goal.
+    pub goal: usize,
+    /// What hit on its straight move towards the nearest connected goal.
+    pub blocker: String,
+}
+
+impl<'a> Roadmap<'a> {
+    /// A roadmap over `goals`; `vertices` bound the part (for lift heights); `height` is
+    /// the clearance plane's tip height along the ram axis.
+    pub fn new(
+        pose: &'a Pose<'a>,
+        goals: Vec<P3>,
+        dir: V3,
+        vertices: &[P3],
+        height: f64,
+    ) -> Roadmap<'a> {
+        let top_dir = vertices
+            .iter()
+            .map(|v| v.coords.dot(&dir))
+            .fold(f64::NEG_INFINITY, f64::max);
+        let n = goals.len();
+        Roadmap {
+            pose,
+            nodes: goals,
+            goals: n,
+            adj: vec![Vec::new(); n],
+            dir,
+            up: pose.up(),
+            height,
+            top_dir,
+            checks: 0,
+        }
+    }
+
+    /// The waypoints of a route from `p` to `q`, without `p`, with `q`.
+    pub fn waypoints(&self, p: &P3, q: &P3, route: Route) -> Vec<P3> {
+        match route {
+            Route::Straight => vec![*q],
+            Route::Probe(h) => vec![p + self.dir * h, q + self.dir * h, *q],
+            Route::ProbeRam(h) => {
+                let (p1, q1) = (p + self.dir * h, q + self.dir * h);
+                let (p2, q2) = (self.raised(&p1), self.raised(&q1));
+                let mut w = vec![p1, p2, q2, q1, *q];
+                w.dedup_by(|a, b| (*a - *b).norm() < 1e-9);
+                w
+            }
+        }
+    }
+
+    /// `x` moved up the ram axis to the clearance height (or left where it is above).
+    fn raised(&self, x: &P3) -> P3 {
+        let h = self.height - x.coords.dot(&self.up);
+        if h > 0.0 {
+            x + self.up * h
+        } else {
+            *x
+        }
+    }
+
+    /// The routes the local planner tries between `p` and `q`, simplest first.
+    fn routes(&self, p: &P3, q: &P3) -> Vec<Route> {
+        let mut out = vec![Route::Straight];
+        // Up the probe axis: a short hop, then far enough to clear the part's extent
+        // along the axis.
+        let clear = (self.top_dir - p.coords.dot(&self.dir))
+            .max(self.top_dir - q.coords.dot(&self.dir))
+            + (self.height - self.top_dir.min(self.height)).max(5.0);
+        for h in [5.0, 20.0, clear] {
+            if h <= clear + 1e-9 && !out.contains(&Route::Probe(h)) {
+                out.push(Route::Probe(h));
+            }
+        }
+        if (self.dir - self.up).norm() > 1e-9 {
+            for h in [0.0, 5.0, 20.0] {
+                out.push(Route::ProbeRam(h));
+            }
+        }
+        out
+    }
+
+    /// Checks a route; its length when every segment is clear, else what hit first.
+    fn check(&self, p: &P3, q: &P3, route: Route) -> (Result<f64, String>, usize) {
+        let mut at = *p;
+        let mut length = 0.0;
+        let mut checks = 0;
+        for w in self.waypoints(p, q, route) {
+            checks += 1;
+            if let Err(e) = self.pose.segment(&at, &w) {
+                return (Err(e), checks);
+            }
+            length += (w - at).norm();
+            at = w;
+        }
+        (Ok(length), checks)
+    }
+
+    /// The local planner: the first route that is clear.
+    fn connect(&self, p: &P3, q: &P3) -> (Result<(Route, f64), String>, usize) {
+        let mut first_err = None;
+        let mut checks = 0;
+        for route in self.routes(p, q) {
+            let (r, c) = self.check(p, q, route);
+            checks += c;
+            match r {
+                Ok(l) => return (Ok((route, l)), checks),
+                Err(e) => {
+                    first_err.get_or_insert(e);
+                }
+            }
+        }
+        (Err(first_err.unwrap_or_default()), checks)
+    }
+
+    /// The k nearest other nodes of node `i` among the first `limit` nodes.
+    fn nearest(&self, i: usize, limit: usize) -> Vec<usize> {
+        let mut v: Vec<(f64, usize)> = (0..limit)
+            .filter(|&j| j != i)
+            .map(|j| ((self.nodes[j] - self.nodes[i]).norm(), j))
+            .collect();
+        v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        v.truncate(K);
+        v.into_iter().map(|(_, j)| j).collect()
+    }
+
+    /// Connects nodes `from..` to their neighbours (in parallel, applied in order).
+    fn link(&mut self, from: usize) {
+        let n = self.nodes.len();
+        let mut pairs: Vec<(usize, usize)> = Vec::new();
+        for i in from..n {
+            for j in self.nearest(i, n) {
+                let e = (i.min(j), i.max(j));
+                pairs.push(e);
+            }
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        pairs.retain(|&(i, j)| !self.adj[i].iter().any(|e| e.to == j));
+        let results: Vec<_> = pairs
+            .par_iter()
+            .map(|&(i, j)| self.connect(&self.nodes[i], &self.nodes[j]))
+            .collect();
+        for (&(i, j), (r, c)) in pairs.iter().zip(results) {
+            self.checks += c;
+            if let Ok((route, length)) = r {
+                self.adj[i].push(Edge {
+                    to: j,
+                    length,
+                    route,
+                });
+                // The reverse route mirrors the waypoints; the same checks cover it.
+                self.adj[j].push(Edge {
+                    to: i,
+                    length,
+                    route,
+                });
+            }
+        }
+    }
+
+    /// Adds the nodes that are clear; returns how many.
+    fn insert(&mut self, candidates: Vec<P3>) -> usize {
+        let free: Vec<bool> = candidates
+            .par_iter()
+            .map(|x| self.pose.free(x).is_ok())
+            .collect();
+        self.checks += candidates.len();
+        let from = self.nodes.len();
+        for (x, ok) in candidates.into_iter().zip(free) {
+            if ok && !self.nodes.iter().any(|y| (y - x).norm() < 1e-6) {
+                self.nodes.push(x);
+                self.adj.push(Vec::new());
+            }
+        }
+        let added = self.nodes.len() - from;
+        if added > 0 {
+            self.link(from);
+        }
+        added
+    }
+
+    /// The component of every node (the lowest node index in it).
+    fn components(&self) -> Vec<usize> {
+        let n = self.nodes.len();
+        let mut comp = vec![usize::MAX; n];
+        for s in 0..n {
+            if comp[s] != usize::MAX {
+                continue;
+            }
+            comp[s] = s;
+            let mut stack = vec![s];
+            while let Some(u) = stack.pop() {
+                for e in &self.adj[u] {
+                    if comp[e.to] == usize::MAX {
+                        comp[e.to] = s;
+                        stack.push(e.to);
+                    }
+                }
+            }
+        }
+        comp
+    }
+
+    /// Goals outside the component holding the most goals (ties: the lower index).
+    fn stray_goals(&self) -> Vec<usize> {
+        let comp = self.components();
+        let mut count = vec![0usize; self.nodes.len()];
+        for g in 0..self.goals {
+            count[comp[g]] += 1;
+        }
+        let mut main = 0;
+        for c in 0..count.len() {
+            if count[c] > count[main] {
+                main = c;
+            }
+        }
+        (0..self.goals).filter(|&g| comp[g] != main).collect()
+    }
+
+    /// Builds the roadmap: initialisation, then enhancement until the goals are
+    /// connected. `face_points(goal)` gives extra stand-off positions on a goal's face.
+    pub fn build(&mut self, face_points: impl Fn(usize) -> Vec<P3>) -> Result<usize, Disconnected> {
+        self.link(0);
+        let mut added = 0;
+        let mut rng = 0x9E37_79B9_7F4A_7C15u64;
+        for round in 0..8 {
+            let stray = self.stray_goals();
+            if stray.is_empty() {
+                return Ok(added);
+            }
+            let mut cands = Vec::new();
+            match round {
+                // Goals lifted along the probe axis and then the ram axis.
+                0 => {
+                    for g in 0..self.goals {
+                        let x = self.nodes[g];
+                        for h in [5.0, 20.0] {
+                            cands.push(x + self.dir * h);
+                            cands.push(self.raised(&(x + self.dir * h)));
+                        }
+                        cands.push(self.raised(&x));
+                    }
+                }
+                // Points on the faces of the goals left out.
+                1 | 2 => {
+                    for &g in &stray {
+                        cands.extend(face_points(g));
+                    }
+                }
+                // Random points around the part.
+                _ => {
+                    let (lo, hi) = self.bounds();
+                    for _ in 0..64 {
+                        let mut r = || {
+                            rng ^= rng << 13;
+                            rng ^= rng >> 7;
+                            rng ^= rng << 17;
+                            (rng >> 11) as f64 / (1u64 << 53) as f64
+                        };
+                        let (a, b, c) = (r(), r(), r());
+                        cands.push(P3::new(
+                            lo.x + a * (hi.x - lo.x),
+                            lo.y + b * (hi.y - lo.y),
+                            lo.z + c * (hi.z - lo.z),
+                        ));
+                    }
+                }
+            }
+            added += self.insert(cands);
+        }
+        let stray = self.stray_goals();
+        match stray.first() {
+            None => Ok(added),
+            Some(&goal) => {
+                let main: Vec<usize> = (0..self.goals).filter(|g| !stray.contains(g)).collect();
+                let near = main
+                    .iter()
+                    .min_by(|&&a, &&b| {
+                        let d = |k: usize| (self.nodes[k] - self.nodes[goal]).norm();
+                        d(a).total_cmp(&d(b))
+                    })
+                    .copied();
+                let blocker = near
+                    .and_then(|m| self.pose.segment(&self.nodes[goal], &self.nodes[m]).err())
+                    .unwrap_or_else(|| "the part".into());
+                Err(Disconnected { goal, blocker })
+            }
+        }
+    }
+
+    /// The box around the nodes, grown by the clearance margin.
+    fn bounds(&self) -> (P3, P3) {
+        let mut lo = self.nodes[0];
+        let mut hi = self.nodes[0];
+        for x in &self.nodes {
+            lo = lo.inf(x);
+            hi = hi.sup(x);
+        }
+        let m = V3::repeat(10.0);
+        (lo - m, hi + m)
+    }
+
+    /// Dijkstra from goal `s`: distance and predecessor (node, route) of every node.
+    fn dijkstra(&self, s: usize) -> (Vec<f64>, Vec<Option<(usize, Route)>>) {
+        let n = self.nodes.len();
+        let mut dist = vec![f64::INFINITY; n];
+        let mut prev: Vec<Option<(usize, Route)>> = vec![None; n];
+        let mut heap = BinaryHeap::new();
+        dist[s] = 0.0;
+        heap.push(Item(0.0, s));
+        while let Some(Item(d, u)) = heap.pop() {
+            if d > dist[u] {
+                continue;
+            }
+            for e in &self.adj[u] {
+                let nd = d + e.length;
+                if nd < dist[e.to] - 1e-12 {
+                    dist[e.to] = nd;
+                    prev[e.to] = Some((u, e.route));
+                    heap.push(Item(nd, e.to));
+                }
+            }
+        }
+        (dist, prev)
+    }
+
+    /// Shortest paths from every goal: distances between goals and the trees to
+    /// extract the paths.
+    pub fn shortest_paths(&self) -> Paths {
+        let trees: Vec<_> = (0..self.goals)
+            .into_par_iter()
+            .map(|g| self.dijkstra(g))
+            .collect();
+        Paths { trees }
+    }
+}
+
+/// Shortest paths from each goal.
+pub struct Paths {
+    trees: Vec<(Vec<f64>, Vec<Option<(usize, Route)>>)>,
+}
+
+impl Paths {
+    /// The length of the shortest path between goals `a` and `b`.
+    pub fn d(&self, a: usize, b: usize) -> f64 {
+        self.trees[a].0[b]
+    }
+
+    /// The waypoints from goal `a` to goal `b` (without `a`, with `b`).
+    pub fn path(&self, map: &Roadmap, a: usize, b: usize) -> Vec<P3> {
+        // Walk back from b to a in a's tree; each edge's route runs from its
+        // predecessor towards the node.
+        let prev = &self.trees[a].1;
+        let mut chain = Vec::new();
+        let mut at = b;
+        while at != a {
+            let Some((p, route)) = prev[at] else { break };
+            chain.push((p, at, route));
+            at = p;
+        }
+        chain.reverse();
+        let mut out = Vec::new();
+        for (p, q, route) in chain {
+            out.extend(map.waypoints(&map.nodes[p], &map.nodes[q], route));
+        }
+        out
+    }
+}
+
+/// A heap entry ordered by smallest distance, then smallest node.
+struct Item(f64, usize);
+
+impl PartialEq for Item {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+impl Eq for Item {}
+impl PartialOrd for Item {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Item {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.0.total_cmp(&self.0).then(o.1.cmp(&self.1))
+    }
+}
