@@ -262,6 +262,9 @@ fn refs(params: &[String]) -> Vec<(String, String)> {
         .collect()
 }
 
+/// A command as the checks see it: label, major word, parameters, offset.
+type Cmd<'a> = (&'a Option<(String, String)>, &'a str, &'a [String], usize);
+
 fn check(
     statements: &[Statement],
     text: &str,
@@ -272,7 +275,7 @@ fn check(
         let end = text[at..].find('\n').map_or(text.len(), |e| at + e);
         (at, end - at).into()
     };
-    let commands: Vec<(&Option<(String, String)>, &str, &[String], usize)> = statements
+    let commands: Vec<Cmd> = statements
         .iter()
         .filter_map(|s| match s {
             Statement::Command {

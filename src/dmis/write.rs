@@ -19,6 +19,8 @@ use std::fmt::Write as _;
 /// The program being written.
 struct Out {
     text: String,
+    /// Where the last `GOTO` went, to drop a repeated one.
+    at: Option<[f64; 3]>,
 }
 
 impl Out {
@@ -53,6 +55,10 @@ impl Out {
     }
 
     fn goto(&mut self, p: &[f64; 3]) {
+        if self.at == Some(*p) {
+            return;
+        }
+        self.at = Some(*p);
         self.stmt(&format!("GOTO/{},{},{}", num(p[0]), num(p[1]), num(p[2])));
     }
 }
@@ -192,6 +198,7 @@ pub fn write(input: &Input) -> String {
     let mut labels = Labels::default();
     let mut o = Out {
         text: String::new(),
+        at: None,
     };
 
     o.comment(&format!(
@@ -263,6 +270,21 @@ pub fn write(input: &Input) -> String {
     let mut feats: BTreeMap<(String, String, bool), String> = BTreeMap::new();
     let mut faces_of: BTreeMap<String, Vec<String>> = BTreeMap::new();
     let mut nominals: BTreeMap<String, Nominal> = BTreeMap::new();
+    // How many faces (or table stand-ins) each feature is measured on.
+    let mut face_count: BTreeMap<String, usize> = BTreeMap::new();
+    {
+        let mut seen = std::collections::BTreeSet::new();
+        for b in llip
+            .setups
+            .iter()
+            .flat_map(|s| &s.groups)
+            .flat_map(|g| &g.blocks)
+        {
+            if seen.insert((&b.feature, &b.face, b.table)) {
+                *face_count.entry(b.feature.clone()).or_default() += 1;
+            }
+        }
+    }
     for g in llip.setups.iter().flat_map(|s| &s.groups) {
         for b in &g.blocks {
             let key = (b.feature.clone(), b.face.clone(), b.table);
@@ -272,25 +294,7 @@ pub fn write(input: &Input) -> String {
             let Some(nominal) = nominal_of(input, b) else {
                 continue;
             };
-            let count = part
-                .features
-                .iter()
-                .position(|f| f.name == b.feature)
-                .and_then(|_| {
-                    let n = hlip
-                        .setups
-                        .iter()
-                        .flat_map(|s| &s.probes)
-                        .flat_map(|p| &p.orients)
-                        .flat_map(|o| &o.inspections)
-                        .filter(|i| i.feature == b.feature)
-                        .flat_map(|i| &i.faces)
-                        .map(|f| (&f.face, f.table))
-                        .collect::<std::collections::BTreeSet<_>>()
-                        .len();
-                    Some(n)
-                })
-                .unwrap_or(1);
+            let count = face_count.get(&b.feature).copied().unwrap_or(1);
             let k = faces_of.get(&b.feature).map_or(0, Vec::len) + 1;
             let name = if b.table {
                 format!("{}_T", b.feature)
@@ -435,6 +439,12 @@ pub fn write(input: &Input) -> String {
                     continue;
                 };
                 let meas = nominals.get(label).map_or("PLANE", Nominal::meas);
+                // A narrow block approaches and retracts by its own, shorter stand-off.
+                let narrow = b.standoff < motion.prehit.max(motion.retract) - 1e-9;
+                if narrow {
+                    o.stmt(&format!("SNSET/APPRCH,{}", num(b.standoff)));
+                    o.stmt(&format!("SNSET/RETRCT,{}", num(b.standoff)));
+                }
                 o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
                 for t in &b.touches {
                     for v in &t.via {
@@ -442,11 +452,15 @@ pub fn write(input: &Input) -> String {
                     }
                     o.goto(&t.standoff);
                     ptmeas(&mut o, hlip, t.point);
-                    if motion.retract < motion.prehit {
+                    if !narrow && motion.retract < motion.prehit {
                         o.goto(&t.standoff);
                     }
                 }
                 o.stmt("ENDMES");
+                if narrow {
+                    o.stmt(&format!("SNSET/APPRCH,{}", num(motion.prehit)));
+                    o.stmt(&format!("SNSET/RETRCT,{}", num(motion.retract)));
+                }
                 let list = measured.entry(b.feature.clone()).or_default();
                 if !list.contains(label) {
                     list.push(label.clone());
@@ -527,6 +541,7 @@ fn select(
 ) {
     if let Some(s) = sensors.get(&sensor_key(g)) {
         if current.as_ref() != Some(s) {
+            o.at = None;
             o.stmt(&format!("SNSLCT/S({s})"));
             *current = Some(s.clone());
         }
@@ -535,6 +550,7 @@ fn select(
 
 fn ptmeas(o: &mut Out, hlip: &crate::plan::Hlip, k: usize) {
     let p = &hlip.points[k];
+    o.at = None;
     o.stmt(&format!(
         "PTMEAS/CART,{},{},{},{},{},{}",
         num(p.position[0]),

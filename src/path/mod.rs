@@ -96,6 +96,9 @@ pub struct BlockPath {
     pub table: bool,
     /// The datum letter when the feature is a datum feature.
     pub datum: Option<String>,
+    /// The stand-off of its touches: `max(prehit, retract)`, or less where the space in
+    /// front of the face is narrower (a small bore), so that the tip waits half-way.
+    pub standoff: f64,
     /// The touches in order.
     pub touches: Vec<Touch>,
 }
@@ -213,6 +216,7 @@ pub fn plan(
                             face: f.face.clone(),
                             table: f.table,
                             datum: datum_of.get(i.feature.as_str()).map(|d| d.1.to_string()),
+                            standoff,
                             touches: f
                                 .points
                                 .iter()
@@ -266,7 +270,7 @@ pub fn plan(
 
     let total = groups.len();
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let results: Vec<Result<GroupOut, PathError>> = groups
+    let results: Vec<Result<GroupOut, Box<PathError>>> = groups
         .par_iter()
         .map(|g| {
             let r = plan_group(input, hlip, &scene, g, standoff, &datum_of);
@@ -285,7 +289,7 @@ pub fn plan(
             Ok(o) => outs.push(o),
             Err(e) => {
                 failed = true;
-                diags.push(part.span.file, e);
+                diags.push(part.span.file, *e);
             }
         }
     }
@@ -318,19 +322,19 @@ pub fn plan(
         let exit_end = o.exit.last().copied().unwrap_or(entry[0]);
         prev = Some((g.setup, exit_end));
         let mut glen = polyline(&entry) + polyline(&o.exit);
-        let mut at = P3::from(o.exit.first().map_or([0.0; 3], |_| [0.0; 3]));
+        let mut at = entry.last().copied().unwrap_or_else(P3::origin);
         let mut first = true;
         for b in &o.blocks {
             for t in &b.touches {
                 let s = P3::from(t.standoff);
+                let mut pts = vec![at];
                 if !first {
-                    let mut pts = vec![at];
                     pts.extend(t.via.iter().map(|&v| P3::from(v)));
-                    pts.push(s);
-                    glen += polyline(&pts);
                 }
+                pts.push(s);
+                glen += polyline(&pts);
                 first = false;
-                glen += 2.0 * standoff;
+                glen += 2.0 * b.standoff;
                 at = s;
                 touches += 1;
             }
@@ -407,9 +411,29 @@ fn plan_group(
     g: &GroupIn,
     standoff: f64,
     datum_of: &BTreeMap<&str, (usize, &str)>,
-) -> Result<GroupOut, PathError> {
+) -> Result<GroupOut, Box<PathError>> {
     let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table);
     let r = g.probe.tip_radius;
+    // Each block's stand-off: no more than half the free space in front of its points.
+    let mut blocks_in = g.blocks.clone();
+    for b in &mut blocks_in {
+        for t in &b.touches {
+            let p = &hlip.points[t.point];
+            let n = V3::from(p.normal);
+            // Start past the tessellation's deviation from the exact surface (0.05 mm).
+            const SKIN: f64 = 0.1;
+            let from = P3::from(p.position) + n * SKIN;
+            if let Some(hit) = scene.cast_ray(&from, &n, 2.0 * (standoff + r) + 1.0) {
+                b.standoff = b.standoff.min(((hit + SKIN - 2.0 * r) / 2.0).max(0.0));
+            }
+        }
+    }
+    let g = &GroupIn {
+        blocks: blocks_in,
+        records: g.records.clone(),
+        label: g.label.clone(),
+        ..*g
+    };
     // Goals: every touch's stand-off, block by block.
     let mut goals = Vec::new();
     let mut owner = Vec::new();
@@ -417,7 +441,7 @@ fn plan_group(
         for (ti, t) in b.touches.iter().enumerate() {
             let p = &hlip.points[t.point];
             let n = V3::from(p.normal);
-            goals.push(P3::from(p.position) + n * (r + standoff));
+            goals.push(P3::from(p.position) + n * (r + b.standoff));
             owner.push((bi, ti));
         }
     }
@@ -455,12 +479,12 @@ fn plan_group(
     let mut map = Roadmap::new(&pose, goals.clone(), g.dir, vertices_of(input), g.height);
     let added = map.build(face_points).map_err(|d| {
         let (bi, _) = owner[d.goal];
-        no_path(input, &g.blocks[bi], g, d.blocker)
+        Box::new(no_path(input, &g.blocks[bi], g, d.blocker))
     })?;
     let paths = map.shortest_paths();
     // The way up from each goal to the clearance plane.
     let lifts: Vec<Option<Vec<P3>>> = goals.par_iter().map(|x| lift(&pose, x, g)).collect();
-    let mut checks = map.checks + goals.len() * 3;
+    let checks = map.checks + goals.len() * 3;
     let lift_len = |k: usize| {
         lifts[k].as_ref().map_or(f64::INFINITY, |w| {
             let mut pts = vec![goals[k]];
@@ -536,15 +560,17 @@ fn plan_group(
         .unwrap_or(0);
     let Some(entry_up) = lifts[first].clone() else {
         let (bi, _) = owner[first];
-        return Err(no_path(
+        return Err(Box::new(no_path(
             input,
             &g.blocks[bi],
             g,
             "the way up to the clearance plane".into(),
-        ));
+        )));
     };
     let mut entry: Vec<P3> = entry_up.into_iter().rev().collect();
-    entry.push(goals[first]);
+    if entry.is_empty() {
+        entry.push(goals[first]);
+    }
     let last = cur.unwrap_or(first);
     let exit_goal = (0..goals.len())
         .filter(|&k| lifts[k].is_some())
@@ -584,7 +610,6 @@ fn plan_group(
             .collect();
         blocks.push(b);
     }
-    checks += 0;
     Ok(GroupOut {
         entry,
         blocks,

@@ -360,7 +360,7 @@ impl<'a> Roadmap<'a> {
     }
 
     /// Dijkstra from goal `s`: distance and predecessor (node, route) of every node.
-    fn dijkstra(&self, s: usize) -> (Vec<f64>, Vec<Option<(usize, Route)>>) {
+    fn dijkstra(&self, s: usize) -> Tree {
         let n = self.nodes.len();
         let mut dist = vec![f64::INFINITY; n];
         let mut prev: Vec<Option<(usize, Route)>> = vec![None; n];
@@ -394,9 +394,12 @@ impl<'a> Roadmap<'a> {
     }
 }
 
+/// Dijkstra's result from one goal: distances and predecessors.
+type Tree = (Vec<f64>, Vec<Option<(usize, Route)>>);
+
 /// Shortest paths from each goal.
 pub struct Paths {
-    trees: Vec<(Vec<f64>, Vec<Option<(usize, Route)>>)>,
+    trees: Vec<Tree>,
 }
 
 impl Paths {
