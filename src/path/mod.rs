@@ -196,17 +196,21 @@ pub fn plan(
             .map(|v| v.coords.dot(&up))
             .fold(f64::NEG_INFINITY, f64::max);
         let mut setup_groups = Vec::new();
+        let reach_max = s
+            .probes
+            .iter()
+            .filter_map(|p| probes.iter().find(|x| x.name == p.probe))
+            .map(ProbeShape::reach)
+            .fold(0.0, f64::max);
         for p in &s.probes {
             let Some(probe) = probes.iter().find(|x| x.name == p.probe) else {
                 continue;
             };
             for o in &p.orients {
                 let dir = V3::from(o.direction);
-                let lift = if probe.bent {
-                    probe.reach() * (1.0 - dir.dot(&up))
-                } else {
-                    0.0
-                };
+                // Every group of a setup keeps the head at one height on the clearance
+                // plane, where the longest probe in any orientation swings clear.
+                let lift = reach_max - probe.reach() * dir.dot(&up);
                 let mut blocks = Vec::new();
                 let mut records = Vec::new();
                 for i in &o.inspections {
@@ -300,18 +304,25 @@ pub fn plan(
     // Join the groups: moves between them run on the clearance plane.
     let mut setups: Vec<SetupPath> = Vec::new();
     let (mut added, mut checks, mut length, mut touches) = (0, 0, 0.0, 0);
+    // The previous group: its setup and where its head ends.
     let mut prev: Option<(usize, P3)> = None;
     for (g, o) in groups.iter().zip(outs) {
         added += o.added;
         checks += o.checks;
         let mut entry = o.entry;
-        if let Some((s, at)) = prev {
+        let arm = |g: &GroupIn| g.probe.reach();
+        if let Some((s, head)) = prev {
             if s == g.setup {
-                // Across from above the previous group's exit, at this group's height.
-                let across = at + g.up * (g.height - at.coords.dot(&g.up));
+                // After the sensor change the tip hangs from the same head position;
+                // from there, up or down to this group's height, then across.
+                let from = head - g.dir * arm(g);
+                let across = from + g.up * (g.height - from.coords.dot(&g.up));
                 let pose = Pose::new(&scene, g.probe, g.dir, g.up, g.table);
-                checks += 1;
-                if let Err(blocker) = pose.segment(&across, &entry[0]) {
+                checks += 2;
+                let moves = pose
+                    .segment(&from, &across)
+                    .and_then(|_| pose.segment(&across, &entry[0]));
+                if let Err(blocker) = moves {
                     let b = &o.blocks[0];
                     diags.push(part.span.file, no_path(input, b, g, blocker));
                     return None;
@@ -320,7 +331,7 @@ pub fn plan(
             }
         }
         let exit_end = o.exit.last().copied().unwrap_or(entry[0]);
-        prev = Some((g.setup, exit_end));
+        prev = Some((g.setup, exit_end + g.dir * arm(g)));
         let mut glen = polyline(&entry) + polyline(&o.exit);
         let mut at = entry.last().copied().unwrap_or_else(P3::origin);
         let mut first = true;
