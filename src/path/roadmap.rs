@@ -448,3 +448,95 @@ impl Ord for Item {
         o.0.total_cmp(&self.0).then(o.1.cmp(&self.1))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::access::{Component, End, ProbeShape, Scene};
+
+    /// The 12 triangles of a box, outward.
+    fn cuboid(lo: P3, hi: P3) -> Vec<[P3; 3]> {
+        let c = |i: usize| {
+            P3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        };
+        let quads = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        quads
+            .iter()
+            .flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]])
+            .collect()
+    }
+
+    fn stylus() -> ProbeShape {
+        ProbeShape {
+            name: "p".into(),
+            tip_radius: 1.0,
+            first: vec![Component {
+                name: "stylus".into(),
+                a: 0.0,
+                b: 30.0,
+                radius: 0.5,
+                end: End::Round,
+            }],
+            second: vec![],
+            bent: false,
+        }
+    }
+
+    #[test]
+    fn a_goal_sealed_in_a_box_is_reported() {
+        let tris = cuboid(P3::new(-10.0, -10.0, -10.0), P3::new(10.0, 10.0, 10.0));
+        let verts: Vec<P3> = tris.iter().flatten().copied().collect();
+        let scene = Scene::of_triangles(&tris);
+        let probe = stylus();
+        let pose = Pose::new(&scene, &probe, V3::z(), V3::z(), -100.0);
+        let goals = vec![
+            P3::origin(),
+            P3::new(30.0, 0.0, 0.0),
+            P3::new(40.0, 0.0, 0.0),
+        ];
+        let mut map = Roadmap::new(&pose, goals, V3::z(), &verts, 40.0);
+        match map.build(|_| vec![P3::new(0.0, 5.0, 0.0)]) {
+            Err(Disconnected { goal, blocker }) => {
+                assert_eq!(goal, 0);
+                assert_eq!(blocker, "the tip", "the straight move out crosses the wall");
+            }
+            Ok(_) => panic!("a sealed goal was connected"),
+        }
+    }
+
+    #[test]
+    fn goals_either_side_of_a_wall_are_joined_over_it() {
+        let tris = cuboid(P3::new(-1.0, -20.0, 0.0), P3::new(1.0, 20.0, 20.0));
+        let verts: Vec<P3> = tris.iter().flatten().copied().collect();
+        let scene = Scene::of_triangles(&tris);
+        let probe = stylus();
+        let pose = Pose::new(&scene, &probe, V3::z(), V3::z(), -100.0);
+        let (a, b) = (P3::new(-5.0, 0.0, 5.0), P3::new(5.0, 0.0, 5.0));
+        assert_eq!(pose.segment(&a, &b), Err("the tip".into()));
+        let mut map = Roadmap::new(&pose, vec![a, b], V3::z(), &verts, 40.0);
+        assert_eq!(map.build(|_| vec![]).ok(), Some(0));
+        let paths = map.shortest_paths();
+        // Up 20 mm along the probe axis (5 mm is not enough), across, down.
+        assert!((paths.d(0, 1) - 50.0).abs() < 1e-9, "{}", paths.d(0, 1));
+        let w = paths.path(&map, 0, 1);
+        assert_eq!(w.len(), 3);
+        for s in std::iter::once(a)
+            .chain(w.iter().copied())
+            .collect::<Vec<_>>()
+            .windows(2)
+        {
+            assert!(pose.segment(&s[0], &s[1]).is_ok());
+        }
+    }
+}

@@ -80,9 +80,18 @@ pub fn solve(m: &Matrix) -> Vec<usize> {
 
 /// Nearest neighbour from the start; ties go to the lower index.
 pub fn nearest_neighbour(m: &Matrix) -> Vec<usize> {
+    nearest_from(m, None)
+}
+
+/// Nearest neighbour, optionally with a given first point.
+fn nearest_from(m: &Matrix, first: Option<usize>) -> Vec<usize> {
     let mut left: Vec<bool> = vec![true; m.n];
     let mut order = Vec::with_capacity(m.n);
-    for _ in 0..m.n {
+    if let Some(f) = first {
+        left[f] = false;
+        order.push(f);
+    }
+    while order.len() < m.n {
         let from = order.last().copied();
         let mut best: Option<(f64, usize)> = None;
         for (j, _) in left.iter().enumerate().filter(|(_, l)| **l) {
@@ -101,17 +110,26 @@ pub fn nearest_neighbour(m: &Matrix) -> Vec<usize> {
     order
 }
 
-/// Nearest neighbour improved by 2-opt and Or-opt (segments of 1–3 points, either way
-/// round) until a pass finds nothing better.
+/// How many first points the heuristic tries.
+const STARTS: usize = 12;
+
+/// Local search from several nearest-neighbour tours — each starting at one of the
+/// [`STARTS`] points nearest the start — with 2-opt and Or-opt (runs of 1–3 points,
+/// either way round) until neither improves; the shortest wins (ties: the first).
 pub fn heuristic(m: &Matrix) -> Vec<usize> {
-    let mut order = nearest_neighbour(m);
-    loop {
-        let a = two_opt(m, &mut order);
-        let b = or_opt(m, &mut order);
-        if !a && !b {
-            return order;
+    let mut firsts: Vec<usize> = (0..m.n).collect();
+    firsts.sort_by(|&a, &b| m.start[a].total_cmp(&m.start[b]).then(a.cmp(&b)));
+    firsts.truncate(STARTS);
+    let mut best: Option<(f64, Vec<usize>)> = None;
+    for first in std::iter::once(None).chain(firsts.into_iter().map(Some)) {
+        let mut order = nearest_from(m, first);
+        while two_opt(m, &mut order) | or_opt(m, &mut order) {}
+        let l = m.length(&order);
+        if best.as_ref().is_none_or(|(b, _)| l < b - EPS) {
+            best = Some((l, order));
         }
     }
+    best.map(|(_, o)| o).unwrap_or_default()
 }
 
 /// One pass of 2-opt on an open path: reverse `order[i..=j]` when that is shorter.
@@ -146,39 +164,56 @@ fn two_opt(m: &Matrix, order: &mut [usize]) -> bool {
     improved
 }
 
-/// One pass of Or-opt: move a run of 1–3 points elsewhere, reversed or not.
+/// The cost of an edge of the open path: `None` on the left is the start, `None` on the
+/// right the free end.
+fn edge(m: &Matrix, a: Option<usize>, b: Option<usize>) -> f64 {
+    match (a, b) {
+        (_, None) => 0.0,
+        (None, Some(j)) => m.start[j],
+        (Some(i), Some(j)) => m.d(i, j),
+    }
+}
+
+/// One pass of Or-opt: move a run of 1–3 points to the best other place, reversed or
+/// not, when that is shorter. O(n²) per run length.
 fn or_opt(m: &Matrix, order: &mut Vec<usize>) -> bool {
     let mut improved = false;
     for len in 1..=3usize {
         let mut i = 0;
         while i + len <= order.len() {
-            let base = m.length(order);
-            let run: Vec<usize> = order[i..i + len].to_vec();
-            let mut rest = order.clone();
-            rest.drain(i..i + len);
-            let mut best: Option<(f64, Vec<usize>)> = None;
-            for at in 0..=rest.len() {
-                if at == i {
+            let n = order.len();
+            let prev = if i == 0 { None } else { Some(order[i - 1]) };
+            let next = order.get(i + len).copied();
+            let (first, last) = (order[i], order[i + len - 1]);
+            let gain = edge(m, prev, Some(first)) + edge(m, Some(last), next) - edge(m, prev, next);
+            // Insert between rest[a-1] and rest[a] of the path without the run.
+            let mut best: Option<(f64, usize, bool)> = None;
+            for a in 0..=(n - len) {
+                if a == i {
                     continue;
                 }
+                let at = |k: usize| if k < i { order[k] } else { order[k + len] };
+                let x = if a == 0 { None } else { Some(at(a - 1)) };
+                let y = if a < n - len { Some(at(a)) } else { None };
+                let base = edge(m, x, y);
                 for rev in [false, true] {
-                    let mut cand = rest.clone();
-                    let mut r = run.clone();
-                    if rev {
-                        r.reverse();
-                    }
-                    cand.splice(at..at, r);
-                    let l = m.length(&cand);
-                    if l < base - EPS && best.as_ref().is_none_or(|(b, _)| l < b - EPS) {
-                        best = Some((l, cand));
+                    let (h, t) = if rev { (last, first) } else { (first, last) };
+                    let cost = edge(m, x, Some(h)) + edge(m, Some(t), y) - base;
+                    if cost < gain - EPS && best.is_none_or(|(b, _, _)| cost < b - EPS) {
+                        best = Some((cost, a, rev));
                     }
                 }
             }
-            if let Some((_, cand)) = best {
-                *order = cand;
+            if let Some((_, a, rev)) = best {
+                let mut run: Vec<usize> = order.drain(i..i + len).collect();
+                if rev {
+                    run.reverse();
+                }
+                order.splice(a..a, run);
                 improved = true;
+            } else {
+                i += 1;
             }
-            i += 1;
         }
     }
     improved
