@@ -409,14 +409,23 @@ fn build(
         let h = &b.hlip;
         let l = &b.llip;
         let s = &h.summary;
+        let n = |k: usize, w: &str| {
+            let es = if w.ends_with("ch") { "es" } else { "s" };
+            format!("{k} {w}{}", if k == 1 { "" } else { es })
+        };
         println!(
-            "plan {}: {} setups, {} probes, {} orientations, {} features, {} touches",
-            h.plan, s.setups, s.probes_used, s.orientations, s.features, l.summary.touches
+            "plan {}: {}, {}, {}, {}, {}",
+            h.plan,
+            n(s.setups, "setup"),
+            n(s.probes_used, "probe"),
+            n(s.orientations, "orientation"),
+            n(s.features, "feature"),
+            n(l.summary.touches, "touch")
         );
         println!(
-            "  path {:.1} m in {} groups ({} roadmap nodes added, {} moves checked)",
+            "  path {:.2} m in {} ({} roadmap nodes added, {} moves checked)",
             l.summary.length / 1000.0,
-            l.summary.groups,
+            n(l.summary.groups, "group"),
             l.summary.added_nodes,
             l.summary.checks
         );

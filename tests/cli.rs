@@ -381,3 +381,85 @@ fn cones_of_unknown_names_are_diagnostics() {
     assert_eq!(status, 1);
     assert!(stderr.contains("insp::access::no_machine"), "{stderr}");
 }
+
+#[test]
+fn build_writes_the_program_and_the_plan() {
+    let dir = std::env::temp_dir().join(format!("inspc-build-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let dmi = dir.join("f2.dmi");
+    let json = dir.join("f2.json");
+    let (code, stdout, stderr) = inspc(&[
+        "build",
+        "examples/f2.insp",
+        "-o",
+        dmi.to_str().unwrap(),
+        "--plan-json",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("1 setup, 2 probes"), "{stdout}");
+    assert!(
+        stdout.contains(&format!("wrote {}", dmi.display())),
+        "{stdout}"
+    );
+    assert!(stdout.contains("time: front end"), "{stdout}");
+    let program = std::fs::read_to_string(&dmi).unwrap();
+    assert!(program.contains("DMISMN/'F2_PLAN',05.3") && program.ends_with("ENDFIL\n"));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(v["paths"].as_array().is_some_and(|p| !p.is_empty()), "{v}");
+    // The program reads back clean.
+    let (code, stdout, stderr) = inspc(&["dmis", dmi.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("touches"), "{stdout}");
+    // No temporary file is left beside it.
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("inspc-tmp"))
+        .collect();
+    assert!(left.is_empty());
+}
+
+#[test]
+fn a_failed_build_writes_nothing() {
+    let dir = std::env::temp_dir().join(format!("inspc-fail-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let dmi = dir.join("slot.dmi");
+    let (code, _, stderr) = inspc(&[
+        "build",
+        "tests/plans/uninspectable_slot/main.insp",
+        "-o",
+        dmi.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(
+        stderr.contains("insp::plan::uninspectable_face"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("nothing written"), "{stderr}");
+    assert!(!dmi.exists());
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        0,
+        "no partial file"
+    );
+}
+
+#[test]
+fn the_dmis_reader_reports_what_a_controller_rejects() {
+    let bad = temp_spec(
+        "bad.dmi",
+        "DMISMN/'X',05.3\nF(bad)=FEAT/POINT,CART,0,0,0,0,0,1\nMEAS/POINT,F(NONE),2\nPTMEAS/CART,1,2,3,0,0,1\nENDMES\nOUTPUT/FA(NONE),TA(T1)\n",
+    );
+    let (code, _, stderr) = inspc(&["dmis", &bad]);
+    assert_eq!(code, 1);
+    for c in [
+        "insp::dmis::bad_label",
+        "insp::dmis::undefined",
+        "insp::dmis::structure",
+    ] {
+        assert!(stderr.contains(c), "{c}: {stderr}");
+    }
+    assert!(stderr.contains("help:"), "{stderr}");
+}
