@@ -22,6 +22,13 @@ const NO_SPEC_EXAMPLE: &[(&str, &str)] = &[
     ("insp::access::unknown_probe", "a command-line request; tests/cli.rs"),
     ("insp::access::no_machine", "a command-line request; tests/cli.rs"),
     ("insp::plan::no_convergence", "a guard: generate-and-test removes a configuration every round, and every example and NIST part settles well inside the limit"),
+    ("insp::path::no_path", "a touch that validates can almost always back out the way it came; src/path/roadmap.rs tests a sealed goal"),
+    ("insp::dmis::long_line", "a DMIS file, not a spec: src/dmis/read.rs"),
+    ("insp::dmis::syntax", "a DMIS file, not a spec: src/dmis/read.rs"),
+    ("insp::dmis::bad_label", "a DMIS file, not a spec: tests/cli.rs"),
+    ("insp::dmis::duplicate_label", "a DMIS file, not a spec: src/dmis/read.rs"),
+    ("insp::dmis::undefined", "a DMIS file, not a spec: tests/cli.rs"),
+    ("insp::dmis::structure", "a DMIS file, not a spec: tests/cli.rs"),
 ];
 
 fn catalogue() -> Vec<Entry> {

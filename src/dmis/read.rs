@@ -429,3 +429,55 @@ fn check(
         ));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn codes(text: &str) -> Vec<String> {
+        match read("t.dmi", text) {
+            Ok(_) => vec![],
+            Err(es) => es
+                .iter()
+                .map(|e| e.code().map(|c| c.to_string()).unwrap_or_default())
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn a_clean_program_reads_and_prints_back() {
+        let text = "$$ a comment\nDMISMN/'X',05.3\nF(P)=FEAT/PLANE,CART,0,0,0,0,0,1\nS(S1)=SNSDEF/PROBE,FIXED,CART,0,0,-50,0,0,1,2\nSNSLCT/S(S1)\nMEAS/PLANE,F(P),1\nGOTO/0,0,3\nPTMEAS/CART,0,0,0,0,0,1\nENDMES\nT(T1)=TOL/FLAT,0.1\nOUTPUT/FA(P),TA(T1)\nENDFIL\n";
+        let p = read("t.dmi", text).unwrap();
+        assert_eq!(p.to_text(), text);
+        assert_eq!(p.commands("PTMEAS").count(), 1);
+    }
+
+    #[test]
+    fn each_problem_has_its_code() {
+        let long = format!("DMISMN/'X',05.3\nTEXT/OPER,'{}'\nENDFIL\n", "A".repeat(80));
+        assert_eq!(codes(&long), ["insp::dmis::long_line"]);
+        assert_eq!(
+            codes("DMISMN/'X',05.3\ngoto 1 2 3\nENDFIL\n"),
+            ["insp::dmis::syntax"]
+        );
+        assert_eq!(
+            codes("DMISMN/'X',05.3\nF(P)=FEAT/POINT,CART,0,0,0,0,0,1\nF(P)=FEAT/POINT,CART,0,0,0,0,0,1\nENDFIL\n"),
+            ["insp::dmis::duplicate_label"]
+        );
+        assert_eq!(
+            codes("DMISMN/'X',05.3\nSNSLCT/S(NONE)\nENDFIL\n"),
+            ["insp::dmis::undefined"]
+        );
+        assert_eq!(
+            codes("DMISMN/'X',05.3\nF(a)=FEAT/POINT,CART,0,0,0,0,0,1\nENDFIL\n"),
+            ["insp::dmis::bad_label"]
+        );
+        assert_eq!(
+            codes("GOTO/1,2,3\n"),
+            ["insp::dmis::structure", "insp::dmis::structure"]
+        );
+        // A continued statement reads as one.
+        let wrapped = "DMISMN/'X',05.3\nF(P)=FEAT/PLANE,CART,$\n0,0,0,0,0,1\nENDFIL\n";
+        assert!(codes(wrapped).is_empty());
+    }
+}
