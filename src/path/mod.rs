@@ -494,8 +494,9 @@ fn plan_group(
     })?;
     let paths = map.shortest_paths();
     // The way up from each goal to the clearance plane.
-    let lifts: Vec<Option<Vec<P3>>> = goals.par_iter().map(|x| lift(&pose, x, g)).collect();
-    let checks = map.checks + goals.len() * 3;
+    let (lifts, lift_checks): (Vec<Option<Vec<P3>>>, Vec<usize>) =
+        goals.par_iter().map(|x| lift(&pose, x, g)).unzip();
+    let checks = map.checks + lift_checks.iter().sum::<usize>();
     let lift_len = |k: usize| {
         lifts[k].as_ref().map_or(f64::INFINITY, |w| {
             let mut pts = vec![goals[k]];
@@ -637,19 +638,23 @@ fn vertices_of<'a>(input: &Input<'a>) -> &'a [P3] {
 
 /// The way from stand-off `x` up to the clearance plane: straight up the ram axis, or
 /// first up the probe axis; the waypoints after `x`, or `None` when every way is blocked.
-fn lift(pose: &Pose, x: &P3, g: &GroupIn) -> Option<Vec<P3>> {
+/// Also returns how many segments it checked.
+fn lift(pose: &Pose, x: &P3, g: &GroupIn) -> (Option<Vec<P3>>, usize) {
     let raise = |y: &P3| y + g.up * (g.height - y.coords.dot(&g.up)).max(0.0);
     let mut tries: Vec<Vec<P3>> = vec![vec![raise(x)]];
     for h in [5.0, 20.0, 60.0] {
         let y = x + g.dir * h;
         tries.push(vec![y, raise(&y)]);
     }
-    tries.into_iter().find(|w| {
+    let mut checks = 0;
+    let found = tries.into_iter().find(|w| {
         let mut at = *x;
         w.iter().all(|y| {
+            checks += 1;
             let ok = pose.segment(&at, y).is_ok();
             at = *y;
             ok
         })
-    })
+    });
+    (found, checks)
 }
