@@ -236,7 +236,6 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
                     let o: Vec<usize> = (0..3).filter(|k| k != axis).collect();
                     let mut w = vec![dir_word(*axis, *positive)];
                     w.extend(o.iter().map(|&k| orig_word(k)));
-                    dirs.push(*axis);
                     (w, o)
                 }
                 Shape::Sphere { .. } => ((0..3).map(orig_word).collect(), (0..3).collect()),
@@ -245,6 +244,9 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
             let Some(points) = spread(pts, 4.min(pts.len()).max(1)) else {
                 continue;
             };
+            if let Shape::Cylinder { axis, .. } = shape {
+                dirs.push(*axis);
+            }
             for k in fixed {
                 origins[k] = true;
                 out.trans.push((AXES[k], shape.at(k)));
