@@ -37,7 +37,7 @@ fn main() {
                 .iter()
                 .flat_map(|b| b.touches.iter().map(|t| t.standoff))
                 .collect();
-            let m = euclid(&pts, g.entry.first().copied());
+            let m = Matrix::euclidean(&pts, g.entry.first().copied());
             ours += m.length(&(0..pts.len()).collect::<Vec<_>>());
             h += m.length(&heuristic(&m));
             nn += m.length(&nearest_neighbour(&m));
@@ -47,19 +47,6 @@ fn main() {
         );
     }
     divan::main();
-}
-
-fn euclid(pts: &[[f64; 3]], start: Option<[f64; 3]>) -> Matrix {
-    let d = |a: &[f64; 3], b: &[f64; 3]| {
-        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-    };
-    Matrix::new(
-        pts.len(),
-        |i, j| d(&pts[i], &pts[j]),
-        pts.iter()
-            .map(|p| start.map_or(0.0, |s| d(&s, p)))
-            .collect(),
-    )
 }
 
 /// `n` random goals in a 200 × 200 × 100 mm box, from a start in its corner.
@@ -74,7 +61,7 @@ fn goals(n: usize, seed: u64) -> Matrix {
     let pts: Vec<[f64; 3]> = (0..n)
         .map(|_| [200.0 * r(), 200.0 * r(), 100.0 * r()])
         .collect();
-    euclid(&pts, Some([0.0, 0.0, 0.0]))
+    Matrix::euclidean(&pts, Some([0.0, 0.0, 0.0]))
 }
 
 #[divan::bench(args = [30, 100, 300])]

@@ -2,7 +2,7 @@
 
 use inspc::diag::{render_human, RenderOptions};
 use inspc::source::FsWorld;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 mod common;
 use common::{diff, spec_of};
@@ -33,17 +33,7 @@ fn run(spec: &Path) -> Outcome {
 #[test]
 fn golden_cases() {
     let bless = std::env::var_os("INSPC_BLESS").is_some();
-    let mut cases: Vec<PathBuf> = std::fs::read_dir("tests/golden")
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.is_dir())
-        .collect();
-    cases.sort();
-    assert!(
-        cases.len() >= 15,
-        "expected the golden cases, found {}",
-        cases.len()
-    );
+    let cases = common::cases("tests/golden", 15);
     let mut failures = Vec::new();
     for case in &cases {
         let name = case.file_name().unwrap().to_string_lossy().into_owned();

@@ -13,10 +13,8 @@ use std::path::{Path, PathBuf};
 mod common;
 use common::{diff, spec_of};
 
-/// Plans a spec: the HLIPs, or the rendered diagnostics.
-fn plan(spec: &Path) -> Result<Vec<Hlip>, String> {
-    let (checked, _, _, planned) =
-        inspc::plans(&FsWorld, &[spec.to_path_buf()], &PlanOptions::default());
+/// `Ok` without errors, else the errors rendered.
+fn errors_of(checked: &inspc::Checked) -> Result<(), String> {
     let opts = RenderOptions {
         width: 100,
         color: false,
@@ -27,13 +25,21 @@ fn plan(spec: &Path) -> Result<Vec<Hlip>, String> {
         .filter(|d| d.severity() == miette::Severity::Error)
         .collect();
     if errors.is_empty() {
-        Ok(planned.into_iter().filter_map(|p| p.hlip).collect())
+        Ok(())
     } else {
         Err(errors
             .iter()
             .map(|d| render_human(&checked.sources, d, opts))
             .collect())
     }
+}
+
+/// Plans a spec: the HLIPs, or the rendered diagnostics.
+fn plan(spec: &Path) -> Result<Vec<Hlip>, String> {
+    let (checked, _, _, planned) =
+        inspc::plans(&FsWorld, &[spec.to_path_buf()], &PlanOptions::default());
+    errors_of(&checked)?;
+    Ok(planned.into_iter().filter_map(|p| p.hlip).collect())
 }
 
 fn one(spec: &str) -> Hlip {
@@ -50,23 +56,8 @@ fn build(spec: &Path) -> Result<Vec<Built>, String> {
         &PlanOptions::default(),
         &|_, _, _| {},
     );
-    let opts = RenderOptions {
-        width: 100,
-        color: false,
-    };
-    let errors: Vec<_> = checked
-        .diagnostics
-        .iter()
-        .filter(|d| d.severity() == miette::Severity::Error)
-        .collect();
-    if errors.is_empty() {
-        Ok(built)
-    } else {
-        Err(errors
-            .iter()
-            .map(|d| render_human(&checked.sources, d, opts))
-            .collect())
-    }
+    errors_of(&checked)?;
+    Ok(built)
 }
 
 /// The program read back: it passes the reader's checks, prints back byte for byte, and
@@ -124,17 +115,7 @@ fn read_back(case: &Path, b: &Built) -> Result<(), String> {
 #[test]
 fn golden_plans_and_programs() {
     let bless = std::env::var_os("INSPC_BLESS").is_some();
-    let mut cases: Vec<PathBuf> = std::fs::read_dir("tests/plans")
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.is_dir())
-        .collect();
-    cases.sort();
-    assert!(
-        cases.len() >= 10,
-        "expected the plan cases, found {}",
-        cases.len()
-    );
+    let cases = common::cases("tests/plans", 10);
     let mut failures = Vec::new();
     for case in &cases {
         let (plan, program) = match build(&spec_of(case)) {

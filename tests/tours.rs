@@ -8,20 +8,6 @@ use inspc::plan::PlanOptions;
 use inspc::source::FsWorld;
 use std::path::PathBuf;
 
-/// An open-path instance over points in space from a start position.
-fn instance(pts: &[[f64; 3]], start: Option<[f64; 3]>) -> Matrix {
-    let d = |a: &[f64; 3], b: &[f64; 3]| {
-        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-    };
-    Matrix::new(
-        pts.len(),
-        |i, j| d(&pts[i], &pts[j]),
-        pts.iter()
-            .map(|p| start.map_or(0.0, |s| d(&s, p)))
-            .collect(),
-    )
-}
-
 /// Windows of up to 12 consecutive stand-offs from the programs of some examples.
 fn real_instances() -> Vec<Matrix> {
     let mut out = Vec::new();
@@ -46,7 +32,7 @@ fn real_instances() -> Vec<Matrix> {
                     .flat_map(|b| b.touches.iter().map(|t| t.standoff))
                     .collect();
                 for w in pts.chunks(12).filter(|w| w.len() >= 5) {
-                    out.push(instance(w, g.entry.first().copied()));
+                    out.push(Matrix::euclidean(w, g.entry.first().copied()));
                 }
             }
         }
@@ -78,7 +64,7 @@ fn random_instances() -> Vec<Matrix> {
                 .collect()
         };
         let start = (k % 3 != 0).then(|| [r(), r(), r()]);
-        out.push(instance(&pts, start));
+        out.push(Matrix::euclidean(&pts, start));
     }
     out
 }

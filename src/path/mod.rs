@@ -220,7 +220,7 @@ pub fn plan(
                             face: f.face.clone(),
                             table: f.table,
                             datum: datum_of.get(i.feature.as_str()).map(|d| d.1.to_string()),
-                            standoff,
+                            standoff: block_standoff(&scene, hlip, &f.points, standoff, probe),
                             touches: f
                                 .points
                                 .iter()
@@ -425,26 +425,6 @@ fn plan_group(
 ) -> Result<GroupOut, Box<PathError>> {
     let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table);
     let r = g.probe.tip_radius;
-    // Each block's stand-off: no more than half the free space in front of its points.
-    let mut blocks_in = g.blocks.clone();
-    for b in &mut blocks_in {
-        for t in &b.touches {
-            let p = &hlip.points[t.point];
-            let n = V3::from(p.normal);
-            // Start past the tessellation's deviation from the exact surface (0.05 mm).
-            const SKIN: f64 = 0.1;
-            let from = P3::from(p.position) + n * SKIN;
-            if let Some(hit) = scene.cast_ray(&from, &n, 2.0 * (standoff + r) + 1.0) {
-                b.standoff = b.standoff.min(((hit + SKIN - 2.0 * r) / 2.0).max(0.0));
-            }
-        }
-    }
-    let g = &GroupIn {
-        blocks: blocks_in,
-        records: g.records.clone(),
-        label: g.label.clone(),
-        ..*g
-    };
     // Goals: every touch's stand-off, block by block.
     let mut goals = Vec::new();
     let mut owner = Vec::new();
@@ -487,7 +467,13 @@ fn plan_group(
             })
             .collect()
     };
-    let mut map = Roadmap::new(&pose, goals.clone(), g.dir, vertices_of(input), g.height);
+    let mut map = Roadmap::new(
+        &pose,
+        goals.clone(),
+        g.dir,
+        &input.geometry.vertices,
+        g.height,
+    );
     let added = map.build(face_points).map_err(|d| {
         let (bi, _) = owner[d.goal];
         Box::new(no_path(input, &g.blocks[bi], g, d.blocker))
@@ -631,9 +617,27 @@ fn plan_group(
     })
 }
 
-/// The part's vertices.
-fn vertices_of<'a>(input: &Input<'a>) -> &'a [P3] {
-    &input.geometry.vertices
+/// A block's stand-off: `standoff`, or half the free space in front of its points when
+/// that is less (a small bore), so that the tip waits on the bore's axis.
+fn block_standoff(
+    scene: &Scene,
+    hlip: &Hlip,
+    points: &[usize],
+    standoff: f64,
+    probe: &ProbeShape,
+) -> f64 {
+    // Rays start past the tessellation's deviation from the exact surface (0.05 mm).
+    const SKIN: f64 = 0.1;
+    let r = probe.tip_radius;
+    points.iter().fold(standoff, |s, &k| {
+        let p = &hlip.points[k];
+        let n = V3::from(p.normal);
+        let from = P3::from(p.position) + n * SKIN;
+        match scene.cast_ray(&from, &n, 2.0 * (standoff + r) + 1.0) {
+            Some(hit) => s.min(((hit + SKIN - 2.0 * r) / 2.0).max(0.0)),
+            None => s,
+        }
+    })
 }
 
 /// The way from stand-off `x` up to the clearance plane: straight up the ram axis, or

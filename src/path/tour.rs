@@ -31,6 +31,21 @@ impl Matrix {
         Matrix { n, d: m, start }
     }
 
+    /// Straight-line distances between points, from `start` (`None`: a free start).
+    pub fn euclidean(points: &[[f64; 3]], start: Option<[f64; 3]>) -> Matrix {
+        let d = |a: &[f64; 3], b: &[f64; 3]| {
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        };
+        Matrix::new(
+            points.len(),
+            |i, j| d(&points[i], &points[j]),
+            points
+                .iter()
+                .map(|p| start.map_or(0.0, |s| d(&s, p)))
+                .collect(),
+        )
+    }
+
     /// The number of points.
     pub fn len(&self) -> usize {
         self.n

@@ -110,3 +110,19 @@ pub fn spec_of(case: &std::path::Path) -> PathBuf {
         case.join("main.insp")
     }
 }
+
+/// The case folders under `dir`, sorted; at least `min` of them.
+pub fn cases(dir: &str, min: usize) -> Vec<PathBuf> {
+    let mut cases: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .collect();
+    cases.sort();
+    assert!(
+        cases.len() >= min,
+        "expected the cases under {dir}, found {}",
+        cases.len()
+    );
+    cases
+}
