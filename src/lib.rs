@@ -190,6 +190,18 @@ fn graphs_of(checked: &mut Checked, parts: &[Option<PartData>]) -> Vec<Graphed> 
     out
 }
 
+/// The names behind plan `plan`'s ids (its model and its part's geometry), when its
+/// part's geometry was built.
+pub fn plan_names<'a>(
+    checked: &'a Checked,
+    parts: &'a [Option<PartData>],
+    plan: usize,
+) -> Option<plan::Names<'a>> {
+    let model = &checked.model;
+    let data = parts.get(model.plans.get(plan)?.part.0)?.as_ref()?;
+    Some(plan::Names::new(model, &data.geometry, model::PlanId(plan)))
+}
+
 /// One plan's result.
 pub struct Planned {
     /// The plan, by index into [`model::Model::plans`].
@@ -263,6 +275,8 @@ pub struct Built {
     pub llip: path::Llip,
     /// The DMIS program.
     pub dmis: String,
+    /// The plan with its paths as JSON (`--plan-json`).
+    pub json: serde_json::Value,
 }
 
 /// Where a build's time went, stage by stage.
@@ -275,6 +289,29 @@ pub struct Timings {
 /// Reports a build's progress: (what, done, total).
 pub type Progress<'a> = &'a (dyn Fn(&str, usize, usize) + Sync);
 
+/// How far [`run`] goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Until {
+    /// Front end, geometry and measurement graphs.
+    Graph,
+    /// On to plans, paths and DMIS.
+    Build,
+}
+
+/// Everything one run of the pipeline produced, stage by stage.
+pub struct Run {
+    /// The front end's result and every diagnostic of the run.
+    pub checked: Checked,
+    /// Per part of the model, its geometry when built.
+    pub parts: Vec<Option<PartData>>,
+    /// The measurement graphs.
+    pub graphs: Vec<Graphed>,
+    /// Every plan that got through to a program.
+    pub built: Vec<Built>,
+    /// Where the time went.
+    pub timings: Timings,
+}
+
 /// The whole pipeline: front end, geometry, graphs, plans, paths and DMIS. `Built` holds
 /// every plan that got through; the caller writes nothing unless `Checked` has no errors.
 pub fn build(
@@ -283,6 +320,19 @@ pub fn build(
     opts: &plan::PlanOptions,
     progress: Progress,
 ) -> (Checked, Vec<Built>, Timings) {
+    let r = run(world, roots, opts, Until::Build, progress);
+    (r.checked, r.built, r.timings)
+}
+
+/// The pipeline up to `until`, keeping every stage's result: what [`build`] runs, for
+/// callers that want the intermediate results of the same run (the golden tests).
+pub fn run(
+    world: &dyn source::World,
+    roots: &[PathBuf],
+    opts: &plan::PlanOptions,
+    until: Until,
+    progress: Progress,
+) -> Run {
     let mut t = Timings::default();
     let mut clock = std::time::Instant::now();
     let mut lap = |t: &mut Timings, stage: &'static str| {
@@ -298,27 +348,53 @@ pub fn build(
     progress("measurement graph", 0, 1);
     let graphs = graphs_of(&mut checked, &parts);
     lap(&mut t, "graph");
-    progress("planning", 0, 1);
-    let planned = plans_of(&mut checked, &parts, &graphs, opts);
-    lap(&mut t, "plan");
-    let mut out = Vec::new();
-    if checked.has_errors() {
-        return (checked, out, t);
+    let mut run = Run {
+        checked,
+        parts,
+        graphs,
+        built: Vec::new(),
+        timings: t,
+    };
+    if until < Until::Build {
+        return run;
     }
+    progress("planning", 0, 1);
+    let planned = plans_of(&mut run.checked, &run.parts, &run.graphs, opts);
+    lap(&mut run.timings, "plan");
+    if run.checked.has_errors() {
+        return run;
+    }
+    let paths = paths_of(&mut run, planned, progress);
+    lap(&mut run.timings, "paths");
+    if run.checked.has_errors() {
+        return run;
+    }
+    progress("dmis", 0, 1);
+    run.built = programs_of(&run, paths);
+    lap(&mut run.timings, "dmis");
+    run
+}
+
+/// The plan, part and moves of each plan whose paths were planned.
+type Pathed = Vec<(usize, usize, plan::Hlip, path::Llip)>;
+
+/// The path stage over the plans (see [`run`]).
+fn paths_of(run: &mut Run, planned: Vec<Planned>, progress: Progress) -> Pathed {
     let mut diags = diag::Diagnostics::new();
     let mut paths = Vec::new();
     for p in planned {
         let Some(hlip) = p.hlip else { continue };
-        let plan = &checked.model.plans[p.plan];
-        let Some(g) = graphs
+        let plan = &run.checked.model.plans[p.plan];
+        let Some(g) = run
+            .graphs
             .iter()
             .find(|g| g.graph.plan.as_deref() == Some(&plan.name))
         else {
             continue;
         };
-        let Some(data) = &parts[g.part] else { continue };
+        let Some(data) = &run.parts[g.part] else { continue };
         let input = plan::Input {
-            model: &checked.model,
+            model: &run.checked.model,
             plan,
             geometry: &data.geometry,
             graph: &g.graph,
@@ -328,14 +404,16 @@ pub fn build(
             paths.push((p.plan, g.part, hlip, llip));
         }
     }
-    checked.absorb(diags);
-    lap(&mut t, "paths");
-    if checked.has_errors() {
-        return (checked, out, t);
-    }
-    progress("dmis", 0, 1);
+    run.checked.absorb(diags);
+    paths
+}
+
+/// The DMIS stage: one program per planned path (see [`run`]).
+fn programs_of(run: &Run, paths: Pathed) -> Vec<Built> {
+    let checked = &run.checked;
+    let mut out = Vec::new();
     for (k, part, hlip, llip) in paths {
-        let Some(data) = &parts[part] else { continue };
+        let Some(data) = &run.parts[part] else { continue };
         let dmis = dmis::write(&dmis::Input {
             model: &checked.model,
             plan: &checked.model.plans[k],
@@ -351,15 +429,17 @@ pub fn build(
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default(),
         });
+        let names = plan::Names::new(&checked.model, &data.geometry, hlip.plan);
+        let json = path::json(&hlip, &llip, &names);
         out.push(Built {
             plan: k,
             hlip,
             llip,
             dmis,
+            json,
         });
     }
-    lap(&mut t, "dmis");
-    (checked, out, t)
+    out
 }
 
 /// Runs the front end (load, parse, resolve) over root files.

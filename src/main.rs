@@ -305,21 +305,27 @@ fn plan(file: &std::path::Path, format: TableFormat, n: u32) -> ExitCode {
         ..Default::default()
     };
     let start = std::time::Instant::now();
-    let (checked, _, _, planned) = inspc::plans(&FsWorld, &[file.to_path_buf()], &opts);
+    let (checked, parts, _, planned) = inspc::plans(&FsWorld, &[file.to_path_buf()], &opts);
     print_diagnostics(&checked.sources, &checked.diagnostics);
     if checked.has_errors() {
         return ExitCode::from(1);
     }
-    let hlips: Vec<&inspc::plan::Hlip> = planned.iter().filter_map(|p| p.hlip.as_ref()).collect();
+    let hlips: Vec<(&inspc::plan::Hlip, inspc::plan::Names)> = planned
+        .iter()
+        .filter_map(|p| Some((p.hlip.as_ref()?, inspc::plan_names(&checked, &parts, p.plan)?)))
+        .collect();
     match format {
         TableFormat::Text => {
-            for h in &hlips {
-                print!("{}", inspc::plan::text(h));
+            for (h, names) in &hlips {
+                print!("{}", inspc::plan::text(h, names));
             }
             eprintln!("inspc: planned in {:.2} s", start.elapsed().as_secs_f64());
         }
         TableFormat::Json => {
-            let all: Vec<serde_json::Value> = hlips.iter().map(|h| inspc::plan::json(h)).collect();
+            let all: Vec<serde_json::Value> = hlips
+                .iter()
+                .map(|(h, names)| inspc::plan::json(h, names))
+                .collect();
             let v = if all.len() == 1 {
                 all.into_iter().next().unwrap_or_default()
             } else {
@@ -394,8 +400,7 @@ fn build(
             .clone()
             .or_else(|| plan.outputs.plan.as_ref().map(|p| dir.join(p)));
         if let Some(j) = json {
-            let v = inspc::path::json(&b.hlip, &b.llip);
-            let text = serde_json::to_string_pretty(&v).unwrap_or_default() + "\n";
+            let text = serde_json::to_string_pretty(&b.json).unwrap_or_default() + "\n";
             writes.push((j, text.into_bytes()));
         }
     }
@@ -415,7 +420,7 @@ fn build(
         };
         println!(
             "plan {}: {}, {}, {}, {}, {}",
-            h.plan,
+            checked.model.plans[b.plan].name,
             n(s.setups, "setup"),
             n(s.probes_used, "probe"),
             n(s.orientations, "orientation"),

@@ -123,11 +123,7 @@ fn verify_halfline(spec: &str, count: usize, n: u32) {
 fn verify_grown(spec: &str, count: usize, n: u32) {
     let c = case(spec, count, 29);
     let probe = &c.probes[0];
-    let mut comps = if probe.bent {
-        probe.first.clone()
-    } else {
-        probe.straight()
-    };
+    let mut comps = probe.leading();
     comps.push(Component {
         name: "grown half-line".into(),
         a: 0.0,
@@ -238,7 +234,7 @@ fn d1_prime_is_pessimistic() {
     use inspc::access::{d1, d1_prime};
     let c = case("examples/f3_indexed.insp", 4, 5);
     let probe = &c.probes[0];
-    assert!(probe.bent);
+    assert_eq!(probe.head, inspc::access::Head::Indexable);
     let radius = probe.second.iter().map(|s| s.radius).fold(0.0, f64::max);
     let up = V3::z();
     let stand = Component {
@@ -279,7 +275,7 @@ fn approach_feature_and_d2_cones() {
     let scene = Scene::of_part(&parts[gr.part].as_ref().unwrap().geometry);
     let model = &checked.model;
     let probe = ProbeShape::of_cmm(model, &model.cmms[model.plans[0].cmm.0]).remove(0);
-    assert!(!probe.bent);
+    assert_eq!(probe.head, inspc::access::Head::Fixed);
     let opts = ConeOptions {
         n: 32,
         ..ConeOptions::default()

@@ -428,7 +428,7 @@ fn a_failed_build_writes_nothing() {
     let dmi = dir.join("slot.dmi");
     let (code, _, stderr) = inspc(&[
         "build",
-        "tests/plans/uninspectable_slot/main.insp",
+        "tests/cases/uninspectable_slot/main.insp",
         "-o",
         dmi.to_str().unwrap(),
     ]);

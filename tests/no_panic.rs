@@ -171,7 +171,7 @@ proptest! {
         let sources = [
             include_str!("../examples/f2.insp"), include_str!("../examples/f4.insp"), include_str!("../examples/swiss_block.insp"),
             include_str!("../examples/parts/f3.insp"), include_str!("../examples/parts/swiss_sphere.insp"),
-            include_str!("../tests/golden/plan_preferences/main.insp"), include_str!("../tests/golden/patterns_and_bosses/main.insp"),
+            include_str!("../tests/cases/plan_preferences/main.insp"), include_str!("../tests/cases/patterns_and_bosses/main.insp"),
             include_str!("../stdlib/hierarchies.insp"),
         ];
         let mut text = sources[which].to_string();

@@ -23,6 +23,7 @@ mod cubemap;
 mod errors;
 mod exact;
 mod heightmap;
+pub mod pose;
 mod probe;
 mod raster;
 mod report;
@@ -32,6 +33,7 @@ pub use cpu::pixels_for;
 pub use cubemap::{face_dir, face_uv, ones, Cell, CubeMap, Pixel};
 pub use errors::AccessError;
 pub use exact::{component_hits, refine};
+pub use pose::{Blocker, Contact, Head, Pose};
 pub use probe::{Component, End, ProbeShape};
 pub use raster::{shadow_polygon, Coverage};
 pub use report::{cone_report, pgm, ConeReport, ConeRequest};
@@ -129,7 +131,7 @@ pub fn gac_with(
 /// Whether the tip ball of radius `r` centred at `c` stays clear of the scene, up to
 /// the mesh's chordal error (a tenth of the radius).
 pub fn tip_fits(scene: &Scene, c: &P3, r: f64) -> bool {
-    scene.distance(c) >= 0.9 * r
+    scene.distance(c) >= pose::TIP_CLEARANCE * r
 }
 
 /// What to compute for a point.
@@ -193,22 +195,19 @@ pub fn point_cones(
         return PointCones {
             tip_fits: false,
             approach: CubeMap::empty(n, pref),
-            d2: probe.bent.then(|| CubeMap::empty(n, pref)),
+            d2: probe.head.indexable().then(|| CubeMap::empty(n, pref)),
         };
     }
     let retract = c + f.normal * opts.retract;
-    let comps = if probe.bent {
-        probe.first.clone()
-    } else {
-        probe.straight()
-    };
+    let comps = probe.leading();
     let exact = opts.exact_boundary;
     let mut approach = gac_with(backend, scene, &c, &comps, n, pref, exact);
     if !approach.is_empty() && opts.retract > 0.0 {
         approach.and_assign(&gac_with(backend, scene, &retract, &comps, n, pref, exact));
     }
     let d2 = probe
-        .bent
+        .head
+        .indexable()
         .then(|| d2(backend, scene, &c, probe, &approach, opts.d2_samples));
     PointCones {
         tip_fits: true,

@@ -4,6 +4,7 @@
 //! same way).
 
 use crate::model::{Cmm, HeadKind, Model, Probe};
+use super::pose::Head;
 
 /// How a component ends towards the tip.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -80,8 +81,9 @@ pub struct ProbeShape {
     /// Head and ram, from the articulation point of an indexable head (at `d` from the
     /// tip centre), or continuing the first for a fixed head.
     pub second: Vec<Component>,
-    /// Whether the head indexes (a bent probe in the seed's terms).
-    pub bent: bool,
+    /// The head it hangs from: fixed (a straight probe in the seed's terms) or
+    /// indexable (a bent probe).
+    pub head: Head,
 }
 
 impl ProbeShape {
@@ -118,9 +120,15 @@ impl ProbeShape {
         });
         at += body.length;
         let head = &model.heads[cmm.head.0];
-        let bent = matches!(head.kind, HeadKind::Indexable { .. });
+        let kind = match head.kind {
+            HeadKind::Fixed => Head::Fixed,
+            HeadKind::Indexable { .. } => Head::Indexable,
+        };
         // A bent probe's second component starts at the articulation point.
-        let base = if bent { 0.0 } else { at };
+        let base = match kind {
+            Head::Indexable => 0.0,
+            Head::Fixed => at,
+        };
         let second = vec![
             Component {
                 name: "head".into(),
@@ -142,7 +150,7 @@ impl ProbeShape {
             tip_radius: model.styli[probe.stylus.0].tip / 2.0,
             first,
             second,
-            bent,
+            head: kind,
         }
     }
 
@@ -155,6 +163,15 @@ impl ProbeShape {
     /// Every component of a straight probe (fixed head), from the tip up.
     pub fn straight(&self) -> Vec<Component> {
         self.first.iter().chain(&self.second).cloned().collect()
+    }
+
+    /// The components whose cones make the approach cone: the first component of a bent
+    /// probe (the second is the setup's business), every component of a straight one.
+    pub fn leading(&self) -> Vec<Component> {
+        match self.head {
+            Head::Indexable => self.first.clone(),
+            Head::Fixed => self.straight(),
+        }
     }
 
     /// The probes of a machine's rack.

@@ -165,10 +165,9 @@ pub fn cone_report(
     let drawn = match &probe {
         None => half,
         Some(probe) => {
-            let head = if probe.bent {
-                "indexable head"
-            } else {
-                "fixed head"
+            let head = match probe.head {
+                Head::Indexable => "indexable head",
+                Head::Fixed => "fixed head",
             };
             let _ = writeln!(
                 text,
@@ -184,12 +183,7 @@ pub fn cone_report(
                     fmt_num(scene.distance(&c))
                 );
             }
-            let comps = if probe.bent {
-                probe.first.clone()
-            } else {
-                probe.straight()
-            };
-            for comp in &comps {
+            for comp in &probe.leading() {
                 let cone = gac(&Cpu, &scene, &c, std::slice::from_ref(comp), n, &prefs);
                 let _ = writeln!(
                     text,
@@ -204,10 +198,9 @@ pub fn cone_report(
                 ..ConeOptions::default()
             };
             let cones = point_cones(&Cpu, &scene, f, probe, &opts);
-            let what = if probe.bent {
-                "D1, approach and retract"
-            } else {
-                "probe, approach and retract"
+            let what = match probe.head {
+                Head::Indexable => "D1, approach and retract",
+                Head::Fixed => "probe, approach and retract",
             };
             let _ = writeln!(text, "  {what:<32} {}", pct(&cones.approach));
             let axes_free: Vec<&str> = ["+x", "-x", "+y", "-y", "+z", "-z"]

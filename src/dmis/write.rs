@@ -10,9 +10,11 @@
 
 use super::text::{num, plain, wrap, Labels};
 use super::Input;
-use crate::geometry::{Surface, P3, V3};
-use crate::model::{Material, TolKind, TolValue};
-use crate::path::{BlockPath, GroupPath};
+use crate::access::pose::{Contact, Head};
+use crate::geometry::{FaceId, Surface, P3, V3};
+use crate::model::{FeatureId, Material, SlotId, TolKind, TolValue, ToleranceId};
+use crate::path::{BlockPath, GroupPath, SetupPath};
+use crate::plan::Names;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -181,369 +183,433 @@ fn material(m: Option<Material>) -> Option<&'static str> {
     }
 }
 
-/// The sensor key of a group.
-fn sensor_key(g: &GroupPath) -> (String, String, String) {
-    (g.probe.clone(), num(g.a), num(g.b))
+/// The sensor key of a group: its probe and its angles as written.
+type SensorKey = (SlotId, String, String);
+
+fn sensor_key(g: &GroupPath) -> SensorKey {
+    (g.probe, num(g.a), num(g.b))
+}
+
+/// A measured face's key: (feature, face, contact).
+type FaceKey = (Option<FeatureId>, FaceId, Contact);
+
+fn face_key(b: &BlockPath) -> FaceKey {
+    (b.feature, b.face, b.contact)
+}
+
+/// The writer's state: the program so far and the labels handed out.
+struct Writer<'a> {
+    input: &'a Input<'a>,
+    names: Names<'a>,
+    o: Out,
+    labels: Labels,
+    /// Sensor labels by probe and angles.
+    sensors: BTreeMap<SensorKey, String>,
+    current_sensor: Option<String>,
+    /// Feature labels by measured face.
+    feats: BTreeMap<FaceKey, String>,
+    /// Per feature, the labels of its measured faces in order.
+    faces_of: BTreeMap<Option<FeatureId>, Vec<String>>,
+    /// Nominals by feature label.
+    nominals: BTreeMap<String, Nominal>,
+    /// Per datum, its label.
+    datums: Vec<String>,
+    /// Per tolerance, its label.
+    tols: Vec<String>,
+    /// Per feature, the labels measured so far.
+    measured: BTreeMap<Option<FeatureId>, Vec<String>>,
 }
 
 /// Writes the program.
 pub fn write(input: &Input) -> String {
-    let model = input.model;
-    let part = &model.parts[input.plan.part.0];
-    let cmm = &model.cmms[input.plan.cmm.0];
-    let hlip = input.hlip;
-    let llip = input.llip;
-    let motion = llip.motion;
-    let probes = crate::access::ProbeShape::of_cmm(model, cmm);
-    let mut labels = Labels::default();
-    let mut o = Out {
-        text: String::new(),
-        at: None,
+    let mut w = Writer {
+        input,
+        names: Names::new(input.model, input.geometry, input.hlip.plan),
+        o: Out {
+            text: String::new(),
+            at: None,
+        },
+        labels: Labels::default(),
+        sensors: BTreeMap::new(),
+        current_sensor: None,
+        feats: BTreeMap::new(),
+        faces_of: BTreeMap::new(),
+        nominals: BTreeMap::new(),
+        datums: Vec::new(),
+        tols: Vec::new(),
+        measured: BTreeMap::new(),
     };
-
-    o.comment(&format!(
-        "inspc {}: plan {}, part {} on cmm {}",
-        env!("CARGO_PKG_VERSION"),
-        input.plan.name,
-        part.name,
-        cmm.name
-    ));
-    if !input.source.is_empty() {
-        o.comment(&format!("from {}", input.source));
-    }
-    let s = &hlip.summary;
-    o.comment(&format!(
-        "{} setups, {} probes, {} orientations, {} touches, path {} mm",
-        s.setups,
-        s.probes_used,
-        s.orientations,
-        llip.summary.touches,
-        num((llip.summary.length * 10.0).round() / 10.0)
-    ));
-    o.stmt(&format!("DMISMN/'{}',05.3", plain(&input.plan.name, 60)));
-    o.stmt("UNITS/MM,ANGDEC");
-    o.stmt("MODE/PROG,MAN");
-    o.stmt(&format!("SNSET/APPRCH,{}", num(motion.prehit)));
-    o.stmt(&format!("SNSET/RETRCT,{}", num(motion.retract)));
-    o.stmt(&format!("SNSET/SEARCH,{}", num(motion.search)));
-    o.stmt(&format!("SNSET/CLRSRF,{}", num(motion.clearance)));
-
-    // Sensors, in order of first use.
-    o.comment("sensors");
-    let mut sensors: BTreeMap<(String, String, String), String> = BTreeMap::new();
-    for g in llip.setups.iter().flat_map(|s| &s.groups) {
-        let key = sensor_key(g);
-        if sensors.contains_key(&key) {
-            continue;
-        }
-        let Some(probe) = probes.iter().find(|p| p.name == g.probe) else {
-            continue;
-        };
-        let name = if hlip.indexable {
-            format!("{}_A{}B{}", g.probe, key.1, key.2)
-                .replace('-', "M")
-                .replace('.', "P")
-        } else {
-            g.probe.clone()
-        };
-        let label = labels.fresh("S", &name);
-        let diam = num(2.0 * probe.tip_radius);
-        let len = num(probe.reach());
-        if hlip.indexable {
-            let d = crate::access::head_direction(g.a, g.b);
-            o.stmt(&format!(
-                "S({label})=SNSDEF/PROBE,INDEX,POL,{},{},VEC,{},{len},{diam}",
-                num(g.a),
-                num(g.b),
-                ijk(&d)
-            ));
-        } else {
-            o.stmt(&format!(
-                "S({label})=SNSDEF/PROBE,FIXED,CART,0,0,-{len},0,0,1,{diam}"
-            ));
-        }
-        sensors.insert(key, label);
-    }
-
-    // Nominals: one feature per (feature, face, table) measured, in order of first use.
-    o.comment("nominals");
-    let mut feats: BTreeMap<(String, String, bool), String> = BTreeMap::new();
-    let mut faces_of: BTreeMap<String, Vec<String>> = BTreeMap::new();
-    let mut nominals: BTreeMap<String, Nominal> = BTreeMap::new();
-    // How many faces (or table stand-ins) each feature is measured on.
-    let mut face_count: BTreeMap<String, usize> = BTreeMap::new();
-    {
-        let mut seen = std::collections::BTreeSet::new();
-        for b in llip
-            .setups
-            .iter()
-            .flat_map(|s| &s.groups)
-            .flat_map(|g| &g.blocks)
-        {
-            if seen.insert((&b.feature, &b.face, b.table)) {
-                *face_count.entry(b.feature.clone()).or_default() += 1;
-            }
+    w.header();
+    w.sensor_definitions();
+    w.nominals();
+    w.tolerances();
+    let setups_n = input.llip.setups.len();
+    for (si, sp) in input.llip.setups.iter().enumerate() {
+        w.setup(si, setups_n, sp);
+        for g in &sp.groups {
+            w.group(g);
         }
     }
-    for g in llip.setups.iter().flat_map(|s| &s.groups) {
-        for b in &g.blocks {
-            let key = (b.feature.clone(), b.face.clone(), b.table);
-            if feats.contains_key(&key) {
+    w.o.stmt("ENDFIL");
+    w.o.text
+}
+
+impl Writer<'_> {
+    fn indexable(&self) -> bool {
+        self.input.hlip.head == Head::Indexable
+    }
+
+    /// Header comments, program name, units and the motion settings.
+    fn header(&mut self) {
+        let input = self.input;
+        let (part, cmm) = (self.names.part(), &input.model.cmms[input.plan.cmm.0]);
+        let (hlip, llip, motion) = (input.hlip, input.llip, input.llip.motion);
+        let o = &mut self.o;
+        o.comment(&format!(
+            "inspc {}: plan {}, part {} on cmm {}",
+            env!("CARGO_PKG_VERSION"),
+            input.plan.name,
+            part.name,
+            cmm.name
+        ));
+        if !input.source.is_empty() {
+            o.comment(&format!("from {}", input.source));
+        }
+        let s = &hlip.summary;
+        o.comment(&format!(
+            "{} setups, {} probes, {} orientations, {} touches, path {} mm",
+            s.setups,
+            s.probes_used,
+            s.orientations,
+            llip.summary.touches,
+            num((llip.summary.length * 10.0).round() / 10.0)
+        ));
+        o.stmt(&format!("DMISMN/'{}',05.3", plain(&input.plan.name, 60)));
+        o.stmt("UNITS/MM,ANGDEC");
+        o.stmt("MODE/PROG,MAN");
+        o.stmt(&format!("SNSET/APPRCH,{}", num(motion.prehit)));
+        o.stmt(&format!("SNSET/RETRCT,{}", num(motion.retract)));
+        o.stmt(&format!("SNSET/SEARCH,{}", num(motion.search)));
+        o.stmt(&format!("SNSET/CLRSRF,{}", num(motion.clearance)));
+    }
+
+    /// One sensor per probe (per probe and A/B on an indexable head), in order of first
+    /// use.
+    fn sensor_definitions(&mut self) {
+        let input = self.input;
+        let cmm = &input.model.cmms[input.plan.cmm.0];
+        let probes = crate::access::ProbeShape::of_cmm(input.model, cmm);
+        self.o.comment("sensors");
+        for g in input.llip.setups.iter().flat_map(|s| &s.groups) {
+            let key = sensor_key(g);
+            if self.sensors.contains_key(&key) {
                 continue;
             }
-            let Some(nominal) = nominal_of(input, b) else {
+            let Some(probe) = probes.get(g.probe.0) else {
+                continue;
+            };
+            let label_text = self.names.probe(g.probe);
+            let name = if self.indexable() {
+                format!("{label_text}_A{}B{}", key.1, key.2)
+                    .replace('-', "M")
+                    .replace('.', "P")
+            } else {
+                label_text.to_string()
+            };
+            let label = self.labels.fresh("S", &name);
+            let diam = num(2.0 * probe.tip_radius);
+            let len = num(probe.reach());
+            if self.indexable() {
+                let d = crate::access::head_direction(g.a, g.b);
+                self.o.stmt(&format!(
+                    "S({label})=SNSDEF/PROBE,INDEX,POL,{},{},VEC,{},{len},{diam}",
+                    num(g.a),
+                    num(g.b),
+                    ijk(&d)
+                ));
+            } else {
+                self.o.stmt(&format!(
+                    "S({label})=SNSDEF/PROBE,FIXED,CART,0,0,-{len},0,0,1,{diam}"
+                ));
+            }
+            self.sensors.insert(key, label);
+        }
+    }
+
+    /// One nominal per (feature, face, table) measured, in order of first use.
+    fn nominals(&mut self) {
+        let llip = self.input.llip;
+        self.o.comment("nominals");
+        // How many faces (or table stand-ins) each feature is measured on.
+        let mut face_count: BTreeMap<Option<FeatureId>, usize> = BTreeMap::new();
+        let mut seen = std::collections::BTreeSet::new();
+        let blocks = || llip.setups.iter().flat_map(|s| &s.groups).flat_map(|g| &g.blocks);
+        for b in blocks() {
+            if seen.insert(face_key(b)) {
+                *face_count.entry(b.feature).or_default() += 1;
+            }
+        }
+        for b in blocks() {
+            let key = face_key(b);
+            if self.feats.contains_key(&key) {
+                continue;
+            }
+            let Some(nominal) = nominal_of(self.input, b) else {
                 continue;
             };
             let count = face_count.get(&b.feature).copied().unwrap_or(1);
-            let k = faces_of.get(&b.feature).map_or(0, Vec::len) + 1;
-            let name = if b.table {
-                format!("{}_T", b.feature)
+            let k = self.faces_of.get(&b.feature).map_or(0, Vec::len) + 1;
+            let feature = self.names.feature(b.feature);
+            let name = if b.contact == Contact::Table {
+                format!("{feature}_T")
             } else if count > 1 {
-                format!("{}_{k}", b.feature)
+                format!("{feature}_{k}")
             } else {
-                b.feature.clone()
+                feature.to_string()
             };
-            let label = labels.fresh("F", &name);
-            o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
-            faces_of
-                .entry(b.feature.clone())
+            let label = self.labels.fresh("F", &name);
+            self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
+            self.faces_of
+                .entry(b.feature)
                 .or_default()
                 .push(label.clone());
-            nominals.insert(label.clone(), nominal);
-            feats.insert(key, label);
+            self.nominals.insert(label.clone(), nominal);
+            self.feats.insert(key, label);
         }
     }
 
-    // Tolerances.
-    o.comment("tolerances");
-    let mut datums: BTreeMap<String, String> = BTreeMap::new();
-    for d in &part.datums {
-        let label = labels.fresh("DAT", &d.name);
-        datums.insert(d.name.clone(), label);
-    }
-    let mut tols: BTreeMap<String, String> = BTreeMap::new();
-    for t in &part.tolerances {
-        let label = labels.fresh("T", &t.name);
-        let mut params = vec![tol_word(t.kind).to_string()];
-        match &t.value {
-            TolValue::Zone { width, diameter } => {
-                if t.kind == TolKind::Position {
-                    params.push(if *diameter { "2D" } else { "3D" }.into());
-                }
-                if t.kind == TolKind::Angularity {
-                    params.push(num(t.basic_angle.unwrap_or(0.0)));
-                }
-                params.push(num(*width));
-                params.extend(material(t.modifier).map(String::from));
-            }
-            TolValue::Size {
-                nominal,
-                lower,
-                upper,
-            } => {
-                if t.kind == TolKind::Distance {
-                    params.push("NOMINL".into());
-                }
-                if matches!(t.kind, TolKind::Distance | TolKind::Angle) {
-                    params.push(num(*nominal));
-                }
-                params.push(num(lower - nominal));
-                params.push(num(upper - nominal));
-            }
+    /// Datum labels, then every tolerance of the part.
+    fn tolerances(&mut self) {
+        let part = self.names.part();
+        self.o.comment("tolerances");
+        for d in &part.datums {
+            let label = self.labels.fresh("DAT", &d.name);
+            self.datums.push(label);
         }
-        for d in &t.datums {
-            let name = &part.datums[d.datum.0].name;
-            if let Some(l) = datums.get(name) {
+        for t in &part.tolerances {
+            let label = self.labels.fresh("T", &t.name);
+            let mut params = vec![tol_word(t.kind).to_string()];
+            match &t.value {
+                TolValue::Zone { width, diameter } => {
+                    if t.kind == TolKind::Position {
+                        params.push(if *diameter { "2D" } else { "3D" }.into());
+                    }
+                    if t.kind == TolKind::Angularity {
+                        params.push(num(t.basic_angle.unwrap_or(0.0)));
+                    }
+                    params.push(num(*width));
+                    params.extend(material(t.modifier).map(String::from));
+                }
+                TolValue::Size {
+                    nominal,
+                    lower,
+                    upper,
+                } => {
+                    if t.kind == TolKind::Distance {
+                        params.push("NOMINL".into());
+                    }
+                    if matches!(t.kind, TolKind::Distance | TolKind::Angle) {
+                        params.push(num(*nominal));
+                    }
+                    params.push(num(lower - nominal));
+                    params.push(num(upper - nominal));
+                }
+            }
+            for d in &t.datums {
+                let l = &self.datums[d.datum.0];
                 params.push(format!("DAT({l})"));
                 params.extend(material(d.modifier).map(String::from));
             }
+            self.o.stmt(&format!("T({label})=TOL/{}", params.join(",")));
+            self.tols.push(label);
         }
-        o.stmt(&format!("T({label})=TOL/{}", params.join(",")));
-        tols.insert(t.name.clone(), label);
     }
 
-    let setups_n = llip.setups.len();
-    let mut measured: BTreeMap<String, Vec<String>> = BTreeMap::new();
-    let mut current_sensor: Option<String> = None;
-    for (si, sp) in llip.setups.iter().enumerate() {
+    /// A setup's operator prompt, its manual alignment and `DATSET`.
+    fn setup(&mut self, si: usize, setups_n: usize, sp: &SetupPath) {
+        let hlip = self.input.hlip;
         let setup = &hlip.setups[sp.setup];
-        let up = V3::from(setup.up);
-        o.comment(&format!("setup {} of {setups_n}", si + 1));
-        o.oper(&format!(
+        self.o.comment(&format!("setup {} of {setups_n}", si + 1));
+        self.o.oper(&format!(
             "SETUP {} OF {setups_n}: PLACE THE PART WITH ITS {} DIRECTION UP",
             si + 1,
-            direction_words(&up)
+            direction_words(&setup.up)
         ));
         for f in &setup.on_table {
-            o.oper(&format!("REST FACE {f} ON THE TABLE"));
+            let face = self.names.face(*f);
+            self.o.oper(&format!("REST FACE {face} ON THE TABLE"));
         }
         let al = &sp.alignment;
         if !al.missing.is_empty() {
-            o.oper(&format!(
+            self.o.oper(&format!(
                 "THE ALIGNMENT LEAVES {} FREE: PLACE THE PART AT ITS NOMINAL POSITION, SQUARE TO THE MACHINE AXES",
                 al.missing.join(", ")
             ));
         }
-        o.stmt("PAUSE");
-        if !al.steps.is_empty() {
-            o.stmt("MODE/MAN");
-            o.oper("TOUCH THE POINTS SHOWN BY HAND, THEN LEAVE THE PROBE ABOVE THE PART");
-            let mut fa = Vec::new();
-            for step in &al.steps {
-                let g = &sp.groups[step.group];
-                let b = &g.blocks[step.block];
-                let Some(label) = feats.get(&(b.feature.clone(), b.face.clone(), b.table)) else {
-                    continue;
-                };
-                select(&mut o, &sensors, g, &mut current_sensor);
-                let meas = nominals.get(label).map_or("PLANE", Nominal::meas);
-                o.stmt(&format!("MEAS/{meas},F({label}),{}", step.points.len()));
-                for &k in &step.points {
-                    ptmeas(&mut o, hlip, k);
-                }
-                o.stmt("ENDMES");
-                fa.push(format!("FA({label}),{}", step.keywords.join(",")));
-            }
-            let d = labels.fresh("D", &format!("SETUP{}", si + 1));
-            o.stmt(&format!("D({d})=DATSET/{}", fa.join(",")));
-            let shifts: Vec<String> = al
-                .trans
-                .iter()
-                .map(|(k, v)| format!("{k}ORIG,{}", num(-v)))
-                .collect();
-            if !shifts.is_empty() {
-                let dt = labels.fresh("D", &format!("PART{}", si + 1));
-                o.stmt(&format!("D({dt})=TRANS/{}", shifts.join(",")));
-            }
-            o.stmt("MODE/PROG,MAN");
+        self.o.stmt("PAUSE");
+        if al.steps.is_empty() {
+            return;
         }
-        for g in &sp.groups {
-            o.comment(&format!(
-                "probe {}{}: {} features",
-                g.probe,
-                if hlip.indexable {
-                    format!(" at a{} b{}", num(g.a), num(g.b))
-                } else {
-                    String::new()
-                },
-                g.blocks.len()
-            ));
-            // The previous group ended on the clearance plane: change the sensor there.
-            select(&mut o, &sensors, g, &mut current_sensor);
-            for p in &g.entry {
-                o.goto(p);
+        self.o.stmt("MODE/MAN");
+        self.o
+            .oper("TOUCH THE POINTS SHOWN BY HAND, THEN LEAVE THE PROBE ABOVE THE PART");
+        let mut fa = Vec::new();
+        for step in &al.steps {
+            let g = &sp.groups[step.group];
+            let b = &g.blocks[step.block];
+            let Some(label) = self.feats.get(&face_key(b)).cloned() else {
+                continue;
+            };
+            self.select(g);
+            let meas = self.nominals.get(&label).map_or("PLANE", Nominal::meas);
+            self.o
+                .stmt(&format!("MEAS/{meas},F({label}),{}", step.points.len()));
+            for &k in &step.points {
+                ptmeas(&mut self.o, hlip, k);
             }
-            let mut in_group: Vec<String> = Vec::new();
-            for b in &g.blocks {
-                let Some(label) = feats.get(&(b.feature.clone(), b.face.clone(), b.table)) else {
-                    continue;
-                };
-                let meas = nominals.get(label).map_or("PLANE", Nominal::meas);
-                // A narrow block approaches and retracts by its own, shorter stand-off.
-                let narrow = b.standoff < motion.prehit.max(motion.retract) - 1e-9;
-                if narrow {
-                    o.stmt(&format!("SNSET/APPRCH,{}", num(b.standoff)));
-                    o.stmt(&format!("SNSET/RETRCT,{}", num(b.standoff)));
+            self.o.stmt("ENDMES");
+            fa.push(format!("FA({label}),{}", step.keywords.join(",")));
+        }
+        let d = self.labels.fresh("D", &format!("SETUP{}", si + 1));
+        self.o.stmt(&format!("D({d})=DATSET/{}", fa.join(",")));
+        let shifts: Vec<String> = al
+            .trans
+            .iter()
+            .map(|(k, v)| format!("{k}ORIG,{}", num(-v)))
+            .collect();
+        if !shifts.is_empty() {
+            let dt = self.labels.fresh("D", &format!("PART{}", si + 1));
+            self.o.stmt(&format!("D({dt})=TRANS/{}", shifts.join(",")));
+        }
+        self.o.stmt("MODE/PROG,MAN");
+    }
+
+    /// A group: its sensor, entry, `MEAS` blocks and exit, the datums it measured and
+    /// the tolerances it completes.
+    fn group(&mut self, g: &GroupPath) {
+        let (hlip, motion) = (self.input.hlip, self.input.llip.motion);
+        let angles = if self.indexable() {
+            format!(" at a{} b{}", num(g.a), num(g.b))
+        } else {
+            String::new()
+        };
+        self.o.comment(&format!(
+            "probe {}{angles}: {} features",
+            self.names.probe(g.probe),
+            g.blocks.len()
+        ));
+        // The previous group ended on the clearance plane: change the sensor there.
+        self.select(g);
+        for p in &g.entry {
+            self.o.goto(p);
+        }
+        let mut in_group: Vec<String> = Vec::new();
+        for b in &g.blocks {
+            let Some(label) = self.feats.get(&face_key(b)).cloned() else {
+                continue;
+            };
+            let meas = self.nominals.get(&label).map_or("PLANE", Nominal::meas);
+            // A narrow block approaches and retracts by its own, shorter stand-off.
+            let narrow = b.standoff < motion.prehit.max(motion.retract) - 1e-9;
+            let o = &mut self.o;
+            if narrow {
+                o.stmt(&format!("SNSET/APPRCH,{}", num(b.standoff)));
+                o.stmt(&format!("SNSET/RETRCT,{}", num(b.standoff)));
+            }
+            o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
+            for t in &b.touches {
+                for v in &t.via {
+                    o.goto(v);
                 }
-                o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
-                for t in &b.touches {
-                    for v in &t.via {
-                        o.goto(v);
-                    }
+                o.goto(&t.standoff);
+                ptmeas(o, hlip, t.point);
+                if !narrow && motion.retract < motion.prehit {
                     o.goto(&t.standoff);
-                    ptmeas(&mut o, hlip, t.point);
-                    if !narrow && motion.retract < motion.prehit {
-                        o.goto(&t.standoff);
-                    }
-                }
-                o.stmt("ENDMES");
-                if narrow {
-                    o.stmt(&format!("SNSET/APPRCH,{}", num(motion.prehit)));
-                    o.stmt(&format!("SNSET/RETRCT,{}", num(motion.retract)));
-                }
-                let list = measured.entry(b.feature.clone()).or_default();
-                if !list.contains(label) {
-                    list.push(label.clone());
-                }
-                in_group.push(label.clone());
-            }
-            for p in &g.exit {
-                o.goto(p);
-            }
-            // Datums measured here, then the tolerances this group completes.
-            let mut defined = Vec::new();
-            for b in &g.blocks {
-                if let (Some(d), Some(label)) = (
-                    &b.datum,
-                    feats.get(&(b.feature.clone(), b.face.clone(), b.table)),
-                ) {
-                    if !defined.contains(d) {
-                        if let Some(dl) = datums.get(d) {
-                            o.stmt(&format!("DAT({dl})=DATDEF/FA({label})"));
-                        }
-                        defined.push(d.clone());
-                    }
                 }
             }
-            for r in &g.records {
-                let Some(t) = part.tolerances.iter().find(|t| &t.name == r) else {
-                    continue;
-                };
-                let Some(tl) = tols.get(r) else { continue };
-                let labels_of = |f: &str| -> Vec<String> {
-                    let here: Vec<String> = faces_of
-                        .get(f)
-                        .into_iter()
-                        .flatten()
-                        .filter(|l| in_group.contains(l))
-                        .cloned()
-                        .collect();
-                    if here.is_empty() {
-                        measured.get(f).cloned().unwrap_or_default()
-                    } else {
-                        here
-                    }
-                };
-                let targets: Vec<&str> = t
-                    .targets
-                    .iter()
-                    .map(|f| part.features[f.0].name.as_str())
-                    .collect();
-                if targets.len() > 1 {
-                    let fa: Vec<String> = targets
-                        .iter()
-                        .filter_map(|f| labels_of(f).into_iter().next())
-                        .map(|l| format!("FA({l})"))
-                        .collect();
-                    if fa.len() == targets.len() {
-                        o.stmt(&format!("OUTPUT/{},TA({tl})", fa.join(",")));
-                    }
-                } else {
-                    for f in &targets {
-                        for l in labels_of(f) {
-                            o.stmt(&format!("OUTPUT/FA({l}),TA({tl})"));
-                        }
-                    }
+            o.stmt("ENDMES");
+            if narrow {
+                o.stmt(&format!("SNSET/APPRCH,{}", num(motion.prehit)));
+                o.stmt(&format!("SNSET/RETRCT,{}", num(motion.retract)));
+            }
+            let list = self.measured.entry(b.feature).or_default();
+            if !list.contains(&label) {
+                list.push(label.clone());
+            }
+            in_group.push(label);
+        }
+        for p in &g.exit {
+            self.o.goto(p);
+        }
+        // Datums measured here, then the tolerances this group completes.
+        let mut defined = Vec::new();
+        for b in &g.blocks {
+            if let (Some(d), Some(label)) = (b.datum, self.feats.get(&face_key(b))) {
+                if !defined.contains(&d) {
+                    let dl = &self.datums[d.0];
+                    self.o.stmt(&format!("DAT({dl})=DATDEF/FA({label})"));
+                    defined.push(d);
                 }
             }
+        }
+        for &r in &g.records {
+            self.output(r, &in_group);
         }
     }
-    o.stmt("ENDFIL");
-    o.text
-}
 
-/// `SNSLCT` when the group's sensor is not the current one.
-fn select(
-    o: &mut Out,
-    sensors: &BTreeMap<(String, String, String), String>,
-    g: &GroupPath,
-    current: &mut Option<String>,
-) {
-    if let Some(s) = sensors.get(&sensor_key(g)) {
-        if current.as_ref() != Some(s) {
-            o.at = None;
-            o.stmt(&format!("SNSLCT/S({s})"));
-            *current = Some(s.clone());
+    /// `OUTPUT` of a tolerance over its features' labels: those measured in this group,
+    /// else those measured before.
+    fn output(&mut self, r: ToleranceId, in_group: &[String]) {
+        let part = self.names.part();
+        let t = &part.tolerances[r.0];
+        let tl = &self.tols[r.0];
+        let labels_of = |f: FeatureId| -> Vec<String> {
+            let f = Some(f);
+            let here: Vec<String> = self
+                .faces_of
+                .get(&f)
+                .into_iter()
+                .flatten()
+                .filter(|l| in_group.contains(l))
+                .cloned()
+                .collect();
+            if here.is_empty() {
+                self.measured.get(&f).cloned().unwrap_or_default()
+            } else {
+                here
+            }
+        };
+        let mut lines = Vec::new();
+        if t.targets.len() > 1 {
+            let fa: Vec<String> = t
+                .targets
+                .iter()
+                .filter_map(|&f| labels_of(f).into_iter().next())
+                .map(|l| format!("FA({l})"))
+                .collect();
+            if fa.len() == t.targets.len() {
+                lines.push(format!("OUTPUT/{},TA({tl})", fa.join(",")));
+            }
+        } else {
+            for &f in &t.targets {
+                for l in labels_of(f) {
+                    lines.push(format!("OUTPUT/FA({l}),TA({tl})"));
+                }
+            }
+        }
+        for l in lines {
+            self.o.stmt(&l);
+        }
+    }
+
+    /// `SNSLCT` when the group's sensor is not the current one.
+    fn select(&mut self, g: &GroupPath) {
+        if let Some(s) = self.sensors.get(&sensor_key(g)) {
+            if self.current_sensor.as_ref() != Some(s) {
+                self.o.at = None;
+                self.o.stmt(&format!("SNSLCT/S({s})"));
+                self.current_sensor = Some(s.clone());
+            }
         }
     }
 }
@@ -552,13 +618,9 @@ fn ptmeas(o: &mut Out, hlip: &crate::plan::Hlip, k: usize) {
     let p = &hlip.points[k];
     o.at = None;
     o.stmt(&format!(
-        "PTMEAS/CART,{},{},{},{},{},{}",
-        num(p.position[0]),
-        num(p.position[1]),
-        num(p.position[2]),
-        num(p.normal[0]),
-        num(p.normal[1]),
-        num(p.normal[2])
+        "PTMEAS/CART,{},{}",
+        xyz(&p.position),
+        ijk(&p.normal)
     ));
 }
 
@@ -576,10 +638,10 @@ fn direction_words(v: &V3) -> String {
 fn nominal_of(input: &Input, b: &BlockPath) -> Option<Nominal> {
     let hlip = input.hlip;
     let first = b.touches.first()?;
-    if b.table {
+    if b.contact == Contact::Table {
         let p = &hlip.points[first.point];
-        return Some(Nominal::Table(P3::from(p.position), V3::from(p.normal)));
+        return Some(Nominal::Table(p.position, p.normal));
     }
-    let face = input.geometry.faces.iter().find(|f| f.name == b.face)?;
+    let face = input.geometry.faces.get(b.face.0)?;
     Some(Nominal::Surface(face.surface.clone(), face.centroid))
 }

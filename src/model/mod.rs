@@ -48,6 +48,10 @@ ids! {
     HierarchyId,
     /// Index into [`Model::samplings`].
     SamplingId,
+    /// Index into [`Model::plans`].
+    PlanId,
+    /// Index into a machine's rack, [`Cmm::probes`]: a probe as mounted, with its label.
+    SlotId,
 }
 
 /// Everything a run declared or imported, in declaration order.

@@ -11,6 +11,10 @@ pub struct FeatureId(pub usize);
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct DatumId(pub usize);
 
+/// Index into [`Part::tolerances`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct ToleranceId(pub usize);
+
 /// Index into [`Part::ops`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct OpId(pub usize);

@@ -10,6 +10,7 @@
 //! and becomes an operator instruction.
 
 use super::{Hlip, SetupPath};
+use crate::access::Contact;
 use crate::geometry::{Surface, P3, V3};
 use crate::plan::Input;
 
@@ -83,9 +84,7 @@ impl Shape {
 
 /// Chooses the alignment of one setup from its groups' blocks.
 pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
-    let part = &input.model.parts[input.plan.part.0];
     let geometry = input.geometry;
-    let face = |name: &str| geometry.faces.iter().find(|f| f.name == name);
     // Candidates: (rank, -area, group, block, shape, points in tour order).
     let mut cands = Vec::new();
     for (gi, g) in sp.groups.iter().enumerate() {
@@ -94,10 +93,10 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
             let Some(&first) = points.first() else {
                 continue;
             };
-            let f = face(&b.face);
-            let shape = if b.table {
+            let f = geometry.faces.get(b.face.0);
+            let shape = if b.contact == Contact::Table {
                 let p = &hlip.points[first];
-                axis_of(&V3::from(p.normal)).map(|(axis, positive)| Shape::Plane {
+                axis_of(&p.normal).map(|(axis, positive)| Shape::Plane {
                     axis,
                     positive,
                     at: p.position[axis],
@@ -123,11 +122,7 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
                 }
             };
             let Some(shape) = shape else { continue };
-            let rank = b
-                .datum
-                .as_ref()
-                .and_then(|d| part.datums.iter().position(|x| &x.name == d))
-                .unwrap_or(usize::MAX);
+            let rank = b.datum.map_or(usize::MAX, |d| d.0);
             let area = f.map_or(0.0, |f| f.area);
             cands.push((rank, -area, gi, bi, shape, points));
         }
@@ -147,7 +142,7 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
         if pts.len() < n {
             return None;
         }
-        let pos = |k: usize| P3::from(hlip.points[k].position);
+        let pos = |k: usize| hlip.points[k].position;
         let mut chosen = vec![pts[0]];
         while chosen.len() < n {
             let next = pts

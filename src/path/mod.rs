@@ -23,22 +23,20 @@ pub mod align;
 mod errors;
 mod render;
 mod roadmap;
-mod sweep;
 pub mod tour;
 
 pub use align::Alignment;
 pub use errors::PathError;
 pub use render::json;
-pub use sweep::Pose;
 
+use crate::access::pose::{table_height, Contact, Head, Pose};
 use crate::access::{ProbeShape, Scene};
 use crate::diag::Diagnostics;
-use crate::geometry::{P3, V3};
-use crate::model::Motion;
-use crate::plan::{Hlip, Input};
+use crate::geometry::{FaceId, P3, V3};
+use crate::model::{DatumId, FeatureId, Motion, SlotId, ToleranceId};
+use crate::plan::{Hlip, Input, Names};
 use rayon::prelude::*;
 use roadmap::Roadmap;
-use std::collections::BTreeMap;
 
 /// The low-level inspection plan: every move of the program.
 #[derive(Debug, Clone, PartialEq)]
@@ -65,8 +63,8 @@ pub struct SetupPath {
 /// One (probe, orientation) group: its entry, blocks of touches, and exit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GroupPath {
-    /// The probe's label in the rack.
-    pub probe: String,
+    /// The probe's slot in the rack.
+    pub probe: SlotId,
     /// Head angle A (degrees).
     pub a: f64,
     /// Head angle B (degrees).
@@ -80,7 +78,7 @@ pub struct GroupPath {
     /// Positions from the last stand-off up to the clearance plane.
     pub exit: Vec<[f64; 3]>,
     /// The tolerances whose features this group completes, in HLIP order.
-    pub records: Vec<String>,
+    pub records: Vec<ToleranceId>,
     /// Travel in this group, touches included (mm).
     pub length: f64,
 }
@@ -89,13 +87,13 @@ pub struct GroupPath {
 #[derive(Debug, Clone, PartialEq)]
 pub struct BlockPath {
     /// The feature.
-    pub feature: String,
+    pub feature: Option<FeatureId>,
     /// The face (or the datum face the table stands in for).
-    pub face: String,
-    /// Whether the table is probed instead of the face.
-    pub table: bool,
-    /// The datum letter when the feature is a datum feature.
-    pub datum: Option<String>,
+    pub face: FaceId,
+    /// The face itself, or the table it rests on.
+    pub contact: Contact,
+    /// The datum when the feature is a datum feature.
+    pub datum: Option<DatumId>,
     /// The stand-off of its touches: `max(prehit, retract)`, or less where the space in
     /// front of the face is narrower (a small bore), so that the tip waits half-way.
     pub standoff: f64,
@@ -133,7 +131,7 @@ pub struct PathSummary {
 struct GroupIn<'a> {
     setup: usize,
     probe: &'a ProbeShape,
-    label: String,
+    slot: SlotId,
     a: f64,
     b: f64,
     dir: V3,
@@ -141,7 +139,7 @@ struct GroupIn<'a> {
     table: f64,
     height: f64,
     blocks: Vec<BlockPath>,
-    records: Vec<String>,
+    records: Vec<ToleranceId>,
     has_datum: bool,
 }
 
@@ -170,27 +168,18 @@ pub fn plan(
     let probes = ProbeShape::of_cmm(model, cmm);
     let scene = Scene::of_part(input.geometry);
     let vertices = &input.geometry.vertices;
-    let datum_of: BTreeMap<&str, (usize, &str)> = part
-        .datums
-        .iter()
-        .enumerate()
-        .map(|(k, d)| {
-            (
-                part.features[d.feature.0].name.as_str(),
-                (k, d.name.as_str()),
-            )
-        })
-        .collect();
+    // Per feature, the datum it carries (the last declared, when several).
+    let mut datum_of: Vec<Option<DatumId>> = vec![None; part.features.len()];
+    for (k, d) in part.datums.iter().enumerate() {
+        datum_of[d.feature.0] = Some(DatumId(k));
+    }
     let standoff = motion.prehit.max(motion.retract);
 
     // Linearise the HLIP into groups, datum groups first within a setup.
     let mut groups: Vec<GroupIn> = Vec::new();
     for (si, s) in hlip.setups.iter().enumerate() {
-        let up = V3::from(s.up);
-        let table = vertices
-            .iter()
-            .map(|v| v.coords.dot(&up))
-            .fold(f64::INFINITY, f64::min);
+        let up = s.up;
+        let table = table_height(&scene, &up);
         let top = vertices
             .iter()
             .map(|v| v.coords.dot(&up))
@@ -199,15 +188,12 @@ pub fn plan(
         let reach_max = s
             .probes
             .iter()
-            .filter_map(|p| probes.iter().find(|x| x.name == p.probe))
-            .map(ProbeShape::reach)
+            .map(|p| probes[p.probe.0].reach())
             .fold(0.0, f64::max);
         for p in &s.probes {
-            let Some(probe) = probes.iter().find(|x| x.name == p.probe) else {
-                continue;
-            };
+            let probe = &probes[p.probe.0];
             for o in &p.orients {
-                let dir = V3::from(o.direction);
+                let dir = o.direction;
                 // Every group of a setup keeps the head at one height on the clearance
                 // plane, where the longest probe in any orientation swings clear.
                 let lift = reach_max - probe.reach() * dir.dot(&up);
@@ -216,10 +202,10 @@ pub fn plan(
                 for i in &o.inspections {
                     for f in &i.faces {
                         blocks.push(BlockPath {
-                            feature: i.feature.clone(),
-                            face: f.face.clone(),
-                            table: f.table,
-                            datum: datum_of.get(i.feature.as_str()).map(|d| d.1.to_string()),
+                            feature: i.feature,
+                            face: f.face,
+                            contact: f.contact,
+                            datum: i.feature.and_then(|x| datum_of[x.0]),
                             standoff: block_standoff(&scene, hlip, &f.points, standoff, probe),
                             touches: f
                                 .points
@@ -234,7 +220,7 @@ pub fn plan(
                     }
                     for r in &i.records {
                         if !records.contains(r) {
-                            records.push(r.clone());
+                            records.push(*r);
                         }
                     }
                 }
@@ -242,7 +228,7 @@ pub fn plan(
                 setup_groups.push(GroupIn {
                     setup: si,
                     probe,
-                    label: p.probe.clone(),
+                    slot: p.probe,
                     a: o.a,
                     b: o.b,
                     dir,
@@ -257,10 +243,10 @@ pub fn plan(
         }
         // Datum groups first, keeping each probe's orientations together.
         let probe_has_datum =
-            |label: &str, gs: &[GroupIn]| gs.iter().any(|g| g.label == label && g.has_datum);
+            |slot: SlotId, gs: &[GroupIn]| gs.iter().any(|g| g.slot == slot && g.has_datum);
         let keys: Vec<(bool, bool)> = setup_groups
             .iter()
-            .map(|g| (!probe_has_datum(&g.label, &setup_groups), !g.has_datum))
+            .map(|g| (!probe_has_datum(g.slot, &setup_groups), !g.has_datum))
             .collect();
         let mut idx: Vec<usize> = (0..setup_groups.len()).collect();
         idx.sort_by_key(|&k| keys[k]);
@@ -277,7 +263,7 @@ pub fn plan(
     let results: Vec<Result<GroupOut, Box<PathError>>> = groups
         .par_iter()
         .map(|g| {
-            let r = plan_group(input, hlip, &scene, g, standoff, &datum_of);
+            let r = plan_group(input, hlip, &scene, g, standoff);
             progress(
                 done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
                 total,
@@ -324,7 +310,7 @@ pub fn plan(
                     .and_then(|_| pose.segment(&across, &entry[0]));
                 if let Err(blocker) = moves {
                     let b = &o.blocks[0];
-                    diags.push(part.span.file, no_path(input, b, g, blocker));
+                    diags.push(part.span.file, no_path(input, b, g, &blocker.to_string()));
                     return None;
                 }
                 entry.insert(0, across);
@@ -352,7 +338,7 @@ pub fn plan(
         }
         length += glen;
         let gp = GroupPath {
-            probe: g.label.clone(),
+            probe: g.slot,
             a: g.a,
             b: g.b,
             direction: g.dir.into(),
@@ -392,25 +378,25 @@ fn polyline(pts: &[P3]) -> f64 {
     pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
 }
 
-/// The diagnostic for a block no move reaches.
-fn no_path(input: &Input, b: &BlockPath, g: &GroupIn, blocker: String) -> PathError {
-    let part = &input.model.parts[input.plan.part.0];
-    let feature = part.features.iter().find(|f| f.name == b.feature);
+/// The diagnostic for a block no move reaches; `blocker` says what hits.
+fn no_path(input: &Input, b: &BlockPath, g: &GroupIn, blocker: &str) -> PathError {
+    let names = Names::new(input.model, input.geometry, input.plan_id());
+    let part = names.part();
+    let feature = b.feature.map(|f| &part.features[f.0]);
     PathError::NoPath {
         span: feature.map_or(part.span, |f| f.span),
-        face: b.face.clone(),
-        feature: b.feature.clone(),
-        probe: g.label.clone(),
-        orient: if g.probe.bent {
-            format!(
+        face: names.face(b.face).to_string(),
+        feature: names.feature(b.feature).to_string(),
+        probe: names.probe(g.slot).to_string(),
+        orient: match g.probe.head {
+            Head::Indexable => format!(
                 " at A{} B{}",
                 crate::model::fmt_num(g.a),
                 crate::model::fmt_num(g.b)
-            )
-        } else {
-            String::new()
+            ),
+            Head::Fixed => String::new(),
         },
-        blocker,
+        blocker: blocker.to_string(),
     }
 }
 
@@ -421,7 +407,6 @@ fn plan_group(
     scene: &Scene,
     g: &GroupIn,
     standoff: f64,
-    datum_of: &BTreeMap<&str, (usize, &str)>,
 ) -> Result<GroupOut, Box<PathError>> {
     let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table);
     let r = g.probe.tip_radius;
@@ -431,28 +416,18 @@ fn plan_group(
     for (bi, b) in g.blocks.iter().enumerate() {
         for (ti, t) in b.touches.iter().enumerate() {
             let p = &hlip.points[t.point];
-            let n = V3::from(p.normal);
-            goals.push(P3::from(p.position) + n * (r + b.standoff));
+            goals.push(p.position + p.normal * (r + b.standoff));
             owner.push((bi, ti));
         }
     }
     let geometry = input.geometry;
-    let face_ids: BTreeMap<&str, usize> = geometry
-        .faces
-        .iter()
-        .enumerate()
-        .map(|(k, f)| (f.name.as_str(), k))
-        .collect();
     let face_points = |goal: usize| -> Vec<P3> {
         let (bi, _) = owner[goal];
         let b = &g.blocks[bi];
-        if b.table {
+        if b.contact == Contact::Table {
             return vec![];
         }
-        let Some(&f) = face_ids.get(b.face.as_str()) else {
-            return vec![];
-        };
-        let tris = &geometry.faces[f].triangles;
+        let tris = &geometry.faces[b.face.0].triangles;
         let stride = tris.len().div_ceil(24).max(1);
         tris.iter()
             .step_by(stride)
@@ -476,7 +451,7 @@ fn plan_group(
     );
     let added = map.build(face_points).map_err(|d| {
         let (bi, _) = owner[d.goal];
-        Box::new(no_path(input, &g.blocks[bi], g, d.blocker))
+        Box::new(no_path(input, &g.blocks[bi], g, &d.blocker.to_string()))
     })?;
     let paths = map.shortest_paths();
     // The way up from each goal to the clearance plane.
@@ -496,12 +471,7 @@ fn plan_group(
         of_block[bi].push(k);
     }
     // Block order: datum blocks first (in datum order), then a tour over the rest.
-    let rank = |bi: usize| {
-        g.blocks[bi]
-            .datum
-            .as_ref()
-            .and_then(|_| datum_of.get(g.blocks[bi].feature.as_str()).map(|d| d.0))
-    };
+    let rank = |bi: usize| g.blocks[bi].datum.map(|d| d.0);
     let mut datum_blocks: Vec<usize> = (0..g.blocks.len()).filter(|&b| rank(b).is_some()).collect();
     datum_blocks.sort_by_key(|&b| (rank(b), b));
     let rest: Vec<usize> = (0..g.blocks.len()).filter(|&b| rank(b).is_none()).collect();
@@ -562,7 +532,7 @@ fn plan_group(
             input,
             &g.blocks[bi],
             g,
-            "the way up to the clearance plane".into(),
+            "the way up to the clearance plane",
         )));
     };
     let mut entry: Vec<P3> = entry_up.into_iter().rev().collect();
@@ -631,8 +601,8 @@ fn block_standoff(
     let r = probe.tip_radius;
     points.iter().fold(standoff, |s, &k| {
         let p = &hlip.points[k];
-        let n = V3::from(p.normal);
-        let from = P3::from(p.position) + n * SKIN;
+        let n = p.normal;
+        let from = p.position + n * SKIN;
         match scene.cast_ray(&from, &n, 2.0 * (standoff + r) + 1.0) {
             Some(hit) => s.min(((hit + SKIN - 2.0 * r) / 2.0).max(0.0)),
             None => s,

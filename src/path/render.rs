@@ -1,7 +1,8 @@
 //! The LLIP as JSON, beside the HLIP (`inspc build --plan-json`).
 
 use super::Llip;
-use crate::plan::Hlip;
+use crate::access::Contact;
+use crate::plan::{Hlip, Names};
 use serde_json::{json, Value};
 
 /// Rounds a coordinate to a micrometre so that the JSON is stable across machines.
@@ -24,8 +25,8 @@ fn pts(p: &[[f64; 3]]) -> Value {
 
 /// The plan with its paths: the HLIP's JSON with, per setup, the alignment and every
 /// group's moves, and a `paths` summary.
-pub fn json(hlip: &Hlip, llip: &Llip) -> Value {
-    let mut v = crate::plan::json(hlip);
+pub fn json(hlip: &Hlip, llip: &Llip, names: &Names) -> Value {
+    let mut v = crate::plan::json(hlip, names);
     let setups: Vec<Value> = llip
         .setups
         .iter()
@@ -43,16 +44,16 @@ pub fn json(hlip: &Hlip, llip: &Llip) -> Value {
                     "missing": s.alignment.missing,
                 },
                 "groups": s.groups.iter().map(|g| json!({
-                    "probe": g.probe,
+                    "probe": names.probe(g.probe),
                     "a": g.a,
                     "b": g.b,
                     "direction": [r(g.direction[0]), r(g.direction[1]), r(g.direction[2])],
                     "entry": pts(&g.entry),
                     "blocks": g.blocks.iter().map(|b| json!({
-                        "feature": b.feature,
-                        "face": b.face,
-                        "table": b.table,
-                        "datum": b.datum,
+                        "feature": names.feature(b.feature),
+                        "face": names.face(b.face),
+                        "table": b.contact == Contact::Table,
+                        "datum": b.datum.map(|d| names.datum(d)),
                         "touches": b.touches.iter().map(|t| json!({
                             "point": t.point,
                             "via": pts(&t.via),
@@ -60,7 +61,7 @@ pub fn json(hlip: &Hlip, llip: &Llip) -> Value {
                         })).collect::<Vec<_>>(),
                     })).collect::<Vec<_>>(),
                     "exit": pts(&g.exit),
-                    "records": g.records,
+                    "records": g.records.iter().map(|t| names.tolerance(*t)).collect::<Vec<_>>(),
                     "length": r(g.length),
                 })).collect::<Vec<_>>(),
             })

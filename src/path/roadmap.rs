@@ -10,7 +10,7 @@
 //! faces of the goals left out, then random points (a fixed seed). Shortest paths between
 //! goals come from Dijkstra on the result (the all-pairs step of ch. 5.3.2).
 
-use super::sweep::Pose;
+use crate::access::pose::{Blocker, Pose};
 use crate::geometry::{P3, V3};
 use rayon::prelude::*;
 use std::cmp::Ordering;
@@ -139,7 +139,7 @@ impl<'a> Roadmap<'a> {
     }
 
     /// Checks a route; its length when every segment is clear, else what hit first.
-    fn check(&self, p: &P3, q: &P3, route: Route) -> (Result<f64, String>, usize) {
+    fn check(&self, p: &P3, q: &P3, route: Route) -> (Result<f64, Blocker>, usize) {
         let mut at = *p;
         let mut length = 0.0;
         let mut checks = 0;
@@ -155,7 +155,7 @@ impl<'a> Roadmap<'a> {
     }
 
     /// The local planner: the first route that is clear.
-    fn connect(&self, p: &P3, q: &P3) -> (Result<(Route, f64), String>, usize) {
+    fn connect(&self, p: &P3, q: &P3) -> (Result<(Route, f64), Option<Blocker>>, usize) {
         let mut first_err = None;
         let mut checks = 0;
         for route in self.routes(p, q) {
@@ -168,7 +168,7 @@ impl<'a> Roadmap<'a> {
                 }
             }
         }
-        (Err(first_err.unwrap_or_default()), checks)
+        (Err(first_err), checks)
     }
 
     /// The k nearest other nodes of node `i` among the first `limit` nodes.
@@ -341,7 +341,7 @@ impl<'a> Roadmap<'a> {
                     .copied();
                 let blocker = near
                     .and_then(|m| self.pose.segment(&self.nodes[goal], &self.nodes[m]).err())
-                    .unwrap_or_else(|| "the part".into());
+                    .map_or_else(|| "the part".into(), |b| b.to_string());
                 Err(Disconnected { goal, blocker })
             }
         }
@@ -489,7 +489,7 @@ mod tests {
                 end: End::Round,
             }],
             second: vec![],
-            bent: false,
+            head: crate::access::Head::Fixed,
         }
     }
 
@@ -523,7 +523,7 @@ mod tests {
         let probe = stylus();
         let pose = Pose::new(&scene, &probe, V3::z(), V3::z(), -100.0);
         let (a, b) = (P3::new(-5.0, 0.0, 5.0), P3::new(5.0, 0.0, 5.0));
-        assert_eq!(pose.segment(&a, &b), Err("the tip".into()));
+        assert_eq!(pose.segment(&a, &b), Err(Blocker::Tip));
         let mut map = Roadmap::new(&pose, vec![a, b], V3::z(), &verts, 40.0);
         assert_eq!(map.build(|_| vec![]).ok(), Some(0));
         let paths = map.shortest_paths();

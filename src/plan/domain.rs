@@ -13,16 +13,14 @@
 //! and the rejected configuration is removed.
 
 use super::cluster::{Bits, Set};
+use crate::access::pose::{above_table, frame, table_height, Blocker, Contact, Head, Pose};
 use crate::access::{self, tip_fits, Cell, ConeOptions, CubeMap, ProbeShape, Scene, SecondMap};
 use crate::geometry::{FaceId, Surface, P3, V3};
 use crate::model::{HeadKind, Model, Plan};
 use crate::sample::Fpoint;
-use nalgebra::{Rotation3, Unit};
+
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
-
-/// The share of the tip radius the mesh may come closer than the radius (chordal error).
-pub(crate) const TIP_CLEARANCE: f64 = 0.9;
 
 /// The machine as the planner sees it.
 pub(crate) struct Machine {
@@ -32,8 +30,8 @@ pub(crate) struct Machine {
     pub costs: Vec<f64>,
     /// Probes the plan allows.
     pub allowed: Vec<bool>,
-    /// Whether the head indexes.
-    pub bent: bool,
+    /// The head: fixed, or indexing on `grid`.
+    pub head: Head,
     /// The head's A/B grid (degrees); one (0, 0) for a fixed head.
     pub grid: Vec<(f64, f64)>,
     /// The grid orientations the plan allows.
@@ -65,14 +63,13 @@ impl Machine {
                 }
             }
         }
-        let (bent, a_max) = match head.kind {
-            HeadKind::Fixed => (false, 0.0),
-            HeadKind::Indexable { a, .. } => (true, a[1]),
+        let (kind, a_max) = match head.kind {
+            HeadKind::Fixed => (Head::Fixed, 0.0),
+            HeadKind::Indexable { a, .. } => (Head::Indexable, a[1]),
         };
-        let grid = if bent {
-            head.orientations()
-        } else {
-            vec![(0.0, 0.0)]
+        let grid = match kind {
+            Head::Indexable => head.orientations(),
+            Head::Fixed => vec![(0.0, 0.0)],
         };
         let mut grid_allowed = Bits::full(grid.len());
         let mut grid_weight = vec![0.5; grid.len()];
@@ -95,7 +92,7 @@ impl Machine {
             probes,
             costs,
             allowed,
-            bent,
+            head: kind,
             grid,
             grid_allowed,
             grid_weight,
@@ -160,57 +157,6 @@ pub(crate) struct Knowledge {
     pub acquired: usize,
 }
 
-/// The rotation taking the part frame to the machine frame of setup `up` (up ↦ +z).
-pub(crate) fn frame(up: &V3) -> Rotation3<f64> {
-    Rotation3::rotation_between(up, &V3::z()).unwrap_or_else(|| {
-        Rotation3::from_axis_angle(&Unit::new_normalize(V3::x()), std::f64::consts::PI)
-    })
-}
-
-/// The probe direction (tip towards head, part frame) of grid orientation (A, B) in setup
-/// `up`.
-pub(crate) fn orientation_dir(up: &V3, a: f64, b: f64) -> V3 {
-    frame(up).inverse() * access::head_direction(a, b)
-}
-
-/// The height of the table under the part in setup `up`: the lowest vertex along `up`.
-pub(crate) fn table_height(scene: &Scene, up: &V3) -> f64 {
-    scene
-        .tris
-        .iter()
-        .flat_map(|t| t.v.iter())
-        .map(|v| v.coords.dot(up))
-        .fold(f64::INFINITY, f64::min)
-}
-
-/// The lowest point along `up` of a component whose axis runs from `from` along unit `d`
-/// over [a, b].
-pub(crate) fn lowest(comp: &access::Component, from: &P3, d: &V3, up: &V3) -> f64 {
-    let b = if comp.b.is_finite() { comp.b } else { comp.a };
-    let h = |t: f64| (from + d * t).coords.dot(up);
-    let ends = h(comp.a).min(h(b));
-    let side = match comp.end {
-        access::End::Round => comp.radius,
-        access::End::Flat => comp.radius * (1.0 - d.dot(up).powi(2)).max(0.0).sqrt(),
-    };
-    ends - side
-}
-
-/// Whether a bent probe at tip centre `c`, along `o`, with the head above its
-/// articulation point, keeps off the table at height `t0` in setup `up`.
-pub(crate) fn above_table(probe: &ProbeShape, c: &P3, o: &V3, up: &V3, t0: f64) -> bool {
-    const MARGIN: f64 = 0.5;
-    let art = c + o * probe.reach();
-    probe
-        .first
-        .iter()
-        .all(|comp| lowest(comp, c, o, up) >= t0 + MARGIN)
-        && probe
-            .second
-            .iter()
-            .all(|comp| lowest(comp, &art, up, up) >= t0 + MARGIN)
-}
-
 /// The cells within `angle` radians of `axis`, in the shape of `like`.
 pub(crate) fn cone_around(like: &CubeMap, axis: &V3, angle: f64) -> CubeMap {
     let mut out = like.empty_like();
@@ -227,6 +173,32 @@ pub(crate) fn cone_around(like: &CubeMap, axis: &V3, angle: f64) -> CubeMap {
 }
 
 impl Knowledge {
+    /// Validates touching point `f` with probe `p` pointing along `dir` in setup `up`
+    /// over a table at `t0` (one primitive inspection plan, seed ch. 4.1).
+    pub(crate) fn pose_check(
+        &self,
+        machine: &Machine,
+        f: usize,
+        p: usize,
+        dir: V3,
+        up: V3,
+        t0: f64,
+    ) -> Result<(), Blocker> {
+        let probe = &machine.probes[p];
+        let point = &self.points[f];
+        let contact = if f >= self.graph_points {
+            Contact::Table
+        } else {
+            Contact::Part
+        };
+        Pose::new(&self.scene, probe, dir, up, t0).approach(
+            &point.tip_centre(probe.tip_radius),
+            &point.normal,
+            self.opts.retract,
+            contact,
+        )
+    }
+
     /// The initial knowledge: half-line cones at every fpoint for every probe, table
     /// alternatives for datum faces that can rest on the table.
     pub(crate) fn new(
@@ -392,7 +364,7 @@ impl Knowledge {
         up: &V3,
         machine: &Machine,
     ) -> Bits {
-        if !machine.bent {
+        if !machine.head.indexable() {
             return Bits::full(1);
         }
         if let Some(b) = self.d1p.get(&(f, p, s)) {
@@ -476,7 +448,7 @@ impl Knowledge {
         }
         let dom = &mut self.dom[f][p];
         let cell = dom.setup.cell(s);
-        if machine.bent {
+        if machine.head.indexable() {
             // No orientation works in this setup: nor, most likely, in setups close by.
             let dir = dom.setup.direction(cell);
             let cap = cone_around(&dom.setup, &dir, REJECT_CAP.to_radians());
@@ -531,11 +503,10 @@ impl Knowledge {
             .par_iter()
             .zip(&computed)
             .map(|(&(f, p), cones)| {
-                if machine.bent || !cones.tip_fits {
+                if machine.head.indexable() || !cones.tip_fits {
                     return vec![];
                 }
                 let old = &self.dom[f][p].setup;
-                let base = 6 * (old.n() as usize).pow(2);
                 (0..old.preferred_len())
                     .filter(|&j| {
                         let cell = Cell::Preferred(j);
@@ -543,20 +514,8 @@ impl Knowledge {
                     })
                     .filter(|&j| {
                         let up = old.preferred(j);
-                        let pip = super::validate::Pip {
-                            point: f,
-                            probe: p,
-                            setup: base + j,
-                            orient: 0,
-                        };
-                        super::validate::check(
-                            self,
-                            machine,
-                            &pip,
-                            &up,
-                            table_height(&self.scene, &up),
-                        )
-                        .is_none()
+                        let t0 = table_height(&self.scene, &up);
+                        self.pose_check(machine, f, p, up, up, t0).is_ok()
                     })
                     .collect()
             })
@@ -610,12 +569,12 @@ fn initial(
         return Dom {
             tip,
             setup: e.clone(),
-            d1: machine.bent.then_some(e),
+            d1: machine.head.indexable().then_some(e),
             full: true,
         };
     }
     let half = access::gac_halfline(scene, &c, n, pref);
-    if !machine.bent {
+    if !machine.head.indexable() {
         return Dom {
             tip,
             setup: half,

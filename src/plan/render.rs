@@ -2,12 +2,72 @@
 //! change-orient, inspect, record) and as JSON (the tree plus a summary).
 
 use super::{Hlip, Summary};
-use crate::model::fmt_num;
+use crate::access::pose::{Contact, Head};
+use crate::geometry::{FaceId, PartGeometry, V3};
+use crate::model::{fmt_num, DatumId, FeatureId, Model, Part, Plan, PlanId, SlotId, ToleranceId};
 use serde_json::{json as j, Value};
 use std::fmt::Write;
 
+/// The names a plan's ids stand for: where the plan meets people (listings, JSON,
+/// DMIS labels and comments, diagnostics).
+#[derive(Clone, Copy)]
+pub struct Names<'a> {
+    /// The model.
+    pub model: &'a Model,
+    /// The plan's part geometry.
+    pub geometry: &'a PartGeometry,
+    /// The plan.
+    pub plan: &'a Plan,
+}
+
+impl<'a> Names<'a> {
+    /// The names of plan `plan` over its part's geometry.
+    pub fn new(model: &'a Model, geometry: &'a PartGeometry, plan: PlanId) -> Names<'a> {
+        Names {
+            model,
+            geometry,
+            plan: &model.plans[plan.0],
+        }
+    }
+
+    /// The plan's part.
+    pub fn part(&self) -> &'a Part {
+        &self.model.parts[self.plan.part.0]
+    }
+
+    /// A feature's name; `—` for faces that hang from the part itself.
+    pub fn feature(&self, f: Option<FeatureId>) -> &'a str {
+        f.map_or("—", |f| self.part().features[f.0].name.as_str())
+    }
+
+    /// A face's name.
+    pub fn face(&self, f: FaceId) -> &'a str {
+        &self.geometry.faces[f.0].name
+    }
+
+    /// A probe's label in the rack.
+    pub fn probe(&self, p: SlotId) -> &'a str {
+        &self.model.cmms[self.plan.cmm.0].probes[p.0].0
+    }
+
+    /// A tolerance's name.
+    pub fn tolerance(&self, t: ToleranceId) -> &'a str {
+        &self.part().tolerances[t.0].name
+    }
+
+    /// A datum's letter.
+    pub fn datum(&self, d: DatumId) -> &'a str {
+        &self.part().datums[d.0].name
+    }
+}
+
+/// A plan coordinate triple in words.
 fn v3(v: &[f64; 3]) -> String {
     format!("({}, {}, {})", fmt_num(v[0]), fmt_num(v[1]), fmt_num(v[2]))
+}
+
+fn arr(v: &V3) -> [f64; 3] {
+    [v.x, v.y, v.z]
 }
 
 /// A direction's name when it is an axis.
@@ -26,7 +86,8 @@ fn axis(v: &[f64; 3]) -> Option<&'static str> {
         .map(|(_, n)| *n)
 }
 
-fn dir_text(v: &[f64; 3]) -> String {
+fn dir_text(v: &V3) -> String {
+    let v = &arr(v);
     match axis(v) {
         Some(a) => format!("{a} {}", v3(v)),
         None => v3(v),
@@ -34,24 +95,28 @@ fn dir_text(v: &[f64; 3]) -> String {
 }
 
 /// The plan as an indented operator listing with a summary.
-pub fn text(h: &Hlip) -> String {
+pub fn text(h: &Hlip, names: &Names) -> String {
+    let (model, plan) = (names.model, names.plan);
     let mut out = String::new();
     let _ = writeln!(
         out,
         "plan {}: part {} on {}, hierarchy {}",
-        h.plan, h.part, h.cmm, h.hierarchy
+        plan.name,
+        names.part().name,
+        model.cmms[plan.cmm.0].name,
+        model.hierarchies[plan.hierarchy.0].name
     );
     let mut o_count = 0;
     for (si, s) in h.setups.iter().enumerate() {
         let _ = writeln!(out, "change-setup s{} up {}", si + 1, dir_text(&s.up));
         for t in &s.on_table {
-            let _ = writeln!(out, "  rest {t} on the table");
+            let _ = writeln!(out, "  rest {} on the table", names.face(*t));
         }
         for p in &s.probes {
-            let _ = writeln!(out, "  change-probe {}", p.probe);
+            let _ = writeln!(out, "  change-probe {}", names.probe(p.probe));
             for o in &p.orients {
                 o_count += 1;
-                if h.indexable {
+                if h.head == Head::Indexable {
                     let _ = writeln!(
                         out,
                         "    change-orient o{o_count} A {}° B {}° along {}",
@@ -69,26 +134,42 @@ pub fn text(h: &Hlip) -> String {
                         .map(|f| {
                             let n = f.points.len();
                             let s = if n == 1 { "" } else { "s" };
-                            if f.table {
-                                format!("table under {} ({n} point{s})", f.face)
-                            } else {
-                                format!("{} ({n} point{s})", f.face)
+                            let face = names.face(f.face);
+                            match f.contact {
+                                Contact::Table => format!("table under {face} ({n} point{s})"),
+                                Contact::Part => format!("{face} ({n} point{s})"),
                             }
                         })
                         .collect();
-                    let _ = writeln!(out, "      inspect {}: {}", i.feature, faces.join(", "));
+                    let feature = names.feature(i.feature);
+                    let _ = writeln!(out, "      inspect {feature}: {}", faces.join(", "));
                     for r in &i.records {
-                        let _ = writeln!(out, "        record {r}({})", i.feature);
+                        let _ = writeln!(out, "        record {}({feature})", names.tolerance(*r));
                     }
                 }
             }
         }
     }
-    out += &summary_text(&h.summary);
+    out += &summary_text(&h.summary, names);
     out
 }
 
-fn summary_text(s: &Summary) -> String {
+/// The hierarchy's levels in words, beside their violation counts.
+fn violations<'a>(s: &'a Summary, names: &Names) -> impl Iterator<Item = (String, u64)> + 'a {
+    let h = &names.model.hierarchies[names.plan.hierarchy.0];
+    let levels: Vec<String> = h
+        .levels
+        .iter()
+        .map(|l| crate::resolve::level_text(l.var, l.group))
+        .collect();
+    levels.into_iter().zip(s.violations.iter().copied())
+}
+
+fn strategy(s: &Summary) -> &'static str {
+    s.strategy.map_or("—", |x| x.name())
+}
+
+fn summary_text(s: &Summary, names: &Names) -> String {
     let mut out = String::from("summary\n");
     let (min, exact) = s.min_setups;
     let _ = writeln!(
@@ -115,38 +196,41 @@ fn summary_text(s: &Summary) -> String {
     let _ = writeln!(
         out,
         "  iterations {}, whole-probe cones {}, clustering {}",
-        s.iterations, s.cones_acquired, s.strategy
+        s.iterations,
+        s.cones_acquired,
+        strategy(s)
     );
-    for (l, v) in &s.violations {
+    for (l, v) in violations(s, names) {
         let _ = writeln!(out, "  violated {l}: {v}");
     }
     out
 }
 
 /// The plan as JSON: the tree, the points and a `summary` object.
-pub fn json(h: &Hlip) -> Value {
+pub fn json(h: &Hlip, names: &Names) -> Value {
+    let (model, plan) = (names.model, names.plan);
     let setups: Vec<Value> = h
         .setups
         .iter()
         .map(|s| {
             j!({
-                "up": s.up,
+                "up": arr(&s.up),
                 "rotation": s.rotation,
-                "on_table": s.on_table,
+                "on_table": s.on_table.iter().map(|f| names.face(*f)).collect::<Vec<_>>(),
                 "probes": s.probes.iter().map(|p| j!({
-                    "probe": p.probe,
+                    "probe": names.probe(p.probe),
                     "orientations": p.orients.iter().map(|o| j!({
                         "a": o.a,
                         "b": o.b,
-                        "direction": o.direction,
+                        "direction": arr(&o.direction),
                         "inspect": o.inspections.iter().map(|i| j!({
-                            "feature": i.feature,
+                            "feature": names.feature(i.feature),
                             "faces": i.faces.iter().map(|f| j!({
-                                "face": f.face,
-                                "table": f.table,
+                                "face": names.face(f.face),
+                                "table": f.contact == Contact::Table,
                                 "points": f.points,
                             })).collect::<Vec<_>>(),
-                            "record": i.records,
+                            "record": i.records.iter().map(|t| names.tolerance(*t)).collect::<Vec<_>>(),
                         })).collect::<Vec<_>>(),
                     })).collect::<Vec<_>>(),
                 })).collect::<Vec<_>>(),
@@ -154,23 +238,20 @@ pub fn json(h: &Hlip) -> Value {
         })
         .collect();
     let s = &h.summary;
-    let violations: serde_json::Map<String, Value> = s
-        .violations
-        .iter()
-        .map(|(l, v)| (l.clone(), j!(v)))
-        .collect();
+    let violations: serde_json::Map<String, Value> =
+        violations(s, names).map(|(l, v)| (l, j!(v))).collect();
     j!({
-        "plan": h.plan,
-        "part": h.part,
-        "cmm": h.cmm,
-        "hierarchy": h.hierarchy,
-        "indexable": h.indexable,
+        "plan": plan.name,
+        "part": names.part().name,
+        "cmm": model.cmms[plan.cmm.0].name,
+        "hierarchy": model.hierarchies[plan.hierarchy.0].name,
+        "indexable": h.head == Head::Indexable,
         "setups": setups,
         "points": h.points.iter().map(|p| j!({
-            "face": p.face,
-            "table": p.table,
-            "position": p.position,
-            "normal": p.normal,
+            "face": names.face(p.face),
+            "table": p.at.contact() == Contact::Table,
+            "position": arr(&p.position.coords),
+            "normal": arr(&p.normal),
         })).collect::<Vec<_>>(),
         "summary": {
             "setups": s.setups,
@@ -186,7 +267,7 @@ pub fn json(h: &Hlip) -> Value {
             "cones_acquired": s.cones_acquired,
             "min_setups": s.min_setups.0,
             "min_setups_proven": s.min_setups.1,
-            "strategy": s.strategy,
+            "strategy": strategy(s),
         },
     })
 }

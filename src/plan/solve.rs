@@ -425,7 +425,7 @@ pub(crate) fn solve(
     let mut by_setup: Vec<(usize, Inst)> = Vec::new();
     for (j, cl) in tree.clusters.iter().enumerate() {
         let sub = extract(root, &tree, &[j as u32]);
-        let s = if m.bent {
+        let s = if m.head.indexable() {
             pick_bent_setup(&cl.set, &sub, k, m)
         } else {
             pick_setup(&cl.set, k)
@@ -530,8 +530,8 @@ struct Meas {
 }
 
 fn measurements(b: &Branch, m: &Machine, out: &mut Vec<Meas>) {
-    let dir = if m.bent {
-        super::domain::orientation_dir(&b.up, m.grid[b.orient].0, m.grid[b.orient].1)
+    let dir = if m.head.indexable() {
+        crate::access::pose::orientation_dir(&b.up, m.grid[b.orient].0, m.grid[b.orient].1)
     } else {
         b.up
     };

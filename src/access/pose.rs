@@ -1,0 +1,370 @@
+//! The pose of a probe and its collision rules: the one owner of how a probe stands in a
+//! setup (the part frame's `up` towards the ram, the table under the part), which way it
+//! points (a fixed head along the ram, an indexable head at A/B), where its components
+//! sit for a tip centre, and what it may not touch.
+//!
+//! The planner's validation ([`Pose::approach`]) and the path stage's move checks
+//! ([`Pose::segment`]) both pose the probe here, so the two agree on every rule: the tip's
+//! clearance at the contact ([`TIP_CLEARANCE`]), the table's margin ([`TABLE_MARGIN`]),
+//! the components' lowest points ([`lowest`]) and the table's height ([`table_height`]).
+//!
+//! **Architecture Invariant:** no other module poses a probe or states a clearance to
+//! part or table; `tests/cases.rs` re-checks every move of every golden program through
+//! [`Pose::segment`].
+
+use super::{component_hits, head_direction, Component, End, ProbeShape, Scene};
+use crate::geometry::{P3, V3};
+use nalgebra::{Rotation3, Unit};
+use parry3d_f64::math::Isometry;
+use parry3d_f64::query::intersection_test;
+use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, RoundShape, Shape, Triangle};
+
+/// The share of the tip radius the mesh may come closer than the radius at a contact:
+/// fpoints lie on the exact surface and a concave face's facets are up to the
+/// tessellation's chord error nearer (a tenth of the radius at most).
+pub const TIP_CLEARANCE: f64 = 0.9;
+
+/// The table may come no closer to the probe than this during a move (mm).
+pub const TABLE_MARGIN: f64 = 0.1;
+
+/// The margin an indexable probe's orientation keeps from the table when the planner
+/// chooses it (mm): more than a move's, so that the moves around it have room.
+pub const ORIENTATION_TABLE_MARGIN: f64 = 0.5;
+
+/// The spacing of the positions tested along an approach (mm).
+const SWEEP_STEP: f64 = 0.25;
+
+/// Sides of the polygon standing in for a cylinder's disc in a swept hull.
+const DISC_SIDES: usize = 16;
+
+/// The kind of head a probe hangs from, as posing sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Head {
+    /// The probe runs along the ram (a straight probe in the seed's terms).
+    Fixed,
+    /// The probe indexes to A/B angles (a bent probe): its first component along the
+    /// orientation, its second (head, ram) along the ram from the articulation point.
+    Indexable,
+}
+
+impl Head {
+    /// Whether the head indexes.
+    pub fn indexable(self) -> bool {
+        self == Head::Indexable
+    }
+}
+
+/// What a pose meets.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Blocker {
+    /// The tip meets the part.
+    Tip,
+    /// The tip comes too near the table.
+    TipOnTable,
+    /// A named component (stylus, extension, body, head, ram) meets the part.
+    Component(String),
+    /// A named component comes too near the table.
+    ComponentOnTable(String),
+}
+
+impl std::fmt::Display for Blocker {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Blocker::Tip => write!(f, "the tip"),
+            Blocker::TipOnTable => write!(f, "the tip (on the table)"),
+            Blocker::Component(c) => write!(f, "the {c}"),
+            Blocker::ComponentOnTable(c) => write!(f, "the {c} (on the table)"),
+        }
+    }
+}
+
+/// What a touch touches: the part, or the table standing in for a datum face resting on
+/// it (ch. 3.6.2), where the tip is meant to reach the table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Contact {
+    /// A point of the part.
+    Part,
+    /// A point of the table.
+    Table,
+}
+
+/// The rotation taking the part frame to the machine frame of setup `up` (up ↦ +z).
+pub fn frame(up: &V3) -> Rotation3<f64> {
+    Rotation3::rotation_between(up, &V3::z()).unwrap_or_else(|| {
+        Rotation3::from_axis_angle(&Unit::new_normalize(V3::x()), std::f64::consts::PI)
+    })
+}
+
+/// The probe direction (tip towards head, part frame) of head orientation (A, B) in
+/// setup `up`.
+pub fn orientation_dir(up: &V3, a: f64, b: f64) -> V3 {
+    frame(up).inverse() * head_direction(a, b)
+}
+
+/// The height of the table under the part in setup `up`: the lowest vertex along `up`.
+pub fn table_height(scene: &Scene, up: &V3) -> f64 {
+    scene
+        .tris
+        .iter()
+        .flat_map(|t| t.v.iter())
+        .map(|v| v.coords.dot(up))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The lowest point along `up` of a component whose axis runs from `from` along unit `d`
+/// over [a, b].
+pub fn lowest(comp: &Component, from: &P3, d: &V3, up: &V3) -> f64 {
+    let b = if comp.b.is_finite() { comp.b } else { comp.a };
+    let h = |t: f64| (from + d * t).coords.dot(up);
+    let ends = h(comp.a).min(h(b));
+    let side = match comp.end {
+        End::Round => comp.radius,
+        End::Flat => comp.radius * (1.0 - d.dot(up).powi(2)).max(0.0).sqrt(),
+    };
+    ends - side
+}
+
+/// Whether an indexable probe at tip centre `c`, along `o`, with the head above its
+/// articulation point, keeps [`ORIENTATION_TABLE_MARGIN`] off the table at height `t0`
+/// in setup `up`.
+pub fn above_table(probe: &ProbeShape, c: &P3, o: &V3, up: &V3, t0: f64) -> bool {
+    let art = c + o * probe.reach();
+    probe
+        .first
+        .iter()
+        .all(|comp| lowest(comp, c, o, up) >= t0 + ORIENTATION_TABLE_MARGIN)
+        && probe
+            .second
+            .iter()
+            .all(|comp| lowest(comp, &art, up, up) >= t0 + ORIENTATION_TABLE_MARGIN)
+}
+
+/// One component of a posed probe: its shape along `dir` from `offset` past the tip
+/// centre.
+#[derive(Debug, Clone)]
+struct Posed {
+    comp: Component,
+    dir: V3,
+    offset: V3,
+}
+
+/// A probe posed in the part frame — setup, orientation — with the obstacles of its
+/// setup: the part and the table under it.
+pub struct Pose<'a> {
+    scene: &'a Scene,
+    tip_radius: f64,
+    parts: Vec<Posed>,
+    up: V3,
+    table: f64,
+}
+
+impl<'a> Pose<'a> {
+    /// `probe` pointing along `dir` (tip to head, part frame) with the ram along `up`;
+    /// the table lies at height `table` along `up`.
+    pub fn new(scene: &'a Scene, probe: &ProbeShape, dir: V3, up: V3, table: f64) -> Pose<'a> {
+        let mut parts = Vec::new();
+        match probe.head {
+            Head::Indexable => {
+                for comp in &probe.first {
+                    parts.push(Posed {
+                        comp: comp.clone(),
+                        dir,
+                        offset: V3::zeros(),
+                    });
+                }
+                for comp in &probe.second {
+                    parts.push(Posed {
+                        comp: comp.clone(),
+                        dir: up,
+                        offset: dir * probe.reach(),
+                    });
+                }
+            }
+            Head::Fixed => {
+                for comp in probe.straight() {
+                    parts.push(Posed {
+                        comp,
+                        dir: up,
+                        offset: V3::zeros(),
+                    });
+                }
+            }
+        }
+        Pose {
+            scene,
+            tip_radius: probe.tip_radius,
+            parts,
+            up,
+            table,
+        }
+    }
+
+    /// The ram direction.
+    pub fn up(&self) -> V3 {
+        self.up
+    }
+
+    /// The lowest point along `up` of a posed component with the tip centre at `c`.
+    fn low(&self, part: &Posed, c: &P3) -> f64 {
+        lowest(&part.comp, &(c + part.offset), &part.dir, &self.up)
+    }
+
+    /// Validation of one touch (seed ch. 4.1): the tip sweeps from the retract point
+    /// `c + n · travel` to the contact's tip centre `c` as an exact capsule of
+    /// [`TIP_CLEARANCE`] times its radius; every other component is tested at both ends
+    /// with its radius grown to cover the motion, and where that is not clear, at
+    /// positions every 0.25 mm along the approach. A table contact may reach the table.
+    pub fn approach(&self, c: &P3, n: &V3, travel: f64, contact: Contact) -> Result<(), Blocker> {
+        let Some(mesh) = self.scene.mesh() else {
+            return Ok(());
+        };
+        let id = Isometry::identity();
+        let r = self.tip_radius;
+        let tip = Capsule::new(*c, c + n * travel, TIP_CLEARANCE * r);
+        if intersection_test(&id, &tip, &id, mesh).unwrap_or(true) {
+            return Err(Blocker::Tip);
+        }
+        let t0 = self.table;
+        let up = &self.up;
+        if contact == Contact::Part
+            && (c.coords.dot(up).min((c + n * travel).coords.dot(up))) - r < t0 - 1e-9
+        {
+            return Err(Blocker::TipOnTable);
+        }
+        for part in &self.parts {
+            let comp = &part.comp;
+            let d = &part.dir;
+            let origin = |t: f64| -> P3 { c + n * t + part.offset };
+            // The table: the lowest point is linear along the approach, so the ends decide.
+            let low = self.low(part, &(c + n * 0.0)).min(self.low(part, &(c + n * travel)));
+            if low < t0 + TABLE_MARGIN {
+                return Err(Blocker::ComponentOnTable(comp.name.clone()));
+            }
+            if component_hits(self.scene, &origin(0.0), d, comp)
+                || component_hits(self.scene, &origin(travel), d, comp)
+            {
+                return Err(Blocker::Component(comp.name.clone()));
+            }
+            let lateral = (n - d * n.dot(d)).norm();
+            let grown = |extra: f64| Component {
+                radius: comp.radius + extra,
+                ..comp.clone()
+            };
+            // Two ends, radius grown by half the travel: covers every position between.
+            let coarse = grown(travel / 2.0 * lateral);
+            if !component_hits(self.scene, &origin(0.0), d, &coarse)
+                && !component_hits(self.scene, &origin(travel), d, &coarse)
+            {
+                continue;
+            }
+            // Positions every SWEEP_STEP, radius grown by half a step.
+            let steps = (travel / SWEEP_STEP).ceil().max(1.0) as usize;
+            let fine = grown(travel / steps as f64 / 2.0 * lateral);
+            for s in 0..=steps {
+                let at = origin(travel * s as f64 / steps as f64);
+                if component_hits(self.scene, &at, d, &fine) {
+                    return Err(Blocker::Component(comp.name.clone()));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether the probe standing with its tip centre at `p` is clear.
+    pub fn free(&self, p: &P3) -> Result<(), Blocker> {
+        self.segment(p, p)
+    }
+
+    /// Whether the probe can translate from tip centre `p` to `q` (seed ch. 5.4.2); else
+    /// what hits. Each component is swept on its own: the tip ball as an exact capsule,
+    /// a stylus or extension capsule as the exact union of two rounded triangles, a
+    /// body, head or ram cylinder as the convex hull of its two end positions (its discs
+    /// as circumscribed 16-gons, so a little larger than the cylinder). A component's
+    /// lowest point moves linearly along a segment, so the two ends decide the table.
+    pub fn segment(&self, p: &P3, q: &P3) -> Result<(), Blocker> {
+        let lo = p.coords.dot(&self.up).min(q.coords.dot(&self.up)) - self.tip_radius;
+        if lo < self.table + TABLE_MARGIN {
+            return Err(Blocker::TipOnTable);
+        }
+        for part in &self.parts {
+            if self.low(part, p).min(self.low(part, q)) < self.table + TABLE_MARGIN {
+                return Err(Blocker::ComponentOnTable(part.comp.name.clone()));
+            }
+        }
+        let Some(mesh) = self.scene.mesh() else {
+            return Ok(());
+        };
+        let id = Isometry::identity();
+        let hits = |shape: &dyn Shape| intersection_test(&id, shape, &id, mesh).unwrap_or(true);
+        let v = q - p;
+        let moving = v.norm() > 1e-9;
+        let tip = if moving {
+            hits(&Capsule::new(*p, *q, self.tip_radius))
+        } else {
+            let at = Isometry::translation(p.x, p.y, p.z);
+            intersection_test(&at, &Ball::new(self.tip_radius), &id, mesh).unwrap_or(true)
+        };
+        if tip {
+            return Err(Blocker::Tip);
+        }
+        let far = 4.0 * self.scene.size + 10.0;
+        for part in &self.parts {
+            let c = &part.comp;
+            let b = c.b.min(c.a + far);
+            let a0 = p + part.offset + part.dir * c.a;
+            let b0 = p + part.offset + part.dir * b;
+            let hit = match (c.end, moving) {
+                (_, _) if c.radius == 0.0 => false,
+                (End::Round, false) => hits(&Capsule::new(a0, b0, c.radius)),
+                (End::Round, true) => {
+                    let round = |t: Triangle| RoundShape {
+                        inner_shape: t,
+                        border_radius: c.radius,
+                    };
+                    hits(&round(Triangle::new(a0, b0, a0 + v)))
+                        || hits(&round(Triangle::new(b0, b0 + v, a0 + v)))
+                }
+                (End::Flat, _) => {
+                    let (e1, e2) = crate::sample::perpendicular_basis(&part.dir);
+                    let r = c.radius / (std::f64::consts::PI / DISC_SIDES as f64).cos();
+                    let mut pts = Vec::with_capacity(4 * DISC_SIDES);
+                    for k in 0..DISC_SIDES {
+                        let t = std::f64::consts::TAU * k as f64 / DISC_SIDES as f64;
+                        let e = (e1 * t.cos() + e2 * t.sin()) * r;
+                        pts.push(a0 + e);
+                        pts.push(b0 + e);
+                        if moving {
+                            pts.push(a0 + e + v);
+                            pts.push(b0 + e + v);
+                        }
+                    }
+                    match ConvexPolyhedron::from_convex_hull(&pts) {
+                        Some(hull) => hits(&hull),
+                        // A hull parry cannot build (a degenerate move): test positions
+                        // along the move with the radius grown to cover the gaps.
+                        None => sampled(self.scene, &a0, &v, part),
+                    }
+                }
+            };
+            if hit {
+                return Err(Blocker::Component(c.name.clone()));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The fallback sweep: positions every millimetre, radius grown by half a step.
+fn sampled(scene: &Scene, from: &P3, v: &V3, part: &Posed) -> bool {
+    let steps = v.norm().ceil().max(1.0) as usize;
+    let grown = Component {
+        radius: part.comp.radius + v.norm() / steps as f64 / 2.0,
+        a: 0.0,
+        b: part.comp.b - part.comp.a,
+        ..part.comp.clone()
+    };
+    (0..=steps).any(|s| {
+        let at = from + v * (s as f64 / steps as f64);
+        component_hits(scene, &at, &part.dir, &grown)
+    })
+}

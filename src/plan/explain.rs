@@ -1,0 +1,156 @@
+//! Explaining a failed plan: for a face no configuration inspects, which probe came
+//! closest, from where, and what stopped it.
+
+use super::domain::{Knowledge, Machine};
+use super::{face_points, min_points, solve, Input, PlanError};
+use crate::diag::Diagnostics;
+use crate::geometry::{FaceId, V3};
+use crate::graph::Node;
+use crate::model::fmt_num;
+
+/// The face a point lies on, in words ("the table under ..." for a table point).
+pub(super) fn face_name(input: &Input, k: &Knowledge, point: usize) -> String {
+    let f = k.points[point].face;
+    let name = &input.geometry.faces[f.0].name;
+    if point >= k.graph_points {
+        format!("the table under {name}")
+    } else {
+        name.clone()
+    }
+}
+
+/// The first feature that names a face.
+fn owner(input: &Input, face: FaceId) -> Option<crate::model::FeatureId> {
+    let g = input.graph;
+    g.nodes().find_map(|(n, node)| match node {
+        Node::Feature { feature, .. } => g
+            .children(n)
+            .iter()
+            .any(|(c, _)| matches!(g.graph[*c], Node::Face { face: f, .. } if f == face))
+            .then_some(*feature),
+        _ => None,
+    })
+}
+
+/// One diagnostic for a face no configuration inspects: which probe came closest, from
+/// where, and what stopped it.
+pub(super) fn report_face(input: &Input, k: &Knowledge, m: &Machine, face: FaceId, diags: &mut Diagnostics) {
+    let part = &input.model.parts[input.plan.part.0];
+    let feature = owner(input, face).map(|f| &part.features[f.0]);
+    let pts = face_points(input.graph, face);
+    let name = input.geometry.faces[face.0].name.clone();
+    let need = min_points(input.geometry.faces[face.0].surface.kind()).min(pts.len());
+    // Per probe: how many points it reaches, and the first blocking component.
+    let mut best: Option<(usize, usize, String, String)> = None;
+    for (p, probe) in m.probes.iter().enumerate() {
+        if !m.allowed[p] {
+            continue;
+        }
+        let reach = pts
+            .iter()
+            .filter(|&&f| k.dom[f][p].tip && !k.dom[f][p].setup.is_empty())
+            .count();
+        let tips = pts.iter().filter(|&&f| k.dom[f][p].tip).count();
+        let (depth, why) = if tips == 0 {
+            (
+                0,
+                format!(
+                    "probe {}'s Ø{} mm tip does not fit at any of its {} points",
+                    probe.name,
+                    fmt_num(2.0 * probe.tip_radius),
+                    pts.len()
+                ),
+            )
+        } else {
+            let f = pts
+                .iter()
+                .copied()
+                .find(|&f| k.dom[f][p].tip)
+                .unwrap_or(pts[0]);
+            blocking(k, m, p, f)
+        };
+        let cand = (reach, depth, why, probe.name.clone());
+        if best.as_ref().is_none_or(|b| (cand.0, cand.1) > (b.0, b.1)) {
+            best = Some(cand);
+        }
+    }
+    let (reach, _, why, probe) =
+        best.unwrap_or((0, 0, "no probe is allowed".into(), String::new()));
+    let why = if probe.is_empty() {
+        why
+    } else {
+        format!(
+            "probe {probe} reaches {reach} of its {} points (it needs {need}); {why}",
+            pts.len()
+        )
+    };
+    let help = "use a smaller tip, a longer or thinner stylus, an extension, or an indexable head; `inspc cones --face` shows the cones".to_string();
+    diags.push(
+        feature.map_or(part.span.file, |f| f.span.file),
+        PlanError::UninspectableFace {
+            span: feature.map_or(part.span, |f| f.span),
+            face: name,
+            feature: feature.map_or_else(|| part.name.clone(), |f| f.name.clone()),
+            why,
+            help,
+        },
+    );
+}
+
+/// What blocks probe `p` at point `f`: the components' cones from the tip up; the first
+/// that leaves no direction is named, with the last direction still open.
+fn blocking(k: &Knowledge, m: &Machine, p: usize, f: usize) -> (usize, String) {
+    let probe = &m.probes[p];
+    let c = k.points[f].tip_centre(probe.tip_radius);
+    let (n, pref) = (k.opts.n, &k.opts.preferred[..]);
+    let mut open = crate::access::gac_halfline(&k.scene, &c, n, pref);
+    if open.is_empty() {
+        return (
+            1,
+            "no straight line leaves the tip centre without meeting the part".into(),
+        );
+    }
+    let comps = probe.leading();
+    for (depth, comp) in comps.iter().enumerate() {
+        let cone = crate::access::gac(
+            &crate::access::Cpu,
+            &k.scene,
+            &c,
+            std::slice::from_ref(comp),
+            n,
+            pref,
+        );
+        let next = open.and(&cone);
+        if next.is_empty() {
+            let d = deepest(&open);
+            return (
+                2 + depth,
+                format!(
+                    "its {} (Ø{} mm) meets the part from every direction the parts below it leave open; closest along ({}, {}, {})",
+                    comp.name,
+                    fmt_num(2.0 * comp.radius),
+                    fmt_num((d.x * 1e3).round() / 1e3),
+                    fmt_num((d.y * 1e3).round() / 1e3),
+                    fmt_num((d.z * 1e3).round() / 1e3)
+                ),
+            );
+        }
+        open = next;
+    }
+    let d = deepest(&open);
+    (
+        2 + comps.len(),
+        format!(
+            "every component clears the part at the contact along ({}, {}, {}), but not on the way to the retract point, or the head cannot tilt that far",
+            fmt_num((d.x * 1e3).round() / 1e3),
+            fmt_num((d.y * 1e3).round() / 1e3),
+            fmt_num((d.z * 1e3).round() / 1e3)
+        ),
+    )
+}
+
+/// The direction deepest inside a cone (+z when it is empty).
+fn deepest(c: &crate::access::CubeMap) -> V3 {
+    solve::deepest(c).map_or(V3::z(), |cell| c.direction(cell))
+}
+

@@ -1,0 +1,410 @@
+//! The high-level inspection plan (HLIP): setups → probes → orientations → what each
+//! inspects, in typed ids. Names appear only when the plan is printed ([`super::text`],
+//! [`super::json`]); the path stage and the DMIS writer follow the ids.
+//!
+//! Coordinates are *quantised* to 1 / [`STEPS_PER_MM`] once, here: the plan that is
+//! printed and the plan the path stage moves by are the same numbers.
+
+use super::cluster::{min_hitting_set, Strategy};
+use super::domain::{Knowledge, Machine};
+use super::solve::{self, Branch, Inst, Kind};
+use super::Input;
+use crate::access::pose::{frame, orientation_dir, Contact, Head};
+use crate::geometry::{FaceId, P3, V3};
+use crate::model::{FeatureId, PlanId, SlotId, ToleranceId};
+use std::collections::BTreeSet;
+
+/// The resolution of the plan's coordinates and directions: steps per millimetre (or
+/// per unit of a direction's components), a nanometre.
+pub const STEPS_PER_MM: f64 = 1e6;
+
+/// A high-level inspection plan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hlip {
+    /// The plan it realises.
+    pub plan: PlanId,
+    /// The head: fixed or indexable.
+    pub head: Head,
+    /// The setups, in the order they are done.
+    pub setups: Vec<SetupNode>,
+    /// Every point the plan may touch (graph fpoints, then table points).
+    pub points: Vec<PlanPoint>,
+    /// Counts.
+    pub summary: Summary,
+}
+
+/// Which point of the knowledge base a plan point is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum PointRef {
+    /// An fpoint of the measurement graph, by index into its `fpoints`.
+    Graph(usize),
+    /// The k-th point on the table, standing in for a datum face resting on it.
+    Table(usize),
+}
+
+impl PointRef {
+    /// What the touch touches.
+    pub fn contact(self) -> Contact {
+        match self {
+            PointRef::Graph(_) => Contact::Part,
+            PointRef::Table(_) => Contact::Table,
+        }
+    }
+}
+
+/// A point of the plan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanPoint {
+    /// Which point it is.
+    pub at: PointRef,
+    /// Its face (for table points, the datum face resting on the table).
+    pub face: FaceId,
+    /// Contact position (part frame, mm).
+    pub position: P3,
+    /// Surface normal at the contact.
+    pub normal: V3,
+}
+
+/// One setup: the part resting so that `up` (part frame) points to the ram.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SetupNode {
+    /// The part-frame direction pointing up.
+    pub up: V3,
+    /// The rotation part frame → machine frame (rows).
+    pub rotation: [[f64; 3]; 3],
+    /// Datum faces resting on the table in this setup.
+    pub on_table: Vec<FaceId>,
+    /// The probes used, in order.
+    pub probes: Vec<ProbeNode>,
+}
+
+/// One probe in a setup.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProbeNode {
+    /// The probe's slot in the machine's rack.
+    pub probe: SlotId,
+    /// The orientations used, in order.
+    pub orients: Vec<OrientNode>,
+}
+
+/// One probe orientation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrientNode {
+    /// Head angle A (degrees); 0 for a fixed head.
+    pub a: f64,
+    /// Head angle B (degrees).
+    pub b: f64,
+    /// The probe direction, tip to head, in the part frame.
+    pub direction: V3,
+    /// What is inspected.
+    pub inspections: Vec<Inspection>,
+}
+
+/// Inspecting one feature in one configuration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Inspection {
+    /// The feature (`None` for faces hanging from the part itself).
+    pub feature: Option<FeatureId>,
+    /// Its faces (or the table standing in for one) and their points.
+    pub faces: Vec<FaceVisit>,
+    /// The tolerances whose measurement this records.
+    pub records: Vec<ToleranceId>,
+}
+
+/// Points taken on one face.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FaceVisit {
+    /// The face.
+    pub face: FaceId,
+    /// The face itself, or the table it rests on.
+    pub contact: Contact,
+    /// Indices into [`Hlip::points`].
+    pub points: Vec<usize>,
+}
+
+/// The plan in numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Summary {
+    /// Setups.
+    pub setups: usize,
+    /// Distinct probes.
+    pub probes_used: usize,
+    /// Probe changes in the linear plan (the first load not counted).
+    pub probe_changes: usize,
+    /// Distinct head orientations (A, B).
+    pub orientations: usize,
+    /// Orientation changes in the linear plan.
+    pub orientation_changes: usize,
+    /// Features inspected.
+    pub features: usize,
+    /// Points touched.
+    pub points: usize,
+    /// Generate-and-test rounds.
+    pub iterations: usize,
+    /// Violated binary same-constraints, per level of the plan's hierarchy.
+    pub violations: Vec<u64>,
+    /// Fpoints filtered out as inaccessible or poorly accessible.
+    pub dropped_points: usize,
+    /// Whole-probe cone computations the validation called for.
+    pub cones_acquired: usize,
+    /// The fewest setups any plan could have, and whether that is proven (else a lower
+    /// bound).
+    pub min_setups: (usize, bool),
+    /// The clustering strategy of the plan kept (`None` when nothing needed clustering).
+    pub strategy: Option<Strategy>,
+}
+
+/// How a round ended, for [`assemble`].
+pub(crate) struct Round<'a> {
+    /// The branches of the plan kept.
+    pub branches: &'a [Branch],
+    /// Generate-and-test rounds run.
+    pub iterations: usize,
+    /// Fpoints filtered out.
+    pub dropped: usize,
+    /// The clustering strategy that made the branches.
+    pub strategy: Option<Strategy>,
+    /// Search nodes for the exact minimum number of setups.
+    pub exact_budget: usize,
+}
+
+/// (probe, [(orientation, instance trees)]) of one setup.
+type Probes<'a> = Vec<(usize, Vec<(usize, Vec<&'a Inst>)>)>;
+
+/// Assembles the HLIP tree from the branches of the plan kept.
+pub(crate) fn assemble(input: &Input, k: &Knowledge, m: &Machine, run: &Round) -> Hlip {
+    let setups = group(run.branches);
+    let mut used_points: BTreeSet<usize> = BTreeSet::new();
+    let mut features: BTreeSet<Option<FeatureId>> = BTreeSet::new();
+    let mut seq: Vec<(usize, (u64, u64))> = Vec::new();
+    let mut out_setups = Vec::new();
+    for (_, up, probes) in &setups {
+        let mut on_table = Vec::new();
+        let mut pnodes = Vec::new();
+        for (p, orients) in probes {
+            let mut onodes = Vec::new();
+            for (o, trees) in orients {
+                let (a, b) = m.grid[*o];
+                let dir = match m.head {
+                    Head::Indexable => orientation_dir(up, a, b),
+                    Head::Fixed => *up,
+                };
+                seq.push((*p, (a.to_bits(), b.to_bits())));
+                let mut insp: Vec<Inspection> = Vec::new();
+                for t in trees {
+                    collect(t, None, None, &mut |tol, feat, face, contact, pts| {
+                        features.insert(feat);
+                        used_points.extend(pts.iter().copied());
+                        if contact == Contact::Table && !on_table.contains(&face) {
+                            on_table.push(face);
+                        }
+                        let i = match insp.iter().position(|x| x.feature == feat) {
+                            Some(i) => i,
+                            None => {
+                                insp.push(Inspection {
+                                    feature: feat,
+                                    faces: vec![],
+                                    records: vec![],
+                                });
+                                insp.len() - 1
+                            }
+                        };
+                        let x = &mut insp[i];
+                        match x
+                            .faces
+                            .iter_mut()
+                            .find(|v| v.face == face && v.contact == contact)
+                        {
+                            Some(v) => {
+                                v.points.extend(pts.iter().copied());
+                                v.points.sort_unstable();
+                                v.points.dedup();
+                            }
+                            None => x.faces.push(FaceVisit {
+                                face,
+                                contact,
+                                points: pts.to_vec(),
+                            }),
+                        }
+                        if let Some(t) = tol {
+                            if !x.records.contains(&t) {
+                                x.records.push(t);
+                            }
+                        }
+                    });
+                }
+                onodes.push(OrientNode {
+                    a,
+                    b,
+                    direction: quantise(&dir),
+                    inspections: insp,
+                });
+            }
+            pnodes.push(ProbeNode {
+                probe: SlotId(*p),
+                orients: onodes,
+            });
+        }
+        let r = frame(up).into_inner();
+        out_setups.push(SetupNode {
+            up: quantise(up),
+            rotation: [0, 1, 2].map(|i| [0, 1, 2].map(|j| round(r[(i, j)]))),
+            on_table,
+            probes: pnodes,
+        });
+    }
+    let probe_changes = seq.windows(2).filter(|w| w[0].0 != w[1].0).count();
+    let orientation_changes = match m.head {
+        Head::Indexable => seq.windows(2).filter(|w| w[0].1 != w[1].1).count(),
+        Head::Fixed => 0,
+    };
+    let orientations: BTreeSet<(u64, u64)> = seq.iter().map(|s| s.1).collect();
+    let probes_used: BTreeSet<usize> = seq.iter().map(|s| s.0).collect();
+    let hierarchy = &input.model.hierarchies[input.plan.hierarchy.0];
+    let violations = solve::violations(run.branches, m, hierarchy);
+    let min_setups = min_setups(k, m, &used_points, run.exact_budget);
+    let points = k
+        .points
+        .iter()
+        .enumerate()
+        .map(|(i, f)| PlanPoint {
+            at: if i < k.graph_points {
+                PointRef::Graph(i)
+            } else {
+                PointRef::Table(i - k.graph_points)
+            },
+            face: f.face,
+            position: P3::from(quantise(&f.position.coords)),
+            normal: quantise(&f.normal),
+        })
+        .collect();
+    Hlip {
+        plan: input.plan_id(),
+        head: m.head,
+        summary: Summary {
+            setups: out_setups.len(),
+            probes_used: probes_used.len(),
+            probe_changes,
+            orientations: orientations.len(),
+            orientation_changes,
+            features: features.len(),
+            points: used_points.len(),
+            iterations: run.iterations,
+            violations,
+            dropped_points: run.dropped,
+            cones_acquired: k.acquired,
+            min_setups,
+            strategy: run.strategy,
+        },
+        setups: out_setups,
+        points,
+    }
+}
+
+/// Groups branches by setup (first appearance), then probe, then orientation; each setup
+/// starts with the probe the last one ended with.
+fn group(branches: &[Branch]) -> Vec<(usize, V3, Probes<'_>)> {
+    let mut setups: Vec<(usize, V3, Probes)> = Vec::new();
+    for b in branches {
+        let si = match setups.iter().position(|s| s.0 == b.setup) {
+            Some(i) => i,
+            None => {
+                setups.push((b.setup, b.up, vec![]));
+                setups.len() - 1
+            }
+        };
+        let probes = &mut setups[si].2;
+        let pi = match probes.iter().position(|p| p.0 == b.probe) {
+            Some(i) => i,
+            None => {
+                probes.push((b.probe, vec![]));
+                probes.len() - 1
+            }
+        };
+        let orients = &mut probes[pi].1;
+        match orients.iter_mut().find(|o| o.0 == b.orient) {
+            Some(o) => o.1.push(&b.tree),
+            None => orients.push((b.orient, vec![&b.tree])),
+        }
+    }
+    let mut last_probe: Option<usize> = None;
+    for s in setups.iter_mut() {
+        if let Some(lp) = last_probe {
+            if let Some(i) = s.2.iter().position(|p| p.0 == lp) {
+                let p = s.2.remove(i);
+                s.2.insert(0, p);
+            }
+        }
+        last_probe = s.2.last().map(|p| p.0);
+    }
+    setups
+}
+
+/// The fewest setups any plan of the used points could have: a hitting set of the
+/// points' setup sets.
+fn min_setups(
+    k: &Knowledge,
+    m: &Machine,
+    used_points: &BTreeSet<usize>,
+    budget: usize,
+) -> (usize, bool) {
+    let mut sets: Vec<crate::access::CubeMap> = Vec::new();
+    for (i, f) in k.points[..k.graph_points].iter().enumerate() {
+        if !used_points.contains(&i) {
+            continue;
+        }
+        let mut s = k.setups(i, m);
+        if let Some(t) = k.tables.iter().find(|t| t.face == f.face && t.alive) {
+            let c = s.cell(t.cell);
+            s.set(c, true);
+        }
+        if !s.is_empty() && !sets.contains(&s) {
+            sets.push(s);
+        }
+    }
+    let refs: Vec<&crate::access::CubeMap> = sets.iter().collect();
+    min_hitting_set(&refs, budget)
+}
+
+/// A face visit: (tolerance, feature, face, contact, points).
+type Visit<'a> =
+    dyn FnMut(Option<ToleranceId>, Option<FeatureId>, FaceId, Contact, &[usize]) + 'a;
+
+/// Walks an instance tree, calling `f(tolerance, feature, face, contact, points)` for
+/// every face or table visit.
+fn collect(i: &Inst, tol: Option<ToleranceId>, feat: Option<FeatureId>, f: &mut Visit) {
+    match &i.kind {
+        Kind::Tol(t) => i
+            .children
+            .iter()
+            .for_each(|c| collect(c, Some(ToleranceId(*t)), feat, f)),
+        Kind::Feature(x) => i.children.iter().for_each(|c| collect(c, tol, Some(*x), f)),
+        Kind::Face { face, .. } | Kind::Table { face } => {
+            let mut pts = Vec::new();
+            solve::leaves(i, &mut pts);
+            pts.sort_unstable();
+            pts.dedup();
+            let contact = match i.kind {
+                Kind::Table { .. } => Contact::Table,
+                _ => Contact::Part,
+            };
+            f(tol, feat, *face, contact, &pts);
+        }
+        _ => i.children.iter().for_each(|c| collect(c, tol, feat, f)),
+    }
+}
+
+/// A number at the plan's resolution, without `-0`.
+fn round(x: f64) -> f64 {
+    let r = (x * STEPS_PER_MM).round() / STEPS_PER_MM;
+    if r == 0.0 {
+        0.0
+    } else {
+        r
+    }
+}
+
+/// A vector at the plan's resolution.
+fn quantise(v: &V3) -> V3 {
+    V3::new(round(v.x), round(v.y), round(v.z))
+}
