@@ -91,7 +91,7 @@ fn geometry_of(world: &dyn source::World, checked: &mut Checked) -> Vec<Option<P
         if !planned && !checked.roots.contains(&part.span.file) {
             continue;
         }
-        let Some(geometry) = geometry::build(part, world, part.span.file, &mut diags) else {
+        let Some(geometry) = geometry::build(part, world, &mut diags) else {
             continue;
         };
         let feature_faces: Vec<Vec<geometry::FaceId>> = part
@@ -100,7 +100,7 @@ fn geometry_of(world: &dyn source::World, checked: &mut Checked) -> Vec<Option<P
             .map(|f| {
                 let mut faces: Vec<geometry::FaceId> = Vec::new();
                 for r in &f.faces {
-                    for id in geometry::resolve_faces(&geometry, r, part.span.file, &mut diags) {
+                    for id in geometry::resolve_faces(&geometry, r, &mut diags) {
                         if !faces.contains(&id) {
                             faces.push(id);
                         }
@@ -109,7 +109,7 @@ fn geometry_of(world: &dyn source::World, checked: &mut Checked) -> Vec<Option<P
                 faces
             })
             .collect();
-        graph::check_surfaces(part, &geometry, &feature_faces, part.span.file, &mut diags);
+        graph::check_surfaces(part, &geometry, &feature_faces, &mut diags);
         out[k] = Some(PartData {
             geometry,
             feature_faces,
@@ -239,9 +239,7 @@ fn plans_of(
     for g in graphs {
         let Some(name) = &g.graph.plan else {
             let part = &model.parts[g.part];
-            diags.push(
-                part.span.file,
-                plan::PlanError::NoPlan {
+            diags.push(plan::PlanError::NoPlan {
                     span: part.span,
                     part: part.name.clone(),
                 },

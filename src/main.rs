@@ -457,7 +457,9 @@ fn read_dmis(file: &std::path::Path) -> ExitCode {
             return ExitCode::from(1);
         }
     };
-    match inspc::dmis::read(&file.display().to_string(), &text) {
+    let mut sources = inspc::source::SourceMap::new();
+    let id = sources.add(file.display().to_string(), Some(file.to_path_buf()), text);
+    match inspc::dmis::read(id, &sources.get(id).text) {
         Ok(p) => {
             let count = |m: &str| p.commands(m).count();
             println!(
@@ -474,15 +476,13 @@ fn read_dmis(file: &std::path::Path) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(errors) => {
-            let handler = miette::GraphicalReportHandler::new_themed(
-                miette::GraphicalTheme::unicode_nocolor(),
-            );
-            for e in &errors {
-                let mut out = String::new();
-                let _ = handler.render_report(&mut out, e);
-                eprint!("{out}");
+            let n = errors.len();
+            let mut diags = inspc::diag::Diagnostics::new();
+            for e in errors {
+                diags.push(e);
             }
-            eprintln!("inspc: {} problems in {}", errors.len(), file.display());
+            print_diagnostics(&sources, &diags.sorted());
+            eprintln!("inspc: {n} problems in {}", file.display());
             ExitCode::from(1)
         }
     }
@@ -547,7 +547,7 @@ fn faces(file: &std::path::Path, segment: bool, units: &str, format: TableFormat
             .iter()
             .filter(|p| checked.roots.contains(&p.span.file))
         {
-            if let Some(g) = geometry::build(part, &FsWorld, part.span.file, &mut diags) {
+            if let Some(g) = geometry::build(part, &FsWorld, &mut diags) {
                 listed.push((part.name.clone(), g));
             }
         }
@@ -572,7 +572,7 @@ fn faces(file: &std::path::Path, segment: bool, units: &str, format: TableFormat
                 );
                 let span = inspc::source::Span::new(id, 0, file.to_string_lossy().len());
                 let mut diags = inspc::diag::Diagnostics::new();
-                diags.push(id, e.at(span, file));
+                diags.push(e.at(span, file));
                 print_diagnostics(&sources, &diags.sorted());
                 return ExitCode::from(1);
             }

@@ -301,7 +301,7 @@ fn failed_builds_write_no_program() {
 fn programs_read_back() {
     let mut n = 0;
     for (c, _, b) in built() {
-        let program = inspc::dmis::read("program.dmi", &b.dmis).unwrap_or_else(|errors| {
+        let program = inspc::dmis::read(inspc::source::FileId(0), &b.dmis).unwrap_or_else(|errors| {
             panic!(
                 "{}: the reader rejects the program: {:?}",
                 c.name,

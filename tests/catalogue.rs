@@ -173,7 +173,7 @@ fn every_catalogue_example_reports_its_code() {
                 diags.iter().map(|d| &d.code).collect::<Vec<_>>()
             ));
         }
-        for d in &diags {
+        for d in diags.iter() {
             assert!(!d.help.is_empty(), "{} has no help line", d.code);
             assert!(
                 !d.span_text.is_empty()

@@ -463,3 +463,25 @@ fn the_dmis_reader_reports_what_a_controller_rejects() {
     }
     assert!(stderr.contains("help:"), "{stderr}");
 }
+
+/// A diagnostic about a machine declared in the stdlib is filed under the stdlib's file
+/// and shows its source, not a failed read of the user's file.
+#[test]
+fn cones_with_a_stdlib_machine_point_into_the_stdlib() {
+    let spec = temp_spec(
+        "cones_std_machine.insp",
+        "use std::cmms::bridge_fixed\n\npart p {\n    units mm\n    stock box(10, 10, 10)\n    feature top = stock.top\n}\n\nplan q { part p, cmm bridge_fixed }\n",
+    );
+    let (status, _, stderr) = inspc(&[
+        "cones",
+        &spec,
+        "--probe",
+        "zz",
+        "-o",
+        "/nonexistent-dir/x.pgm",
+    ]);
+    assert_eq!(status, 1, "{stderr}");
+    assert!(stderr.contains("insp::access::unknown_probe"), "{stderr}");
+    assert!(stderr.contains("cmm bridge_fixed"), "{stderr}");
+    assert!(!stderr.contains("Failed to read"), "{stderr}");
+}

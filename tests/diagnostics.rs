@@ -2,13 +2,15 @@
 
 mod common;
 
-use common::{check_files, check_src, Flat};
+use common::{check_files, check_src, Diags, Flat};
 
 /// Asserts that a diagnostic with `code` labels exactly `span` and its message contains
-/// `message`.
+/// `message`, and marks it expected: a test that expects any diagnostic must expect
+/// them all (see `common::Diags`).
 #[track_caller]
-fn expect(diags: &[Flat], code: &str, span: &str, message: &str) {
-    let found = diags.iter().find(|d| d.code == code && d.span_text == span);
+fn expect(diags: &Diags, code: &str, span: &str, message: &str) {
+    let found = diags.saw(|d| d.code == code && d.span_text == span && d.message.contains(message));
+    let found = found.or_else(|| diags.saw(|d| d.code == code && d.span_text == span));
     let Some(d) = found else {
         panic!("no `{code}` on `{span}`; got:\n{}", render(diags));
     };
@@ -45,28 +47,28 @@ fn part(body: &str) -> String {
 fn syntax_errors_name_expectations_in_words() {
     let d = check_src("part p {\n    units mm\n    stock box(1, 2, 3\n}\n");
     assert_eq!(d.len(), 1, "{}", render(&d));
-    assert_eq!(d[0].code, "insp::syntax::unexpected");
+    assert_eq!(d.only().code, "insp::syntax::unexpected");
     // Never a raw pest rule name.
     for raw in ["_stmt", "_item", "quantity", "Rule", "EOI", "ident"] {
         assert!(
-            !d[0].message.contains(raw),
+            !d.only().message.contains(raw),
             "raw rule name in {:?}",
-            d[0].message
+            d.only().message
         );
     }
-    assert!(d[0].message.contains("expected"), "{}", d[0].message);
+    assert!(d.only().message.contains("expected"), "{}", d.only().message);
 }
 
 #[test]
 fn syntax_error_at_end_of_file_says_so() {
     let d = check_src("part p {\n    units mm\n");
-    assert_eq!(d[0].code, "insp::syntax::unexpected");
+    assert_eq!(d.only().code, "insp::syntax::unexpected");
     assert!(
-        d[0].message.ends_with("found end of file"),
+        d.only().message.ends_with("found end of file"),
         "{}",
-        d[0].message
+        d.only().message
     );
-    assert!(d[0].help.contains('}'), "{}", d[0].help);
+    assert!(d.only().help.contains('}'), "{}", d.only().help);
 }
 
 #[test]
@@ -97,8 +99,8 @@ fn syntax_error_names_missing_literal_tokens() {
 #[test]
 fn unknown_item_keyword() {
     let d = check_src("probee p { }\n");
-    assert_eq!(d[0].code, "insp::syntax::unexpected");
-    assert!(d[0].message.contains("an item"), "{}", d[0].message);
+    assert_eq!(d.only().code, "insp::syntax::unexpected");
+    assert!(d.only().message.contains("an item"), "{}", d.only().message);
 }
 
 #[test]
@@ -125,7 +127,7 @@ fn deep_nesting_is_an_error_not_a_crash() {
         ")".repeat(5000)
     );
     let d = check_src(&src);
-    assert_eq!(d[0].code, "insp::syntax::too_deep");
+    assert_eq!(d.only().code, "insp::syntax::too_deep");
 }
 
 // ---- loading --------------------------------------------------------------------------

@@ -50,3 +50,11 @@ pub enum AccessError {
         part: String,
     },
 }
+
+crate::located!(AccessError {
+    UnknownFace,
+    NoPoint,
+    UnknownProbe,
+    NoMachine,
+});
+

@@ -43,15 +43,12 @@ pub fn cone_report(
     let gr = graphs.first()?;
     let part = &model.parts[gr.part];
     let g = &parts[gr.part].as_ref()?.geometry;
-    let file = part.span.file;
     let chosen: Vec<&Fpoint> = match &req.face {
         Some(name) => {
             let Some(face) = g.faces.iter().position(|f| &f.name == name) else {
                 let mut known: Vec<&str> = g.faces.iter().map(|f| f.name.as_str()).collect();
                 known.truncate(12);
-                diags.push(
-                    file,
-                    AccessError::UnknownFace {
+                diags.push(AccessError::UnknownFace {
                         span: part.span,
                         face: name.clone(),
                         part: part.name.clone(),
@@ -69,9 +66,7 @@ pub fn cone_report(
         None => gr.graph.fpoints.iter().collect(),
     };
     let Some(f) = chosen.get(req.point) else {
-        diags.push(
-            file,
-            AccessError::NoPoint {
+        diags.push(AccessError::NoPoint {
                 span: part.span,
                 face: req.face.clone().unwrap_or_else(|| "the part".into()),
                 index: req.point,
@@ -94,9 +89,7 @@ pub fn cone_report(
                 None => shapes.into_iter().next(),
             };
             if found.is_none() {
-                diags.push(
-                    plan.span.file,
-                    AccessError::UnknownProbe {
+                diags.push(AccessError::UnknownProbe {
                         span: cmm.span,
                         probe: req.probe.clone().unwrap_or_default(),
                         cmm: cmm.name.clone(),
@@ -113,9 +106,7 @@ pub fn cone_report(
             found
         }
         None if req.probe.is_some() => {
-            diags.push(
-                file,
-                AccessError::NoMachine {
+            diags.push(AccessError::NoMachine {
                     span: part.span,
                     part: part.name.clone(),
                 },

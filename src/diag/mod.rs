@@ -5,16 +5,45 @@
 //! line. Errors are plain data; this module renders them, either as miette's graphical
 //! report (for people) or as one JSON object per line (for editors).
 //!
-//! **Architecture Invariant:** a diagnostic's labels all lie in the file it is filed
-//! under; a related place in another file is named in the message or help instead.
+//! **Architecture Invariant:** a diagnostic is filed under the file of its primary span,
+//! by construction: [`Diagnostics::push`] takes no file, it asks the error ([`Located`]).
+//! Its other labels lie in that file too; a related place in another file is named in
+//! the message or help instead.
 
 mod render;
 pub mod suggest;
 
 pub use render::{render_human, to_json, RenderOptions};
 
-use crate::source::FileId;
+use crate::source::{FileId, Span};
 use miette::Severity;
+
+/// Where a diagnostic belongs: the file of its primary span.
+pub trait Located {
+    /// The file its primary label points into.
+    fn file(&self) -> FileId;
+}
+
+/// Implements [`Located`] for an error enum whose every variant has a primary
+/// `span: Span` field: `located!(PlanError { UninspectableFace, NoConvergence, NoPlan })`.
+/// A variant added without a `span` does not compile, nor does one left out of the list.
+#[macro_export]
+macro_rules! located {
+    ($ty:ty { $($variant:ident),* $(,)? }) => {
+        impl $crate::diag::Located for $ty {
+            fn file(&self) -> $crate::source::FileId {
+                match self {
+                    $(Self::$variant { span, .. } => $crate::diag::primary_file(span),)*
+                }
+            }
+        }
+    };
+}
+
+/// The file of a primary span (for [`located!`]).
+pub fn primary_file(span: &Span) -> FileId {
+    span.file
+}
 
 /// One diagnostic, filed under the file its labels point into.
 pub struct Diagnostic {
@@ -74,10 +103,10 @@ impl Diagnostics {
         Self::default()
     }
 
-    /// Files a diagnostic under `file`.
-    pub fn push(&mut self, file: FileId, err: impl miette::Diagnostic + Send + Sync + 'static) {
+    /// Files a diagnostic under the file of its primary span.
+    pub fn push(&mut self, err: impl miette::Diagnostic + Located + Send + Sync + 'static) {
         self.items.push(Diagnostic {
-            file,
+            file: err.file(),
             inner: Box::new(err),
         });
     }

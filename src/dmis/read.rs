@@ -4,7 +4,8 @@
 //! announce and nothing but moves inside, `DMISMN` first and `ENDFIL` last.
 
 use super::text::{is_label, split_params, LINE_MAX};
-use miette::{Diagnostic, NamedSource, SourceSpan};
+use crate::source::{FileId, Span};
+use miette::Diagnostic;
 use std::collections::{BTreeMap, BTreeSet};
 use thiserror::Error;
 
@@ -91,10 +92,8 @@ pub enum DmisError {
         help("break the statement after a comma and end the line with `$`")
     )]
     LongLine {
-        #[source_code]
-        src: NamedSource<String>,
         #[label("this line")]
-        span: SourceSpan,
+        span: Span,
         line: usize,
         len: usize,
     },
@@ -104,10 +103,8 @@ pub enum DmisError {
         help("statements read `[KIND(label)=]MAJOR/param,param,…`, comments start with `$$`")
     )]
     Syntax {
-        #[source_code]
-        src: NamedSource<String>,
         #[label("here")]
-        span: SourceSpan,
+        span: Span,
         text: String,
     },
     #[error("`{label}` is not a legal label")]
@@ -116,10 +113,8 @@ pub enum DmisError {
         help("labels are 1 to 16 characters: an upper-case letter, then letters, digits or `_`")
     )]
     BadLabel {
-        #[source_code]
-        src: NamedSource<String>,
         #[label("this label")]
-        span: SourceSpan,
+        span: Span,
         label: String,
     },
     #[error("{kind}({label}) is defined twice")]
@@ -128,10 +123,8 @@ pub enum DmisError {
         help("every feature, sensor and tolerance needs a label of its own")
     )]
     Duplicate {
-        #[source_code]
-        src: NamedSource<String>,
         #[label("defined again here")]
-        span: SourceSpan,
+        span: Span,
         kind: String,
         label: String,
     },
@@ -141,31 +134,37 @@ pub enum DmisError {
         help("define it with `{kind}({label})=…` before this statement")
     )]
     Undefined {
-        #[source_code]
-        src: NamedSource<String>,
         #[label("used here")]
-        span: SourceSpan,
+        span: Span,
         kind: String,
         label: String,
     },
     #[error("{what}")]
     #[diagnostic(code(insp::dmis::structure), help("{help}"))]
     Structure {
-        #[source_code]
-        src: NamedSource<String>,
         #[label("here")]
-        span: SourceSpan,
+        span: Span,
         what: String,
         help: String,
     },
 }
 
+crate::located!(DmisError {
+    LongLine,
+    Syntax,
+    BadLabel,
+    Duplicate,
+    Undefined,
+    Structure,
+});
+
+
 /// Statements that may appear between `MEAS` and `ENDMES`.
 const IN_MEAS: &[&str] = &["GOTO", "PTMEAS"];
 
-/// Parses and checks a program; every problem found, in text order.
-pub fn read(name: &str, text: &str) -> Result<Program, Vec<DmisError>> {
-    let src = || NamedSource::new(name, text.to_string());
+/// Parses and checks a program (the text of `file`); every problem found, in text order.
+pub fn read(file: FileId, text: &str) -> Result<Program, Vec<DmisError>> {
+    let at_len = |start: usize, len: usize| Span::new(file, start, start + len);
     let mut errors = Vec::new();
     let mut statements = Vec::new();
     // Physical lines → logical statements.
@@ -177,8 +176,7 @@ pub fn read(name: &str, text: &str) -> Result<Program, Vec<DmisError>> {
         let line = line.trim_end_matches('\n').trim_end_matches('\r');
         if line.chars().count() > LINE_MAX {
             errors.push(DmisError::LongLine {
-                src: src(),
-                span: (at, line.len()).into(),
+                span: at_len(at, line.len()),
                 line: k + 1,
                 len: line.chars().count(),
             });
@@ -204,20 +202,18 @@ pub fn read(name: &str, text: &str) -> Result<Program, Vec<DmisError>> {
         match parse(&acc, start) {
             Some(s) => statements.push(s),
             None => errors.push(DmisError::Syntax {
-                src: src(),
-                span: (start, acc.len().min(text.len() - start)).into(),
+                span: at_len(start, acc.len().min(text.len() - start)),
                 text: acc.chars().take(40).collect(),
             }),
         }
     }
     if let Some((start, acc)) = pending {
         errors.push(DmisError::Syntax {
-            src: src(),
-            span: (start, 0).into(),
+            span: at_len(start, 0),
             text: acc.chars().take(40).collect(),
         });
     }
-    check(&statements, text, &src, &mut errors);
+    check(&statements, text, file, &mut errors);
     if errors.is_empty() {
         Ok(Program { statements })
     } else {
@@ -268,12 +264,12 @@ type Cmd<'a> = (&'a Option<(String, String)>, &'a str, &'a [String], usize);
 fn check(
     statements: &[Statement],
     text: &str,
-    src: &dyn Fn() -> NamedSource<String>,
+    file: FileId,
     errors: &mut Vec<DmisError>,
 ) {
-    let span = |at: usize| -> SourceSpan {
+    let span = |at: usize| -> Span {
         let end = text[at..].find('\n').map_or(text.len(), |e| at + e);
-        (at, end - at).into()
+        Span::new(file, at, end)
     };
     let commands: Vec<Cmd> = statements
         .iter()
@@ -288,7 +284,6 @@ fn check(
         })
         .collect();
     let structure = |at: usize, what: &str, help: &str| DmisError::Structure {
-        src: src(),
         span: span(at),
         what: what.into(),
         help: help.into(),
@@ -321,8 +316,7 @@ fn check(
         let Some((kind, l)) = label else { continue };
         if !is_label(l) {
             errors.push(DmisError::BadLabel {
-                src: src(),
-                span: span(*at),
+                        span: span(*at),
                 label: l.clone(),
             });
         }
@@ -330,8 +324,7 @@ fn check(
         let key = (kind.clone(), l.clone());
         if defined.contains_key(&key) && *major != "DATDEF" {
             errors.push(DmisError::Duplicate {
-                src: src(),
-                span: span(*at),
+                        span: span(*at),
                 kind: kind.clone(),
                 label: l.clone(),
             });
@@ -355,8 +348,7 @@ fn check(
             let ok = ok && (kind != "F" || defined.contains_key(&("F".to_string(), l.clone())));
             if !ok {
                 errors.push(DmisError::Undefined {
-                    src: src(),
-                    span: span(*at),
+                                span: span(*at),
                     kind: k.clone(),
                     label: l,
                 });
@@ -435,7 +427,7 @@ mod tests {
     use super::*;
 
     fn codes(text: &str) -> Vec<String> {
-        match read("t.dmi", text) {
+        match read(FileId(0), text) {
             Ok(_) => vec![],
             Err(es) => es
                 .iter()
@@ -447,7 +439,7 @@ mod tests {
     #[test]
     fn a_clean_program_reads_and_prints_back() {
         let text = "$$ a comment\nDMISMN/'X',05.3\nF(P)=FEAT/PLANE,CART,0,0,0,0,0,1\nS(S1)=SNSDEF/PROBE,FIXED,CART,0,0,-50,0,0,1,2\nSNSLCT/S(S1)\nMEAS/PLANE,F(P),1\nGOTO/0,0,3\nPTMEAS/CART,0,0,0,0,0,1\nENDMES\nT(T1)=TOL/FLAT,0.1\nOUTPUT/FA(P),TA(T1)\nENDFIL\n";
-        let p = read("t.dmi", text).unwrap();
+        let p = read(FileId(0), text).unwrap();
         assert_eq!(p.to_text(), text);
         assert_eq!(p.commands("PTMEAS").count(), 1);
     }

@@ -8,8 +8,7 @@ use super::primitives::{
 };
 use super::{PartGeometry, Surface, P3, V3};
 use crate::diag::Diagnostics;
-use crate::model::{self, Depth, FaceSource, OpId, OpKind, Pattern, Placement, Stock};
-use crate::source::FileId;
+use crate::model::{self, Depth, FaceSource, OpId, OpKind, Pattern, Placement, Role, Stock};
 use boolmesh::prelude::{compute_boolean, Manifold, OpType};
 use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion};
 
@@ -19,7 +18,7 @@ pub(crate) struct Spec {
     pub name: String,
     pub surface: Surface,
     pub source: FaceSource,
-    pub roles: Vec<&'static str>,
+    pub roles: Vec<Role>,
     lo: P3,
     hi: P3,
 }
@@ -35,11 +34,10 @@ struct Tool {
 pub(super) fn build(
     part: &model::Part,
     stock: &Stock,
-    file: FileId,
     diags: &mut Diagnostics,
 ) -> Option<PartGeometry> {
     let mut specs: Vec<Spec> = Vec::new();
-    let (stock_prim, stock_roles): (Prim, Vec<&'static str>) = match stock {
+    let (stock_prim, stock_roles): (Prim, Vec<Role>) = match stock {
         Stock::Box { size } => {
             let f = Frame {
                 o: P3::origin(),
@@ -49,7 +47,7 @@ pub(super) fn build(
             };
             (
                 prism(&f, &rectangle(0.0, 0.0, size[0], size[1]), 0.0, size[2]),
-                vec!["front", "right", "back", "left", "bottom", "top"],
+                vec![Role::Front, Role::Right, Role::Back, Role::Left, Role::Bottom, Role::Top],
             )
         }
         Stock::Cylinder { diameter, height } => {
@@ -61,10 +59,10 @@ pub(super) fn build(
             };
             (
                 prism(&f, &circle(diameter / 2.0), 0.0, *height),
-                vec!["side", "bottom", "top"],
+                vec![Role::Side, Role::Bottom, Role::Top],
             )
         }
-        Stock::Sphere { diameter } => (sphere(P3::origin(), diameter / 2.0), vec!["surface"]),
+        Stock::Sphere { diameter } => (sphere(P3::origin(), diameter / 2.0), vec![Role::Surface]),
     };
     let (slo, shi) = stock_prim.bounds();
     let diag = (shi - slo).norm();
@@ -77,7 +75,7 @@ pub(super) fn build(
             name: format!("stock.{role}"),
             surface: stock_prim.surfaces[k].clone(),
             source: FaceSource::Stock,
-            roles: vec![role],
+            roles: vec![*role],
             lo: lo - V3::repeat(grow),
             hi: hi + V3::repeat(grow),
         });
@@ -104,9 +102,7 @@ pub(super) fn build(
             if (0..3).any(|k| hi[k] < slo[k] || lo[k] > shi[k]) {
                 let what = op.kind.word();
                 let name = inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name));
-                diags.push(
-                    file,
-                    E::MissesPart {
+                diags.push(E::MissesPart {
                         span: op.span,
                         what: what.into(),
                         name,
@@ -169,9 +165,7 @@ pub(super) fn build(
             Ok(m) => current = m,
             Err(reason) => {
                 let op = &part.ops[tools[i].op];
-                diags.push(
-                    file,
-                    E::BooleanFailed {
+                diags.push(E::BooleanFailed {
                         span: op.span,
                         part: part.name.clone(),
                         reason,
@@ -370,7 +364,7 @@ fn cutter(
     center: P3,
     ext: f64,
     big: f64,
-) -> Option<(Prim, Vec<Vec<&'static str>>)> {
+) -> Option<(Prim, Vec<Vec<Role>>)> {
     Some(match &op.kind {
         OpKind::Hole {
             at,
@@ -385,11 +379,11 @@ fn cutter(
             let f = Frame::along(entry, v3(axis));
             let (z1, bottom) = match depth {
                 Depth::Through => (big, vec![]),
-                Depth::Blind(d) => (*d, vec!["bottom"]),
+                Depth::Blind(d) => (*d, vec![Role::Bottom]),
             };
             (
                 prism(&f, &circle(diameter / 2.0), -ext, z1),
-                vec![vec!["wall"], vec![], bottom],
+                vec![vec![Role::Wall], vec![], bottom],
             )
         }
         OpKind::Slot {
@@ -402,19 +396,19 @@ fn cutter(
         } => {
             let f = Frame::from_uw(P3::new(at[0], at[1], at[2]), v3(along), v3(into));
             let (x0, x1, ends) = match length {
-                Some(l) => (0.0, *l, vec!["ends"]),
+                Some(l) => (0.0, *l, vec![Role::Ends]),
                 None => (-big, big, vec![]),
             };
             let prof = rectangle(x0, -width / 2.0, x1, width / 2.0);
             (
                 prism(&f, &prof, -ext, *depth),
                 vec![
-                    vec!["left_wall", "walls"],
+                    vec![Role::LeftWall, Role::Walls],
                     ends.clone(),
-                    vec!["right_wall", "walls"],
+                    vec![Role::RightWall, Role::Walls],
                     ends,
                     vec![],
-                    vec!["floor"],
+                    vec![Role::Floor],
                 ],
             )
         }
@@ -428,9 +422,9 @@ fn cutter(
         } => {
             let f = Frame::from_uw(P3::new(at[0], at[1], at[2]), v3(along), v3(into));
             let prof = rounded_rectangle(size[0], size[1], *corner_radius);
-            let mut roles = vec![vec!["walls"]; prof.len()];
+            let mut roles = vec![vec![Role::Walls]; prof.len()];
             roles.push(vec![]);
-            roles.push(vec!["floor"]);
+            roles.push(vec![Role::Floor]);
             (prism(&f, &prof, -ext, *depth), roles)
         }
         OpKind::Step {
@@ -448,7 +442,7 @@ fn cutter(
             let prof = rectangle(-big, -big, big, *width);
             (
                 prism(&f, &prof, -ext, *depth),
-                vec![vec![], vec![], vec!["wall"], vec![], vec![], vec!["floor"]],
+                vec![vec![], vec![], vec![Role::Wall], vec![], vec![], vec![Role::Floor]],
             )
         }
         OpKind::Boss {
@@ -460,7 +454,7 @@ fn cutter(
             let f = Frame::along(P3::new(at[0], at[1], at[2]), v3(axis));
             (
                 prism(&f, &circle(diameter / 2.0), -ext, *height),
-                vec![vec!["wall"], vec![], vec!["top"]],
+                vec![vec![Role::Wall], vec![], vec![Role::Top]],
             )
         }
     })

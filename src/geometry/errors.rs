@@ -110,6 +110,21 @@ pub enum GeometryError {
     },
 }
 
+crate::located!(GeometryError {
+    MeshUnreadable,
+    MeshCorrupt,
+    MeshNotClosed,
+    MeshDefects,
+    MeshTooLarge,
+    BooleanFailed,
+    MissesPart,
+    FaceGone,
+    UnknownGroup,
+    UnknownSegment,
+    NoMatch,
+});
+
+
 /// A mesh-reading failure, located later at the spec's path.
 #[derive(Debug, Clone)]
 pub enum MeshError {

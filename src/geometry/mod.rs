@@ -30,7 +30,7 @@ pub use select::resolve_faces;
 
 use crate::diag::Diagnostics;
 use crate::model::{self, Geometry as Source};
-use crate::source::{FileId, World};
+use crate::source::World;
 use nalgebra::{Point3, Vector3};
 
 /// A point in the part frame (mm).
@@ -197,7 +197,7 @@ pub struct PartGeometry {
     pub faces: Vec<Face>,
     /// For constructive parts, per face: whose face it is and the roles it answers to
     /// (`walls`, `left_wall`, …); empty for mesh parts.
-    pub roles: Vec<(model::FaceSource, Vec<&'static str>)>,
+    pub roles: Vec<(model::FaceSource, Vec<model::Role>)>,
 }
 
 impl PartGeometry {
@@ -254,18 +254,15 @@ impl PartGeometry {
     }
 }
 
-/// Evaluates a part's geometry. The entry point of the geometry stage.
-///
-/// `file` is the spec file the part is declared in: diagnostics point at the part's
-/// declaration (or the mesh path) there.
+/// Evaluates a part's geometry. The entry point of the geometry stage. Diagnostics
+/// point at the part's declaration (or the mesh path).
 pub fn build(
     part: &model::Part,
     world: &dyn World,
-    file: FileId,
     diags: &mut Diagnostics,
 ) -> Option<PartGeometry> {
     match &part.geometry {
-        Source::Stock(stock) => csg::build(part, stock, file, diags),
+        Source::Stock(stock) => csg::build(part, stock, diags),
         Source::Mesh {
             path,
             unit_mm,
@@ -274,14 +271,12 @@ pub fn build(
             let raw = match read_mesh(world, path, *unit_mm) {
                 Ok(m) => m,
                 Err(e) => {
-                    diags.push(file, e.at(*span, path));
+                    diags.push(e.at(*span, path));
                     return None;
                 }
             };
             if raw.open_edges + raw.nonmanifold_edges > 0 {
-                diags.push(
-                    file,
-                    GeometryError::MeshDefects {
+                diags.push(GeometryError::MeshDefects {
                         span: *span,
                         path: errors::shown_path(path),
                         open: raw.open_edges,

@@ -4,7 +4,6 @@ use super::errors::GeometryError as E;
 use super::{FaceId, PartGeometry, Surface, V3};
 use crate::diag::{suggest, Diagnostics};
 use crate::model::{FaceRef, FaceSource, Selector};
-use crate::source::FileId;
 
 /// Angle within which a selector's normal or axis matches (degrees).
 const SELECT_DEG: f64 = 5.0;
@@ -13,7 +12,6 @@ const SELECT_DEG: f64 = 5.0;
 pub fn resolve_faces(
     g: &PartGeometry,
     r: &FaceRef,
-    file: FileId,
     diags: &mut Diagnostics,
 ) -> Vec<FaceId> {
     let alive = |k: usize| g.faces[k].area > 0.0;
@@ -26,7 +24,7 @@ pub fn resolve_faces(
                             (FaceSource::Op(a, None), FaceSource::Op(b, _)) => a == b,
                             _ => source == s,
                         };
-                        same && roles.contains(&role.as_str())
+                        same && roles.contains(role)
                     })
                 })
                 .collect();
@@ -39,8 +37,8 @@ pub fn resolve_faces(
             if live.is_empty() {
                 let face = matching
                     .first()
-                    .map_or_else(|| role.clone(), |&k| g.faces[k].name.clone());
-                diags.push(file, E::FaceGone { span: *span, face });
+                    .map_or_else(|| role.to_string(), |&k| g.faces[k].name.clone());
+                diags.push(E::FaceGone { span: *span, face });
             }
             live
         }
@@ -55,9 +53,7 @@ pub fn resolve_faces(
                     name,
                     g.faces.iter().map(|f| f.name.as_str()),
                 );
-                diags.push(
-                    file,
-                    E::UnknownGroup {
+                diags.push(E::UnknownGroup {
                         span: *span,
                         group: name.clone(),
                         help,
@@ -77,9 +73,7 @@ pub fn resolve_faces(
                     "the mesh has {} segments, numbered from 1; `inspc faces MESH` lists them",
                     g.faces.len()
                 );
-                diags.push(
-                    file,
-                    E::UnknownSegment {
+                diags.push(E::UnknownSegment {
                         span: *span,
                         segment: *n,
                         help,
@@ -91,9 +85,7 @@ pub fn resolve_faces(
         FaceRef::Select(sel, span) => {
             let found = select(g, sel);
             if found.is_empty() {
-                diags.push(
-                    file,
-                    E::NoMatch {
+                diags.push(E::NoMatch {
                         span: *span,
                         help: "relax a criterion, or list the faces with `inspc faces MESH`".into(),
                     },

@@ -34,3 +34,9 @@ pub enum GraphError {
         help: String,
     },
 }
+
+crate::located!(GraphError {
+    NoPoints,
+    WrongSurface,
+});
+

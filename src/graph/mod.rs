@@ -22,7 +22,6 @@ use crate::diag::Diagnostics;
 use crate::geometry::{FaceId, PartGeometry, Surface};
 use crate::model::{FeatureId, Part, Sampling, Strategy, SurfaceKind, TolKind};
 use crate::sample::{Fpoint, Sampler};
-use crate::source::FileId;
 use petgraph::graph::{DiGraph, NodeIndex};
 use std::collections::HashMap;
 
@@ -227,9 +226,7 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
         let points = sampler.sample(face, &strategy);
         if points.is_empty() {
             let feature = &part.features[first_feature.0];
-            diags.push(
-                feature.span.file,
-                GraphError::NoPoints {
+            diags.push(GraphError::NoPoints {
                     span: feature.span,
                     face: g.faces[face.0].name.clone(),
                     feature: feature.name.clone(),
@@ -298,7 +295,6 @@ pub fn check_surfaces(
     part: &Part,
     g: &PartGeometry,
     feature_faces: &[Vec<FaceId>],
-    file: FileId,
     diags: &mut Diagnostics,
 ) {
     for t in &part.tolerances {
@@ -321,9 +317,9 @@ pub fn check_surfaces(
             [init @ .., last] => format!("{} or {last}", init.join(", ")),
             [] => String::new(),
         };
-        diags.push(file, GraphError::WrongSurface {
+        diags.push(GraphError::WrongSurface {
             span: t.span,
-            tolerance: crate::resolve::tolerance_keyword(t.kind).to_string(),
+            tolerance: t.kind.keyword().to_string(),
             needs,
             face: g.faces[face.0].name.clone(),
             feature: part.features[f.0].name.clone(),

@@ -14,7 +14,7 @@ fn round6(v: f64) -> f64 {
 fn tolerance_text(part: &Part, k: usize) -> (String, String) {
     let t = &part.tolerances[k];
     let value = t.value.text();
-    let kind = crate::resolve::tolerance_keyword(t.kind);
+    let kind = t.kind.keyword();
     let datums: Vec<&str> = t
         .datums
         .iter()

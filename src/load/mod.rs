@@ -68,6 +68,9 @@ pub enum LoadError {
         /// The `use` or mesh path that named it, if any.
         #[label("imported here")]
         span: Option<Span>,
+        /// The file it is filed under: the importing file, or for a root file the
+        /// (empty) source registered under its own name.
+        file: FileId,
         /// The path.
         path: String,
         /// The system's reason.
@@ -123,6 +126,19 @@ pub enum LoadError {
         cycle: String,
     },
 }
+
+impl crate::diag::Located for LoadError {
+    fn file(&self) -> FileId {
+        match self {
+            LoadError::Unreadable { file, .. } => *file,
+            LoadError::NotUtf8 { span, .. }
+            | LoadError::UnknownModule { span, .. }
+            | LoadError::ModuleImport { span, .. }
+            | LoadError::ImportCycle { span, .. } => span.file,
+        }
+    }
+}
+
 
 /// Loads the root files and everything they import. The entry point of the load stage.
 pub fn load(
@@ -187,10 +203,9 @@ impl Loader<'_> {
                     },
                     |f| f.0,
                 );
-                self.diags.push(
-                    file,
-                    LoadError::Unreadable {
+                self.diags.push(LoadError::Unreadable {
                         span: from.map(|f| f.1),
+                        file,
                         path: shown,
                         reason: e.0,
                     },
@@ -208,9 +223,7 @@ impl Loader<'_> {
         let file = self.sources.add(shown.clone(), Some(canonical), text);
         if let Some(at) = bad {
             // The lossy text holds U+FFFD (3 bytes) where the bad byte was.
-            self.diags.push(
-                file,
-                LoadError::NotUtf8 {
+            self.diags.push(LoadError::NotUtf8 {
                     span: Span::new(file, at, at + 3),
                     path: shown,
                 },
@@ -242,7 +255,7 @@ impl Loader<'_> {
         let ast = match syntax::parse(file, &self.sources.get(file).text) {
             Ok(ast) => ast,
             Err(e) => {
-                self.diags.push(file, e);
+                self.diags.push(e);
                 ast::File::default()
             }
         };
@@ -274,9 +287,7 @@ impl Loader<'_> {
                         .map(|m| self.module_name(*m))
                         .collect();
                     names.push(self.module_name(target));
-                    self.diags.push(
-                        file,
-                        LoadError::ImportCycle {
+                    self.diags.push(LoadError::ImportCycle {
                             span: u.span,
                             cycle: names.join(" → "),
                         },
@@ -323,7 +334,7 @@ impl Loader<'_> {
                     && STD_MODULES.iter().any(|(n, _)| *n == names.join("::"))
                 {
                     let full = names.join("::");
-                    self.diags.push(file, LoadError::ModuleImport {
+                    self.diags.push(LoadError::ModuleImport {
                         span: u.span,
                         help: format!("name the items: `use {full}::{{…}}`, or all of them: `use {full}::*`"),
                         name: full,
@@ -340,9 +351,7 @@ impl Loader<'_> {
                                 std_module_names().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
                             ),
                         };
-                        self.diags.push(
-                            file,
-                            LoadError::UnknownModule {
+                        self.diags.push(LoadError::UnknownModule {
                                 span,
                                 name: module,
                                 help,

@@ -241,6 +241,28 @@ pub struct Level {
     pub span: Span,
 }
 
+impl Level {
+    /// The level as the spec writes it: `same_setup(T, *)`.
+    pub fn text(&self) -> String {
+        level_text(self.var, self.group)
+    }
+}
+
+/// The spelling of a level, for messages and reports.
+pub fn level_text(var: SameVar, group: Group) -> String {
+    let v = match var {
+        SameVar::Setup => "same_setup",
+        SameVar::Probe => "same_probe",
+        SameVar::Orient => "same_orient",
+    };
+    let g = match group {
+        Group::TolFeature => "T, F, *",
+        Group::Tol => "T, *",
+        Group::All => "*, *",
+    };
+    format!("{v}({g})")
+}
+
 /// A constraint hierarchy: required approachability, then soft levels, most important
 /// first.
 #[derive(Debug, Clone)]

@@ -263,6 +263,119 @@ pub struct Selector {
     pub nearest: Option<Vec3>,
 }
 
+/// A face's role on the stock or an operation: what `stock.top` or `slot.walls` names.
+/// The geometry stage tags the faces it makes with these; the resolver checks names
+/// against [`Role::of_stock`] and [`Role::of_op`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[allow(missing_docs)]
+pub enum Role {
+    Top,
+    Bottom,
+    Left,
+    Right,
+    Front,
+    Back,
+    Side,
+    Surface,
+    Wall,
+    Walls,
+    LeftWall,
+    RightWall,
+    Floor,
+    Ends,
+}
+
+impl Role {
+    /// Every role.
+    pub const ALL: [Role; 14] = [
+        Role::Top,
+        Role::Bottom,
+        Role::Left,
+        Role::Right,
+        Role::Front,
+        Role::Back,
+        Role::Side,
+        Role::Surface,
+        Role::Wall,
+        Role::Walls,
+        Role::LeftWall,
+        Role::RightWall,
+        Role::Floor,
+        Role::Ends,
+    ];
+
+    /// Its name in the spec language.
+    pub fn name(self) -> &'static str {
+        match self {
+            Role::Top => "top",
+            Role::Bottom => "bottom",
+            Role::Left => "left",
+            Role::Right => "right",
+            Role::Front => "front",
+            Role::Back => "back",
+            Role::Side => "side",
+            Role::Surface => "surface",
+            Role::Wall => "wall",
+            Role::Walls => "walls",
+            Role::LeftWall => "left_wall",
+            Role::RightWall => "right_wall",
+            Role::Floor => "floor",
+            Role::Ends => "ends",
+        }
+    }
+
+    /// The role a name spells.
+    pub fn from_name(name: &str) -> Option<Role> {
+        Role::ALL.into_iter().find(|r| r.name() == name)
+    }
+
+    /// The roles a stock's faces answer to.
+    pub fn of_stock(stock: &Stock) -> &'static [Role] {
+        match stock {
+            Stock::Box { .. } => &[
+                Role::Top,
+                Role::Bottom,
+                Role::Left,
+                Role::Right,
+                Role::Front,
+                Role::Back,
+            ],
+            Stock::Cylinder { .. } => &[Role::Top, Role::Bottom, Role::Side],
+            Stock::Sphere { .. } => &[Role::Surface],
+        }
+    }
+
+    /// The roles an operation's faces answer to.
+    pub fn of_op(op: &OpKind) -> &'static [Role] {
+        match op {
+            OpKind::Hole {
+                depth: Depth::Through,
+                ..
+            } => &[Role::Wall],
+            OpKind::Hole { .. } => &[Role::Wall, Role::Bottom],
+            OpKind::Slot {
+                length: Some(_), ..
+            } => &[
+                Role::Walls,
+                Role::LeftWall,
+                Role::RightWall,
+                Role::Floor,
+                Role::Ends,
+            ],
+            OpKind::Slot { .. } => &[Role::Walls, Role::LeftWall, Role::RightWall, Role::Floor],
+            OpKind::Pocket { .. } => &[Role::Walls, Role::Floor],
+            OpKind::Step { .. } => &[Role::Wall, Role::Floor],
+            OpKind::Boss { .. } => &[Role::Wall, Role::Top],
+        }
+    }
+}
+
+impl std::fmt::Display for Role {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// A reference to faces of the part geometry.
 #[derive(Debug, Clone, PartialEq)]
 pub enum FaceRef {
@@ -270,8 +383,8 @@ pub enum FaceRef {
     Role {
         /// Whose face.
         source: FaceSource,
-        /// The role: `top`, `wall`, `walls`, `floor`, …
-        role: String,
+        /// The role.
+        role: Role,
         /// Where it was written.
         span: Span,
     },
@@ -381,6 +494,34 @@ pub enum TolKind {
     Distance,
     /// Angle between features.
     Angle,
+}
+
+impl TolKind {
+    /// Its keyword in the spec language (`flatness`, `position`, …).
+    pub fn keyword(self) -> &'static str {
+        match self {
+            TolKind::Flatness => "flatness",
+            TolKind::Straightness => "straightness",
+            TolKind::Circularity => "circularity",
+            TolKind::Cylindricity => "cylindricity",
+            TolKind::ProfileLine => "profile_line",
+            TolKind::ProfileSurface => "profile_surface",
+            TolKind::Perpendicularity => "perpendicularity",
+            TolKind::Parallelism => "parallelism",
+            TolKind::Angularity => "angularity",
+            TolKind::Position => "position",
+            TolKind::Concentricity => "concentricity",
+            TolKind::Coaxiality => "coaxiality",
+            TolKind::Symmetry => "symmetry",
+            TolKind::CircularRunout => "circular_runout",
+            TolKind::TotalRunout => "total_runout",
+            TolKind::Diameter => "diameter",
+            TolKind::Radius => "radius",
+            TolKind::Width => "width",
+            TolKind::Distance => "distance",
+            TolKind::Angle => "angle",
+        }
+    }
 }
 
 /// A tolerance's value.

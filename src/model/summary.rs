@@ -153,7 +153,7 @@ impl Model {
             let levels: Vec<String> = h
                 .levels
                 .iter()
-                .map(|l| crate::resolve::level_text(l.var, l.group))
+                .map(|l| l.text())
                 .collect();
             let _ = writeln!(
                 o,
@@ -441,7 +441,7 @@ fn part_summary(o: &mut String, p: &Part) {
         let basic = t
             .basic_angle
             .map_or(String::new(), |a| format!(" basic {}°", fmt_num(a)));
-        let kind = crate::resolve::tolerance_keyword(t.kind);
+        let kind = t.kind.keyword();
         let _ = writeln!(
             o,
             "  tolerance {}: {kind}({}) {value}{m}{datums}{basic}",

@@ -23,3 +23,8 @@ pub enum PathError {
         blocker: String,
     },
 }
+
+crate::located!(PathError {
+    NoPath,
+});
+

@@ -279,7 +279,7 @@ pub fn plan(
             Ok(o) => outs.push(o),
             Err(e) => {
                 failed = true;
-                diags.push(part.span.file, *e);
+                diags.push(*e);
             }
         }
     }
@@ -310,7 +310,7 @@ pub fn plan(
                     .and_then(|_| pose.segment(&across, &entry[0]));
                 if let Err(blocker) = moves {
                     let b = &o.blocks[0];
-                    diags.push(part.span.file, no_path(input, b, g, &blocker.to_string()));
+                    diags.push(no_path(input, b, g, &blocker.to_string()));
                     return None;
                 }
                 entry.insert(0, across);

@@ -39,3 +39,10 @@ pub enum PlanError {
         part: String,
     },
 }
+
+crate::located!(PlanError {
+    UninspectableFace,
+    NoConvergence,
+    NoPlan,
+});
+

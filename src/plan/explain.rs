@@ -85,9 +85,7 @@ pub(super) fn report_face(input: &Input, k: &Knowledge, m: &Machine, face: FaceI
         )
     };
     let help = "use a smaller tip, a longer or thinner stylus, an extension, or an indexable head; `inspc cones --face` shows the cones".to_string();
-    diags.push(
-        feature.map_or(part.span.file, |f| f.span.file),
-        PlanError::UninspectableFace {
+    diags.push(PlanError::UninspectableFace {
             span: feature.map_or(part.span, |f| f.span),
             face: name,
             feature: feature.map_or_else(|| part.name.clone(), |f| f.name.clone()),

@@ -260,9 +260,7 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
         }
         learn(&mut k, &machine, invalid);
     }
-    diags.push(
-        plan.span.file,
-        PlanError::NoConvergence {
+    diags.push(PlanError::NoConvergence {
             span: plan.span,
             plan: plan.name.clone(),
             iterations: opts.max_iterations,

@@ -160,7 +160,7 @@ fn violations<'a>(s: &'a Summary, names: &Names) -> impl Iterator<Item = (String
     let levels: Vec<String> = h
         .levels
         .iter()
-        .map(|l| crate::resolve::level_text(l.var, l.group))
+        .map(|l| l.text())
         .collect();
     levels.into_iter().zip(s.violations.iter().copied())
 }

@@ -28,19 +28,19 @@ pub(super) fn lower(
             model.heads.push(head);
         }
         Kind::Stylus => {
-            let tip = p
+            let tip_ok = p
                 .req(cx, "tip", "2 mm")
-                .and_then(|v| cx.positive(v, Dim::Length, "tip"))
-                .unwrap_or(1.0);
+                .and_then(|v| cx.positive(v, Dim::Length, "tip"));
+            let tip = tip_ok.unwrap_or(1.0);
             let length = p
                 .req(cx, "length", "20 mm")
                 .and_then(|v| cx.positive(v, Dim::Length, "length"))
                 .unwrap_or(1.0);
             let stem_v = p.req(cx, "stem", "1.5 mm");
-            let stem = stem_v
-                .and_then(|v| cx.positive(v, Dim::Length, "stem"))
-                .unwrap_or(0.5);
-            if let Some(v) = stem_v {
+            let stem_ok = stem_v.and_then(|v| cx.positive(v, Dim::Length, "stem"));
+            let stem = stem_ok.unwrap_or(0.5);
+            // Only two good values are compared: a bad one was reported already.
+            if let (Some(v), Some(_), Some(_)) = (stem_v, stem_ok, tip_ok) {
                 if stem >= tip {
                     cx.err(E::StemThickerThanTip {
                         span: v.span,

@@ -1,25 +1,11 @@
 //! Constraint hierarchies (Spitz ch. 3.4): levels, groups and the order the solver needs.
 
+use crate::model::level_text;
 use super::errors::ResolveError as E;
 use super::props::Cx;
 use crate::diag::suggest;
 use crate::model::{Group, Hierarchy, Level, SameVar};
 use crate::syntax::ast;
-
-/// The spelling of a level, for messages.
-pub fn level_text(var: SameVar, group: Group) -> String {
-    let v = match var {
-        SameVar::Setup => "same_setup",
-        SameVar::Probe => "same_probe",
-        SameVar::Orient => "same_orient",
-    };
-    let g = match group {
-        Group::TolFeature => "T, F, *",
-        Group::Tol => "T, *",
-        Group::All => "*, *",
-    };
-    format!("{v}({g})")
-}
 
 pub(super) fn lower(cx: &mut Cx, h: &ast::Hierarchy) -> Hierarchy {
     let mut levels: Vec<Level> = Vec::new();

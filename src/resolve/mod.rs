@@ -11,17 +11,18 @@
 //! [`World`] whether a mesh file exists. Geometry is evaluated by a later stage.
 
 mod catalogue;
+mod datum;
+mod faces;
 mod errors;
 mod hierarchy;
 mod part;
 mod plan;
 mod props;
+mod scope;
 mod tolerance;
 
 pub use errors::ResolveError;
-pub use hierarchy::level_text;
 pub use props::length_unit_mm;
-pub use tolerance::keyword as tolerance_keyword;
 
 use crate::diag::{suggest, Diagnostics};
 use crate::load::{ModuleId, Program};
@@ -148,9 +149,7 @@ impl<'a> Resolver<'a> {
                     ),
                 };
                 if let Some(&first) = scope.get(&name.name) {
-                    diags.push(
-                        module.file,
-                        E::DuplicateName {
+                    diags.push(E::DuplicateName {
                             span: name.span,
                             first: Some(self.decls[first].name.span),
                             name: name.name.clone(),
@@ -218,9 +217,7 @@ impl<'a> Resolver<'a> {
                                 .trim_start_matches("known ")
                             ),
                         };
-                        diags.push(
-                            module.file,
-                            E::UnknownName {
+                        diags.push(E::UnknownName {
                                 span: ident.span,
                                 what: "item".into(),
                                 name: ident.name.clone(),
@@ -236,7 +233,7 @@ impl<'a> Resolver<'a> {
                     match self.scopes[mi].get(&ident.name) {
                         Some(&existing) if existing != d && existing != POISONED => {
                             let first = self.decls[existing].name.span;
-                            diags.push(module.file, E::DuplicateName {
+                            diags.push(E::DuplicateName {
                                 span: ident.span,
                                 first: (first.file == module.file).then_some(first),
                                 name: ident.name.clone(),

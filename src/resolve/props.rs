@@ -84,7 +84,7 @@ pub(crate) struct Cx<'d> {
 
 impl Cx<'_> {
     pub fn err(&mut self, e: E) {
-        self.diags.push(self.file, e);
+        self.diags.push(e);
     }
 
     pub fn mismatch(&mut self, v: &Value, expected: &str, help: &str) {

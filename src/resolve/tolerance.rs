@@ -1,7 +1,8 @@
 //! Tolerances: one table of GD&T rules per type, and the checks it drives.
 
 use super::errors::ResolveError as E;
-use super::part::{check_unique_datums, datum_ref, material, Local, PartCx};
+use super::datum::{check_unique_datums, datum_ref, material};
+use super::scope::{Local, PartCx};
 use super::props::{describe, num, path_text, Cx, Dim};
 use crate::diag::suggest;
 use crate::model::*;
@@ -87,12 +88,16 @@ const RULES: &[Rule] = &[
     size("angle", K::Angle, (2, 2), Dim::Angle),
 ];
 
-/// The keyword of a tolerance type.
-pub fn keyword(kind: TolKind) -> &'static str {
-    RULES
-        .iter()
-        .find(|r| r.kind == kind)
-        .map_or("?", |r| r.name)
+#[cfg(test)]
+mod tests {
+    /// The table's names are the model's keywords, and it has a rule for every kind.
+    #[test]
+    fn rule_names_are_the_keywords() {
+        for r in super::RULES {
+            assert_eq!(r.name, r.kind.keyword());
+        }
+        assert_eq!(super::RULES.len(), 20);
+    }
 }
 
 pub(super) fn lower(
@@ -305,7 +310,8 @@ pub(super) fn lower(
                 ok = false;
             }
         }
-        Required if datums.is_empty() => {
+        // A datum that failed to resolve was reported already: no cascade.
+        Required if datums.is_empty() && ok => {
             cx.err(E::DatumsRequired { span: call.span, kind: what.clone(), help: format!("{what} is measured relative to a datum: add one, e.g. `{}(feature, 0.05 mm, A)`", rule.name) });
             ok = false;
         }

@@ -80,6 +80,14 @@ pub enum SyntaxError {
     },
 }
 
+crate::located!(SyntaxError {
+    Unexpected,
+    InvalidNumber,
+    TooDeep,
+    InvalidEscape,
+});
+
+
 /// Parses one file. The entry point of the syntax stage.
 pub fn parse(file: FileId, text: &str) -> Result<ast::File, SyntaxError> {
     use pest::Parser;

@@ -16,15 +16,107 @@ pub struct Flat {
     pub warning: bool,
 }
 
+/// The diagnostics of one check, with the rule of typst's test runner: once a test
+/// states what it expects ([`Diags::saw`], through `expect`), every diagnostic must be
+/// expected — one it did not annotate fails the test when the value is dropped.
+pub struct Diags {
+    items: Vec<Flat>,
+    seen: std::cell::RefCell<Vec<bool>>,
+    annotated: std::cell::Cell<bool>,
+}
+
+impl Diags {
+    fn new(items: Vec<Flat>) -> Diags {
+        let n = items.len();
+        Diags {
+            items,
+            seen: std::cell::RefCell::new(vec![false; n]),
+            annotated: std::cell::Cell::new(false),
+        }
+    }
+
+    /// Marks the first not-yet-seen diagnostic that satisfies `pred` as expected and
+    /// returns it (the first seen one when every match was seen already).
+    pub fn saw(&self, pred: impl Fn(&Flat) -> bool) -> Option<&Flat> {
+        self.annotated.set(true);
+        let mut seen = self.seen.borrow_mut();
+        let k = (0..self.items.len())
+            .find(|&k| !seen[k] && pred(&self.items[k]))
+            .or_else(|| (0..self.items.len()).find(|&k| pred(&self.items[k])))?;
+        seen[k] = true;
+        Some(&self.items[k])
+    }
+
+    /// The one diagnostic, marked expected; fails unless there is exactly one.
+    #[track_caller]
+    pub fn only(&self) -> &Flat {
+        assert_eq!(
+            self.items.len(),
+            1,
+            "expected one diagnostic, got {:?}",
+            self.items.iter().map(|d| &d.code).collect::<Vec<_>>()
+        );
+        self.saw(|_| true).unwrap()
+    }
+
+    /// Marks every diagnostic with `code` as expected without asserting on it (for
+    /// tests about something else that produce it on the way).
+    pub fn allow(&self, code: &str) {
+        let mut seen = self.seen.borrow_mut();
+        for (k, d) in self.items.iter().enumerate() {
+            if d.code == code {
+                seen[k] = true;
+            }
+        }
+    }
+
+    /// The diagnostics not (yet) expected.
+    pub fn unexpected(&self) -> Vec<&Flat> {
+        let seen = self.seen.borrow();
+        self.items
+            .iter()
+            .zip(seen.iter())
+            .filter(|(_, s)| !**s)
+            .map(|(d, _)| d)
+            .collect()
+    }
+}
+
+impl std::ops::Deref for Diags {
+    type Target = [Flat];
+    fn deref(&self) -> &[Flat] {
+        &self.items
+    }
+}
+
+impl Drop for Diags {
+    fn drop(&mut self) {
+        if std::thread::panicking() || !self.annotated.get() {
+            return;
+        }
+        let left = self.unexpected();
+        if !left.is_empty() {
+            let lines: Vec<String> = left
+                .iter()
+                .map(|d| format!("  {} `{}`: {}", d.code, d.span_text, d.message))
+                .collect();
+            panic!(
+                "diagnostics the test did not expect:\n{}",
+                lines.join("\n")
+            );
+        }
+    }
+}
+
 /// Checks `files` (path, contents) in memory; the first file is the root.
-pub fn check_files(files: &[(&str, &[u8])]) -> Vec<Flat> {
-    run_files(files, false)
+pub fn check_files(files: &[(&str, &[u8])]) -> Diags {
+    Diags::new(run_files(files, false))
 }
 
 /// [`check_files`] through the planner too.
 #[allow(dead_code)]
-pub fn plan_files(files: &[(&str, &[u8])]) -> Vec<Flat> {
-    run_files(files, true)
+pub fn plan_files(files: &[(&str, &[u8])]) -> Diags {
+    Diags::new(run_files(files, true))
 }
 
 fn run_files(files: &[(&str, &[u8])], plan: bool) -> Vec<Flat> {
@@ -67,7 +159,7 @@ fn run_files(files: &[(&str, &[u8])], plan: bool) -> Vec<Flat> {
 }
 
 /// Checks one in-memory file named `main.insp`.
-pub fn check_src(src: &str) -> Vec<Flat> {
+pub fn check_src(src: &str) -> Diags {
     check_files(&[("main.insp", src.as_bytes())])
 }
 
