@@ -275,6 +275,9 @@ pub struct Built {
     pub dmis: String,
     /// The plan with its paths as JSON (`--plan-json`).
     pub json: serde_json::Value,
+    /// The plan's measurement graph, when its `output { graph }` names a file: the text
+    /// in the format that file's extension asks for.
+    pub graph: Option<String>,
 }
 
 /// Where a build's time went, stage by stage.
@@ -429,12 +432,27 @@ fn programs_of(run: &Run, paths: Pathed) -> Vec<Built> {
         });
         let names = plan::Names::new(&checked.model, &data.geometry, hlip.plan);
         let json = path::json(&hlip, &llip, &names);
+        let plan = &checked.model.plans[k];
+        let graph = plan.outputs.graph.as_deref().and_then(|file| {
+            let g = run.graphs.iter().find(|g| g.graph.plan.as_deref() == Some(&plan.name))?;
+            let p = &checked.model.parts[part];
+            let ext = std::path::Path::new(file).extension();
+            Some(match ext.and_then(|e| e.to_str()) {
+                Some("mmd") => graph::mermaid(p, &data.geometry, &g.graph, false),
+                Some("json") => {
+                    let v = graph::json(p, &data.geometry, &g.graph);
+                    serde_json::to_string_pretty(&v).unwrap_or_default() + "\n"
+                }
+                _ => graph::dot(p, &data.geometry, &g.graph, false),
+            })
+        });
         out.push(Built {
             plan: k,
             hlip,
             llip,
             dmis,
             json,
+            graph,
         });
     }
     out

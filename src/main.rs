@@ -403,6 +403,9 @@ fn build(
             let text = serde_json::to_string_pretty(&b.json).unwrap_or_default() + "\n";
             writes.push((j, text.into_bytes()));
         }
+        if let (Some(g), Some(text)) = (&plan.outputs.graph, &b.graph) {
+            writes.push((dir.join(g), text.clone().into_bytes()));
+        }
     }
     for (path, bytes) in &writes {
         if let Err(e) = write_atomically(path, bytes) {

@@ -485,3 +485,28 @@ fn cones_with_a_stdlib_machine_point_into_the_stdlib() {
     assert!(stderr.contains("cmm bridge_fixed"), "{stderr}");
     assert!(!stderr.contains("Failed to read"), "{stderr}");
 }
+
+/// `output { graph }` writes the plan's measurement graph beside the program, in the
+/// format its extension asks for.
+#[test]
+fn build_writes_the_graph_the_plan_asks_for() {
+    let dir = std::env::temp_dir().join(format!("inspc-graph-out-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f2 = std::fs::read_to_string("examples/f2.insp").unwrap();
+    let spec = dir.join("f2.insp");
+    std::fs::write(
+        &spec,
+        f2.replace(
+            "    sampling fan_leu\n}",
+            "    sampling fan_leu\n    output { dmis \"f2.dmi\", graph \"f2.mmd\" }\n}",
+        ),
+    )
+    .unwrap();
+    let (code, stdout, stderr) = inspc(&["build", spec.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    let graph = std::fs::read_to_string(dir.join("f2.mmd")).unwrap();
+    assert!(graph.starts_with("flowchart") || graph.contains("graph"), "{graph}");
+    assert!(graph.contains("small_slot"), "{graph}");
+    assert!(stdout.contains("f2.mmd"), "{stdout}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -8,7 +8,7 @@ use super::primitives::{
 };
 use super::{PartGeometry, Surface, P3, V3};
 use crate::diag::Diagnostics;
-use crate::model::{self, Depth, FaceSource, OpId, OpKind, Pattern, Placement, Role, Stock};
+use crate::model::{self, Action, Depth, FaceSource, OpId, OpKind, Pattern, Placement, Role, Stock};
 use boolmesh::prelude::{compute_boolean, Manifold, OpType};
 use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion};
 
@@ -27,7 +27,7 @@ pub(crate) struct Spec {
 struct Tool {
     prim: Prim,
     bounds: (P3, P3),
-    add: bool,
+    action: Action,
     op: usize,
 }
 
@@ -116,7 +116,7 @@ pub(super) fn build(
                 }
                 let (lo, hi) = prim.bounds_of_part(k as u32);
                 let mut surface = prim.surfaces[k].clone();
-                if !op.add {
+                if op.action == Action::Cut {
                     surface = flip(surface);
                 }
                 let base = inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name));
@@ -133,7 +133,7 @@ pub(super) fn build(
             tools.push(Tool {
                 bounds: (lo, hi),
                 prim,
-                add: op.add,
+                action: op.action,
                 op: oi,
             });
         }
@@ -146,7 +146,7 @@ pub(super) fn build(
         let mut batch = vec![i];
         let mut j = i + 1;
         while j < tools.len()
-            && tools[j].add == tools[i].add
+            && tools[j].action == tools[i].action
             && batch
                 .iter()
                 .all(|&b| disjoint(tools[b].bounds, tools[j].bounds))
@@ -155,7 +155,7 @@ pub(super) fn build(
             j += 1;
         }
         let prims: Vec<&Prim> = batch.iter().map(|&b| &tools[b].prim).collect();
-        let op = if tools[i].add {
+        let op = if tools[i].action == Action::Add {
             OpType::Add
         } else {
             OpType::Subtract

@@ -375,12 +375,19 @@ impl Sampling {
 pub struct SetupPref {
     /// Unit direction in the part frame.
     pub direction: Vec3,
-    /// Weight for the weighted clustering (1 = strong); ignored when forbidden.
-    pub weight: f64,
-    /// Never use this setup.
-    pub forbidden: bool,
+    /// Preferred with a weight for the weighted clustering (1 = strong), or forbidden.
+    pub stance: Stance<f64>,
     /// Where it was written.
     pub span: Span,
+}
+
+/// What a preference says: use this (with a weight or cost), or never use it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stance<T> {
+    /// Prefer it, with its weight or cost.
+    Prefer(T),
+    /// Never use it.
+    Forbid,
 }
 
 /// A head orientation preference (indexable heads).
@@ -390,10 +397,8 @@ pub struct OrientPref {
     pub a: f64,
     /// B angle (degrees).
     pub b: f64,
-    /// Weight (1 = strong).
-    pub weight: f64,
-    /// Never use this orientation.
-    pub forbidden: bool,
+    /// Preferred with a weight (1 = strong), or forbidden.
+    pub stance: Stance<f64>,
     /// Where it was written.
     pub span: Span,
 }
@@ -403,10 +408,8 @@ pub struct OrientPref {
 pub struct ProbePref {
     /// The probe's label in the CMM's rack.
     pub label: String,
-    /// Cost override.
-    pub cost: Option<f64>,
-    /// Never use this probe.
-    pub forbidden: bool,
+    /// Allowed, with a cost override if given, or forbidden.
+    pub stance: Stance<Option<f64>>,
     /// Where it was written.
     pub span: Span,
 }
@@ -418,7 +421,7 @@ pub struct Outputs {
     pub dmis: Option<String>,
     /// The plan as JSON.
     pub plan: Option<String>,
-    /// The measurement graph.
+    /// The measurement graph: Mermaid for `.mmd`, JSON for `.json`, else DOT.
     pub graph: Option<String>,
 }
 

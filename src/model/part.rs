@@ -222,13 +222,32 @@ impl Pattern {
     }
 }
 
+/// What an operation does to the material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    /// `cut`: removes material.
+    Cut,
+    /// `add`: adds material.
+    Add,
+}
+
+impl Action {
+    /// The spec's keyword.
+    pub fn keyword(self) -> &'static str {
+        match self {
+            Action::Cut => "cut",
+            Action::Add => "add",
+        }
+    }
+}
+
 /// A named machining operation.
 #[derive(Debug, Clone)]
 pub struct Op {
     /// Its name.
     pub name: String,
-    /// Material added (`add`) rather than removed (`cut`).
-    pub add: bool,
+    /// Whether it removes material (`cut`) or adds it (`add`).
+    pub action: Action,
     /// The shape.
     pub kind: OpKind,
     /// Copies, if patterned.
@@ -258,6 +277,8 @@ pub struct Selector {
     /// Radius (mm).
     pub radius: Option<f64>,
     /// Keep the face with the highest (`true`) or lowest centroid coordinate on an axis.
+    /// (Still a flag: the model summary prints selectors with `Debug`, and golden model
+    /// files hold that text.)
     pub extreme: Option<(u8, bool)>,
     /// Keep the face whose centroid is nearest this point (mm).
     pub nearest: Option<Vec3>,

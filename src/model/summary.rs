@@ -189,20 +189,16 @@ impl Model {
                 self.hierarchies[p.hierarchy.0].name,
                 self.samplings[p.sampling.0].name
             );
+            let verb = |s: &super::Stance<f64>| match s {
+                super::Stance::Forbid => "forbid".to_string(),
+                super::Stance::Prefer(w) => format!("prefer (weight {})", fmt_num(*w)),
+            };
             for s in &p.setups {
-                let verb = if s.forbidden {
-                    "forbid".to_string()
-                } else {
-                    format!("prefer (weight {})", fmt_num(s.weight))
-                };
+                let verb = verb(&s.stance);
                 let _ = writeln!(o, "  {verb} setup {}", v3(&s.direction));
             }
             for s in &p.orientations {
-                let verb = if s.forbidden {
-                    "forbid".to_string()
-                } else {
-                    format!("prefer (weight {})", fmt_num(s.weight))
-                };
+                let verb = verb(&s.stance);
                 let _ = writeln!(
                     o,
                     "  {verb} orientation A {} B {}",
@@ -211,10 +207,11 @@ impl Model {
                 );
             }
             for s in &p.probes {
-                let what = if s.forbidden {
-                    "forbid".to_string()
-                } else {
-                    format!("cost {}", s.cost.map_or("-".into(), fmt_num))
+                let what = match s.stance {
+                    super::Stance::Forbid => "forbid".to_string(),
+                    super::Stance::Prefer(cost) => {
+                        format!("cost {}", cost.map_or("-".into(), fmt_num))
+                    }
                 };
                 let _ = writeln!(o, "  probe {}: {what}", s.label);
             }
@@ -311,7 +308,7 @@ fn part_summary(o: &mut String, p: &Part) {
     };
     let _ = writeln!(o, "part {}: {geometry}", p.name);
     for op in &p.ops {
-        let verb = if op.add { "add" } else { "cut" };
+        let verb = op.action.keyword();
         let shape = match &op.kind {
             OpKind::Hole {
                 at,

@@ -160,13 +160,53 @@ pub fn plan(
     progress: &(dyn Fn(usize, usize) + Sync),
     diags: &mut Diagnostics,
 ) -> Option<Llip> {
-    let model = input.model;
-    let plan = input.plan;
-    let motion = plan.motion;
-    let part = &model.parts[plan.part.0];
-    let cmm = &model.cmms[plan.cmm.0];
-    let probes = ProbeShape::of_cmm(model, cmm);
+    let motion = input.plan.motion;
+    let probes = ProbeShape::of_cmm(input.model, &input.model.cmms[input.plan.cmm.0]);
     let scene = Scene::of_part(input.geometry);
+    let groups = linearise(input, hlip, &probes, &scene);
+    let standoff = motion.prehit.max(motion.retract);
+    let total = groups.len();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let results: Vec<Result<GroupOut, Box<PathError>>> = groups
+        .par_iter()
+        .map(|g| {
+            let r = plan_group(input, hlip, &scene, g, standoff);
+            progress(
+                done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+                total,
+            );
+            r
+        })
+        .collect();
+    let mut outs = Vec::new();
+    for r in results {
+        match r {
+            Ok(o) => outs.push(o),
+            Err(e) => diags.push(*e),
+        }
+    }
+    if outs.len() < total {
+        return None;
+    }
+    match join(input, hlip, &scene, &groups, outs) {
+        Ok(llip) => Some(llip),
+        Err(e) => {
+            diags.push(*e);
+            None
+        }
+    }
+}
+
+/// Linearises the HLIP into groups — one per (setup, probe, orientation) — with their
+/// blocks, datum groups first within a setup.
+fn linearise<'a>(
+    input: &Input,
+    hlip: &Hlip,
+    probes: &'a [ProbeShape],
+    scene: &Scene,
+) -> Vec<GroupIn<'a>> {
+    let motion = input.plan.motion;
+    let part = &input.model.parts[input.plan.part.0];
     let vertices = &input.geometry.vertices;
     // Per feature, the datum it carries (the last declared, when several).
     let mut datum_of: Vec<Option<DatumId>> = vec![None; part.features.len()];
@@ -174,12 +214,10 @@ pub fn plan(
         datum_of[d.feature.0] = Some(DatumId(k));
     }
     let standoff = motion.prehit.max(motion.retract);
-
-    // Linearise the HLIP into groups, datum groups first within a setup.
     let mut groups: Vec<GroupIn> = Vec::new();
     for (si, s) in hlip.setups.iter().enumerate() {
         let up = s.up;
-        let table = table_height(&scene, &up);
+        let table = table_height(scene, &up);
         let top = vertices
             .iter()
             .map(|v| v.coords.dot(&up))
@@ -206,7 +244,7 @@ pub fn plan(
                             face: f.face,
                             contact: f.contact,
                             datum: i.feature.and_then(|x| datum_of[x.0]),
-                            standoff: block_standoff(&scene, hlip, &f.points, standoff, probe),
+                            standoff: block_standoff(scene, hlip, &f.points, standoff, probe),
                             touches: f
                                 .points
                                 .iter()
@@ -257,37 +295,20 @@ pub fn plan(
             }
         }
     }
+    groups
+}
 
+/// Joins the planned groups: moves between groups of a setup run on the clearance
+/// plane, each setup gets its alignment, and the counts are summed.
+fn join(
+    input: &Input,
+    hlip: &Hlip,
+    scene: &Scene,
+    groups: &[GroupIn],
+    outs: Vec<GroupOut>,
+) -> Result<Llip, Box<PathError>> {
+    let motion = input.plan.motion;
     let total = groups.len();
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    let results: Vec<Result<GroupOut, Box<PathError>>> = groups
-        .par_iter()
-        .map(|g| {
-            let r = plan_group(input, hlip, &scene, g, standoff);
-            progress(
-                done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
-                total,
-            );
-            r
-        })
-        .collect();
-
-    let mut failed = false;
-    let mut outs = Vec::new();
-    for r in results {
-        match r {
-            Ok(o) => outs.push(o),
-            Err(e) => {
-                failed = true;
-                diags.push(*e);
-            }
-        }
-    }
-    if failed {
-        return None;
-    }
-
-    // Join the groups: moves between them run on the clearance plane.
     let mut setups: Vec<SetupPath> = Vec::new();
     let (mut added, mut checks, mut length, mut touches) = (0, 0, 0.0, 0);
     // The previous group: its setup and where its head ends.
@@ -303,15 +324,14 @@ pub fn plan(
                 // from there, up or down to this group's height, then across.
                 let from = head - g.dir * arm(g);
                 let across = from + g.up * (g.height - from.coords.dot(&g.up));
-                let pose = Pose::new(&scene, g.probe, g.dir, g.up, g.table);
+                let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table);
                 checks += 2;
                 let moves = pose
                     .segment(&from, &across)
                     .and_then(|_| pose.segment(&across, &entry[0]));
                 if let Err(blocker) = moves {
                     let b = &o.blocks[0];
-                    diags.push(no_path(input, b, g, &blocker.to_string()));
-                    return None;
+                    return Err(Box::new(no_path(input, b, g, &blocker.to_string())));
                 }
                 entry.insert(0, across);
             }
@@ -360,7 +380,7 @@ pub fn plan(
     for sp in &mut setups {
         sp.alignment = align::align(input, hlip, sp);
     }
-    Some(Llip {
+    Ok(Llip {
         motion,
         summary: PathSummary {
             groups: total,

@@ -16,7 +16,7 @@ use super::cluster::{Bits, Set};
 use crate::access::pose::{above_table, frame, table_height, Blocker, Contact, Head, Pose};
 use crate::access::{self, tip_fits, Cell, ConeOptions, CubeMap, ProbeShape, Scene, SecondMap};
 use crate::geometry::{FaceId, Surface, P3, V3};
-use crate::model::{HeadKind, Model, Plan};
+use crate::model::{HeadKind, Model, Plan, Stance};
 use crate::sample::Fpoint;
 
 use rayon::prelude::*;
@@ -55,11 +55,10 @@ impl Machine {
         let mut allowed = vec![true; probes.len()];
         for pref in &plan.probes {
             if let Some(k) = cmm.probes.iter().position(|(l, _)| *l == pref.label) {
-                if pref.forbidden {
-                    allowed[k] = false;
-                }
-                if let Some(c) = pref.cost {
-                    costs[k] = c;
+                match pref.stance {
+                    Stance::Forbid => allowed[k] = false,
+                    Stance::Prefer(Some(c)) => costs[k] = c,
+                    Stance::Prefer(None) => {}
                 }
             }
         }
@@ -80,10 +79,9 @@ impl Machine {
                         || (g.1 - o.b).rem_euclid(360.0) > 360.0 - 1e-6
                         || g.0.abs() < 1e-9 && o.a.abs() < 1e-9);
                 if same {
-                    if o.forbidden {
-                        grid_allowed.remove(k);
-                    } else {
-                        grid_weight[k] = o.weight;
+                    match o.stance {
+                        Stance::Forbid => grid_allowed.remove(k),
+                        Stance::Prefer(w) => grid_weight[k] = w,
                     }
                 }
             }
@@ -258,11 +256,14 @@ impl Knowledge {
         for s in &plan.setups {
             let d = V3::from(s.direction).normalize();
             let cell = empty.index(empty.cell_of(&d));
-            if s.forbidden {
-                forbidden.or_assign(&cone_around(&empty, &d, FORBID_ANGLE.to_radians()));
-            } else {
-                setup_weight.insert(cell, s.weight);
-                setup_prefs.push((cell, s.weight));
+            match s.stance {
+                Stance::Forbid => {
+                    forbidden.or_assign(&cone_around(&empty, &d, FORBID_ANGLE.to_radians()));
+                }
+                Stance::Prefer(w) => {
+                    setup_weight.insert(cell, w);
+                    setup_prefs.push((cell, w));
+                }
             }
         }
         let mut points = fpoints.to_vec();

@@ -112,7 +112,7 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
             let op = operation(cx, *add, kind, name, props);
             pc.part.ops.push(op.unwrap_or(Op {
                 name: name.name.clone(),
-                add: *add,
+                action: if *add { Action::Add } else { Action::Cut },
                 kind: OpKind::Boss {
                     at: [0.0; 3],
                     axis: [0.0, 0.0, 1.0],
@@ -601,7 +601,7 @@ fn operation(
     p.finish(cx);
     Some(Op {
         name: name.name.clone(),
-        add,
+        action: if add { Action::Add } else { Action::Cut },
         kind: op,
         pattern,
         span: name.span,

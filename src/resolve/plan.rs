@@ -165,8 +165,7 @@ pub(super) fn lower(
                         if let Some(direction) = cx.direction(value) {
                             plan.setups.push(SetupPref {
                                 direction,
-                                weight: weight.unwrap_or(1.0),
-                                forbidden: *forbid,
+                                stance: stance(*forbid, weight.unwrap_or(1.0)),
                                 span: *span,
                             });
                         }
@@ -181,8 +180,7 @@ pub(super) fn lower(
                             plan.orientations.push(OrientPref {
                                 a,
                                 b,
-                                weight: weight.unwrap_or(1.0),
-                                forbidden: *forbid,
+                                stance: stance(*forbid, weight.unwrap_or(1.0)),
                                 span: *span,
                             });
                         }
@@ -197,8 +195,7 @@ pub(super) fn lower(
                             if the_cmm.probes.iter().any(|(l, _)| *l == label.name) {
                                 plan.probes.push(ProbePref {
                                     label: label.name.clone(),
-                                    cost,
-                                    forbidden: *forbid,
+                                    stance: stance(*forbid, cost),
                                     span: *span,
                                 });
                             } else {
@@ -309,4 +306,13 @@ fn orientation(cx: &mut Cx, v: &ast::Value, head: Option<&Head>) -> Option<(f64,
         }
     }
     ok.then_some((a, b))
+}
+
+/// `forbid …` or `prefer …` with its weight or cost.
+fn stance<T>(forbid: bool, value: T) -> Stance<T> {
+    if forbid {
+        Stance::Forbid
+    } else {
+        Stance::Prefer(value)
+    }
 }

@@ -88,17 +88,6 @@ const RULES: &[Rule] = &[
     size("angle", K::Angle, (2, 2), Dim::Angle),
 ];
 
-#[cfg(test)]
-mod tests {
-    /// The table's names are the model's keywords, and it has a rule for every kind.
-    #[test]
-    fn rule_names_are_the_keywords() {
-        for r in super::RULES {
-            assert_eq!(r.name, r.kind.keyword());
-        }
-        assert_eq!(super::RULES.len(), 20);
-    }
-}
 
 pub(super) fn lower(
     cx: &mut Cx,
@@ -478,4 +467,16 @@ fn size_limits(cx: &mut Cx, v: &ast::Value, dim: Dim) -> Option<TolValue> {
         lower,
         upper,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    /// The table's names are the model's keywords, and it has a rule for every kind.
+    #[test]
+    fn rule_names_are_the_keywords() {
+        for r in super::RULES {
+            assert_eq!(r.name, r.kind.keyword());
+        }
+        assert_eq!(super::RULES.len(), 20);
+    }
 }
