@@ -180,6 +180,9 @@ fn outcomes() -> &'static [(Case, Outcome)] {
             .map(|d| case(d))
             .filter(|c| !(c.slow && quick()))
             .collect();
+        // Slow cases start first, so that the others run beside them.
+        let mut order: Vec<usize> = (0..cases.len()).collect();
+        order.sort_by_key(|&k| (!cases[k].slow, k));
         let next = std::sync::atomic::AtomicUsize::new(0);
         let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
         let mut done: Vec<(usize, Outcome)> = std::thread::scope(|s| {
@@ -192,8 +195,9 @@ fn outcomes() -> &'static [(Case, Outcome)] {
                             .unwrap();
                         let mut out = Vec::new();
                         loop {
-                            let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                            let Some(c) = cases.get(k) else { break };
+                            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                            let Some(&k) = order.get(i) else { break };
+                            let c = &cases[k];
                             out.push((k, pool.install(|| run_case(c))));
                         }
                         out

@@ -20,7 +20,7 @@ pub use render::{dot, json, mermaid};
 
 use crate::diag::Diagnostics;
 use crate::geometry::{FaceId, PartGeometry, Surface};
-use crate::model::{FeatureId, Part, Sampling, Strategy, SurfaceKind, TolKind};
+use crate::model::{Declared, FeatureId, Part, Sampling, Strategy, SurfaceKind, TolKind};
 use crate::sample::{Fpoint, Sampler};
 use petgraph::graph::{DiGraph, NodeIndex};
 use std::collections::HashMap;
@@ -177,7 +177,7 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
             .node_weights()
             .any(|n| matches!(n, Node::Feature { feature, .. } if *feature == id));
         // Face aliases (`face top = …`) only name a face for use in features.
-        let alias_only = f.is_face_alias && !datums_of.contains_key(&id);
+        let alias_only = f.declared == Declared::Face && !datums_of.contains_key(&id);
         if !named && !alias_only {
             let fnode = feature_node(&mut graph, id);
             graph.add_edge(root, fnode, Edge::Target);

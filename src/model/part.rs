@@ -417,6 +417,15 @@ pub enum FaceRef {
     Select(Selector, Span),
 }
 
+/// How a feature came to be.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Declared {
+    /// `feature x = …`, or the feature of a datum on a face expression.
+    Feature,
+    /// `face x = …`: a named face, measured only when a tolerance or datum uses it.
+    Face,
+}
+
 /// A feature: faces measured together.
 #[derive(Debug, Clone)]
 pub struct Feature {
@@ -424,8 +433,8 @@ pub struct Feature {
     pub name: String,
     /// Its faces (with repeats removed).
     pub faces: Vec<FaceRef>,
-    /// Declared with `face` rather than `feature` (a named face reused in features).
-    pub is_face_alias: bool,
+    /// Declared with `feature`, or with `face` (a named face reused in features).
+    pub declared: Declared,
     /// Where it was declared.
     pub span: Span,
 }

@@ -408,7 +408,10 @@ fn part_summary(o: &mut String, p: &Part) {
     }
     for f in &p.features {
         let faces: Vec<String> = f.faces.iter().map(|r| face_text(p, r)).collect();
-        let what = if f.is_face_alias { "face" } else { "feature" };
+        let what = match f.declared {
+            super::Declared::Face => "face",
+            super::Declared::Feature => "feature",
+        };
         let _ = writeln!(o, "  {what} {} = {}", f.name, faces.join(" + "));
     }
     for d in &p.datums {

@@ -58,7 +58,7 @@ pub(super) fn datum(
             pc.part.features.push(Feature {
                 name: name.name.clone(),
                 faces,
-                is_face_alias: false,
+                declared: Declared::Feature,
                 span: name.span,
             });
             FeatureId(pc.part.features.len() - 1)

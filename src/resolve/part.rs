@@ -146,7 +146,11 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
                 pc.part.features.push(Feature {
                     name: name.name.clone(),
                     faces,
-                    is_face_alias: *what == NamedKind::Face,
+                    declared: if *what == NamedKind::Face {
+                        Declared::Face
+                    } else {
+                        Declared::Feature
+                    },
                     span: name.span,
                 });
                 pc.lowered_features += 1;

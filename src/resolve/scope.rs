@@ -2,7 +2,7 @@
 //! far. Shared by the part, datum and tolerance lowering (`part.rs`, `datum.rs`,
 //! `tolerance.rs`), none of which imports another that imports it back.
 
-use crate::model::Part;
+use crate::model::{Declared, Part};
 use crate::source::Span;
 use crate::syntax::ast::PartStmt;
 use std::collections::BTreeMap;
@@ -24,7 +24,7 @@ impl Local {
         match self {
             Local::Stock => "the stock".into(),
             Local::Op(i) => format!("a {}", part.ops[i].kind.word()),
-            Local::Feature(i) if part.features[i].is_face_alias => "a face".into(),
+            Local::Feature(i) if part.features[i].declared == Declared::Face => "a face".into(),
             Local::Feature(_) => "a feature".into(),
             Local::Datum(_) => "a datum".into(),
             Local::Frame(_) => "a datum reference frame".into(),
