@@ -282,7 +282,21 @@ fn cones(
         return ExitCode::from(1);
     }
     let mut diags = inspc::diag::Diagnostics::new();
-    let report = inspc::access::cone_report(&checked, &parts, &graphs, req, &mut diags);
+    let report = graphs.first().and_then(|gr| {
+        let model = &checked.model;
+        let input = inspc::access::ConeInput {
+            model,
+            part: &model.parts[gr.part],
+            geometry: &parts[gr.part].as_ref()?.geometry,
+            fpoints: &gr.graph.fpoints,
+            plan: gr
+                .graph
+                .plan
+                .as_ref()
+                .and_then(|name| model.plans.iter().find(|p| &p.name == name)),
+        };
+        inspc::access::cone_report(&input, req, &mut diags)
+    });
     print_diagnostics(&checked.sources, &diags.sorted());
     let Some(report) = report else {
         return ExitCode::from(1);

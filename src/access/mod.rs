@@ -36,7 +36,7 @@ pub use exact::{component_hits, refine};
 pub use pose::{Blocker, Contact, Head, Pose};
 pub use probe::{Component, End, ProbeShape};
 pub use raster::{shadow_polygon, Coverage};
-pub use report::{cone_report, pgm, ConeReport, ConeRequest};
+pub use report::{cone_report, pgm, ConeInput, ConeReport, ConeRequest};
 pub use scene::{point_triangle_distance, Scene, Tri};
 
 use crate::geometry::{PartGeometry, P3, V3};

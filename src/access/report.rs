@@ -30,19 +30,28 @@ pub struct ConeReport {
     pub pgm: Vec<u8>,
 }
 
-/// Computes the cones the request names on the first measurement graph, or files a
-/// diagnostic saying what does not exist.
+/// The measurement graph a cone report looks into.
+pub struct ConeInput<'a> {
+    /// The model.
+    pub model: &'a crate::model::Model,
+    /// The part.
+    pub part: &'a crate::model::Part,
+    /// Its geometry.
+    pub geometry: &'a PartGeometry,
+    /// The graph's fpoints.
+    pub fpoints: &'a [Fpoint],
+    /// The plan the graph was sampled for, whose machine supplies the probes.
+    pub plan: Option<&'a crate::model::Plan>,
+}
+
+/// Computes the cones the request names, or files a diagnostic saying what does not
+/// exist.
 pub fn cone_report(
-    checked: &crate::Checked,
-    parts: &[Option<crate::PartData>],
-    graphs: &[crate::Graphed],
+    input: &ConeInput,
     req: &ConeRequest,
     diags: &mut Diagnostics,
 ) -> Option<ConeReport> {
-    let model = &checked.model;
-    let gr = graphs.first()?;
-    let part = &model.parts[gr.part];
-    let g = &parts[gr.part].as_ref()?.geometry;
+    let (model, part, g) = (input.model, input.part, input.geometry);
     let chosen: Vec<&Fpoint> = match &req.face {
         Some(name) => {
             let Some(face) = g.faces.iter().position(|f| &f.name == name) else {
@@ -57,13 +66,13 @@ pub fn cone_report(
                 );
                 return None;
             };
-            gr.graph
+            input
                 .fpoints
                 .iter()
                 .filter(|f| f.face.0 == face)
                 .collect()
         }
-        None => gr.graph.fpoints.iter().collect(),
+        None => input.fpoints.iter().collect(),
     };
     let Some(f) = chosen.get(req.point) else {
         diags.push(AccessError::NoPoint {
@@ -75,11 +84,7 @@ pub fn cone_report(
         );
         return None;
     };
-    let plan = gr
-        .graph
-        .plan
-        .as_ref()
-        .and_then(|name| model.plans.iter().find(|p| &p.name == name));
+    let plan = input.plan;
     let probe = match plan {
         Some(plan) => {
             let cmm = &model.cmms[plan.cmm.0];

@@ -1,0 +1,507 @@
+//! The golden cases: one folder per case under `tests/cases/`, run once, a snapshot per
+//! stage, and every check of the results (read-back, collision re-check of every move,
+//! the seed's results, coverage) on that one run. See `tests/README.md`.
+//!
+//! Each case runs on a one-thread pool while cases run side by side, so comparing with
+//! the snapshots (blessed on any number of threads) is also the determinism check.
+
+use inspc::diag::{render_human, RenderOptions};
+use inspc::model::fmt_num;
+use inspc::plan::{Hlip, Names, PlanOptions};
+use inspc::source::FsWorld;
+use inspc::{Built, Run, Until};
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use crate::common;
+use common::diff;
+
+/// How far a case runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Depth {
+    /// The front end: `model.txt`.
+    Check,
+    /// Through the measurement graphs: `graph.dot`, `fpoints.txt`.
+    Graph,
+    /// Through plans, paths and DMIS: `plan.txt`, `program.dmi`.
+    Build,
+}
+
+/// A case folder and what its `case.txt` says.
+struct Case {
+    name: String,
+    dir: PathBuf,
+    spec: PathBuf,
+    depth: Depth,
+    slow: bool,
+}
+
+/// What one run of a case produced.
+struct Outcome {
+    /// Snapshots by file name.
+    files: Vec<(&'static str, String)>,
+    /// The run, when it went past the front end.
+    run: Option<Run>,
+}
+
+/// Reads `case.txt`: `spec PATH` (default `main.insp` in the folder), `until check|graph|build`
+/// (default `check`), and `slow` for cases that take more than a few seconds.
+fn case(dir: &Path) -> Case {
+    let mut spec = dir.join("main.insp");
+    let mut depth = Depth::Check;
+    let mut slow = false;
+    let text = std::fs::read_to_string(dir.join("case.txt")).unwrap_or_default();
+    for line in text.lines().map(str::trim).filter(|l| !l.is_empty()) {
+        match line.split_once(' ') {
+            Some(("spec", p)) => spec = PathBuf::from(p.trim()),
+            Some(("until", "check")) => depth = Depth::Check,
+            Some(("until", "graph")) => depth = Depth::Graph,
+            Some(("until", "build")) => depth = Depth::Build,
+            None if line == "slow" => slow = true,
+            _ => panic!("{}: cannot read `{line}` in case.txt", dir.display()),
+        }
+    }
+    Case {
+        name: dir.file_name().unwrap().to_string_lossy().into_owned(),
+        dir: dir.to_path_buf(),
+        spec,
+        depth,
+        slow,
+    }
+}
+
+/// Every diagnostic rendered at width 100 without colour.
+fn render(checked: &inspc::Checked) -> String {
+    let opts = RenderOptions {
+        width: 100,
+        color: false,
+    };
+    checked
+        .diagnostics
+        .iter()
+        .map(|d| render_human(&checked.sources, d, opts))
+        .collect()
+}
+
+/// The graphs of a run as DOT, and every fpoint (face, position, normal).
+fn graph_files(run: &Run) -> (String, String) {
+    let (mut dot, mut points) = (String::new(), String::new());
+    let r = |v: f64| fmt_num((v * 1e6).round() / 1e6);
+    for gr in &run.graphs {
+        let part = &run.checked.model.parts[gr.part];
+        let g = &run.parts[gr.part].as_ref().unwrap().geometry;
+        dot += &inspc::graph::dot(part, g, &gr.graph, false);
+        let _ = writeln!(
+            points,
+            "# {} · plan {} · sampling {}",
+            part.name,
+            gr.graph.plan.as_deref().unwrap_or("-"),
+            gr.graph.sampling
+        );
+        for (i, p) in gr.graph.fpoints.iter().enumerate() {
+            let (q, n) = (&p.position, &p.normal);
+            let _ = writeln!(
+                points,
+                "p{i}\t{}\t{} {} {}\t{} {} {}",
+                g.faces[p.face.0].name,
+                r(q.x),
+                r(q.y),
+                r(q.z),
+                r(n.x),
+                r(n.y),
+                r(n.z)
+            );
+        }
+    }
+    (dot, points)
+}
+
+/// The names behind a built plan's ids.
+fn names<'a>(run: &'a Run, b: &Built) -> Names<'a> {
+    inspc::plan_names(&run.checked, &run.parts, b.plan).expect("a built plan has geometry")
+}
+
+/// Runs one case once, as far as it goes.
+fn run_case(c: &Case) -> Outcome {
+    let roots = [c.spec.clone()];
+    let front = inspc::check(&FsWorld, &roots);
+    if front.has_errors() {
+        return Outcome {
+            files: vec![("diagnostics.txt", render(&front))],
+            run: None,
+        };
+    }
+    let mut files = vec![("model.txt", front.summary() + &render(&front))];
+    if c.depth == Depth::Check {
+        return Outcome { files, run: None };
+    }
+    let until = if c.depth == Depth::Build {
+        Until::Build
+    } else {
+        Until::Graph
+    };
+    let run = inspc::run(&FsWorld, &roots, &PlanOptions::default(), until, &|_, _, _| {});
+    if !run.graphs.is_empty() || !run.checked.has_errors() {
+        let (dot, points) = graph_files(&run);
+        files.push(("graph.dot", dot));
+        files.push(("fpoints.txt", points));
+    }
+    if run.checked.has_errors() {
+        files.push(("diagnostics.txt", render(&run.checked)));
+    } else if c.depth == Depth::Build {
+        let plan: String = run
+            .built
+            .iter()
+            .map(|b| inspc::plan::text(&b.hlip, &names(&run, b)))
+            .collect();
+        let program: String = run.built.iter().map(|b| b.dmis.clone()).collect();
+        files.push(("plan.txt", plan));
+        files.push(("program.dmi", program));
+    }
+    Outcome {
+        files,
+        run: Some(run),
+    }
+}
+
+/// Whether slow cases are skipped (`INSPC_QUICK=1`, for development; CI runs them all).
+fn quick() -> bool {
+    std::env::var_os("INSPC_QUICK").is_some()
+}
+
+/// Every case, run once: side by side, each on a one-thread pool.
+fn outcomes() -> &'static [(Case, Outcome)] {
+    static ALL: OnceLock<Vec<(Case, Outcome)>> = OnceLock::new();
+    ALL.get_or_init(|| {
+        let cases: Vec<Case> = common::cases("tests/cases", 20)
+            .iter()
+            .map(|d| case(d))
+            .filter(|c| !(c.slow && quick()))
+            .collect();
+        // Slow cases start first, so that the others run beside them.
+        let mut order: Vec<usize> = (0..cases.len()).collect();
+        order.sort_by_key(|&k| (!cases[k].slow, k));
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
+        let mut done: Vec<(usize, Outcome)> = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..workers)
+                .map(|_| {
+                    s.spawn(|| {
+                        let pool = rayon::ThreadPoolBuilder::new()
+                            .num_threads(1)
+                            .build()
+                            .unwrap();
+                        let mut out = Vec::new();
+                        loop {
+                            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                            let Some(&k) = order.get(i) else { break };
+                            let c = &cases[k];
+                            out.push((k, pool.install(|| run_case(c))));
+                        }
+                        out
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().unwrap())
+                .collect()
+        });
+        done.sort_by_key(|(k, _)| *k);
+        cases
+            .into_iter()
+            .zip(done)
+            .map(|(c, (_, o))| (c, o))
+            .collect()
+    })
+}
+
+/// The built plans of every case that built, with the run they came from.
+fn built() -> impl Iterator<Item = (&'static Case, &'static Run, &'static Built)> {
+    outcomes().iter().flat_map(|(c, o)| {
+        o.run
+            .iter()
+            .flat_map(move |r| r.built.iter().map(move |b| (c, r, b)))
+    })
+}
+
+/// The one plan of a case, which must have built.
+fn one(name: &str) -> (&'static Run, &'static Built) {
+    let (_, o) = outcomes()
+        .iter()
+        .find(|(c, _)| c.name == name)
+        .unwrap_or_else(|| panic!("no case {name}"));
+    let run = o.run.as_ref().unwrap_or_else(|| panic!("{name} did not run"));
+    assert_eq!(run.built.len(), 1, "{name}: one plan");
+    (run, &run.built[0])
+}
+
+#[test]
+fn golden_cases() {
+    let bless = std::env::var_os("INSPC_BLESS").is_some();
+    let mut failures = Vec::new();
+    for (c, o) in outcomes() {
+        let has = |f: &str| o.files.iter().any(|(n, _)| *n == f);
+        // A case never silently flips between passing and failing, even under bless.
+        for (file, state) in [
+            ("model.txt", "fails in the front end"),
+            ("diagnostics.txt", "passes"),
+        ] {
+            if !has(file) && c.dir.join(file).exists() {
+                failures.push(format!(
+                    "{}: now {state}, but it expects {file}; if that is intended, delete it and bless",
+                    c.name
+                ));
+            }
+        }
+        if failures.iter().any(|f| f.starts_with(&format!("{}:", c.name))) {
+            continue;
+        }
+        for (name, actual) in &o.files {
+            let path = c.dir.join(name);
+            if bless {
+                std::fs::write(&path, actual).unwrap();
+                continue;
+            }
+            match std::fs::read_to_string(&path) {
+                Ok(expected) if &expected == actual => {}
+                Ok(expected) => failures.push(format!(
+                    "{}: differs\n{}",
+                    path.display(),
+                    diff(&expected, actual)
+                )),
+                Err(_) => failures.push(format!(
+                    "{}: no expectation; run `INSPC_BLESS=1 cargo test --test suite cases::`",
+                    path.display()
+                )),
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "snapshots differ (INSPC_BLESS=1 to accept):\n{}",
+        failures.join("\n\n")
+    );
+}
+
+#[test]
+fn failed_builds_write_no_program() {
+    for (c, o) in outcomes() {
+        if o.files.iter().any(|(n, _)| *n == "diagnostics.txt") {
+            assert!(
+                !c.dir.join("program.dmi").exists() && !c.dir.join("plan.txt").exists(),
+                "{}: a failed case has no plan or program",
+                c.name
+            );
+        }
+    }
+}
+
+/// Every program read back: it passes the reader's checks, prints back byte for byte,
+/// and touches exactly the plan's points in the plan's order.
+#[test]
+fn programs_read_back() {
+    let mut n = 0;
+    for (c, _, b) in built() {
+        let program = inspc::dmis::read(inspc::source::FileId(0), &b.dmis).unwrap_or_else(|errors| {
+            panic!(
+                "{}: the reader rejects the program: {:?}",
+                c.name,
+                errors.iter().map(|e| e.to_string()).collect::<Vec<_>>()
+            )
+        });
+        assert!(
+            program.to_text() == b.dmis,
+            "{}: the program does not print back the same:\n{}",
+            c.name,
+            diff(&b.dmis, &program.to_text())
+        );
+        // Every touch of the plan, in program order (the manual alignment's first).
+        let mut want = Vec::new();
+        for s in &b.llip.setups {
+            for step in &s.alignment.steps {
+                want.extend(step.points.iter().map(|&k| b.hlip.points[k].position));
+            }
+            for g in &s.groups {
+                for bl in &g.blocks {
+                    want.extend(bl.touches.iter().map(|t| b.hlip.points[t.point].position));
+                }
+            }
+        }
+        let got: Vec<[f64; 3]> = program
+            .commands("PTMEAS")
+            .map(|p| {
+                let v: Vec<f64> = p[1..4].iter().map(|x| x.parse().unwrap()).collect();
+                [v[0], v[1], v[2]]
+            })
+            .collect();
+        assert_eq!(got.len(), want.len(), "{}: touches", c.name);
+        for (a, w) in got.iter().zip(&want) {
+            assert!(
+                (0..3).all(|k| (a[k] - w[k]).abs() <= 1e-4),
+                "{}: touches {a:?}, the plan {w:?}",
+                c.name
+            );
+        }
+        n += 1;
+    }
+    assert!(n >= 8, "only {n} programs");
+}
+
+/// Every move of every program, re-checked with parry on its own: the probe of each
+/// group swept along every segment between the positions the program commands, over a
+/// table computed here from the part's vertices.
+#[test]
+fn every_move_is_collision_free() {
+    let mut programs = 0;
+    for (c, run, b) in built() {
+        let model = &run.checked.model;
+        let plan = &model.plans[b.plan];
+        let geometry = &run.parts[plan.part.0].as_ref().unwrap().geometry;
+        let scene = inspc::access::Scene::of_part(geometry);
+        let probes = inspc::access::ProbeShape::of_cmm(model, &model.cmms[plan.cmm.0]);
+        let mut segments = 0;
+        for s in &b.llip.setups {
+            let up = b.hlip.setups[s.setup].up;
+            let table = geometry
+                .vertices
+                .iter()
+                .map(|v| v.coords.dot(&up))
+                .fold(f64::INFINITY, f64::min);
+            for g in &s.groups {
+                let probe = &probes[g.probe.0];
+                let dir = nalgebra::Vector3::from(g.direction);
+                let pose = inspc::access::Pose::new(&scene, probe, dir, up, table);
+                let mut pts: Vec<[f64; 3]> = g.entry.clone();
+                for bl in &g.blocks {
+                    for t in &bl.touches {
+                        pts.extend(t.via.iter().copied());
+                        pts.push(t.standoff);
+                    }
+                }
+                pts.extend(g.exit.iter().copied());
+                for w in pts.windows(2) {
+                    let (p, q) = (w[0].into(), w[1].into());
+                    if let Err(e) = pose.segment(&p, &q) {
+                        panic!(
+                            "{}: {} A{} B{}: {:?} -> {:?}: {e}",
+                            c.name,
+                            probe.name,
+                            g.a,
+                            g.b,
+                            w[0],
+                            w[1]
+                        );
+                    }
+                    segments += 1;
+                }
+            }
+        }
+        assert!(segments > 10, "{}: {segments} segments", c.name);
+        programs += 1;
+    }
+    assert!(programs >= 8, "only {programs} programs");
+}
+
+/// Which (probe, A, B) inspect a feature.
+fn configs_of(run: &Run, b: &Built, feature: &str) -> BTreeSet<(String, String)> {
+    let names = names(run, b);
+    let mut out = BTreeSet::new();
+    for s in &b.hlip.setups {
+        for p in &s.probes {
+            for o in &p.orients {
+                if o.inspections.iter().any(|i| names.feature(i.feature) == feature) {
+                    out.insert((names.probe(p.probe).to_string(), format!("{} {}", o.a, o.b)));
+                }
+            }
+        }
+    }
+    out
+}
+
+fn hlip(name: &str) -> &'static Hlip {
+    &one(name).1.hlip
+}
+
+#[test]
+fn the_seeds_results() {
+    // F2 (fig. 3.10): one setup, two probes, the top inspected under each.
+    let (run, b) = one("example_f2");
+    assert_eq!((b.hlip.summary.setups, b.hlip.summary.probes_used), (1, 2));
+    let probes: BTreeSet<String> = configs_of(run, b, "top").into_iter().map(|c| c.0).collect();
+    assert_eq!(probes.len(), 2, "the top under each probe");
+    // F3: two setups on a fixed head; one setup, one probe, two orientations indexed.
+    assert_eq!(hlip("example_f3_fixed").summary.setups, 2);
+    let s = &hlip("example_f3_indexed").summary;
+    assert_eq!((s.setups, s.probes_used, s.orientations), (1, 1, 2));
+    // F4: each hole by a different probe and orientation.
+    let (run, b) = one("example_f4");
+    let (large, small) = (
+        configs_of(run, b, "large_hole"),
+        configs_of(run, b, "small_hole"),
+    );
+    assert_eq!((large.len(), small.len()), (1, 1), "{large:?} {small:?}");
+    let (l, s) = (large.first().unwrap(), small.first().unwrap());
+    assert!(l.0 != s.0 && l.1 != s.1, "{l:?} {s:?}");
+    // The swiss-block in one setup, the swiss-sphere in 20 (fixed) or 2 (indexable).
+    assert_eq!(hlip("example_swiss_block").summary.setups, 1);
+    assert_eq!(hlip("example_swiss_sphere_fixed").summary.setups, 20);
+    assert_eq!(hlip("example_swiss_sphere_indexed").summary.setups, 2);
+}
+
+/// Every face of the graph is inspected (or the table stands in for it), every point
+/// inspected is a point of its face, no plan has fewer setups than the proven minimum,
+/// and violations are counted for every level of the hierarchy.
+#[test]
+fn plans_cover_the_graph_and_find_the_minimum_setups() {
+    for (c, run, b) in built() {
+        let h = &b.hlip;
+        let g = &run
+            .graphs
+            .iter()
+            .find(|g| g.graph.plan.as_deref() == Some(&run.checked.model.plans[b.plan].name))
+            .unwrap()
+            .graph;
+        let mut faces = BTreeSet::new();
+        for s in &h.setups {
+            for p in &s.probes {
+                for o in &p.orients {
+                    for i in &o.inspections {
+                        for f in &i.faces {
+                            faces.insert(f.face);
+                            for &k in &f.points {
+                                assert_eq!(h.points[k].face, f.face, "{}", c.name);
+                                assert_eq!(h.points[k].at.contact(), f.contact, "{}", c.name);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        for n in g.graph.node_indices() {
+            if let inspc::graph::Node::Face { face, .. } = g.graph[n] {
+                if g.fpoints.iter().any(|f| f.face == face) {
+                    assert!(
+                        faces.contains(&face),
+                        "{}: face {} is not inspected",
+                        c.name,
+                        names(run, b).face(face)
+                    );
+                }
+            }
+        }
+        let (min, proven) = h.summary.min_setups;
+        assert!(h.summary.setups >= min || !proven, "{}", c.name);
+        let model = &run.checked.model;
+        assert_eq!(
+            h.summary.violations.len(),
+            model.hierarchies[model.plans[b.plan].hierarchy.0]
+                .levels
+                .len(),
+            "{}",
+            c.name
+        );
+    }
+}

@@ -1,0 +1,512 @@
+//! The `inspc` binary: exit codes and the JSON diagnostics contract.
+
+use crate::common;
+
+use std::process::Command;
+
+fn inspc(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_inspc"))
+        .args(args)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("inspc runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+fn temp_spec(name: &str, text: &str) -> String {
+    let dir = std::env::temp_dir().join(format!("inspc-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_string_lossy().into_owned()
+}
+
+#[test]
+fn check_clean_example_exits_zero() {
+    let (code, stdout, stderr) = inspc(&["check", "examples/f2.insp"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.is_empty());
+    assert!(stderr.contains("1 file checked, no errors"), "{stderr}");
+}
+
+#[test]
+fn check_reports_errors_and_exits_one() {
+    let bad = temp_spec(
+        "bad.insp",
+        "stylus s { tip 0 mm, length 20 deg, stem 1 mmm }\n",
+    );
+    let (code, _, stderr) = inspc(&["check", &bad]);
+    assert_eq!(code, 1);
+    assert!(
+        stderr.contains("insp::resolve::non_positive") && stderr.contains("help:"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("3 errors"), "{stderr}");
+}
+
+#[test]
+fn json_diagnostics_are_one_object_per_line() {
+    let bad = temp_spec(
+        "json.insp",
+        "// é\nstylus s { tip 0 mm, length 20 deg, stem 1 mmm }\n",
+    );
+    let (code, stdout, stderr) = inspc(&["check", "--message-format", "json", &bad]);
+    assert_eq!(code, 1);
+    assert!(stderr.is_empty(), "json mode keeps stderr quiet: {stderr}");
+    let lines: Vec<serde_json::Value> = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("each line is JSON"))
+        .collect();
+    assert_eq!(lines.len(), 3);
+    for v in &lines {
+        for key in [
+            "severity",
+            "code",
+            "message",
+            "file",
+            "line",
+            "column",
+            "end_line",
+            "end_column",
+            "labels",
+            "help",
+        ] {
+            assert!(v.get(key).is_some(), "missing `{key}` in {v}");
+        }
+        assert_eq!(v["severity"], "error");
+        assert!(v["code"].as_str().unwrap().starts_with("insp::"));
+        assert!(!v["labels"].as_array().unwrap().is_empty());
+    }
+    // `tip 0 mm`: line 2, column of `0` (1-based, in characters).
+    assert_eq!(lines[0]["line"], 2);
+    assert_eq!(lines[0]["column"], 16);
+    assert_eq!(lines[0]["end_column"], 20);
+    assert_eq!(lines[2]["code"], "insp::resolve::unknown_unit");
+    assert_eq!(lines[2]["help"], "did you mean `mm`?");
+}
+
+#[test]
+fn missing_file_is_a_diagnostic() {
+    let (code, stdout, _) = inspc(&["check", "--message-format", "json", "no/such/spec.insp"]);
+    assert_eq!(code, 1);
+    let v: serde_json::Value = serde_json::from_str(stdout.lines().next().unwrap()).unwrap();
+    assert_eq!(v["code"], "insp::load::unreadable");
+}
+
+#[test]
+fn emit_model_prints_the_resolved_spec() {
+    let (code, stdout, _) = inspc(&["check", "--emit", "model", "examples/f2.insp"]);
+    assert_eq!(code, 0);
+    assert!(stdout.contains("part f2: box (120, 60, 40)"), "{stdout}");
+    assert!(
+        stdout.contains("tolerance T2: perpendicularity(small_slot) 0.02 | A"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn usage_errors_exit_two() {
+    let (code, _, stderr) = inspc(&["check"]);
+    assert_eq!(code, 2, "{stderr}");
+}
+
+fn type_counts(stdout: &str) -> std::collections::BTreeMap<String, usize> {
+    let v: serde_json::Value = serde_json::from_str(stdout).expect("faces --format json is JSON");
+    let mut counts = std::collections::BTreeMap::new();
+    for f in v[0]["faces"].as_array().unwrap() {
+        *counts
+            .entry(f["type"].as_str().unwrap().to_string())
+            .or_default() += 1;
+    }
+    counts
+}
+
+#[test]
+fn faces_of_the_nist_obj_groups_match_the_pmi_surface_types() {
+    // The PMI lists CTC 01 as 56 planes, 57 cylinders and 4 cones; FTC 08 as 82 planes,
+    // 134 cylinders, 20 spheres and 12 tori (free-form for inspc).
+    common::require_shared_parts();
+    let (code, stdout, stderr) = inspc(&[
+        "faces",
+        "--format",
+        "json",
+        "../shared/parts/nist_ctc_01_asme1_ap242-e1.obj",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let c = type_counts(&stdout);
+    assert_eq!((c["plane"], c["cylinder"], c["cone"]), (56, 57, 4), "{c:?}");
+    let (_, stdout, _) = inspc(&[
+        "faces",
+        "--format",
+        "json",
+        "../shared/parts/nist_ftc_08_asme1_ap242-e1.obj",
+    ]);
+    let c = type_counts(&stdout);
+    assert_eq!(
+        (c["plane"], c["cylinder"], c["sphere"], c["freeform"]),
+        (82, 134, 20, 12),
+        "{c:?}"
+    );
+}
+
+#[test]
+fn faces_segments_the_nist_stl_files_into_sensible_types() {
+    common::require_shared_parts();
+    for (mesh, min_faces) in [
+        ("nist_ctc_01_asme1_ap242-e1.stl", 90),
+        ("nist_ftc_08_asme1_ap242-e1.stl", 200),
+    ] {
+        let (code, stdout, stderr) = inspc(&[
+            "faces",
+            "--format",
+            "json",
+            &format!("../shared/parts/{mesh}"),
+        ]);
+        assert_eq!(code, 0, "{stderr}");
+        let c = type_counts(&stdout);
+        let total: usize = c.values().sum();
+        assert!(total >= min_faces, "{mesh}: {c:?}");
+        // Planes and cylinders dominate; almost nothing is left free-form.
+        assert!(c["plane"] + c["cylinder"] > total * 2 / 3, "{mesh}: {c:?}");
+        assert!(
+            c.get("freeform").copied().unwrap_or(0) * 20 < total,
+            "{mesh}: {c:?}"
+        );
+    }
+    let (_, text, _) = inspc(&["faces", "../shared/parts/nist_ctc_01_asme1_ap242-e1.stl"]);
+    assert!(
+        text.contains("segment_1 ") && text.contains("cylinder") && text.contains("(hole)"),
+        "{text}"
+    );
+}
+
+#[test]
+fn faces_of_a_spec_name_the_constructive_faces() {
+    let (code, stdout, stderr) = inspc(&["faces", "examples/f2.insp"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.starts_with("f2: 12 faces"), "{stdout}");
+    assert!(
+        stdout.contains("large.left_wall") && stdout.contains("small.floor"),
+        "{stdout}"
+    );
+    let (code, stdout, _) = inspc(&["faces", "examples/swiss_block.insp"]);
+    assert_eq!(code, 0);
+    assert!(stdout.starts_with("swiss_block: 206 faces"), "{stdout}");
+}
+
+#[test]
+fn faces_of_a_missing_mesh_is_a_diagnostic() {
+    let (code, _, stderr) = inspc(&["faces", "no/such/part.stl"]);
+    assert_eq!(code, 1);
+    assert!(
+        stderr.contains("insp::geometry::mesh_unreadable"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn graph_prints_dot_mermaid_and_json() {
+    let (code, dot, stderr) = inspc(&["graph", "examples/f2.insp"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        dot.starts_with("digraph \"f2\" {") && dot.trim_end().ends_with('}'),
+        "{dot}"
+    );
+    assert!(
+        dot.contains("stock.top\\nplane · 4 points\\ncan rest on the table"),
+        "{dot}"
+    );
+    assert!(dot.contains("[style=dashed, label=\"datum\"]"), "{dot}");
+
+    let (code, with_points, _) = inspc(&["graph", "examples/f2.insp", "--points"]);
+    assert_eq!(code, 0);
+    assert_eq!(
+        with_points.matches("shape=point").count(),
+        20,
+        "{with_points}"
+    );
+
+    let (code, mermaid, _) = inspc(&["graph", "examples/f2.insp", "--format", "mermaid"]);
+    assert_eq!(code, 0);
+    assert!(
+        mermaid.starts_with("flowchart TD\n") && mermaid.contains("-. datum .->"),
+        "{mermaid}"
+    );
+
+    let (code, json, _) = inspc(&["graph", "examples/swiss_block.insp", "--format", "json"]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&json).expect("graph --format json is JSON");
+    let g = &v[0];
+    assert_eq!(g["plan"], "swiss_block_plan");
+    assert_eq!(g["counts"]["faces"], 101);
+    let points: usize = g["faces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["points"].as_array().unwrap().len())
+        .sum();
+    assert_eq!(g["counts"]["fpoints"], points);
+    assert_eq!(g["faces"][0]["points"][0]["n"].as_array().unwrap().len(), 3);
+}
+
+#[test]
+fn graph_of_both_nist_parts() {
+    common::require_shared_parts();
+    for (spec, tolerances) in [
+        ("tests/real/nist_ctc_01.insp", 12),
+        ("tests/real/nist_ftc_08.insp", 42),
+    ] {
+        let (code, json, stderr) = inspc(&["graph", spec, "--format", "json"]);
+        assert_eq!(code, 0, "{spec}: {stderr}");
+        let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+        assert_eq!(v[0]["counts"]["tolerances"], tolerances, "{spec}");
+        assert!(
+            v[0]["faces"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|f| !f["points"].as_array().unwrap().is_empty()),
+            "{spec}: a face without points"
+        );
+    }
+}
+
+#[test]
+fn graph_of_a_bad_spec_exits_one() {
+    let spec = temp_spec(
+        "bad_graph.insp",
+        "part p { units mm, stock box(10, 10, 10), feature f = stock.tpo }\n",
+    );
+    let (code, out, stderr) = inspc(&["graph", &spec]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        out.is_empty() && stderr.contains("insp::resolve::"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn cones_prints_a_summary_and_draws_the_cone() {
+    let dir = std::env::temp_dir().join(format!("inspc-cones-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("cone.pgm");
+    let (code, stdout, stderr) = inspc(&[
+        "cones",
+        "examples/f4.insp",
+        "--face",
+        "small.wall",
+        "--point",
+        "2",
+        "--probe",
+        "small",
+        "-n",
+        "32",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    for needle in [
+        "face small.wall (cylinder)",
+        "probe small",
+        "stylus",
+        "body",
+        "D2 (setup directions)",
+        "wrote",
+    ] {
+        assert!(stdout.contains(needle), "no `{needle}` in:\n{stdout}");
+    }
+    let bytes = std::fs::read(&out).unwrap();
+    assert!(bytes.starts_with(b"P5\n128 96\n255\n"));
+    assert_eq!(bytes.len(), "P5\n128 96\n255\n".len() + 128 * 96);
+    // Deep in the small hole few directions are free, but the exact hole axis is.
+    assert!(stdout.contains("axes in the cone: +x"), "{stdout}");
+    let (code, stdout, stderr) = inspc(&[
+        "cones",
+        "examples/f4.insp",
+        "--face",
+        "stock.top",
+        "-n",
+        "32",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let axes = stdout
+        .lines()
+        .find(|l| l.contains("axes in the cone"))
+        .unwrap();
+    assert!(axes.ends_with("+z") && !axes.contains("-z"), "{stdout}");
+    let bytes = std::fs::read(&out).unwrap();
+    // On the top, the upper half of the sphere is largely free.
+    let px = &bytes["P5\n128 96\n255\n".len()..];
+    let white = px.iter().filter(|&&b| b == 255).count();
+    let black = px.iter().filter(|&&b| b == 0).count();
+    assert!(white > 0 && black > white, "{white} free, {black} blocked");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn cones_of_unknown_names_are_diagnostics() {
+    for (args, code) in [
+        (&["--face", "nope"][..], "insp::access::unknown_face"),
+        (&["--probe", "zz"][..], "insp::access::unknown_probe"),
+        (
+            &["--face", "small.wall", "--point", "99"][..],
+            "insp::access::no_point",
+        ),
+    ] {
+        let mut all = vec!["cones", "examples/f4.insp"];
+        all.extend_from_slice(args);
+        all.extend_from_slice(&["-o", "/nonexistent-dir/never.pgm"]);
+        let (status, _, stderr) = inspc(&all);
+        assert_eq!(status, 1);
+        assert!(stderr.contains(code), "{args:?}: {stderr}");
+    }
+    let spec = temp_spec(
+        "cones_no_machine.insp",
+        "part p {\n    units mm\n    stock box(10, 10, 10)\n    feature top = stock.top\n}\n",
+    );
+    let (status, _, stderr) = inspc(&[
+        "cones",
+        &spec,
+        "--probe",
+        "p1",
+        "-o",
+        "/nonexistent-dir/x.pgm",
+    ]);
+    assert_eq!(status, 1);
+    assert!(stderr.contains("insp::access::no_machine"), "{stderr}");
+}
+
+#[test]
+fn build_writes_the_program_and_the_plan() {
+    let dir = std::env::temp_dir().join(format!("inspc-build-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let dmi = dir.join("f2.dmi");
+    let json = dir.join("f2.json");
+    let (code, stdout, stderr) = inspc(&[
+        "build",
+        "examples/f2.insp",
+        "-o",
+        dmi.to_str().unwrap(),
+        "--plan-json",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("1 setup, 2 probes"), "{stdout}");
+    assert!(
+        stdout.contains(&format!("wrote {}", dmi.display())),
+        "{stdout}"
+    );
+    assert!(stdout.contains("time: front end"), "{stdout}");
+    let program = std::fs::read_to_string(&dmi).unwrap();
+    assert!(program.contains("DMISMN/'F2_PLAN',05.3") && program.ends_with("ENDFIL\n"));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(v["paths"].as_array().is_some_and(|p| !p.is_empty()), "{v}");
+    // The program reads back clean.
+    let (code, stdout, stderr) = inspc(&["dmis", dmi.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("touches"), "{stdout}");
+    // No temporary file is left beside it.
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("inspc-tmp"))
+        .collect();
+    assert!(left.is_empty());
+}
+
+#[test]
+fn a_failed_build_writes_nothing() {
+    let dir = std::env::temp_dir().join(format!("inspc-fail-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let dmi = dir.join("slot.dmi");
+    let (code, _, stderr) = inspc(&[
+        "build",
+        "tests/cases/uninspectable_slot/main.insp",
+        "-o",
+        dmi.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(
+        stderr.contains("insp::plan::uninspectable_face"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("nothing written"), "{stderr}");
+    assert!(!dmi.exists());
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        0,
+        "no partial file"
+    );
+}
+
+#[test]
+fn the_dmis_reader_reports_what_a_controller_rejects() {
+    let bad = temp_spec(
+        "bad.dmi",
+        "DMISMN/'X',05.3\nF(bad)=FEAT/POINT,CART,0,0,0,0,0,1\nMEAS/POINT,F(NONE),2\nPTMEAS/CART,1,2,3,0,0,1\nENDMES\nOUTPUT/FA(NONE),TA(T1)\n",
+    );
+    let (code, _, stderr) = inspc(&["dmis", &bad]);
+    assert_eq!(code, 1);
+    for c in [
+        "insp::dmis::bad_label",
+        "insp::dmis::undefined",
+        "insp::dmis::structure",
+    ] {
+        assert!(stderr.contains(c), "{c}: {stderr}");
+    }
+    assert!(stderr.contains("help:"), "{stderr}");
+}
+
+/// A diagnostic about a machine declared in the stdlib is filed under the stdlib's file
+/// and shows its source, not a failed read of the user's file.
+#[test]
+fn cones_with_a_stdlib_machine_point_into_the_stdlib() {
+    let spec = temp_spec(
+        "cones_std_machine.insp",
+        "use std::cmms::bridge_fixed\n\npart p {\n    units mm\n    stock box(10, 10, 10)\n    feature top = stock.top\n}\n\nplan q { part p, cmm bridge_fixed }\n",
+    );
+    let (status, _, stderr) = inspc(&[
+        "cones",
+        &spec,
+        "--probe",
+        "zz",
+        "-o",
+        "/nonexistent-dir/x.pgm",
+    ]);
+    assert_eq!(status, 1, "{stderr}");
+    assert!(stderr.contains("insp::access::unknown_probe"), "{stderr}");
+    assert!(stderr.contains("cmm bridge_fixed"), "{stderr}");
+    assert!(!stderr.contains("Failed to read"), "{stderr}");
+}
+
+/// `output { graph }` writes the plan's measurement graph beside the program, in the
+/// format its extension asks for.
+#[test]
+fn build_writes_the_graph_the_plan_asks_for() {
+    let dir = std::env::temp_dir().join(format!("inspc-graph-out-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f2 = std::fs::read_to_string("examples/f2.insp").unwrap();
+    let spec = dir.join("f2.insp");
+    std::fs::write(
+        &spec,
+        f2.replace(
+            "    sampling fan_leu\n}",
+            "    sampling fan_leu\n    output { dmis \"f2.dmi\", graph \"f2.mmd\" }\n}",
+        ),
+    )
+    .unwrap();
+    let (code, stdout, stderr) = inspc(&["build", spec.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    let graph = std::fs::read_to_string(dir.join("f2.mmd")).unwrap();
+    assert!(graph.starts_with("flowchart") || graph.contains("graph"), "{graph}");
+    assert!(graph.contains("small_slot"), "{graph}");
+    assert!(stdout.contains("f2.mmd"), "{stdout}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,220 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use inspc::source::MemoryWorld;
+use std::path::PathBuf;
+
+/// One diagnostic, flattened for assertions.
+#[derive(Debug, Clone)]
+pub struct Flat {
+    pub code: String,
+    pub message: String,
+    pub help: String,
+    pub file: String,
+    /// The text under the first label.
+    pub span_text: String,
+    pub warning: bool,
+}
+
+/// The diagnostics of one check, with the rule of typst's test runner: once a test
+/// states what it expects ([`Diags::saw`], through `expect`), every diagnostic must be
+/// expected — one it did not annotate fails the test when the value is dropped.
+pub struct Diags {
+    items: Vec<Flat>,
+    seen: std::cell::RefCell<Vec<bool>>,
+    annotated: std::cell::Cell<bool>,
+}
+
+impl Diags {
+    fn new(items: Vec<Flat>) -> Diags {
+        let n = items.len();
+        Diags {
+            items,
+            seen: std::cell::RefCell::new(vec![false; n]),
+            annotated: std::cell::Cell::new(false),
+        }
+    }
+
+    /// Marks the first not-yet-seen diagnostic that satisfies `pred` as expected and
+    /// returns it (the first seen one when every match was seen already).
+    pub fn saw(&self, pred: impl Fn(&Flat) -> bool) -> Option<&Flat> {
+        self.annotated.set(true);
+        let mut seen = self.seen.borrow_mut();
+        let k = (0..self.items.len())
+            .find(|&k| !seen[k] && pred(&self.items[k]))
+            .or_else(|| (0..self.items.len()).find(|&k| pred(&self.items[k])))?;
+        seen[k] = true;
+        Some(&self.items[k])
+    }
+
+    /// The one diagnostic, marked expected; fails unless there is exactly one.
+    #[track_caller]
+    pub fn only(&self) -> &Flat {
+        assert_eq!(
+            self.items.len(),
+            1,
+            "expected one diagnostic, got {:?}",
+            self.items.iter().map(|d| &d.code).collect::<Vec<_>>()
+        );
+        self.saw(|_| true).unwrap()
+    }
+
+    /// Marks every diagnostic with `code` as expected without asserting on it (for
+    /// tests about something else that produce it on the way).
+    pub fn allow(&self, code: &str) {
+        let mut seen = self.seen.borrow_mut();
+        for (k, d) in self.items.iter().enumerate() {
+            if d.code == code {
+                seen[k] = true;
+            }
+        }
+    }
+
+    /// The diagnostics not (yet) expected.
+    pub fn unexpected(&self) -> Vec<&Flat> {
+        let seen = self.seen.borrow();
+        self.items
+            .iter()
+            .zip(seen.iter())
+            .filter(|(_, s)| !**s)
+            .map(|(d, _)| d)
+            .collect()
+    }
+}
+
+impl std::ops::Deref for Diags {
+    type Target = [Flat];
+    fn deref(&self) -> &[Flat] {
+        &self.items
+    }
+}
+
+impl Drop for Diags {
+    fn drop(&mut self) {
+        if std::thread::panicking() || !self.annotated.get() {
+            return;
+        }
+        let left = self.unexpected();
+        if !left.is_empty() {
+            let lines: Vec<String> = left
+                .iter()
+                .map(|d| format!("  {} `{}`: {}", d.code, d.span_text, d.message))
+                .collect();
+            panic!(
+                "diagnostics the test did not expect:\n{}",
+                lines.join("\n")
+            );
+        }
+    }
+}
+
+/// Checks `files` (path, contents) in memory; the first file is the root.
+pub fn check_files(files: &[(&str, &[u8])]) -> Diags {
+    Diags::new(run_files(files, false))
+}
+
+/// [`check_files`] through the planner too.
+#[allow(dead_code)]
+pub fn plan_files(files: &[(&str, &[u8])]) -> Diags {
+    Diags::new(run_files(files, true))
+}
+
+fn run_files(files: &[(&str, &[u8])], plan: bool) -> Vec<Flat> {
+    let mut world = MemoryWorld::new();
+    for (p, c) in files {
+        world.insert(p, c.to_vec());
+    }
+    let roots = [PathBuf::from(files[0].0)];
+    let checked = if plan {
+        inspc::plans(&world, &roots, &inspc::plan::PlanOptions::default()).0
+    } else {
+        inspc::measurement_graphs(&world, &roots).0
+    };
+    checked
+        .diagnostics
+        .iter()
+        .map(|d| {
+            let file = checked.sources.get(d.file);
+            let span_text = d
+                .inner
+                .labels()
+                .and_then(|mut l| l.next())
+                .map(|l| {
+                    file.text
+                        .get(l.offset()..l.offset() + l.len())
+                        .unwrap_or("")
+                        .to_string()
+                })
+                .unwrap_or_default();
+            Flat {
+                code: d.code(),
+                message: d.message(),
+                help: d.inner.help().map(|h| h.to_string()).unwrap_or_default(),
+                file: file.name.clone(),
+                span_text,
+                warning: d.severity() == miette::Severity::Warning,
+            }
+        })
+        .collect()
+}
+
+/// Checks one in-memory file named `main.insp`.
+pub fn check_src(src: &str) -> Diags {
+    check_files(&[("main.insp", src.as_bytes())])
+}
+
+/// The NIST parts are expected in ../shared/parts/ beside the repository, as CI has them.
+pub fn require_shared_parts() {
+    assert!(
+        std::path::Path::new("../shared/parts/nist_ctc_01_asme1_ap242-e1.obj").exists(),
+        "the NIST parts are expected in ../shared/parts/ beside the repository, as CI has them"
+    );
+}
+
+/// The first differing lines, enough to see what changed.
+pub fn diff(expected: &str, actual: &str) -> String {
+    let (e, a): (Vec<&str>, Vec<&str>) = (expected.lines().collect(), actual.lines().collect());
+    let mut out = Vec::new();
+    for i in 0..e.len().max(a.len()) {
+        let (x, y) = (e.get(i), a.get(i));
+        if x != y {
+            out.push(format!(
+                "line {}:\n  - {}\n  + {}",
+                i + 1,
+                x.unwrap_or(&"<none>"),
+                y.unwrap_or(&"<none>")
+            ));
+            if out.len() == 5 {
+                break;
+            }
+        }
+    }
+    out.join("\n")
+}
+
+/// The spec of a golden case folder: the path in its `source.txt`, else its `main.insp`.
+#[allow(dead_code)]
+pub fn spec_of(case: &std::path::Path) -> PathBuf {
+    let source = case.join("source.txt");
+    if source.exists() {
+        PathBuf::from(std::fs::read_to_string(&source).unwrap().trim())
+    } else {
+        case.join("main.insp")
+    }
+}
+
+/// The case folders under `dir`, sorted; at least `min` of them.
+pub fn cases(dir: &str, min: usize) -> Vec<PathBuf> {
+    let mut cases: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .collect();
+    cases.sort();
+    assert!(
+        cases.len() >= min,
+        "expected the cases under {dir}, found {}",
+        cases.len()
+    );
+    cases
+}
