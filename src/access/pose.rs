@@ -9,7 +9,7 @@
 //! the components' lowest points ([`lowest`]) and the table's height ([`table_height`]).
 //!
 //! **Architecture Invariant:** no other module poses a probe or states a clearance to
-//! part or table; `tests/cases.rs` re-checks every move of every golden program through
+//! part or table; `tests/suite/cases.rs` re-checks every move of every golden program through
 //! [`Pose::segment`].
 
 use super::{component_hits, head_direction, Component, End, ProbeShape, Scene};

@@ -1,7 +1,7 @@
 //! Lowering pest pairs into the typed AST.
 //!
 //! The grammar guarantees the shape of every pair, so the `expect`s here state grammar
-//! facts; the fuzz property test (`tests/no_panic.rs`) holds us to them.
+//! facts; the fuzz property test (`tests/suite/no_panic.rs`) holds us to them.
 
 use super::ast::*;
 use super::{Rule, SyntaxError};

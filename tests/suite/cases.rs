@@ -3,7 +3,8 @@
 //! the seed's results, coverage) on that one run. See `tests/README.md`.
 //!
 //! Each case runs on a one-thread pool while cases run side by side, so comparing with
-//! the snapshots (blessed on any number of threads) is also the determinism check.
+//! the snapshots (blessed on any number of threads) is also the determinism check; a
+//! `slow` case runs on every thread instead, so that it does not hold up the suite.
 
 use inspc::diag::{render_human, RenderOptions};
 use inspc::model::fmt_num;
@@ -198,7 +199,18 @@ fn outcomes() -> &'static [(Case, Outcome)] {
                             let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                             let Some(&k) = order.get(i) else { break };
                             let c = &cases[k];
-                            out.push((k, pool.install(|| run_case(c))));
+                            // A slow case takes every thread (it would otherwise be the
+                            // whole suite's critical path); the rest take one each.
+                            let outcome = if c.slow {
+                                rayon::ThreadPoolBuilder::new()
+                                    .num_threads(workers)
+                                    .build()
+                                    .unwrap()
+                                    .install(|| run_case(c))
+                            } else {
+                                pool.install(|| run_case(c))
+                            };
+                            out.push((k, outcome));
                         }
                         out
                     })

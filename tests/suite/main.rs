@@ -1,0 +1,20 @@
+//! The integration tests, as one binary: one link instead of one per file, and its tests
+//! run side by side (the long golden cases beside the accessibility checks). Run a part
+//! with `cargo test --test suite <module>::`, e.g. `cargo test --test suite cases::`.
+
+mod common;
+
+mod access;
+mod cases;
+mod catalogue;
+mod cli;
+mod cluster_props;
+mod diagnostics;
+mod examples;
+mod fpoints;
+mod geometry_props;
+mod grammar;
+mod mesh_fuzz;
+mod no_panic;
+mod sampling;
+mod tours;
