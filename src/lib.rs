@@ -19,7 +19,7 @@ pub mod sample;
 pub mod source;
 pub mod syntax;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The result of checking a spec: the model (meaningful only without errors), every
 /// diagnostic, and the sources they point into.
@@ -50,6 +50,18 @@ impl Checked {
         }
         all.extend(later);
         self.diagnostics = all.sorted();
+    }
+
+    /// Every file the run read or will read: the specs it loaded and the meshes their
+    /// parts name. No output may replace one of them.
+    pub fn inputs(&self) -> Vec<PathBuf> {
+        let mut out: Vec<PathBuf> = self.sources.paths().map(Path::to_path_buf).collect();
+        for part in &self.model.parts {
+            if let model::Geometry::Mesh { path, .. } = &part.geometry {
+                out.push(path.clone());
+            }
+        }
+        out
     }
 
     /// The model as text, showing what the root files declare and use.
@@ -240,10 +252,9 @@ fn plans_of(
         let Some(name) = &g.graph.plan else {
             let part = &model.parts[g.part];
             diags.push(plan::PlanError::NoPlan {
-                    span: part.span,
-                    part: part.name.clone(),
-                },
-            );
+                span: part.span,
+                part: part.name.clone(),
+            });
             continue;
         };
         let Some(k) = model.plans.iter().position(|p| &p.name == name) else {
@@ -393,7 +404,9 @@ fn paths_of(run: &mut Run, planned: Vec<Planned>, progress: Progress) -> Pathed 
         else {
             continue;
         };
-        let Some(data) = &run.parts[g.part] else { continue };
+        let Some(data) = &run.parts[g.part] else {
+            continue;
+        };
         let input = plan::Input {
             model: &run.checked.model,
             plan,
@@ -414,7 +427,9 @@ fn programs_of(run: &Run, paths: Pathed) -> Vec<Built> {
     let checked = &run.checked;
     let mut out = Vec::new();
     for (k, part, hlip, llip) in paths {
-        let Some(data) = &run.parts[part] else { continue };
+        let Some(data) = &run.parts[part] else {
+            continue;
+        };
         let dmis = dmis::write(&dmis::Input {
             model: &checked.model,
             plan: &checked.model.plans[k],
@@ -434,7 +449,10 @@ fn programs_of(run: &Run, paths: Pathed) -> Vec<Built> {
         let json = path::json(&hlip, &llip, &names);
         let plan = &checked.model.plans[k];
         let graph = plan.outputs.graph.as_deref().and_then(|file| {
-            let g = run.graphs.iter().find(|g| g.graph.plan.as_deref() == Some(&plan.name))?;
+            let g = run
+                .graphs
+                .iter()
+                .find(|g| g.graph.plan.as_deref() == Some(&plan.name))?;
             let p = &checked.model.parts[part];
             let ext = std::path::Path::new(file).extension();
             Some(match ext.and_then(|e| e.to_str()) {

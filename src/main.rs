@@ -1,4 +1,6 @@
-//! The `inspc` command line: the only place that does IO.
+//! The `inspc` command line: the only place that does IO (with `cli/`, its helpers).
+
+mod cli;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use inspc::diag::{render_human, to_json, RenderOptions};
@@ -301,9 +303,13 @@ fn cones(
     let Some(report) = report else {
         return ExitCode::from(1);
     };
-    if let Err(e) = write_atomically(output, &report.pgm) {
-        eprintln!("inspc: cannot write {}: {e}", output.display());
-        return ExitCode::from(1);
+    let image = cli::outputs::Output {
+        path: output.to_path_buf(),
+        bytes: report.pgm,
+        what: "the cone image",
+    };
+    if let Err(code) = commit(&[image], &checked.inputs()) {
+        return code;
     }
     print!("{}", report.text);
     println!(
@@ -326,7 +332,12 @@ fn plan(file: &std::path::Path, format: TableFormat, n: u32) -> ExitCode {
     }
     let hlips: Vec<(&inspc::plan::Hlip, inspc::plan::Names)> = planned
         .iter()
-        .filter_map(|p| Some((p.hlip.as_ref()?, inspc::plan_names(&checked, &parts, p.plan)?)))
+        .filter_map(|p| {
+            Some((
+                p.hlip.as_ref()?,
+                inspc::plan_names(&checked, &parts, p.plan)?,
+            ))
+        })
         .collect();
     match format {
         TableFormat::Text => {
@@ -401,7 +412,10 @@ fn build(
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "program".into());
-    let mut writes: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    let mut writes: Vec<cli::outputs::Output> = Vec::new();
+    let mut push = |path: PathBuf, bytes: Vec<u8>, what: &'static str| {
+        writes.push(cli::outputs::Output { path, bytes, what });
+    };
     for b in &built {
         let plan = &checked.model.plans[b.plan];
         let dmi = output.clone().unwrap_or_else(|| match &plan.outputs.dmis {
@@ -409,23 +423,20 @@ fn build(
             None if built.len() == 1 => dir.join(format!("{stem}.dmi")),
             None => dir.join(format!("{stem}_{}.dmi", plan.name)),
         });
-        writes.push((dmi, b.dmis.clone().into_bytes()));
+        push(dmi, b.dmis.clone().into_bytes(), "the program");
         let json = plan_json
             .clone()
             .or_else(|| plan.outputs.plan.as_ref().map(|p| dir.join(p)));
         if let Some(j) = json {
             let text = serde_json::to_string_pretty(&b.json).unwrap_or_default() + "\n";
-            writes.push((j, text.into_bytes()));
+            push(j, text.into_bytes(), "the plan JSON");
         }
         if let (Some(g), Some(text)) = (&plan.outputs.graph, &b.graph) {
-            writes.push((dir.join(g), text.clone().into_bytes()));
+            push(dir.join(g), text.clone().into_bytes(), "the graph");
         }
     }
-    for (path, bytes) in &writes {
-        if let Err(e) = write_atomically(path, bytes) {
-            eprintln!("inspc: cannot write {}: {e}", path.display());
-            return ExitCode::from(1);
-        }
+    if let Err(code) = commit(&writes, &checked.inputs()) {
+        return code;
     }
     for b in &built {
         let h = &b.hlip;
@@ -458,8 +469,8 @@ fn build(
         .map(|(s, t)| format!("{s} {t:.2} s"))
         .collect();
     println!("  time: {}", stages.join(", "));
-    for (path, bytes) in &writes {
-        println!("wrote {} ({} bytes)", path.display(), bytes.len());
+    for w in &writes {
+        println!("wrote {} ({} bytes)", w.path.display(), w.bytes.len());
     }
     eprintln!("inspc: built in {:.2} s", start.elapsed().as_secs_f64());
     ExitCode::SUCCESS
@@ -467,14 +478,23 @@ fn build(
 
 /// `inspc dmis`: reads a program and reports what a controller would reject.
 fn read_dmis(file: &std::path::Path) -> ExitCode {
-    let text = match std::fs::read(file) {
+    use inspc::source::World;
+    let mut sources = inspc::source::SourceMap::new();
+    let text = match FsWorld.read(file, inspc::source::FileKind::Dmis) {
         Ok(b) => String::from_utf8_lossy(&b).into_owned(),
         Err(e) => {
-            eprintln!("inspc: cannot read {}: {e}", file.display());
+            let shown = file.display().to_string();
+            let id = sources.add(shown.clone(), Some(file.to_path_buf()), String::new());
+            let mut diags = inspc::diag::Diagnostics::new();
+            diags.push(inspc::source::io::IoError::Unreadable {
+                file: id,
+                path: shown,
+                reason: e.0,
+            });
+            print_diagnostics(&sources, &diags.sorted());
             return ExitCode::from(1);
         }
     };
-    let mut sources = inspc::source::SourceMap::new();
     let id = sources.add(file.display().to_string(), Some(file.to_path_buf()), text);
     match inspc::dmis::read(id, &sources.get(id).text) {
         Ok(p) => {
@@ -493,29 +513,40 @@ fn read_dmis(file: &std::path::Path) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(errors) => {
+            // A broken file can hold a problem on every line: show the first ones.
+            const SHOWN: usize = 50;
             let n = errors.len();
             let mut diags = inspc::diag::Diagnostics::new();
-            for e in errors {
+            for e in errors.into_iter().take(SHOWN) {
                 diags.push(e);
             }
             print_diagnostics(&sources, &diags.sorted());
-            eprintln!("inspc: {n} problems in {}", file.display());
+            if n > SHOWN {
+                eprintln!(
+                    "inspc: {n} problems in {}, the first {SHOWN} shown",
+                    file.display()
+                );
+            } else {
+                eprintln!("inspc: {n} problems in {}", file.display());
+            }
             ExitCode::from(1)
         }
     }
 }
 
-/// Writes a file whole or not at all: a temporary beside it, then a rename.
-fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.inspc-tmp"));
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
+/// Writes every output or none (see `cli::outputs`); on failure the diagnostic is
+/// printed and the exit code returned.
+fn commit(outputs: &[cli::outputs::Output], inputs: &[PathBuf]) -> Result<(), ExitCode> {
+    let mut sources = inspc::source::SourceMap::new();
+    match cli::outputs::commit(outputs, inputs, &mut sources) {
+        Ok(()) => Ok(()),
+        Err(e) => {
+            let mut diags = inspc::diag::Diagnostics::new();
+            diags.push(e);
+            print_diagnostics(&sources, &diags.sorted());
+            Err(ExitCode::from(1))
+        }
+    }
 }
 
 fn graph(file: &std::path::Path, format: GraphFormat, points: bool) -> ExitCode {

@@ -57,4 +57,3 @@ crate::located!(AccessError {
     UnknownProbe,
     NoMachine,
 });
-

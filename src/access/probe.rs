@@ -3,8 +3,8 @@
 //! the tip centre (seed ch. 2.4; Álvarez et al. model column, head, probe and stylus the
 //! same way).
 
-use crate::model::{Cmm, HeadKind, Model, Probe};
 use super::pose::Head;
+use crate::model::{Cmm, HeadKind, Model, Probe};
 
 /// How a component ends towards the tip.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

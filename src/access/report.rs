@@ -58,30 +58,24 @@ pub fn cone_report(
                 let mut known: Vec<&str> = g.faces.iter().map(|f| f.name.as_str()).collect();
                 known.truncate(12);
                 diags.push(AccessError::UnknownFace {
-                        span: part.span,
-                        face: name.clone(),
-                        part: part.name.clone(),
-                        known: known.join(", "),
-                    },
-                );
+                    span: part.span,
+                    face: name.clone(),
+                    part: part.name.clone(),
+                    known: known.join(", "),
+                });
                 return None;
             };
-            input
-                .fpoints
-                .iter()
-                .filter(|f| f.face.0 == face)
-                .collect()
+            input.fpoints.iter().filter(|f| f.face.0 == face).collect()
         }
         None => input.fpoints.iter().collect(),
     };
     let Some(f) = chosen.get(req.point) else {
         diags.push(AccessError::NoPoint {
-                span: part.span,
-                face: req.face.clone().unwrap_or_else(|| "the part".into()),
-                index: req.point,
-                count: chosen.len(),
-            },
-        );
+            span: part.span,
+            face: req.face.clone().unwrap_or_else(|| "the part".into()),
+            index: req.point,
+            count: chosen.len(),
+        });
         return None;
     };
     let plan = input.plan;
@@ -95,27 +89,25 @@ pub fn cone_report(
             };
             if found.is_none() {
                 diags.push(AccessError::UnknownProbe {
-                        span: cmm.span,
-                        probe: req.probe.clone().unwrap_or_default(),
-                        cmm: cmm.name.clone(),
-                        known: cmm
-                            .probes
-                            .iter()
-                            .map(|(l, _)| l.as_str())
-                            .collect::<Vec<_>>()
-                            .join(", "),
-                    },
-                );
+                    span: cmm.span,
+                    probe: req.probe.clone().unwrap_or_default(),
+                    cmm: cmm.name.clone(),
+                    known: cmm
+                        .probes
+                        .iter()
+                        .map(|(l, _)| l.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                });
                 return None;
             }
             found
         }
         None if req.probe.is_some() => {
             diags.push(AccessError::NoMachine {
-                    span: part.span,
-                    part: part.name.clone(),
-                },
-            );
+                span: part.span,
+                part: part.name.clone(),
+            });
             return None;
         }
         None => None,

@@ -4,7 +4,35 @@ use super::Diagnostic;
 use crate::source::SourceMap;
 use miette::{GraphicalReportHandler, GraphicalTheme, NamedSource, Severity};
 use serde_json::json;
+use std::borrow::Cow;
 use std::fmt;
+
+/// Text from a user's files as a terminal may show it: control characters other than a
+/// newline, a carriage return or a tab become `?`, and bidirectional controls (which can
+/// reorder what a reader sees, U+202A–U+202E, U+2066–U+2069) become U+FFFD. Both keep
+/// their UTF-8 length, so spans into the text still point at the same characters.
+pub fn terminal_safe(s: &str) -> Cow<'_, str> {
+    let bad = |c: char| {
+        (c.is_control() && !matches!(c, '\n' | '\r' | '\t'))
+            || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}')
+    };
+    if !s.chars().any(bad) {
+        return Cow::Borrowed(s);
+    }
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        if !bad(c) {
+            out.push(c);
+        } else if c.len_utf8() == 3 {
+            out.push('\u{FFFD}');
+        } else {
+            // Controls other than the bidirectional ones: one byte (C0, DEL) or two
+            // (C1); keep the length with as many `?`.
+            out.extend(std::iter::repeat_n('?', c.len_utf8()));
+        }
+    }
+    Cow::Owned(out)
+}
 
 /// How to draw a human-readable report.
 #[derive(Debug, Clone, Copy)]
@@ -29,7 +57,10 @@ pub fn render_human(map: &SourceMap, d: &Diagnostic, opts: RenderOptions) -> Str
     let file = map.get(d.file);
     let located = Located {
         inner: d.inner.as_ref(),
-        src: NamedSource::new(file.name.clone(), file.text.clone()),
+        src: NamedSource::new(
+            terminal_safe(&file.name),
+            terminal_safe(&file.text).into_owned(),
+        ),
     };
     let theme = if opts.color {
         GraphicalTheme::unicode()
@@ -98,7 +129,7 @@ impl fmt::Debug for Located<'_> {
 
 impl fmt::Display for Located<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        fmt::Display::fmt(self.inner, f)
+        f.write_str(&terminal_safe(&self.inner.to_string()))
     }
 }
 
@@ -112,10 +143,20 @@ impl miette::Diagnostic for Located<'_> {
         self.inner.severity()
     }
     fn help<'b>(&'b self) -> Option<Box<dyn fmt::Display + 'b>> {
-        self.inner.help()
+        let help = self.inner.help()?.to_string();
+        Some(Box::new(terminal_safe(&help).into_owned()))
     }
     fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
-        self.inner.labels()
+        let labels = self.inner.labels()?.map(|l| {
+            let text = l.label().map(|t| terminal_safe(t).into_owned());
+            let span = (l.offset(), l.len());
+            if l.primary() {
+                miette::LabeledSpan::new_primary_with_span(text, span)
+            } else {
+                miette::LabeledSpan::new_with_span(text, span)
+            }
+        });
+        Some(Box::new(labels))
     }
     fn source_code(&self) -> Option<&dyn miette::SourceCode> {
         Some(&self.src)

@@ -158,7 +158,6 @@ crate::located!(DmisError {
     Structure,
 });
 
-
 /// Statements that may appear between `MEAS` and `ENDMES`.
 const IN_MEAS: &[&str] = &["GOTO", "PTMEAS"];
 
@@ -261,12 +260,7 @@ fn refs(params: &[String]) -> Vec<(String, String)> {
 /// A command as the checks see it: label, major word, parameters, offset.
 type Cmd<'a> = (&'a Option<(String, String)>, &'a str, &'a [String], usize);
 
-fn check(
-    statements: &[Statement],
-    text: &str,
-    file: FileId,
-    errors: &mut Vec<DmisError>,
-) {
+fn check(statements: &[Statement], text: &str, file: FileId, errors: &mut Vec<DmisError>) {
     let span = |at: usize| -> Span {
         let end = text[at..].find('\n').map_or(text.len(), |e| at + e);
         Span::new(file, at, end)
@@ -316,7 +310,7 @@ fn check(
         let Some((kind, l)) = label else { continue };
         if !is_label(l) {
             errors.push(DmisError::BadLabel {
-                        span: span(*at),
+                span: span(*at),
                 label: l.clone(),
             });
         }
@@ -324,7 +318,7 @@ fn check(
         let key = (kind.clone(), l.clone());
         if defined.contains_key(&key) && *major != "DATDEF" {
             errors.push(DmisError::Duplicate {
-                        span: span(*at),
+                span: span(*at),
                 kind: kind.clone(),
                 label: l.clone(),
             });
@@ -348,7 +342,7 @@ fn check(
             let ok = ok && (kind != "F" || defined.contains_key(&("F".to_string(), l.clone())));
             if !ok {
                 errors.push(DmisError::Undefined {
-                                span: span(*at),
+                    span: span(*at),
                     kind: k.clone(),
                     label: l,
                 });

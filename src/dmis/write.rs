@@ -343,7 +343,12 @@ impl Writer<'_> {
         // How many faces (or table stand-ins) each feature is measured on.
         let mut face_count: BTreeMap<Option<FeatureId>, usize> = BTreeMap::new();
         let mut seen = std::collections::BTreeSet::new();
-        let blocks = || llip.setups.iter().flat_map(|s| &s.groups).flat_map(|g| &g.blocks);
+        let blocks = || {
+            llip.setups
+                .iter()
+                .flat_map(|s| &s.groups)
+                .flat_map(|g| &g.blocks)
+        };
         for b in blocks() {
             if seen.insert(face_key(b)) {
                 *face_count.entry(b.feature).or_default() += 1;

@@ -8,7 +8,9 @@ use super::primitives::{
 };
 use super::{PartGeometry, Surface, P3, V3};
 use crate::diag::Diagnostics;
-use crate::model::{self, Action, Depth, FaceSource, OpId, OpKind, Pattern, Placement, Role, Stock};
+use crate::model::{
+    self, Action, Depth, FaceSource, OpId, OpKind, Pattern, Placement, Role, Stock,
+};
 use boolmesh::prelude::{compute_boolean, Manifold, OpType};
 use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion};
 
@@ -47,7 +49,14 @@ pub(super) fn build(
             };
             (
                 prism(&f, &rectangle(0.0, 0.0, size[0], size[1]), 0.0, size[2]),
-                vec![Role::Front, Role::Right, Role::Back, Role::Left, Role::Bottom, Role::Top],
+                vec![
+                    Role::Front,
+                    Role::Right,
+                    Role::Back,
+                    Role::Left,
+                    Role::Bottom,
+                    Role::Top,
+                ],
             )
         }
         Stock::Cylinder { diameter, height } => {
@@ -103,11 +112,10 @@ pub(super) fn build(
                 let what = op.kind.word();
                 let name = inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name));
                 diags.push(E::MissesPart {
-                        span: op.span,
-                        what: what.into(),
-                        name,
-                    },
-                );
+                    span: op.span,
+                    what: what.into(),
+                    name,
+                });
                 continue;
             }
             for (k, rs) in roles.iter().enumerate() {
@@ -166,11 +174,10 @@ pub(super) fn build(
             Err(reason) => {
                 let op = &part.ops[tools[i].op];
                 diags.push(E::BooleanFailed {
-                        span: op.span,
-                        part: part.name.clone(),
-                        reason,
-                    },
-                );
+                    span: op.span,
+                    part: part.name.clone(),
+                    reason,
+                });
                 return None;
             }
         }
@@ -442,7 +449,14 @@ fn cutter(
             let prof = rectangle(-big, -big, big, *width);
             (
                 prism(&f, &prof, -ext, *depth),
-                vec![vec![], vec![], vec![Role::Wall], vec![], vec![], vec![Role::Floor]],
+                vec![
+                    vec![],
+                    vec![],
+                    vec![Role::Wall],
+                    vec![],
+                    vec![],
+                    vec![Role::Floor],
+                ],
             )
         }
         OpKind::Boss {

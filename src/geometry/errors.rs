@@ -124,7 +124,6 @@ crate::located!(GeometryError {
     NoMatch,
 });
 
-
 /// A mesh-reading failure, located later at the spec's path.
 #[derive(Debug, Clone)]
 pub enum MeshError {

@@ -3,7 +3,7 @@
 
 use super::errors::MeshError;
 use super::P3;
-use crate::source::World;
+use crate::source::{FileKind, World};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -29,7 +29,9 @@ pub struct RawMesh {
 
 /// Reads a mesh file through the world, scaling by `unit_mm`.
 pub fn read_mesh(world: &dyn World, path: &Path, unit_mm: f64) -> Result<RawMesh, MeshError> {
-    let bytes = world.read(path).map_err(|e| MeshError::Unreadable(e.0))?;
+    let bytes = world
+        .read(path, FileKind::Mesh)
+        .map_err(|e| MeshError::Unreadable(e.0))?;
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())

@@ -277,12 +277,11 @@ pub fn build(
             };
             if raw.open_edges + raw.nonmanifold_edges > 0 {
                 diags.push(GeometryError::MeshDefects {
-                        span: *span,
-                        path: errors::shown_path(path),
-                        open: raw.open_edges,
-                        nonmanifold: raw.nonmanifold_edges,
-                    },
-                );
+                    span: *span,
+                    path: errors::shown_path(path),
+                    open: raw.open_edges,
+                    nonmanifold: raw.nonmanifold_edges,
+                });
             }
             let uses_groups = part
                 .features

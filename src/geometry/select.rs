@@ -9,11 +9,7 @@ use crate::model::{FaceRef, FaceSource, Selector};
 const SELECT_DEG: f64 = 5.0;
 
 /// The faces a reference names, in face order; reports references that name nothing.
-pub fn resolve_faces(
-    g: &PartGeometry,
-    r: &FaceRef,
-    diags: &mut Diagnostics,
-) -> Vec<FaceId> {
+pub fn resolve_faces(g: &PartGeometry, r: &FaceRef, diags: &mut Diagnostics) -> Vec<FaceId> {
     let alive = |k: usize| g.faces[k].area > 0.0;
     match r {
         FaceRef::Role { source, role, span } => {
@@ -54,11 +50,10 @@ pub fn resolve_faces(
                     g.faces.iter().map(|f| f.name.as_str()),
                 );
                 diags.push(E::UnknownGroup {
-                        span: *span,
-                        group: name.clone(),
-                        help,
-                    },
-                );
+                    span: *span,
+                    group: name.clone(),
+                    help,
+                });
             }
             found
         }
@@ -74,11 +69,10 @@ pub fn resolve_faces(
                     g.faces.len()
                 );
                 diags.push(E::UnknownSegment {
-                        span: *span,
-                        segment: *n,
-                        help,
-                    },
-                );
+                    span: *span,
+                    segment: *n,
+                    help,
+                });
             }
             found
         }
@@ -86,10 +80,9 @@ pub fn resolve_faces(
             let found = select(g, sel);
             if found.is_empty() {
                 diags.push(E::NoMatch {
-                        span: *span,
-                        help: "relax a criterion, or list the faces with `inspc faces MESH`".into(),
-                    },
-                );
+                    span: *span,
+                    help: "relax a criterion, or list the faces with `inspc faces MESH`".into(),
+                });
             }
             found
         }

@@ -39,4 +39,3 @@ crate::located!(GraphError {
     NoPoints,
     WrongSurface,
 });
-

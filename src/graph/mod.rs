@@ -227,12 +227,11 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
         if points.is_empty() {
             let feature = &part.features[first_feature.0];
             diags.push(GraphError::NoPoints {
-                    span: feature.span,
-                    face: g.faces[face.0].name.clone(),
-                    feature: feature.name.clone(),
-                    margin: crate::model::fmt_num(input.margin),
-                },
-            );
+                span: feature.span,
+                face: g.faces[face.0].name.clone(),
+                feature: feature.name.clone(),
+                margin: crate::model::fmt_num(input.margin),
+            });
         }
         for p in points {
             let pn = graph.add_node(Node::Point(fpoints.len()));

@@ -14,7 +14,7 @@ mod stdlib;
 pub use stdlib::{std_module_names, STD_MODULES};
 
 use crate::diag::{suggest, Diagnostics};
-use crate::source::{FileId, SourceMap, Span, World};
+use crate::source::{FileId, FileKind, SourceMap, Span, World};
 use crate::syntax::{self, ast};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -76,6 +76,21 @@ pub enum LoadError {
         /// The system's reason.
         reason: String,
     },
+    /// A file that is not a spec, named where a spec belongs.
+    #[error("`{path}` is not an `.insp` spec")]
+    #[diagnostic(
+        code(insp::load::not_a_spec),
+        help("specs and the files they `use` end in `.insp`; meshes are named by `mesh \"…\"` in a part")
+    )]
+    NotASpec {
+        /// The `use` that named it, if any.
+        #[label("not a spec")]
+        span: Option<Span>,
+        /// The file it is filed under (see `Unreadable`).
+        file: FileId,
+        /// The path.
+        path: String,
+    },
     /// A file is not UTF-8.
     #[error("`{path}` is not UTF-8 text")]
     #[diagnostic(code(insp::load::not_utf8), help("save the file as UTF-8"))]
@@ -130,7 +145,7 @@ pub enum LoadError {
 impl crate::diag::Located for LoadError {
     fn file(&self) -> FileId {
         match self {
-            LoadError::Unreadable { file, .. } => *file,
+            LoadError::Unreadable { file, .. } | LoadError::NotASpec { file, .. } => *file,
             LoadError::NotUtf8 { span, .. }
             | LoadError::UnknownModule { span, .. }
             | LoadError::ModuleImport { span, .. }
@@ -138,7 +153,6 @@ impl crate::diag::Located for LoadError {
         }
     }
 }
-
 
 /// Loads the root files and everything they import. The entry point of the load stage.
 pub fn load(
@@ -193,7 +207,24 @@ impl Loader<'_> {
             return Some(id);
         }
         let shown = shown.to_string();
-        let bytes = match self.world.read(path) {
+        // Only specs are read as source (and quoted in messages): a `use` of any other
+        // file is refused before it is opened.
+        if path.extension().is_none_or(|e| e != "insp") {
+            let file = from.map_or_else(
+                || {
+                    self.sources
+                        .add(shown.clone(), Some(canonical.clone()), String::new())
+                },
+                |f| f.0,
+            );
+            self.diags.push(LoadError::NotASpec {
+                span: from.map(|f| f.1),
+                file,
+                path: shown,
+            });
+            return None;
+        }
+        let bytes = match self.world.read(path, FileKind::Spec) {
             Ok(b) => b,
             Err(e) => {
                 let file = from.map_or_else(
@@ -204,12 +235,11 @@ impl Loader<'_> {
                     |f| f.0,
                 );
                 self.diags.push(LoadError::Unreadable {
-                        span: from.map(|f| f.1),
-                        file,
-                        path: shown,
-                        reason: e.0,
-                    },
-                );
+                    span: from.map(|f| f.1),
+                    file,
+                    path: shown,
+                    reason: e.0,
+                });
                 return None;
             }
         };
@@ -224,10 +254,9 @@ impl Loader<'_> {
         if let Some(at) = bad {
             // The lossy text holds U+FFFD (3 bytes) where the bad byte was.
             self.diags.push(LoadError::NotUtf8 {
-                    span: Span::new(file, at, at + 3),
-                    path: shown,
-                },
-            );
+                span: Span::new(file, at, at + 3),
+                path: shown,
+            });
             return None;
         }
         Some(self.add_module(key, file, None, root))
@@ -288,10 +317,9 @@ impl Loader<'_> {
                         .collect();
                     names.push(self.module_name(target));
                     self.diags.push(LoadError::ImportCycle {
-                            span: u.span,
-                            cycle: names.join(" → "),
-                        },
-                    );
+                        span: u.span,
+                        cycle: names.join(" → "),
+                    });
                     continue;
                 }
                 self.program.modules[id.0].imports.push((index, target));
@@ -336,7 +364,9 @@ impl Loader<'_> {
                     let full = names.join("::");
                     self.diags.push(LoadError::ModuleImport {
                         span: u.span,
-                        help: format!("name the items: `use {full}::{{…}}`, or all of them: `use {full}::*`"),
+                        help: format!(
+                            "name the items: `use {full}::{{…}}`, or all of them: `use {full}::*`"
+                        ),
                         name: full,
                     });
                     return None;
@@ -352,11 +382,10 @@ impl Loader<'_> {
                             ),
                         };
                         self.diags.push(LoadError::UnknownModule {
-                                span,
-                                name: module,
-                                help,
-                            },
-                        );
+                            span,
+                            name: module,
+                            help,
+                        });
                         None
                     }
                 }

@@ -150,11 +150,7 @@ impl Model {
             .filter(|(i, x)| keep(&x.span, 5, *i))
             .map(|(_, x)| x)
         {
-            let levels: Vec<String> = h
-                .levels
-                .iter()
-                .map(|l| l.text())
-                .collect();
+            let levels: Vec<String> = h.levels.iter().map(|l| l.text()).collect();
             let _ = writeln!(
                 o,
                 "hierarchy {}: required approachability > {}",

@@ -24,7 +24,4 @@ pub enum PathError {
     },
 }
 
-crate::located!(PathError {
-    NoPath,
-});
-
+crate::located!(PathError { NoPath });

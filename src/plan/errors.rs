@@ -45,4 +45,3 @@ crate::located!(PlanError {
     NoConvergence,
     NoPlan,
 });
-

@@ -34,7 +34,13 @@ fn owner(input: &Input, face: FaceId) -> Option<crate::model::FeatureId> {
 
 /// One diagnostic for a face no configuration inspects: which probe came closest, from
 /// where, and what stopped it.
-pub(super) fn report_face(input: &Input, k: &Knowledge, m: &Machine, face: FaceId, diags: &mut Diagnostics) {
+pub(super) fn report_face(
+    input: &Input,
+    k: &Knowledge,
+    m: &Machine,
+    face: FaceId,
+    diags: &mut Diagnostics,
+) {
     let part = &input.model.parts[input.plan.part.0];
     let feature = owner(input, face).map(|f| &part.features[f.0]);
     let pts = face_points(input.graph, face);
@@ -86,13 +92,12 @@ pub(super) fn report_face(input: &Input, k: &Knowledge, m: &Machine, face: FaceI
     };
     let help = "use a smaller tip, a longer or thinner stylus, an extension, or an indexable head; `inspc cones --face` shows the cones".to_string();
     diags.push(PlanError::UninspectableFace {
-            span: feature.map_or(part.span, |f| f.span),
-            face: name,
-            feature: feature.map_or_else(|| part.name.clone(), |f| f.name.clone()),
-            why,
-            help,
-        },
-    );
+        span: feature.map_or(part.span, |f| f.span),
+        face: name,
+        feature: feature.map_or_else(|| part.name.clone(), |f| f.name.clone()),
+        why,
+        help,
+    });
 }
 
 /// What blocks probe `p` at point `f`: the components' cones from the tip up; the first
@@ -151,4 +156,3 @@ fn blocking(k: &Knowledge, m: &Machine, p: usize, f: usize) -> (usize, String) {
 fn deepest(c: &crate::access::CubeMap) -> V3 {
     solve::deepest(c).map_or(V3::z(), |cell| c.direction(cell))
 }
-

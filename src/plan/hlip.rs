@@ -367,8 +367,7 @@ fn min_setups(
 }
 
 /// A face visit: (tolerance, feature, face, contact, points).
-type Visit<'a> =
-    dyn FnMut(Option<ToleranceId>, Option<FeatureId>, FaceId, Contact, &[usize]) + 'a;
+type Visit<'a> = dyn FnMut(Option<ToleranceId>, Option<FeatureId>, FaceId, Contact, &[usize]) + 'a;
 
 /// Walks an instance tree, calling `f(tolerance, feature, face, contact, points)` for
 /// every face or table visit.

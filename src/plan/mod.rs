@@ -24,8 +24,8 @@ mod validate;
 
 pub use errors::PlanError;
 pub use hlip::{
-    FaceVisit, Hlip, Inspection, OrientNode, PlanPoint, PointRef, ProbeNode, SetupNode,
-    Summary, STEPS_PER_MM,
+    FaceVisit, Hlip, Inspection, OrientNode, PlanPoint, PointRef, ProbeNode, SetupNode, Summary,
+    STEPS_PER_MM,
 };
 pub use render::{json, text, Names};
 
@@ -239,7 +239,12 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
                         face_name(input, &k, p.point),
                         w
                     );
-                    invalid.push((p.point, p.probe, p.setup, machine.head.indexable().then_some(p.orient)));
+                    invalid.push((
+                        p.point,
+                        p.probe,
+                        p.setup,
+                        machine.head.indexable().then_some(p.orient),
+                    ));
                 }
             }
         }
@@ -261,12 +266,11 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
         learn(&mut k, &machine, invalid);
     }
     diags.push(PlanError::NoConvergence {
-            span: plan.span,
-            plan: plan.name.clone(),
-            iterations: opts.max_iterations,
-            last,
-        },
-    );
+        span: plan.span,
+        plan: plan.name.clone(),
+        iterations: opts.max_iterations,
+        last,
+    });
     None
 }
 
@@ -417,4 +421,3 @@ fn filter(
     }
     (dropped, bad)
 }
-

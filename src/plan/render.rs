@@ -157,11 +157,7 @@ pub fn text(h: &Hlip, names: &Names) -> String {
 /// The hierarchy's levels in words, beside their violation counts.
 fn violations<'a>(s: &'a Summary, names: &Names) -> impl Iterator<Item = (String, u64)> + 'a {
     let h = &names.model.hierarchies[names.plan.hierarchy.0];
-    let levels: Vec<String> = h
-        .levels
-        .iter()
-        .map(|l| l.text())
-        .collect();
+    let levels: Vec<String> = h.levels.iter().map(|l| l.text()).collect();
     levels.into_iter().zip(s.violations.iter().copied())
 }
 

@@ -21,7 +21,13 @@ pub(crate) struct Pip {
 }
 
 /// Checks one PIP in setup `up` over a table at height `t0`; what collides, if anything.
-pub(crate) fn check(k: &Knowledge, m: &Machine, pip: &Pip, up: &V3, t0: f64) -> Result<(), Blocker> {
+pub(crate) fn check(
+    k: &Knowledge,
+    m: &Machine,
+    pip: &Pip,
+    up: &V3,
+    t0: f64,
+) -> Result<(), Blocker> {
     let dir = if m.head.indexable() {
         let (a, b) = m.grid[pip.orient];
         orientation_dir(up, a, b)

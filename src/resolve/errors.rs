@@ -316,6 +316,16 @@ pub enum ResolveError {
         first: Span,
         part: String,
     },
+    #[error("output `{path}` would be written outside the spec's folder")]
+    #[diagnostic(
+        code(insp::resolve::output_outside),
+        help("outputs a spec names stay in its folder or below: give a relative path without `..`; `inspc build -o` may write anywhere")
+    )]
+    OutputOutside {
+        #[label("outside the spec's folder")]
+        span: Span,
+        path: String,
+    },
     #[error("mesh file `{path}` not found")]
     #[diagnostic(
         code(insp::resolve::file_not_found),
@@ -448,6 +458,7 @@ crate::located!(ResolveError {
     NoGeometry,
     DuplicateGeometry,
     FileNotFound,
+    OutputOutside,
     MeshFormat,
     WrongOperation,
     HierarchyRequired,
@@ -458,4 +469,3 @@ crate::located!(ResolveError {
     StemThickerThanTip,
     DatumLetter,
 });
-

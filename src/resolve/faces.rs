@@ -21,7 +21,12 @@ fn roles(part: &Part, source: &FaceSource) -> &'static [Role] {
     }
 }
 
-pub(super) fn face_expr(cx: &mut Cx, pc: &PartCx, e: &ast::FaceExpr, is_mesh: bool) -> Vec<FaceRef> {
+pub(super) fn face_expr(
+    cx: &mut Cx,
+    pc: &PartCx,
+    e: &ast::FaceExpr,
+    is_mesh: bool,
+) -> Vec<FaceRef> {
     let mut out: Vec<FaceRef> = Vec::new();
     for t in &e.terms {
         for f in face_term(cx, pc, t, is_mesh) {
@@ -282,4 +287,3 @@ fn selector(cx: &mut Cx, args: &[ast::Arg], span: Span) -> Option<Selector> {
     }
     Some(s)
 }
-

@@ -1,9 +1,9 @@
 //! Constraint hierarchies (Spitz ch. 3.4): levels, groups and the order the solver needs.
 
-use crate::model::level_text;
 use super::errors::ResolveError as E;
 use super::props::Cx;
 use crate::diag::suggest;
+use crate::model::level_text;
 use crate::model::{Group, Hierarchy, Level, SameVar};
 use crate::syntax::ast;
 

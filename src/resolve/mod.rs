@@ -12,8 +12,8 @@
 
 mod catalogue;
 mod datum;
-mod faces;
 mod errors;
+mod faces;
 mod hierarchy;
 mod part;
 mod plan;
@@ -150,12 +150,11 @@ impl<'a> Resolver<'a> {
                 };
                 if let Some(&first) = scope.get(&name.name) {
                     diags.push(E::DuplicateName {
-                            span: name.span,
-                            first: Some(self.decls[first].name.span),
-                            name: name.name.clone(),
-                            help: "rename one of them".into(),
-                        },
-                    );
+                        span: name.span,
+                        first: Some(self.decls[first].name.span),
+                        name: name.name.clone(),
+                        help: "rename one of them".into(),
+                    });
                     continue;
                 }
                 let count = counts.entry(kind).or_default();
@@ -218,12 +217,11 @@ impl<'a> Resolver<'a> {
                             ),
                         };
                         diags.push(E::UnknownName {
-                                span: ident.span,
-                                what: "item".into(),
-                                name: ident.name.clone(),
-                                help,
-                            },
-                        );
+                            span: ident.span,
+                            what: "item".into(),
+                            name: ident.name.clone(),
+                            help,
+                        });
                         // Poison the name so its uses do not report it again.
                         self.scopes[mi]
                             .entry(ident.name.clone())

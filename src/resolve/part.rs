@@ -1,9 +1,9 @@
 //! Parts: units, geometry source, machining operations, faces, features, datums, frames.
 
-use super::errors::ResolveError as E;
-use super::props::{describe, path_text, Cx, Dim, Props, UNITS};
 use super::datum::{check_unique_datums, datum, datum_ref};
+use super::errors::ResolveError as E;
 use super::faces::face_expr;
+use super::props::{describe, path_text, Cx, Dim, Props, UNITS};
 use super::scope::{Local, PartCx};
 use super::{tolerance, Resolver};
 use crate::diag::suggest;

@@ -47,18 +47,20 @@ pub(super) fn lower(
         match &v.kind {
             ValueKind::Block(ops) => {
                 let mut o = Props::new(cx, "`output`", v.span, ops);
-                outputs.dmis = o
-                    .get("dmis")
-                    .and_then(|x| cx.string(x))
-                    .map(|s| s.value.clone());
-                outputs.plan = o
-                    .get("plan")
-                    .and_then(|x| cx.string(x))
-                    .map(|s| s.value.clone());
-                outputs.graph = o
-                    .get("graph")
-                    .and_then(|x| cx.string(x))
-                    .map(|s| s.value.clone());
+                let mut path = |key: &'static str| {
+                    let s = o.get(key).and_then(|x| cx.string(x))?;
+                    if !stays_inside(&s.value) {
+                        cx.err(E::OutputOutside {
+                            span: s.span,
+                            path: s.value.clone(),
+                        });
+                        return None;
+                    }
+                    Some(s.value.clone())
+                };
+                outputs.dmis = path("dmis");
+                outputs.plan = path("plan");
+                outputs.graph = path("graph");
                 o.finish(cx);
             }
             _ => cx.mismatch(v, "a block `{ dmis \"out.dmi\" }`", ""),
@@ -315,4 +317,14 @@ fn stance<T>(forbid: bool, value: T) -> Stance<T> {
     } else {
         Stance::Prefer(value)
     }
+}
+
+/// Whether a path a spec names for an output stays in the spec's folder: relative, no
+/// `..`, not empty.
+fn stays_inside(path: &str) -> bool {
+    use std::path::Component;
+    let p = std::path::Path::new(path);
+    !path.is_empty()
+        && p.components()
+            .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
 }

@@ -42,4 +42,3 @@ pub(super) struct PartCx<'p> {
     pub lowered_features: usize,
     pub stmts: &'p [PartStmt],
 }
-

@@ -1,9 +1,9 @@
 //! Tolerances: one table of GD&T rules per type, and the checks it drives.
 
-use super::errors::ResolveError as E;
 use super::datum::{check_unique_datums, datum_ref, material};
-use super::scope::{Local, PartCx};
+use super::errors::ResolveError as E;
 use super::props::{describe, num, path_text, Cx, Dim};
+use super::scope::{Local, PartCx};
 use crate::diag::suggest;
 use crate::model::*;
 use crate::source::Span;
@@ -87,7 +87,6 @@ const RULES: &[Rule] = &[
     size("distance", K::Distance, (1, 2), Dim::Length),
     size("angle", K::Angle, (2, 2), Dim::Angle),
 ];
-
 
 pub(super) fn lower(
     cx: &mut Cx,

@@ -8,10 +8,11 @@
 //! asks the [`World`]. The command line provides [`FsWorld`]; tests provide in-memory
 //! worlds. That keeps every stage a pure function of its input.
 
+pub mod io;
 mod world;
 
 pub(crate) use world::normalize as normalize_path;
-pub use world::{FsWorld, MemoryWorld, World, WorldError};
+pub use world::{FileKind, FsWorld, MemoryWorld, World, WorldError};
 
 use std::path::{Path, PathBuf};
 
@@ -132,6 +133,11 @@ impl SourceMap {
     /// The text a span covers.
     pub fn slice(&self, span: Span) -> &str {
         self.get(span.file).text.get(span.range()).unwrap_or("")
+    }
+
+    /// The paths of the files read from disk (the stdlib has none).
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        self.files.iter().filter_map(|f| f.path.as_deref())
     }
 
     /// The id of the file with this display name, if loaded.

@@ -87,7 +87,6 @@ crate::located!(SyntaxError {
     InvalidEscape,
 });
 
-
 /// Parses one file. The entry point of the syntax stage.
 pub fn parse(file: FileId, text: &str) -> Result<ast::File, SyntaxError> {
     use pest::Parser;

@@ -143,7 +143,13 @@ fn run_case(c: &Case) -> Outcome {
     } else {
         Until::Graph
     };
-    let run = inspc::run(&FsWorld, &roots, &PlanOptions::default(), until, &|_, _, _| {});
+    let run = inspc::run(
+        &FsWorld,
+        &roots,
+        &PlanOptions::default(),
+        until,
+        &|_, _, _| {},
+    );
     if !run.graphs.is_empty() || !run.checked.has_errors() {
         let (dot, points) = graph_files(&run);
         files.push(("graph.dot", dot));
@@ -245,7 +251,10 @@ fn one(name: &str) -> (&'static Run, &'static Built) {
         .iter()
         .find(|(c, _)| c.name == name)
         .unwrap_or_else(|| panic!("no case {name}"));
-    let run = o.run.as_ref().unwrap_or_else(|| panic!("{name} did not run"));
+    let run = o
+        .run
+        .as_ref()
+        .unwrap_or_else(|| panic!("{name} did not run"));
     assert_eq!(run.built.len(), 1, "{name}: one plan");
     (run, &run.built[0])
 }
@@ -268,7 +277,10 @@ fn golden_cases() {
                 ));
             }
         }
-        if failures.iter().any(|f| f.starts_with(&format!("{}:", c.name))) {
+        if failures
+            .iter()
+            .any(|f| f.starts_with(&format!("{}:", c.name)))
+        {
             continue;
         }
         for (name, actual) in &o.files {
@@ -317,13 +329,14 @@ fn failed_builds_write_no_program() {
 fn programs_read_back() {
     let mut n = 0;
     for (c, _, b) in built() {
-        let program = inspc::dmis::read(inspc::source::FileId(0), &b.dmis).unwrap_or_else(|errors| {
-            panic!(
-                "{}: the reader rejects the program: {:?}",
-                c.name,
-                errors.iter().map(|e| e.to_string()).collect::<Vec<_>>()
-            )
-        });
+        let program =
+            inspc::dmis::read(inspc::source::FileId(0), &b.dmis).unwrap_or_else(|errors| {
+                panic!(
+                    "{}: the reader rejects the program: {:?}",
+                    c.name,
+                    errors.iter().map(|e| e.to_string()).collect::<Vec<_>>()
+                )
+            });
         assert!(
             program.to_text() == b.dmis,
             "{}: the program does not print back the same:\n{}",
@@ -399,12 +412,7 @@ fn every_move_is_collision_free() {
                     if let Err(e) = pose.segment(&p, &q) {
                         panic!(
                             "{}: {} A{} B{}: {:?} -> {:?}: {e}",
-                            c.name,
-                            probe.name,
-                            g.a,
-                            g.b,
-                            w[0],
-                            w[1]
+                            c.name, probe.name, g.a, g.b, w[0], w[1]
                         );
                     }
                     segments += 1;
@@ -424,7 +432,10 @@ fn configs_of(run: &Run, b: &Built, feature: &str) -> BTreeSet<(String, String)>
     for s in &b.hlip.setups {
         for p in &s.probes {
             for o in &p.orients {
-                if o.inspections.iter().any(|i| names.feature(i.feature) == feature) {
+                if o.inspections
+                    .iter()
+                    .any(|i| names.feature(i.feature) == feature)
+                {
                     out.insert((names.probe(p.probe).to_string(), format!("{} {}", o.a, o.b)));
                 }
             }

@@ -29,6 +29,11 @@ const NO_SPEC_EXAMPLE: &[(&str, &str)] = &[
     ("insp::dmis::duplicate_label", "a DMIS file, not a spec: src/dmis/read.rs"),
     ("insp::dmis::undefined", "a DMIS file, not a spec: tests/cli.rs"),
     ("insp::dmis::structure", "a DMIS file, not a spec: tests/cli.rs"),
+    ("insp::io::unreadable", "a file named on the command line: tests/suite/cli.rs"),
+    ("insp::io::unwritable", "an output of the command line: tests/suite/cli.rs"),
+    ("insp::io::not_a_file", "an output of the command line: tests/suite/cli.rs"),
+    ("insp::io::overwrites_input", "an output of the command line: tests/suite/cli.rs"),
+    ("insp::io::same_output", "an output of the command line: tests/suite/cli.rs"),
 ];
 
 fn catalogue() -> Vec<Entry> {

@@ -505,8 +505,161 @@ fn build_writes_the_graph_the_plan_asks_for() {
     let (code, stdout, stderr) = inspc(&["build", spec.to_str().unwrap()]);
     assert_eq!(code, 0, "{stderr}");
     let graph = std::fs::read_to_string(dir.join("f2.mmd")).unwrap();
-    assert!(graph.starts_with("flowchart") || graph.contains("graph"), "{graph}");
+    assert!(
+        graph.starts_with("flowchart") || graph.contains("graph"),
+        "{graph}"
+    );
     assert!(graph.contains("small_slot"), "{graph}");
     assert!(stdout.contains("f2.mmd"), "{stdout}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A scratch folder holding a copy of F2's spec, for the file-rule tests.
+fn f2_in(tag: &str) -> (std::path::PathBuf, String) {
+    let dir = std::env::temp_dir().join(format!("inspc-files-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = dir.join("f2.insp");
+    std::fs::copy("examples/f2.insp", &spec).unwrap();
+    let s = spec.to_string_lossy().into_owned();
+    (dir, s)
+}
+
+/// An existing target that is not a regular file is refused, not replaced; nothing is
+/// written.
+#[test]
+fn outputs_never_replace_a_folder_or_a_device() {
+    let (dir, spec) = f2_in("notafile");
+    let folder = dir.join("out.dmi");
+    std::fs::create_dir_all(&folder).unwrap();
+    let (code, _, stderr) = inspc(&["build", &spec, "-o", folder.to_str().unwrap()]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("insp::io::not_a_file"), "{stderr}");
+    assert!(folder.is_dir());
+    if std::path::Path::new("/dev/full").exists() {
+        let (code, _, stderr) = inspc(&["build", &spec, "-o", "/dev/full"]);
+        assert_eq!(code, 1, "{stderr}");
+        assert!(stderr.contains("insp::io::not_a_file"), "{stderr}");
+        let meta = std::fs::metadata("/dev/full").unwrap();
+        assert!(!meta.is_file(), "/dev/full was replaced by a regular file");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// An output never replaces an input, and two outputs never share a file.
+#[test]
+fn outputs_never_replace_an_input_or_each_other() {
+    let (dir, spec) = f2_in("inputs");
+    let before = std::fs::read(&spec).unwrap();
+    let (code, _, stderr) = inspc(&["build", &spec, "-o", &spec]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("insp::io::overwrites_input"), "{stderr}");
+    assert_eq!(
+        std::fs::read(&spec).unwrap(),
+        before,
+        "the spec was overwritten"
+    );
+    let out = dir.join("x.dmi");
+    let out = out.to_str().unwrap();
+    let (code, _, stderr) = inspc(&["build", &spec, "-o", out, "--plan-json", out]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("insp::io::same_output"), "{stderr}");
+    assert!(!std::path::Path::new(out).exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// When one output cannot be written, none is: the program is not left behind by a
+/// plan JSON that failed.
+#[test]
+fn outputs_are_written_all_or_none() {
+    let (dir, spec) = f2_in("allornone");
+    let dmi = dir.join("f2.dmi");
+    let json = dir.join("missing-folder").join("plan.json");
+    let (code, _, stderr) = inspc(&[
+        "build",
+        &spec,
+        "-o",
+        dmi.to_str().unwrap(),
+        "--plan-json",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("insp::io::unwritable"), "{stderr}");
+    assert!(
+        !dmi.exists(),
+        "the program was written although the plan JSON failed"
+    );
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("inspc-tmp"))
+        .collect();
+    assert!(left.is_empty(), "temporaries left: {left:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Links planted where inspc writes are never followed: not at the temporary names
+/// (they are new and exclusive), and not at the target (the rename replaces the link).
+#[cfg(unix)]
+#[test]
+fn planted_links_are_not_followed() {
+    let (dir, spec) = f2_in("links");
+    let victim = dir.join("victim.txt");
+    std::fs::write(&victim, "keep me").unwrap();
+    for name in [".f2.dmi.inspc-tmp", ".f2.dmi.tmp"] {
+        std::os::unix::fs::symlink(&victim, dir.join(name)).unwrap();
+    }
+    let target = dir.join("f2.dmi");
+    std::os::unix::fs::symlink(&victim, &target).unwrap();
+    let (code, _, stderr) = inspc(&["build", &spec]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep me");
+    let meta = std::fs::symlink_metadata(&target).unwrap();
+    assert!(
+        meta.is_file(),
+        "the program replaced the link, as a file of its own"
+    );
+    assert!(std::fs::read_to_string(&target)
+        .unwrap()
+        .starts_with("$$ inspc"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Reading stops at what is not a regular file, and `use` reads only specs, quoting
+/// nothing of anything else.
+#[test]
+fn only_regular_files_and_only_specs_are_read() {
+    if std::path::Path::new("/dev/zero").exists() {
+        let (code, _, stderr) = inspc(&["dmis", "/dev/zero"]);
+        assert_eq!(code, 1, "{stderr}");
+        assert!(stderr.contains("insp::io::unreadable"), "{stderr}");
+        assert!(stderr.contains("not a regular file"), "{stderr}");
+        let spec = temp_spec("use_zero.insp", "use \"/dev/zero\"\n");
+        let (code, _, stderr) = inspc(&["check", &spec]);
+        assert_eq!(code, 1, "{stderr}");
+        assert!(stderr.contains("insp::load::not_a_spec"), "{stderr}");
+    }
+    let dir = std::env::temp_dir().join(format!("inspc-secret-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("secret.txt"), "root:x:0:0:TOP-SECRET\n").unwrap();
+    let spec = dir.join("main.insp");
+    std::fs::write(&spec, "use \"secret.txt\"\n").unwrap();
+    let (code, _, stderr) = inspc(&["check", spec.to_str().unwrap()]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("insp::load::not_a_spec"), "{stderr}");
+    assert!(!stderr.contains("TOP-SECRET"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Escape sequences and bidirectional overrides in a spec never reach the terminal raw.
+#[test]
+fn control_characters_are_not_printed_raw() {
+    let spec = temp_spec(
+        "escapes.insp",
+        "part p {\n    units mm\n    stock box(10, 10, 10)\n    feature f = stock.t\u{1b}[31mop\u{202e}x\n}\n",
+    );
+    let (code, _, stderr) = inspc(&["check", &spec]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(!stderr.contains('\u{1b}'), "{stderr:?}");
+    assert!(!stderr.contains('\u{202e}'), "{stderr:?}");
 }

@@ -100,10 +100,7 @@ impl Drop for Diags {
                 .iter()
                 .map(|d| format!("  {} `{}`: {}", d.code, d.span_text, d.message))
                 .collect();
-            panic!(
-                "diagnostics the test did not expect:\n{}",
-                lines.join("\n")
-            );
+            panic!("diagnostics the test did not expect:\n{}", lines.join("\n"));
         }
     }
 }

@@ -56,7 +56,11 @@ fn syntax_errors_name_expectations_in_words() {
             d.only().message
         );
     }
-    assert!(d.only().message.contains("expected"), "{}", d.only().message);
+    assert!(
+        d.only().message.contains("expected"),
+        "{}",
+        d.only().message
+    );
 }
 
 #[test]

@@ -1,0 +1,3 @@
+//! The command line's own IO helpers (binary only): writing outputs safely.
+
+pub mod outputs;
