@@ -236,12 +236,28 @@ fn parse(s: &str, at: usize) -> Option<Statement> {
     if major.is_empty() || !major.bytes().all(|c| c.is_ascii_uppercase()) {
         return None;
     }
+    // A quote opened and never closed swallows the rest of the statement.
+    if rest.matches('\'').count() % 2 == 1 {
+        return None;
+    }
     Some(Statement::Command {
         label,
         major: major.to_string(),
         params,
         at,
     })
+}
+
+/// A plain decimal number as DMIS writes it — an optional sign, digits, at most one
+/// point — and finite: not `nan`, `inf`, an exponent or a number past `f64`.
+fn decimal(s: &str) -> Option<f64> {
+    let body = s.strip_prefix(['-', '+']).unwrap_or(s);
+    let digits = body.bytes().filter(u8::is_ascii_digit).count();
+    let points = body.bytes().filter(|&c| c == b'.').count();
+    if digits == 0 || points > 1 || digits + points != body.len() {
+        return None;
+    }
+    s.parse::<f64>().ok().filter(|x| x.is_finite())
 }
 
 /// The `KIND(label)` references in a parameter list.
@@ -398,7 +414,7 @@ fn check(statements: &[Statement], text: &str, file: FileId, errors: &mut Vec<Dm
         }
         if matches!(*major, "GOTO" | "PTMEAS") {
             let nums = params.iter().filter(|p| *p != "CART");
-            if nums.clone().any(|p| p.parse::<f64>().is_err()) {
+            if nums.clone().any(|p| decimal(p).is_none()) {
                 errors.push(structure(
                     *at,
                     &format!("{major} with a parameter that is not a number"),
@@ -465,5 +481,22 @@ mod tests {
         // A continued statement reads as one.
         let wrapped = "DMISMN/'X',05.3\nF(P)=FEAT/PLANE,CART,$\n0,0,0,0,0,1\nENDFIL\n";
         assert!(codes(wrapped).is_empty());
+    }
+
+    #[test]
+    fn unterminated_quotes_and_odd_numbers_are_rejected() {
+        assert_eq!(
+            codes("DMISMN/'X',05.3\nTEXT/OPER,'never closed\nENDFIL\n"),
+            ["insp::dmis::syntax"]
+        );
+        for bad in ["nan", "inf", "-inf", "1e999", "1e3", "1.2.3", "+", "0x10", ""] {
+            let text = format!(
+                "DMISMN/'X',05.3\nF(P)=FEAT/PLANE,CART,0,0,0,0,0,1\nMEAS/PLANE,F(P),1\nGOTO/{bad},0,3\nPTMEAS/CART,0,0,0,0,0,1\nENDMES\nENDFIL\n"
+            );
+            assert_eq!(codes(&text), ["insp::dmis::structure"], "{bad:?}");
+        }
+        for good in ["1", "-1.5", "+0.25", "10.", ".5"] {
+            assert!(decimal(good).is_some(), "{good}");
+        }
     }
 }

@@ -188,9 +188,9 @@ fn weld(
     let mut remap = Vec::with_capacity(positions.len());
     for p in &positions {
         let q = p.map(|c| c * unit_mm);
-        if q.iter().any(|c| !c.is_finite() || c.abs() > 1e9) {
+        if q.iter().any(|c| !c.is_finite() || c.abs() > crate::model::MAX_LENGTH_MM) {
             return Err(MeshError::Corrupt(
-                "a vertex lies at infinity or beyond a kilometre".into(),
+                "a vertex lies at infinity or more than 10 m from the origin".into(),
             ));
         }
         let key = q.map(|c| (c * 1e6).round() as i64);

@@ -29,6 +29,11 @@ macro_rules! ids {
     )*};
 }
 
+/// The largest length inspc accepts (mm), in a spec or as a mesh coordinate: no CMM
+/// measures beyond 10 m. Every length past the front end (geometry, sampling, paths,
+/// DMIS numbers) is bounded by it, so no stage meets a size it cannot handle.
+pub const MAX_LENGTH_MM: f64 = 10_000.0;
+
 ids! {
     /// Index into [`Model::parts`].
     PartId,

@@ -562,7 +562,19 @@ fn operation(
             });
             let depth = positive(cx, &mut p, "depth");
             let corner_radius = match p.get("corner_radius") {
-                Some(v) => cx.length(v).filter(|x| *x >= 0.0),
+                Some(v) => cx.length(v).and_then(|x| {
+                    if x < 0.0 {
+                        cx.err(E::OutOfRange {
+                            span: v.span,
+                            what: "`corner_radius`".into(),
+                            value: describe(v),
+                            range: "it cannot be negative".into(),
+                            help: "a corner radius is 0 (sharp) or more".into(),
+                        });
+                        return None;
+                    }
+                    Some(x)
+                }),
                 None => Some(0.0),
             };
             OpKind::Pocket {

@@ -7,6 +7,8 @@ use crate::model::Vec3;
 use crate::source::{FileId, Span};
 use crate::syntax::ast::{self, Quantity, Value, ValueKind};
 
+use crate::model::MAX_LENGTH_MM;
+
 /// A physical dimension a quantity must have.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Dim {
@@ -108,6 +110,21 @@ impl Cx<'_> {
 
     /// Converts a quantity to the internal unit of `dim`.
     pub fn quantity(&mut self, q: &Quantity, dim: Dim) -> Option<f64> {
+        let x = self.quantity_unbounded(q, dim)?;
+        if dim == Dim::Length && x.abs() > MAX_LENGTH_MM {
+            self.err(E::OutOfRange {
+                span: q.span,
+                what: "length".into(),
+                value: format!("{x:e} mm"),
+                range: format!("a spec's lengths are at most {} m", MAX_LENGTH_MM / 1000.0),
+                help: "no CMM measures beyond 10 m; check the value and its unit".into(),
+            });
+            return None;
+        }
+        Some(x)
+    }
+
+    fn quantity_unbounded(&mut self, q: &Quantity, dim: Dim) -> Option<f64> {
         match &q.unit {
             None => {
                 if dim == Dim::Ratio || q.value == 0.0 {
@@ -287,11 +304,15 @@ impl Cx<'_> {
                 return None;
             }
         };
-        let n = (raw[0] * raw[0] + raw[1] * raw[1] + raw[2] * raw[2]).sqrt();
-        if n < 1e-12 {
+        // Scaled by its largest component first, so that huge components do not
+        // overflow into a zero vector.
+        let scale = raw.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if !(scale.is_finite() && scale > 0.0) {
             self.err(E::ZeroVector { span: v.span });
             return None;
         }
+        let raw = raw.map(|x| x / scale);
+        let n = (raw[0] * raw[0] + raw[1] * raw[1] + raw[2] * raw[2]).sqrt();
         Some([raw[0] / n, raw[1] / n, raw[2] / n])
     }
 

@@ -16,9 +16,13 @@ struct L {
 }
 
 impl L {
+    /// A pair's span without the blanks pest's implicit whitespace leaves at its end (a
+    /// bare number's optional unit consumes the space after it), so that labels
+    /// underline what was written.
     fn span(&self, p: &P) -> Span {
         let s = p.as_span();
-        Span::new(self.file, s.start(), s.end())
+        let kept = s.as_str().trim_end_matches([' ', '\t']).len();
+        Span::new(self.file, s.start(), s.start() + kept)
     }
 
     fn ident(&self, p: P) -> Ident {

@@ -1042,3 +1042,40 @@ fn no_points_in_an_imported_part_points_into_the_part_file() {
         .unwrap();
     assert!(d.file.ends_with("part.insp"), "filed under {}", d.file);
 }
+
+#[test]
+fn lengths_past_ten_metres_are_refused() {
+    // A box of 1e200 mm used to panic inside the boolean library; a clearance of 1e9 mm
+    // ran the path stage for hours; a search of 1e300 mm wrote a 301-character line.
+    expect_src(
+        &part("cut hole h { at (0, 0, 20), axis -z, diameter 5, depth 1.7e308 }"),
+        "insp::resolve::out_of_range",
+        "1.7e308",
+        "at most 10 m",
+    );
+    let d = check_src(
+        "use std::cmms::bridge_fixed\npart p { units mm, stock box(1e200, 60, 40) }\nplan q { part p, cmm bridge_fixed, motion { search 1e300 mm, clearance 1e9 mm } }\n",
+    );
+    expect(&d, "insp::resolve::out_of_range", "1e200", "1e200 mm is out of range");
+    expect(&d, "insp::resolve::out_of_range", "1e300 mm", "at most 10 m");
+    expect(&d, "insp::resolve::out_of_range", "1e9 mm", "at most 10 m");
+}
+
+#[test]
+fn a_negative_corner_radius_is_an_error() {
+    expect_src(
+        &part("cut pocket q { at (25, 20, 20), along +x, into -z, size (10, 10), depth 5, corner_radius -3 }"),
+        "insp::resolve::out_of_range",
+        "-3",
+        "cannot be negative",
+    );
+}
+
+#[test]
+fn huge_direction_components_do_not_vanish() {
+    // (1e300, 0, 0) used to overflow into a zero vector that passed as a direction.
+    let d = check_src(&part(
+        "cut hole h { at (25, 20, 20), axis (0, 0, -1e300), diameter 5, depth 5 }\nfeature w = h.wall",
+    ));
+    assert!(d.iter().all(|x| x.warning), "{:?}", d.iter().map(|x| &x.code).collect::<Vec<_>>());
+}
