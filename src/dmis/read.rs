@@ -489,7 +489,9 @@ mod tests {
             codes("DMISMN/'X',05.3\nTEXT/OPER,'never closed\nENDFIL\n"),
             ["insp::dmis::syntax"]
         );
-        for bad in ["nan", "inf", "-inf", "1e999", "1e3", "1.2.3", "+", "0x10", ""] {
+        for bad in [
+            "nan", "inf", "-inf", "1e999", "1e3", "1.2.3", "+", "0x10", "",
+        ] {
             let text = format!(
                 "DMISMN/'X',05.3\nF(P)=FEAT/PLANE,CART,0,0,0,0,0,1\nMEAS/PLANE,F(P),1\nGOTO/{bad},0,3\nPTMEAS/CART,0,0,0,0,0,1\nENDMES\nENDFIL\n"
             );

@@ -188,7 +188,9 @@ fn weld(
     let mut remap = Vec::with_capacity(positions.len());
     for p in &positions {
         let q = p.map(|c| c * unit_mm);
-        if q.iter().any(|c| !c.is_finite() || c.abs() > crate::model::MAX_LENGTH_MM) {
+        if q.iter()
+            .any(|c| !c.is_finite() || c.abs() > crate::model::MAX_LENGTH_MM)
+        {
             return Err(MeshError::Corrupt(
                 "a vertex lies at infinity or more than 10 m from the origin".into(),
             ));

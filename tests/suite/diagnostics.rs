@@ -1056,8 +1056,18 @@ fn lengths_past_ten_metres_are_refused() {
     let d = check_src(
         "use std::cmms::bridge_fixed\npart p { units mm, stock box(1e200, 60, 40) }\nplan q { part p, cmm bridge_fixed, motion { search 1e300 mm, clearance 1e9 mm } }\n",
     );
-    expect(&d, "insp::resolve::out_of_range", "1e200", "1e200 mm is out of range");
-    expect(&d, "insp::resolve::out_of_range", "1e300 mm", "at most 10 m");
+    expect(
+        &d,
+        "insp::resolve::out_of_range",
+        "1e200",
+        "1e200 mm is out of range",
+    );
+    expect(
+        &d,
+        "insp::resolve::out_of_range",
+        "1e300 mm",
+        "at most 10 m",
+    );
     expect(&d, "insp::resolve::out_of_range", "1e9 mm", "at most 10 m");
 }
 
@@ -1077,5 +1087,9 @@ fn huge_direction_components_do_not_vanish() {
     let d = check_src(&part(
         "cut hole h { at (25, 20, 20), axis (0, 0, -1e300), diameter 5, depth 5 }\nfeature w = h.wall",
     ));
-    assert!(d.iter().all(|x| x.warning), "{:?}", d.iter().map(|x| &x.code).collect::<Vec<_>>());
+    assert!(
+        d.iter().all(|x| x.warning),
+        "{:?}",
+        d.iter().map(|x| &x.code).collect::<Vec<_>>()
+    );
 }
