@@ -261,6 +261,9 @@ fn plans_of(
             continue;
         };
         let Some(data) = &parts[g.part] else { continue };
+        if !plan::check_machine(model, &model.plans[k], &data.geometry, &mut diags) {
+            continue;
+        }
         let input = plan::Input {
             model,
             plan: &model.plans[k],

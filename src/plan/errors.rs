@@ -28,6 +28,32 @@ pub enum PlanError {
         iterations: usize,
         last: String,
     },
+    #[error("part `{part}` does not fit on the table of `{cmm}`: its smallest footprint is {footprint}, the table {table}")]
+    #[diagnostic(
+        code(insp::plan::part_off_table),
+        help("plan it on a machine with a larger table (`table {{ size (…) }}`), or check the part's units")
+    )]
+    PartOffTable {
+        #[label("this plan")]
+        span: Span,
+        part: String,
+        cmm: String,
+        footprint: String,
+        table: String,
+    },
+    #[error("probe `{probe}` of `{cmm}` reaches {reach} mm below the head, as far as the ram travels ({ram} mm) or more")]
+    #[diagnostic(
+        code(insp::plan::probe_too_long),
+        help("a probe longer than the ram cannot be lifted clear of the table; use a shorter stylus or extension")
+    )]
+    ProbeTooLong {
+        #[label("this plan")]
+        span: Span,
+        probe: String,
+        cmm: String,
+        reach: String,
+        ram: String,
+    },
     #[error("part `{part}` has no plan, so there is no machine to plan for")]
     #[diagnostic(
         code(insp::plan::no_plan),
@@ -44,4 +70,6 @@ crate::located!(PlanError {
     UninspectableFace,
     NoConvergence,
     NoPlan,
+    PartOffTable,
+    ProbeTooLong,
 });

@@ -18,6 +18,7 @@ mod domain;
 mod errors;
 mod explain;
 mod hlip;
+mod machine;
 mod render;
 mod solve;
 mod validate;
@@ -27,6 +28,7 @@ pub use hlip::{
     FaceVisit, Hlip, Inspection, OrientNode, PlanPoint, PointRef, ProbeNode, SetupNode, Summary,
     STEPS_PER_MM,
 };
+pub use machine::check_machine;
 pub use render::{json, text, Names};
 
 use crate::diag::Diagnostics;

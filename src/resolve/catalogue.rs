@@ -8,6 +8,10 @@ use crate::load::ModuleId;
 use crate::model::*;
 use crate::syntax::ast::{self, ValueKind};
 
+/// The most points a sampling strategy may ask for on one face: each is a touch, and the
+/// tour over a group's touches is quadratic in their number.
+const MAX_POINTS_PER_FACE: u32 = 1_000;
+
 /// Lowers one property item and pushes it onto the model (always exactly one entry, so
 /// indices stay aligned with declarations even after errors).
 pub(super) fn lower(
@@ -415,7 +419,21 @@ pub(super) fn strategy(
     let mut inset = None;
     for a in args {
         match a {
-            ast::Arg::Named(k, val) if k.name == "points" => points = cx.count(val, "points"),
+            ast::Arg::Named(k, val) if k.name == "points" => {
+                points = cx.count(val, "points").and_then(|n| {
+                    if n > MAX_POINTS_PER_FACE {
+                        cx.err(E::OutOfRange {
+                            span: val.span,
+                            what: "`points`".into(),
+                            value: n.to_string(),
+                            range: format!("a face gets at most {MAX_POINTS_PER_FACE} points"),
+                            help: "touch probes take tens of points a face; a dense cloud is a scanner's job".into(),
+                        });
+                        return None;
+                    }
+                    Some(n)
+                })
+            }
             ast::Arg::Named(k, val) if k.name == "inset" => inset = inset_value(cx, val),
             ast::Arg::Named(k, _) => {
                 let help = suggest::help_for_unknown("option", &k.name, ["points", "inset"]);

@@ -94,6 +94,7 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
     };
     declare_locals(cx, &mut pc);
 
+    let mut instances: u64 = 0;
     for s in &p.stmts {
         if let PartStmt::Cut {
             add,
@@ -109,7 +110,25 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
                     what: format!("`{}` {}", if *add { "add" } else { "cut" }, kind.name),
                 });
             }
-            let op = operation(cx, *add, kind, name, props);
+            let mut op = operation(cx, *add, kind, name, props);
+            // The part's operations together stay within the instance limit: every
+            // instance is booleaned, sampled and measured.
+            if let Some(o) = &op {
+                let n = u64::from(o.pattern.as_ref().map_or(1, Pattern::count));
+                if instances + n > u64::from(MAX_INSTANCES) {
+                    cx.err(E::OutOfRange {
+                        span: o.span,
+                        what: format!("`{}`", o.name),
+                        value: format!("brings the part to {} instances", instances + n),
+                        range: format!("a part has at most {MAX_INSTANCES}"),
+                        help: "a CMM program measures each instance; check the pattern counts"
+                            .into(),
+                    });
+                    op = None;
+                } else {
+                    instances += n;
+                }
+            }
             pc.part.ops.push(op.unwrap_or(Op {
                 name: name.name.clone(),
                 action: if *add { Action::Add } else { Action::Cut },
@@ -624,7 +643,7 @@ fn operation(
     })
 }
 
-/// The most instances one pattern may have.
+/// The most instances one pattern, or all of a part's operations together, may have.
 const MAX_INSTANCES: u32 = 10_000;
 
 fn perpendicular(cx: &mut Cx, p: &mut Props, along: Option<Vec3>, into: Option<Vec3>) {

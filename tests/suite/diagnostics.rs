@@ -1093,3 +1093,27 @@ fn huge_direction_components_do_not_vanish() {
         d.iter().map(|x| &x.code).collect::<Vec<_>>()
     );
 }
+
+#[test]
+fn a_part_has_at_most_ten_thousand_instances_in_all() {
+    // Each pattern is within its limit; together they are not.
+    let d = check_src(&part(
+        "cut hole a { at (5, 5, 20), axis -z, diameter 0.1, depth 5, pattern grid(100, 60, 0.4, 0.4) }\ncut hole b { at (5, 30, 20), axis -z, diameter 0.1, depth 5, pattern grid(100, 50, 0.4, 0.4) }",
+    ));
+    expect(
+        &d,
+        "insp::resolve::out_of_range",
+        "b",
+        "brings the part to 11000 instances",
+    );
+}
+
+#[test]
+fn a_face_gets_at_most_a_thousand_points() {
+    expect_src(
+        "sampling s { plane uniform(points 10000) }",
+        "insp::resolve::out_of_range",
+        "10000",
+        "at most 1000 points",
+    );
+}
