@@ -144,16 +144,17 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
     for d in &part.datums {
         datums_of.entry(d.feature).or_default().push(d.name.clone());
     }
-    let mut feature_nodes: Vec<(FeatureId, NodeIndex)> = Vec::new();
+    // Per feature, its node once made (lookups stay linear in the part's size).
+    let mut node_of: Vec<Option<NodeIndex>> = vec![None; part.features.len()];
     let mut feature_node = |graph: &mut DiGraph<Node, Edge>, f: FeatureId| -> NodeIndex {
-        if let Some(&(_, n)) = feature_nodes.iter().find(|(g, _)| *g == f) {
+        if let Some(n) = node_of[f.0] {
             return n;
         }
         let n = graph.add_node(Node::Feature {
             feature: f,
             datums: datums_of.get(&f).cloned().unwrap_or_default(),
         });
-        feature_nodes.push((f, n));
+        node_of[f.0] = Some(n);
         n
     };
     for (k, t) in part.tolerances.iter().enumerate() {
@@ -171,11 +172,15 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
             }
         }
     }
+    let mut named: Vec<bool> = vec![false; part.features.len()];
+    for n in graph.node_weights() {
+        if let Node::Feature { feature, .. } = n {
+            named[feature.0] = true;
+        }
+    }
     for (k, f) in part.features.iter().enumerate() {
         let id = FeatureId(k);
-        let named = graph
-            .node_weights()
-            .any(|n| matches!(n, Node::Feature { feature, .. } if *feature == id));
+        let named = named[k];
         // Face aliases (`face top = …`) only name a face for use in features.
         let alias_only = f.declared == Declared::Face && !datums_of.contains_key(&id);
         if !named && !alias_only {
@@ -193,11 +198,16 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
 
     let g = input.geometry;
     let mut face_nodes: Vec<(FaceId, NodeIndex, FeatureId)> = Vec::new();
+    let mut face_node_of: HashMap<FaceId, NodeIndex> = HashMap::new();
+    // Per face, the features that list it, in declaration order (for its strategy).
+    let mut owners_of: HashMap<FaceId, Vec<FeatureId>> = HashMap::new();
     for &(f, fnode) in &feature_nodes {
         let datum = datums_of.contains_key(&f);
         for &face in &input.feature_faces[f.0] {
-            let node = match face_nodes.iter().find(|(x, _, _)| *x == face) {
-                Some(&(_, n, _)) => {
+            // Each feature comes once and lists each face once.
+            owners_of.entry(face).or_default().push(f);
+            let node = match face_node_of.get(&face).copied() {
+                Some(n) => {
                     if datum && on_table(g, face) {
                         graph[n] = Node::Face {
                             face,
@@ -212,6 +222,7 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
                         on_table: datum && on_table(g, face),
                     });
                     face_nodes.push((face, n, f));
+                    face_node_of.insert(face, n);
                     n
                 }
             };
@@ -222,7 +233,9 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
     let sampler = Sampler::new(g, input.margin);
     let mut fpoints = Vec::new();
     for &(face, fnode, first_feature) in &face_nodes {
-        let strategy = strategy_for(input, face, &feature_nodes);
+        let mut owners = owners_of.remove(&face).unwrap_or_default();
+        owners.sort();
+        let strategy = strategy_for(input, face, &owners);
         let points = sampler.sample(face, &strategy);
         if points.is_empty() {
             let feature = &part.features[first_feature.0];
@@ -250,14 +263,9 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
 }
 
 /// The strategy for a face: the override of the first feature (in declaration order)
-/// that has one and lists the face, else the sampling's strategy for its surface type.
-fn strategy_for(input: &Input, face: FaceId, features: &[(FeatureId, NodeIndex)]) -> Strategy {
-    let mut owners: Vec<FeatureId> = features
-        .iter()
-        .map(|(f, _)| *f)
-        .filter(|f| input.feature_faces[f.0].contains(&face))
-        .collect();
-    owners.sort();
+/// that has one and lists the face (`owners`, sorted), else the sampling's strategy for
+/// its surface type.
+fn strategy_for(input: &Input, face: FaceId, owners: &[FeatureId]) -> Strategy {
     owners
         .iter()
         .find_map(|f| {
