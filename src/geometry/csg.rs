@@ -91,6 +91,24 @@ pub(super) fn build(
     }
 
     let center = P3::from((slo.coords + shi.coords) / 2.0);
+    // Where material may be: the stock and every added instance, as boxes.
+    let (mut mlo, mut mhi) = (slo, shi);
+    for op in part.ops.iter().filter(|o| o.action == Action::Add) {
+        let Some((prim, _)) = cutter(op, stock, center, ext, big) else {
+            continue;
+        };
+        for m in op
+            .pattern
+            .as_ref()
+            .map_or_else(|| vec![Isometry3::identity()], pattern)
+        {
+            let mut prim = prim.clone();
+            prim.transform(&m);
+            let (lo, hi) = prim.bounds();
+            mlo = mlo.inf(&lo);
+            mhi = mhi.sup(&hi);
+        }
+    }
     let mut tools: Vec<Tool> = Vec::new();
     for (oi, op) in part.ops.iter().enumerate() {
         let Some((prim, roles)) = cutter(op, stock, center, ext, big) else {
@@ -108,7 +126,14 @@ pub(super) fn build(
             let mut prim = prim.clone();
             prim.transform(&m);
             let (lo, hi) = prim.bounds();
-            if (0..3).any(|k| hi[k] < slo[k] || lo[k] > shi[k]) {
+            // A hole goes into the material from its entry: just past the entry along
+            // its axis there must be material, or the hole points out of the part (its
+            // tool would only cut the overlap kept behind the entry).
+            let points_out = hole_start(op, stock, center).is_some_and(|p| {
+                let p = m * p;
+                (0..3).any(|k| p[k] < mlo[k] || p[k] > mhi[k])
+            });
+            if points_out || (0..3).any(|k| hi[k] < slo[k] || lo[k] > shi[k]) {
                 let what = op.kind.word();
                 let name = inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name));
                 diags.push(E::MissesPart {
@@ -365,6 +390,26 @@ fn radial_entry(stock: &Stock, center: P3, d: V3) -> P3 {
 
 /// The primitive an operation adds or removes, and for each primitive part the roles
 /// its face answers to (empty: the part lies outside the finished solid).
+/// For a hole, the point a little past its entry along its axis (inside the material
+/// when the hole goes into the part).
+fn hole_start(op: &model::Op, stock: &Stock, center: P3) -> Option<P3> {
+    let OpKind::Hole {
+        at, axis, depth, ..
+    } = &op.kind
+    else {
+        return None;
+    };
+    let entry = match at {
+        Placement::At(p) => P3::new(p[0], p[1], p[2]),
+        Placement::Radial(d) => radial_entry(stock, center, v3(d)),
+    };
+    let reach = match depth {
+        Depth::Through => f64::INFINITY,
+        Depth::Blind(d) => *d,
+    };
+    Some(entry + v3(axis).normalize() * (reach / 2.0).min(0.1))
+}
+
 fn cutter(
     op: &model::Op,
     stock: &Stock,

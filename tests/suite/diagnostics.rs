@@ -1117,3 +1117,13 @@ fn a_face_gets_at_most_a_thousand_points() {
         "at most 1000 points",
     );
 }
+
+#[test]
+fn a_hole_pointing_out_of_the_part_misses_it() {
+    // It used to cut a phantom 1.7 mm hole: the overlap its tool keeps behind the entry.
+    let d = common::plan_files(&[(
+        "main.insp",
+        part("cut hole h { at (25, 20, 20), axis +z, diameter 5, depth 10 }").as_bytes(),
+    )]);
+    expect(&d, "insp::geometry::misses_part", "h", "misses the part");
+}
