@@ -36,6 +36,18 @@ pub enum GeometryError {
         path: String,
         reason: String,
     },
+    #[error("part `{part}` falls apart into {bodies} separate bodies")]
+    #[diagnostic(
+        code(insp::geometry::several_bodies),
+        severity(Warning),
+        help("an operation cuts right through the part (a slot or step deeper than the stock?); a CMM measures one body at a time, and loose pieces cannot be fixtured as one")
+    )]
+    SeveralBodies {
+        #[label("this part")]
+        span: Span,
+        part: String,
+        bodies: usize,
+    },
     #[error("mesh `{path}` has {open} open and {nonmanifold} non-manifold edges")]
     #[diagnostic(code(insp::geometry::mesh_defects), severity(Warning), help("the mesh is used as it is; collision checks near those edges may be off; repair or re-export it for a watertight solid"))]
     MeshDefects {
@@ -115,6 +127,7 @@ crate::located!(GeometryError {
     MeshCorrupt,
     MeshNotClosed,
     MeshDefects,
+    SeveralBodies,
     MeshTooLarge,
     BooleanFailed,
     MissesPart,

@@ -262,7 +262,18 @@ pub fn build(
     diags: &mut Diagnostics,
 ) -> Option<PartGeometry> {
     match &part.geometry {
-        Source::Stock(stock) => csg::build(part, stock, diags),
+        Source::Stock(stock) => {
+            let g = csg::build(part, stock, diags)?;
+            let bodies = bodies(&g);
+            if bodies > 1 {
+                diags.push(GeometryError::SeveralBodies {
+                    span: part.span,
+                    part: part.name.clone(),
+                    bodies,
+                });
+            }
+            Some(g)
+        }
         Source::Mesh {
             path,
             unit_mm,
@@ -296,4 +307,34 @@ pub fn build(
             Some(geometry)
         }
     }
+}
+
+/// How many separate bodies a part's triangles make: groups of triangles joined by
+/// shared vertices (union-find over the welded vertices).
+fn bodies(g: &PartGeometry) -> usize {
+    let mut parent: Vec<u32> = (0..g.vertices.len() as u32).collect();
+    fn root(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            parent[x as usize] = parent[parent[x as usize] as usize];
+            x = parent[x as usize];
+        }
+        x
+    }
+    for t in &g.triangles {
+        let a = root(&mut parent, t[0]);
+        for &v in &t[1..] {
+            let b = root(&mut parent, v);
+            if a != b {
+                parent[b as usize] = a;
+            }
+        }
+    }
+    let mut roots: Vec<u32> = g
+        .triangles
+        .iter()
+        .map(|t| root(&mut parent, t[0]))
+        .collect();
+    roots.sort_unstable();
+    roots.dedup();
+    roots.len()
 }
