@@ -126,10 +126,10 @@ pub(super) fn build(
             let mut prim = prim.clone();
             prim.transform(&m);
             let (lo, hi) = prim.bounds();
-            // A hole goes into the material from its entry: just past the entry along
-            // its axis there must be material, or the hole points out of the part (its
-            // tool would only cut the overlap kept behind the entry).
-            let points_out = hole_start(op, stock, center).is_some_and(|p| {
+            // A cut goes into the material from its entry: just past the entry along its
+            // direction there must be material, or it points out of the part (its tool
+            // would only cut the overlap kept behind the entry).
+            let points_out = cut_start(op, stock, center).is_some_and(|p| {
                 let p = m * p;
                 (0..3).any(|k| p[k] < mlo[k] || p[k] > mhi[k])
             });
@@ -390,24 +390,30 @@ fn radial_entry(stock: &Stock, center: P3, d: V3) -> P3 {
 
 /// The primitive an operation adds or removes, and for each primitive part the roles
 /// its face answers to (empty: the part lies outside the finished solid).
-/// For a hole, the point a little past its entry along its axis (inside the material
-/// when the hole goes into the part).
-fn hole_start(op: &model::Op, stock: &Stock, center: P3) -> Option<P3> {
-    let OpKind::Hole {
-        at, axis, depth, ..
-    } = &op.kind
-    else {
-        return None;
+/// For a hole or a pocket, the point a little past where it enters, along the direction
+/// it goes into the part: inside the material when it does. (A slot's or a step's
+/// `at` lies on the part's edge, where this test would be unreliable; not checked.)
+fn cut_start(op: &model::Op, stock: &Stock, center: P3) -> Option<P3> {
+    let (entry, dir, reach) = match &op.kind {
+        OpKind::Hole {
+            at, axis, depth, ..
+        } => {
+            let entry = match at {
+                Placement::At(p) => P3::new(p[0], p[1], p[2]),
+                Placement::Radial(d) => radial_entry(stock, center, v3(d)),
+            };
+            let reach = match depth {
+                Depth::Through => f64::INFINITY,
+                Depth::Blind(d) => *d,
+            };
+            (entry, v3(axis), reach)
+        }
+        OpKind::Pocket {
+            at, into, depth, ..
+        } => (P3::new(at[0], at[1], at[2]), v3(into), *depth),
+        OpKind::Slot { .. } | OpKind::Step { .. } | OpKind::Boss { .. } => return None,
     };
-    let entry = match at {
-        Placement::At(p) => P3::new(p[0], p[1], p[2]),
-        Placement::Radial(d) => radial_entry(stock, center, v3(d)),
-    };
-    let reach = match depth {
-        Depth::Through => f64::INFINITY,
-        Depth::Blind(d) => *d,
-    };
-    Some(entry + v3(axis).normalize() * (reach / 2.0).min(0.1))
+    Some(entry + dir.normalize() * (reach / 2.0).min(0.1))
 }
 
 fn cutter(

@@ -1127,3 +1127,13 @@ fn a_hole_pointing_out_of_the_part_misses_it() {
     )]);
     expect(&d, "insp::geometry::misses_part", "h", "misses the part");
 }
+
+#[test]
+fn a_pocket_pointing_out_of_the_part_misses_it() {
+    let d = common::plan_files(&[(
+        "main.insp",
+        part("cut pocket q { at (25, 20, 20), along +x, into +z, size (10, 10), depth 5 }")
+            .as_bytes(),
+    )]);
+    expect(&d, "insp::geometry::misses_part", "q", "misses the part");
+}
