@@ -236,9 +236,7 @@ impl<'a> Pose<'a> {
             let d = &part.dir;
             let origin = |t: f64| -> P3 { c + n * t + part.offset };
             // The table: the lowest point is linear along the approach, so the ends decide.
-            let low = self
-                .low(part, &(c + n * 0.0))
-                .min(self.low(part, &(c + n * travel)));
+            let low = self.low(part, c).min(self.low(part, &(c + n * travel)));
             if low < t0 + TABLE_MARGIN {
                 return Err(Blocker::ComponentOnTable(comp.name.clone()));
             }

@@ -398,10 +398,7 @@ fn cut_start(op: &model::Op, stock: &Stock, center: P3) -> Option<P3> {
         OpKind::Hole {
             at, axis, depth, ..
         } => {
-            let entry = match at {
-                Placement::At(p) => P3::new(p[0], p[1], p[2]),
-                Placement::Radial(d) => radial_entry(stock, center, v3(d)),
-            };
+            let entry = hole_entry(at, stock, center);
             let reach = match depth {
                 Depth::Through => f64::INFINITY,
                 Depth::Blind(d) => *d,
@@ -414,6 +411,15 @@ fn cut_start(op: &model::Op, stock: &Stock, center: P3) -> Option<P3> {
         OpKind::Slot { .. } | OpKind::Step { .. } | OpKind::Boss { .. } => return None,
     };
     Some(entry + dir.normalize() * (reach / 2.0).min(0.1))
+}
+
+/// Where a hole enters the part: its given point, or where its radial direction meets the
+/// stock.
+fn hole_entry(at: &Placement, stock: &Stock, center: P3) -> P3 {
+    match at {
+        Placement::At(p) => P3::new(p[0], p[1], p[2]),
+        Placement::Radial(d) => radial_entry(stock, center, v3(d)),
+    }
 }
 
 fn cutter(
@@ -430,11 +436,7 @@ fn cutter(
             diameter,
             depth,
         } => {
-            let entry = match at {
-                Placement::At(p) => P3::new(p[0], p[1], p[2]),
-                Placement::Radial(d) => radial_entry(stock, center, v3(d)),
-            };
-            let f = Frame::along(entry, v3(axis));
+            let f = Frame::along(hole_entry(at, stock, center), v3(axis));
             let (z1, bottom) = match depth {
                 Depth::Through => (big, vec![]),
                 Depth::Blind(d) => (*d, vec![Role::Bottom]),

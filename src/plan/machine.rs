@@ -18,12 +18,8 @@ pub fn check_machine(
     let cmm = &model.cmms[plan.cmm.0];
     let part = &model.parts[plan.part.0];
     let mut ok = true;
-    if let (Some(table), Some(first)) = (cmm.table_size, geometry.vertices.first()) {
-        let (mut lo, mut hi) = (first.coords, first.coords);
-        for v in &geometry.vertices {
-            lo = lo.inf(&v.coords);
-            hi = hi.sup(&v.coords);
-        }
+    if let (Some(table), false) = (cmm.table_size, geometry.vertices.is_empty()) {
+        let (lo, hi) = geometry.bounds();
         let mut e = [hi.x - lo.x, hi.y - lo.y, hi.z - lo.z];
         e.sort_by(f64::total_cmp);
         let mut t = table;
