@@ -192,6 +192,7 @@ fn graphs_of(checked: &mut Checked, parts: &[Option<PartData>]) -> Vec<Graphed> 
             sampling,
             overrides: plan.map_or(&[][..], |p| &p.overrides),
             margin: sampling_margin(model, plan),
+            span: plan.map_or(model.parts[k].span, |p| p.span),
         };
         out.push(Graphed {
             part: k,

@@ -52,15 +52,20 @@ impl Default for RenderOptions {
     }
 }
 
-/// Renders one diagnostic as miette's graphical report.
+/// Renders one diagnostic as miette's graphical report. Only the lines around its
+/// labels are quoted, and of a long line only [`QUOTE_WIDTH`] bytes around the label.
 pub fn render_human(map: &SourceMap, d: &Diagnostic, opts: RenderOptions) -> String {
     let file = map.get(d.file);
+    let spans: Vec<(usize, usize)> = d
+        .inner
+        .labels()
+        .into_iter()
+        .flatten()
+        .map(|l| (l.offset(), l.len()))
+        .collect();
     let located = Located {
         inner: d.inner.as_ref(),
-        src: NamedSource::new(
-            terminal_safe(&file.name),
-            terminal_safe(&file.text).into_owned(),
-        ),
+        src: Excerpt::of(file, &spans),
     };
     let theme = if opts.color {
         GraphicalTheme::unicode()
@@ -115,10 +120,120 @@ pub fn to_json(map: &SourceMap, d: &Diagnostic) -> serde_json::Value {
     })
 }
 
+/// The most bytes of one source line a report quotes.
+pub const QUOTE_WIDTH: usize = 240;
+
+/// Lines quoted before the first label's line and after the last's.
+const CONTEXT_LINES: usize = 2;
+
+/// One quoted line: where it starts in the file and in the excerpt, and the window of
+/// it that was kept (the whole line unless it is longer than [`QUOTE_WIDTH`]).
+struct QuotedLine {
+    start: usize,
+    keep: std::ops::Range<usize>,
+    at: usize,
+}
+
+/// The part of a file a report quotes: the lines around its labels, long lines cut to
+/// a window around the label, made terminal-safe; line numbers stay the file's.
+struct Excerpt {
+    src: NamedSource<String>,
+    first_line: usize,
+    lines: Vec<QuotedLine>,
+}
+
+impl Excerpt {
+    fn of(file: &crate::source::SourceFile, spans: &[(usize, usize)]) -> Excerpt {
+        let text = &file.text;
+        let (lo, hi) = spans.iter().fold((usize::MAX, 0), |(lo, hi), &(o, l)| {
+            (lo.min(o), hi.max(o + l))
+        });
+        let (lo, hi) = if lo == usize::MAX { (0, 0) } else { (lo, hi) };
+        let first = file.line_of(lo).saturating_sub(CONTEXT_LINES);
+        let last = (file.line_of(hi) + CONTEXT_LINES).min(file.line_count() - 1);
+        let mut out = String::new();
+        let mut lines = Vec::new();
+        for line in first..=last {
+            let range = file.line_range(line);
+            let keep = if range.len() <= QUOTE_WIDTH {
+                range.clone()
+            } else {
+                // The window starts a little before the first label on the line.
+                let on_line = spans
+                    .iter()
+                    .map(|&(o, _)| o)
+                    .filter(|o| range.contains(o))
+                    .min()
+                    .unwrap_or(range.start);
+                let mut a = on_line.saturating_sub(QUOTE_WIDTH / 4).max(range.start);
+                let mut b = (a + QUOTE_WIDTH).min(range.end);
+                while !text.is_char_boundary(a) {
+                    a -= 1;
+                }
+                while !text.is_char_boundary(b) {
+                    b -= 1;
+                }
+                a..b
+            };
+            let lead = if keep.start > range.start { "…" } else { "" };
+            let at = out.len() + lead.len();
+            out.push_str(lead);
+            out.push_str(&terminal_safe(&text[keep.clone()]));
+            if keep.end < range.end {
+                out.push('…');
+            }
+            if line < last {
+                out.push('\n');
+            }
+            lines.push(QuotedLine {
+                start: range.start,
+                keep,
+                at,
+            });
+        }
+        Excerpt {
+            src: NamedSource::new(terminal_safe(&file.name), out),
+            first_line: first,
+            lines,
+        }
+    }
+
+    /// Where file offset `o` falls in the excerpt (clamped into its line's window).
+    fn map(&self, o: usize) -> usize {
+        let k = self
+            .lines
+            .partition_point(|l| l.start <= o)
+            .saturating_sub(1);
+        let Some(l) = self.lines.get(k) else {
+            return 0;
+        };
+        l.at + o.clamp(l.keep.start, l.keep.end) - l.keep.start
+    }
+}
+
+impl miette::SourceCode for Excerpt {
+    fn read_span<'a>(
+        &'a self,
+        span: &miette::SourceSpan,
+        before: usize,
+        after: usize,
+    ) -> Result<Box<dyn miette::SpanContents<'a> + 'a>, miette::MietteError> {
+        let c = self.src.read_span(span, before, after)?;
+        Ok(Box::new(miette::MietteSpanContents::new_named(
+            c.name().unwrap_or_default().to_owned(),
+            c.data(),
+            *c.span(),
+            c.line() + self.first_line,
+            c.column(),
+            c.line_count(),
+        )))
+    }
+}
+
 /// A diagnostic together with the source its labels point into.
 struct Located<'a> {
     inner: &'a (dyn miette::Diagnostic + Send + Sync),
-    src: NamedSource<String>,
+    src: Excerpt,
 }
 
 impl fmt::Debug for Located<'_> {
@@ -149,7 +264,8 @@ impl miette::Diagnostic for Located<'_> {
     fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
         let labels = self.inner.labels()?.map(|l| {
             let text = l.label().map(|t| terminal_safe(t).into_owned());
-            let span = (l.offset(), l.len());
+            let (a, b) = (self.src.map(l.offset()), self.src.map(l.offset() + l.len()));
+            let span = (a, b - a);
             if l.primary() {
                 miette::LabeledSpan::new_primary_with_span(text, span)
             } else {

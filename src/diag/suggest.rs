@@ -47,7 +47,7 @@ pub fn help_for_unknown<'a>(
     } else {
         String::new()
     };
-    format!("known {what}s: {}{more}", shown.join(", "))
+    format!("known {}: {}{more}", plural(what), shown.join(", "))
 }
 
 /// Edit distance over characters where swapping two neighbours counts as one edit
@@ -90,5 +90,14 @@ mod tests {
         assert_eq!(did_you_mean("TP20", ["PH6", "PH10MQ"]), None);
         assert_eq!(did_you_mean("mM", ["mm", "cm"]), Some("mm".into()));
         assert_eq!(edit_distance("kitten", "sitting"), 3);
+    }
+}
+
+/// The plural of a noun naming a kind of item (`property` → `properties`).
+fn plural(what: &str) -> String {
+    match what.strip_suffix('y') {
+        Some(stem) if !stem.ends_with(['a', 'e', 'o', 'u']) => format!("{stem}ies"),
+        _ if what.ends_with('s') || what.ends_with('x') => format!("{what}es"),
+        _ => format!("{what}s"),
     }
 }

@@ -122,6 +122,8 @@ pub(super) fn build(
                 .map(|(i, m)| (Some(i as u32), m))
                 .collect(),
         };
+        let total = instances.len();
+        let mut missed: Vec<String> = Vec::new();
         for (inst, m) in instances {
             let mut prim = prim.clone();
             prim.transform(&m);
@@ -134,13 +136,7 @@ pub(super) fn build(
                 (0..3).any(|k| p[k] < mlo[k] || p[k] > mhi[k])
             });
             if points_out || (0..3).any(|k| hi[k] < slo[k] || lo[k] > shi[k]) {
-                let what = op.kind.word();
-                let name = inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name));
-                diags.push(E::MissesPart {
-                    span: op.span,
-                    what: what.into(),
-                    name,
-                });
+                missed.push(inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name)));
                 continue;
             }
             for (k, rs) in roles.iter().enumerate() {
@@ -168,6 +164,19 @@ pub(super) fn build(
                 prim,
                 action: op.action,
                 op: oi,
+            });
+        }
+        // One error per operation, however many of its instances miss.
+        if let Some(first) = missed.first() {
+            diags.push(E::MissesPart {
+                span: op.span,
+                what: op.kind.word().into(),
+                name: first.clone(),
+                more: match missed.len() {
+                    _ if total == 1 => String::new(),
+                    1 => format!(" (one of the {total} instances of `{}`)", op.name),
+                    n => format!(" ({n} of the {total} instances of `{}` miss it)", op.name),
+                },
             });
         }
     }

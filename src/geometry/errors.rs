@@ -76,13 +76,14 @@ pub enum GeometryError {
         part: String,
         reason: String,
     },
-    #[error("{what} `{name}` misses the part")]
+    #[error("{what} `{name}` misses the part{more}")]
     #[diagnostic(code(insp::geometry::misses_part), help("move it onto the part: its position and direction are in the part frame (boxes span from the origin)"))]
     MissesPart {
         #[label("removes nothing")]
         span: Span,
         what: String,
         name: String,
+        more: String,
     },
     #[error("face `{face}` does not survive the booleans")]
     #[diagnostic(

@@ -30,11 +30,13 @@ pub fn resolve_faces(g: &PartGeometry, r: &FaceRef, diags: &mut Diagnostics) -> 
                 .filter(|&k| alive(k))
                 .map(FaceId)
                 .collect();
-            if live.is_empty() {
-                let face = matching
-                    .first()
-                    .map_or_else(|| role.to_string(), |&k| g.faces[k].name.clone());
-                diags.push(E::FaceGone { span: *span, face });
+            // No face at all comes from an operation that missed the part, which
+            // `insp::geometry::misses_part` has reported: one error, not two.
+            if let (true, Some(&k)) = (live.is_empty(), matching.first()) {
+                diags.push(E::FaceGone {
+                    span: *span,
+                    face: g.faces[k].name.clone(),
+                });
             }
             live
         }

@@ -33,9 +33,21 @@ pub enum GraphError {
         found: String,
         help: String,
     },
+    #[error("{what} samples more than {limit} measuring points on its {faces} faces", limit = super::MAX_POINTS)]
+    #[diagnostic(
+        code(insp::graph::too_many_points),
+        help("a plan measures at most {limit} points; give the features fewer points (`sample F with hammersley(points 4)`) or split the part into several plans", limit = super::MAX_POINTS)
+    )]
+    TooManyPoints {
+        #[label("this plan")]
+        span: Span,
+        what: String,
+        faces: usize,
+    },
 }
 
 crate::located!(GraphError {
+    TooManyPoints,
     NoPoints,
     WrongSurface,
 });

@@ -82,6 +82,11 @@ pub struct MeasurementGraph {
     pub margin: f64,
 }
 
+/// The most measuring points one graph may hold. The path stage keeps a shortest-path
+/// tree per point of a group (points × roadmap nodes), so this bounds its memory to a
+/// few hundred megabytes and a build to seconds; real parts use far fewer (FTC 08: 737).
+pub const MAX_POINTS: usize = 5_000;
+
 impl MeasurementGraph {
     /// The nodes of a kind, in order.
     pub fn nodes(&self) -> impl Iterator<Item = (NodeIndex, &Node)> {
@@ -131,6 +136,8 @@ pub struct Input<'a> {
     pub overrides: &'a [(FeatureId, Strategy)],
     /// The distance points keep from face boundaries (mm).
     pub margin: f64,
+    /// Where a problem of the whole graph is reported: the plan's name, or the part's.
+    pub span: crate::source::Span,
 }
 
 /// Builds the measurement graph of a part, sampling every face. The entry point of the
@@ -237,6 +244,17 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
         owners.sort();
         let strategy = strategy_for(input, face, &owners);
         let points = sampler.sample(face, &strategy);
+        if fpoints.len() + points.len() > MAX_POINTS {
+            diags.push(GraphError::TooManyPoints {
+                span: input.span,
+                what: match input.plan {
+                    Some(p) => format!("plan `{p}`"),
+                    None => format!("part `{}`", part.name),
+                },
+                faces: face_nodes.len(),
+            });
+            break;
+        }
         if points.is_empty() {
             let feature = &part.features[first_feature.0];
             diags.push(GraphError::NoPoints {

@@ -363,7 +363,7 @@ impl<'a> Roadmap<'a> {
     fn dijkstra(&self, s: usize) -> Tree {
         let n = self.nodes.len();
         let mut dist = vec![f64::INFINITY; n];
-        let mut prev: Vec<Option<(usize, Route)>> = vec![None; n];
+        let mut prev = vec![NO_EDGE; n];
         let mut heap = BinaryHeap::new();
         dist[s] = 0.0;
         heap.push(Item(0.0, s));
@@ -371,16 +371,17 @@ impl<'a> Roadmap<'a> {
             if d > dist[u] {
                 continue;
             }
-            for e in &self.adj[u] {
+            for (k, e) in self.adj[u].iter().enumerate() {
                 let nd = d + e.length;
                 if nd < dist[e.to] - 1e-12 {
                     dist[e.to] = nd;
-                    prev[e.to] = Some((u, e.route));
+                    prev[e.to] = (u as u32, k as u32);
                     heap.push(Item(nd, e.to));
                 }
             }
         }
-        (dist, prev)
+        dist.truncate(self.goals);
+        Tree { dist, prev }
     }
 
     /// Shortest paths from every goal: distances between goals and the trees to
@@ -394,8 +395,16 @@ impl<'a> Roadmap<'a> {
     }
 }
 
-/// Dijkstra's result from one goal: distances and predecessors.
-type Tree = (Vec<f64>, Vec<Option<(usize, Route)>>);
+/// No predecessor.
+const NO_EDGE: (u32, u32) = (u32::MAX, u32::MAX);
+
+/// Dijkstra's result from one goal: the distances to the goals, and per node the
+/// predecessor and the index of the edge from it. Kept this small because a group holds
+/// one tree per goal (goals × nodes entries: 8 bytes each, not 40).
+struct Tree {
+    dist: Vec<f64>,
+    prev: Vec<(u32, u32)>,
+}
 
 /// Shortest paths from each goal.
 pub struct Paths {
@@ -405,19 +414,23 @@ pub struct Paths {
 impl Paths {
     /// The length of the shortest path between goals `a` and `b`.
     pub fn d(&self, a: usize, b: usize) -> f64 {
-        self.trees[a].0[b]
+        self.trees[a].dist[b]
     }
 
     /// The waypoints from goal `a` to goal `b` (without `a`, with `b`).
     pub fn path(&self, map: &Roadmap, a: usize, b: usize) -> Vec<P3> {
         // Walk back from b to a in a's tree; each edge's route runs from its
         // predecessor towards the node.
-        let prev = &self.trees[a].1;
+        let prev = &self.trees[a].prev;
         let mut chain = Vec::new();
         let mut at = b;
         while at != a {
-            let Some((p, route)) = prev[at] else { break };
-            chain.push((p, at, route));
+            let (p, k) = prev[at];
+            if (p, k) == NO_EDGE {
+                break;
+            }
+            let (p, k) = (p as usize, k as usize);
+            chain.push((p, at, map.adj[p][k].route));
             at = p;
         }
         chain.reverse();

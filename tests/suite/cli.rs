@@ -34,6 +34,30 @@ fn check_clean_example_exits_zero() {
 }
 
 #[test]
+fn a_report_quotes_a_window_of_a_long_line() {
+    // A 2 MB line used to be echoed whole, once per diagnostic.
+    let filler = "x".repeat(1_000_000);
+    let text = format!(
+        "part p {{\n    units mm // {filler}\n    stock box(1, 1, 1), bogus 3 // {filler}\n}}\n"
+    );
+    let spec = temp_spec("long_line.insp", &text);
+    let (code, _, stderr) = inspc(&["check", &spec]);
+    assert_eq!(code, 1);
+    assert!(
+        stderr.contains("insp::syntax::unexpected"),
+        "{}",
+        &stderr[..stderr.len().min(2000)]
+    );
+    assert!(stderr.len() < 4_000, "{} bytes of report", stderr.len());
+    // The label still points at the property, on the file's own line number.
+    assert!(
+        stderr.contains("bogus") && stderr.contains("long_line.insp:3:"),
+        "{stderr}"
+    );
+    assert!(stderr.contains('…'), "{stderr}");
+}
+
+#[test]
 fn check_reports_errors_and_exits_one() {
     let bad = temp_spec(
         "bad.insp",

@@ -1095,16 +1095,16 @@ fn huge_direction_components_do_not_vanish() {
 }
 
 #[test]
-fn a_part_has_at_most_ten_thousand_instances_in_all() {
+fn a_part_has_at_most_two_thousand_instances_in_all() {
     // Each pattern is within its limit; together they are not.
     let d = check_src(&part(
-        "cut hole a { at (5, 5, 20), axis -z, diameter 0.1, depth 5, pattern grid(100, 60, 0.4, 0.4) }\ncut hole b { at (5, 30, 20), axis -z, diameter 0.1, depth 5, pattern grid(100, 50, 0.4, 0.4) }",
+        "cut hole a { at (5, 5, 20), axis -z, diameter 0.1, depth 5, pattern grid(40, 30, 0.4, 0.4) }\ncut hole b { at (5, 30, 20), axis -z, diameter 0.1, depth 5, pattern grid(40, 25, 0.4, 0.4) }",
     ));
     expect(
         &d,
         "insp::resolve::out_of_range",
         "b",
-        "brings the part to 11000 instances",
+        "brings the part to 2200 instances",
     );
 }
 
@@ -1126,6 +1126,36 @@ fn a_hole_pointing_out_of_the_part_misses_it() {
         part("cut hole h { at (25, 20, 20), axis +z, diameter 5, depth 10 }").as_bytes(),
     )]);
     expect(&d, "insp::geometry::misses_part", "h", "misses the part");
+}
+
+#[test]
+fn a_pattern_missing_the_part_is_one_error_and_its_faces_are_not_gone() {
+    // 1,600 instances used to give 1,600 errors, and every face naming them one more.
+    let d = common::plan_files(&[(
+        "main.insp",
+        part("cut hole h { at (-500, -500, 20), axis -z, diameter 2, depth 5, pattern grid(40, 40, 5, 5) }\nfeature holes = h.wall")
+            .as_bytes(),
+    )]);
+    expect(
+        &d,
+        "insp::geometry::misses_part",
+        "h",
+        "1600 of the 1600 instances of `h` miss it",
+    );
+}
+
+#[test]
+fn a_plan_samples_at_most_five_thousand_points() {
+    let d = check_src(&format!(
+        "{}\ncmm lab {{ table {{ z 0 mm }}, ram {{ radius 35 mm, length 600 mm }}, head std::heads::PH6, probes [p1: std::probes::TP20_D2_L20] }}\nplan q {{ part p, cmm lab, sample all with uniform(points 1000) }}\n",
+        part("feature all = stock.top + stock.bottom + stock.front + stock.back + stock.left + stock.right")
+    ));
+    expect(
+        &d,
+        "insp::graph::too_many_points",
+        "q",
+        "more than 5000 measuring points",
+    );
 }
 
 #[test]
