@@ -17,7 +17,9 @@ use crate::geometry::{P3, V3};
 use nalgebra::{Rotation3, Unit};
 use parry3d_f64::math::Isometry;
 use parry3d_f64::query::intersection_test;
-use parry3d_f64::shape::{Ball, Capsule, ConvexPolyhedron, RoundShape, Shape, Triangle};
+use parry3d_f64::shape::{
+    Capsule, ConvexPolyhedron, Cuboid, Cylinder, RoundShape, Shape, Triangle,
+};
 
 /// The share of the tip radius the mesh may come closer than the radius at a contact:
 /// fpoints lie on the exact surface and a concave face's facets are up to the
@@ -65,6 +67,8 @@ pub enum Blocker {
     Component(String),
     /// A named component comes too near the table.
     ComponentOnTable(String),
+    /// A named component (or the tip) meets the fixture holding the part.
+    Fixture(String),
 }
 
 impl std::fmt::Display for Blocker {
@@ -74,6 +78,7 @@ impl std::fmt::Display for Blocker {
             Blocker::TipOnTable => write!(f, "the tip (on the table)"),
             Blocker::Component(c) => write!(f, "the {c}"),
             Blocker::ComponentOnTable(c) => write!(f, "the {c} (on the table)"),
+            Blocker::Fixture(c) => write!(f, "the {c} (on the fixture)"),
         }
     }
 }
@@ -139,6 +144,85 @@ pub fn above_table(probe: &ProbeShape, c: &P3, o: &V3, up: &V3, t0: f64) -> bool
             .all(|comp| lowest(comp, &art, up, up) >= t0 + ORIENTATION_TABLE_MARGIN)
 }
 
+/// A solid of a fixture, placed in the part frame of one setup: a box, or a cylinder
+/// (along its local y axis, as parry's).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solid {
+    /// Where it stands: local frame → part frame.
+    pub at: Isometry<f64>,
+    /// Its shape.
+    pub shape: SolidShape,
+}
+
+/// The shapes fixtures are made of.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SolidShape {
+    /// A box with these half extents.
+    Box(V3),
+    /// A cylinder of this half height (along local y) and radius.
+    Cylinder {
+        /// Half its height.
+        half_height: f64,
+        /// Its radius.
+        radius: f64,
+    },
+}
+
+impl Solid {
+    /// A box centred at `centre` with its local axes turned by `rot`.
+    pub fn cuboid(centre: P3, rot: Rotation3<f64>, half: V3) -> Solid {
+        Solid {
+            at: Isometry::from_parts(centre.coords.into(), rot.into()),
+            shape: SolidShape::Box(half.map(|x| x.max(1e-3))),
+        }
+    }
+
+    /// A cylinder around the axis from `base` along unit `axis` over `height`.
+    pub fn cylinder(base: P3, axis: V3, height: f64, radius: f64) -> Solid {
+        let rot = Rotation3::rotation_between(&V3::y(), &axis).unwrap_or_else(|| {
+            Rotation3::from_axis_angle(&Unit::new_normalize(V3::x()), std::f64::consts::PI)
+        });
+        let centre = base + axis * (height / 2.0);
+        Solid {
+            at: Isometry::from_parts(centre.coords.into(), rot.into()),
+            shape: SolidShape::Cylinder {
+                half_height: (height / 2.0).max(1e-3),
+                radius: radius.max(1e-3),
+            },
+        }
+    }
+
+    /// Whether a shape given in the part frame meets this solid.
+    pub fn hits(&self, shape: &dyn Shape) -> bool {
+        let id = Isometry::identity();
+        match self.shape {
+            SolidShape::Box(h) => intersection_test(&self.at, &Cuboid::new(h), &id, shape),
+            SolidShape::Cylinder {
+                half_height,
+                radius,
+            } => intersection_test(&self.at, &Cylinder::new(half_height, radius), &id, shape),
+        }
+        .unwrap_or(true)
+    }
+
+    /// The lowest point along unit `up`.
+    pub fn lowest(&self, up: &V3) -> f64 {
+        let local = self.at.rotation.inverse() * up;
+        let c = self.at.translation.vector.dot(up);
+        match self.shape {
+            SolidShape::Box(h) => {
+                c - (h.x * local.x.abs() + h.y * local.y.abs() + h.z * local.z.abs())
+            }
+            SolidShape::Cylinder {
+                half_height,
+                radius,
+            } => {
+                c - half_height * local.y.abs() - radius * (1.0 - local.y * local.y).max(0.0).sqrt()
+            }
+        }
+    }
+}
+
 /// One component of a posed probe: its shape along `dir` from `offset` past the tip
 /// centre.
 #[derive(Debug, Clone)]
@@ -149,13 +233,14 @@ struct Posed {
 }
 
 /// A probe posed in the part frame — setup, orientation — with the obstacles of its
-/// setup: the part and the table under it.
+/// setup: the part, the table under it and the fixture holding it.
 pub struct Pose<'a> {
     scene: &'a Scene,
     tip_radius: f64,
     parts: Vec<Posed>,
     up: V3,
     table: f64,
+    fixture: &'a [Solid],
 }
 
 impl<'a> Pose<'a> {
@@ -196,7 +281,14 @@ impl<'a> Pose<'a> {
             parts,
             up,
             table,
+            fixture: &[],
         }
+    }
+
+    /// The same pose with the fixture's solids as obstacles too.
+    pub fn with_fixture(mut self, solids: &'a [Solid]) -> Pose<'a> {
+        self.fixture = solids;
+        self
     }
 
     /// The ram direction.
@@ -267,7 +359,20 @@ impl<'a> Pose<'a> {
                 }
             }
         }
-        Ok(())
+        self.sweep_fixture(c, &(c + n * travel))
+    }
+
+    /// Whether the probe meets the fixture anywhere on the move from tip centre `p` to
+    /// `q`.
+    fn sweep_fixture(&self, p: &P3, q: &P3) -> Result<(), Blocker> {
+        if self.fixture.is_empty() {
+            return Ok(());
+        }
+        let hits = |s: &dyn Shape| self.fixture.iter().any(|f| f.hits(s));
+        self.sweep(p, q, &hits).map_err(|b| match b {
+            Blocker::Component(c) => Blocker::Fixture(c),
+            _ => Blocker::Fixture("tip".into()),
+        })
     }
 
     /// Whether the probe standing with its tip centre at `p` is clear.
@@ -291,20 +396,22 @@ impl<'a> Pose<'a> {
                 return Err(Blocker::ComponentOnTable(part.comp.name.clone()));
             }
         }
-        let Some(mesh) = self.scene.mesh() else {
-            return Ok(());
-        };
-        let id = Isometry::identity();
-        let hits = |shape: &dyn Shape| intersection_test(&id, shape, &id, mesh).unwrap_or(true);
+        if let Some(mesh) = self.scene.mesh() {
+            let id = Isometry::identity();
+            let hits = |shape: &dyn Shape| intersection_test(&id, shape, &id, mesh).unwrap_or(true);
+            self.sweep(p, q, &hits)?;
+        }
+        self.sweep_fixture(p, q)
+    }
+
+    /// Sweeps every component from tip centre `p` to `q` against what `hits` tests:
+    /// the tip as an exact capsule, a stylus or extension capsule as the exact union of
+    /// two rounded triangles, a body, head or ram cylinder as the convex hull of its two
+    /// end positions (its discs as circumscribed 16-gons).
+    fn sweep(&self, p: &P3, q: &P3, hits: &dyn Fn(&dyn Shape) -> bool) -> Result<(), Blocker> {
         let v = q - p;
         let moving = v.norm() > 1e-9;
-        let tip = if moving {
-            hits(&Capsule::new(*p, *q, self.tip_radius))
-        } else {
-            let at = Isometry::translation(p.x, p.y, p.z);
-            intersection_test(&at, &Ball::new(self.tip_radius), &id, mesh).unwrap_or(true)
-        };
-        if tip {
+        if hits(&Capsule::new(*p, *q, self.tip_radius)) {
             return Err(Blocker::Tip);
         }
         let far = 4.0 * self.scene.size + 10.0;
@@ -342,7 +449,7 @@ impl<'a> Pose<'a> {
                         Some(hull) => hits(&hull),
                         // A hull parry cannot build (a degenerate move): test positions
                         // along the move with the radius grown to cover the gaps.
-                        None => sampled(self.scene, &a0, &v, part),
+                        None => sampled(&a0, &b0, &v, c.radius, hits),
                     }
                 }
             };
@@ -354,17 +461,13 @@ impl<'a> Pose<'a> {
     }
 }
 
-/// The fallback sweep: positions every millimetre, radius grown by half a step.
-fn sampled(scene: &Scene, from: &P3, v: &V3, part: &Posed) -> bool {
+/// The fallback sweep: capsules every millimetre around the component's axis, radius
+/// grown by half a step (a capsule holds the flat-ended cylinder).
+fn sampled(a: &P3, b: &P3, v: &V3, radius: f64, hits: &dyn Fn(&dyn Shape) -> bool) -> bool {
     let steps = v.norm().ceil().max(1.0) as usize;
-    let grown = Component {
-        radius: part.comp.radius + v.norm() / steps as f64 / 2.0,
-        a: 0.0,
-        b: part.comp.b - part.comp.a,
-        ..part.comp.clone()
-    };
+    let radius = radius + v.norm() / steps as f64 / 2.0;
     (0..=steps).any(|s| {
-        let at = from + v * (s as f64 / steps as f64);
-        component_hits(scene, &at, &part.dir, &grown)
+        let t = v * (s as f64 / steps as f64);
+        hits(&Capsule::new(a + t, b + t, radius))
     })
 }

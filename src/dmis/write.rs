@@ -440,6 +440,23 @@ impl Writer<'_> {
             si + 1,
             direction_words(&setup.up)
         ));
+        self.o.oper(&format!(
+            "HOLD IT BY {}",
+            self.names.holder(&setup.holder).to_uppercase()
+        ));
+        // How it is turned about the vertical: where a part axis across `up` points.
+        let r = nalgebra::Matrix3::from_fn(|i, j| setup.rotation[i][j]);
+        let across = if setup.up.x.abs() < 0.9 {
+            V3::x()
+        } else {
+            V3::y()
+        };
+        let name = if across == V3::x() { "X" } else { "Y" };
+        let m = r * across;
+        self.o.oper(&format!(
+            "TURN IT SO THAT ITS +{name} DIRECTION POINTS ALONG MACHINE {}",
+            direction_words(&V3::new(round3(m.x), round3(m.y), round3(m.z)))
+        ));
         for f in &setup.on_table {
             let face = self.names.face(*f);
             self.o.oper(&format!("REST FACE {face} ON THE TABLE"));
@@ -649,4 +666,14 @@ fn nominal_of(input: &Input, b: &BlockPath) -> Option<Nominal> {
     }
     let face = input.geometry.faces.get(b.face.0)?;
     Some(Nominal::Surface(face.surface.clone(), face.centroid))
+}
+
+/// A number rounded to 1e-3, without `-0`.
+fn round3(x: f64) -> f64 {
+    let r = (x * 1e3).round() / 1e3;
+    if r == 0.0 {
+        0.0
+    } else {
+        r
+    }
 }

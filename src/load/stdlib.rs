@@ -11,6 +11,7 @@ pub const STD_MODULES: &[(&str, &str)] = &[
         include_str!("../../stdlib/hierarchies.insp"),
     ),
     ("std::sampling", include_str!("../../stdlib/sampling.insp")),
+    ("std::fixtures", include_str!("../../stdlib/fixtures.insp")),
 ];
 
 /// The names of the standard modules.

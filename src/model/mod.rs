@@ -55,6 +55,8 @@ ids! {
     SamplingId,
     /// Index into [`Model::plans`].
     PlanId,
+    /// Index into [`Model::fixtures`].
+    FixtureId,
     /// Index into a machine's rack, [`Cmm::probes`]: a probe as mounted, with its label.
     SlotId,
 }
@@ -80,6 +82,8 @@ pub struct Model {
     pub hierarchies: Vec<Hierarchy>,
     /// Sampling strategy sets.
     pub samplings: Vec<Sampling>,
+    /// Fixtures.
+    pub fixtures: Vec<Fixture>,
     /// Plans declared in the root files (imported files' plans are not run).
     pub plans: Vec<Plan>,
     /// `std::sampling::fan_leu`, the sampling of a plan that names none and of a part
@@ -104,8 +108,63 @@ pub struct Cmm {
     pub head: HeadId,
     /// The probes in its rack, by label.
     pub probes: Vec<(String, ProbeId)>,
+    /// The fixtures beside it, by label.
+    pub fixtures: Vec<(String, FixtureId)>,
     /// Where it was declared.
     pub span: Span,
+}
+
+/// A fixture that holds a part where it would not stand on the table by itself.
+#[derive(Debug, Clone)]
+pub struct Fixture {
+    /// Its name.
+    pub name: String,
+    /// What it is and its sizes.
+    pub kind: FixtureKind,
+    /// How high it holds the part's lowest point above the table (mm).
+    pub height: f64,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// The kinds of fixture, with their sizes (mm, degrees).
+#[derive(Debug, Clone, PartialEq)]
+pub enum FixtureKind {
+    /// A machine vise: two jaws clamp two opposite parallel faces at most `opening`
+    /// apart, the part on parallels on a face square to them.
+    Vise {
+        /// The widest opening.
+        opening: f64,
+        /// Jaw width (along the clamped faces) and height.
+        jaw: [f64; 2],
+    },
+    /// A three-jaw chuck: holds a round part (an outer cylinder, or a sphere) with its
+    /// axis vertical.
+    Chuck {
+        /// The diameters it grips.
+        diameter: [f64; 2],
+        /// How far up the part its jaws reach.
+        jaws: f64,
+        /// The chuck body's diameter.
+        body: f64,
+    },
+    /// A sine plate (an angle plate at 90°): the part clamped on one of its flat faces to
+    /// a plate tilted by an angle within `tilt` about a horizontal axis.
+    SinePlate {
+        /// The tilt range (degrees).
+        tilt: [f64; 2],
+    },
+}
+
+impl FixtureKind {
+    /// The keyword.
+    pub fn word(&self) -> &'static str {
+        match self {
+            FixtureKind::Vise { .. } => "vise",
+            FixtureKind::Chuck { .. } => "chuck",
+            FixtureKind::SinePlate { .. } => "sine_plate",
+        }
+    }
 }
 
 /// How a head orients its probe.
@@ -481,6 +540,9 @@ pub struct Plan {
     pub outputs: Outputs,
     /// Approach, retract and clearance distances.
     pub motion: Motion,
+    /// The fixtures of the plan's CMM it may use (indices into [`Cmm::fixtures`]); none:
+    /// the table alone.
+    pub fixtures: Vec<usize>,
     /// Where it was declared.
     pub span: Span,
 }

@@ -29,7 +29,7 @@ pub use align::Alignment;
 pub use errors::PathError;
 pub use render::json;
 
-use crate::access::pose::{table_height, Contact, Head, Pose};
+use crate::access::pose::{Contact, Head, Pose};
 use crate::access::{ProbeShape, Scene};
 use crate::diag::Diagnostics;
 use crate::geometry::{FaceId, P3, V3};
@@ -137,6 +137,8 @@ struct GroupIn<'a> {
     dir: V3,
     up: V3,
     table: f64,
+    /// The fixture's solids.
+    fixture: &'a [crate::access::pose::Solid],
     height: f64,
     blocks: Vec<BlockPath>,
     records: Vec<ToleranceId>,
@@ -201,7 +203,7 @@ pub fn plan(
 /// blocks, datum groups first within a setup.
 fn linearise<'a>(
     input: &Input,
-    hlip: &Hlip,
+    hlip: &'a Hlip,
     probes: &'a [ProbeShape],
     scene: &Scene,
 ) -> Vec<GroupIn<'a>> {
@@ -217,7 +219,7 @@ fn linearise<'a>(
     let mut groups: Vec<GroupIn> = Vec::new();
     for (si, s) in hlip.setups.iter().enumerate() {
         let up = s.up;
-        let table = table_height(scene, &up);
+        let table = s.table;
         let top = vertices
             .iter()
             .map(|v| v.coords.dot(&up))
@@ -272,6 +274,7 @@ fn linearise<'a>(
                     dir,
                     up,
                     table,
+                    fixture: &s.fixture,
                     height: top + motion.clearance + lift,
                     blocks,
                     records,
@@ -324,7 +327,7 @@ fn join(
                 // from there, up or down to this group's height, then across.
                 let from = head - g.dir * arm(g);
                 let across = from + g.up * (g.height - from.coords.dot(&g.up));
-                let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table);
+                let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table).with_fixture(g.fixture);
                 checks += 2;
                 let moves = pose
                     .segment(&from, &across)
@@ -428,7 +431,7 @@ fn plan_group(
     g: &GroupIn,
     standoff: f64,
 ) -> Result<GroupOut, Box<PathError>> {
-    let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table);
+    let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table).with_fixture(g.fixture);
     let r = g.probe.tip_radius;
     // Goals: every touch's stand-off, block by block.
     let mut goals = Vec::new();

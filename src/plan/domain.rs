@@ -126,7 +126,12 @@ pub(crate) struct TableAlt {
 }
 
 /// The planner's knowledge base.
-pub(crate) struct Knowledge {
+pub(crate) struct Knowledge<'a> {
+    /// The setups the plan may use and what holds the part in each.
+    pub setups: super::poses::Setups<'a>,
+    /// Per setup cell used: what holds the part, the table's height and the fixture's
+    /// solids.
+    held: BTreeMap<usize, Held>,
     /// Cube-map options (resolution, preferred directions, retract distance).
     pub opts: ConeOptions,
     /// The part as obstacle.
@@ -139,6 +144,9 @@ pub(crate) struct Knowledge {
     pub dom: Vec<Vec<Dom>>,
     /// Setups the plan forbids.
     pub forbidden: CubeMap,
+    /// Setups an operator can realise: the part's stable poses and its fixtures'
+    /// (see [`super::poses`]); every other setup is out of every point's domain.
+    pub realisable: CubeMap,
     /// Preference weight per cube-map cell index (0.5 when unspecified).
     pub setup_weight: BTreeMap<usize, f64>,
     /// Setup preferences in declaration order: (cell index, weight).
@@ -149,8 +157,6 @@ pub(crate) struct Knowledge {
     d1p: BTreeMap<(usize, usize, usize), Bits>,
     /// The second component's depth map per setup cell.
     second: BTreeMap<usize, SecondMap>,
-    /// The table's height per setup cell.
-    heights: BTreeMap<usize, f64>,
     /// How many times the whole probe's cones were computed.
     pub acquired: usize,
 }
@@ -170,9 +176,17 @@ pub(crate) fn cone_around(like: &CubeMap, axis: &V3, angle: f64) -> CubeMap {
     out
 }
 
-impl Knowledge {
+/// How the part is held in one setup.
+#[derive(Debug, Clone)]
+pub(crate) struct Held {
+    pub holder: super::poses::Holder,
+    pub table: f64,
+    pub solids: Vec<crate::access::pose::Solid>,
+}
+
+impl<'a> Knowledge<'a> {
     /// Validates touching point `f` with probe `p` pointing along `dir` in setup `up`
-    /// over a table at `t0` (one primitive inspection plan, seed ch. 4.1).
+    /// held as `held` says (one primitive inspection plan, seed ch. 4.1).
     pub(crate) fn pose_check(
         &self,
         machine: &Machine,
@@ -180,7 +194,7 @@ impl Knowledge {
         p: usize,
         dir: V3,
         up: V3,
-        t0: f64,
+        held: &Held,
     ) -> Result<(), Blocker> {
         let probe = &machine.probes[p];
         let point = &self.points[f];
@@ -189,12 +203,14 @@ impl Knowledge {
         } else {
             Contact::Part
         };
-        Pose::new(&self.scene, probe, dir, up, t0).approach(
-            &point.tip_centre(probe.tip_radius),
-            &point.normal,
-            self.opts.retract,
-            contact,
-        )
+        Pose::new(&self.scene, probe, dir, up, held.table)
+            .with_fixture(&held.solids)
+            .approach(
+                &point.tip_centre(probe.tip_radius),
+                &point.normal,
+                self.opts.retract,
+                contact,
+            )
     }
 
     /// The initial knowledge: half-line cones at every fpoint for every probe, table
@@ -205,8 +221,10 @@ impl Knowledge {
         geometry: &crate::geometry::PartGeometry,
         fpoints: &[Fpoint],
         table_faces: &[FaceId],
+        setups: super::poses::Setups<'a>,
         opts: ConeOptions,
-    ) -> Knowledge {
+    ) -> Knowledge<'a> {
+        let realisable = setups.exact_dirs();
         let scene = Scene::of_part(geometry);
         // Preferred directions: the axes, the plan's setups, the table setups, then
         // feature axes and plane normals — a probe often fits a hole only along its
@@ -222,6 +240,9 @@ impl Knowledge {
         }
         for s in &plan.setups {
             add(&mut pref, V3::from(s.direction));
+        }
+        for d in &realisable {
+            add(&mut pref, *d);
         }
         let mut table_dirs = Vec::new();
         for &f in table_faces {
@@ -251,6 +272,14 @@ impl Knowledge {
         };
         let empty = CubeMap::empty(opts.n, &pref);
         let mut forbidden = empty.clone();
+        let mut real = empty.clone();
+        let total = 6 * (empty.n() as usize).pow(2) + empty.preferred_len();
+        for k in 0..total {
+            let cell = empty.cell(k);
+            if setups.holder(&empty.direction(cell)).is_some() {
+                real.set(cell, true);
+            }
+        }
         let mut setup_weight = BTreeMap::new();
         let mut setup_prefs = Vec::new();
         for s in &plan.setups {
@@ -276,11 +305,13 @@ impl Knowledge {
                 position,
                 normal: up,
             }));
+            // A datum face can rest on the table only in a pose that stands.
+            let cell = empty.cell_of(&up);
             tables.push(TableAlt {
                 face,
-                cell: empty.index(empty.cell_of(&up)),
+                cell: empty.index(cell),
                 points: (first..points.len()).collect(),
-                alive: true,
+                alive: real.get(cell),
             });
         }
         let graph_points = fpoints.len();
@@ -295,18 +326,20 @@ impl Knowledge {
             })
             .collect();
         Knowledge {
+            setups,
+            held: BTreeMap::new(),
             opts,
             scene,
             points,
             graph_points,
             dom,
             forbidden,
+            realisable: real,
             setup_weight,
             setup_prefs,
             tables,
             d1p: BTreeMap::new(),
             second: BTreeMap::new(),
-            heights: BTreeMap::new(),
             acquired: 0,
         }
     }
@@ -322,14 +355,32 @@ impl Knowledge {
         shape.direction(shape.cell(s))
     }
 
+    /// How the part is held in setup cell `s` (cached): what holds it, the table's
+    /// height under it and the fixture's solids. A cell outside the realisable setups
+    /// (which no plan uses) rests on its lowest point with no fixture.
+    pub(crate) fn held(&mut self, s: usize) -> &Held {
+        let up = self.setup_dir(s);
+        let setups = &self.setups;
+        let scene = &self.scene;
+        self.held
+            .entry(s)
+            .or_insert_with(|| match setups.holder(&up) {
+                Some(holder) => Held {
+                    table: setups.table(&holder, &up),
+                    solids: setups.solids(&holder, &up),
+                    holder,
+                },
+                None => Held {
+                    holder: super::poses::Holder::Table { faces: vec![] },
+                    table: table_height(scene, &up),
+                    solids: vec![],
+                },
+            })
+    }
+
     /// The table's height under the part in setup cell `s` (cached).
     pub(crate) fn table_height(&mut self, s: usize) -> f64 {
-        if let Some(&h) = self.heights.get(&s) {
-            return h;
-        }
-        let h = table_height(&self.scene, &self.setup_dir(s));
-        self.heights.insert(s, h);
-        h
+        self.held(s).table
     }
 
     /// The setups from which some allowed probe reaches graph fpoint `f`.
@@ -341,6 +392,7 @@ impl Knowledge {
             }
         }
         out.and_not_assign(&self.forbidden);
+        out.and_assign(&self.realisable);
         out
     }
 
@@ -422,7 +474,9 @@ impl Knowledge {
 
     /// Learns that probe `p` cannot reach point `f` from setup cell `s` (and, for a bent
     /// probe, orientation `o`): the first time, the point's half-line domain is replaced
-    /// by the whole probe's cones; the configuration is then removed.
+    /// by the whole probe's cones; the configuration is then removed. In a setup with a
+    /// fixture it is removed at once: the cones do not see fixtures, so better cones
+    /// would not change the answer.
     pub(crate) fn reject(
         &mut self,
         f: usize,
@@ -437,13 +491,31 @@ impl Knowledge {
             }
             return;
         }
-        if !self.dom[f][p].full {
+        let fixture = self.held.get(&s).is_some_and(|h| !h.solids.is_empty());
+        if !self.dom[f][p].full && !fixture {
             self.acquire(f, p, machine);
             return;
         }
-        if let (Some(o), Some(b)) = (o, self.d1p.get_mut(&(f, p, s))) {
-            b.remove(o);
-            if !b.is_empty() {
+        if let (Some(o), true) = (o, self.d1p.contains_key(&(f, p, s))) {
+            let mut left = self.d1p[&(f, p, s)].clone();
+            left.remove(o);
+            if fixture {
+                // Every other orientation against the fixture now, not one a round.
+                let up = self.setup_dir(s);
+                let held = self.held[&s].clone();
+                let keep: Vec<usize> = left
+                    .ones()
+                    .filter(|&k| {
+                        let (a, b) = machine.grid[k];
+                        let dir = access::pose::orientation_dir(&up, a, b);
+                        self.pose_check(machine, f, p, dir, up, &held).is_ok()
+                    })
+                    .collect();
+                left = Bits::of(machine.grid.len(), keep);
+            }
+            let empty = left.is_empty();
+            self.d1p.insert((f, p, s), left);
+            if !empty {
                 return;
             }
         }
@@ -500,6 +572,15 @@ impl Knowledge {
             .collect();
         // Preferred directions the half-line allowed and the rasterized probe did not:
         // its grown pixels err on the blocked side, so test them exactly.
+        let shape = self.empty_cone();
+        let cells: Vec<usize> = (0..shape.preferred_len())
+            .map(|j| shape.index(Cell::Preferred(j)))
+            .filter(|&s| self.realisable.get(shape.cell(s)))
+            .collect();
+        let held: BTreeMap<usize, Held> = cells
+            .into_iter()
+            .map(|s| (s, self.held(s).clone()))
+            .collect();
         let exact: Vec<Vec<usize>> = todo
             .par_iter()
             .zip(&computed)
@@ -515,8 +596,9 @@ impl Knowledge {
                     })
                     .filter(|&j| {
                         let up = old.preferred(j);
-                        let t0 = table_height(&self.scene, &up);
-                        self.pose_check(machine, f, p, up, up, t0).is_ok()
+                        let s = old.index(Cell::Preferred(j));
+                        held.get(&s)
+                            .is_some_and(|h| self.pose_check(machine, f, p, up, up, h).is_ok())
                     })
                     .collect()
             })

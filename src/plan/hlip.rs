@@ -7,9 +7,10 @@
 
 use super::cluster::{min_hitting_set, Strategy};
 use super::domain::{Knowledge, Machine};
+use super::poses::Holder;
 use super::solve::{self, Branch, Inst, Kind};
 use super::Input;
-use crate::access::pose::{frame, orientation_dir, Contact, Head};
+use crate::access::pose::{frame, orientation_dir, Contact, Head, Solid};
 use crate::geometry::{FaceId, P3, V3};
 use crate::model::{FeatureId, PlanId, SlotId, ToleranceId};
 use std::collections::BTreeSet;
@@ -74,6 +75,12 @@ pub struct SetupNode {
     pub rotation: [[f64; 3]; 3],
     /// Datum faces resting on the table in this setup.
     pub on_table: Vec<FaceId>,
+    /// What holds the part: the table (a stable pose) or a fixture.
+    pub holder: Holder,
+    /// The table's height along `up` (part frame, mm).
+    pub table: f64,
+    /// The fixture's solids in the part frame: obstacles like the part.
+    pub fixture: Vec<Solid>,
     /// The probes used, in order.
     pub probes: Vec<ProbeNode>,
 }
@@ -172,13 +179,14 @@ pub(crate) struct Round<'a> {
 type Probes<'a> = Vec<(usize, Vec<(usize, Vec<&'a Inst>)>)>;
 
 /// Assembles the HLIP tree from the branches of the plan kept.
-pub(crate) fn assemble(input: &Input, k: &Knowledge, m: &Machine, run: &Round) -> Hlip {
+pub(crate) fn assemble(input: &Input, k: &mut Knowledge, m: &Machine, run: &Round) -> Hlip {
     let setups = group(run.branches);
     let mut used_points: BTreeSet<usize> = BTreeSet::new();
     let mut features: BTreeSet<Option<FeatureId>> = BTreeSet::new();
     let mut seq: Vec<(usize, (u64, u64))> = Vec::new();
     let mut out_setups = Vec::new();
-    for (_, up, probes) in &setups {
+    for (cell, up, probes) in &setups {
+        let held = k.held(*cell).clone();
         let mut on_table = Vec::new();
         let mut pnodes = Vec::new();
         for (p, orients) in probes {
@@ -250,6 +258,9 @@ pub(crate) fn assemble(input: &Input, k: &Knowledge, m: &Machine, run: &Round) -
             up: quantise(up),
             rotation: [0, 1, 2].map(|i| [0, 1, 2].map(|j| round(r[(i, j)]))),
             on_table,
+            holder: held.holder,
+            table: round(held.table),
+            fixture: held.solids,
             probes: pnodes,
         });
     }

@@ -19,6 +19,7 @@ mod errors;
 mod explain;
 mod hlip;
 mod machine;
+pub mod poses;
 mod render;
 mod solve;
 mod validate;
@@ -107,6 +108,7 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
     let (model, plan, g) = (input.model, input.plan, input.graph);
     let hierarchy = &model.hierarchies[plan.hierarchy.0];
     let machine = Machine::new(model, plan);
+    let setups = poses::Setups::new(model, plan, input.geometry);
     // Datum faces that can rest on the table.
     let mut table_faces: Vec<FaceId> = Vec::new();
     for (n, node) in g.nodes() {
@@ -139,6 +141,7 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
         input.geometry,
         &g.fpoints,
         &table_faces,
+        setups,
         cone_opts,
     );
     let mut validated: BTreeSet<Pip> = BTreeSet::new();
@@ -174,7 +177,7 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
                 strategy: None,
                 exact_budget: opts.exact_budget,
             };
-            return Some(assemble(input, &k, &machine, &round));
+            return Some(assemble(input, &mut k, &machine, &round));
         };
         let mut results: Vec<(Strategy, Vec<Branch>)> = Vec::new();
         let mut failures = Vec::new();
@@ -220,13 +223,13 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
         pips.sort_by_key(|(p, _)| *p);
         pips.dedup_by_key(|(p, _)| *p);
         pips.retain(|(p, _)| !validated.contains(p));
-        let heights: BTreeMap<usize, f64> = pips
+        let held: BTreeMap<usize, domain::Held> = pips
             .iter()
-            .map(|(p, _)| (p.setup, k.table_height(p.setup)))
+            .map(|(p, _)| (p.setup, k.held(p.setup).clone()))
             .collect();
         let checked: Vec<(Pip, Result<(), _>)> = pips
             .par_iter()
-            .map(|(p, up)| (*p, validate::check(&k, &machine, p, up, heights[&p.setup])))
+            .map(|(p, up)| (*p, validate::check(&k, &machine, p, up, &held[&p.setup])))
             .collect();
         let mut invalid = Vec::new();
         for (p, what) in checked {
@@ -263,7 +266,7 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
                 strategy: Some(best.0),
                 exact_budget: opts.exact_budget,
             };
-            return Some(assemble(input, &k, &machine, &round));
+            return Some(assemble(input, &mut k, &machine, &round));
         }
         learn(&mut k, &machine, invalid);
     }

@@ -59,6 +59,30 @@ impl<'a> Names<'a> {
     pub fn datum(&self, d: DatumId) -> &'a str {
         &self.part().datums[d.0].name
     }
+
+    /// A fixture's label beside the CMM, and its kind's keyword.
+    pub fn fixture(&self, slot: usize) -> (&'a str, &'static str) {
+        let (label, id) = &self.model.cmms[self.plan.cmm.0].fixtures[slot];
+        (label, self.model.fixtures[id.0].kind.word())
+    }
+
+    /// What holds the part in a setup, in words: `the table on faces …` or `fixture
+    /// vise (a vise) on faces …`.
+    pub fn holder(&self, h: &super::poses::Holder) -> String {
+        let faces = |fs: &[FaceId]| {
+            fs.iter()
+                .map(|f| self.face(*f))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        match h {
+            super::poses::Holder::Table { faces: fs } => format!("the table on {}", faces(fs)),
+            super::poses::Holder::Fixture { slot, faces: fs } => {
+                let (label, kind) = self.fixture(*slot);
+                format!("fixture {label} ({kind}) on {}", faces(fs))
+            }
+        }
+    }
 }
 
 /// A plan coordinate triple in words.
@@ -109,6 +133,7 @@ pub fn text(h: &Hlip, names: &Names) -> String {
     let mut o_count = 0;
     for (si, s) in h.setups.iter().enumerate() {
         let _ = writeln!(out, "change-setup s{} up {}", si + 1, dir_text(&s.up));
+        let _ = writeln!(out, "  held by {}", names.holder(&s.holder));
         for t in &s.on_table {
             let _ = writeln!(out, "  rest {} on the table", names.face(*t));
         }
@@ -213,6 +238,7 @@ pub fn json(h: &Hlip, names: &Names) -> Value {
                 "up": arr(&s.up),
                 "rotation": s.rotation,
                 "on_table": s.on_table.iter().map(|f| names.face(*f)).collect::<Vec<_>>(),
+                "held_by": names.holder(&s.holder),
                 "probes": s.probes.iter().map(|p| j!({
                     "probe": names.probe(p.probe),
                     "orientations": p.orients.iter().map(|o| j!({

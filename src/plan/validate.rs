@@ -3,7 +3,7 @@
 //! point to the contact, every other component is tested along the approach, the part is
 //! an obstacle and the table is a plane under the part in that setup.
 
-use super::domain::{Knowledge, Machine};
+use super::domain::{Held, Knowledge, Machine};
 use crate::access::pose::{orientation_dir, Blocker};
 use crate::geometry::V3;
 
@@ -20,13 +20,13 @@ pub(crate) struct Pip {
     pub orient: usize,
 }
 
-/// Checks one PIP in setup `up` over a table at height `t0`; what collides, if anything.
+/// Checks one PIP in setup `up` held as `held` says; what collides, if anything.
 pub(crate) fn check(
     k: &Knowledge,
     m: &Machine,
     pip: &Pip,
     up: &V3,
-    t0: f64,
+    held: &Held,
 ) -> Result<(), Blocker> {
     let dir = if m.head.indexable() {
         let (a, b) = m.grid[pip.orient];
@@ -34,5 +34,5 @@ pub(crate) fn check(
     } else {
         *up
     };
-    k.pose_check(m, pip.point, pip.probe, dir, *up, t0)
+    k.pose_check(m, pip.point, pip.probe, dir, *up, held)
 }

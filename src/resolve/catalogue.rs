@@ -125,6 +125,10 @@ pub(super) fn lower(
                 span,
             });
         }
+        Kind::Fixture => {
+            let f = fixture(cx, &mut p, name, span);
+            model.fixtures.push(f);
+        }
         Kind::Cmm => {
             let cmm = cmm(r, cx, module, &mut p, name, span);
             model.cmms.push(cmm);
@@ -353,6 +357,39 @@ fn cmm(
             _ => cx.mismatch(v, "a list of probes", "write `probes [p1: TP20_D2_L20]`"),
         }
     }
+    let mut fixtures: Vec<(String, FixtureId)> = Vec::new();
+    if let Some(v) = p.get("fixtures") {
+        match &v.kind {
+            ValueKind::List(entries) => {
+                for e in entries {
+                    let Some(id) = r.lookup_value(cx, module, &e.value, Kind::Fixture) else {
+                        continue;
+                    };
+                    let (label, lspan) = match &e.label {
+                        Some(l) => (l.name.clone(), l.span),
+                        None => (
+                            match &e.value.kind {
+                                ValueKind::Path(path) => super::props::path_text(path),
+                                _ => String::new(),
+                            },
+                            e.value.span,
+                        ),
+                    };
+                    if fixtures.iter().any(|(l, _)| *l == label) {
+                        cx.err(E::DuplicateName {
+                            span: lspan,
+                            first: None,
+                            name: label,
+                            help: "each fixture beside the CMM needs its own label".into(),
+                        });
+                        continue;
+                    }
+                    fixtures.push((label, FixtureId(id)));
+                }
+            }
+            _ => cx.mismatch(v, "a list of fixtures", "write `fixtures [vise: VISE_160]`"),
+        }
+    }
     Cmm {
         name,
         table_z,
@@ -361,8 +398,139 @@ fn cmm(
         ram_length,
         head: HeadId(head),
         probes,
+        fixtures,
         span,
     }
+}
+
+/// A fixture: `kind vise|chuck|sine_plate`, its sizes, and `height`, how high it holds
+/// the part above the table.
+fn fixture(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Fixture {
+    let height = p
+        .req(cx, "height", "100 mm")
+        .and_then(|v| cx.positive(v, Dim::Length, "height"))
+        .unwrap_or(100.0);
+    let kind_v = p.req(cx, "kind", "vise");
+    let word = kind_v
+        .and_then(|v| cx.name(v))
+        .map(|i| (i.name.clone(), i.span));
+    let length = |cx: &mut Cx, p: &mut Props, key: &'static str, example: &str, dflt: f64| {
+        p.req(cx, key, example)
+            .and_then(|v| cx.positive(v, Dim::Length, key))
+            .unwrap_or(dflt)
+    };
+    let kind = match word.as_ref().map(|(w, _)| w.as_str()) {
+        Some("vise") => {
+            let opening = length(cx, p, "opening", "160 mm", 100.0);
+            let jaw = p
+                .req(cx, "jaw", "(150 mm, 40 mm)")
+                .and_then(|v| {
+                    let j = cx.lengths::<2>(v)?;
+                    if j.iter().any(|x| *x <= 0.0) {
+                        cx.err(E::NonPositive {
+                            span: v.span,
+                            what: "the jaw size".into(),
+                            value: describe(v),
+                            help: "give the jaws' width and height".into(),
+                        });
+                        return None;
+                    }
+                    Some(j)
+                })
+                .unwrap_or([100.0, 30.0]);
+            FixtureKind::Vise { opening, jaw }
+        }
+        Some("chuck") => {
+            let diameter = p
+                .req(cx, "diameter", "3 mm .. 200 mm")
+                .and_then(|v| length_range(cx, v, "diameter"))
+                .unwrap_or([1.0, 100.0]);
+            let jaws = length(cx, p, "jaws", "20 mm", 20.0);
+            let body = length(cx, p, "body", "200 mm", 200.0);
+            FixtureKind::Chuck {
+                diameter,
+                jaws,
+                body,
+            }
+        }
+        Some("sine_plate") => {
+            let tilt = p
+                .req(cx, "tilt", "0 deg .. 60 deg")
+                .and_then(|v| tilt_range(cx, v))
+                .unwrap_or([0.0, 0.0]);
+            FixtureKind::SinePlate { tilt }
+        }
+        Some(other) => {
+            if let Some((_, s)) = &word {
+                let help = suggest::help_for_unknown(
+                    "fixture kind",
+                    other,
+                    ["vise", "chuck", "sine_plate"],
+                );
+                cx.err(E::UnknownName {
+                    span: *s,
+                    what: "fixture kind".into(),
+                    name: other.into(),
+                    help,
+                });
+            }
+            FixtureKind::SinePlate { tilt: [0.0, 0.0] }
+        }
+        None => FixtureKind::SinePlate { tilt: [0.0, 0.0] },
+    };
+    describe_only(cx, p);
+    Fixture {
+        name,
+        kind,
+        height,
+        span,
+    }
+}
+
+/// A range of positive lengths, `3 mm .. 200 mm`.
+fn length_range(cx: &mut Cx, v: &ast::Value, what: &str) -> Option<[f64; 2]> {
+    let ValueKind::Range(lo, hi) = &v.kind else {
+        cx.mismatch(
+            v,
+            "a range of lengths",
+            &format!("write `{what} 3 mm .. 200 mm`"),
+        );
+        return None;
+    };
+    let (lo, hi) = (cx.quantity(lo, Dim::Length), cx.quantity(hi, Dim::Length));
+    let (lo, hi) = (lo?, hi?);
+    if lo <= 0.0 || lo > hi {
+        cx.err(E::OutOfRange {
+            span: v.span,
+            what: format!("`{what}` range"),
+            value: format!("{} mm .. {} mm", num(lo), num(hi)),
+            range: "it must be positive and run upwards".into(),
+            help: "give the smallest and largest size from the data sheet".into(),
+        });
+        return None;
+    }
+    Some([lo, hi])
+}
+
+/// A sine plate's tilt range within 0°..90° (`90 deg .. 90 deg`: an angle plate).
+fn tilt_range(cx: &mut Cx, v: &ast::Value) -> Option<[f64; 2]> {
+    let ValueKind::Range(lo, hi) = &v.kind else {
+        cx.mismatch(v, "an angle range", "write `tilt 0 deg .. 60 deg`");
+        return None;
+    };
+    let (lo, hi) = (cx.quantity(lo, Dim::Angle), cx.quantity(hi, Dim::Angle));
+    let (lo, hi) = (lo?, hi?);
+    if lo < 0.0 || hi > 90.0 || lo > hi {
+        cx.err(E::OutOfRange {
+            span: v.span,
+            what: "`tilt` range".into(),
+            value: format!("{}°..{}°", num(lo), num(hi)),
+            range: "it must run upwards within 0°..90°".into(),
+            help: "a sine plate tilts from flat (0°) to square (90°, an angle plate)".into(),
+        });
+        return None;
+    }
+    Some([lo, hi])
 }
 
 /// A sampling strategy: `fan_leu`, `uniform(points 9, inset 1 mm)`, `hammersley(points 16)`.

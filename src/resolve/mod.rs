@@ -45,6 +45,7 @@ pub(crate) enum Kind {
     Extension,
     Hierarchy,
     Sampling,
+    Fixture,
     Plan,
 }
 
@@ -60,6 +61,7 @@ impl Kind {
             Kind::Extension => "an extension",
             Kind::Hierarchy => "a hierarchy",
             Kind::Sampling => "a sampling",
+            Kind::Fixture => "a fixture",
             Kind::Plan => "a plan",
         }
     }
@@ -144,6 +146,7 @@ impl<'a> Resolver<'a> {
                             ast::BlockKind::Body => Kind::Body,
                             ast::BlockKind::Extension => Kind::Extension,
                             ast::BlockKind::Sampling => Kind::Sampling,
+                            ast::BlockKind::Fixture => Kind::Fixture,
                         },
                         &b.name,
                     ),

@@ -86,6 +86,7 @@ pub(super) fn lower(
             _ => cx.mismatch(v, "a block `{ prehit 2 mm, retract 2 mm }`", ""),
         }
     }
+    let fixtures_v = pp.get("fixtures");
     pp.finish(cx);
     let (part, cmm, hierarchy, sampling) = (part?, cmm?, hierarchy?, sampling?);
     let the_part = &model.parts[part];
@@ -104,8 +105,12 @@ pub(super) fn lower(
         probes: vec![],
         outputs,
         motion,
+        fixtures: vec![],
         span: p.name.span,
     };
+    if let Some(v) = fixtures_v {
+        plan.fixtures = plan_fixtures(cx, v, the_cmm);
+    }
     for s in &p.stmts {
         match s {
             PlanStmt::Prop(_) => {}
@@ -327,4 +332,42 @@ fn stays_inside(path: &str) -> bool {
     !path.is_empty()
         && p.components()
             .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+}
+
+/// `fixtures [vise, chuck]`: labels of the CMM's fixtures, in the order the plan tries
+/// them.
+fn plan_fixtures(cx: &mut Cx, v: &ast::Value, cmm: &Cmm) -> Vec<usize> {
+    let ValueKind::List(entries) = &v.kind else {
+        cx.mismatch(v, "a list of the CMM's fixtures", "write `fixtures [vise]`");
+        return vec![];
+    };
+    let mut out: Vec<usize> = Vec::new();
+    for e in entries {
+        let Some(id) = cx.name(&e.value) else {
+            continue;
+        };
+        match cmm.fixtures.iter().position(|(l, _)| *l == id.name) {
+            Some(k) if !out.contains(&k) => out.push(k),
+            Some(_) => {}
+            None => {
+                let help = format!(
+                    "CMM `{}` has no fixture `{}`; {}",
+                    cmm.name,
+                    id.name,
+                    suggest::help_for_unknown(
+                        "fixture",
+                        &id.name,
+                        cmm.fixtures.iter().map(|(l, _)| l.as_str())
+                    )
+                );
+                cx.err(E::UnknownName {
+                    span: id.span,
+                    what: "fixture".into(),
+                    name: id.name.clone(),
+                    help,
+                });
+            }
+        }
+    }
+    out
 }

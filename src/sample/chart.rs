@@ -349,7 +349,7 @@ fn plane_chart(origin: P3, normal: V3, points: &[P3]) -> Chart {
 }
 
 /// Andrew's monotone chain; counter-clockwise, without collinear points.
-fn convex_hull(mut pts: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+pub(crate) fn convex_hull(mut pts: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
     pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     pts.dedup();
     if pts.len() < 3 {

@@ -25,6 +25,7 @@
 
 mod chart;
 
+pub(crate) use chart::convex_hull;
 pub use chart::{perpendicular_basis, Chart};
 
 use crate::geometry::{FaceId, FaceIndex, PartGeometry, Surface, P3, V3};

@@ -90,6 +90,8 @@ pub enum BlockKind {
     Extension,
     /// A sampling strategy set.
     Sampling,
+    /// A fixture that holds a part on the table.
+    Fixture,
 }
 
 impl BlockKind {
@@ -103,6 +105,7 @@ impl BlockKind {
             BlockKind::Body => "body",
             BlockKind::Extension => "extension",
             BlockKind::Sampling => "sampling",
+            BlockKind::Fixture => "fixture",
         }
     }
 }

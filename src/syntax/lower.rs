@@ -250,6 +250,7 @@ impl L {
                     "stylus" => BlockKind::Stylus,
                     "body" => BlockKind::Body,
                     "extension" => BlockKind::Extension,
+                    "fixture" => BlockKind::Fixture,
                     _ => BlockKind::Sampling,
                 };
                 let name = self.ident(it.next().expect("name"));

@@ -35,7 +35,7 @@ pub(crate) fn word(rule: Rule) -> Option<&'static str> {
         Rule::kw_forbid => "`forbid`",
         Rule::kw_sample => "`sample`",
         Rule::kw_with => "`with`",
-        Rule::block_kw => "`cmm`, `head`, `probe`, `stylus`, `body`, `extension` or `sampling`",
+        Rule::block_kw => "`cmm`, `head`, `probe`, `stylus`, `body`, `extension`, `sampling` or `fixture`",
         Rule::file | Rule::item => "an item (`use`, `part`, `cmm`, `plan`, …)",
         Rule::use_item => "a `use` statement",
         Rule::module_path => "a module path such as `std::probes`",

@@ -8,6 +8,7 @@
 
 use inspc::diag::{render_human, RenderOptions};
 use inspc::model::fmt_num;
+use inspc::plan::poses::{Holder, MIN_TIP_DEG};
 use inspc::plan::{Hlip, Names, PlanOptions};
 use inspc::source::FsWorld;
 use inspc::{Built, Run, Until};
@@ -389,16 +390,26 @@ fn every_move_is_collision_free() {
         let probes = inspc::access::ProbeShape::of_cmm(model, &model.cmms[plan.cmm.0]);
         let mut segments = 0;
         for s in &b.llip.setups {
-            let up = b.hlip.setups[s.setup].up;
-            let table = geometry
+            let setup = &b.hlip.setups[s.setup];
+            let up = setup.up;
+            let low = geometry
                 .vertices
                 .iter()
                 .map(|v| v.coords.dot(&up))
                 .fold(f64::INFINITY, f64::min);
+            // On the table the part rests on its lowest point; a fixture holds it higher.
+            let table = match setup.holder {
+                Holder::Table { .. } => low,
+                Holder::Fixture { .. } => {
+                    assert!(setup.table < low, "{}: a fixture under the part", c.name);
+                    setup.table
+                }
+            };
             for g in &s.groups {
                 let probe = &probes[g.probe.0];
                 let dir = nalgebra::Vector3::from(g.direction);
-                let pose = inspc::access::Pose::new(&scene, probe, dir, up, table);
+                let pose = inspc::access::Pose::new(&scene, probe, dir, up, table)
+                    .with_fixture(&setup.fixture);
                 let mut pts: Vec<[f64; 3]> = g.entry.clone();
                 for bl in &g.blocks {
                     for t in &bl.touches {
@@ -423,6 +434,97 @@ fn every_move_is_collision_free() {
         programs += 1;
     }
     assert!(programs >= 8, "only {programs} programs");
+}
+
+/// Every setup of every golden plan is one an operator can realise, checked here on its
+/// own: resting on the table, the part's centre of mass (from the tetrahedra of its
+/// mesh) lies over the support polygon of its lowest vertices with at least
+/// `MIN_TIP_DEG` to tip; or one of the fixtures the plan names holds it.
+#[test]
+fn every_setup_stands_or_is_held() {
+    let mut setups = 0;
+    for (c, run, b) in built() {
+        let model = &run.checked.model;
+        let plan = &model.plans[b.plan];
+        let g = &run.parts[plan.part.0].as_ref().unwrap().geometry;
+        let (mut vol, mut m) = (0.0, nalgebra::Vector3::zeros());
+        for t in &g.triangles {
+            let [p, q, r] = t.map(|i| g.vertices[i as usize].coords);
+            let v = p.dot(&q.cross(&r)) / 6.0;
+            vol += v;
+            m += (p + q + r) / 4.0 * v;
+        }
+        let com = m / vol;
+        for (si, s) in b.hlip.setups.iter().enumerate() {
+            setups += 1;
+            match &s.holder {
+                Holder::Fixture { slot, .. } => assert!(
+                    plan.fixtures.contains(slot),
+                    "{}: setup {} uses a fixture the plan does not name",
+                    c.name,
+                    si + 1
+                ),
+                Holder::Table { .. } => {
+                    let up = s.up;
+                    let (e1, e2) = inspc::sample::perpendicular_basis(&up);
+                    let low = g
+                        .vertices
+                        .iter()
+                        .map(|v| v.coords.dot(&up))
+                        .fold(f64::INFINITY, f64::min);
+                    let mut pts: Vec<(f64, f64)> = g
+                        .vertices
+                        .iter()
+                        .filter(|v| v.coords.dot(&up) < low + 1e-3)
+                        .map(|v| (v.coords.dot(&e1), v.coords.dot(&e2)))
+                        .collect();
+                    pts.sort_by(|a, b| a.partial_cmp(b).unwrap());
+                    pts.dedup();
+                    // Monotone chain, counter-clockwise.
+                    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
+                        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+                    };
+                    let mut hull: Vec<(f64, f64)> = Vec::new();
+                    for pass in [pts.clone(), pts.iter().rev().copied().collect()] {
+                        let start = hull.len();
+                        for p in pass {
+                            while hull.len() >= start + 2
+                                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+                            {
+                                hull.pop();
+                            }
+                            hull.push(p);
+                        }
+                        hull.pop();
+                    }
+                    assert!(
+                        hull.len() >= 3,
+                        "{}: setup {} rests on a line",
+                        c.name,
+                        si + 1
+                    );
+                    let c2 = (com.dot(&e1), com.dot(&e2));
+                    let h = com.dot(&up) - low;
+                    let d = (0..hull.len())
+                        .map(|k| {
+                            let (a, b) = (hull[k], hull[(k + 1) % hull.len()]);
+                            let len = ((b.0 - a.0).powi(2) + (b.1 - a.1).powi(2)).sqrt();
+                            cross(a, b, c2) / len
+                        })
+                        .fold(f64::INFINITY, f64::min);
+                    let tip = d.atan2(h).to_degrees();
+                    assert!(
+                        tip >= MIN_TIP_DEG - 1e-6,
+                        "{}: setup {} up {:?} tips over at {tip:.1}°",
+                        c.name,
+                        si + 1,
+                        up
+                    );
+                }
+            }
+        }
+    }
+    assert!(setups >= 10, "only {setups} setups");
 }
 
 /// Which (probe, A, B) inspect a feature.

@@ -1,0 +1,645 @@
+//! Setups an operator can realise (issue 14): the part resting on the table in a stable
+//! pose. Spitz treats a setup as any direction and assumes a fixture exists; a CMM user
+//! has a table and gravity, so the planner chooses among these poses only (and those of
+//! the fixtures a plan names, see [`super::fixture`]).
+//!
+//! A pose rests the part on a facet of its convex hull. Its *support polygon* is the
+//! convex hull of the points that really touch the table there: vertices of part faces
+//! lying in the facet's plane (flat contact), and sharp corners — vertices all of whose
+//! faces are planes. A cylinder's tessellation facet is not a support: the real cylinder
+//! touches the table along a line and rolls. The pose is stable when the centre of mass
+//! of the solid projects inside the polygon and the part must tip by at least
+//! [`MIN_TIP_DEG`] about the nearest edge before it falls over: `atan(d / h)`, `d` the
+//! projection's distance to that edge, `h` the centre's height above the table.
+//!
+//! **Architecture Invariant:** a function of the geometry alone; poses come out in a
+//! fixed order (largest support area first, then by direction).
+
+use crate::access::pose::Solid;
+use crate::geometry::{FaceId, PartGeometry, Surface, P3, V3};
+use crate::model::{Fixture, FixtureKind, Model, Plan};
+use crate::sample::{convex_hull, perpendicular_basis};
+
+/// The least tipping angle of a stable pose (degrees): a 480 mm shaft on its Ø51 end
+/// tips at 6°, a disc on its rim at 3°; a cube on a face at 45°.
+pub const MIN_TIP_DEG: f64 = 10.0;
+
+/// Directions closer than this are one pose (degrees).
+const SAME_PLANE_DEG: f64 = 0.5;
+
+/// A way the part can rest on the table.
+#[derive(Debug, Clone)]
+pub struct RestPose {
+    /// The part frame's up direction in this pose (minus the resting facet's normal).
+    pub up: V3,
+    /// The planar faces that lie on the table.
+    pub faces: Vec<FaceId>,
+    /// The support polygon's area (mm²).
+    pub area: f64,
+    /// How far the part tips before it falls (degrees); negative: the centre of mass
+    /// lies outside the support.
+    pub tip_deg: f64,
+    /// Whether the contact is a polygon of flat contact and corners (not a line or point
+    /// of a curved face).
+    pub flat: bool,
+}
+
+impl RestPose {
+    /// Whether the part stays in this pose on its own.
+    pub fn stable(&self) -> bool {
+        self.flat && self.tip_deg >= MIN_TIP_DEG
+    }
+
+    /// Why it is not stable, in words; `None` when it is.
+    pub fn excluded(&self) -> Option<String> {
+        if !self.flat {
+            Some("it would rest on a curved face's line or point and roll".into())
+        } else if self.tip_deg < 0.0 {
+            Some("its centre of mass lies outside the support".into())
+        } else if self.tip_deg < MIN_TIP_DEG {
+            Some(format!(
+                "it tips over at {:.1}° (a stable pose needs {MIN_TIP_DEG}°)",
+                self.tip_deg
+            ))
+        } else {
+            None
+        }
+    }
+}
+
+/// What holds the part in a setup.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Holder {
+    /// It rests on the table on these faces (a stable pose).
+    Table {
+        /// The planar faces on the table.
+        faces: Vec<FaceId>,
+    },
+    /// A fixture of the CMM holds it.
+    Fixture {
+        /// The fixture's index in the CMM's list.
+        slot: usize,
+        /// The faces the fixture grips or the part rests on in it.
+        faces: Vec<FaceId>,
+    },
+}
+
+/// Jaw thickness of a vise and a chuck, and a sine plate's thickness (mm): the solids
+/// stand for the real fixture, a little larger rather than smaller.
+const JAW_MM: f64 = 25.0;
+
+/// How far a sine plate reaches past the part on every side (mm).
+const PLATE_MARGIN_MM: f64 = 30.0;
+
+/// The setups a plan may use and what holds the part in each: the stable rest poses
+/// first, then the plan's fixtures in the order it names them.
+pub struct Setups<'a> {
+    geometry: &'a PartGeometry,
+    rests: Vec<RestPose>,
+    fixtures: Vec<(usize, &'a Fixture)>,
+    /// Pairs of opposite planar faces a vise can clamp: (normal of the first, first,
+    /// second, distance).
+    clamps: Vec<(V3, FaceId, FaceId, f64)>,
+    /// The convex hull's vertices: the part's extremes in any direction.
+    hull: Vec<P3>,
+}
+
+impl<'a> Setups<'a> {
+    /// The setups of `plan` on `geometry`.
+    pub fn new(model: &'a Model, plan: &Plan, geometry: &'a PartGeometry) -> Setups<'a> {
+        let cmm = &model.cmms[plan.cmm.0];
+        let fixtures: Vec<(usize, &Fixture)> = plan
+            .fixtures
+            .iter()
+            .filter_map(|&k| cmm.fixtures.get(k).map(|(_, f)| (k, &model.fixtures[f.0])))
+            .collect();
+        let hull = match parry3d_f64::transformation::try_convex_hull(&geometry.vertices) {
+            Ok((v, _)) => v,
+            Err(_) => geometry.vertices.clone(),
+        };
+        let mut clamps = Vec::new();
+        if fixtures
+            .iter()
+            .any(|(_, f)| matches!(f.kind, FixtureKind::Vise { .. }))
+        {
+            clamps = clamp_pairs(geometry, &hull);
+        }
+        Setups {
+            geometry,
+            rests: rest_poses(geometry),
+            fixtures,
+            clamps,
+            hull,
+        }
+    }
+
+    /// Every pose on the table, stable or not.
+    pub fn rests(&self) -> &[RestPose] {
+        &self.rests
+    }
+
+    /// Directions the cube maps should hold exactly: the rest poses' (stable or flat)
+    /// and the round faces' axes a chuck may hold.
+    pub fn exact_dirs(&self) -> Vec<V3> {
+        let mut out: Vec<V3> = self
+            .rests
+            .iter()
+            .filter(|r| r.stable() || (r.flat && !self.fixtures.is_empty()))
+            .map(|r| r.up)
+            .collect();
+        for (_, f) in &self.fixtures {
+            if let FixtureKind::Chuck { diameter, .. } = f.kind {
+                for face in &self.geometry.faces {
+                    if let Surface::Cylinder {
+                        axis,
+                        radius,
+                        convex: true,
+                        ..
+                    } = face.surface
+                    {
+                        if (diameter[0]..=diameter[1]).contains(&(2.0 * radius)) {
+                            out.extend([axis, -axis]);
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The lowest point of the part along `up`.
+    fn low(&self, up: &V3) -> f64 {
+        self.hull
+            .iter()
+            .map(|v| v.coords.dot(up))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// What holds the part with `up` pointing up, if anything can: resting on the table
+    /// when that pose is stable, else the first of the plan's fixtures that can.
+    pub fn holder(&self, up: &V3) -> Option<Holder> {
+        let same = |a: &V3| (a - up).norm() < 1e-6;
+        if let Some(r) = self.rests.iter().find(|r| r.stable() && same(&r.up)) {
+            return Some(Holder::Table {
+                faces: r.faces.clone(),
+            });
+        }
+        for &(slot, f) in &self.fixtures {
+            if let Some(faces) = self.holds(f, up) {
+                return Some(Holder::Fixture { slot, faces });
+            }
+        }
+        None
+    }
+
+    /// The faces fixture `f` holds with `up` pointing up, if it can hold the part so.
+    fn holds(&self, f: &Fixture, up: &V3) -> Option<Vec<FaceId>> {
+        let g = self.geometry;
+        let same = |a: &V3| (a - up).norm() < 1e-6;
+        match f.kind {
+            FixtureKind::SinePlate { tilt } => {
+                let (lo, hi) = (tilt[0].to_radians(), tilt[1].to_radians());
+                self.rests
+                    .iter()
+                    .find(|r| {
+                        let a = r.up.dot(up).clamp(-1.0, 1.0).acos();
+                        r.flat && a >= lo - 1e-9 && a <= hi + 1e-9
+                    })
+                    .map(|r| r.faces.clone())
+            }
+            FixtureKind::Vise { opening, .. } => {
+                let base = self.rests.iter().find(|r| r.flat && same(&r.up))?;
+                self.clamps
+                    .iter()
+                    .find(|(n, _, _, w)| n.dot(up).abs() < 1e-6 && *w <= opening)
+                    .map(|&(_, a, b, _)| {
+                        let mut faces = vec![a, b];
+                        faces.extend(&base.faces);
+                        faces
+                    })
+            }
+            FixtureKind::Chuck { diameter, .. } => {
+                let tol = 1e-3 * self.size().max(1.0);
+                let low = self.low(up);
+                for (k, face) in g.faces.iter().enumerate() {
+                    let fits = |r: f64| (diameter[0]..=diameter[1]).contains(&(2.0 * r));
+                    match face.surface {
+                        Surface::Cylinder {
+                            axis,
+                            radius,
+                            convex: true,
+                            ..
+                        } if fits(radius) && axis.dot(up).abs() > 1.0 - 1e-9 => {
+                            let face_low = face
+                                .triangles
+                                .iter()
+                                .flat_map(|&t| g.triangles[t as usize])
+                                .map(|v| g.vertices[v as usize].coords.dot(up))
+                                .fold(f64::INFINITY, f64::min);
+                            if face_low <= low + tol {
+                                return Some(vec![FaceId(k)]);
+                            }
+                        }
+                        Surface::Sphere {
+                            center,
+                            radius,
+                            convex: true,
+                        } if fits(radius) && low >= center.coords.dot(up) - radius - tol => {
+                            return Some(vec![FaceId(k)]);
+                        }
+                        _ => {}
+                    }
+                }
+                None
+            }
+        }
+    }
+
+    fn size(&self) -> f64 {
+        let (lo, hi) = self.geometry.bounds();
+        (hi - lo).norm()
+    }
+
+    /// Where the table lies along `up` under the part held by `holder`.
+    pub fn table(&self, holder: &Holder, up: &V3) -> f64 {
+        let low = self.low(up);
+        match holder {
+            Holder::Table { .. } => low,
+            Holder::Fixture { slot, .. } => {
+                let f = self.fixture(*slot);
+                let solids = self.solids(holder, up);
+                let base = solids.iter().map(|s| s.lowest(up)).fold(low, f64::min);
+                base.min(low - f.height)
+            }
+        }
+    }
+
+    fn fixture(&self, slot: usize) -> &Fixture {
+        self.fixtures
+            .iter()
+            .find(|(k, _)| *k == slot)
+            .map(|(_, f)| *f)
+            .expect("holders name the plan's fixtures")
+    }
+
+    /// The fixture's solids in the part frame with `up` pointing up: obstacles to the
+    /// probe like the part itself. None for the table.
+    pub fn solids(&self, holder: &Holder, up: &V3) -> Vec<Solid> {
+        let Holder::Fixture { slot, faces } = holder else {
+            return vec![];
+        };
+        let g = self.geometry;
+        let f = self.fixture(*slot);
+        let low = self.low(up);
+        let high = self
+            .hull
+            .iter()
+            .map(|v| v.coords.dot(up))
+            .fold(f64::NEG_INFINITY, f64::max);
+        let height = high - low;
+        let size = self.size();
+        match f.kind {
+            FixtureKind::Chuck { jaws, body, .. } => {
+                let Some(face) = faces.first() else {
+                    return vec![];
+                };
+                let (centre, radius) = match g.faces[face.0].surface {
+                    Surface::Cylinder { origin, radius, .. } => (origin, radius),
+                    Surface::Sphere { center, radius, .. } => (center, radius),
+                    _ => return vec![],
+                };
+                // The axis through the held face, down to the part's lowest point.
+                let foot = centre + up * (low - centre.coords.dot(up));
+                let grip = jaws.min(0.5 * height);
+                vec![
+                    Solid::cylinder(foot - up * f.height, *up, f.height, body / 2.0),
+                    Solid::cylinder(foot - up * 1e-3, *up, grip, radius + JAW_MM),
+                ]
+            }
+            FixtureKind::Vise { jaw, .. } => {
+                let (Some(a), Some(b)) = (faces.first(), faces.get(1)) else {
+                    return vec![];
+                };
+                let (
+                    Surface::Plane {
+                        origin: oa,
+                        normal: n,
+                    },
+                    Surface::Plane { origin: ob, .. },
+                ) = (&g.faces[a.0].surface, &g.faces[b.0].surface)
+                else {
+                    return vec![];
+                };
+                let grip = jaw[1].min(0.5 * height);
+                // The jaws: boxes outside the two clamped faces from the table to the
+                // grip height, centred under the part's middle.
+                let mid = g.faces[a.0]
+                    .centroid
+                    .coords
+                    .lerp(&g.faces[b.0].centroid.coords, 0.5);
+                let along = up.cross(n).normalize();
+                let rot = nalgebra::Rotation3::from_basis_unchecked(&[*n, along, *up]);
+                let mut out = Vec::new();
+                for (o, s) in [(oa, 1.0), (ob, -1.0)] {
+                    let face_plane = o.coords.dot(n);
+                    let c_n = face_plane + s * JAW_MM / 2.0;
+                    let c_up = low - f.height + (f.height + grip) / 2.0;
+                    let c = mid - n * mid.dot(n) - up * mid.dot(up) + n * c_n + up * c_up;
+                    out.push(Solid::cuboid(
+                        P3::from(c),
+                        rot,
+                        V3::new(JAW_MM / 2.0, jaw[0] / 2.0, (f.height + grip) / 2.0),
+                    ));
+                }
+                out
+            }
+            FixtureKind::SinePlate { .. } => {
+                // The plate under the face the part is clamped on.
+                let Some(r) = self
+                    .rests
+                    .iter()
+                    .find(|r| r.flat && faces.iter().all(|x| r.faces.contains(x)))
+                else {
+                    return vec![];
+                };
+                let n = -r.up;
+                let plane = self
+                    .hull
+                    .iter()
+                    .map(|v| v.coords.dot(&n))
+                    .fold(f64::NEG_INFINITY, f64::max);
+                let com = centre_of_mass(g);
+                let (e1, e2) = perpendicular_basis(&n);
+                let rot = nalgebra::Rotation3::from_basis_unchecked(&[e1, e2, n]);
+                let half = size / 2.0 + PLATE_MARGIN_MM;
+                let c = com.coords + n * (plane - com.coords.dot(&n) + JAW_MM / 2.0 + 1e-3);
+                vec![Solid::cuboid(
+                    P3::from(c),
+                    rot,
+                    V3::new(half, half, JAW_MM / 2.0),
+                )]
+            }
+        }
+    }
+
+    /// The fixture's name of a holder, for prompts and listings.
+    pub fn fixture_name(&self, slot: usize) -> &str {
+        &self.fixture(slot).name
+    }
+}
+
+/// Pairs of planar faces with opposite normals that bound the part along their normal
+/// (nothing sticks out past either), for a vise's jaws: (normal of the first, first,
+/// second, distance between them). Largest faces first.
+fn clamp_pairs(g: &PartGeometry, hull: &[P3]) -> Vec<(V3, FaceId, FaceId, f64)> {
+    let (lo, hi) = g.bounds();
+    let tol = 1e-4 * (hi - lo).norm().max(1.0);
+    let extent = |n: &V3| {
+        hull.iter()
+            .map(|v| v.coords.dot(n))
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let mut planes: Vec<(usize, V3, f64)> = g
+        .faces
+        .iter()
+        .enumerate()
+        .filter_map(|(k, f)| match f.surface {
+            Surface::Plane { origin, normal } if f.area > 0.0 => {
+                let d = origin.coords.dot(&normal);
+                (d >= extent(&normal) - tol).then_some((k, normal, d))
+            }
+            _ => None,
+        })
+        .collect();
+    planes.sort_by(|a, b| {
+        g.faces[b.0]
+            .area
+            .total_cmp(&g.faces[a.0].area)
+            .then(a.0.cmp(&b.0))
+    });
+    let mut out = Vec::new();
+    for (i, &(a, na, da)) in planes.iter().enumerate() {
+        for &(b, nb, db) in &planes[i + 1..] {
+            if na.dot(&nb) < -(1.0 - 1e-6) {
+                out.push((na, FaceId(a), FaceId(b), da + db));
+            }
+        }
+    }
+    out
+}
+
+/// The centre of mass of the solid (uniform density), from the signed volumes of the
+/// tetrahedra from the origin to each triangle; the area centroid for a mesh without
+/// volume.
+pub fn centre_of_mass(g: &PartGeometry) -> P3 {
+    let (mut vol, mut m) = (0.0, V3::zeros());
+    let (mut area, mut a) = (0.0, V3::zeros());
+    for t in &g.triangles {
+        let [p, q, r] = t.map(|i| g.vertices[i as usize].coords);
+        let v = p.dot(&q.cross(&r)) / 6.0;
+        vol += v;
+        m += (p + q + r) / 4.0 * v;
+        let s = (q - p).cross(&(r - p)).norm() / 2.0;
+        area += s;
+        a += (p + q + r) / 3.0 * s;
+    }
+    if vol.abs() > 1e-9 {
+        P3::from(m / vol)
+    } else if area > 0.0 {
+        P3::from(a / area)
+    } else {
+        P3::origin()
+    }
+}
+
+/// The poses in which the part can rest on the table, stable or not, largest support
+/// first: every facet of the convex hull that holds a planar face of the part (a flat
+/// contact a fixture can clamp against), and every facet that may be stable. A facet
+/// whose hull polygon alone tips under [`MIN_TIP_DEG`] cannot be stable (no real contact
+/// inside it does better), so its support polygon is not computed.
+pub fn rest_poses(g: &PartGeometry) -> Vec<RestPose> {
+    if g.vertices.len() < 4 {
+        return vec![];
+    }
+    let com = centre_of_mass(g);
+    let (lo, hi) = g.bounds();
+    let size = (hi - lo).norm().max(1.0);
+    let tol = 1e-5 * size + 1e-4;
+    let pts: Vec<parry3d_f64::math::Point<f64>> = g.vertices.clone();
+    let Ok((hv, hi_tris)) = parry3d_f64::transformation::try_convex_hull(&pts) else {
+        return vec![];
+    };
+    // Hull facets grouped by plane, largest first.
+    struct Plane {
+        n: V3,
+        d: f64,
+        area: f64,
+        verts: Vec<P3>,
+    }
+    let mut tris: Vec<(f64, usize)> = hi_tris
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let [a, b, c] = t.map(|k| hv[k as usize]);
+            ((b - a).cross(&(c - a)).norm() / 2.0, i)
+        })
+        .collect();
+    tris.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+    let cos_same = SAME_PLANE_DEG.to_radians().cos();
+    let mut planes: Vec<Plane> = Vec::new();
+    for (area, i) in tris {
+        let [a, b, c] = hi_tris[i].map(|k| hv[k as usize]);
+        let Some(mut n) = (b - a).cross(&(c - a)).try_normalize(1e-12) else {
+            continue;
+        };
+        if n.dot(&(a - com)) < 0.0 {
+            n = -n;
+        }
+        let d = n.dot(&a.coords);
+        match planes
+            .iter_mut()
+            .find(|p| p.n.dot(&n) > cos_same && (p.d - d).abs() < 10.0 * tol)
+        {
+            Some(p) => {
+                p.area += area;
+                p.verts.extend([a, b, c]);
+            }
+            None => planes.push(Plane {
+                n,
+                d,
+                area,
+                verts: vec![a, b, c],
+            }),
+        }
+    }
+    // Per vertex: whether a curved face meets it (then it is no sharp corner).
+    let mut curved = vec![false; g.vertices.len()];
+    for (t, tri) in g.triangles.iter().enumerate() {
+        let face = &g.faces[g.tri_face[t] as usize];
+        if !matches!(face.surface, Surface::Plane { .. }) {
+            for &v in tri {
+                curved[v as usize] = true;
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for p in &planes {
+        let (e1, e2) = perpendicular_basis(&p.n);
+        let flat2 = |x: &P3| (x.coords.dot(&e1), x.coords.dot(&e2));
+        let h = p.d - p.n.dot(&com.coords);
+        let c = flat2(&com);
+        let hull_tip = tip(&convex_hull(p.verts.iter().map(flat2).collect()), c, h);
+        // Planar faces of the part in the facet's plane.
+        let mut faces: Vec<FaceId> = g
+            .faces
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| match f.surface {
+                Surface::Plane { origin, normal } => {
+                    f.area > 0.0
+                        && normal.dot(&p.n) > cos_same
+                        && (origin.coords.dot(&p.n) - p.d).abs() <= 10.0 * tol
+                }
+                _ => false,
+            })
+            .map(|(k, _)| FaceId(k))
+            .collect();
+        if hull_tip < MIN_TIP_DEG {
+            if !faces.is_empty() {
+                let area = faces.iter().map(|f| g.faces[f.0].area).sum();
+                out.push(RestPose {
+                    up: -p.n,
+                    faces,
+                    area,
+                    tip_deg: hull_tip,
+                    flat: true,
+                });
+            }
+            continue;
+        }
+        faces.clear();
+        // The real contact: flat triangles in the plane, and sharp corners.
+        let in_plane = |v: &P3| (p.n.dot(&v.coords) - p.d).abs() <= 10.0 * tol;
+        let mut contact: Vec<(f64, f64)> = Vec::new();
+        let mut faces: Vec<FaceId> = Vec::new();
+        for (t, tri) in g.triangles.iter().enumerate() {
+            let vs = tri.map(|i| g.vertices[i as usize]);
+            if !vs.iter().all(in_plane) {
+                continue;
+            }
+            let face = g.tri_face[t] as usize;
+            if let Surface::Plane { normal, .. } = g.faces[face].surface {
+                if normal.dot(&p.n) > cos_same {
+                    contact.extend(vs.iter().map(flat2));
+                    if !faces.contains(&FaceId(face)) {
+                        faces.push(FaceId(face));
+                    }
+                }
+            }
+        }
+        for (v, x) in g.vertices.iter().enumerate() {
+            if !curved[v] && in_plane(x) {
+                contact.push(flat2(x));
+            }
+        }
+        faces.sort();
+        let poly = convex_hull(contact);
+        let flat = poly.len() >= 3 && polygon_area(&poly) > tol * size;
+        out.push(RestPose {
+            up: -p.n,
+            faces,
+            area: if flat { polygon_area(&poly) } else { 0.0 },
+            tip_deg: if flat { tip(&poly, c, h) } else { 0.0 },
+            flat,
+        });
+    }
+    out.sort_by(|a, b| {
+        b.area
+            .total_cmp(&a.area)
+            .then(a.up.z.total_cmp(&b.up.z))
+            .then(a.up.y.total_cmp(&b.up.y))
+            .then(a.up.x.total_cmp(&b.up.x))
+    });
+    out
+}
+
+/// The tipping angle (degrees) of a convex counter-clockwise polygon about its nearest
+/// edge with the centre of mass over `c` at height `h`; negative when `c` is outside.
+fn tip(poly: &[(f64, f64)], c: (f64, f64), h: f64) -> f64 {
+    if poly.len() < 3 {
+        return -90.0;
+    }
+    let mut d = f64::INFINITY;
+    for k in 0..poly.len() {
+        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+        let (ex, ey) = (b.0 - a.0, b.1 - a.1);
+        let len = (ex * ex + ey * ey).sqrt();
+        if len < 1e-12 {
+            continue;
+        }
+        // Left of a counter-clockwise edge is inside.
+        d = d.min((ex * (c.1 - a.1) - ey * (c.0 - a.0)) / len);
+    }
+    d.atan2(h.max(1e-9)).to_degrees()
+}
+
+fn polygon_area(poly: &[(f64, f64)]) -> f64 {
+    let mut s = 0.0;
+    for k in 0..poly.len() {
+        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+        s += a.0 * b.1 - b.0 * a.1;
+    }
+    s.abs() / 2.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tipping_angle_of_a_square() {
+        let sq = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)];
+        assert!((tip(&sq, (1.0, 1.0), 1.0) - 45.0).abs() < 1e-9);
+        assert!(tip(&sq, (3.0, 1.0), 1.0) < 0.0);
+    }
+}
