@@ -116,6 +116,10 @@ enum Command {
         /// Cube-map resolution of the accessibility cones.
         #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(8..=256))]
         resolution: u32,
+        /// First list the setups each plan may use: the poses the part stands in on the
+        /// table, those excluded and why, and what its fixtures can hold.
+        #[arg(long)]
+        explain_setups: bool,
     },
     /// Builds a spec into a DMIS program: plans, paths, program. Writes nothing unless
     /// every plan succeeds.
@@ -190,7 +194,8 @@ fn main() -> ExitCode {
             file,
             format,
             resolution,
-        } => plan(&file, format, resolution),
+            explain_setups,
+        } => plan(&file, format, resolution, explain_setups),
         Command::Build {
             file,
             output,
@@ -319,13 +324,24 @@ fn cones(
     ExitCode::SUCCESS
 }
 
-fn plan(file: &std::path::Path, format: TableFormat, n: u32) -> ExitCode {
+fn plan(file: &std::path::Path, format: TableFormat, n: u32, explain: bool) -> ExitCode {
     let opts = inspc::plan::PlanOptions {
         n,
         ..Default::default()
     };
     let start = std::time::Instant::now();
     let (checked, parts, _, planned) = inspc::plans(&FsWorld, &[file.to_path_buf()], &opts);
+    if explain {
+        let model = &checked.model;
+        for plan in &model.plans {
+            if let Some(Some(data)) = parts.get(plan.part.0) {
+                print!(
+                    "{}",
+                    inspc::plan::explain_setups(model, plan, &data.geometry)
+                );
+            }
+        }
+    }
     print_diagnostics(&checked.sources, &checked.diagnostics);
     if checked.has_errors() {
         return ExitCode::from(1);

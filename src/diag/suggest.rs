@@ -77,6 +77,15 @@ fn edit_distance(a: &str, b: &str) -> usize {
     d[a.len()][b.len()]
 }
 
+/// The plural of a noun naming a kind of item (`property` → `properties`).
+fn plural(what: &str) -> String {
+    match what.strip_suffix('y') {
+        Some(stem) if !stem.ends_with(['a', 'e', 'o', 'u']) => format!("{stem}ies"),
+        _ if what.ends_with('s') || what.ends_with('x') => format!("{what}es"),
+        _ => format!("{what}s"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -90,14 +99,5 @@ mod tests {
         assert_eq!(did_you_mean("TP20", ["PH6", "PH10MQ"]), None);
         assert_eq!(did_you_mean("mM", ["mm", "cm"]), Some("mm".into()));
         assert_eq!(edit_distance("kitten", "sitting"), 3);
-    }
-}
-
-/// The plural of a noun naming a kind of item (`property` → `properties`).
-fn plural(what: &str) -> String {
-    match what.strip_suffix('y') {
-        Some(stem) if !stem.ends_with(['a', 'e', 'o', 'u']) => format!("{stem}ies"),
-        _ if what.ends_with('s') || what.ends_with('x') => format!("{what}es"),
-        _ => format!("{what}s"),
     }
 }

@@ -442,7 +442,7 @@ impl Writer<'_> {
         ));
         self.o.oper(&format!(
             "HOLD IT BY {}",
-            self.names.holder(&setup.holder).to_uppercase()
+            self.names.holder(&setup.holder, &setup.up).to_uppercase()
         ));
         // How it is turned about the vertical: where a part axis across `up` points.
         let r = nalgebra::Matrix3::from_fn(|i, j| setup.rotation[i][j]);

@@ -10,7 +10,7 @@ pub enum GraphError {
     #[diagnostic(
         code(insp::graph::no_points),
         severity(Warning),
-        help("no candidate point lies inside the face and {margin} mm (the largest tip radius, at most a fifth of the face) from its edges; lower the sampling inset or drop the face from the feature")
+        help("no candidate point lies inside the face and {margin} mm (the largest tip radius, at most 45 % of the face's width) from its edges; lower the sampling inset or drop the face from the feature")
     )]
     NoPoints {
         #[label("this feature")]

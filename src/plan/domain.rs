@@ -434,12 +434,19 @@ impl<'a> Knowledge<'a> {
             .map(|&(a, b)| to_part * access::head_direction(a, b))
             .collect();
         let table = f >= self.graph_points;
+        // A table point's tip touches the table: its stylus comes as near as the stem
+        // leaves (the move's own margin still holds), not the orientation margin.
+        let table_slack = if table {
+            access::pose::ORIENTATION_TABLE_MARGIN - access::pose::TABLE_MARGIN
+        } else {
+            0.0
+        };
         let d1 = self.dom.get(f).and_then(|d| d[p].d1.clone());
         let candidates: Vec<usize> = (0..dirs.len())
             .filter(|&k| {
                 Set::has(&machine.grid_allowed, k)
                     && (table || d1.as_ref().is_some_and(|d1| d1.contains(&dirs[k])))
-                    && above_table(probe, &c, &dirs[k], up, t0)
+                    && above_table(probe, &c, &dirs[k], up, t0 - table_slack)
                     && (!table || dirs[k].dot(&point.normal) > 0.2)
             })
             .collect();

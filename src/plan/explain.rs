@@ -46,8 +46,9 @@ pub(super) fn report_face(
     let pts = face_points(input.graph, face);
     let name = input.geometry.faces[face.0].name.clone();
     let need = min_points(input.geometry.faces[face.0].surface.kind()).min(pts.len());
-    // Per probe: how many points it reaches, and the first blocking component.
-    let mut best: Option<(usize, usize, String, String)> = None;
+    // Per probe: how many points it reaches in a setup the part can be put in, how
+    // many in any direction, and the first blocking component.
+    let mut best: Option<(usize, usize, usize, String, String, usize)> = None;
     for (p, probe) in m.probes.iter().enumerate() {
         if !m.allowed[p] {
             continue;
@@ -55,6 +56,17 @@ pub(super) fn report_face(
         let reach = pts
             .iter()
             .filter(|&&f| k.dom[f][p].tip && !k.dom[f][p].setup.is_empty())
+            .count();
+        let real = pts
+            .iter()
+            .filter(|&&f| {
+                k.dom[f][p].tip
+                    && !k.dom[f][p]
+                        .setup
+                        .and(&k.realisable)
+                        .and(&k.forbidden.not())
+                        .is_empty()
+            })
             .count();
         let tips = pts.iter().filter(|&&f| k.dom[f][p].tip).count();
         let (depth, why) = if tips == 0 {
@@ -75,22 +87,40 @@ pub(super) fn report_face(
                 .unwrap_or(pts[0]);
             blocking(k, m, p, f)
         };
-        let cand = (reach, depth, why, probe.name.clone());
-        if best.as_ref().is_none_or(|b| (cand.0, cand.1) > (b.0, b.1)) {
+        let cand = (real, reach, depth, why, probe.name.clone(), p);
+        if best
+            .as_ref()
+            .is_none_or(|b| (cand.0, cand.1, cand.2) > (b.0, b.1, b.2))
+        {
             best = Some(cand);
         }
     }
-    let (reach, _, why, probe) =
-        best.unwrap_or((0, 0, "no probe is allowed".into(), String::new()));
+    let (real, reach, _, why, probe, p) =
+        best.unwrap_or((0, 0, 0, "no probe is allowed".into(), String::new(), 0));
+    let mut help = "use a smaller tip, a longer or thinner stylus, an extension, or an indexable head; `inspc cones --face` shows the cones".to_string();
     let why = if probe.is_empty() {
         why
+    } else if real < need && reach >= need {
+        // The probe gets there, but only with the part in a pose it cannot take.
+        let mut any = k.empty_cone();
+        for &f in &pts {
+            any.or_assign(&k.dom[f][p].setup);
+        }
+        let d = deepest(&any.and(&k.forbidden.not()));
+        help = "name a fixture that holds the part so (`fixtures [vise: VISE_150]` on the CMM, `fixtures [vise]` in the plan: a vise, a chuck, a sine or angle plate from `std::fixtures`); `inspc plan --explain-setups` lists the poses the part can take".into();
+        format!(
+            "probe {probe} reaches {reach} of its {} points only with the part turned so that ({}, {}, {}) points up, a pose in which it does not stand on the table and no fixture of the plan holds it",
+            pts.len(),
+            fmt_num((d.x * 1e3).round() / 1e3),
+            fmt_num((d.y * 1e3).round() / 1e3),
+            fmt_num((d.z * 1e3).round() / 1e3)
+        )
     } else {
         format!(
             "probe {probe} reaches {reach} of its {} points (it needs {need}); {why}",
             pts.len()
         )
     };
-    let help = "use a smaller tip, a longer or thinner stylus, an extension, or an indexable head; `inspc cones --face` shows the cones".to_string();
     diags.push(PlanError::UninspectableFace {
         span: feature.map_or(part.span, |f| f.span),
         face: name,

@@ -102,6 +102,22 @@ pub(crate) fn min_points(kind: SurfaceKind) -> usize {
     }
 }
 
+/// The setups plan `plan` may use on `geometry`, in words: the poses on the table (and
+/// why the others are excluded) and what the plan's fixtures can hold.
+pub fn explain_setups(model: &Model, plan: &Plan, geometry: &PartGeometry) -> String {
+    let labels: Vec<String> = model.cmms[plan.cmm.0]
+        .fixtures
+        .iter()
+        .map(|(l, _)| l.clone())
+        .collect();
+    format!(
+        "setups of plan {} (part {}):\n{}",
+        plan.name,
+        model.parts[plan.part.0].name,
+        poses::Setups::new(model, plan, geometry).explain(&labels)
+    )
+}
+
 /// Plans one plan: the entry point of the planner. Faces that cannot be inspected, and
 /// a search that does not settle, are reported in `diags` and give `None`.
 pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Option<Hlip> {

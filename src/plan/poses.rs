@@ -382,9 +382,106 @@ impl<'a> Setups<'a> {
         }
     }
 
-    /// The fixture's name of a holder, for prompts and listings.
-    pub fn fixture_name(&self, slot: usize) -> &str {
-        &self.fixture(slot).name
+    /// The candidate setups in words (`inspc plan --explain-setups`): each pose on the
+    /// table with its support and tipping angle, or why it is excluded; then what each
+    /// fixture of the plan can hold. `labels` are the CMM's fixture labels.
+    pub fn explain(&self, labels: &[String]) -> String {
+        use std::fmt::Write as _;
+        let g = self.geometry;
+        let dir = |v: &V3| {
+            let r = |x: f64| {
+                let y = (x * 1e3).round() / 1e3;
+                if y == 0.0 {
+                    0.0
+                } else {
+                    y
+                }
+            };
+            format!("({}, {}, {})", r(v.x), r(v.y), r(v.z))
+        };
+        let faces = |fs: &[FaceId]| {
+            fs.iter()
+                .map(|f| g.faces[f.0].name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let mut out = String::new();
+        let com = centre_of_mass(g);
+        let _ = writeln!(out, "  centre of mass {}", dir(&com.coords));
+        for r in &self.rests {
+            match r.excluded() {
+                None => {
+                    let _ = writeln!(
+                        out,
+                        "  up {}: stands on {} (support {:.0} mm², tips at {:.1}°)",
+                        dir(&r.up),
+                        faces(&r.faces),
+                        r.area,
+                        r.tip_deg
+                    );
+                }
+                Some(why) => {
+                    let on = if r.faces.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" on {}", faces(&r.faces))
+                    };
+                    let _ = writeln!(out, "  up {}{on}: excluded, {why}", dir(&r.up));
+                }
+            }
+        }
+        if self.rests.iter().all(|r| !r.stable()) {
+            let _ = writeln!(out, "  no pose stands on the table by itself");
+        }
+        for &(slot, f) in &self.fixtures {
+            let label = labels.get(slot).map_or("?", String::as_str);
+            let what = match f.kind {
+                FixtureKind::Vise { opening, .. } => {
+                    let n = self.clamps.iter().filter(|c| c.3 <= opening).count();
+                    format!("clamps {n} pairs of opposite faces at most {opening} mm apart, the part on a flat face square to them")
+                }
+                FixtureKind::Chuck { diameter, .. } => {
+                    let round: Vec<&str> = g
+                        .faces
+                        .iter()
+                        .filter(|x| match x.surface {
+                            Surface::Cylinder {
+                                radius,
+                                convex: true,
+                                ..
+                            }
+                            | Surface::Sphere {
+                                radius,
+                                convex: true,
+                                ..
+                            } => (diameter[0]..=diameter[1]).contains(&(2.0 * radius)),
+                            _ => false,
+                        })
+                        .map(|x| x.name.as_str())
+                        .collect();
+                    if round.is_empty() {
+                        format!(
+                            "grips Ø{}..{} mm, but no outer cylinder or sphere of the part fits",
+                            diameter[0], diameter[1]
+                        )
+                    } else {
+                        format!(
+                            "grips {} at the part's end, axis vertical",
+                            round.join(", ")
+                        )
+                    }
+                }
+                FixtureKind::SinePlate { tilt } => {
+                    let n = self.rests.iter().filter(|r| r.flat).count();
+                    format!(
+                        "clamps the part on one of its {n} flat faces, tilted {}°..{}°",
+                        tilt[0], tilt[1]
+                    )
+                }
+            };
+            let _ = writeln!(out, "  fixture {label} ({}): {what}", f.kind.word());
+        }
+        out
     }
 }
 

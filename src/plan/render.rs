@@ -66,9 +66,11 @@ impl<'a> Names<'a> {
         (label, self.model.fixtures[id.0].kind.word())
     }
 
-    /// What holds the part in a setup, in words: `the table on faces …` or `fixture
-    /// vise (a vise) on faces …`.
-    pub fn holder(&self, h: &super::poses::Holder) -> String {
+    /// What holds the part in a setup with `up` pointing up, in words: `the table on
+    /// …`, `vise v (vise): jaws on … and …, resting on …`, `chuck c (chuck) gripping …`,
+    /// `plate p (sine_plate) under …, tilted 30°`.
+    pub fn holder(&self, h: &super::poses::Holder, up: &V3) -> String {
+        use crate::model::FixtureKind;
         let faces = |fs: &[FaceId]| {
             fs.iter()
                 .map(|f| self.face(*f))
@@ -78,8 +80,35 @@ impl<'a> Names<'a> {
         match h {
             super::poses::Holder::Table { faces: fs } => format!("the table on {}", faces(fs)),
             super::poses::Holder::Fixture { slot, faces: fs } => {
-                let (label, kind) = self.fixture(*slot);
-                format!("fixture {label} ({kind}) on {}", faces(fs))
+                let (label, id) = &self.model.cmms[self.plan.cmm.0].fixtures[*slot];
+                let kind = &self.model.fixtures[id.0].kind;
+                let name = format!("fixture {label} ({})", kind.word());
+                match kind {
+                    FixtureKind::Vise { .. } if fs.len() >= 2 => format!(
+                        "{name}: jaws on {} and {}, resting on {}",
+                        self.face(fs[0]),
+                        self.face(fs[1]),
+                        faces(&fs[2..])
+                    ),
+                    FixtureKind::Chuck { .. } => format!("{name} gripping {}", faces(fs)),
+                    FixtureKind::SinePlate { .. } => {
+                        let tilt = fs
+                            .first()
+                            .and_then(|f| match self.geometry.faces[f.0].surface {
+                                crate::geometry::Surface::Plane { normal, .. } => {
+                                    Some((-normal).dot(up).clamp(-1.0, 1.0).acos().to_degrees())
+                                }
+                                _ => None,
+                            })
+                            .unwrap_or(0.0);
+                        format!(
+                            "{name} under {}, tilted {}°",
+                            faces(fs),
+                            fmt_num((tilt * 10.0).round() / 10.0)
+                        )
+                    }
+                    _ => format!("{name} on {}", faces(fs)),
+                }
             }
         }
     }
@@ -133,7 +162,7 @@ pub fn text(h: &Hlip, names: &Names) -> String {
     let mut o_count = 0;
     for (si, s) in h.setups.iter().enumerate() {
         let _ = writeln!(out, "change-setup s{} up {}", si + 1, dir_text(&s.up));
-        let _ = writeln!(out, "  held by {}", names.holder(&s.holder));
+        let _ = writeln!(out, "  held by {}", names.holder(&s.holder, &s.up));
         for t in &s.on_table {
             let _ = writeln!(out, "  rest {} on the table", names.face(*t));
         }
@@ -238,7 +267,7 @@ pub fn json(h: &Hlip, names: &Names) -> Value {
                 "up": arr(&s.up),
                 "rotation": s.rotation,
                 "on_table": s.on_table.iter().map(|f| names.face(*f)).collect::<Vec<_>>(),
-                "held_by": names.holder(&s.holder),
+                "held_by": names.holder(&s.holder, &s.up),
                 "probes": s.probes.iter().map(|p| j!({
                     "probe": names.probe(p.probe),
                     "orientations": p.orients.iter().map(|o| j!({

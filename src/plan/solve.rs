@@ -297,12 +297,12 @@ fn pick_setup(mu: &CubeMap, k: &Knowledge) -> usize {
 }
 
 /// The cell deepest inside a cone: the first left by eroding it until one more erosion
-/// would empty it.
+/// would empty it (the whole sphere, which erosion never shrinks, gives its first cell).
 pub(crate) fn deepest(mu: &CubeMap) -> Option<Cell> {
     let mut cur = mu.clone();
     loop {
         let eroded = cur.and(&cur.not().grow().not());
-        if eroded.is_empty() {
+        if eroded.is_empty() || eroded == cur {
             break;
         }
         cur = eroded;

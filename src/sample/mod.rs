@@ -84,7 +84,9 @@ impl<'a> Sampler<'a> {
             return self.freeform(face, strategy.method, n);
         };
         let (eu, ev) = chart.extent_mm();
-        let margin = self.margin.min(0.2 * eu.min(ev));
+        // A face narrower than the tip keeps as much of the margin as it can: its points
+        // gather towards the mid-line (a 1 mm ring gets a row on its middle, not none).
+        let margin = self.margin.min(NARROW_SHARE * eu.min(ev));
         let place = Place {
             s: self,
             chart: &chart,
@@ -163,6 +165,10 @@ impl<'a> Sampler<'a> {
         pick_evenly(best, n)
     }
 }
+
+/// The most of a face's width the margin may take on each side: a face narrower than
+/// twice the margin keeps its points in the middle tenth.
+const NARROW_SHARE: f64 = 0.45;
 
 /// Placing points on one analytic face.
 struct Place<'s, 'a> {
@@ -295,7 +301,7 @@ impl Place<'_, '_> {
         let c = self.chart;
         let h = c.v.1 - c.v.0;
         let (_, sv) = c.scale();
-        let r = (self.margin / sv).min(h / 4.0);
+        let r = (self.margin / sv).min(NARROW_SHARE * h);
         let heights = [
             c.v.0 + r + (h - 2.0 * r) / 5.0,
             c.v.0 + r + 4.0 * (h - 2.0 * r) / 5.0,
