@@ -136,6 +136,10 @@ enum Command {
         /// Cube-map resolution of the accessibility cones.
         #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(8..=256))]
         resolution: u32,
+        /// Write the program even when some tolerances cannot be measured (each is
+        /// listed as a warning), instead of failing.
+        #[arg(long)]
+        allow_unmeasured: bool,
     },
     /// Reads a DMIS program and checks it as a controller would: line lengths, labels,
     /// names defined before use, MEAS blocks.
@@ -201,7 +205,8 @@ fn main() -> ExitCode {
             output,
             plan_json,
             resolution,
-        } => build(&file, output, plan_json, resolution),
+            allow_unmeasured,
+        } => build(&file, output, plan_json, resolution, allow_unmeasured),
         Command::Dmis { file } => read_dmis(&file),
         Command::Check {
             files,
@@ -384,9 +389,11 @@ fn build(
     output: Option<PathBuf>,
     plan_json: Option<PathBuf>,
     n: u32,
+    allow_unmeasured: bool,
 ) -> ExitCode {
     let opts = inspc::plan::PlanOptions {
         n,
+        allow_unmeasured,
         ..Default::default()
     };
     let start = std::time::Instant::now();
@@ -463,8 +470,10 @@ fn build(
             format!("{k} {w}{}", if k == 1 { "" } else { es })
         };
         println!(
-            "plan {}: {}, {}, {}, {}, {}",
+            "plan {}: tolerances measured {} of {}, {}, {}, {}, {}, {}",
             checked.model.plans[b.plan].name,
+            s.tolerances.0,
+            s.tolerances.1,
             n(s.setups, "setup"),
             n(s.probes_used, "probe"),
             n(s.orientations, "orientation"),

@@ -54,6 +54,35 @@ pub enum PlanError {
         reach: String,
         ram: String,
     },
+    #[error("tolerance `{tolerance}` is not measured: face `{face}` of feature `{feature}` {why}")]
+    #[diagnostic(
+        code(insp::plan::unmeasured),
+        help("{help}; `inspc build --allow-unmeasured` writes the program without it")
+    )]
+    Unmeasured {
+        #[label("this tolerance")]
+        span: Span,
+        tolerance: String,
+        feature: String,
+        face: String,
+        why: String,
+        help: String,
+    },
+    #[error("tolerance `{tolerance}` is not measured (allowed): face `{face}` of feature `{feature}` {why}")]
+    #[diagnostic(
+        code(insp::plan::unmeasured_allowed),
+        severity(Warning),
+        help("{help}; the program leaves it out")
+    )]
+    UnmeasuredAllowed {
+        #[label("this tolerance")]
+        span: Span,
+        tolerance: String,
+        feature: String,
+        face: String,
+        why: String,
+        help: String,
+    },
     #[error("part `{part}` has no plan, so there is no machine to plan for")]
     #[diagnostic(
         code(insp::plan::no_plan),
@@ -67,6 +96,8 @@ pub enum PlanError {
 }
 
 crate::located!(PlanError {
+    Unmeasured,
+    UnmeasuredAllowed,
     UninspectableFace,
     NoConvergence,
     NoPlan,

@@ -159,6 +159,9 @@ pub struct Summary {
     pub min_setups: (usize, bool),
     /// The clustering strategy of the plan kept (`None` when nothing needed clustering).
     pub strategy: Option<Strategy>,
+    /// Tolerances whose every face (of their features and datum features) the plan
+    /// touches, and the part's tolerances in all.
+    pub tolerances: (usize, usize),
 }
 
 /// How a round ended, for [`assemble`].
@@ -293,6 +296,7 @@ pub(crate) fn assemble(input: &Input, k: &mut Knowledge, m: &Machine, run: &Roun
         plan: input.plan_id(),
         head: m.head,
         summary: Summary {
+            tolerances: (0, 0),
             setups: out_setups.len(),
             probes_used: probes_used.len(),
             probe_changes,

@@ -54,6 +54,8 @@ pub struct PlanOptions {
     pub max_iterations: usize,
     /// Search nodes for the exact minimum number of setups.
     pub exact_budget: usize,
+    /// Tolerances the plan cannot measure are warnings, not errors.
+    pub allow_unmeasured: bool,
 }
 
 impl Default for PlanOptions {
@@ -62,6 +64,7 @@ impl Default for PlanOptions {
             n: 64,
             max_iterations: 40,
             exact_budget: 200_000,
+            allow_unmeasured: false,
         }
     }
 }
@@ -100,6 +103,106 @@ pub(crate) fn min_points(kind: SurfaceKind) -> usize {
         SurfaceKind::Sphere => 4,
         SurfaceKind::Freeform => 3,
     }
+}
+
+/// Counts the tolerances the plan measures — every face of their features and datum
+/// features touched — and reports each one it does not (an error unless
+/// `allow_unmeasured`), naming the first face it misses and why.
+fn account(input: &Input, mut hlip: Hlip, opts: &PlanOptions, diags: &mut Diagnostics) -> Hlip {
+    let part = &input.model.parts[input.plan.part.0];
+    let g = input.graph;
+    let mut touched: BTreeSet<FaceId> = BTreeSet::new();
+    for s in &hlip.setups {
+        for p in &s.probes {
+            for o in &p.orients {
+                for i in &o.inspections {
+                    for f in &i.faces {
+                        if !f.points.is_empty() {
+                            touched.insert(f.face);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Per feature its faces, per face whether sampling gave it points.
+    let mut faces_of: BTreeMap<crate::model::FeatureId, Vec<FaceId>> = BTreeMap::new();
+    let mut sampled: BTreeSet<FaceId> = BTreeSet::new();
+    for (n, node) in g.nodes() {
+        match node {
+            Node::Feature { feature, .. } => {
+                for (c, _) in g.children(n) {
+                    if let Node::Face { face, .. } = g.graph[c] {
+                        faces_of.entry(*feature).or_default().push(face);
+                    }
+                }
+            }
+            Node::Face { face, .. } => {
+                if !g.children(n).is_empty() {
+                    sampled.insert(*face);
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut measured = 0;
+    for t in &part.tolerances {
+        let features = t
+            .targets
+            .iter()
+            .copied()
+            .chain(t.datums.iter().map(|d| part.datums[d.datum.0].feature));
+        let missing = features.into_iter().find_map(|f| {
+            faces_of
+                .get(&f)
+                .into_iter()
+                .flatten()
+                .find(|face| !touched.contains(face))
+                .map(|&face| (f, face))
+        });
+        let Some((f, face)) = missing else {
+            measured += 1;
+            continue;
+        };
+        let (why, help) = if sampled.contains(&face) {
+            (
+                "gets no touch in the plan".to_string(),
+                "its points were dropped as hard to reach; a probe that reaches more of them, or more points (`sample`), keeps it".to_string(),
+            )
+        } else {
+            (
+                "gets no measuring point".to_string(),
+                "no point of it keeps the sampling margin from its edges; lower the sampling inset"
+                    .to_string(),
+            )
+        };
+        let (tolerance, feature, face) = (
+            t.name.clone(),
+            part.features[f.0].name.clone(),
+            input.geometry.faces[face.0].name.clone(),
+        );
+        if opts.allow_unmeasured {
+            diags.push(PlanError::UnmeasuredAllowed {
+                span: t.span,
+                tolerance,
+                feature,
+                face,
+                why,
+                help,
+            });
+        } else {
+            diags.push(PlanError::Unmeasured {
+                span: t.span,
+                tolerance,
+                feature,
+                face,
+                why,
+                help,
+            });
+        }
+    }
+    hlip.summary.tolerances = (measured, part.tolerances.len());
+    hlip
 }
 
 /// The setups plan `plan` may use on `geometry`, in words: the poses on the table (and
@@ -193,7 +296,12 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
                 strategy: None,
                 exact_budget: opts.exact_budget,
             };
-            return Some(assemble(input, &mut k, &machine, &round));
+            return Some(account(
+                input,
+                assemble(input, &mut k, &machine, &round),
+                opts,
+                diags,
+            ));
         };
         let mut results: Vec<(Strategy, Vec<Branch>)> = Vec::new();
         let mut failures = Vec::new();
@@ -282,7 +390,12 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
                 strategy: Some(best.0),
                 exact_budget: opts.exact_budget,
             };
-            return Some(assemble(input, &mut k, &machine, &round));
+            return Some(account(
+                input,
+                assemble(input, &mut k, &machine, &round),
+                opts,
+                diags,
+            ));
         }
         learn(&mut k, &machine, invalid);
     }

@@ -230,6 +230,11 @@ fn summary_text(s: &Summary, names: &Names) -> String {
     );
     let _ = writeln!(
         out,
+        "  tolerances measured {} of {}",
+        s.tolerances.0, s.tolerances.1
+    );
+    let _ = writeln!(
+        out,
         "  probes used {}, probe changes {}",
         s.probes_used, s.probe_changes
     );
@@ -306,6 +311,8 @@ pub fn json(h: &Hlip, names: &Names) -> Value {
         })).collect::<Vec<_>>(),
         "summary": {
             "setups": s.setups,
+            "tolerances_measured": s.tolerances.0,
+            "tolerances": s.tolerances.1,
             "probes_used": s.probes_used,
             "probe_changes": s.probe_changes,
             "orientations": s.orientations,

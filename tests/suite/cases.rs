@@ -527,6 +527,40 @@ fn every_setup_stands_or_is_held() {
     assert!(setups >= 10, "only {setups} setups");
 }
 
+/// Every tolerance of every golden plan is measured and reported: its `TOL` is defined
+/// and an `OUTPUT` names it (the summary counts it among those measured).
+#[test]
+fn every_tolerance_is_output() {
+    let mut tolerances = 0;
+    for (c, run, b) in built() {
+        let part = &run.checked.model.parts[run.checked.model.plans[b.plan].part.0];
+        let (measured, total) = b.hlip.summary.tolerances;
+        assert_eq!(
+            (measured, total),
+            (part.tolerances.len(), part.tolerances.len()),
+            "{}",
+            c.name
+        );
+        let defined: Vec<&str> = b
+            .dmis
+            .lines()
+            .filter_map(|l| l.strip_prefix("T(")?.split_once(")=TOL/").map(|(t, _)| t))
+            .collect();
+        assert_eq!(defined.len(), total, "{}: TOL statements", c.name);
+        for t in defined {
+            assert!(
+                b.dmis
+                    .lines()
+                    .any(|l| l.starts_with("OUTPUT/") && l.contains(&format!("TA({t})"))),
+                "{}: tolerance {t} is never output",
+                c.name
+            );
+            tolerances += 1;
+        }
+    }
+    assert!(tolerances >= 20, "only {tolerances} tolerances");
+}
+
 /// Which (probe, A, B) inspect a feature.
 fn configs_of(run: &Run, b: &Built, feature: &str) -> BTreeSet<(String, String)> {
     let names = names(run, b);

@@ -58,6 +58,35 @@ fn a_report_quotes_a_window_of_a_long_line() {
 }
 
 #[test]
+fn an_unmeasured_tolerance_fails_the_build_unless_allowed() {
+    let spec = temp_spec(
+        "unmeasured.insp",
+        "use std::heads::PH6\nuse std::probes::TP20_D2_L20\npart p {\n    units mm\n    stock box(100, 100, 20)\n    cut hole bore { at (50, 50, 20), axis -z, diameter 40, depth through }\n    feature top = stock.top\n    feature side = stock.left\n    tolerance flat = flatness(top, 0.05 mm)\n    tolerance flat_side = flatness(side, 0.05 mm)\n}\ncmm lab { table { z 0 mm }, ram { radius 35 mm, length 600 mm }, head PH6, probes [p1: TP20_D2_L20] }\nplan q { part p, cmm lab, sample top with uniform(points 4, inset 45 %) }\n",
+    );
+    let out = spec.replace(".insp", ".dmi");
+    let _ = std::fs::remove_file(&out);
+    let (code, _, stderr) = inspc(&["build", &spec, "-o", &out]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("insp::plan::unmeasured") && stderr.contains("`flat`"),
+        "{stderr}"
+    );
+    assert!(!std::path::Path::new(&out).exists());
+    let (code, stdout, stderr) = inspc(&["build", &spec, "-o", &out, "--allow-unmeasured"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("insp::plan::unmeasured_allowed"),
+        "{stderr}"
+    );
+    assert!(stdout.contains("tolerances measured 1 of 2"), "{stdout}");
+    let program = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        program.contains("TA(FLAT_SIDE)") && !program.contains("TA(FLAT)"),
+        "{program}"
+    );
+}
+
+#[test]
 fn check_reports_errors_and_exits_one() {
     let bad = temp_spec(
         "bad.insp",
