@@ -293,6 +293,9 @@ pub struct Built {
     /// The plan's measurement graph, when its `output { graph }` names a file: the text
     /// in the format that file's extension asks for.
     pub graph: Option<String>,
+    /// Faces whose stand-offs keep less than the plan's margin, by name, with the least
+    /// margin kept there (mm).
+    pub tight: Vec<(String, f64)>,
 }
 
 /// Where a build's time went, stage by stage.
@@ -468,6 +471,12 @@ fn programs_of(run: &Run, paths: Pathed) -> Vec<Built> {
                 _ => graph::dot(p, &data.geometry, &g.graph, false),
             })
         });
+        let tight = llip
+            .summary
+            .tight
+            .iter()
+            .map(|(f, m)| (names.face(*f).to_string(), *m))
+            .collect();
         out.push(Built {
             plan: k,
             hlip,
@@ -475,6 +484,7 @@ fn programs_of(run: &Run, paths: Pathed) -> Vec<Built> {
             dmis,
             json,
             graph,
+            tight,
         });
     }
     out

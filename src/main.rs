@@ -487,6 +487,29 @@ fn build(
             l.summary.added_nodes,
             l.summary.checks
         );
+        let m = l.motion.margin;
+        let fmt = inspc::model::fmt_num;
+        if l.summary.tight.is_empty() {
+            println!("  moves keep {} mm from part, fixtures and table", fmt(m));
+        } else {
+            let faces: Vec<String> = b
+                .tight
+                .iter()
+                .take(6)
+                .map(|(face, x)| format!("{face} {} mm", fmt(*x)))
+                .collect();
+            let more = b.tight.len().saturating_sub(6);
+            println!(
+                "  moves keep {} mm from part, fixtures and table; less at stand-offs on {}{}",
+                fmt(m),
+                faces.join(", "),
+                if more > 0 {
+                    format!(" and {more} more faces")
+                } else {
+                    String::new()
+                }
+            );
+        }
     }
     let stages: Vec<String> = timings
         .stages

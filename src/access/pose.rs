@@ -241,6 +241,10 @@ pub struct Pose<'a> {
     up: V3,
     table: f64,
     fixture: &'a [Solid],
+    /// The margin moves keep ([`Pose::segment`]).
+    margin: f64,
+    /// Stand-offs where the margin is less (quantised position → margin).
+    tight: std::collections::HashMap<[i64; 3], f64>,
 }
 
 impl<'a> Pose<'a> {
@@ -282,7 +286,34 @@ impl<'a> Pose<'a> {
             up,
             table,
             fixture: &[],
+            margin: 0.0,
+            tight: Default::default(),
         }
+    }
+
+    /// The same pose with moves keeping `margin` (mm) from part, fixture and table.
+    pub fn with_margin(mut self, margin: f64) -> Pose<'a> {
+        self.margin = margin.max(0.0);
+        self
+    }
+
+    /// The margin moves keep.
+    pub fn margin(&self) -> f64 {
+        self.margin
+    }
+
+    /// Lets moves from and to stand-off `at` keep only `margin`: a narrow feature
+    /// leaves no more room there.
+    pub fn set_tight(&mut self, at: &P3, margin: f64) {
+        self.tight.insert(spot(at), margin.max(0.0));
+    }
+
+    /// The margin a move from or to `x` keeps.
+    pub fn margin_at(&self, x: &P3) -> f64 {
+        if self.tight.is_empty() {
+            return self.margin;
+        }
+        self.tight.get(&spot(x)).copied().unwrap_or(self.margin)
     }
 
     /// The same pose with the fixture's solids as obstacles too.
@@ -359,25 +390,32 @@ impl<'a> Pose<'a> {
                 }
             }
         }
-        self.sweep_fixture(c, &(c + n * travel))
+        self.sweep_fixture(c, &(c + n * travel), 0.0)
     }
 
-    /// Whether the probe meets the fixture anywhere on the move from tip centre `p` to
-    /// `q`.
-    fn sweep_fixture(&self, p: &P3, q: &P3) -> Result<(), Blocker> {
+    /// Whether the probe, grown by `grow`, meets the fixture anywhere on the move from
+    /// tip centre `p` to `q`.
+    fn sweep_fixture(&self, p: &P3, q: &P3, grow: f64) -> Result<(), Blocker> {
         if self.fixture.is_empty() {
             return Ok(());
         }
         let hits = |s: &dyn Shape| self.fixture.iter().any(|f| f.hits(s));
-        self.sweep(p, q, &hits).map_err(|b| match b {
+        self.sweep(p, q, &hits, grow).map_err(|b| match b {
             Blocker::Component(c) => Blocker::Fixture(c),
             _ => Blocker::Fixture("tip".into()),
         })
     }
 
-    /// Whether the probe standing with its tip centre at `p` is clear.
+    /// Whether the probe standing with its tip centre at `p` is clear by the margin
+    /// there.
     pub fn free(&self, p: &P3) -> Result<(), Blocker> {
         self.segment(p, p)
+    }
+
+    /// Whether the probe can move from tip centre `p` to `q` keeping the margin: the
+    /// smaller of the margins at the two ends (see [`Pose::set_tight`]).
+    pub fn segment(&self, p: &P3, q: &P3) -> Result<(), Blocker> {
+        self.segment_with(p, q, self.margin_at(p).min(self.margin_at(q)))
     }
 
     /// Whether the probe can translate from tip centre `p` to `q` (seed ch. 5.4.2); else
@@ -386,54 +424,63 @@ impl<'a> Pose<'a> {
     /// body, head or ram cylinder as the convex hull of its two end positions (its discs
     /// as circumscribed 16-gons, so a little larger than the cylinder). A component's
     /// lowest point moves linearly along a segment, so the two ends decide the table.
-    pub fn segment(&self, p: &P3, q: &P3) -> Result<(), Blocker> {
+    /// Every shape is grown by `margin`, and the table kept at least that far.
+    pub fn segment_with(&self, p: &P3, q: &P3, margin: f64) -> Result<(), Blocker> {
+        let table = self.table + TABLE_MARGIN.max(margin);
         let lo = p.coords.dot(&self.up).min(q.coords.dot(&self.up)) - self.tip_radius;
-        if lo < self.table + TABLE_MARGIN {
+        if lo < table {
             return Err(Blocker::TipOnTable);
         }
         for part in &self.parts {
-            if self.low(part, p).min(self.low(part, q)) < self.table + TABLE_MARGIN {
+            if self.low(part, p).min(self.low(part, q)) < table {
                 return Err(Blocker::ComponentOnTable(part.comp.name.clone()));
             }
         }
         if let Some(mesh) = self.scene.mesh() {
             let id = Isometry::identity();
             let hits = |shape: &dyn Shape| intersection_test(&id, shape, &id, mesh).unwrap_or(true);
-            self.sweep(p, q, &hits)?;
+            self.sweep(p, q, &hits, margin)?;
         }
-        self.sweep_fixture(p, q)
+        self.sweep_fixture(p, q, margin)
     }
 
     /// Sweeps every component from tip centre `p` to `q` against what `hits` tests:
     /// the tip as an exact capsule, a stylus or extension capsule as the exact union of
     /// two rounded triangles, a body, head or ram cylinder as the convex hull of its two
     /// end positions (its discs as circumscribed 16-gons).
-    fn sweep(&self, p: &P3, q: &P3, hits: &dyn Fn(&dyn Shape) -> bool) -> Result<(), Blocker> {
+    fn sweep(
+        &self,
+        p: &P3,
+        q: &P3,
+        hits: &dyn Fn(&dyn Shape) -> bool,
+        grow: f64,
+    ) -> Result<(), Blocker> {
         let v = q - p;
         let moving = v.norm() > 1e-9;
-        if hits(&Capsule::new(*p, *q, self.tip_radius)) {
+        if hits(&Capsule::new(*p, *q, self.tip_radius + grow)) {
             return Err(Blocker::Tip);
         }
         let far = 4.0 * self.scene.size + 10.0;
         for part in &self.parts {
             let c = &part.comp;
+            let radius = c.radius + grow;
             let b = c.b.min(c.a + far);
             let a0 = p + part.offset + part.dir * c.a;
             let b0 = p + part.offset + part.dir * b;
             let hit = match (c.end, moving) {
                 (_, _) if c.radius == 0.0 => false,
-                (End::Round, false) => hits(&Capsule::new(a0, b0, c.radius)),
+                (End::Round, false) => hits(&Capsule::new(a0, b0, radius)),
                 (End::Round, true) => {
                     let round = |t: Triangle| RoundShape {
                         inner_shape: t,
-                        border_radius: c.radius,
+                        border_radius: radius,
                     };
                     hits(&round(Triangle::new(a0, b0, a0 + v)))
                         || hits(&round(Triangle::new(b0, b0 + v, a0 + v)))
                 }
                 (End::Flat, _) => {
                     let (e1, e2) = crate::sample::perpendicular_basis(&part.dir);
-                    let r = c.radius / (std::f64::consts::PI / DISC_SIDES as f64).cos();
+                    let r = radius / (std::f64::consts::PI / DISC_SIDES as f64).cos();
                     let mut pts = Vec::with_capacity(4 * DISC_SIDES);
                     for k in 0..DISC_SIDES {
                         let t = std::f64::consts::TAU * k as f64 / DISC_SIDES as f64;
@@ -449,7 +496,7 @@ impl<'a> Pose<'a> {
                         Some(hull) => hits(&hull),
                         // A hull parry cannot build (a degenerate move): test positions
                         // along the move with the radius grown to cover the gaps.
-                        None => sampled(&a0, &b0, &v, c.radius, hits),
+                        None => sampled(&a0, &b0, &v, radius, hits),
                     }
                 }
             };
@@ -470,4 +517,10 @@ fn sampled(a: &P3, b: &P3, v: &V3, radius: f64, hits: &dyn Fn(&dyn Shape) -> boo
         let t = v * (s as f64 / steps as f64);
         hits(&Capsule::new(a + t, b + t, radius))
     })
+}
+
+/// A stand-off's key: its position to 0.1 µm (the plan's coordinates are quantised to
+/// 1 nm, so a stand-off read back from a program finds its own key).
+fn spot(x: &P3) -> [i64; 3] {
+    [x.x, x.y, x.z].map(|c| (c * 1e4).round() as i64)
 }

@@ -500,17 +500,22 @@ pub struct Motion {
     pub search: f64,
     /// Height above the part's top of the clearance plane between groups (DMIS `CLRSRF`).
     pub clearance: f64,
+    /// The least distance every move but the touch itself keeps from part, fixture
+    /// and table; less only at a stand-off where the feature leaves less room.
+    pub margin: f64,
 }
 
 impl Default for Motion {
     /// Defaults for a TP20 on a touch-trigger head: 2 mm pre-hit and retract (the
-    /// module's pre-travel is well under 1 mm), 4 mm search, 20 mm clearance.
+    /// module's pre-travel is well under 1 mm), 4 mm search, 20 mm clearance, 1 mm
+    /// margin: more than a machined part's deviation from its nominal.
     fn default() -> Self {
         Motion {
             prehit: 2.0,
             retract: 2.0,
             search: 4.0,
             clearance: 20.0,
+            margin: 1.0,
         }
     }
 }

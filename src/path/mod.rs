@@ -110,6 +110,9 @@ pub struct Touch {
     pub via: Vec<[f64; 3]>,
     /// The stand-off: where the touch starts and ends.
     pub standoff: [f64; 3],
+    /// The margin moves to and from the stand-off keep (mm): the plan's, or less where
+    /// the feature leaves less room.
+    pub margin: f64,
 }
 
 /// The LLIP in numbers.
@@ -125,6 +128,8 @@ pub struct PathSummary {
     pub added_nodes: usize,
     /// Move segments checked with parry.
     pub checks: usize,
+    /// Faces whose stand-offs keep less than the plan's margin, with the least kept.
+    pub tight: Vec<(crate::geometry::FaceId, f64)>,
 }
 
 /// Everything a group needs while it is planned.
@@ -254,6 +259,7 @@ fn linearise<'a>(
                                     point: k,
                                     via: vec![],
                                     standoff: [0.0; 3],
+                                    margin: 0.0,
                                 })
                                 .collect(),
                         });
@@ -314,6 +320,8 @@ fn join(
     let total = groups.len();
     let mut setups: Vec<SetupPath> = Vec::new();
     let (mut added, mut checks, mut length, mut touches) = (0, 0, 0.0, 0);
+    let mut tight: std::collections::BTreeMap<crate::geometry::FaceId, f64> =
+        std::collections::BTreeMap::new();
     // The previous group: its setup and where its head ends.
     let mut prev: Option<(usize, P3)> = None;
     for (g, o) in groups.iter().zip(outs) {
@@ -382,7 +390,18 @@ fn join(
     }
     for sp in &mut setups {
         sp.alignment = align::align(input, hlip, sp);
+        for g in &sp.groups {
+            for b in &g.blocks {
+                for t in &b.touches {
+                    if t.margin < motion.margin {
+                        let m = tight.entry(b.face).or_insert(t.margin);
+                        *m = m.min(t.margin);
+                    }
+                }
+            }
+        }
     }
+    let tight: Vec<(crate::geometry::FaceId, f64)> = tight.into_iter().collect();
     Ok(Llip {
         motion,
         summary: PathSummary {
@@ -391,10 +410,14 @@ fn join(
             length,
             added_nodes: added,
             checks,
+            tight,
         },
         setups,
     })
 }
+
+/// The shares of the plan's margin a stand-off tries, largest first.
+const MARGIN_STEPS: [f64; 5] = [1.0, 0.5, 0.25, 0.125, 0.0];
 
 /// The length of a polyline.
 fn polyline(pts: &[P3]) -> f64 {
@@ -431,7 +454,10 @@ fn plan_group(
     g: &GroupIn,
     standoff: f64,
 ) -> Result<GroupOut, Box<PathError>> {
-    let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table).with_fixture(g.fixture);
+    let full = input.plan.motion.margin;
+    let mut pose = Pose::new(scene, g.probe, g.dir, g.up, g.table)
+        .with_fixture(g.fixture)
+        .with_margin(full);
     let r = g.probe.tip_radius;
     // Goals: every touch's stand-off, block by block.
     let mut goals = Vec::new();
@@ -443,6 +469,24 @@ fn plan_group(
             owner.push((bi, ti));
         }
     }
+    // Each stand-off keeps the largest of the margin, a half, a quarter, an eighth or
+    // none that its feature leaves room for; moves to and from it keep that much.
+    let margins: Vec<f64> = goals
+        .par_iter()
+        .map(|x| {
+            MARGIN_STEPS
+                .iter()
+                .map(|f| full * f)
+                .find(|&m| pose.segment_with(x, x, m).is_ok())
+                .unwrap_or(0.0)
+        })
+        .collect();
+    for (x, &m) in goals.iter().zip(&margins) {
+        if m < full {
+            pose.set_tight(x, m);
+        }
+    }
+    let pose = pose;
     let geometry = input.geometry;
     let face_points = |goal: usize| -> Vec<P3> {
         let (bi, _) = owner[goal];
@@ -596,6 +640,7 @@ fn plan_group(
                     point: g.blocks[bi].touches[ti].point,
                     via,
                     standoff: goals[k].coords.into(),
+                    margin: margins[k],
                 }
             })
             .collect();

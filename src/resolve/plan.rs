@@ -81,6 +81,21 @@ pub(super) fn lower(
                         *slot = x;
                     }
                 }
+                let m = o.get("margin");
+                if let Some((x, v)) = m.and_then(|v| Some((cx.dim(v, Dim::Length)?, v))) {
+                    if x < 0.0 {
+                        cx.err(E::OutOfRange {
+                            span: v.span,
+                            what: "`margin`".into(),
+                            value: format!("{} mm", num(x)),
+                            range: "it must be 0 mm or more".into(),
+                            help: "the least distance moves keep from the part; 0 mm keeps none"
+                                .into(),
+                        });
+                    } else {
+                        motion.margin = x;
+                    }
+                }
                 o.finish(cx);
             }
             _ => cx.mismatch(v, "a block `{ prehit 2 mm, retract 2 mm }`", ""),

@@ -377,8 +377,9 @@ fn programs_read_back() {
 }
 
 /// Every move of every program, re-checked with parry on its own: the probe of each
-/// group swept along every segment between the positions the program commands, over a
-/// table computed here from the part's vertices.
+/// group, grown by the plan's margin (less only at the stand-offs the program says keep
+/// less), swept along every segment between the positions the program commands, over a
+/// table computed here from the part's vertices and the fixture holding the part.
 #[test]
 fn every_move_is_collision_free() {
     let mut programs = 0;
@@ -408,8 +409,17 @@ fn every_move_is_collision_free() {
             for g in &s.groups {
                 let probe = &probes[g.probe.0];
                 let dir = nalgebra::Vector3::from(g.direction);
-                let pose = inspc::access::Pose::new(&scene, probe, dir, up, table)
-                    .with_fixture(&setup.fixture);
+                // Every move keeps the plan's margin, less only next to a stand-off
+                // that keeps less (the program records how much).
+                let mut pose = inspc::access::Pose::new(&scene, probe, dir, up, table)
+                    .with_fixture(&setup.fixture)
+                    .with_margin(plan.motion.margin);
+                for bl in &g.blocks {
+                    for t in &bl.touches {
+                        assert!(t.margin <= plan.motion.margin && t.margin >= 0.0);
+                        pose.set_tight(&t.standoff.into(), t.margin);
+                    }
+                }
                 let mut pts: Vec<[f64; 3]> = g.entry.clone();
                 for bl in &g.blocks {
                     for t in &bl.touches {

@@ -1145,6 +1145,31 @@ fn a_pattern_missing_the_part_is_one_error_and_its_faces_are_not_gone() {
 }
 
 #[test]
+fn a_negative_margin_is_refused() {
+    let d = check_src(&format!(
+        "{}\nuse std::cmms::bridge_fixed\nplan q {{ part p, cmm bridge_fixed, motion {{ margin -1 mm }} }}\n",
+        part("feature top = stock.top")
+    ));
+    expect(&d, "insp::resolve::out_of_range", "-1 mm", "`margin`");
+}
+
+#[test]
+fn fixtures_are_checked_by_kind_and_by_label() {
+    let d = check_src(&format!(
+        "{}\nfixture f {{ kind clamp, height 10 mm }}\nfixture g {{ kind sine_plate, tilt 0 deg .. 120 deg, height 10 mm }}\ncmm lab {{ table {{ z 0 mm }}, ram {{ radius 35 mm, length 600 mm }}, head std::heads::PH6, probes [p1: std::probes::TP20_D2_L20], fixtures [f: f, g: g] }}\nplan q {{ part p, cmm lab, fixtures [h] }}\n",
+        part("feature top = stock.top")
+    ));
+    expect(&d, "insp::resolve::unknown_name", "clamp", "fixture kind");
+    expect(
+        &d,
+        "insp::resolve::out_of_range",
+        "0 deg .. 120 deg",
+        "`tilt` range",
+    );
+    expect(&d, "insp::resolve::unknown_name", "h", "fixture");
+}
+
+#[test]
 fn a_plan_samples_at_most_five_thousand_points() {
     let d = check_src(&format!(
         "{}\ncmm lab {{ table {{ z 0 mm }}, ram {{ radius 35 mm, length 600 mm }}, head std::heads::PH6, probes [p1: std::probes::TP20_D2_L20] }}\nplan q {{ part p, cmm lab, sample all with uniform(points 1000) }}\n",
