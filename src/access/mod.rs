@@ -191,18 +191,35 @@ pub fn point_cones(
 ) -> PointCones {
     let (n, pref) = (opts.n, &opts.preferred[..]);
     let c = f.tip_centre(probe.tip_radius);
-    if !tip_fits(scene, &c, probe.tip_radius) {
+    if !tip_fits(scene, &c, probe.tip_radius)
+        || !pose::room_to_touch(
+            scene,
+            &f.position,
+            &f.normal,
+            probe.tip_radius,
+            opts.retract,
+        )
+    {
         return PointCones {
             tip_fits: false,
             approach: CubeMap::empty(n, pref),
             d2: probe.head.indexable().then(|| CubeMap::empty(n, pref)),
         };
     }
+    // In a narrow feature the retract point moves in (see `pose::backoff`); there the
+    // contact's cone alone stands, and validation sweeps the real approach.
+    let travel = pose::backoff(
+        scene,
+        &f.position,
+        &f.normal,
+        probe.tip_radius,
+        opts.retract,
+    );
     let retract = c + f.normal * opts.retract;
     let comps = probe.leading();
     let exact = opts.exact_boundary;
     let mut approach = gac_with(backend, scene, &c, &comps, n, pref, exact);
-    if !approach.is_empty() && opts.retract > 0.0 {
+    if !approach.is_empty() && opts.retract > 0.0 && travel >= opts.retract {
         approach.and_assign(&gac_with(backend, scene, &retract, &comps, n, pref, exact));
     }
     let d2 = probe

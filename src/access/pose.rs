@@ -93,6 +93,30 @@ pub enum Contact {
     Table,
 }
 
+/// The least travel a touch needs before and after its contact (mm): a tip that cannot
+/// back off this far from the surface (a 4 mm ball in a 4 mm slot) does not fit.
+pub const MIN_TRAVEL: f64 = 0.25;
+
+/// Whether the tip at contact `p` can back off as far as a touch needs
+/// ([`MIN_TRAVEL`], or `travel` when that is less).
+pub fn room_to_touch(scene: &Scene, p: &P3, n: &V3, tip_radius: f64, travel: f64) -> bool {
+    backoff(scene, p, n, tip_radius, travel) >= MIN_TRAVEL.min(travel) - 1e-9
+}
+
+/// How far the tip backs off contact `p` (normal `n`) before and after a touch: `travel`,
+/// or half the free space in front of the point when that is less (a small bore: the
+/// tip waits on its axis rather than past the far wall). The planner validates a touch
+/// over this distance and the path stage moves by it.
+pub fn backoff(scene: &Scene, p: &P3, n: &V3, tip_radius: f64, travel: f64) -> f64 {
+    // Rays start past the tessellation's deviation from the exact surface (0.05 mm).
+    const SKIN: f64 = 0.1;
+    let from = p + n * SKIN;
+    match scene.cast_ray(&from, n, 2.0 * (travel + tip_radius) + 1.0) {
+        Some(hit) => travel.min(((hit + SKIN - 2.0 * tip_radius) / 2.0).max(0.0)),
+        None => travel,
+    }
+}
+
 /// The rotation taking the part frame to the machine frame of setup `up` (up ↦ +z).
 pub fn frame(up: &V3) -> Rotation3<f64> {
     Rotation3::rotation_between(up, &V3::z()).unwrap_or_else(|| {

@@ -664,17 +664,15 @@ fn block_standoff(
     standoff: f64,
     probe: &ProbeShape,
 ) -> f64 {
-    // Rays start past the tessellation's deviation from the exact surface (0.05 mm).
-    const SKIN: f64 = 0.1;
-    let r = probe.tip_radius;
     points.iter().fold(standoff, |s, &k| {
         let p = &hlip.points[k];
-        let n = p.normal;
-        let from = p.position + n * SKIN;
-        match scene.cast_ray(&from, &n, 2.0 * (standoff + r) + 1.0) {
-            Some(hit) => s.min(((hit + SKIN - 2.0 * r) / 2.0).max(0.0)),
-            None => s,
-        }
+        s.min(crate::access::pose::backoff(
+            scene,
+            &p.position,
+            &p.normal,
+            probe.tip_radius,
+            standoff,
+        ))
     })
 }
 

@@ -333,7 +333,11 @@ pub fn min_hitting_set<S: Set>(w: &[&S], budget: usize) -> (usize, bool) {
             *complete = false;
             return;
         }
-        let Some(first) = (0..n).find(|&i| !covered.has(i)) else {
+        // Branch on the uncovered set the fewest candidates hit (most constrained).
+        let Some(first) = (0..n)
+            .filter(|&i| !covered.has(i))
+            .min_by_key(|&i| (keep.iter().filter(|c| c.has(i)).count(), i))
+        else {
             *best = (*best).min(depth);
             return;
         };

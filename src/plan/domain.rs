@@ -203,12 +203,22 @@ impl<'a> Knowledge<'a> {
         } else {
             Contact::Part
         };
+        let travel = match contact {
+            Contact::Part => access::pose::backoff(
+                &self.scene,
+                &point.position,
+                &point.normal,
+                probe.tip_radius,
+                self.opts.retract,
+            ),
+            Contact::Table => self.opts.retract,
+        };
         Pose::new(&self.scene, probe, dir, up, held.table)
             .with_fixture(&held.solids)
             .approach(
                 &point.tip_centre(probe.tip_radius),
                 &point.normal,
-                self.opts.retract,
+                travel,
                 contact,
             )
     }
@@ -653,7 +663,10 @@ fn initial(
     let (n, pref) = (opts.n, &opts.preferred[..]);
     let c = f.tip_centre(probe.tip_radius);
     let r = probe.tip_radius;
-    let tip = tip_fits(scene, &c, r) && tip_fits(scene, &(c + f.normal * opts.retract), r);
+    let travel = access::pose::backoff(scene, &f.position, &f.normal, r, opts.retract);
+    let tip = tip_fits(scene, &c, r)
+        && access::pose::room_to_touch(scene, &f.position, &f.normal, r, opts.retract)
+        && tip_fits(scene, &(c + f.normal * travel), r);
     if !tip {
         let e = CubeMap::empty(n, pref);
         return Dom {

@@ -73,10 +73,11 @@ pub(super) fn report_face(
             (
                 0,
                 format!(
-                    "probe {}'s Ø{} mm tip does not fit at any of its {} points",
+                    "probe {}'s Ø{} mm tip does not fit at any of its {} points with {} mm to back off the surface",
                     probe.name,
                     fmt_num(2.0 * probe.tip_radius),
-                    pts.len()
+                    pts.len(),
+                    fmt_num(crate::access::pose::MIN_TRAVEL)
                 ),
             )
         } else {

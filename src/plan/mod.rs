@@ -137,10 +137,8 @@ fn account(input: &Input, mut hlip: Hlip, opts: &PlanOptions, diags: &mut Diagno
                     }
                 }
             }
-            Node::Face { face, .. } => {
-                if !g.children(n).is_empty() {
-                    sampled.insert(*face);
-                }
+            Node::Face { face, .. } if !g.children(n).is_empty() => {
+                sampled.insert(*face);
             }
             _ => {}
         }

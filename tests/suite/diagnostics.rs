@@ -1145,6 +1145,26 @@ fn a_pattern_missing_the_part_is_one_error_and_its_faces_are_not_gone() {
 }
 
 #[test]
+fn a_bore_just_wider_than_the_tip_is_measured_and_a_tip_as_wide_is_not() {
+    // The 2 mm retract point used to land past the far wall of a Ø2.5 bore, so a Ø2 tip
+    // "did not fit" at any point; it waits on the axis now. A Ø4 tip in a 4 mm slot has
+    // no room to back off and is refused (it used to pass the 0.9 × radius clearance).
+    let spec = |d: &str| {
+        format!("use std::heads::PH6\nuse std::probes::TP20_D2_L20\n{}\ncmm lab {{ table {{ z 0 mm }}, ram {{ radius 35 mm, length 600 mm }}, head PH6, probes [p1: TP20_D2_L20] }}\nplan q {{ part p, cmm lab }}\n",
+            part(&format!("cut hole h {{ at (25, 20, 20), axis -z, diameter {d}, depth 6 }}\nfeature bore = h.wall\ntolerance t = diameter(bore, {d} mm ± 0.02 mm)")))
+    };
+    let d = common::plan_files(&[("main.insp", spec("2.5").as_bytes())]);
+    assert_eq!(d.len(), 0, "{}", render(&d));
+    let d = common::plan_files(&[("main.insp", spec("2").as_bytes())]);
+    expect(
+        &d,
+        "insp::plan::uninspectable_face",
+        "bore",
+        "to back off the surface",
+    );
+}
+
+#[test]
 fn a_negative_margin_is_refused() {
     let d = check_src(&format!(
         "{}\nuse std::cmms::bridge_fixed\nplan q {{ part p, cmm bridge_fixed, motion {{ margin -1 mm }} }}\n",
