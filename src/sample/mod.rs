@@ -72,21 +72,34 @@ impl<'a> Sampler<'a> {
         }
     }
 
-    /// The measuring points of one face. The entry point of the sampling stage. Faces too
-    /// small to keep the margin get fewer points, possibly none.
+    /// The measuring points of one face. The entry point of the sampling stage. A face
+    /// no point of which keeps the margin (a ring narrower than the tip's diameter) is
+    /// sampled again with the margin halved, down to [`MIN_MARGIN_MM`]: its points gather
+    /// on its mid-line, and the planner decides which probe fits there.
     pub fn sample(&self, face: FaceId, strategy: &Strategy) -> Vec<Fpoint> {
+        let mut margin = self.margin;
+        loop {
+            let pts = self.sample_with_margin(face, strategy, margin);
+            if !pts.is_empty() || margin <= MIN_MARGIN_MM {
+                return pts;
+            }
+            margin = (margin / 2.0).max(MIN_MARGIN_MM);
+        }
+    }
+
+    fn sample_with_margin(&self, face: FaceId, strategy: &Strategy, margin: f64) -> Vec<Fpoint> {
         let f = &self.g.faces[face.0];
         if f.area <= 0.0 {
             return Vec::new();
         }
         let Some(chart) = Chart::of(self.g, face) else {
             let n = strategy.points.unwrap_or(16) as usize;
-            return self.freeform(face, strategy.method, n);
+            return self.freeform(face, strategy.method, n, margin);
         };
         let (eu, ev) = chart.extent_mm();
         // A face narrower than the tip keeps as much of the margin as it can: its points
         // gather towards the mid-line (a 1 mm ring gets a row on its middle, not none).
-        let margin = self.margin.min(NARROW_SHARE * eu.min(ev));
+        let margin = margin.min(NARROW_SHARE * eu.min(ev));
         let place = Place {
             s: self,
             chart: &chart,
@@ -117,10 +130,10 @@ impl<'a> Sampler<'a> {
     }
 
     /// Points on a free-form face's triangles, chosen by area.
-    fn freeform(&self, face: FaceId, method: SampleMethod, n: usize) -> Vec<Fpoint> {
+    fn freeform(&self, face: FaceId, method: SampleMethod, n: usize, margin: f64) -> Vec<Fpoint> {
         let g = self.g;
         let f = &g.faces[face.0];
-        let margin = self.margin.min(0.1 * f.area.sqrt());
+        let margin = margin.min(0.1 * f.area.sqrt());
         let mut cdf = Vec::with_capacity(f.triangles.len());
         let mut total = 0.0;
         for &t in &f.triangles {
@@ -165,6 +178,9 @@ impl<'a> Sampler<'a> {
         pick_evenly(best, n)
     }
 }
+
+/// The least margin a face is sampled with (mm), however narrow it is.
+pub const MIN_MARGIN_MM: f64 = 0.1;
 
 /// The most of a face's width the margin may take on each side: a face narrower than
 /// twice the margin keeps its points in the middle tenth.
