@@ -244,12 +244,17 @@ fn normals_agree(p: &Patch, s: &Surface, max_deg: f64) -> bool {
     agreeing >= 0.95 * total
 }
 
+/// How far a planar face's facet normals may turn from the plane's (degrees).
+pub const PLANE_NORMAL_DEG: f64 = 10.0;
+
 /// The best analytic surface for a patch, or free-form when none is within `tol` (mm).
 /// The simplest surface that fits wins: plane, then cylinder or cone, then sphere (a
-/// cylinder tessellated with one row of facets also lies on a sphere).
+/// cylinder tessellated with one row of facets also lies on a sphere). A plane must
+/// also agree with its facets' normals within [`PLANE_NORMAL_DEG`]: a small fillet (R0.5
+/// in two facets) lies within the tolerance of a plane but turns through 90°.
 pub fn best(p: &Patch, tol: f64) -> Fit {
     let pl = plane(p);
-    if pl.rms <= tol {
+    if pl.rms <= tol && normals_agree(p, &pl.surface, PLANE_NORMAL_DEG) {
         return pl;
     }
     for f in [cylinder_or_cone(p), sphere(p)].into_iter().flatten() {
@@ -260,5 +265,55 @@ pub fn best(p: &Patch, tol: f64) -> Fit {
     Fit {
         surface: Surface::Freeform,
         rms: pl.rms,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A quarter-round fillet of radius `r` along x, `n` facets across, 10 mm long.
+    fn fillet(r: f64, n: usize) -> (Vec<P3>, Vec<(V3, f64, P3)>) {
+        let at = |k: usize, x: f64| {
+            let t = std::f64::consts::FRAC_PI_2 * k as f64 / n as f64;
+            P3::new(x, r * t.cos(), r * t.sin())
+        };
+        let mut pts = Vec::new();
+        let mut normals = Vec::new();
+        for k in 0..=n {
+            pts.push(at(k, 0.0));
+            pts.push(at(k, 10.0));
+        }
+        for k in 0..n {
+            let (a, b, c) = (at(k, 0.0), at(k + 1, 0.0), at(k, 10.0));
+            let nrm = (b - a).cross(&(c - a));
+            let t = std::f64::consts::FRAC_PI_2 * (k as f64 + 0.5) / n as f64;
+            let out = V3::new(0.0, t.cos(), t.sin());
+            let nrm = if nrm.dot(&out) < 0.0 { -nrm } else { nrm };
+            normals.push((
+                nrm.normalize(),
+                nrm.norm(),
+                P3::from((a.coords + b.coords + c.coords) / 3.0),
+            ));
+        }
+        (pts, normals)
+    }
+
+    #[test]
+    fn a_small_fillet_is_not_a_plane() {
+        // Within a 0.06 mm fit tolerance of its chord plane, but its facets turn 90°.
+        let (points, normals) = fillet(0.5, 2);
+        let fit = best(
+            &Patch {
+                points: &points,
+                normals: &normals,
+            },
+            0.1,
+        );
+        assert!(
+            !matches!(fit.surface, Surface::Plane { .. }),
+            "{:?}",
+            fit.surface
+        );
     }
 }

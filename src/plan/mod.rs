@@ -354,18 +354,23 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
             .map(|(p, up)| (*p, validate::check(&k, &machine, p, up, &held[&p.setup])))
             .collect();
         let mut invalid = Vec::new();
+        // Per face, the touches that failed and the first cause, for the diagnostic.
+        let mut failed: BTreeMap<String, (usize, String)> = BTreeMap::new();
         for (p, what) in checked {
             match what {
                 Ok(()) => {
                     validated.insert(p);
                 }
                 Err(w) => {
-                    last = format!(
-                        "probe {} at a point of {} hits {}",
-                        machine.probes[p.probe].name,
-                        face_name(input, &k, p.point),
-                        w
-                    );
+                    let e = failed
+                        .entry(face_name(input, &k, p.point))
+                        .or_insert_with(|| {
+                            (
+                                0,
+                                format!("probe {} hits {w}", machine.probes[p.probe].name),
+                            )
+                        });
+                    e.0 += 1;
                     invalid.push((
                         p.point,
                         p.probe,
@@ -394,6 +399,23 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
                 opts,
                 diags,
             ));
+        }
+        if !failed.is_empty() {
+            let faces: Vec<String> = failed
+                .iter()
+                .take(4)
+                .map(|(face, (n, why))| format!("{face} ({n} touches; {why})"))
+                .collect();
+            let more = failed.len().saturating_sub(4);
+            last = format!(
+                "in the last round touches failed on {}{}",
+                faces.join(", "),
+                if more > 0 {
+                    format!(" and {more} more faces")
+                } else {
+                    String::new()
+                }
+            );
         }
         learn(&mut k, &machine, invalid);
     }
