@@ -157,6 +157,8 @@ pub struct Summary {
     /// The fewest setups any plan could have, and whether that is proven (else a lower
     /// bound).
     pub min_setups: (usize, bool),
+    /// Why the plan has more setups than the minimum, when it has.
+    pub more_setups: Option<String>,
     /// The clustering strategy of the plan kept (`None` when nothing needed clustering).
     pub strategy: Option<Strategy>,
     /// Tolerances whose every face (of their features and datum features) the plan
@@ -296,6 +298,7 @@ pub(crate) fn assemble(input: &Input, k: &mut Knowledge, m: &Machine, run: &Roun
         plan: input.plan_id(),
         head: m.head,
         summary: Summary {
+            more_setups: None,
             tolerances: (0, 0),
             setups: out_setups.len(),
             probes_used: probes_used.len(),

@@ -203,6 +203,41 @@ fn account(input: &Input, mut hlip: Hlip, opts: &PlanOptions, diags: &mut Diagno
     hlip
 }
 
+/// Why a plan has more setups than the proven minimum, when the hierarchy is the cause:
+/// clustered again without its per-tolerance and per-feature `same_setup` levels (the
+/// `(*, *)` level kept), the plan needs fewer setups; those levels are named.
+fn forcing_levels(
+    root: &solve::Inst,
+    k: &mut Knowledge,
+    m: &Machine,
+    h: &crate::model::Hierarchy,
+    branches: &[Branch],
+) -> Option<String> {
+    use crate::model::{Group, SameVar};
+    let count = |b: &[Branch]| b.iter().map(|x| x.setup).collect::<BTreeSet<_>>().len();
+    let used = count(branches);
+    let grouped = |l: &&crate::model::Level| l.var == SameVar::Setup && l.group != Group::All;
+    let names: Vec<String> = h.levels.iter().filter(grouped).map(|l| l.text()).collect();
+    if names.is_empty() {
+        return None;
+    }
+    let mut relaxed = h.clone();
+    relaxed.levels.retain(|l| !grouped(&l));
+    let fewest = Strategy::ALL
+        .iter()
+        .filter_map(|&s| solve::solve(root, k, m, &relaxed, s).ok())
+        .map(|b| count(&b))
+        .min()?;
+    (fewest < used).then(|| {
+        format!(
+            "{} {} for {used} setups; without {} {fewest} would do",
+            names.join(", "),
+            if names.len() == 1 { "asks" } else { "ask" },
+            if names.len() == 1 { "it" } else { "them" }
+        )
+    })
+}
+
 /// The setups plan `plan` may use on `geometry`, in words: the poses on the table (and
 /// why the others are excluded) and what the plan's fixtures can hold.
 pub fn explain_setups(model: &Model, plan: &Plan, geometry: &PartGeometry) -> String {
@@ -393,12 +428,14 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
                 strategy: Some(best.0),
                 exact_budget: opts.exact_budget,
             };
-            return Some(account(
-                input,
-                assemble(input, &mut k, &machine, &round),
-                opts,
-                diags,
-            ));
+            let forcing = forcing_levels(&root, &mut k, &machine, hierarchy, &best.1);
+            let mut hlip = assemble(input, &mut k, &machine, &round);
+            if hlip.summary.setups > hlip.summary.min_setups.0 {
+                hlip.summary.more_setups = Some(forcing.unwrap_or_else(|| {
+                    "no clustering found fewer; the minimum may need setups the hierarchy's order does not reach".into()
+                }));
+            }
+            return Some(account(input, hlip, opts, diags));
         }
         if !failed.is_empty() {
             let faces: Vec<String> = failed

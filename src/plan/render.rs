@@ -228,6 +228,9 @@ fn summary_text(s: &Summary, names: &Names) -> String {
         s.setups,
         if exact { "minimum" } else { "at least" }
     );
+    if let Some(why) = &s.more_setups {
+        let _ = writeln!(out, "  more setups than the minimum: {why}");
+    }
     let _ = writeln!(
         out,
         "  tolerances measured {} of {}",
@@ -325,6 +328,7 @@ pub fn json(h: &Hlip, names: &Names) -> Value {
             "cones_acquired": s.cones_acquired,
             "min_setups": s.min_setups.0,
             "min_setups_proven": s.min_setups.1,
+            "more_setups": s.more_setups,
             "strategy": strategy(s),
         },
     })
