@@ -322,31 +322,10 @@ fn cmm(
     if let Some(v) = p.req(cx, "probes", "[p1: TP20_D2_L20]") {
         match &v.kind {
             ValueKind::List(entries) if !entries.is_empty() => {
-                for e in entries {
-                    let Some(id) = r.lookup_value(cx, module, &e.value, Kind::Probe) else {
-                        continue;
-                    };
-                    let (label, lspan) = match &e.label {
-                        Some(l) => (l.name.clone(), l.span),
-                        None => (
-                            match &e.value.kind {
-                                ValueKind::Path(path) => super::props::path_text(path),
-                                _ => String::new(),
-                            },
-                            e.value.span,
-                        ),
-                    };
-                    if probes.iter().any(|(l, _)| *l == label) {
-                        cx.err(E::DuplicateName {
-                            span: lspan,
-                            first: None,
-                            name: label,
-                            help: "each probe in the rack needs its own label".into(),
-                        });
-                        continue;
-                    }
-                    probes.push((label, ProbeId(id)));
-                }
+                probes = labelled(r, cx, module, entries, Kind::Probe, "probe in the rack")
+                    .into_iter()
+                    .map(|(l, id)| (l, ProbeId(id)))
+                    .collect();
             }
             ValueKind::List(_) => cx.err(E::MissingProperty {
                 span: v.span,
@@ -361,33 +340,19 @@ fn cmm(
     if let Some(v) = p.get("fixtures") {
         match &v.kind {
             ValueKind::List(entries) => {
-                for e in entries {
-                    let Some(id) = r.lookup_value(cx, module, &e.value, Kind::Fixture) else {
-                        continue;
-                    };
-                    let (label, lspan) = match &e.label {
-                        Some(l) => (l.name.clone(), l.span),
-                        None => (
-                            match &e.value.kind {
-                                ValueKind::Path(path) => super::props::path_text(path),
-                                _ => String::new(),
-                            },
-                            e.value.span,
-                        ),
-                    };
-                    if fixtures.iter().any(|(l, _)| *l == label) {
-                        cx.err(E::DuplicateName {
-                            span: lspan,
-                            first: None,
-                            name: label,
-                            help: "each fixture beside the CMM needs its own label".into(),
-                        });
-                        continue;
-                    }
-                    fixtures.push((label, FixtureId(id)));
-                }
+                fixtures = labelled(
+                    r,
+                    cx,
+                    module,
+                    entries,
+                    Kind::Fixture,
+                    "fixture beside the CMM",
+                )
+                .into_iter()
+                .map(|(l, id)| (l, FixtureId(id)))
+                .collect();
             }
-            _ => cx.mismatch(v, "a list of fixtures", "write `fixtures [vise: VISE_160]`"),
+            _ => cx.mismatch(v, "a list of fixtures", "write `fixtures [vise: VISE_150]`"),
         }
     }
     Cmm {
@@ -401,6 +366,45 @@ fn cmm(
         fixtures,
         span,
     }
+}
+
+/// A list of catalogue items of one kind with labels (`[p1: TP20_D2_L20, VISE_150]`; an
+/// unlabelled entry is labelled by its name): (label, index), each label once.
+fn labelled(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    entries: &[ast::ListEntry],
+    kind: Kind,
+    what: &str,
+) -> Vec<(String, usize)> {
+    let mut out: Vec<(String, usize)> = Vec::new();
+    for e in entries {
+        let Some(id) = r.lookup_value(cx, module, &e.value, kind) else {
+            continue;
+        };
+        let (label, lspan) = match &e.label {
+            Some(l) => (l.name.clone(), l.span),
+            None => (
+                match &e.value.kind {
+                    ValueKind::Path(path) => super::props::path_text(path),
+                    _ => String::new(),
+                },
+                e.value.span,
+            ),
+        };
+        if out.iter().any(|(l, _)| *l == label) {
+            cx.err(E::DuplicateName {
+                span: lspan,
+                first: None,
+                name: label,
+                help: format!("each {what} needs its own label"),
+            });
+            continue;
+        }
+        out.push((label, id));
+    }
+    out
 }
 
 /// A fixture: `kind vise|chuck|sine_plate`, its sizes, and `height`, how high it holds
