@@ -148,6 +148,12 @@ pub enum FixtureKind {
         /// The chuck body's diameter.
         body: f64,
     },
+    /// A V-block: holds an outer cylinder with its axis horizontal, turned about the
+    /// axis as the plan needs.
+    VBlock {
+        /// The diameters it holds.
+        diameter: [f64; 2],
+    },
     /// A sine plate (an angle plate at 90°): the part clamped on one of its flat faces to
     /// a plate tilted by an angle within `tilt` about a horizontal axis.
     SinePlate {
@@ -162,6 +168,7 @@ impl FixtureKind {
         match self {
             FixtureKind::Vise { .. } => "vise",
             FixtureKind::Chuck { .. } => "chuck",
+            FixtureKind::VBlock { .. } => "vblock",
             FixtureKind::SinePlate { .. } => "sine_plate",
         }
     }

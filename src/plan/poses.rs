@@ -88,6 +88,12 @@ pub enum Holder {
 /// stand for the real fixture, a little larger rather than smaller.
 const JAW_MM: f64 = 25.0;
 
+/// A V-block's turning steps about the held cylinder's axis (degrees), how many axes it
+/// is tried on, and its length along the axis (mm).
+const VBLOCK_STEP_DEG: f64 = 15.0;
+const VBLOCK_AXES: usize = 4;
+const VBLOCK_LENGTH_MM: f64 = 50.0;
+
 /// How far a sine plate reaches past the part on every side (mm).
 const PLATE_MARGIN_MM: f64 = 30.0;
 
@@ -148,6 +154,32 @@ impl<'a> Setups<'a> {
             .map(|r| r.up)
             .collect();
         for (_, f) in &self.fixtures {
+            if let FixtureKind::VBlock { diameter } = f.kind {
+                // Turned about each cylinder's axis in VBLOCK_STEP_DEG steps.
+                let mut axes: Vec<V3> = Vec::new();
+                for face in &self.geometry.faces {
+                    if let Surface::Cylinder {
+                        axis,
+                        radius,
+                        convex: true,
+                        ..
+                    } = face.surface
+                    {
+                        let fits = (diameter[0]..=diameter[1]).contains(&(2.0 * radius));
+                        if fits && !axes.iter().any(|a| a.cross(&axis).norm() < 1e-9) {
+                            axes.push(axis);
+                        }
+                    }
+                }
+                for axis in axes.iter().take(VBLOCK_AXES) {
+                    let (e1, e2) = perpendicular_basis(axis);
+                    let steps = (360.0 / VBLOCK_STEP_DEG) as usize;
+                    for k in 0..steps {
+                        let t = (k as f64 * VBLOCK_STEP_DEG).to_radians();
+                        out.push(e1 * t.cos() + e2 * t.sin());
+                    }
+                }
+            }
             if let FixtureKind::Chuck { diameter, .. } = f.kind {
                 for face in &self.geometry.faces {
                     if let Surface::Cylinder {
@@ -216,6 +248,27 @@ impl<'a> Setups<'a> {
                         let mut faces = vec![a, b];
                         faces.extend(&base.faces);
                         faces
+                    })
+            }
+            FixtureKind::VBlock { diameter } => {
+                let tol = 1e-3 * self.size().max(1.0);
+                let low = self.low(up);
+                g.faces
+                    .iter()
+                    .enumerate()
+                    .find_map(|(k, face)| match face.surface {
+                        Surface::Cylinder {
+                            origin,
+                            axis,
+                            radius,
+                            convex: true,
+                        } if (diameter[0]..=diameter[1]).contains(&(2.0 * radius))
+                            && axis.dot(up).abs() < 1e-6
+                            && low >= origin.coords.dot(up) - radius - tol =>
+                        {
+                            Some(vec![FaceId(k)])
+                        }
+                        _ => None,
                     })
             }
             FixtureKind::Chuck { diameter, .. } => {
@@ -315,6 +368,39 @@ impl<'a> Setups<'a> {
                     Solid::cylinder(foot - up * f.height, *up, f.height, body / 2.0),
                     Solid::cylinder(foot - up * 1e-3, *up, grip, radius + JAW_MM),
                 ]
+            }
+            FixtureKind::VBlock { .. } => {
+                let Some(face) = faces.first() else {
+                    return vec![];
+                };
+                let Surface::Cylinder {
+                    origin,
+                    axis,
+                    radius,
+                    ..
+                } = g.faces[face.0].surface
+                else {
+                    return vec![];
+                };
+                // A block under the cylinder's middle up to its V's contact lines (45°
+                // each side), as wide as the cylinder and a jaw on each side.
+                let c = g.faces[face.0].centroid;
+                let along = c.coords - origin.coords;
+                let mid = origin + axis * along.dot(&axis);
+                let top = mid.coords.dot(up) - radius * std::f64::consts::FRAC_1_SQRT_2;
+                let bottom = low - f.height;
+                let across = up.cross(&axis).normalize();
+                let rot = nalgebra::Rotation3::from_basis_unchecked(&[axis, across, *up]);
+                let centre = mid - up * (mid.coords.dot(up) - (top + bottom) / 2.0);
+                vec![Solid::cuboid(
+                    centre,
+                    rot,
+                    V3::new(
+                        VBLOCK_LENGTH_MM / 2.0,
+                        radius + JAW_MM,
+                        (top - bottom) / 2.0,
+                    ),
+                )]
             }
             FixtureKind::Vise { jaw, .. } => {
                 let (Some(a), Some(b)) = (faces.first(), faces.get(1)) else {
@@ -470,6 +556,14 @@ impl<'a> Setups<'a> {
                             round.join(", ")
                         )
                     }
+                }
+                FixtureKind::VBlock { diameter } => {
+                    let n = g
+                        .faces
+                        .iter()
+                        .filter(|x| matches!(x.surface, Surface::Cylinder { radius, convex: true, .. } if (diameter[0]..=diameter[1]).contains(&(2.0 * radius))))
+                        .count();
+                    format!("holds one of {n} outer cylinders of Ø{}..{} mm with its axis horizontal, turned in {VBLOCK_STEP_DEG}° steps", diameter[0], diameter[1])
                 }
                 FixtureKind::SinePlate { tilt } => {
                     let n = self.rests.iter().filter(|r| r.flat).count();

@@ -91,6 +91,9 @@ impl<'a> Names<'a> {
                         faces(&fs[2..])
                     ),
                     FixtureKind::Chuck { .. } => format!("{name} gripping {}", faces(fs)),
+                    FixtureKind::VBlock { .. } => {
+                        format!("{name} under {}, its axis horizontal", faces(fs))
+                    }
                     FixtureKind::SinePlate { .. } => {
                         let tilt = fs
                             .first()

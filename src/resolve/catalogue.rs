@@ -407,7 +407,7 @@ fn labelled(
     out
 }
 
-/// A fixture: `kind vise|chuck|sine_plate`, its sizes, and `height`, how high it holds
+/// A fixture: `kind vise|chuck|vblock|sine_plate`, its sizes, and `height`, how high it holds
 /// the part above the table.
 fn fixture(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Fixture {
     let height = p
@@ -457,6 +457,13 @@ fn fixture(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) 
                 body,
             }
         }
+        Some("vblock") => {
+            let diameter = p
+                .req(cx, "diameter", "5 mm .. 100 mm")
+                .and_then(|v| length_range(cx, v, "diameter"))
+                .unwrap_or([1.0, 100.0]);
+            FixtureKind::VBlock { diameter }
+        }
         Some("sine_plate") => {
             let tilt = p
                 .req(cx, "tilt", "0 deg .. 60 deg")
@@ -469,7 +476,7 @@ fn fixture(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) 
                 let help = suggest::help_for_unknown(
                     "fixture kind",
                     other,
-                    ["vise", "chuck", "sine_plate"],
+                    ["vise", "chuck", "vblock", "sine_plate"],
                 );
                 cx.err(E::UnknownName {
                     span: *s,
