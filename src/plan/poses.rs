@@ -154,49 +154,47 @@ impl<'a> Setups<'a> {
             .map(|r| r.up)
             .collect();
         for (_, f) in &self.fixtures {
-            if let FixtureKind::VBlock { diameter } = f.kind {
-                // Turned about each cylinder's axis in VBLOCK_STEP_DEG steps.
-                let mut axes: Vec<V3> = Vec::new();
-                for face in &self.geometry.faces {
-                    if let Surface::Cylinder {
-                        axis,
-                        radius,
-                        convex: true,
-                        ..
-                    } = face.surface
-                    {
-                        let fits = (diameter[0]..=diameter[1]).contains(&(2.0 * radius));
-                        if fits && !axes.iter().any(|a| a.cross(&axis).norm() < 1e-9) {
-                            axes.push(axis);
+            match f.kind {
+                FixtureKind::VBlock { diameter } => {
+                    // Turned about each cylinder's axis in VBLOCK_STEP_DEG steps.
+                    for axis in self.outer_axes(diameter).iter().take(VBLOCK_AXES) {
+                        let (e1, e2) = perpendicular_basis(axis);
+                        let steps = (360.0 / VBLOCK_STEP_DEG) as usize;
+                        for k in 0..steps {
+                            let t = (k as f64 * VBLOCK_STEP_DEG).to_radians();
+                            out.push(e1 * t.cos() + e2 * t.sin());
                         }
                     }
                 }
-                for axis in axes.iter().take(VBLOCK_AXES) {
-                    let (e1, e2) = perpendicular_basis(axis);
-                    let steps = (360.0 / VBLOCK_STEP_DEG) as usize;
-                    for k in 0..steps {
-                        let t = (k as f64 * VBLOCK_STEP_DEG).to_radians();
-                        out.push(e1 * t.cos() + e2 * t.sin());
+                FixtureKind::Chuck { diameter, .. } => {
+                    for axis in self.outer_axes(diameter) {
+                        out.extend([axis, -axis]);
                     }
                 }
-            }
-            if let FixtureKind::Chuck { diameter, .. } = f.kind {
-                for face in &self.geometry.faces {
-                    if let Surface::Cylinder {
-                        axis,
-                        radius,
-                        convex: true,
-                        ..
-                    } = face.surface
-                    {
-                        if (diameter[0]..=diameter[1]).contains(&(2.0 * radius)) {
-                            out.extend([axis, -axis]);
-                        }
-                    }
-                }
+                _ => {}
             }
         }
         out
+    }
+
+    /// The distinct axes of the part's outer cylinders whose diameter lies in `diameter`.
+    fn outer_axes(&self, diameter: [f64; 2]) -> Vec<V3> {
+        let mut axes: Vec<V3> = Vec::new();
+        for face in &self.geometry.faces {
+            if let Surface::Cylinder {
+                axis,
+                radius,
+                convex: true,
+                ..
+            } = face.surface
+            {
+                let fits = (diameter[0]..=diameter[1]).contains(&(2.0 * radius));
+                if fits && !axes.iter().any(|a| a.cross(&axis).norm() < 1e-9) {
+                    axes.push(axis);
+                }
+            }
+        }
+        axes
     }
 
     /// The lowest point of the part along `up`.
