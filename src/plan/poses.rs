@@ -144,8 +144,9 @@ impl<'a> Setups<'a> {
         &self.rests
     }
 
-    /// Directions the cube maps should hold exactly: the rest poses' (stable or flat)
-    /// and the round faces' axes a chuck may hold.
+    /// Directions the cube maps should hold exactly: the rest poses' (stable, or flat
+    /// when the plan has fixtures), the outer cylinders' axes a chuck may hold, and the
+    /// turns about them a V-block may hold.
     pub fn exact_dirs(&self) -> Vec<V3> {
         let mut out: Vec<V3> = self
             .rests
