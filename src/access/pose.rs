@@ -321,11 +321,6 @@ impl<'a> Pose<'a> {
         self
     }
 
-    /// The margin moves keep.
-    pub fn margin(&self) -> f64 {
-        self.margin
-    }
-
     /// Lets moves from and to stand-off `at` keep only `margin`: a narrow feature
     /// leaves no more room there.
     pub fn set_tight(&mut self, at: &P3, margin: f64) {

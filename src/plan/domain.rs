@@ -375,11 +375,14 @@ impl<'a> Knowledge<'a> {
         self.held
             .entry(s)
             .or_insert_with(|| match setups.holder(&up) {
-                Some(holder) => Held {
-                    table: setups.table(&holder, &up),
-                    solids: setups.solids(&holder, &up),
-                    holder,
-                },
+                Some(holder) => {
+                    let solids = setups.solids(&holder, &up);
+                    Held {
+                        table: setups.table(&holder, &up, &solids),
+                        solids,
+                        holder,
+                    }
+                }
                 None => Held {
                     holder: super::poses::Holder::Table { faces: vec![] },
                     table: table_height(scene, &up),

@@ -49,6 +49,7 @@ pub(super) fn report_face(
     // Per probe: how many points it reaches in a setup the part can be put in, how
     // many in any direction, and the first blocking component.
     let mut best: Option<(usize, usize, usize, String, String, usize)> = None;
+    let usable = k.realisable.and(&k.forbidden.not());
     for (p, probe) in m.probes.iter().enumerate() {
         if !m.allowed[p] {
             continue;
@@ -59,14 +60,7 @@ pub(super) fn report_face(
             .count();
         let real = pts
             .iter()
-            .filter(|&&f| {
-                k.dom[f][p].tip
-                    && !k.dom[f][p]
-                        .setup
-                        .and(&k.realisable)
-                        .and(&k.forbidden.not())
-                        .is_empty()
-            })
+            .filter(|&&f| k.dom[f][p].tip && !k.dom[f][p].setup.and(&usable).is_empty())
             .count();
         let tips = pts.iter().filter(|&&f| k.dom[f][p].tip).count();
         let (depth, why) = if tips == 0 {

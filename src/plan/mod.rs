@@ -428,9 +428,9 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
                 strategy: Some(best.0),
                 exact_budget: opts.exact_budget,
             };
-            let forcing = forcing_levels(&root, &mut k, &machine, hierarchy, &best.1);
             let mut hlip = assemble(input, &mut k, &machine, &round);
             if hlip.summary.setups > hlip.summary.min_setups.0 {
+                let forcing = forcing_levels(&root, &mut k, &machine, hierarchy, &best.1);
                 hlip.summary.more_setups = Some(forcing.unwrap_or_else(|| {
                     "no clustering found fewer; the minimum may need setups the hierarchy's order does not reach".into()
                 }));

@@ -108,6 +108,8 @@ pub struct Setups<'a> {
     clamps: Vec<(V3, FaceId, FaceId, f64)>,
     /// The convex hull's vertices: the part's extremes in any direction.
     hull: Vec<P3>,
+    /// The part's bounding-box diagonal (mm).
+    size: f64,
 }
 
 impl<'a> Setups<'a> {
@@ -119,10 +121,14 @@ impl<'a> Setups<'a> {
             .iter()
             .filter_map(|&k| cmm.fixtures.get(k).map(|(_, f)| (k, &model.fixtures[f.0])))
             .collect();
-        let hull = match parry3d_f64::transformation::try_convex_hull(&geometry.vertices) {
-            Ok((v, _)) => v,
-            Err(_) => geometry.vertices.clone(),
+        let (hull, rests) = match parry3d_f64::transformation::try_convex_hull(&geometry.vertices) {
+            Ok((v, tris)) => {
+                let rests = rest_poses(geometry, &v, &tris);
+                (v, rests)
+            }
+            Err(_) => (geometry.vertices.clone(), vec![]),
         };
+        let (lo, hi) = geometry.bounds();
         let mut clamps = Vec::new();
         if fixtures
             .iter()
@@ -132,16 +138,12 @@ impl<'a> Setups<'a> {
         }
         Setups {
             geometry,
-            rests: rest_poses(geometry),
+            rests,
             fixtures,
             clamps,
             hull,
+            size: (hi - lo).norm(),
         }
-    }
-
-    /// Every pose on the table, stable or not.
-    pub fn rests(&self) -> &[RestPose] {
-        &self.rests
     }
 
     /// Directions the cube maps should hold exactly: the rest poses' (stable, or flat
@@ -250,8 +252,9 @@ impl<'a> Setups<'a> {
                     })
             }
             FixtureKind::VBlock { diameter } => {
-                let tol = 1e-3 * self.size().max(1.0);
-                let low = self.low(up);
+                let tol = 1e-3 * self.size.max(1.0);
+                // The part's lowest point, once a cylinder lies across `up`.
+                let mut low = None;
                 g.faces
                     .iter()
                     .enumerate()
@@ -263,7 +266,8 @@ impl<'a> Setups<'a> {
                             convex: true,
                         } if (diameter[0]..=diameter[1]).contains(&(2.0 * radius))
                             && axis.dot(up).abs() < 1e-6
-                            && low >= origin.coords.dot(up) - radius - tol =>
+                            && *low.get_or_insert_with(|| self.low(up))
+                                >= origin.coords.dot(up) - radius - tol =>
                         {
                             Some(vec![FaceId(k)])
                         }
@@ -271,7 +275,7 @@ impl<'a> Setups<'a> {
                     })
             }
             FixtureKind::Chuck { diameter, .. } => {
-                let tol = 1e-3 * self.size().max(1.0);
+                let tol = 1e-3 * self.size.max(1.0);
                 let low = self.low(up);
                 for (k, face) in g.faces.iter().enumerate() {
                     let fits = |r: f64| (diameter[0]..=diameter[1]).contains(&(2.0 * r));
@@ -307,19 +311,14 @@ impl<'a> Setups<'a> {
         }
     }
 
-    fn size(&self) -> f64 {
-        let (lo, hi) = self.geometry.bounds();
-        (hi - lo).norm()
-    }
-
-    /// Where the table lies along `up` under the part held by `holder`.
-    pub fn table(&self, holder: &Holder, up: &V3) -> f64 {
+    /// Where the table lies along `up` under the part held by `holder` with the
+    /// fixture's `solids` (from [`Setups::solids`]).
+    pub fn table(&self, holder: &Holder, up: &V3, solids: &[Solid]) -> f64 {
         let low = self.low(up);
         match holder {
             Holder::Table { .. } => low,
             Holder::Fixture { slot, .. } => {
                 let f = self.fixture(*slot);
-                let solids = self.solids(holder, up);
                 let base = solids.iter().map(|s| s.lowest(up)).fold(low, f64::min);
                 base.min(low - f.height)
             }
@@ -349,7 +348,7 @@ impl<'a> Setups<'a> {
             .map(|v| v.coords.dot(up))
             .fold(f64::NEG_INFINITY, f64::max);
         let height = high - low;
-        let size = self.size();
+        let size = self.size;
         match f.kind {
             FixtureKind::Chuck { jaws, body, .. } => {
                 let Some(face) = faces.first() else {
@@ -646,8 +645,9 @@ pub fn centre_of_mass(g: &PartGeometry) -> P3 {
 /// first: every facet of the convex hull that holds a planar face of the part (a flat
 /// contact a fixture can clamp against), and every facet that may be stable. A facet
 /// whose hull polygon alone tips under [`MIN_TIP_DEG`] cannot be stable (no real contact
-/// inside it does better), so its support polygon is not computed.
-pub fn rest_poses(g: &PartGeometry) -> Vec<RestPose> {
+/// inside it does better), so its support polygon is not computed. `hv` and `hi_tris`
+/// are the part's convex hull.
+fn rest_poses(g: &PartGeometry, hv: &[P3], hi_tris: &[[u32; 3]]) -> Vec<RestPose> {
     if g.vertices.len() < 4 {
         return vec![];
     }
@@ -655,10 +655,6 @@ pub fn rest_poses(g: &PartGeometry) -> Vec<RestPose> {
     let (lo, hi) = g.bounds();
     let size = (hi - lo).norm().max(1.0);
     let tol = 1e-5 * size + 1e-4;
-    let pts: Vec<parry3d_f64::math::Point<f64>> = g.vertices.clone();
-    let Ok((hv, hi_tris)) = parry3d_f64::transformation::try_convex_hull(&pts) else {
-        return vec![];
-    };
     // Hull facets grouped by plane, largest first.
     struct Plane {
         n: V3,
