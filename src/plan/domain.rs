@@ -436,33 +436,8 @@ impl<'a> Knowledge<'a> {
         if let Some(b) = self.d1p.get(&(f, p, s)) {
             return b.clone();
         }
-        let t0 = self.table_height(s);
+        let (c, dirs, candidates) = self.candidates(f, p, s, up, machine);
         let probe = &machine.probes[p];
-        let point = &self.points[f];
-        let c = point.tip_centre(probe.tip_radius);
-        let to_part = frame(up).inverse();
-        let dirs: Vec<V3> = machine
-            .grid
-            .iter()
-            .map(|&(a, b)| to_part * access::head_direction(a, b))
-            .collect();
-        let table = f >= self.graph_points;
-        // A table point's tip touches the table: its stylus comes as near as the stem
-        // leaves (the move's own margin still holds), not the orientation margin.
-        let table_slack = if table {
-            access::pose::ORIENTATION_TABLE_MARGIN - access::pose::TABLE_MARGIN
-        } else {
-            0.0
-        };
-        let d1 = self.dom.get(f).and_then(|d| d[p].d1.clone());
-        let candidates: Vec<usize> = (0..dirs.len())
-            .filter(|&k| {
-                Set::has(&machine.grid_allowed, k)
-                    && (table || d1.as_ref().is_some_and(|d1| d1.contains(&dirs[k])))
-                    && above_table(probe, &c, &dirs[k], up, t0 - table_slack)
-                    && (!table || dirs[k].dot(&point.normal) > 0.2)
-            })
-            .collect();
         let clear: Vec<bool> = if candidates.is_empty() {
             vec![]
         } else {
@@ -490,6 +465,76 @@ impl<'a> Knowledge<'a> {
         );
         self.d1p.insert((f, p, s), out.clone());
         out
+    }
+
+    /// Whether probe `p` may have a grid orientation in D1′ that keeps its stylus off the
+    /// table when it touches graph fpoint `f` in setup `up` (cell `s`): the orientations
+    /// before the second-order clearance test, cheap enough to ask of every realisable
+    /// setup. It errs towards yes (a fixed head, a point higher above the table than the
+    /// probe is long), so a minimum counted with it stays a lower bound.
+    pub(crate) fn reaches_off_table(
+        &mut self,
+        f: usize,
+        p: usize,
+        s: usize,
+        up: &V3,
+        machine: &Machine,
+    ) -> bool {
+        if !machine.head.indexable() {
+            return true;
+        }
+        let probe = &machine.probes[p];
+        let widest = probe
+            .first
+            .iter()
+            .chain(&probe.second)
+            .map(|c| c.radius)
+            .fold(0.0, f64::max);
+        let height = self.points[f].tip_centre(probe.tip_radius).coords.dot(up)
+            - self.table_height(s);
+        height >= probe.reach() + widest + access::pose::ORIENTATION_TABLE_MARGIN
+            || !self.candidates(f, p, s, up, machine).2.is_empty()
+    }
+
+    /// The tip centre of probe `p` on point `f`, the grid's directions in the part frame of
+    /// setup `up`, and the allowed grid orientations in D1′ that keep the stylus above the
+    /// table.
+    fn candidates(
+        &mut self,
+        f: usize,
+        p: usize,
+        s: usize,
+        up: &V3,
+        machine: &Machine,
+    ) -> (P3, Vec<V3>, Vec<usize>) {
+        let t0 = self.table_height(s);
+        let probe = &machine.probes[p];
+        let point = &self.points[f];
+        let c = point.tip_centre(probe.tip_radius);
+        let to_part = frame(up).inverse();
+        let dirs: Vec<V3> = machine
+            .grid
+            .iter()
+            .map(|&(a, b)| to_part * access::head_direction(a, b))
+            .collect();
+        let table = f >= self.graph_points;
+        // A table point's tip touches the table: its stylus comes as near as the stem
+        // leaves (the move's own margin still holds), not the orientation margin.
+        let table_slack = if table {
+            access::pose::ORIENTATION_TABLE_MARGIN - access::pose::TABLE_MARGIN
+        } else {
+            0.0
+        };
+        let d1 = self.dom.get(f).and_then(|d| d[p].d1.clone());
+        let candidates: Vec<usize> = (0..dirs.len())
+            .filter(|&k| {
+                Set::has(&machine.grid_allowed, k)
+                    && (table || d1.as_ref().is_some_and(|d1| d1.contains(&dirs[k])))
+                    && above_table(probe, &c, &dirs[k], up, t0 - table_slack)
+                    && (!table || dirs[k].dot(&point.normal) > 0.2)
+            })
+            .collect();
+        (c, dirs, candidates)
     }
 
     /// Learns that probe `p` cannot reach point `f` from setup cell `s` (and, for a bent

@@ -159,6 +159,9 @@ pub struct Summary {
     pub min_setups: (usize, bool),
     /// Why the plan has more setups than the minimum, when it has.
     pub more_setups: Option<String>,
+    /// When generate-and-test did not settle: the touches of the best plan found that
+    /// failed validation and moved to another configuration, and those left out.
+    pub unsettled: Option<(usize, usize)>,
     /// The clustering strategy of the plan kept (`None` when nothing needed clustering).
     pub strategy: Option<Strategy>,
     /// Tolerances whose every face (of their features and datum features) the plan
@@ -299,6 +302,7 @@ pub(crate) fn assemble(input: &Input, k: &mut Knowledge, m: &Machine, run: &Roun
         head: m.head,
         summary: Summary {
             more_setups: None,
+            unsettled: None,
             tolerances: (0, 0),
             setups: out_setups.len(),
             probes_used: probes_used.len(),
@@ -359,20 +363,35 @@ fn group(branches: &[Branch]) -> Vec<(usize, V3, Probes<'_>)> {
 }
 
 /// The fewest setups any plan of the used points could have: a hitting set of the
-/// points' setup sets.
+/// points' setup sets. A point's set holds the realisable setups in which some probe has
+/// an orientation that reaches it with its stylus off the table (or the fixture's
+/// table), so the minimum is one a real plan can meet.
 fn min_setups(
-    k: &Knowledge,
+    k: &mut Knowledge,
     m: &Machine,
     used_points: &BTreeSet<usize>,
     budget: usize,
 ) -> (usize, bool) {
     let mut sets: Vec<crate::access::CubeMap> = Vec::new();
-    for (i, f) in k.points[..k.graph_points].iter().enumerate() {
+    for i in 0..k.graph_points {
         if !used_points.contains(&i) {
             continue;
         }
+        let face = k.points[i].face;
         let mut s = k.setups(i, m);
-        if let Some(t) = k.tables.iter().find(|t| t.face == f.face && t.alive) {
+        let cells: Vec<usize> = s.cells().map(|c| s.index(c)).collect();
+        for cell in cells {
+            let up = k.setup_dir(cell);
+            let probes = k.probes(i, cell, m);
+            let reaches = probes
+                .ones()
+                .any(|p| k.reaches_off_table(i, p, cell, &up, m));
+            if !reaches {
+                let c = s.cell(cell);
+                s.set(c, false);
+            }
+        }
+        if let Some(t) = k.tables.iter().find(|t| t.face == face && t.alive) {
             let c = s.cell(t.cell);
             s.set(c, true);
         }

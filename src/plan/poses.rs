@@ -110,6 +110,8 @@ pub struct Setups<'a> {
     hull: Vec<P3>,
     /// The part's bounding-box diagonal (mm).
     size: f64,
+    /// The solid's centre of mass.
+    com: P3,
 }
 
 impl<'a> Setups<'a> {
@@ -143,6 +145,7 @@ impl<'a> Setups<'a> {
             clamps,
             hull,
             size: (hi - lo).norm(),
+            com: centre_of_mass(geometry),
         }
     }
 
@@ -452,7 +455,7 @@ impl<'a> Setups<'a> {
                     .iter()
                     .map(|v| v.coords.dot(&n))
                     .fold(f64::NEG_INFINITY, f64::max);
-                let com = centre_of_mass(g);
+                let com = self.com;
                 let (e1, e2) = perpendicular_basis(&n);
                 let rot = nalgebra::Rotation3::from_basis_unchecked(&[e1, e2, n]);
                 let half = size / 2.0 + PLATE_MARGIN_MM;
@@ -490,7 +493,7 @@ impl<'a> Setups<'a> {
                 .join(", ")
         };
         let mut out = String::new();
-        let com = centre_of_mass(g);
+        let com = self.com;
         let _ = writeln!(out, "  centre of mass {}", dir(&com.coords));
         for r in &self.rests {
             match r.excluded() {
