@@ -113,9 +113,8 @@ enum Command {
         /// Output format.
         #[arg(long, value_enum, default_value_t = TableFormat::Text)]
         format: TableFormat,
-        /// Cube-map resolution of the accessibility cones.
-        #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(8..=256))]
-        resolution: u32,
+        #[command(flatten)]
+        search: Search,
         /// First list the setups each plan may use: the poses the part stands in on the
         /// table, those excluded and why, and what its fixtures can hold.
         #[arg(long)]
@@ -133,9 +132,8 @@ enum Command {
         /// Also write the plan with its paths as JSON.
         #[arg(long)]
         plan_json: Option<PathBuf>,
-        /// Cube-map resolution of the accessibility cones.
-        #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(8..=256))]
-        resolution: u32,
+        #[command(flatten)]
+        search: Search,
         /// Write the program even when some tolerances cannot be measured (each is
         /// listed as a warning), instead of failing.
         #[arg(long)]
@@ -162,6 +160,29 @@ enum Command {
         #[arg(long, value_enum, default_value_t = Emit::Nothing)]
         emit: Emit,
     },
+}
+
+/// How hard the planner searches.
+#[derive(clap::Args)]
+struct Search {
+    /// Cube-map resolution of the accessibility cones.
+    #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(8..=256))]
+    resolution: u32,
+    /// Generate-and-test rounds; when none settles, the plan is the best one found less
+    /// the touches that never validated, each face's left-out points named.
+    #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    rounds: u32,
+}
+
+impl Search {
+    fn options(&self, allow_unmeasured: bool) -> inspc::plan::PlanOptions {
+        inspc::plan::PlanOptions {
+            n: self.resolution,
+            max_iterations: self.rounds as usize,
+            allow_unmeasured,
+            ..Default::default()
+        }
+    }
 }
 
 fn main() -> ExitCode {
@@ -197,16 +218,16 @@ fn main() -> ExitCode {
         Command::Plan {
             file,
             format,
-            resolution,
+            search,
             explain_setups,
-        } => plan(&file, format, resolution, explain_setups),
+        } => plan(&file, format, &search.options(false), explain_setups),
         Command::Build {
             file,
             output,
             plan_json,
-            resolution,
+            search,
             allow_unmeasured,
-        } => build(&file, output, plan_json, resolution, allow_unmeasured),
+        } => build(&file, output, plan_json, &search.options(allow_unmeasured)),
         Command::Dmis { file } => read_dmis(&file),
         Command::Check {
             files,
@@ -329,11 +350,12 @@ fn cones(
     ExitCode::SUCCESS
 }
 
-fn plan(file: &std::path::Path, format: TableFormat, n: u32, explain: bool) -> ExitCode {
-    let opts = inspc::plan::PlanOptions {
-        n,
-        ..Default::default()
-    };
+fn plan(
+    file: &std::path::Path,
+    format: TableFormat,
+    opts: &inspc::plan::PlanOptions,
+    explain: bool,
+) -> ExitCode {
     let start = std::time::Instant::now();
     let (checked, parts, _, planned) = inspc::plans(&FsWorld, &[file.to_path_buf()], &opts);
     if explain {
@@ -388,14 +410,8 @@ fn build(
     file: &std::path::Path,
     output: Option<PathBuf>,
     plan_json: Option<PathBuf>,
-    n: u32,
-    allow_unmeasured: bool,
+    opts: &inspc::plan::PlanOptions,
 ) -> ExitCode {
-    let opts = inspc::plan::PlanOptions {
-        n,
-        allow_unmeasured,
-        ..Default::default()
-    };
     let start = std::time::Instant::now();
     let bar = indicatif::ProgressBar::new_spinner();
     if std::io::stderr().is_terminal() {

@@ -28,6 +28,23 @@ pub enum PlanError {
         iterations: usize,
         last: String,
     },
+    #[error("{left} of the {total} points of face `{face}` {verb} left out: generate-and-test did not settle after {iterations} rounds, and in the best plan found {why}")]
+    #[diagnostic(
+        code(insp::plan::points_left_out),
+        severity(Warning),
+        help("{help}")
+    )]
+    PointsLeftOut {
+        #[label("`{face}` is part of this feature")]
+        span: Span,
+        face: String,
+        left: usize,
+        total: usize,
+        verb: &'static str,
+        iterations: usize,
+        why: String,
+        help: String,
+    },
     #[error("part `{part}` does not fit on the table of `{cmm}`: its smallest footprint is {footprint}, the table {table}")]
     #[diagnostic(
         code(insp::plan::part_off_table),
@@ -100,6 +117,7 @@ crate::located!(PlanError {
     UnmeasuredAllowed,
     UninspectableFace,
     NoConvergence,
+    PointsLeftOut,
     NoPlan,
     PartOffTable,
     ProbeTooLong,

@@ -181,3 +181,50 @@ fn blocking(k: &Knowledge, m: &Machine, p: usize, f: usize) -> (usize, String) {
 fn deepest(c: &crate::access::CubeMap) -> V3 {
     solve::deepest(c).map_or(V3::z(), |cell| c.direction(cell))
 }
+
+/// One warning for a face some of whose touches never validated when generate-and-test
+/// ran out of rounds: how many points the plan leaves out, which probe was tried last and
+/// what it hit, and the fix for that cause.
+pub(super) fn report_left_out(
+    input: &Input,
+    face: FaceId,
+    left: usize,
+    iterations: usize,
+    (probe, blocker): (&str, &crate::access::pose::Blocker),
+    diags: &mut Diagnostics,
+) {
+    use crate::access::pose::Blocker;
+    let part = &input.model.parts[input.plan.part.0];
+    let feature = owner(input, face).map(|f| &part.features[f.0]);
+    let total = face_points(input.graph, face).len();
+    let help = match blocker {
+        Blocker::Tip => "the tip meets the part on its way in or out: shorten `motion { retract }` and `prehit`, or use a smaller tip",
+        Blocker::TipOnTable | Blocker::ComponentOnTable(_) => {
+            "the probe comes down to the table here: a setup or fixture that lifts this face off the table (`fixtures [..]`), or a probe with a longer stylus"
+        }
+        Blocker::Component(_) => {
+            "a longer or thinner stylus, an extension, or another setup (`prefer setup`) gives the probe room"
+        }
+        Blocker::Fixture(_) => {
+            "another fixture, or a setup on the table, leaves this face free; `inspc plan --explain-setups` lists them"
+        }
+    };
+    diags.push(PlanError::PointsLeftOut {
+        span: feature.map_or(part.span, |f| f.span),
+        face: input.geometry.faces[face.0].name.clone(),
+        left,
+        total,
+        verb: if left == 1 { "is" } else { "are" },
+        iterations,
+        why: match blocker {
+            Blocker::Tip => format!("the tip of probe {probe} meets the part coming in or backing off"),
+            Blocker::TipOnTable => format!("the tip of probe {probe} comes too near the table"),
+            Blocker::Component(c) => format!("the {c} of probe {probe} meets the part"),
+            Blocker::ComponentOnTable(c) => {
+                format!("the {c} of probe {probe} comes too near the table")
+            }
+            Blocker::Fixture(c) => format!("the {c} of probe {probe} meets the fixture"),
+        },
+        help: help.into(),
+    });
+}

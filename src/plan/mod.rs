@@ -17,6 +17,7 @@ pub mod cluster;
 mod domain;
 mod errors;
 mod explain;
+mod fallback;
 mod hlip;
 mod machine;
 pub mod poses;
@@ -39,6 +40,7 @@ use crate::model::{Model, Plan, PlanId, SurfaceKind};
 use cluster::Strategy;
 use domain::{Knowledge, Machine};
 use explain::{face_name, report_face};
+use fallback::Fallback;
 use hlip::{assemble, Round};
 use rayon::prelude::*;
 use solve::Branch;
@@ -111,15 +113,14 @@ pub(crate) fn min_points(kind: SurfaceKind) -> usize {
 fn account(input: &Input, mut hlip: Hlip, opts: &PlanOptions, diags: &mut Diagnostics) -> Hlip {
     let part = &input.model.parts[input.plan.part.0];
     let g = input.graph;
-    let mut touched: BTreeSet<FaceId> = BTreeSet::new();
+    // Per face the distinct points the plan touches on it (or on the table under it).
+    let mut touches: BTreeMap<FaceId, BTreeSet<usize>> = BTreeMap::new();
     for s in &hlip.setups {
         for p in &s.probes {
             for o in &p.orients {
                 for i in &o.inspections {
                     for f in &i.faces {
-                        if !f.points.is_empty() {
-                            touched.insert(f.face);
-                        }
+                        touches.entry(f.face).or_default().extend(&f.points);
                     }
                 }
             }
@@ -143,6 +144,17 @@ fn account(input: &Input, mut hlip: Hlip, opts: &PlanOptions, diags: &mut Diagno
             _ => {}
         }
     }
+    // A face is measured with as many points as its surface's fit needs (fewer only
+    // where sampling gave it fewer).
+    let touched: BTreeSet<FaceId> = touches
+        .iter()
+        .filter(|(face, pts)| {
+            let sampled = face_points(g, **face).len();
+            let need = min_points(input.geometry.faces[face.0].surface.kind()).min(sampled.max(1));
+            pts.len() >= need
+        })
+        .map(|(face, _)| *face)
+        .collect();
     let mut measured = 0;
     for t in &part.tolerances {
         let features = t
@@ -162,7 +174,16 @@ fn account(input: &Input, mut hlip: Hlip, opts: &PlanOptions, diags: &mut Diagno
             measured += 1;
             continue;
         };
-        let (why, help) = if sampled.contains(&face) {
+        let few = touches.get(&face).map_or(0, |p| p.len());
+        let (why, help) = if few > 0 {
+            (
+                format!(
+                    "gets {few} {} in the plan, fewer than its surface's fit needs",
+                    if few == 1 { "touch" } else { "touches" }
+                ),
+                "its other points were left out as hard to reach; a probe that reaches more of them, or more points (`sample`), keeps it".to_string(),
+            )
+        } else if sampled.contains(&face) {
             (
                 "gets no touch in the plan".to_string(),
                 "its points were dropped as hard to reach; a probe that reaches more of them, or more points (`sample`), keeps it".to_string(),
@@ -255,7 +276,8 @@ pub fn explain_setups(model: &Model, plan: &Plan, geometry: &PartGeometry) -> St
 }
 
 /// Plans one plan: the entry point of the planner. Faces that cannot be inspected, and
-/// a search that does not settle, are reported in `diags` and give `None`.
+/// a search that never gets a plan to validate, are reported in `diags` and give `None`;
+/// a search that does not settle ends with the best plan found ([`fallback`]).
 pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Option<Hlip> {
     let (model, plan, g) = (input.model, input.plan, input.graph);
     let hierarchy = &model.hierarchies[plan.hierarchy.0];
@@ -298,6 +320,9 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
     );
     let mut validated: BTreeSet<Pip> = BTreeSet::new();
     let mut last = String::from("no round was run");
+    // The round whose plan had the fewest touches that failed validation: what the plan
+    // falls back on, less those touches, if no round settles.
+    let mut fallback: Option<Fallback> = None;
     for iteration in 1..=opts.max_iterations {
         let (dropped, bad) = filter(g, input.geometry, &k, &machine);
         if !bad.is_empty() {
@@ -389,14 +414,22 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
             .map(|(p, up)| (*p, validate::check(&k, &machine, p, up, &held[&p.setup])))
             .collect();
         let mut invalid = Vec::new();
+        let mut left: BTreeSet<Pip> = BTreeSet::new();
         // Per face, the touches that failed and the first cause, for the diagnostic.
         let mut failed: BTreeMap<String, (usize, String)> = BTreeMap::new();
+        let mut causes: BTreeMap<FaceId, (usize, usize, crate::access::pose::Blocker)> =
+            BTreeMap::new();
         for (p, what) in checked {
             match what {
                 Ok(()) => {
                     validated.insert(p);
                 }
                 Err(w) => {
+                    left.insert(p);
+                    causes
+                        .entry(k.points[p.point].face)
+                        .or_insert_with(|| (0, p.probe, w.clone()))
+                        .0 += 1;
                     let e = failed
                         .entry(face_name(input, &k, p.point))
                         .or_insert_with(|| {
@@ -454,7 +487,21 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
                 }
             );
         }
+        if fallback.as_ref().is_none_or(|f| left.len() <= f.left.len()) {
+            fallback = Some(Fallback {
+                branches: best.1.clone(),
+                left,
+                causes,
+                strategy: best.0,
+                dropped: dropped.len(),
+            });
+        }
         learn(&mut k, &machine, invalid);
+    }
+    if let Some(f) = fallback {
+        if let Some(hlip) = f.settle(input, &mut k, &machine, opts, diags) {
+            return Some(account(input, hlip, opts, diags));
+        }
     }
     diags.push(PlanError::NoConvergence {
         span: plan.span,

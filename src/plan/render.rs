@@ -234,6 +234,13 @@ fn summary_text(s: &Summary, names: &Names) -> String {
     if let Some(why) = &s.more_setups {
         let _ = writeln!(out, "  more setups than the minimum: {why}");
     }
+    if let Some((moved, left)) = s.unsettled {
+        let _ = writeln!(
+            out,
+            "  generate-and-test did not settle in {} rounds: the best plan found, {moved} of its touches moved to configurations that validate, {left} left out",
+            s.iterations
+        );
+    }
     let _ = writeln!(
         out,
         "  tolerances measured {} of {}",
@@ -332,6 +339,7 @@ pub fn json(h: &Hlip, names: &Names) -> Value {
             "min_setups": s.min_setups.0,
             "min_setups_proven": s.min_setups.1,
             "more_setups": s.more_setups,
+            "unsettled": s.unsettled.map(|(moved, left)| serde_json::json!({"moved": moved, "left_out": left})),
             "strategy": strategy(s),
         },
     })

@@ -209,6 +209,21 @@ pub(crate) fn leaves(inst: &Inst, out: &mut Vec<usize>) {
     }
 }
 
+/// The tree without the leaves `drop` names, and without the nodes that leaves none;
+/// `None` when nothing is left.
+pub(crate) fn prune(inst: &Inst, drop: &dyn Fn(usize) -> bool) -> Option<Inst> {
+    match inst.kind {
+        Kind::Point { point, .. } => (!drop(point)).then(|| inst.clone()),
+        _ => {
+            let children: Vec<Inst> = inst.children.iter().filter_map(|c| prune(c, drop)).collect();
+            (!children.is_empty()).then(|| Inst {
+                kind: inst.kind.clone(),
+                children,
+            })
+        }
+    }
+}
+
 /// The leaves of a tree with their table alternatives, in order.
 fn leaf_kinds(inst: &Inst, out: &mut Vec<(usize, Option<usize>)>) {
     match inst.kind {
@@ -265,6 +280,18 @@ pub(crate) struct Branch {
     pub orient: usize,
     /// The measurement sub-graph.
     pub tree: Inst,
+}
+
+impl Branch {
+    /// The touch of fpoint `point` in this branch's configuration.
+    pub(crate) fn pip(&self, point: usize) -> super::validate::Pip {
+        super::validate::Pip {
+            point,
+            probe: self.probe,
+            setup: self.setup,
+            orient: self.orient,
+        }
+    }
 }
 
 /// Something the solver could not place: a point with no orientation in a setup.

@@ -38,6 +38,8 @@ struct Case {
     spec: PathBuf,
     depth: Depth,
     slow: bool,
+    /// Generate-and-test rounds (`rounds N`; the default otherwise).
+    rounds: Option<usize>,
 }
 
 /// What one run of a case produced.
@@ -49,11 +51,13 @@ struct Outcome {
 }
 
 /// Reads `case.txt`: `spec PATH` (default `main.insp` in the folder), `until check|graph|build`
-/// (default `check`), and `slow` for cases that take more than a few seconds.
+/// (default `check`), `rounds N` to cut generate-and-test short, and `slow` for cases that
+/// take more than a few seconds.
 fn case(dir: &Path) -> Case {
     let mut spec = dir.join("main.insp");
     let mut depth = Depth::Check;
     let mut slow = false;
+    let mut rounds = None;
     let text = std::fs::read_to_string(dir.join("case.txt")).unwrap_or_default();
     for line in text.lines().map(str::trim).filter(|l| !l.is_empty()) {
         match line.split_once(' ') {
@@ -61,6 +65,9 @@ fn case(dir: &Path) -> Case {
             Some(("until", "check")) => depth = Depth::Check,
             Some(("until", "graph")) => depth = Depth::Graph,
             Some(("until", "build")) => depth = Depth::Build,
+            Some(("rounds", n)) if n.trim().parse::<usize>().is_ok() => {
+                rounds = n.trim().parse().ok()
+            }
             None if line == "slow" => slow = true,
             _ => panic!("{}: cannot read `{line}` in case.txt", dir.display()),
         }
@@ -71,6 +78,7 @@ fn case(dir: &Path) -> Case {
         spec,
         depth,
         slow,
+        rounds,
     }
 }
 
@@ -144,10 +152,15 @@ fn run_case(c: &Case) -> Outcome {
     } else {
         Until::Graph
     };
+    let defaults = PlanOptions::default();
+    let opts = PlanOptions {
+        max_iterations: c.rounds.unwrap_or(defaults.max_iterations),
+        ..defaults
+    };
     let run = inspc::run(
         &FsWorld,
         &roots,
-        &PlanOptions::default(),
+        &opts,
         until,
         &|_, _, _| {},
     );
@@ -167,6 +180,13 @@ fn run_case(c: &Case) -> Outcome {
         let program: String = run.built.iter().map(|b| b.dmis.clone()).collect();
         files.push(("plan.txt", plan));
         files.push(("program.dmi", program));
+        // The build's warnings past the front end's (model.txt has those).
+        let warnings = render(&run.checked);
+        let front_end = render(&front);
+        let later = warnings.strip_prefix(front_end.as_str()).unwrap_or(&warnings);
+        if !later.is_empty() {
+            files.push(("warnings.txt", later.to_string()));
+        }
     }
     Outcome {
         files,

@@ -1,0 +1,160 @@
+//! What generate-and-test ends with when no round settles (issue 14, "always an
+//! answer"): the round whose plan had the fewest touches that failed validation, each of
+//! those touches moved to another configuration that validates (a setup the plan already
+//! has, any probe, any orientation), and the few that none takes left out with a warning
+//! naming the face, the probe and what it hit. Every touch of the result validated.
+
+use super::domain::{Knowledge, Machine};
+use super::hlip::{assemble, Round};
+use super::solve::{self, Branch};
+use super::validate::{self, Pip};
+use super::{explain, Hlip, Input, PlanOptions};
+use crate::access::pose::Blocker;
+use crate::diag::Diagnostics;
+use crate::geometry::FaceId;
+use super::cluster::Strategy;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// The most configurations tried for one left-out touch.
+const TRIES_PER_POINT: usize = 240;
+
+/// A round's plan and the touches in it that failed validation.
+pub(super) struct Fallback {
+    /// The round's best branches.
+    pub branches: Vec<Branch>,
+    /// Its touches that failed validation.
+    pub left: BTreeSet<Pip>,
+    /// Per face: touches that failed, the probe of the first and what it hit.
+    pub causes: BTreeMap<FaceId, (usize, usize, Blocker)>,
+    /// The clustering strategy that made the branches.
+    pub strategy: Strategy,
+    /// Fpoints the round's filter dropped.
+    pub dropped: usize,
+}
+
+impl Fallback {
+    /// The plan: the branches less their failed touches, each failed touch moved to the
+    /// first configuration that validates, the rest left out and reported. `None` when
+    /// nothing of the plan is left.
+    pub fn settle(
+        self,
+        input: &Input,
+        k: &mut Knowledge,
+        m: &Machine,
+        opts: &PlanOptions,
+        diags: &mut Diagnostics,
+    ) -> Option<Hlip> {
+        let mut branches: Vec<Branch> = Vec::new();
+        // Per failed touch, its branch: the tree it came from.
+        let mut origin: Vec<(Pip, usize)> = Vec::new();
+        for (i, b) in self.branches.iter().enumerate() {
+            let failed = |point: usize| self.left.contains(&b.pip(point));
+            if let Some(tree) = solve::prune(&b.tree, &failed) {
+                branches.push(Branch { tree, ..b.clone() });
+            }
+            let mut pts = Vec::new();
+            solve::leaves(&b.tree, &mut pts);
+            origin.extend(pts.into_iter().filter(|&p| failed(p)).map(|p| (b.pip(p), i)));
+        }
+        // The configurations the plan already uses, tried first.
+        let used: BTreeSet<(usize, usize, usize)> = branches
+            .iter()
+            .map(|b| (b.setup, b.probe, b.orient))
+            .collect();
+        let setups: BTreeSet<usize> = self.branches.iter().map(|b| b.setup).collect();
+        // Moved touches, grouped by the branch they came from and where they went.
+        let mut moved: BTreeMap<(usize, usize, usize, usize), Vec<usize>> = BTreeMap::new();
+        let mut still: BTreeMap<FaceId, (usize, usize, Blocker)> = BTreeMap::new();
+        for (pip, from) in origin {
+            match relocate(k, m, &pip, &setups, &used) {
+                Some((s, p, o)) => moved.entry((from, s, p, o)).or_default().push(pip.point),
+                None => {
+                    let face = k.points[pip.point].face;
+                    let cause = self.causes.get(&face).map(|c| (c.1, c.2.clone()));
+                    let (probe, blocker) = cause.unwrap_or((pip.probe, Blocker::Tip));
+                    still.entry(face).or_insert((0, probe, blocker)).0 += 1;
+                }
+            }
+        }
+        for ((from, setup, probe, orient), points) in moved {
+            let b = &self.branches[from];
+            let others = |point: usize| !points.contains(&point);
+            if let Some(tree) = solve::prune(&b.tree, &others) {
+                branches.push(Branch {
+                    setup,
+                    up: k.setup_dir(setup),
+                    probe,
+                    orient,
+                    tree,
+                });
+            }
+        }
+        if branches.is_empty() {
+            return None;
+        }
+        for (face, (n, probe, blocker)) in &still {
+            explain::report_left_out(
+                input,
+                *face,
+                *n,
+                opts.max_iterations,
+                (&m.probes[*probe].name, blocker),
+                diags,
+            );
+        }
+        let left: usize = still.values().map(|c| c.0).sum();
+        let moved_touches = self.left.len() - left;
+        let round = Round {
+            branches: &branches,
+            iterations: opts.max_iterations,
+            dropped: self.dropped + left,
+            strategy: Some(self.strategy),
+            exact_budget: opts.exact_budget,
+        };
+        let mut hlip = assemble(input, k, m, &round);
+        hlip.summary.unsettled = Some((moved_touches, left));
+        Some(hlip)
+    }
+}
+
+/// A configuration in one of `setups` that validates for the failed touch `pip`: the
+/// plan's own configurations first, then its probes' other orientations in grid order.
+fn relocate(
+    k: &mut Knowledge,
+    m: &Machine,
+    pip: &Pip,
+    setups: &BTreeSet<usize>,
+    used: &BTreeSet<(usize, usize, usize)>,
+) -> Option<(usize, usize, usize)> {
+    if pip.point >= k.graph_points {
+        return None;
+    }
+    let mut candidates: Vec<(bool, usize, usize, usize)> = Vec::new();
+    for &s in setups {
+        let up = k.setup_dir(s);
+        for p in k.probes(pip.point, s, m).ones() {
+            for o in k.orientations(pip.point, p, s, &up, m).ones() {
+                let same = (s, p, o) == (pip.setup, pip.probe, pip.orient);
+                if !same {
+                    candidates.push((!used.contains(&(s, p, o)), s, p, o));
+                }
+            }
+        }
+    }
+    candidates.sort();
+    candidates
+        .into_iter()
+        .take(TRIES_PER_POINT)
+        .map(|(_, s, p, o)| (s, p, o))
+        .find(|&(s, p, o)| {
+            let up = k.setup_dir(s);
+            let held = k.held(s).clone();
+            let try_ = Pip {
+                point: pip.point,
+                probe: p,
+                setup: s,
+                orient: o,
+            };
+            validate::check(k, m, &try_, &up, &held).is_ok()
+        })
+}
