@@ -61,6 +61,11 @@ impl Checked {
                 out.push(path.clone());
             }
         }
+        for f in &self.model.fixtures {
+            if let model::FixtureKind::Mesh { path, .. } = &f.kind {
+                out.push(path.clone());
+            }
+        }
         out
     }
 
@@ -77,6 +82,8 @@ pub struct PartData {
     pub geometry: geometry::PartGeometry,
     /// Per feature of the part, its faces.
     pub feature_faces: Vec<Vec<geometry::FaceId>>,
+    /// The mesh fixtures its plans name, placed with it.
+    pub fixtures: Vec<geometry::FixtureMesh>,
 }
 
 /// Runs the front end and then evaluates the geometry of every part the root files
@@ -122,9 +129,30 @@ fn geometry_of(world: &dyn source::World, checked: &mut Checked) -> Vec<Option<P
             })
             .collect();
         graph::check_surfaces(part, &geometry, &feature_faces, &mut diags);
+        let mut fixtures: Vec<geometry::FixtureMesh> = Vec::new();
+        let model = &checked.model;
+        for plan in model.plans.iter().filter(|p| p.part.0 == k) {
+            let cmm = &model.cmms[plan.cmm.0];
+            for &slot in &plan.fixtures {
+                let Some((_, id)) = cmm.fixtures.get(slot) else {
+                    continue;
+                };
+                let f = &model.fixtures[id.0];
+                if matches!(f.kind, model::FixtureKind::Mesh { .. })
+                    && !fixtures.iter().any(|m| m.fixture == *id)
+                {
+                    if let Some(m) =
+                        geometry::place_fixture(&geometry, &part.name, *id, f, world, &mut diags)
+                    {
+                        fixtures.push(m);
+                    }
+                }
+            }
+        }
         out[k] = Some(PartData {
             geometry,
             feature_faces,
+            fixtures,
         });
     }
     checked.absorb(diags);
@@ -269,6 +297,7 @@ fn plans_of(
             model,
             plan: &model.plans[k],
             geometry: &data.geometry,
+            fixtures: &data.fixtures,
             graph: &g.graph,
         };
         let hlip = plan::plan(&input, opts, &mut diags);
@@ -418,6 +447,7 @@ fn paths_of(run: &mut Run, planned: Vec<Planned>, progress: Progress) -> Pathed 
             model: &run.checked.model,
             plan,
             geometry: &data.geometry,
+            fixtures: &data.fixtures,
             graph: &g.graph,
         };
         let report = |done: usize, total: usize| progress("paths", done, total);

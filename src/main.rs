@@ -364,7 +364,7 @@ fn plan(
             if let Some(Some(data)) = parts.get(plan.part.0) {
                 print!(
                     "{}",
-                    inspc::plan::explain_setups(model, plan, &data.geometry)
+                    inspc::plan::explain_setups(model, plan, &data.geometry, &data.fixtures)
                 );
             }
         }

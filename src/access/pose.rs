@@ -18,6 +18,7 @@ use nalgebra::{Rotation3, Unit};
 use parry3d_f64::math::Isometry;
 use parry3d_f64::query::intersection_test;
 use parry3d_f64::shape::{
+    TriMesh,
     Capsule, ConvexPolyhedron, Cuboid, Cylinder, RoundShape, Shape, Triangle,
 };
 
@@ -179,7 +180,7 @@ pub struct Solid {
 }
 
 /// The shapes fixtures are made of.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone)]
 pub enum SolidShape {
     /// A box with these half extents.
     Box(V3),
@@ -190,6 +191,28 @@ pub enum SolidShape {
         /// Its radius.
         radius: f64,
     },
+    /// A triangle mesh (a fixture from a mesh file), shared between setups.
+    Mesh(std::sync::Arc<TriMesh>),
+}
+
+impl PartialEq for SolidShape {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (SolidShape::Box(a), SolidShape::Box(b)) => a == b,
+            (
+                SolidShape::Cylinder {
+                    half_height: h1,
+                    radius: r1,
+                },
+                SolidShape::Cylinder {
+                    half_height: h2,
+                    radius: r2,
+                },
+            ) => h1 == h2 && r1 == r2,
+            (SolidShape::Mesh(a), SolidShape::Mesh(b)) => std::sync::Arc::ptr_eq(a, b),
+            _ => false,
+        }
+    }
 }
 
 impl Solid {
@@ -216,15 +239,26 @@ impl Solid {
         }
     }
 
+    /// A mesh in the part frame (vertices in mm); `None` when the triangles do not make
+    /// a mesh (the geometry stage refuses those).
+    pub fn mesh(vertices: &[P3], triangles: &[[u32; 3]]) -> Option<Solid> {
+        let mesh = TriMesh::new(vertices.to_vec(), triangles.to_vec()).ok()?;
+        Some(Solid {
+            at: Isometry::identity(),
+            shape: SolidShape::Mesh(std::sync::Arc::new(mesh)),
+        })
+    }
+
     /// Whether a shape given in the part frame meets this solid.
     pub fn hits(&self, shape: &dyn Shape) -> bool {
         let id = Isometry::identity();
-        match self.shape {
-            SolidShape::Box(h) => intersection_test(&self.at, &Cuboid::new(h), &id, shape),
+        match &self.shape {
+            SolidShape::Box(h) => intersection_test(&self.at, &Cuboid::new(*h), &id, shape),
             SolidShape::Cylinder {
                 half_height,
                 radius,
-            } => intersection_test(&self.at, &Cylinder::new(half_height, radius), &id, shape),
+            } => intersection_test(&self.at, &Cylinder::new(*half_height, *radius), &id, shape),
+            SolidShape::Mesh(m) => intersection_test(&self.at, &**m, &id, shape),
         }
         .unwrap_or(true)
     }
@@ -233,7 +267,7 @@ impl Solid {
     pub fn lowest(&self, up: &V3) -> f64 {
         let local = self.at.rotation.inverse() * up;
         let c = self.at.translation.vector.dot(up);
-        match self.shape {
+        match &self.shape {
             SolidShape::Box(h) => {
                 c - (h.x * local.x.abs() + h.y * local.y.abs() + h.z * local.z.abs())
             }
@@ -242,6 +276,13 @@ impl Solid {
                 radius,
             } => {
                 c - half_height * local.y.abs() - radius * (1.0 - local.y * local.y).max(0.0).sqrt()
+            }
+            SolidShape::Mesh(m) => {
+                c + m
+                    .vertices()
+                    .iter()
+                    .map(|v| v.coords.dot(&local))
+                    .fold(f64::INFINITY, f64::min)
             }
         }
     }

@@ -57,6 +57,30 @@ pub enum GeometryError {
         open: usize,
         nonmanifold: usize,
     },
+    #[error("fixture `{fixture}` cuts {depth} mm into part `{part}`")]
+    #[diagnostic(
+        code(insp::geometry::fixture_overlaps_part),
+        help("a mesh fixture is given in the part's frame, touching the part where it holds it; export the fixture and the part from one assembly, in the same units")
+    )]
+    FixtureOverlapsPart {
+        #[label("this fixture mesh")]
+        span: Span,
+        fixture: String,
+        part: String,
+        depth: String,
+    },
+    #[error("fixture `{fixture}` touches no face of part `{part}`: it comes no nearer than {gap} mm")]
+    #[diagnostic(
+        code(insp::geometry::fixture_misses_part),
+        help("a mesh fixture is given in the part's frame, touching the part where it holds it (within 0.05 mm); export the fixture and the part from one assembly, in the same units")
+    )]
+    FixtureMissesPart {
+        #[label("this fixture mesh")]
+        span: Span,
+        fixture: String,
+        part: String,
+        gap: String,
+    },
     #[error("mesh `{path}` is too large: {reason}")]
     #[diagnostic(
         code(insp::geometry::mesh_too_large),
@@ -128,6 +152,8 @@ crate::located!(GeometryError {
     MeshCorrupt,
     MeshNotClosed,
     MeshDefects,
+    FixtureOverlapsPart,
+    FixtureMissesPart,
     SeveralBodies,
     MeshTooLarge,
     BooleanFailed,

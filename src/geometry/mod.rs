@@ -14,6 +14,7 @@
 
 mod csg;
 mod errors;
+mod fixture;
 pub mod fit;
 mod mesh_io;
 mod primitives;
@@ -23,6 +24,7 @@ pub mod segment;
 mod select;
 
 pub use errors::GeometryError;
+pub use fixture::{place_fixture, FixtureMesh, CONTACT_MM};
 pub use mesh_io::{read_mesh, RawMesh};
 pub use query::{edge_triangles, line_triangle, segment_distance, FaceIndex};
 pub use report::{describe, faces_json, faces_table};

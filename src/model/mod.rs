@@ -121,7 +121,8 @@ pub struct Fixture {
     pub name: String,
     /// What it is and its sizes.
     pub kind: FixtureKind,
-    /// How high it holds the part's lowest point above the table (mm).
+    /// How high it holds the part's lowest point above the table (mm); 0 for a mesh
+    /// fixture, whose mesh says where the part sits.
     pub height: f64,
     /// Where it was declared.
     pub span: Span,
@@ -160,6 +161,19 @@ pub enum FixtureKind {
         /// The tilt range (degrees).
         tilt: [f64; 2],
     },
+    /// A fixture made for one part, from its mesh in the part's frame (a nest, a wedge,
+    /// a cradle): it stands on the table with `up` pointing up and holds the part on
+    /// the faces it touches (its locating faces).
+    Mesh {
+        /// The mesh file (STL or OBJ).
+        path: std::path::PathBuf,
+        /// Millimetres per mesh unit.
+        unit_mm: f64,
+        /// The part direction that points up when the fixture stands on the table.
+        up: Vec3,
+        /// The file name in the spec.
+        span: Span,
+    },
 }
 
 impl FixtureKind {
@@ -170,6 +184,7 @@ impl FixtureKind {
             FixtureKind::Chuck { .. } => "chuck",
             FixtureKind::VBlock { .. } => "vblock",
             FixtureKind::SinePlate { .. } => "sine_plate",
+            FixtureKind::Mesh { .. } => "mesh",
         }
     }
 }

@@ -132,9 +132,19 @@ impl Model {
             let size = c.table_size.map_or(String::new(), |s| {
                 format!(" size {} × {}", fmt_num(s[0]), fmt_num(s[1]))
             });
+            let fixtures: Vec<String> = c
+                .fixtures
+                .iter()
+                .map(|(l, f)| format!("{l}: {}", self.fixtures[f.0].name))
+                .collect();
+            let fixtures = if fixtures.is_empty() {
+                String::new()
+            } else {
+                format!(", fixtures [{}]", fixtures.join(", "))
+            };
             let _ = writeln!(
                 o,
-                "cmm {}: table z {}{size}, ram r {} l {}, head {}, probes [{}]",
+                "cmm {}: table z {}{size}, ram r {} l {}, head {}, probes [{}]{fixtures}",
                 c.name,
                 fmt_num(c.table_z),
                 fmt_num(c.ram_radius),
@@ -142,6 +152,45 @@ impl Model {
                 self.heads[c.head.0].name,
                 probes.join(", ")
             );
+            for (_, f) in &c.fixtures {
+                let f = &self.fixtures[f.0];
+                let r = |x: &[f64; 2], unit: &str| {
+                    format!("{} {unit} .. {} {unit}", fmt_num(x[0]), fmt_num(x[1]))
+                };
+                let what = match &f.kind {
+                    FixtureKind::Vise { opening, jaw } => format!(
+                        "opening {} mm, jaw {} × {} mm",
+                        fmt_num(*opening),
+                        fmt_num(jaw[0]),
+                        fmt_num(jaw[1])
+                    ),
+                    FixtureKind::Chuck {
+                        diameter,
+                        jaws,
+                        body,
+                    } => format!(
+                        "diameter {}, jaws {} mm, body {} mm",
+                        r(diameter, "mm"),
+                        fmt_num(*jaws),
+                        fmt_num(*body)
+                    ),
+                    FixtureKind::VBlock { diameter } => format!("diameter {}", r(diameter, "mm")),
+                    FixtureKind::SinePlate { tilt } => format!("tilt {}", r(tilt, "deg")),
+                    FixtureKind::Mesh {
+                        path, unit_mm, up, ..
+                    } => format!(
+                        "file {}, units ×{}, up {}",
+                        path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+                        fmt_num(*unit_mm),
+                        v3(up)
+                    ),
+                };
+                let height = match f.kind {
+                    FixtureKind::Mesh { .. } => String::new(),
+                    _ => format!(", height {} mm", fmt_num(f.height)),
+                };
+                let _ = writeln!(o, "  fixture {}: {} {what}{height}", f.name, f.kind.word());
+            }
         }
         for h in self
             .hierarchies
@@ -189,6 +238,15 @@ impl Model {
                 super::Stance::Forbid => "forbid".to_string(),
                 super::Stance::Prefer(w) => format!("prefer (weight {})", fmt_num(*w)),
             };
+            if !p.fixtures.is_empty() {
+                let cmm = &self.cmms[p.cmm.0];
+                let labels: Vec<&str> = p
+                    .fixtures
+                    .iter()
+                    .filter_map(|&k| cmm.fixtures.get(k).map(|(l, _)| l.as_str()))
+                    .collect();
+                let _ = writeln!(o, "  fixtures [{}]", labels.join(", "));
+            }
             for s in &p.setups {
                 let verb = verb(&s.stance);
                 let _ = writeln!(o, "  {verb} setup {}", v3(&s.direction));

@@ -79,6 +79,8 @@ pub struct Input<'a> {
     pub plan: &'a Plan,
     /// The part's geometry.
     pub geometry: &'a PartGeometry,
+    /// The mesh fixtures placed with the part.
+    pub fixtures: &'a [crate::geometry::FixtureMesh],
     /// The plan's measurement graph.
     pub graph: &'a MeasurementGraph,
 }
@@ -261,7 +263,12 @@ fn forcing_levels(
 
 /// The setups plan `plan` may use on `geometry`, in words: the poses on the table (and
 /// why the others are excluded) and what the plan's fixtures can hold.
-pub fn explain_setups(model: &Model, plan: &Plan, geometry: &PartGeometry) -> String {
+pub fn explain_setups(
+    model: &Model,
+    plan: &Plan,
+    geometry: &PartGeometry,
+    fixtures: &[crate::geometry::FixtureMesh],
+) -> String {
     let labels: Vec<String> = model.cmms[plan.cmm.0]
         .fixtures
         .iter()
@@ -271,7 +278,7 @@ pub fn explain_setups(model: &Model, plan: &Plan, geometry: &PartGeometry) -> St
         "setups of plan {} (part {}):\n{}",
         plan.name,
         model.parts[plan.part.0].name,
-        poses::Setups::new(model, plan, geometry).explain(&labels)
+        poses::Setups::new(model, plan, geometry, fixtures).explain(&labels)
     )
 }
 
@@ -282,7 +289,7 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
     let (model, plan, g) = (input.model, input.plan, input.graph);
     let hierarchy = &model.hierarchies[plan.hierarchy.0];
     let machine = Machine::new(model, plan);
-    let setups = poses::Setups::new(model, plan, input.geometry);
+    let setups = poses::Setups::new(model, plan, input.geometry, input.fixtures);
     // Datum faces that can rest on the table.
     let mut table_faces: Vec<FaceId> = Vec::new();
     for (n, node) in g.nodes() {

@@ -16,7 +16,7 @@
 //! fixed order (largest support area first, then by direction).
 
 use crate::access::pose::Solid;
-use crate::geometry::{FaceId, PartGeometry, Surface, P3, V3};
+use crate::geometry::{FaceId, FixtureMesh, PartGeometry, Surface, P3, V3};
 use crate::model::{Fixture, FixtureKind, Model, Plan};
 use crate::sample::{convex_hull, perpendicular_basis};
 
@@ -112,12 +112,28 @@ pub struct Setups<'a> {
     size: f64,
     /// The solid's centre of mass.
     com: P3,
+    /// The plan's mesh fixtures placed with the part, by slot, each as a solid.
+    meshes: Vec<(usize, &'a FixtureMesh, Solid)>,
 }
 
 impl<'a> Setups<'a> {
-    /// The setups of `plan` on `geometry`.
-    pub fn new(model: &'a Model, plan: &Plan, geometry: &'a PartGeometry) -> Setups<'a> {
+    /// The setups of `plan` on `geometry`, with the mesh fixtures placed with it.
+    pub fn new(
+        model: &'a Model,
+        plan: &Plan,
+        geometry: &'a PartGeometry,
+        placed: &'a [FixtureMesh],
+    ) -> Setups<'a> {
         let cmm = &model.cmms[plan.cmm.0];
+        let meshes = plan
+            .fixtures
+            .iter()
+            .filter_map(|&k| {
+                let id = cmm.fixtures.get(k)?.1;
+                let m = placed.iter().find(|m| m.fixture == id)?;
+                Some((k, m, Solid::mesh(&m.vertices, &m.triangles)?))
+            })
+            .collect();
         let fixtures: Vec<(usize, &Fixture)> = plan
             .fixtures
             .iter()
@@ -146,6 +162,7 @@ impl<'a> Setups<'a> {
             hull,
             size: (hi - lo).norm(),
             com: centre_of_mass(geometry),
+            meshes,
         }
     }
 
@@ -177,10 +194,19 @@ impl<'a> Setups<'a> {
                         out.extend([axis, -axis]);
                     }
                 }
+                FixtureKind::Mesh { up, .. } => out.push(V3::from(up).normalize()),
                 _ => {}
             }
         }
         out
+    }
+
+    /// The placed mesh of the fixture in `slot` and its solid, if it is a mesh fixture.
+    fn mesh_of(&self, slot: usize) -> Option<(&'a FixtureMesh, &Solid)> {
+        self.meshes
+            .iter()
+            .find(|(k, _, _)| *k == slot)
+            .map(|(_, m, solid)| (*m, solid))
     }
 
     /// The distinct axes of the part's outer cylinders whose diameter lies in `diameter`.
@@ -221,18 +247,23 @@ impl<'a> Setups<'a> {
             });
         }
         for &(slot, f) in &self.fixtures {
-            if let Some(faces) = self.holds(f, up) {
+            if let Some(faces) = self.holds(slot, f, up) {
                 return Some(Holder::Fixture { slot, faces });
             }
         }
         None
     }
 
-    /// The faces fixture `f` holds with `up` pointing up, if it can hold the part so.
-    fn holds(&self, f: &Fixture, up: &V3) -> Option<Vec<FaceId>> {
+    /// The faces fixture `f` (in `slot`) holds with `up` pointing up, if it can hold the
+    /// part so.
+    fn holds(&self, slot: usize, f: &Fixture, up: &V3) -> Option<Vec<FaceId>> {
         let g = self.geometry;
         let same = |a: &V3| (a - up).norm() < 1e-6;
         match f.kind {
+            FixtureKind::Mesh { up: its_up, .. } => {
+                let (m, _) = self.mesh_of(slot)?;
+                same(&V3::from(its_up).normalize()).then(|| m.locating.clone())
+            }
             FixtureKind::SinePlate { tilt } => {
                 let (lo, hi) = (tilt[0].to_radians(), tilt[1].to_radians());
                 self.rests
@@ -353,6 +384,10 @@ impl<'a> Setups<'a> {
         let height = high - low;
         let size = self.size;
         match f.kind {
+            FixtureKind::Mesh { .. } => self
+                .mesh_of(*slot)
+                .map(|(_, solid)| vec![solid.clone()])
+                .unwrap_or_default(),
             FixtureKind::Chuck { jaws, body, .. } => {
                 let Some(face) = faces.first() else {
                     return vec![];
@@ -523,6 +558,14 @@ impl<'a> Setups<'a> {
         for &(slot, f) in &self.fixtures {
             let label = labels.get(slot).map_or("?", String::as_str);
             let what = match f.kind {
+                FixtureKind::Mesh { up, .. } => match self.mesh_of(slot) {
+                    Some((m, _)) => format!(
+                        "holds the part with {} up on {} (the faces its mesh touches)",
+                        dir(&V3::from(up).normalize()),
+                        faces(&m.locating)
+                    ),
+                    None => "was not placed with the part".into(),
+                },
                 FixtureKind::Vise { opening, .. } => {
                     let n = self.clamps.iter().filter(|c| c.3 <= opening).count();
                     format!("clamps {n} pairs of opposite faces at most {opening} mm apart, the part on a flat face square to them")

@@ -110,6 +110,7 @@ impl<'a> Names<'a> {
                             fmt_num((tilt * 10.0).round() / 10.0)
                         )
                     }
+                    FixtureKind::Mesh { .. } => format!("{name} located on {}", faces(fs)),
                     _ => format!("{name} on {}", faces(fs)),
                 }
             }

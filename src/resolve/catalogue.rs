@@ -126,7 +126,7 @@ pub(super) fn lower(
             });
         }
         Kind::Fixture => {
-            let f = fixture(cx, &mut p, name, span);
+            let f = fixture(r, cx, &mut p, name, span);
             model.fixtures.push(f);
         }
         Kind::Cmm => {
@@ -409,15 +409,25 @@ fn labelled(
 
 /// A fixture: `kind vise|chuck|vblock|sine_plate`, its sizes, and `height`, how high it holds
 /// the part above the table.
-fn fixture(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Fixture {
-    let height = p
-        .req(cx, "height", "100 mm")
-        .and_then(|v| cx.positive(v, Dim::Length, "height"))
-        .unwrap_or(100.0);
+fn fixture(
+    r: &Resolver,
+    cx: &mut Cx,
+    p: &mut Props,
+    name: String,
+    span: crate::source::Span,
+) -> Fixture {
     let kind_v = p.req(cx, "kind", "vise");
     let word = kind_v
         .and_then(|v| cx.name(v))
         .map(|i| (i.name.clone(), i.span));
+    // A mesh fixture's mesh says where it holds the part; the others say how high.
+    let height = if word.as_ref().is_some_and(|(w, _)| w == "mesh") {
+        0.0
+    } else {
+        p.req(cx, "height", "100 mm")
+            .and_then(|v| cx.positive(v, Dim::Length, "height"))
+            .unwrap_or(100.0)
+    };
     let length = |cx: &mut Cx, p: &mut Props, key: &'static str, example: &str, dflt: f64| {
         p.req(cx, key, example)
             .and_then(|v| cx.positive(v, Dim::Length, key))
@@ -471,12 +481,33 @@ fn fixture(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) 
                 .unwrap_or([0.0, 0.0]);
             FixtureKind::SinePlate { tilt }
         }
+        Some("mesh") => {
+            let file = p.req(cx, "mesh", "\"nest.stl\"").and_then(|v| cx.string(v)).cloned();
+            let unit_mm = p
+                .get("units")
+                .and_then(|v| cx.name(v).cloned())
+                .and_then(|u| super::part::length_unit(cx, &u))
+                .unwrap_or(1.0);
+            let up = p
+                .req(cx, "up", "+z")
+                .and_then(|v| cx.direction(v))
+                .unwrap_or([0.0, 0.0, 1.0]);
+            match file.and_then(|f| super::part::mesh_file(r, cx, &f).map(|path| (path, f.span))) {
+                Some((path, span)) => FixtureKind::Mesh {
+                    path,
+                    unit_mm,
+                    up,
+                    span,
+                },
+                None => FixtureKind::SinePlate { tilt: [0.0, 0.0] },
+            }
+        }
         Some(other) => {
             if let Some((_, s)) = &word {
                 let help = suggest::help_for_unknown(
                     "fixture kind",
                     other,
-                    ["vise", "chuck", "vblock", "sine_plate"],
+                    ["vise", "chuck", "vblock", "sine_plate", "mesh"],
                 );
                 cx.err(E::UnknownName {
                     span: *s,

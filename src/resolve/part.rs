@@ -210,7 +210,7 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
     pc.part
 }
 
-fn length_unit(cx: &mut Cx, u: &ast::Ident) -> Option<f64> {
+pub(super) fn length_unit(cx: &mut Cx, u: &ast::Ident) -> Option<f64> {
     if let Some(f) = super::props::length_unit_mm(&u.name) {
         return Some(f);
     }
@@ -407,6 +407,17 @@ fn mesh(
         .and_then(|u| length_unit(cx, &u))
         .unwrap_or(part_unit);
     p.finish(cx);
+    let full = mesh_file(r, cx, path)?;
+    Some(Geometry::Mesh {
+        path: full,
+        unit_mm,
+        span: path.span,
+    })
+}
+
+/// The full path of a mesh file a spec names (relative to the spec's folder): an STL or
+/// OBJ file that exists. A missing file is reported and still gives its path.
+pub(super) fn mesh_file(r: &Resolver, cx: &mut Cx, path: &ast::Str) -> Option<std::path::PathBuf> {
     let ext = std::path::Path::new(&path.value)
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
@@ -435,11 +446,7 @@ fn mesh(
             path: path.value.clone(),
         });
     }
-    Some(Geometry::Mesh {
-        path: full,
-        unit_mm,
-        span: path.span,
-    })
+    Some(full)
 }
 
 fn operation(
