@@ -16,6 +16,20 @@ pub enum PlanError {
         why: String,
         help: String,
     },
+    #[error("face `{face}` of feature `{feature}` cannot be inspected (allowed): {why}")]
+    #[diagnostic(
+        code(insp::plan::uninspectable_face_allowed),
+        severity(Warning),
+        help("{help}; the program leaves it out")
+    )]
+    UninspectableFaceAllowed {
+        #[label("`{face}` is part of this feature")]
+        span: Span,
+        face: String,
+        feature: String,
+        why: String,
+        help: String,
+    },
     #[error("planning `{plan}` did not settle after {iterations} rounds of generate-and-test")]
     #[diagnostic(
         code(insp::plan::no_convergence),
@@ -116,6 +130,7 @@ crate::located!(PlanError {
     Unmeasured,
     UnmeasuredAllowed,
     UninspectableFace,
+    UninspectableFaceAllowed,
     NoConvergence,
     PointsLeftOut,
     NoPlan,

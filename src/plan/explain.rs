@@ -39,6 +39,7 @@ pub(super) fn report_face(
     k: &Knowledge,
     m: &Machine,
     face: FaceId,
+    allowed: bool,
     diags: &mut Diagnostics,
 ) {
     let part = &input.model.parts[input.plan.part.0];
@@ -116,12 +117,26 @@ pub(super) fn report_face(
             pts.len()
         )
     };
-    diags.push(PlanError::UninspectableFace {
-        span: feature.map_or(part.span, |f| f.span),
-        face: name,
-        feature: feature.map_or_else(|| part.name.clone(), |f| f.name.clone()),
-        why,
-        help,
+    let (span, feature) = (
+        feature.map_or(part.span, |f| f.span),
+        feature.map_or_else(|| part.name.clone(), |f| f.name.clone()),
+    );
+    diags.push(if allowed {
+        PlanError::UninspectableFaceAllowed {
+            span,
+            face: name,
+            feature,
+            why,
+            help,
+        }
+    } else {
+        PlanError::UninspectableFace {
+            span,
+            face: name,
+            feature,
+            why,
+            help,
+        }
     });
 }
 

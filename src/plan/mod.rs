@@ -330,8 +330,12 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
     // The round whose plan had the fewest touches that failed validation: what the plan
     // falls back on, less those touches, if no round settles.
     let mut fallback: Option<Fallback> = None;
+    // Faces no probe inspects, left out under `allow_unmeasured`.
+    let mut skipped: BTreeSet<FaceId> = BTreeSet::new();
     for iteration in 1..=opts.max_iterations {
-        let (dropped, bad) = filter(g, input.geometry, &k, &machine);
+        let (mut dropped, mut bad) = filter(g, input.geometry, &k, &machine);
+        bad.retain(|f| !skipped.contains(f));
+        dropped.extend(skipped.iter().flat_map(|f| face_points(g, *f)));
         if !bad.is_empty() {
             // Know the whole probe before blaming a face.
             let pairs: Vec<(usize, usize)> = bad
@@ -342,16 +346,23 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
             let before = k.acquired;
             k.acquire_many(&pairs, &machine);
             if k.acquired > before && iteration < opts.max_iterations {
-                let (_, bad2) = filter(g, input.geometry, &k, &machine);
+                let (_, mut bad2) = filter(g, input.geometry, &k, &machine);
+                bad2.retain(|f| !skipped.contains(f));
                 if bad2.is_empty() {
                     continue;
                 }
             }
-            let (_, bad) = filter(g, input.geometry, &k, &machine);
-            for face in bad {
-                report_face(input, &k, &machine, face, diags);
+            let (_, mut bad) = filter(g, input.geometry, &k, &machine);
+            bad.retain(|f| !skipped.contains(f));
+            for &face in &bad {
+                report_face(input, &k, &machine, face, opts.allow_unmeasured, diags);
             }
-            return None;
+            if !opts.allow_unmeasured {
+                return None;
+            }
+            // Plan the rest; the tolerances on these faces are reported unmeasured.
+            skipped.extend(bad);
+            continue;
         }
         let Some(root) = solve::unfold(g, &k, &machine, &dropped) else {
             let round = Round {

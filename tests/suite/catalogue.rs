@@ -22,6 +22,7 @@ const NO_SPEC_EXAMPLE: &[(&str, &str)] = &[
     ("insp::access::unknown_probe", "a command-line request; tests/suite/cli.rs"),
     ("insp::access::no_machine", "a command-line request; tests/suite/cli.rs"),
     ("insp::plan::unmeasured_allowed", "needs `--allow-unmeasured` on the command line: tests/suite/cli.rs"),
+    ("insp::plan::uninspectable_face_allowed", "needs `--allow-unmeasured` on the command line: tests/suite/cli.rs"),
     ("insp::plan::no_convergence", "a guard: generate-and-test removes a configuration every round, and every example and NIST part settles well inside the limit"),
     ("insp::plan::points_left_out", "needs `--rounds` cut short: the golden case fallback_best_plan_found"),
     ("insp::path::no_path", "a touch that validates can almost always back out the way it came; src/path/roadmap.rs tests a sealed goal"),

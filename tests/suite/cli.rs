@@ -87,6 +87,35 @@ fn an_unmeasured_tolerance_fails_the_build_unless_allowed() {
 }
 
 #[test]
+fn a_face_no_probe_inspects_is_left_out_when_allowed() {
+    // The slot is narrower than the tip: the build fails, or, allowed, measures the rest.
+    let spec = temp_spec(
+        "narrow.insp",
+        "use std::heads::PH6\nuse std::probes::TP20_D2_L20\npart p {\n    units mm\n    stock box(60, 40, 20)\n    cut slot narrow { at (30, 0, 20), along +y, width 1.5, depth 10 }\n    feature top = stock.top\n    feature gap = narrow.walls\n    tolerance flat = flatness(top, 0.05 mm)\n    tolerance w = width(gap, 1.5 mm ± 0.05 mm)\n}\ncmm lab { table { z 0 mm }, ram { radius 35 mm, length 600 mm }, head PH6, probes [p1: TP20_D2_L20] }\nplan q { part p, cmm lab }\n",
+    );
+    let out = spec.replace(".insp", ".dmi");
+    let _ = std::fs::remove_file(&out);
+    let (code, _, stderr) = inspc(&["build", &spec, "-o", &out]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("insp::plan::uninspectable_face"), "{stderr}");
+    assert!(!std::path::Path::new(&out).exists());
+    let (code, stdout, stderr) = inspc(&["build", &spec, "-o", &out, "--allow-unmeasured"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("insp::plan::uninspectable_face_allowed")
+            && stderr.contains("insp::plan::unmeasured_allowed")
+            && stderr.contains("`w`"),
+        "{stderr}"
+    );
+    assert!(stdout.contains("tolerances measured 1 of 2"), "{stdout}");
+    let program = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        program.contains("TA(FLAT)") && !program.contains("TA(W)"),
+        "{program}"
+    );
+}
+
+#[test]
 fn check_reports_errors_and_exits_one() {
     let bad = temp_spec(
         "bad.insp",
