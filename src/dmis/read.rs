@@ -379,6 +379,12 @@ fn check(statements: &[Statement], text: &str, file: FileId, errors: &mut Vec<Dm
                     measured.insert(l.clone());
                 }
             }
+            ("CONST", None) => {
+                // A constructed feature is measured once its sources are.
+                if let Some((_, l)) = refs(params).first() {
+                    measured.insert(l.clone());
+                }
+            }
             ("MEAS", Some(_)) => errors.push(structure(
                 *at,
                 "MEAS inside a MEAS block",

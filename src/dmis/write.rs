@@ -1,11 +1,13 @@
 //! The DMIS 5.3 writer: LLIP + spec → program text (DESIGN.md, DMIS conventions).
 //!
 //! Layout: header and units, approach/retract/search/clearance, one sensor per probe (per
-//! A/B for an indexable head), the nominal of every face measured, datum-free
-//! tolerances and datum tolerances, then per setup the operator's prompt, the manual
-//! 3-2-1 alignment and `DATSET`, and per group its sensor, `MEAS` blocks of `GOTO` and
-//! `PTMEAS`, the `DATDEF` of datum features it measured and the `OUTPUT` of the
-//! tolerances it completes; `ENDFIL` last. Coordinates are in the part frame: after each
+//! A/B for an indexable head), the nominal of every surface measured (a feature's faces
+//! on one surface are one `FEAT`; a surface whose points are split between groups is
+//! measured as `FEAT/POINT`s joined by a best-fit `CONST`), then per setup the
+//! operator's prompt, the manual 3-2-1 alignment and `DATSET`, and per group its sensor,
+//! `MEAS` blocks of `GOTO` and `PTMEAS`, the `DATDEF` of datum features it completed and,
+//! for each tolerance whose surfaces are all complete, its `TOL` (once, after the
+//! `DATDEF`s it names) and `OUTPUT`; `ENDFIL` last. Coordinates are in the part frame: after each
 //! setup's `DATSET`, a `TRANS` puts the origin back at the part's.
 
 use super::text::{num, plain, wrap, Labels};
@@ -190,11 +192,29 @@ fn sensor_key(g: &GroupPath) -> SensorKey {
     (g.probe, num(g.a), num(g.b))
 }
 
-/// A measured face's key: (feature, face, contact).
-type FaceKey = (Option<FeatureId>, FaceId, Contact);
+/// A block's place in the program: (setup, group, block).
+type BlockKey = (usize, usize, usize);
 
-fn face_key(b: &BlockPath) -> FaceKey {
-    (b.feature, b.face, b.contact)
+/// One surface of a feature as the program measures it, round by round: a round in one
+/// block measures the feature itself; one whose points are split between orientations
+/// or setups measures each touch as a point feature, and a best-fit `CONST` joins them
+/// into the whole at its last block.
+struct Surf {
+    /// The label of the whole surface: what `DATDEF` and `OUTPUT` name (empty for a
+    /// free-form surface measured in several blocks, each its own feature).
+    full: String,
+    /// Its rounds of measurement, in program order.
+    rounds: Vec<Round>,
+    /// Its feature.
+    feature: Option<FeatureId>,
+}
+
+/// One measurement of a surface: the blocks up to the one that touches a point again.
+struct Round {
+    /// The point features' labels, in program order; empty when one block measures it.
+    partials: Vec<String>,
+    /// The block that completes it.
+    last: BlockKey,
 }
 
 /// The writer's state: the program so far and the labels handed out.
@@ -206,10 +226,22 @@ struct Writer<'a> {
     /// Sensor labels by probe and angles.
     sensors: BTreeMap<SensorKey, String>,
     current_sensor: Option<String>,
-    /// Feature labels by measured face.
-    feats: BTreeMap<FaceKey, String>,
-    /// Per feature, the labels of its measured faces in order.
+    /// Per block, the feature label its `MEAS` names, the surface and the round.
+    feats: BTreeMap<BlockKey, (String, usize, usize)>,
+    /// The surfaces measured.
+    surfs: Vec<Surf>,
+    /// The surfaces complete so far.
+    done: std::collections::BTreeSet<usize>,
+    /// Tolerances recorded before all their surfaces were complete.
+    pending: Vec<ToleranceId>,
+    /// Per touch of a joined surface's blocks, its point feature's label.
+    points: BTreeMap<(BlockKey, usize), String>,
+    /// Per feature, the labels of its measured surfaces in order.
     faces_of: BTreeMap<Option<FeatureId>, Vec<String>>,
+    /// Tolerance statements written so far (each just before its first `OUTPUT`).
+    defined_tols: std::collections::BTreeSet<usize>,
+    /// Per tolerance, its `TOL` statement.
+    tol_stmts: Vec<String>,
     /// Nominals by feature label.
     nominals: BTreeMap<String, Nominal>,
     /// Per datum, its label.
@@ -233,7 +265,13 @@ pub fn write(input: &Input) -> String {
         sensors: BTreeMap::new(),
         current_sensor: None,
         feats: BTreeMap::new(),
+        surfs: Vec::new(),
+        points: BTreeMap::new(),
+        done: std::collections::BTreeSet::new(),
+        pending: Vec::new(),
         faces_of: BTreeMap::new(),
+        defined_tols: std::collections::BTreeSet::new(),
+        tol_stmts: Vec::new(),
         nominals: BTreeMap::new(),
         datums: Vec::new(),
         tols: Vec::new(),
@@ -246,8 +284,8 @@ pub fn write(input: &Input) -> String {
     let setups_n = input.llip.setups.len();
     for (si, sp) in input.llip.setups.iter().enumerate() {
         w.setup(si, setups_n, sp);
-        for g in &sp.groups {
-            w.group(g);
+        for (gi, g) in sp.groups.iter().enumerate() {
+            w.group((si, gi), g);
         }
     }
     w.o.stmt("ENDFIL");
@@ -337,56 +375,135 @@ impl Writer<'_> {
     }
 
     /// One nominal per (feature, face, table) measured, in order of first use.
+    /// One `FEAT` per surface of a feature (faces on one surface are one feature), and
+    /// one per partial where the program measures a surface in several blocks.
     fn nominals(&mut self) {
         let llip = self.input.llip;
+        let geometry = self.input.geometry;
         self.o.comment("nominals");
-        // How many faces (or table stand-ins) each feature is measured on.
-        let mut face_count: BTreeMap<Option<FeatureId>, usize> = BTreeMap::new();
-        let mut seen = std::collections::BTreeSet::new();
-        let blocks = || {
-            llip.setups
-                .iter()
-                .flat_map(|s| &s.groups)
-                .flat_map(|g| &g.blocks)
-        };
-        for b in blocks() {
-            if seen.insert(face_key(b)) {
-                *face_count.entry(b.feature).or_default() += 1;
+        // The surfaces, in program order: (feature, contact, face, blocks).
+        let mut surfs: Vec<(Option<FeatureId>, Contact, FaceId, Vec<BlockKey>)> = Vec::new();
+        for (si, sp) in llip.setups.iter().enumerate() {
+            for (gi, g) in sp.groups.iter().enumerate() {
+                for (bi, b) in g.blocks.iter().enumerate() {
+                    let same = |f: FaceId| {
+                        f == b.face
+                            || (b.contact == Contact::Part
+                                && geometry.faces[f.0].surface.same_as(&geometry.faces[b.face.0].surface))
+                    };
+                    match surfs
+                        .iter_mut()
+                        .find(|s| s.0 == b.feature && s.1 == b.contact && same(s.2))
+                    {
+                        Some(s) => s.3.push((si, gi, bi)),
+                        None => surfs.push((b.feature, b.contact, b.face, vec![(si, gi, bi)])),
+                    }
+                }
             }
         }
-        for b in blocks() {
-            let key = face_key(b);
-            if self.feats.contains_key(&key) {
+        let block = |k: &BlockKey| &llip.setups[k.0].groups[k.1].blocks[k.2];
+        let mut count: BTreeMap<Option<FeatureId>, usize> = BTreeMap::new();
+        for s in &surfs {
+            if s.1 == Contact::Part {
+                *count.entry(s.0).or_default() += 1;
+            }
+        }
+        let mut k_of: BTreeMap<Option<FeatureId>, usize> = BTreeMap::new();
+        for (feature, contact, _, blocks) in surfs {
+            let Some(nominal) = nominal_of(self.input, block(&blocks[0])) else {
+                continue;
+            };
+            let name = self.names.feature(feature).to_string();
+            let name = if contact == Contact::Table {
+                format!("{name}_T")
+            } else if count.get(&feature).copied().unwrap_or(1) > 1 {
+                let k = k_of.entry(feature).or_default();
+                *k += 1;
+                format!("{name}_{k}")
+            } else {
+                name
+            };
+            let id = self.surfs.len();
+            // A free-form surface has no best fit to join: each block stands alone.
+            if matches!(nominal, Nominal::Surface(Surface::Freeform, _)) && blocks.len() > 1 {
+                let mut rounds = Vec::new();
+                for (j, k) in blocks.iter().enumerate() {
+                    let label = self.labels.fresh("F", &format!("{name}_{}", j + 1));
+                    self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
+                    self.nominals.insert(label.clone(), nominal.clone());
+                    self.feats.insert(*k, (label.clone(), id, j));
+                    self.faces_of.entry(feature).or_default().push(label);
+                    rounds.push(Round {
+                        partials: vec![],
+                        last: *k,
+                    });
+                }
+                self.surfs.push(Surf {
+                    full: String::new(),
+                    rounds,
+                    feature,
+                });
                 continue;
             }
-            let Some(nominal) = nominal_of(self.input, b) else {
-                continue;
-            };
-            let count = face_count.get(&b.feature).copied().unwrap_or(1);
-            let k = self.faces_of.get(&b.feature).map_or(0, Vec::len) + 1;
-            let feature = self.names.feature(b.feature);
-            let name = if b.contact == Contact::Table {
-                format!("{feature}_T")
-            } else if count > 1 {
-                format!("{feature}_{k}")
-            } else {
-                feature.to_string()
-            };
-            let label = self.labels.fresh("F", &name);
-            self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
-            self.faces_of
-                .entry(b.feature)
-                .or_default()
-                .push(label.clone());
-            self.nominals.insert(label.clone(), nominal);
-            self.feats.insert(key, label);
+            // Rounds: a block that touches a point again (a datum measured anew with
+            // another probe) starts a new round, which measures the surface anew.
+            let mut rounds_of: Vec<Vec<BlockKey>> = Vec::new();
+            let mut seen: std::collections::BTreeSet<usize> = std::collections::BTreeSet::new();
+            for k in &blocks {
+                let pts: Vec<usize> = block(k).touches.iter().map(|t| t.point).collect();
+                if rounds_of.is_empty() || pts.iter().any(|p| seen.contains(p)) {
+                    rounds_of.push(Vec::new());
+                    seen.clear();
+                }
+                seen.extend(pts);
+                rounds_of.last_mut().expect("a round").push(*k);
+            }
+            let full = self.labels.fresh("F", &name);
+            self.o.stmt(&format!("F({full})=FEAT/{}", nominal.feat()));
+            self.nominals.insert(full.clone(), nominal.clone());
+            self.faces_of.entry(feature).or_default().push(full.clone());
+            // A round of several blocks measures points (`FEAT/POINT`): a block of one
+            // or two touches fits no cylinder; a best-fit `CONST` over them all is the
+            // surface.
+            let mut rounds = Vec::new();
+            let mut n = 0;
+            for (r, keys) in rounds_of.iter().enumerate() {
+                let mut partials = Vec::new();
+                for k in keys {
+                    self.feats.insert(*k, (full.clone(), id, r));
+                    if keys.len() == 1 {
+                        continue;
+                    }
+                    for (ti, t) in block(k).touches.iter().enumerate() {
+                        n += 1;
+                        let label = self.labels.fresh("F", &format!("{name}_P{n}"));
+                        let p = &self.input.hlip.points[t.point];
+                        self.o.stmt(&format!(
+                            "F({label})=FEAT/POINT,CART,{},{}",
+                            xyz(&p.position),
+                            ijk(&p.normal)
+                        ));
+                        self.points.insert((*k, ti), label.clone());
+                        partials.push(label);
+                    }
+                }
+                rounds.push(Round {
+                    partials,
+                    last: *keys.last().expect("a round has a block"),
+                });
+            }
+            self.surfs.push(Surf {
+                full,
+                rounds,
+                feature,
+            });
         }
     }
 
-    /// Datum labels, then every tolerance of the part.
+    /// Datum labels, then every tolerance's label and statement; each statement is
+    /// written just before its first `OUTPUT`, after the `DATDEF`s it names.
     fn tolerances(&mut self) {
         let part = self.names.part();
-        self.o.comment("tolerances");
         for d in &part.datums {
             let label = self.labels.fresh("DAT", &d.name);
             self.datums.push(label);
@@ -425,7 +542,7 @@ impl Writer<'_> {
                 params.push(format!("DAT({l})"));
                 params.extend(material(d.modifier).map(String::from));
             }
-            self.o.stmt(&format!("T({label})=TOL/{}", params.join(",")));
+            self.tol_stmts.push(format!("T({label})=TOL/{}", params.join(",")));
             self.tols.push(label);
         }
     }
@@ -478,8 +595,7 @@ impl Writer<'_> {
         let mut fa = Vec::new();
         for step in &al.steps {
             let g = &sp.groups[step.group];
-            let b = &g.blocks[step.block];
-            let Some(label) = self.feats.get(&face_key(b)).cloned() else {
+            let Some((label, ..)) = self.feats.get(&(si, step.group, step.block)).cloned() else {
                 continue;
             };
             self.select(g);
@@ -508,7 +624,7 @@ impl Writer<'_> {
 
     /// A group: its sensor, entry, `MEAS` blocks and exit, the datums it measured and
     /// the tolerances it completes.
-    fn group(&mut self, g: &GroupPath) {
+    fn group(&mut self, (si, gi): (usize, usize), g: &GroupPath) {
         let (hlip, motion) = (self.input.hlip, self.input.llip.motion);
         let angles = if self.indexable() {
             format!(" at a{} b{}", num(g.a), num(g.b))
@@ -526,8 +642,10 @@ impl Writer<'_> {
             self.o.goto(p);
         }
         let mut in_group: Vec<String> = Vec::new();
-        for b in &g.blocks {
-            let Some(label) = self.feats.get(&face_key(b)).cloned() else {
+        // Per datum measured here, the label that completes its surface.
+        let mut datums_here: Vec<(crate::model::DatumId, String)> = Vec::new();
+        for (bi, b) in g.blocks.iter().enumerate() {
+            let Some((label, surf, round)) = self.feats.get(&(si, gi, bi)).cloned() else {
                 continue;
             };
             let meas = self.nominals.get(&label).map_or("PLANE", Nominal::meas);
@@ -538,8 +656,15 @@ impl Writer<'_> {
                 o.stmt(&format!("SNSET/APPRCH,{}", num(b.standoff)));
                 o.stmt(&format!("SNSET/RETRCT,{}", num(b.standoff)));
             }
-            o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
-            for t in &b.touches {
+            let joined = !self.surfs[surf].rounds[round].partials.is_empty();
+            if !joined {
+                o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
+            }
+            for (ti, t) in b.touches.iter().enumerate() {
+                if joined {
+                    let point = &self.points[&((si, gi, bi), ti)];
+                    o.stmt(&format!("MEAS/POINT,F({point}),1"));
+                }
                 for v in &t.via {
                     o.goto(v);
                 }
@@ -548,35 +673,85 @@ impl Writer<'_> {
                 if !narrow && motion.retract < motion.prehit {
                     o.goto(&t.standoff);
                 }
+                if joined {
+                    o.stmt("ENDMES");
+                }
             }
-            o.stmt("ENDMES");
+            if !joined {
+                o.stmt("ENDMES");
+            }
             if narrow {
                 o.stmt(&format!("SNSET/APPRCH,{}", num(motion.prehit)));
                 o.stmt(&format!("SNSET/RETRCT,{}", num(motion.retract)));
             }
+            // The last block of a round in points joins them into the whole.
+            let s = &self.surfs[surf];
+            let r = &s.rounds[round];
+            let complete = if r.partials.is_empty() {
+                Some(label.clone())
+            } else if r.last == (si, gi, bi) {
+                let fa: Vec<String> = r.partials.iter().map(|l| format!("FA({l})")).collect();
+                let full = s.full.clone();
+                self.o
+                    .stmt(&format!("CONST/{meas},F({full}),BF,{}", fa.join(",")));
+                Some(full)
+            } else {
+                None
+            };
+            let Some(done) = complete else {
+                // Measured anew: not complete until the round's last block.
+                self.done.remove(&surf);
+                continue;
+            };
+            self.done.insert(surf);
             let list = self.measured.entry(b.feature).or_default();
-            if !list.contains(&label) {
-                list.push(label.clone());
+            if !list.contains(&done) {
+                list.push(done.clone());
             }
-            in_group.push(label);
+            if let Some(d) = b.datum {
+                if !datums_here.iter().any(|(x, _)| *x == d) {
+                    datums_here.push((d, done.clone()));
+                }
+            }
+            in_group.push(done);
         }
         for p in &g.exit {
             self.o.goto(p);
         }
         // Datums measured here, then the tolerances this group completes.
-        let mut defined = Vec::new();
-        for b in &g.blocks {
-            if let (Some(d), Some(label)) = (b.datum, self.feats.get(&face_key(b))) {
-                if !defined.contains(&d) {
-                    let dl = &self.datums[d.0];
-                    self.o.stmt(&format!("DAT({dl})=DATDEF/FA({label})"));
-                    defined.push(d);
-                }
+        for (d, label) in datums_here {
+            let dl = &self.datums[d.0];
+            self.o.stmt(&format!("DAT({dl})=DATDEF/FA({label})"));
+        }
+        // A tolerance is output once every surface of its features and datum features
+        // is complete (a surface joined from points completes at its last block).
+        self.pending.extend(g.records.iter().copied());
+        let pending = std::mem::take(&mut self.pending);
+        for r in pending {
+            if self.ready(r) {
+                self.output(r, &in_group);
+            } else {
+                self.pending.push(r);
             }
         }
-        for &r in &g.records {
-            self.output(r, &in_group);
-        }
+    }
+
+    /// Whether every measured surface of tolerance `r`'s features and datum features
+    /// is complete.
+    fn ready(&self, r: ToleranceId) -> bool {
+        let part = self.names.part();
+        let t = &part.tolerances[r.0];
+        let features: Vec<FeatureId> = t
+            .targets
+            .iter()
+            .copied()
+            .chain(t.datums.iter().map(|d| part.datums[d.datum.0].feature))
+            .collect();
+        self.surfs
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.feature.is_some_and(|f| features.contains(&f)))
+            .all(|(k, _)| self.done.contains(&k))
     }
 
     /// `OUTPUT` of a tolerance over its features' labels: those measured in this group,
@@ -618,6 +793,10 @@ impl Writer<'_> {
                     lines.push(format!("OUTPUT/FA({l}),TA({tl})"));
                 }
             }
+        }
+        if !lines.is_empty() && self.defined_tols.insert(r.0) {
+            let stmt = self.tol_stmts[r.0].clone();
+            self.o.stmt(&stmt);
         }
         for l in lines {
             self.o.stmt(&l);

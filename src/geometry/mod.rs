@@ -88,7 +88,84 @@ pub enum Surface {
     Freeform,
 }
 
+/// Two faces lie on one surface when their axes or normals agree within this angle
+/// (degrees) ...
+const SAME_SURFACE_DEG: f64 = 0.1;
+/// ... and their positions and radii within this distance (mm): fitted halves of one
+/// mesh bore differ by about a hundredth.
+const SAME_SURFACE_MM: f64 = 0.02;
+
 impl Surface {
+    /// Whether two faces' surfaces are one surface (the halves of a bore, the pieces of
+    /// a plane the CAD split): same type, sense and shape, an axis either way for a
+    /// cylinder. Free-form faces are never one surface.
+    pub fn same_as(&self, other: &Surface) -> bool {
+        let cos = SAME_SURFACE_DEG.to_radians().cos();
+        let tol = SAME_SURFACE_MM;
+        // The distance from `p` to the line through `o` along unit `a`.
+        let off_line = |p: &P3, o: &P3, a: &V3| (p - o).cross(a).norm();
+        match (self, other) {
+            (
+                Surface::Plane { origin, normal },
+                Surface::Plane {
+                    origin: o2,
+                    normal: n2,
+                },
+            ) => normal.dot(n2) >= cos && (o2 - origin).dot(normal).abs() <= tol,
+            (
+                Surface::Cylinder {
+                    origin,
+                    axis,
+                    radius,
+                    convex,
+                },
+                Surface::Cylinder {
+                    origin: o2,
+                    axis: a2,
+                    radius: r2,
+                    convex: c2,
+                },
+            ) => {
+                convex == c2
+                    && axis.dot(a2).abs() >= cos
+                    && (radius - r2).abs() <= tol
+                    && off_line(o2, origin, axis) <= tol
+            }
+            (
+                Surface::Cone {
+                    apex,
+                    axis,
+                    half_angle,
+                    convex,
+                },
+                Surface::Cone {
+                    apex: p2,
+                    axis: a2,
+                    half_angle: h2,
+                    convex: c2,
+                },
+            ) => {
+                convex == c2
+                    && axis.dot(a2) >= cos
+                    && (half_angle - h2).abs() <= SAME_SURFACE_DEG.to_radians()
+                    && (apex - p2).norm() <= tol
+            }
+            (
+                Surface::Sphere {
+                    center,
+                    radius,
+                    convex,
+                },
+                Surface::Sphere {
+                    center: c2,
+                    radius: r2,
+                    convex: x2,
+                },
+            ) => convex == x2 && (radius - r2).abs() <= tol && (center - c2).norm() <= tol,
+            _ => false,
+        }
+    }
+
     /// The surface type.
     pub fn kind(&self) -> model::SurfaceKind {
         match self {

@@ -246,6 +246,31 @@ fn linearise<'a>(
                 let mut records = Vec::new();
                 for i in &o.inspections {
                     for f in &i.faces {
+                        // The faces of a feature that lie on one surface (a bore in two
+                        // halves) are one block: one feature, one `MEAS`.
+                        let surface = &input.geometry.faces[f.face.0].surface;
+                        let one = blocks.iter_mut().find(|b: &&mut BlockPath| {
+                            b.feature == i.feature
+                                && b.contact == Contact::Part
+                                && f.contact == Contact::Part
+                                && (b.face == f.face
+                                    || input.geometry.faces[b.face.0].surface.same_as(surface))
+                        });
+                        if let Some(b) = one {
+                            let own = block_standoff(scene, hlip, &f.points, standoff, probe);
+                            b.standoff = b.standoff.min(own);
+                            for &k in &f.points {
+                                if !b.touches.iter().any(|t| t.point == k) {
+                                    b.touches.push(Touch {
+                                        point: k,
+                                        via: vec![],
+                                        standoff: [0.0; 3],
+                                        margin: 0.0,
+                                    });
+                                }
+                            }
+                            continue;
+                        }
                         blocks.push(BlockPath {
                             feature: i.feature,
                             face: f.face,
@@ -489,12 +514,13 @@ fn plan_group(
     let pose = pose;
     let geometry = input.geometry;
     let face_points = |goal: usize| -> Vec<P3> {
-        let (bi, _) = owner[goal];
+        let (bi, ti) = owner[goal];
         let b = &g.blocks[bi];
         if b.contact == Contact::Table {
             return vec![];
         }
-        let tris = &geometry.faces[b.face.0].triangles;
+        let face = hlip.points[b.touches[ti].point].face;
+        let tris = &geometry.faces[face.0].triangles;
         let stride = tris.len().div_ceil(24).max(1);
         tris.iter()
             .step_by(stride)
