@@ -95,6 +95,7 @@ fn path_stage(bencher: divan::Bencher, spec: &str) {
         model,
         plan,
         geometry: &parts[g.part].as_ref().unwrap().geometry,
+        fixtures: &parts[g.part].as_ref().unwrap().fixtures,
         graph: &g.graph,
     };
     let hlip = p.hlip.as_ref().unwrap();

@@ -32,6 +32,7 @@ fn plan(bencher: divan::Bencher, spec: &str) {
         model,
         plan,
         geometry: &parts[g.part].as_ref().unwrap().geometry,
+        fixtures: &parts[g.part].as_ref().unwrap().fixtures,
         graph: &g.graph,
     };
     bencher.bench_local(|| {

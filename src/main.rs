@@ -357,7 +357,7 @@ fn plan(
     explain: bool,
 ) -> ExitCode {
     let start = std::time::Instant::now();
-    let (checked, parts, _, planned) = inspc::plans(&FsWorld, &[file.to_path_buf()], &opts);
+    let (checked, parts, _, planned) = inspc::plans(&FsWorld, &[file.to_path_buf()], opts);
     if explain {
         let model = &checked.model;
         for plan in &model.plans {
@@ -426,7 +426,7 @@ fn build(
             bar.set_message(what.to_string());
         }
     };
-    let (checked, built, timings) = inspc::build(&FsWorld, &[file.to_path_buf()], &opts, &report);
+    let (checked, built, timings) = inspc::build(&FsWorld, &[file.to_path_buf()], opts, &report);
     bar.finish_and_clear();
     print_diagnostics(&checked.sources, &checked.diagnostics);
     if checked.has_errors() {

@@ -18,8 +18,7 @@ use nalgebra::{Rotation3, Unit};
 use parry3d_f64::math::Isometry;
 use parry3d_f64::query::intersection_test;
 use parry3d_f64::shape::{
-    TriMesh,
-    Capsule, ConvexPolyhedron, Cuboid, Cylinder, RoundShape, Shape, Triangle,
+    Capsule, ConvexPolyhedron, Cuboid, Cylinder, RoundShape, Shape, TriMesh, Triangle,
 };
 
 /// The share of the tip radius the mesh may come closer than the radius at a contact:

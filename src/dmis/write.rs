@@ -389,7 +389,9 @@ impl Writer<'_> {
                     let same = |f: FaceId| {
                         f == b.face
                             || (b.contact == Contact::Part
-                                && geometry.faces[f.0].surface.same_as(&geometry.faces[b.face.0].surface))
+                                && geometry.faces[f.0]
+                                    .surface
+                                    .same_as(&geometry.faces[b.face.0].surface))
                     };
                     match surfs
                         .iter_mut()
@@ -542,7 +544,8 @@ impl Writer<'_> {
                 params.push(format!("DAT({l})"));
                 params.extend(material(d.modifier).map(String::from));
             }
-            self.tol_stmts.push(format!("T({label})=TOL/{}", params.join(",")));
+            self.tol_stmts
+                .push(format!("T({label})=TOL/{}", params.join(",")));
             self.tols.push(label);
         }
     }

@@ -69,7 +69,9 @@ pub enum GeometryError {
         part: String,
         depth: String,
     },
-    #[error("fixture `{fixture}` touches no face of part `{part}`: it comes no nearer than {gap} mm")]
+    #[error(
+        "fixture `{fixture}` touches no face of part `{part}`: it comes no nearer than {gap} mm"
+    )]
     #[diagnostic(
         code(insp::geometry::fixture_misses_part),
         help("a mesh fixture is given in the part's frame, touching the part where it holds it (within 0.05 mm); export the fixture and the part from one assembly, in the same units")

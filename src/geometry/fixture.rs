@@ -3,7 +3,7 @@
 //! locating faces, which it covers) and must not cut into it.
 
 use super::errors::{self, GeometryError};
-use super::{read_mesh, FaceId, PartGeometry, P3};
+use super::{FaceId, PartGeometry, P3};
 use crate::diag::Diagnostics;
 use crate::model::{Fixture, FixtureId, FixtureKind};
 use crate::source::World;
@@ -57,21 +57,7 @@ pub fn place_fixture(
     else {
         return None;
     };
-    let raw = match read_mesh(world, path, *unit_mm) {
-        Ok(m) => m,
-        Err(e) => {
-            diags.push(e.at(*span, path));
-            return None;
-        }
-    };
-    if raw.open_edges + raw.nonmanifold_edges > 0 {
-        diags.push(GeometryError::MeshDefects {
-            span: *span,
-            path: errors::shown_path(path),
-            open: raw.open_edges,
-            nonmanifold: raw.nonmanifold_edges,
-        });
-    }
+    let raw = super::read_reported(world, path, *unit_mm, *span, diags)?;
     let Ok(fixture_mesh) = TriMesh::new(raw.vertices.clone(), raw.triangles.clone()) else {
         diags.push(GeometryError::MeshCorrupt {
             span: *span,
@@ -98,8 +84,11 @@ pub fn place_fixture(
     };
     let in_fixture = |p: &P3| winding_number(&raw.vertices, &raw.triangles, p) > 0.5;
     let in_part = |p: &P3| g.winding_number(p) > 0.5;
-    let sunk = depth(&g.vertices, &fixture_mesh, &in_fixture)
-        .max(depth(&raw.vertices, &part_mesh, &in_part));
+    let sunk = depth(&g.vertices, &fixture_mesh, &in_fixture).max(depth(
+        &raw.vertices,
+        &part_mesh,
+        &in_part,
+    ));
     if sunk > OVERLAP_MM {
         diags.push(GeometryError::FixtureOverlapsPart {
             span: *span,
@@ -112,9 +101,8 @@ pub fn place_fixture(
     // Locating faces: those with at least MIN_CONTACT_MM2 of their area within
     // CONTACT_MM of the fixture, each triangle cut into pieces of about SAMPLE_MM.
     let (flo, fhi) = bounds(&raw.vertices);
-    let near_box = |p: &P3| {
-        (0..3).all(|i| p[i] >= flo[i] - CONTACT_MM && p[i] <= fhi[i] + CONTACT_MM)
-    };
+    let near_box =
+        |p: &P3| (0..3).all(|i| p[i] >= flo[i] - CONTACT_MM && p[i] <= fhi[i] + CONTACT_MM);
     let contact = |t: u32| -> f64 {
         let [a, b, c] = g.triangles[t as usize].map(|i| g.vertices[i as usize]);
         let (tlo, thi) = bounds(&[a, b, c]);
@@ -138,7 +126,9 @@ pub fn place_fixture(
                 }
                 touching += centres
                     .iter()
-                    .filter(|p| near_box(p) && fixture_mesh.distance_to_local_point(p, false) <= CONTACT_MM)
+                    .filter(|p| {
+                        near_box(p) && fixture_mesh.distance_to_local_point(p, false) <= CONTACT_MM
+                    })
                     .count();
             }
         }
@@ -146,7 +136,14 @@ pub fn place_fixture(
     };
     let locating: Vec<FaceId> = (0..g.faces.len())
         .into_par_iter()
-        .filter(|&k| g.faces[k].triangles.iter().map(|&t| contact(t)).sum::<f64>() >= MIN_CONTACT_MM2)
+        .filter(|&k| {
+            g.faces[k]
+                .triangles
+                .iter()
+                .map(|&t| contact(t))
+                .sum::<f64>()
+                >= MIN_CONTACT_MM2
+        })
         .map(FaceId)
         .collect();
     if locating.is_empty() {
@@ -188,7 +185,10 @@ pub fn winding_number(vertices: &[P3], triangles: &[[u32; 3]], p: &P3) -> f64 {
 /// The bounding box of points.
 fn bounds(points: &[P3]) -> (P3, P3) {
     points.iter().fold(
-        (P3::from([f64::INFINITY; 3]), P3::from([f64::NEG_INFINITY; 3])),
+        (
+            P3::from([f64::INFINITY; 3]),
+            P3::from([f64::NEG_INFINITY; 3]),
+        ),
         |(lo, hi), p| (lo.inf(p), hi.sup(p)),
     )
 }

@@ -14,8 +14,8 @@
 
 mod csg;
 mod errors;
-mod fixture;
 pub mod fit;
+mod fixture;
 mod mesh_io;
 mod primitives;
 mod query;
@@ -358,21 +358,7 @@ pub fn build(
             unit_mm,
             span,
         } => {
-            let raw = match read_mesh(world, path, *unit_mm) {
-                Ok(m) => m,
-                Err(e) => {
-                    diags.push(e.at(*span, path));
-                    return None;
-                }
-            };
-            if raw.open_edges + raw.nonmanifold_edges > 0 {
-                diags.push(GeometryError::MeshDefects {
-                    span: *span,
-                    path: errors::shown_path(path),
-                    open: raw.open_edges,
-                    nonmanifold: raw.nonmanifold_edges,
-                });
-            }
+            let raw = read_reported(world, path, *unit_mm, *span, diags)?;
             let uses_groups = part
                 .features
                 .iter()
@@ -386,6 +372,33 @@ pub fn build(
             Some(geometry)
         }
     }
+}
+
+/// Reads a mesh file a spec names at `span`: an unreadable or corrupt file is reported
+/// and gives `None`, open or non-manifold edges a warning.
+pub(crate) fn read_reported(
+    world: &dyn World,
+    path: &std::path::Path,
+    unit_mm: f64,
+    span: crate::source::Span,
+    diags: &mut Diagnostics,
+) -> Option<RawMesh> {
+    let raw = match read_mesh(world, path, unit_mm) {
+        Ok(m) => m,
+        Err(e) => {
+            diags.push(e.at(span, path));
+            return None;
+        }
+    };
+    if raw.open_edges + raw.nonmanifold_edges > 0 {
+        diags.push(GeometryError::MeshDefects {
+            span,
+            path: errors::shown_path(path),
+            open: raw.open_edges,
+            nonmanifold: raw.nonmanifold_edges,
+        });
+    }
+    Some(raw)
 }
 
 /// How many separate bodies a part's triangles make: groups of triangles joined by

@@ -180,7 +180,8 @@ impl Model {
                         path, unit_mm, up, ..
                     } => format!(
                         "file {}, units ×{}, up {}",
-                        path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+                        path.file_name()
+                            .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
                         fmt_num(*unit_mm),
                         v3(up)
                     ),

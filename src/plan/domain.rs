@@ -490,8 +490,8 @@ impl<'a> Knowledge<'a> {
             .chain(&probe.second)
             .map(|c| c.radius)
             .fold(0.0, f64::max);
-        let height = self.points[f].tip_centre(probe.tip_radius).coords.dot(up)
-            - self.table_height(s);
+        let height =
+            self.points[f].tip_centre(probe.tip_radius).coords.dot(up) - self.table_height(s);
         height >= probe.reach() + widest + access::pose::ORIENTATION_TABLE_MARGIN
             || !self.candidates(f, p, s, up, machine).2.is_empty()
     }

@@ -43,11 +43,7 @@ pub enum PlanError {
         last: String,
     },
     #[error("{left} of the {total} points of face `{face}` {verb} left out: generate-and-test did not settle after {iterations} rounds, and in the best plan found {why}")]
-    #[diagnostic(
-        code(insp::plan::points_left_out),
-        severity(Warning),
-        help("{help}")
-    )]
+    #[diagnostic(code(insp::plan::points_left_out), severity(Warning), help("{help}"))]
     PointsLeftOut {
         #[label("`{face}` is part of this feature")]
         span: Span,

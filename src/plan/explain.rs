@@ -232,7 +232,9 @@ pub(super) fn report_left_out(
         verb: if left == 1 { "is" } else { "are" },
         iterations,
         why: match blocker {
-            Blocker::Tip => format!("the tip of probe {probe} meets the part coming in or backing off"),
+            Blocker::Tip => {
+                format!("the tip of probe {probe} meets the part coming in or backing off")
+            }
             Blocker::TipOnTable => format!("the tip of probe {probe} comes too near the table"),
             Blocker::Component(c) => format!("the {c} of probe {probe} meets the part"),
             Blocker::ComponentOnTable(c) => {

@@ -4,6 +4,7 @@
 //! has, any probe, any orientation), and the few that none takes left out with a warning
 //! naming the face, the probe and what it hit. Every touch of the result validated.
 
+use super::cluster::Strategy;
 use super::domain::{Knowledge, Machine};
 use super::hlip::{assemble, Round};
 use super::solve::{self, Branch};
@@ -12,7 +13,6 @@ use super::{explain, Hlip, Input, PlanOptions};
 use crate::access::pose::Blocker;
 use crate::diag::Diagnostics;
 use crate::geometry::FaceId;
-use super::cluster::Strategy;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// The most configurations tried for one left-out touch.
@@ -54,7 +54,11 @@ impl Fallback {
             }
             let mut pts = Vec::new();
             solve::leaves(&b.tree, &mut pts);
-            origin.extend(pts.into_iter().filter(|&p| failed(p)).map(|p| (b.pip(p), i)));
+            origin.extend(
+                pts.into_iter()
+                    .filter(|&p| failed(p))
+                    .map(|p| (b.pip(p), i)),
+            );
         }
         // The configurations the plan already uses, tried first.
         let used: BTreeSet<(usize, usize, usize)> = branches

@@ -215,7 +215,11 @@ pub(crate) fn prune(inst: &Inst, drop: &dyn Fn(usize) -> bool) -> Option<Inst> {
     match inst.kind {
         Kind::Point { point, .. } => (!drop(point)).then(|| inst.clone()),
         _ => {
-            let children: Vec<Inst> = inst.children.iter().filter_map(|c| prune(c, drop)).collect();
+            let children: Vec<Inst> = inst
+                .children
+                .iter()
+                .filter_map(|c| prune(c, drop))
+                .collect();
             (!children.is_empty()).then(|| Inst {
                 kind: inst.kind.clone(),
                 children,

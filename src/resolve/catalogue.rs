@@ -482,7 +482,10 @@ fn fixture(
             FixtureKind::SinePlate { tilt }
         }
         Some("mesh") => {
-            let file = p.req(cx, "mesh", "\"nest.stl\"").and_then(|v| cx.string(v)).cloned();
+            let file = p
+                .req(cx, "mesh", "\"nest.stl\"")
+                .and_then(|v| cx.string(v))
+                .cloned();
             let unit_mm = p
                 .get("units")
                 .and_then(|v| cx.name(v).cloned())

@@ -157,13 +157,7 @@ fn run_case(c: &Case) -> Outcome {
         max_iterations: c.rounds.unwrap_or(defaults.max_iterations),
         ..defaults
     };
-    let run = inspc::run(
-        &FsWorld,
-        &roots,
-        &opts,
-        until,
-        &|_, _, _| {},
-    );
+    let run = inspc::run(&FsWorld, &roots, &opts, until, &|_, _, _| {});
     if !run.graphs.is_empty() || !run.checked.has_errors() {
         let (dot, points) = graph_files(&run);
         files.push(("graph.dot", dot));
@@ -183,7 +177,9 @@ fn run_case(c: &Case) -> Outcome {
         // The build's warnings past the front end's (model.txt has those).
         let warnings = render(&run.checked);
         let front_end = render(&front);
-        let later = warnings.strip_prefix(front_end.as_str()).unwrap_or(&warnings);
+        let later = warnings
+            .strip_prefix(front_end.as_str())
+            .unwrap_or(&warnings);
         if !later.is_empty() {
             files.push(("warnings.txt", later.to_string()));
         }

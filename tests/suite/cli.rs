@@ -97,7 +97,10 @@ fn a_face_no_probe_inspects_is_left_out_when_allowed() {
     let _ = std::fs::remove_file(&out);
     let (code, _, stderr) = inspc(&["build", &spec, "-o", &out]);
     assert_eq!(code, 1, "{stderr}");
-    assert!(stderr.contains("insp::plan::uninspectable_face"), "{stderr}");
+    assert!(
+        stderr.contains("insp::plan::uninspectable_face"),
+        "{stderr}"
+    );
     assert!(!std::path::Path::new(&out).exists());
     let (code, stdout, stderr) = inspc(&["build", &spec, "-o", &out, "--allow-unmeasured"]);
     assert_eq!(code, 0, "{stderr}");
