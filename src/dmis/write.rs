@@ -230,6 +230,10 @@ struct Writer<'a> {
     feats: BTreeMap<BlockKey, (String, usize, usize)>,
     /// The surfaces measured.
     surfs: Vec<Surf>,
+    /// The `OUTPUT` statements written.
+    outputs: std::collections::BTreeSet<String>,
+    /// Per feature of two opposed planes, its constructed `PARPLN` and the two surfaces.
+    pairs: BTreeMap<FeatureId, (String, [usize; 2])>,
     /// The surfaces complete so far.
     done: std::collections::BTreeSet<usize>,
     /// Tolerances recorded before all their surfaces were complete.
@@ -267,6 +271,8 @@ pub fn write(input: &Input) -> String {
         feats: BTreeMap::new(),
         surfs: Vec::new(),
         points: BTreeMap::new(),
+        pairs: BTreeMap::new(),
+        outputs: std::collections::BTreeSet::new(),
         done: std::collections::BTreeSet::new(),
         pending: Vec::new(),
         faces_of: BTreeMap::new(),
@@ -500,6 +506,54 @@ impl Writer<'_> {
                 feature,
             });
         }
+        self.centre_planes();
+    }
+
+    /// A feature made of two opposed parallel planes (a slot, a tab) is a feature of
+    /// size: its width, position, symmetry and orientation belong to the pair, a
+    /// `FEAT/PARPLN` constructed from the two walls once both are measured.
+    fn centre_planes(&mut self) {
+        let cos = (0.1f64).to_radians().cos();
+        let mut by_feature: BTreeMap<FeatureId, Vec<usize>> = BTreeMap::new();
+        for (k, s) in self.surfs.iter().enumerate() {
+            if let Some(f) = s.feature {
+                by_feature.entry(f).or_default().push(k);
+            }
+        }
+        for (f, surfs) in by_feature {
+            let [a, b] = surfs[..] else { continue };
+            let plane = |k: usize| match self.nominals.get(&self.surfs[k].full) {
+                Some(Nominal::Surface(Surface::Plane { normal, .. }, c)) => Some((*c, *normal)),
+                _ => None,
+            };
+            let (Some((pa, na)), Some((pb, nb))) = (plane(a), plane(b)) else {
+                continue;
+            };
+            if na.dot(&nb) > -cos {
+                continue;
+            }
+            // On each wall's plane, the point nearest the other's centre.
+            let (full_a, full_b) = (&self.nominals[&self.surfs[a].full], &self.nominals[&self.surfs[b].full]);
+            let (Nominal::Surface(Surface::Plane { origin: oa, .. }, _), Nominal::Surface(Surface::Plane { origin: ob, .. }, _)) = (full_a, full_b) else {
+                continue;
+            };
+            let width = (ob - oa).dot(&na).abs();
+            let qa = pa - na * (pa - oa).dot(&na);
+            let qb = pb - nb * (pb - ob).dot(&nb);
+            let mid = P3::from((qa.coords + qb.coords) / 2.0);
+            // A slot's walls face each other; a tab's face away.
+            let inner = (ob - oa).dot(&na) > 0.0;
+            let name = self.names.feature(Some(f)).to_string();
+            let label = self.labels.fresh("F", &format!("{name}_MID"));
+            self.o.stmt(&format!(
+                "F({label})=FEAT/PARPLN,{},CART,{},{},{}",
+                if inner { "INNER" } else { "OUTER" },
+                xyz(&mid),
+                ijk(&na),
+                num(width)
+            ));
+            self.pairs.insert(f, (label, [a, b]));
+        }
     }
 
     /// Datum labels, then every tolerance's label and statement; each statement is
@@ -701,12 +755,25 @@ impl Writer<'_> {
             } else {
                 None
             };
-            let Some(done) = complete else {
+            let Some(mut done) = complete else {
                 // Measured anew: not complete until the round's last block.
                 self.done.remove(&surf);
                 continue;
             };
             self.done.insert(surf);
+            // The second wall of a slot or tab makes the pair.
+            if let Some((pair, walls)) = b.feature.and_then(|f| self.pairs.get(&f)).cloned() {
+                if !walls.iter().all(|w| self.done.contains(w)) {
+                    continue;
+                }
+                let fa: Vec<String> = walls
+                    .iter()
+                    .map(|w| format!("FA({})", self.surfs[*w].full))
+                    .collect();
+                self.o
+                    .stmt(&format!("CONST/PARPLN,F({pair}),BF,{}", fa.join(",")));
+                done = pair;
+            }
             let list = self.measured.entry(b.feature).or_default();
             if !list.contains(&done) {
                 list.push(done.clone());
@@ -763,7 +830,19 @@ impl Writer<'_> {
         let part = self.names.part();
         let t = &part.tolerances[r.0];
         let tl = &self.tols[r.0];
+        // Form and profile tolerances apply to each wall of a slot; the others to the pair.
+        let per_wall = matches!(
+            t.kind,
+            TolKind::Flatness | TolKind::Straightness | TolKind::ProfileLine | TolKind::ProfileSurface
+        );
         let labels_of = |f: FeatureId| -> Vec<String> {
+            if let Some((pair, walls)) = self.pairs.get(&f) {
+                return if per_wall {
+                    walls.iter().map(|w| self.surfs[*w].full.clone()).collect()
+                } else {
+                    vec![pair.clone()]
+                };
+            }
             let f = Some(f);
             let here: Vec<String> = self
                 .faces_of
@@ -797,6 +876,9 @@ impl Writer<'_> {
                 }
             }
         }
+        // A tolerance recorded in several groups reports the same features once.
+        lines.retain(|l| !self.outputs.contains(l));
+        self.outputs.extend(lines.iter().cloned());
         if !lines.is_empty() && self.defined_tols.insert(r.0) {
             let stmt = self.tol_stmts[r.0].clone();
             self.o.stmt(&stmt);
