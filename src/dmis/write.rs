@@ -217,6 +217,18 @@ struct Round {
     last: BlockKey,
 }
 
+/// A setup's alignment, to repeat on the program's own measurements of its features.
+struct Realign {
+    setup: usize,
+    /// The alignment features' labels.
+    labels: Vec<String>,
+    /// `DATSET` parameters and `TRANS` shifts.
+    fa: Vec<String>,
+    shifts: Vec<String>,
+    /// Alignment-feature labels measured under DCC so far in the setup.
+    measured: std::collections::BTreeSet<String>,
+}
+
 /// The writer's state: the program so far and the labels handed out.
 struct Writer<'a> {
     input: &'a Input<'a>,
@@ -230,6 +242,8 @@ struct Writer<'a> {
     feats: BTreeMap<BlockKey, (String, usize, usize)>,
     /// The surfaces measured.
     surfs: Vec<Surf>,
+    /// The current setup's alignment, until it is repeated under DCC.
+    realign: Option<Realign>,
     /// The `OUTPUT` statements written.
     outputs: std::collections::BTreeSet<String>,
     /// Per feature of two opposed planes, its constructed `PARPLN` and the two surfaces.
@@ -272,6 +286,7 @@ pub fn write(input: &Input) -> String {
         surfs: Vec::new(),
         points: BTreeMap::new(),
         pairs: BTreeMap::new(),
+        realign: None,
         outputs: std::collections::BTreeSet::new(),
         done: std::collections::BTreeSet::new(),
         pending: Vec::new(),
@@ -665,18 +680,38 @@ impl Writer<'_> {
             self.o.stmt("ENDMES");
             fa.push(format!("FA({label}),{}", step.keywords.join(",")));
         }
-        let d = self.labels.fresh("D", &format!("SETUP{}", si + 1));
-        self.o.stmt(&format!("D({d})=DATSET/{}", fa.join(",")));
         let shifts: Vec<String> = al
             .trans
             .iter()
             .map(|(k, v)| format!("{k}ORIG,{}", num(-v)))
             .collect();
+        self.datset(&format!("SETUP{}", si + 1), &fa, &shifts);
+        self.o.stmt("MODE/PROG,MAN");
+        // Once the program has measured the alignment features itself, it aligns again
+        // on those measurements: the hand-touched points only start it.
+        let labels: Vec<String> = al
+            .steps
+            .iter()
+            .filter_map(|st| self.feats.get(&(si, st.group, st.block)).map(|f| f.0.clone()))
+            .collect();
+        self.realign = Some(Realign {
+            setup: si,
+            labels,
+            fa,
+            shifts,
+            measured: std::collections::BTreeSet::new(),
+        });
+    }
+
+    /// `DATSET` on the alignment features (`FA(label),keywords`), then the `TRANS` that
+    /// puts the origin back at the part's.
+    fn datset(&mut self, name: &str, fa: &[String], shifts: &[String]) {
+        let d = self.labels.fresh("D", name);
+        self.o.stmt(&format!("D({d})=DATSET/{}", fa.join(",")));
         if !shifts.is_empty() {
-            let dt = self.labels.fresh("D", &format!("PART{}", si + 1));
+            let dt = self.labels.fresh("D", &name.replace("SETUP", "PART"));
             self.o.stmt(&format!("D({dt})=TRANS/{}", shifts.join(",")));
         }
-        self.o.stmt("MODE/PROG,MAN");
     }
 
     /// A group: its sensor, entry, `MEAS` blocks and exit, the datums it measured and
@@ -761,6 +796,9 @@ impl Writer<'_> {
                 continue;
             };
             self.done.insert(surf);
+            if let Some(r) = self.realign.as_mut() {
+                r.measured.insert(done.clone());
+            }
             // The second wall of a slot or tab makes the pair.
             if let Some((pair, walls)) = b.feature.and_then(|f| self.pairs.get(&f)).cloned() {
                 if !walls.iter().all(|w| self.done.contains(w)) {
@@ -787,6 +825,15 @@ impl Writer<'_> {
         }
         for p in &g.exit {
             self.o.goto(p);
+        }
+        // The DCC alignment, once every alignment feature is measured under the program.
+        if let Some(r) = self.realign.take() {
+            if r.setup == si && r.labels.iter().all(|l| r.measured.contains(l)) {
+                self.o.comment("alignment again, on the features as the program measured them");
+                self.datset(&format!("SETUP{}_DCC", si + 1), &r.fa, &r.shifts);
+            } else {
+                self.realign = Some(r);
+            }
         }
         // Datums measured here, then the tolerances this group completes.
         for (d, label) in datums_here {
