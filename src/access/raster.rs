@@ -166,7 +166,7 @@ fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage
     let clampi = |k: i64| k.clamp(0, n - 1);
     match cov {
         Coverage::Cells => {
-            let cell = |x: f64| clampi(((x + 1.0) / h).floor() as i64);
+            let cell = |x: f64| clampi(floor_i((x + 1.0) / h));
             for j in cell(vmin)..=cell(vmax) {
                 let (lo, hi) = (-1.0 + j as f64 * h, -1.0 + (j + 1) as f64 * h);
                 // The polygon's u extent over the strip lo ≤ v ≤ hi: at corners inside the
@@ -194,8 +194,8 @@ fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage
         }
         Coverage::Centres => {
             // Rows whose centre line is within a hair of the polygon.
-            let j0 = ((vmin - HAIR + 1.0) / h - 0.5).ceil() as i64;
-            let j1 = ((vmax + HAIR + 1.0) / h - 0.5).floor() as i64;
+            let j0 = ceil_i((vmin - HAIR + 1.0) / h - 0.5);
+            let j1 = floor_i((vmax + HAIR + 1.0) / h - 0.5);
             for j in j0.max(0)..=j1.min(n - 1) {
                 let v = (-1.0 + (j as f64 + 0.5) * h).clamp(vmin, vmax);
                 let (mut umin, mut umax) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -216,12 +216,60 @@ fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage
                 if umin > umax {
                     continue;
                 }
-                let i0 = ((umin - HAIR + 1.0) / h - 0.5).ceil() as i64;
-                let i1 = ((umax + HAIR + 1.0) / h - 0.5).floor() as i64;
+                let i0 = ceil_i((umin - HAIR + 1.0) / h - 0.5);
+                let i1 = floor_i((umax + HAIR + 1.0) / h - 0.5);
                 if i0 <= i1 && i1 >= 0 && i0 < n {
                     out.set_span(face, j as u32, clampi(i0) as u32, clampi(i1) as u32);
                 }
             }
+        }
+    }
+}
+
+/// `x.floor() as i64` without the libm call the baseline x86-64 target makes of
+/// `floor` (no SSE4.1 rounding): the same integer for every `x`, NaN and infinities
+/// saturating as the cast does. The rasterizer calls it for every span.
+#[inline]
+pub(super) fn floor_i(x: f64) -> i64 {
+    let i = x as i64;
+    if (i as f64) > x {
+        i.saturating_sub(1)
+    } else {
+        i
+    }
+}
+
+/// `x.ceil() as i64`, as [`floor_i`].
+#[inline]
+pub(super) fn ceil_i(x: f64) -> i64 {
+    let i = x as i64;
+    if (i as f64) < x {
+        i.saturating_add(1)
+    } else {
+        i
+    }
+}
+
+#[cfg(test)]
+mod rounding {
+    use super::{ceil_i, floor_i};
+
+    #[test]
+    fn fast_floor_and_ceil_match_the_library() {
+        let mut xs = vec![
+            0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 1.5, -1.5, 63.999999, -63.999999, 1e-300, -1e-300,
+            f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 9.3e18, -9.3e18, 4503599627370497.0,
+        ];
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..100_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            xs.push((s as f64 / u64::MAX as f64 - 0.5) * 300.0);
+        }
+        for x in xs {
+            assert_eq!(floor_i(x), x.floor() as i64, "floor {x}");
+            assert_eq!(ceil_i(x), x.ceil() as i64, "ceil {x}");
         }
     }
 }
