@@ -182,7 +182,8 @@ impl CubeMap {
     pub fn pixel_of(&self, d: &V3) -> Pixel {
         let (face, u, v) = face_uv(d);
         let at = |x: f64| {
-            super::raster::floor_i((x + 1.0) / 2.0 * self.n as f64).clamp(0, self.n as i64 - 1) as u32
+            super::raster::floor_i((x + 1.0) / 2.0 * self.n as f64).clamp(0, self.n as i64 - 1)
+                as u32
         };
         Pixel {
             face,

@@ -548,8 +548,15 @@ impl Writer<'_> {
                 continue;
             }
             // On each wall's plane, the point nearest the other's centre.
-            let (full_a, full_b) = (&self.nominals[&self.surfs[a].full], &self.nominals[&self.surfs[b].full]);
-            let (Nominal::Surface(Surface::Plane { origin: oa, .. }, _), Nominal::Surface(Surface::Plane { origin: ob, .. }, _)) = (full_a, full_b) else {
+            let (full_a, full_b) = (
+                &self.nominals[&self.surfs[a].full],
+                &self.nominals[&self.surfs[b].full],
+            );
+            let (
+                Nominal::Surface(Surface::Plane { origin: oa, .. }, _),
+                Nominal::Surface(Surface::Plane { origin: ob, .. }, _),
+            ) = (full_a, full_b)
+            else {
                 continue;
             };
             let width = (ob - oa).dot(&na).abs();
@@ -692,7 +699,11 @@ impl Writer<'_> {
         let labels: Vec<String> = al
             .steps
             .iter()
-            .filter_map(|st| self.feats.get(&(si, st.group, st.block)).map(|f| f.0.clone()))
+            .filter_map(|st| {
+                self.feats
+                    .get(&(si, st.group, st.block))
+                    .map(|f| f.0.clone())
+            })
             .collect();
         self.realign = Some(Realign {
             setup: si,
@@ -829,7 +840,8 @@ impl Writer<'_> {
         // The DCC alignment, once every alignment feature is measured under the program.
         if let Some(r) = self.realign.take() {
             if r.setup == si && r.labels.iter().all(|l| r.measured.contains(l)) {
-                self.o.comment("alignment again, on the features as the program measured them");
+                self.o
+                    .comment("alignment again, on the features as the program measured them");
                 self.datset(&format!("SETUP{}_DCC", si + 1), &r.fa, &r.shifts);
             } else {
                 self.realign = Some(r);
@@ -880,7 +892,10 @@ impl Writer<'_> {
         // Form and profile tolerances apply to each wall of a slot; the others to the pair.
         let per_wall = matches!(
             t.kind,
-            TolKind::Flatness | TolKind::Straightness | TolKind::ProfileLine | TolKind::ProfileSurface
+            TolKind::Flatness
+                | TolKind::Straightness
+                | TolKind::ProfileLine
+                | TolKind::ProfileSurface
         );
         let labels_of = |f: FeatureId| -> Vec<String> {
             if let Some((pair, walls)) = self.pairs.get(&f) {
