@@ -218,6 +218,25 @@ impl CubeMap {
         }
     }
 
+    /// The cells whose direction makes at least `cos` with unit `axis` (less 1e-12):
+    /// a cap of directions, from a table of pixel directions built once per resolution.
+    pub fn cap(&self, axis: &V3, cos: f64) -> CubeMap {
+        let mut out = self.empty_like();
+        let pixels = pixel_directions(self);
+        for (k, d) in pixels.iter().enumerate() {
+            if d.dot(axis) >= cos - 1e-12 {
+                out.bits[k / 64] |= 1 << (k % 64);
+            }
+        }
+        for k in 0..self.extra.len() {
+            if self.preferred(k).dot(axis) >= cos - 1e-12 {
+                let i = pixels.len() + k;
+                out.bits[i / 64] |= 1 << (i % 64);
+            }
+        }
+        out
+    }
+
     /// The raw bits: 6·N² pixels then the preferred directions, 64 to a word, in
     /// [`CubeMap::index`] order. For set algorithms that work on any bitset.
     pub fn words(&self) -> &[u64] {
@@ -547,6 +566,22 @@ fn row_mask(n: usize) -> u64 {
     } else {
         (1u64 << n) - 1
     }
+}
+
+/// The unit directions of the pixels of a map of `like`'s resolution, in bit-index order
+/// (exactly what [`CubeMap::direction`] gives), built once per resolution.
+fn pixel_directions(like: &CubeMap) -> Arc<[V3]> {
+    use std::collections::BTreeMap;
+    use std::sync::{Mutex, OnceLock};
+    static TABLES: OnceLock<Mutex<BTreeMap<u32, Arc<[V3]>>>> = OnceLock::new();
+    let tables = TABLES.get_or_init(|| Mutex::new(BTreeMap::new()));
+    let mut t = tables.lock().unwrap_or_else(|e| e.into_inner());
+    t.entry(like.n)
+        .or_insert_with(|| {
+            let n = 6 * (like.n as usize).pow(2);
+            (0..n).map(|k| like.direction(like.cell(k))).collect()
+        })
+        .clone()
 }
 
 #[cfg(test)]

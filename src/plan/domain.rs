@@ -163,17 +163,7 @@ pub(crate) struct Knowledge<'a> {
 
 /// The cells within `angle` radians of `axis`, in the shape of `like`.
 pub(crate) fn cone_around(like: &CubeMap, axis: &V3, angle: f64) -> CubeMap {
-    let mut out = like.empty_like();
-    let cos = angle.min(std::f64::consts::PI).cos();
-    let total = 6 * (like.n() as usize).pow(2) + like.preferred_len();
-    let axis = axis.normalize();
-    for k in 0..total {
-        let cell = like.cell(k);
-        if like.direction(cell).dot(&axis) >= cos - 1e-12 {
-            out.set(cell, true);
-        }
-    }
-    out
+    like.cap(&axis.normalize(), angle.min(std::f64::consts::PI).cos())
 }
 
 /// How the part is held in one setup.
