@@ -196,7 +196,16 @@ impl CubeMap {
     /// 1e-9 rad, so a head's A = 90°, B = 0° is +x despite rounding), else its pixel.
     pub fn cell_of(&self, d: &V3) -> Cell {
         let u = d.normalize();
-        match (0..self.extra.len()).find(|&k| (self.preferred(k) - u).norm() < 1e-9) {
+        // A component more than 2e-9 off rules a preferred direction out before the norm
+        // (the norm is at least as large): the same answer, without a square root each.
+        let near = |k: usize| {
+            let p = self.preferred(k);
+            (p.x - u.x).abs() < 2e-9
+                && (p.y - u.y).abs() < 2e-9
+                && (p.z - u.z).abs() < 2e-9
+                && (p - u).norm() < 1e-9
+        };
+        match (0..self.extra.len()).find(|&k| near(k)) {
             Some(i) => Cell::Preferred(i),
             None => Cell::Pixel(self.pixel_of(d)),
         }
