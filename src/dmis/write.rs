@@ -409,10 +409,7 @@ impl Writer<'_> {
                 for (bi, b) in g.blocks.iter().enumerate() {
                     let same = |f: FaceId| {
                         f == b.face
-                            || (b.contact == Contact::Part
-                                && geometry.faces[f.0]
-                                    .surface
-                                    .same_as(&geometry.faces[b.face.0].surface))
+                            || (b.contact == Contact::Part && geometry.same_surface(f, b.face))
                     };
                     match surfs
                         .iter_mut()
@@ -537,28 +534,20 @@ impl Writer<'_> {
         }
         for (f, surfs) in by_feature {
             let [a, b] = surfs[..] else { continue };
+            // Each wall's centre, a point of its plane and its normal.
             let plane = |k: usize| match self.nominals.get(&self.surfs[k].full) {
-                Some(Nominal::Surface(Surface::Plane { normal, .. }, c)) => Some((*c, *normal)),
+                Some(Nominal::Surface(Surface::Plane { origin, normal }, c)) => {
+                    Some((*c, *origin, *normal))
+                }
                 _ => None,
             };
-            let (Some((pa, na)), Some((pb, nb))) = (plane(a), plane(b)) else {
+            let (Some((pa, oa, na)), Some((pb, ob, nb))) = (plane(a), plane(b)) else {
                 continue;
             };
             if na.dot(&nb) > -cos {
                 continue;
             }
-            // On each wall's plane, the point nearest the other's centre.
-            let (full_a, full_b) = (
-                &self.nominals[&self.surfs[a].full],
-                &self.nominals[&self.surfs[b].full],
-            );
-            let (
-                Nominal::Surface(Surface::Plane { origin: oa, .. }, _),
-                Nominal::Surface(Surface::Plane { origin: ob, .. }, _),
-            ) = (full_a, full_b)
-            else {
-                continue;
-            };
+            // On each wall's plane, the point nearest its centre.
             let width = (ob - oa).dot(&na).abs();
             let qa = pa - na * (pa - oa).dot(&na);
             let qb = pb - nb * (pb - ob).dot(&nb);

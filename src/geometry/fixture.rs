@@ -82,7 +82,7 @@ pub fn place_fixture(
             })
             .reduce(|| 0.0, f64::max)
     };
-    let in_fixture = |p: &P3| winding_number(&raw.vertices, &raw.triangles, p) > 0.5;
+    let in_fixture = |p: &P3| super::query::winding_number(&raw.vertices, &raw.triangles, p) > 0.5;
     let in_part = |p: &P3| g.winding_number(p) > 0.5;
     let sunk = depth(&g.vertices, &fixture_mesh, &in_fixture).max(depth(
         &raw.vertices,
@@ -166,20 +166,6 @@ pub fn place_fixture(
         triangles: raw.triangles,
         locating,
     })
-}
-
-/// The generalized winding number of a closed triangle mesh around `p`: 1 inside, 0
-/// outside (Van Oosterom and Strackee's solid angle, summed over triangles).
-pub fn winding_number(vertices: &[P3], triangles: &[[u32; 3]], p: &P3) -> f64 {
-    let mut total = 0.0;
-    for tri in triangles {
-        let [a, b, c] = tri.map(|i| vertices[i as usize] - p);
-        let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
-        let num = a.dot(&b.cross(&c));
-        let den = la * lb * lc + a.dot(&b) * lc + b.dot(&c) * la + c.dot(&a) * lb;
-        total += 2.0 * num.atan2(den);
-    }
-    total / (4.0 * std::f64::consts::PI)
 }
 
 /// The bounding box of points.

@@ -280,6 +280,12 @@ pub struct PartGeometry {
 }
 
 impl PartGeometry {
+    /// Whether faces `a` and `b` lie on one surface (the same face, or
+    /// [`Surface::same_as`]): the faces a feature measures as one.
+    pub fn same_surface(&self, a: FaceId, b: FaceId) -> bool {
+        a == b || self.faces[a.0].surface.same_as(&self.faces[b.0].surface)
+    }
+
     /// Assembles faces from per-triangle face indices, computing areas and centroids.
     pub(crate) fn new(
         vertices: Vec<P3>,

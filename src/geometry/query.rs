@@ -104,6 +104,20 @@ impl PartGeometry {
     /// The generalized winding number of the closed mesh around `p`: 1 inside the solid,
     /// 0 outside (Van Oosterom and Strackee's solid angle, summed over triangles).
     pub fn winding_number(&self, p: &P3) -> f64 {
-        super::fixture::winding_number(&self.vertices, &self.triangles, p)
+        winding_number(&self.vertices, &self.triangles, p)
     }
+}
+
+/// The generalized winding number of a closed triangle mesh around `p`: 1 inside, 0
+/// outside (Van Oosterom and Strackee's solid angle, summed over triangles).
+pub fn winding_number(vertices: &[P3], triangles: &[[u32; 3]], p: &P3) -> f64 {
+    let mut total = 0.0;
+    for tri in triangles {
+        let [a, b, c] = tri.map(|i| vertices[i as usize] - p);
+        let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
+        let num = a.dot(&b.cross(&c));
+        let den = la * lb * lc + a.dot(&b) * lc + b.dot(&c) * la + c.dot(&a) * lb;
+        total += 2.0 * num.atan2(den);
+    }
+    total / (4.0 * std::f64::consts::PI)
 }

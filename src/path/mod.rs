@@ -248,13 +248,11 @@ fn linearise<'a>(
                     for f in &i.faces {
                         // The faces of a feature that lie on one surface (a bore in two
                         // halves) are one block: one feature, one `MEAS`.
-                        let surface = &input.geometry.faces[f.face.0].surface;
                         let one = blocks.iter_mut().find(|b: &&mut BlockPath| {
                             b.feature == i.feature
                                 && b.contact == Contact::Part
                                 && f.contact == Contact::Part
-                                && (b.face == f.face
-                                    || input.geometry.faces[b.face.0].surface.same_as(surface))
+                                && input.geometry.same_surface(b.face, f.face)
                         });
                         if let Some(b) = one {
                             let own = block_standoff(scene, hlip, &f.points, standoff, probe);

@@ -146,19 +146,20 @@ fn relocate(
         }
     }
     candidates.sort();
+    let mut held_of = BTreeMap::new();
     candidates
         .into_iter()
         .take(TRIES_PER_POINT)
         .map(|(_, s, p, o)| (s, p, o))
         .find(|&(s, p, o)| {
             let up = k.setup_dir(s);
-            let held = k.held(s).clone();
+            let held = held_of.entry(s).or_insert_with(|| k.held(s).clone());
             let try_ = Pip {
                 point: pip.point,
                 probe: p,
                 setup: s,
                 orient: o,
             };
-            validate::check(k, m, &try_, &up, &held).is_ok()
+            validate::check(k, m, &try_, &up, held).is_ok()
         })
 }

@@ -333,9 +333,7 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
     // Faces no probe inspects, left out under `allow_unmeasured`.
     let mut skipped: BTreeSet<FaceId> = BTreeSet::new();
     for iteration in 1..=opts.max_iterations {
-        let (mut dropped, mut bad) = filter(g, input.geometry, &k, &machine);
-        bad.retain(|f| !skipped.contains(f));
-        dropped.extend(skipped.iter().flat_map(|f| face_points(g, *f)));
+        let (dropped, bad) = filter(g, input.geometry, &k, &machine, &skipped);
         if !bad.is_empty() {
             // Know the whole probe before blaming a face.
             let pairs: Vec<(usize, usize)> = bad
@@ -346,14 +344,12 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
             let before = k.acquired;
             k.acquire_many(&pairs, &machine);
             if k.acquired > before && iteration < opts.max_iterations {
-                let (_, mut bad2) = filter(g, input.geometry, &k, &machine);
-                bad2.retain(|f| !skipped.contains(f));
+                let (_, bad2) = filter(g, input.geometry, &k, &machine, &skipped);
                 if bad2.is_empty() {
                     continue;
                 }
             }
-            let (_, mut bad) = filter(g, input.geometry, &k, &machine);
-            bad.retain(|f| !skipped.contains(f));
+            let (_, bad) = filter(g, input.geometry, &k, &machine, &skipped);
             for &face in &bad {
                 report_face(input, &k, &machine, face, opts.allow_unmeasured, diags);
             }
@@ -624,12 +620,14 @@ pub(crate) fn face_points(g: &MeasurementGraph, face: FaceId) -> Vec<usize> {
 
 /// Drops fpoints no probe reaches and, while a face keeps enough, those reached from
 /// under a twentieth of the face's median count of setups (ch. 3.6.3). Returns the
-/// dropped fpoints and the faces left with too few.
+/// dropped fpoints and the faces left with too few. The `skipped` faces (left out under
+/// `allow_unmeasured`) drop all their points.
 fn filter(
     g: &MeasurementGraph,
     geo: &PartGeometry,
     k: &Knowledge,
     m: &Machine,
+    skipped: &BTreeSet<FaceId>,
 ) -> (BTreeSet<usize>, Vec<FaceId>) {
     let mut by_face: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
     for (i, f) in g.fpoints.iter().enumerate() {
@@ -638,6 +636,10 @@ fn filter(
     let mut dropped = BTreeSet::new();
     let mut bad = Vec::new();
     for (face, pts) in by_face {
+        if skipped.contains(&FaceId(face)) {
+            dropped.extend(pts);
+            continue;
+        }
         let on_table = k.tables.iter().any(|t| t.face.0 == face && t.alive);
         if on_table {
             // The table can stand in for the whole face where it is a datum; elsewhere
