@@ -16,6 +16,7 @@ pub mod path;
 pub mod plan;
 pub mod resolve;
 pub mod sample;
+pub mod simulate;
 pub mod source;
 pub mod syntax;
 
@@ -538,4 +539,133 @@ pub fn check(world: &dyn source::World, roots: &[PathBuf]) -> Checked {
         sources,
         roots,
     }
+}
+
+/// A program run on the virtual CMM (see [`simulate`]).
+pub struct Simulated {
+    /// The spec's front end and every diagnostic of the run (the program's and the
+    /// deviations file's problems included, filed under their files).
+    pub checked: Checked,
+    /// The report, when the program ran to its end.
+    pub report: Option<simulate::Report>,
+}
+
+/// Runs DMIS program `program` on the virtual CMM against the part of spec `spec` (the
+/// plan whose name the program carries), deformed and placed as `deviations` says.
+pub fn simulate(
+    world: &dyn source::World,
+    spec: &Path,
+    program: &Path,
+    deviations: Option<&Path>,
+    opts: &simulate::Options,
+) -> Simulated {
+    let (mut checked, parts) = check_geometry(world, &[spec.to_path_buf()]);
+    let mut diags = diag::Diagnostics::new();
+    // Reads a file the run names outside the spec into the source map.
+    let read = |checked: &mut Checked, path: &Path, kind: source::FileKind| {
+        let shown = path.display().to_string();
+        match world.read(path, kind) {
+            Ok(b) => {
+                let text = String::from_utf8_lossy(&b).into_owned();
+                Ok(checked.sources.add(shown, Some(path.to_path_buf()), text))
+            }
+            Err(e) => {
+                let file =
+                    checked
+                        .sources
+                        .add(shown.clone(), Some(path.to_path_buf()), String::new());
+                Err(source::io::IoError::Unreadable {
+                    file,
+                    path: shown,
+                    reason: e.0,
+                })
+            }
+        }
+    };
+    let finish = |mut checked: Checked, diags: diag::Diagnostics, report| {
+        checked.absorb(diags);
+        Simulated { checked, report }
+    };
+    if checked.has_errors() {
+        return Simulated {
+            checked,
+            report: None,
+        };
+    }
+    let dmi = match read(&mut checked, program, source::FileKind::Dmis) {
+        Ok(id) => id,
+        Err(e) => {
+            diags.push(e);
+            return finish(checked, diags, None);
+        }
+    };
+    let text = checked.sources.get(dmi).text.clone();
+    let prog = match dmis::read(dmi, &text) {
+        Ok(p) => p,
+        Err(errors) => {
+            for e in errors {
+                diags.push(e);
+            }
+            return finish(checked, diags, None);
+        }
+    };
+    let plan = match simulate::plan_of(&checked.model, &prog, dmi, &text) {
+        Ok(k) => k,
+        Err(e) => {
+            diags.push(e);
+            return finish(checked, diags, None);
+        }
+    };
+    let part = checked.model.plans[plan].part.0;
+    let Some(data) = parts.get(part).and_then(|p| p.as_ref()) else {
+        return finish(checked, diags, None);
+    };
+    let deviations = match deviations {
+        None => simulate::Deviations::nominal(data.geometry.faces.len()),
+        Some(path) => {
+            let id = match read(&mut checked, path, source::FileKind::Spec) {
+                Ok(id) => id,
+                Err(e) => {
+                    diags.push(e);
+                    return finish(checked, diags, None);
+                }
+            };
+            let dtext = checked.sources.get(id).text.clone();
+            match simulate::deviation::parse(
+                id,
+                &dtext,
+                &checked.model.parts[part],
+                &data.geometry,
+                &data.feature_faces,
+            ) {
+                Ok(d) => d,
+                Err(errors) => {
+                    for e in errors {
+                        diags.push(e);
+                    }
+                    return finish(checked, diags, None);
+                }
+            }
+        }
+    };
+    let input = simulate::Input {
+        model: &checked.model,
+        geometry: &data.geometry,
+        feature_faces: &data.feature_faces,
+        fixtures: &data.fixtures,
+        program: &prog,
+        file: dmi,
+        text: &text,
+        deviations: &deviations,
+    };
+    let report = match simulate::simulate(&input, opts) {
+        Ok(r) => Some(r),
+        Err(errors) => {
+            for e in errors {
+                diags.push(e);
+            }
+            None
+        }
+    };
+    finish(checked, diags, report)
 }

@@ -139,6 +139,28 @@ enum Command {
         #[arg(long)]
         allow_unmeasured: bool,
     },
+    /// Runs a DMIS program on a virtual CMM against the part of its spec: moves swept
+    /// with the real probe, touches searched on the actual surfaces, features fitted,
+    /// alignments built, every tolerance it outputs judged. Exits 0 when every one is
+    /// in tolerance, 2 when some are out, 1 when the run stops.
+    Simulate {
+        /// The `.dmi` program (as `inspc build` wrote it).
+        program: PathBuf,
+        /// The `.insp` spec it was built from.
+        spec: PathBuf,
+        /// How the part and its placement differ from nominal (see README).
+        #[arg(long)]
+        deviations: Option<PathBuf>,
+        /// Measurement noise: standard deviation along each touch's vector (mm).
+        #[arg(long, default_value_t = 0.0)]
+        noise: f64,
+        /// Seed of the noise.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Also write the report: `.json` as JSON, `.dmo` as DMIS output, else text.
+        #[arg(long)]
+        report: Option<PathBuf>,
+    },
     /// Reads a DMIS program and checks it as a controller would: line lengths, labels,
     /// names defined before use, MEAS blocks.
     Dmis {
@@ -229,6 +251,14 @@ fn main() -> ExitCode {
             allow_unmeasured,
         } => build(&file, output, plan_json, &search.options(allow_unmeasured)),
         Command::Dmis { file } => read_dmis(&file),
+        Command::Simulate {
+            program,
+            spec,
+            deviations,
+            noise,
+            seed,
+            report,
+        } => simulate(&program, &spec, deviations.as_deref(), noise, seed, report),
         Command::Check {
             files,
             message_format,
@@ -541,6 +571,49 @@ fn build(
 }
 
 /// `inspc dmis`: reads a program and reports what a controller would reject.
+fn simulate(
+    program: &std::path::Path,
+    spec: &std::path::Path,
+    deviations: Option<&std::path::Path>,
+    noise: f64,
+    seed: u64,
+    report: Option<PathBuf>,
+) -> ExitCode {
+    if !(noise.is_finite() && noise >= 0.0) {
+        eprintln!("inspc: --noise takes a standard deviation in mm, 0 or more");
+        return ExitCode::from(2);
+    }
+    let opts = inspc::simulate::Options { noise, seed };
+    let run = inspc::simulate(&FsWorld, spec, program, deviations, &opts);
+    print_diagnostics(&run.checked.sources, &run.checked.diagnostics);
+    let Some(r) = run.report else {
+        eprintln!("inspc: the run stopped");
+        return ExitCode::from(1);
+    };
+    if let Some(path) = report {
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        let bytes = match ext {
+            "json" => serde_json::to_string_pretty(&r.json()).unwrap_or_default() + "\n",
+            "dmo" => r.dmis(),
+            _ => r.text(),
+        };
+        let out = cli::outputs::Output {
+            path,
+            bytes: bytes.into_bytes(),
+            what: "the report",
+        };
+        if let Err(code) = commit(&[out], &run.checked.inputs()) {
+            return code;
+        }
+    }
+    print!("{}", r.text());
+    if r.failed() > 0 {
+        ExitCode::from(2)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
 fn read_dmis(file: &std::path::Path) -> ExitCode {
     use inspc::source::World;
     let mut sources = inspc::source::SourceMap::new();

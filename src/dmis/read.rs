@@ -322,6 +322,8 @@ fn check(statements: &[Statement], text: &str, file: FileId, errors: &mut Vec<Dm
     }
     // Definitions (any position: a tolerance may name a datum defined later).
     let mut defined: BTreeMap<(String, String), usize> = BTreeMap::new();
+    // The machine's own coordinate system is always there.
+    defined.insert(("D".into(), "MCS".into()), 0);
     for (label, major, _, at) in &commands {
         let Some((kind, l)) = label else { continue };
         if !is_label(l) {

@@ -620,6 +620,16 @@ impl Writer<'_> {
         let hlip = self.input.hlip;
         let setup = &hlip.setups[sp.setup];
         self.o.comment(&format!("setup {} of {setups_n}", si + 1));
+        // The frame the manual points are written in: the part's own, at its nominal
+        // place in this setup (machine axes turned by the setup's rotation).
+        let r = nalgebra::Matrix3::from_fn(|i, j| setup.rotation[i][j]);
+        if si > 0 {
+            self.o.stmt("RECALL/D(MCS)");
+        }
+        for (axis, angle) in zxz_rotations(&r) {
+            let d = self.labels.fresh("D", &format!("NOM{}", si + 1));
+            self.o.stmt(&format!("D({d})=ROTATE/{axis},{}", num(angle)));
+        }
         self.o.oper(&format!(
             "SETUP {} OF {setups_n}: PLACE THE PART WITH ITS {} DIRECTION UP",
             si + 1,
@@ -630,7 +640,6 @@ impl Writer<'_> {
             self.names.holder(&setup.holder, &setup.up).to_uppercase()
         ));
         // How it is turned about the vertical: where a part axis across `up` points.
-        let r = nalgebra::Matrix3::from_fn(|i, j| setup.rotation[i][j]);
         let across = if setup.up.x.abs() < 0.9 {
             V3::x()
         } else {
@@ -959,6 +968,24 @@ fn ptmeas(o: &mut Out, hlip: &crate::plan::Hlip, k: usize) {
         xyz(&p.position),
         ijk(&p.normal)
     ));
+}
+
+/// The `ROTATE` statements that turn the machine's frame into the part's at its nominal
+/// place: `r` (part → machine) as intrinsic rotations about Z, then X, then Z (degrees),
+/// those of no angle left out. `ROTATE/ZAXIS,a` turns the current frame's axes by `a`
+/// about its own Z, so the three compose as `Rz(α)·Rx(β)·Rz(γ) = r`.
+pub(crate) fn zxz_rotations(r: &nalgebra::Matrix3<f64>) -> Vec<(&'static str, f64)> {
+    let beta = r[(2, 2)].clamp(-1.0, 1.0).acos();
+    let (alpha, gamma) = if beta.sin().abs() > 1e-9 {
+        (r[(0, 2)].atan2(-r[(1, 2)]), r[(2, 0)].atan2(r[(2, 1)]))
+    } else {
+        (r[(1, 0)].atan2(r[(0, 0)]), 0.0)
+    };
+    [("ZAXIS", alpha), ("XAXIS", beta), ("ZAXIS", gamma)]
+        .into_iter()
+        .map(|(a, x)| (a, x.to_degrees()))
+        .filter(|(_, x)| num(*x) != "0")
+        .collect()
 }
 
 /// `+Z`, `-X`, or the vector for a direction off the axes.

@@ -205,7 +205,29 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
             if keywords.is_empty() {
                 continue;
             }
-            let Some(points) = spread(pts, n) else {
+            // The secondary's two points lie along it, across the primary direction:
+            // two points one above the other say nothing of the turn about it.
+            let points = match (stage, shape, dirs.first()) {
+                (1, Shape::Plane { axis, .. }, Some(&p)) => {
+                    let along = V3::ith(p, 1.0).cross(&V3::ith(*axis, 1.0));
+                    let pos = |k: usize| hlip.points[k].position;
+                    let mut best: Option<(f64, [usize; 2])> = None;
+                    for (i, &a) in pts.iter().enumerate() {
+                        for &b in &pts[i + 1..] {
+                            let d = (pos(b) - pos(a)).dot(&along).abs();
+                            if best.is_none_or(|(x, _)| d > x + 1e-9) {
+                                best = Some((d, [a, b]));
+                            }
+                        }
+                    }
+                    match best {
+                        Some((d, pair)) if d > 1e-3 => Some(pair.to_vec()),
+                        _ => None,
+                    }
+                }
+                _ => spread(pts, n),
+            };
+            let Some(points) = points else {
                 continue;
             };
             used[ci] = true;
@@ -236,7 +258,17 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
                 Shape::Sphere { .. } => ((0..3).map(orig_word).collect(), (0..3).collect()),
                 Shape::Plane { .. } => continue,
             };
-            let Some(points) = spread(pts, 4.min(pts.len()).max(1)) else {
+            // A circle takes 3 touches, a sphere 4: a block of fewer (one of a
+            // surface's split touches) aligns nothing.
+            let need = if matches!(shape, Shape::Sphere { .. }) {
+                4
+            } else {
+                3
+            };
+            if pts.len() < need {
+                continue;
+            }
+            let Some(points) = spread(pts, 4.min(pts.len())) else {
                 continue;
             };
             if let Shape::Cylinder { axis, .. } = shape {

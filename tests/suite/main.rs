@@ -17,4 +17,5 @@ mod grammar;
 mod mesh_fuzz;
 mod no_panic;
 mod sampling;
+mod simulate;
 mod tours;

@@ -1,0 +1,754 @@
+//! The deviations file: how the virtual part and its placement differ from nominal.
+//!
+//! One change per line, `#` to the end of a line is a comment; lengths in mm, angles in
+//! degrees (a trailing `mm` or `deg` may say so):
+//!
+//! ```text
+//! feature bore_1 move (0.3, 0, 0)        # the feature's faces translate (part frame)
+//! feature top tilt 0.2 about (0, 1, 0)   # turn about an axis through its centroid
+//! feature bore_1 grow 0.05               # its size grows: a diameter, a slot's width
+//! face stock.top bow 0.1                 # a plane's centre stands out (flatness)
+//! face stock.top shift 0.1               # a plane moves along its outward normal
+//! part move (5, 0)                       # the part lies off on the table (machine x, y)
+//! part turn 3                            # … and turned about the vertical (degrees)
+//! setup 2 move (1, 0)                    # the same, in one setup only
+//! ```
+//!
+//! Changes to one face compose in file order. A feature's changes apply to each of its
+//! faces about the feature's centroid, so a moved bore stays one cylinder.
+
+use super::errors::SimError;
+use crate::geometry::{FaceId, PartGeometry, Surface, P3, V3};
+use crate::model::Part;
+use crate::source::{FileId, Span};
+use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion};
+
+/// How one face differs from its nominal.
+#[derive(Debug, Clone)]
+pub struct FaceChange {
+    /// A rigid motion in the part frame.
+    pub motion: Isometry3<f64>,
+    /// Growth of the face's size (mm): a cylinder's, sphere's or cone's diameter.
+    pub grow: f64,
+    /// A plane's bow (mm): its centre stands this far out along its normal, falling
+    /// off with the square of the distance to nothing at its farthest corner.
+    pub bow: f64,
+}
+
+/// A planar face bowed: a paraboloid over the plane, in the nominal part frame.
+#[derive(Debug, Clone, Copy)]
+pub struct Bow {
+    /// Height at the centre (mm).
+    pub height: f64,
+    /// The face's centroid.
+    pub centre: P3,
+    /// The distance from it, across the normal, where the bow ends.
+    pub reach: f64,
+}
+
+impl Bow {
+    /// How far the bowed plane stands out at (the projection of) `x`.
+    pub fn at(&self, normal: &V3, x: &P3) -> f64 {
+        let d = x - self.centre;
+        let across = (d - normal * d.dot(normal)).norm();
+        self.height * (1.0 - (across / self.reach).powi(2))
+    }
+}
+
+impl Default for FaceChange {
+    fn default() -> Self {
+        FaceChange {
+            motion: Isometry3::identity(),
+            grow: 0.0,
+            bow: 0.0,
+        }
+    }
+}
+
+/// Where the part lies on the table against where the program expects it.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Placement {
+    /// Machine x and y (mm).
+    pub shift: [f64; 2],
+    /// About the vertical through the part's centre (degrees).
+    pub turn: f64,
+}
+
+/// Everything a deviations file says.
+#[derive(Debug, Clone, Default)]
+pub struct Deviations {
+    /// Per face (by index), its change; faces not named are nominal.
+    pub faces: Vec<FaceChange>,
+    /// For every setup.
+    pub placement: Placement,
+    /// Per setup (from 1), on top of [`Deviations::placement`].
+    pub setups: Vec<(usize, Placement)>,
+}
+
+impl Deviations {
+    /// The nominal part, placed where the program expects it.
+    pub fn nominal(faces: usize) -> Deviations {
+        Deviations {
+            faces: vec![FaceChange::default(); faces],
+            ..Default::default()
+        }
+    }
+
+    /// The placement of setup `k` (from 1).
+    pub fn placement_of(&self, k: usize) -> Placement {
+        let mut p = self.placement;
+        for (s, q) in &self.setups {
+            if *s == k {
+                p.shift[0] += q.shift[0];
+                p.shift[1] += q.shift[1];
+                p.turn += q.turn;
+            }
+        }
+        p
+    }
+
+    /// A planar face's bow, moved with it; `None` when it has none.
+    pub fn bow_of(&self, g: &PartGeometry, f: FaceId) -> Option<Bow> {
+        let c = self.faces.get(f.0)?;
+        if c.bow == 0.0 {
+            return None;
+        }
+        let face = &g.faces[f.0];
+        let Surface::Plane { normal, .. } = face.surface else {
+            return None;
+        };
+        let reach = face
+            .triangles
+            .iter()
+            .flat_map(|t| g.triangles[*t as usize])
+            .map(|v| {
+                let d = g.vertices[v as usize] - face.centroid;
+                (d - normal * d.dot(&normal)).norm()
+            })
+            .fold(0.0f64, f64::max);
+        Some(Bow {
+            height: c.bow,
+            centre: c.motion * face.centroid,
+            reach: reach.max(1e-6),
+        })
+    }
+
+    /// The face's actual surface: the nominal moved and grown.
+    pub fn surface(&self, g: &PartGeometry, f: FaceId) -> Surface {
+        let nominal = &g.faces[f.0].surface;
+        let Some(c) = self.faces.get(f.0) else {
+            return nominal.clone();
+        };
+        let m = &c.motion;
+        let half = c.grow / 2.0;
+        match nominal {
+            Surface::Plane { origin, normal } => Surface::Plane {
+                origin: m * origin,
+                normal: m * normal,
+            },
+            Surface::Cylinder {
+                origin,
+                axis,
+                radius,
+                convex,
+            } => Surface::Cylinder {
+                origin: m * origin,
+                axis: m * axis,
+                radius: radius + half,
+                convex: *convex,
+            },
+            Surface::Cone {
+                apex,
+                axis,
+                half_angle,
+                convex,
+            } => {
+                // Every diameter grows by `grow`: the apex moves back along the axis.
+                let back = half / half_angle.tan().max(1e-9);
+                Surface::Cone {
+                    apex: m * (apex - axis * back),
+                    axis: m * axis,
+                    half_angle: *half_angle,
+                    convex: *convex,
+                }
+            }
+            Surface::Sphere {
+                center,
+                radius,
+                convex,
+            } => Surface::Sphere {
+                center: m * center,
+                radius: radius + half,
+                convex: *convex,
+            },
+            Surface::Freeform => Surface::Freeform,
+        }
+    }
+}
+
+/// A token of the file with its byte range.
+#[derive(Debug, Clone, PartialEq)]
+enum Tok {
+    Word(String),
+    Num(f64),
+    Open,
+    Close,
+    Comma,
+}
+
+/// Tokens with their byte ranges, or the range of a character that is none.
+type Tokens = Result<Vec<(Tok, usize, usize)>, (usize, usize)>;
+
+fn tokens(line: &str, base: usize) -> Tokens {
+    let b = line.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        let c = b[i] as char;
+        if c.is_whitespace() {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        let tok = match c {
+            '(' => {
+                i += 1;
+                Tok::Open
+            }
+            ')' => {
+                i += 1;
+                Tok::Close
+            }
+            ',' => {
+                i += 1;
+                Tok::Comma
+            }
+            '-' | '+' | '.' | '0'..='9' => {
+                while i < b.len() && matches!(b[i] as char, '-' | '+' | '.' | 'e' | 'E' | '0'..='9')
+                {
+                    i += 1;
+                }
+                match line[start..i].parse::<f64>() {
+                    Ok(x) if x.is_finite() => Tok::Num(x),
+                    _ => return Err((base + start, base + i)),
+                }
+            }
+            _ if c.is_ascii_alphabetic() || c == '_' => {
+                while i < b.len()
+                    && ((b[i] as char).is_ascii_alphanumeric()
+                        || matches!(b[i], b'_' | b'.' | b'[' | b']'))
+                {
+                    i += 1;
+                }
+                Tok::Word(line[start..i].to_string())
+            }
+            _ => return Err((base + start, base + start + c.len_utf8())),
+        };
+        out.push((tok, base + start, base + i));
+    }
+    Ok(out)
+}
+
+/// Reads a deviations file against a part: every problem is a diagnostic with its span.
+pub fn parse(
+    file: FileId,
+    text: &str,
+    part: &Part,
+    g: &PartGeometry,
+    feature_faces: &[Vec<FaceId>],
+) -> Result<Deviations, Vec<SimError>> {
+    let mut dev = Deviations::nominal(g.faces.len());
+    let mut errors = Vec::new();
+    let mut offset = 0;
+    for raw in text.split_inclusive('\n') {
+        let base = offset;
+        offset += raw.len();
+        let line = raw.split('#').next().unwrap_or("");
+        let line = line.trim_end_matches(['\n', '\r']);
+        if line.trim().is_empty() {
+            continue;
+        }
+        let bad =
+            |s: usize, e: usize, what: &str, label: &str, help: &str| SimError::BadDeviation {
+                span: Span::new(file, s, e.max(s + 1).min(base + line.len().max(1))),
+                what: what.into(),
+                label: label.into(),
+                help: help.into(),
+            };
+        let toks = match tokens(line, base) {
+            Ok(t) => t,
+            Err((s, e)) => {
+                errors.push(bad(
+                    s,
+                    e,
+                    "a deviation line holds a character it cannot read",
+                    "not a word, number, parenthesis or comma",
+                    "write one change per line: `feature NAME move (x, y, z)`",
+                ));
+                continue;
+            }
+        };
+        if let Err(e) = one_line(&toks, &mut dev, part, g, feature_faces, &bad) {
+            errors.push(e);
+        }
+    }
+    if errors.is_empty() {
+        Ok(dev)
+    } else {
+        Err(errors)
+    }
+}
+
+type Bad<'a> = dyn Fn(usize, usize, &str, &str, &str) -> SimError + 'a;
+
+const USAGE: &str = "lines read `feature NAME move (x, y, z)`, `… tilt DEG about (x, y, z)`, `… grow MM`, `face NAME shift MM`, `face NAME bow MM`, `part move (x, y)`, `part turn DEG` or `setup N move|turn …`";
+
+/// A cursor over one line's tokens.
+struct Cur<'t> {
+    toks: &'t [(Tok, usize, usize)],
+    k: usize,
+}
+
+impl Cur<'_> {
+    fn end(&self) -> (usize, usize) {
+        self.toks.last().map(|t| (t.2, t.2 + 1)).unwrap_or((0, 1))
+    }
+
+    fn span(&self) -> (usize, usize) {
+        self.toks
+            .get(self.k)
+            .map(|t| (t.1, t.2))
+            .unwrap_or_else(|| self.end())
+    }
+
+    fn word(&mut self) -> Option<String> {
+        match self.toks.get(self.k) {
+            Some((Tok::Word(w), ..)) => {
+                self.k += 1;
+                Some(w.clone())
+            }
+            _ => None,
+        }
+    }
+
+    fn num(&mut self) -> Option<f64> {
+        match self.toks.get(self.k) {
+            Some((Tok::Num(x), ..)) => {
+                self.k += 1;
+                Some(*x)
+            }
+            _ => None,
+        }
+    }
+
+    fn is(&mut self, t: &Tok) -> bool {
+        if self.toks.get(self.k).map(|x| &x.0) == Some(t) {
+            self.k += 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// An optional unit word among `units`.
+    fn unit(&mut self, units: &[&str]) {
+        if let Some((Tok::Word(w), ..)) = self.toks.get(self.k) {
+            if units.contains(&w.as_str()) {
+                self.k += 1;
+            }
+        }
+    }
+
+    /// `(a, b[, c])` with `n` numbers.
+    fn tuple(&mut self, n: usize) -> Option<Vec<f64>> {
+        if !self.is(&Tok::Open) {
+            return None;
+        }
+        let mut v = Vec::new();
+        for i in 0..n {
+            if i > 0 && !self.is(&Tok::Comma) {
+                return None;
+            }
+            v.push(self.num()?);
+        }
+        self.is(&Tok::Close).then_some(v)
+    }
+}
+
+fn one_line(
+    toks: &[(Tok, usize, usize)],
+    dev: &mut Deviations,
+    part: &Part,
+    g: &PartGeometry,
+    feature_faces: &[Vec<FaceId>],
+    bad: &Bad,
+) -> Result<(), SimError> {
+    let mut c = Cur { toks, k: 0 };
+    let (s0, e0) = c.span();
+    let Some(kind) = c.word() else {
+        return Err(bad(
+            s0,
+            e0,
+            "a deviation line starts with what it changes",
+            "expected `feature`, `face`, `part` or `setup`",
+            USAGE,
+        ));
+    };
+    match kind.as_str() {
+        "part" | "setup" => {
+            let setup = if kind == "setup" {
+                let (s, e) = c.span();
+                match c.num() {
+                    Some(n) if n >= 1.0 && n.fract() == 0.0 => Some(n as usize),
+                    _ => {
+                        return Err(bad(
+                            s,
+                            e,
+                            "`setup` takes the setup's number, from 1",
+                            "expected a whole number",
+                            USAGE,
+                        ))
+                    }
+                }
+            } else {
+                None
+            };
+            let (s, e) = c.span();
+            let mut p = Placement::default();
+            match c.word().as_deref() {
+                Some("move") => {
+                    let Some(v) = c.tuple(2) else {
+                        let (s, e) = c.span();
+                        return Err(bad(s, e, "`move` of the part takes its shift on the table", "expected `(x, y)`", "the part moves in the table's plane: `part move (5, 0) mm`"));
+                    };
+                    c.unit(&["mm"]);
+                    p.shift = [v[0], v[1]];
+                }
+                Some("turn") => {
+                    let Some(a) = c.num() else {
+                        let (s, e) = c.span();
+                        return Err(bad(s, e, "`turn` takes an angle in degrees", "expected a number", "`part turn 3 deg`"));
+                    };
+                    c.unit(&["deg"]);
+                    p.turn = a;
+                }
+                _ => return Err(bad(s, e, "the part on the table can `move` or `turn`", "expected `move` or `turn`", "the part rests on the table: it moves in its plane and turns about the vertical")),
+            }
+            match setup {
+                Some(k) => dev.setups.push((k, p)),
+                None => {
+                    dev.placement.shift[0] += p.shift[0];
+                    dev.placement.shift[1] += p.shift[1];
+                    dev.placement.turn += p.turn;
+                }
+            }
+        }
+        "feature" | "face" => {
+            let (ns, ne) = c.span();
+            let Some(name) = c.word() else {
+                return Err(bad(
+                    ns,
+                    ne,
+                    &format!("`{kind}` takes a name"),
+                    "expected a name",
+                    USAGE,
+                ));
+            };
+            let faces: Vec<FaceId> = if kind == "feature" {
+                match part.features.iter().position(|f| f.name == name) {
+                    Some(k) => feature_faces.get(k).cloned().unwrap_or_default(),
+                    None => {
+                        let names: Vec<&str> =
+                            part.features.iter().map(|f| f.name.as_str()).collect();
+                        let help = match crate::diag::suggest::did_you_mean(
+                            &name,
+                            names.iter().copied(),
+                        ) {
+                            Some(s) => format!("did you mean `{s}`?"),
+                            None => {
+                                format!("part `{}` has features {}", part.name, names.join(", "))
+                            }
+                        };
+                        return Err(bad(
+                            ns,
+                            ne,
+                            &format!("part `{}` has no feature `{name}`", part.name),
+                            "unknown feature",
+                            &help,
+                        ));
+                    }
+                }
+            } else {
+                match g.faces.iter().position(|f| f.name == name) {
+                    Some(k) => vec![FaceId(k)],
+                    None => {
+                        let help = match crate::diag::suggest::did_you_mean(
+                            &name,
+                            g.faces.iter().map(|f| f.name.as_str()),
+                        ) {
+                            Some(s) => format!("did you mean `{s}`?"),
+                            None => "`inspc faces SPEC` lists the part's faces".into(),
+                        };
+                        return Err(bad(
+                            ns,
+                            ne,
+                            &format!("part `{}` has no face `{name}`", part.name),
+                            "unknown face",
+                            &help,
+                        ));
+                    }
+                }
+            };
+            if faces.is_empty() {
+                return Err(bad(
+                    ns,
+                    ne,
+                    &format!("feature `{name}` has no faces to change"),
+                    "no faces",
+                    USAGE,
+                ));
+            }
+            let centroid = {
+                let (mut s, mut w) = (V3::zeros(), 0.0);
+                for f in &faces {
+                    let face = &g.faces[f.0];
+                    s += face.centroid.coords * face.area;
+                    w += face.area;
+                }
+                P3::from(s / w.max(1e-12))
+            };
+            let (vs, ve) = c.span();
+            let verb = c.word();
+            let change: Vec<(FaceId, FaceChange)> = match verb.as_deref() {
+                Some("move") => {
+                    let Some(v) = c.tuple(3) else {
+                        let (s, e) = c.span();
+                        return Err(bad(
+                            s,
+                            e,
+                            "`move` takes a translation",
+                            "expected `(x, y, z)`",
+                            "`feature bore move (0.3, 0, 0) mm`, in the part frame",
+                        ));
+                    };
+                    c.unit(&["mm"]);
+                    let m = Isometry3::from_parts(
+                        Translation3::new(v[0], v[1], v[2]),
+                        UnitQuaternion::identity(),
+                    );
+                    faces
+                        .iter()
+                        .map(|f| {
+                            (
+                                *f,
+                                FaceChange {
+                                    motion: m,
+                                    grow: 0.0,
+                                    bow: 0.0,
+                                },
+                            )
+                        })
+                        .collect()
+                }
+                Some("tilt") => {
+                    let Some(a) = c.num() else {
+                        let (s, e) = c.span();
+                        return Err(bad(
+                            s,
+                            e,
+                            "`tilt` takes an angle in degrees",
+                            "expected a number",
+                            "`feature top tilt 0.2 deg about (0, 1, 0)`",
+                        ));
+                    };
+                    c.unit(&["deg"]);
+                    let (s, e) = c.span();
+                    let axis = if c.word().as_deref() == Some("about") {
+                        c.tuple(3)
+                    } else {
+                        None
+                    };
+                    let Some(axis) =
+                        axis.and_then(|v| Unit::try_new(V3::new(v[0], v[1], v[2]), 1e-12))
+                    else {
+                        return Err(bad(s, e, "`tilt` needs the axis it turns about", "expected `about (x, y, z)`", "the axis passes through the feature's centroid: `tilt 0.2 deg about (0, 1, 0)`"));
+                    };
+                    let r = UnitQuaternion::from_axis_angle(&axis, a.to_radians());
+                    // About the centroid: x ↦ c + R (x − c).
+                    let m = Isometry3::from_parts(
+                        Translation3::from(centroid.coords - r * centroid.coords),
+                        r,
+                    );
+                    faces
+                        .iter()
+                        .map(|f| {
+                            (
+                                *f,
+                                FaceChange {
+                                    motion: m,
+                                    grow: 0.0,
+                                    bow: 0.0,
+                                },
+                            )
+                        })
+                        .collect()
+                }
+                Some("shift") => {
+                    let Some(d) = c.num() else {
+                        let (s, e) = c.span();
+                        return Err(bad(
+                            s,
+                            e,
+                            "`shift` takes a distance",
+                            "expected a number",
+                            "`face stock.top shift 0.1 mm` moves a plane along its outward normal",
+                        ));
+                    };
+                    c.unit(&["mm"]);
+                    let mut out = Vec::new();
+                    for f in &faces {
+                        let Surface::Plane { normal, .. } = g.faces[f.0].surface else {
+                            return Err(bad(vs, ve, &format!("`shift` moves planes along their normal; `{}` is not a plane", g.faces[f.0].name), "not a plane", "move other faces with `move (x, y, z)`, or change their size with `grow`"));
+                        };
+                        let t = normal * d;
+                        out.push((
+                            *f,
+                            FaceChange {
+                                motion: Isometry3::from_parts(
+                                    Translation3::from(t),
+                                    UnitQuaternion::identity(),
+                                ),
+                                grow: 0.0,
+                                bow: 0.0,
+                            },
+                        ));
+                    }
+                    out
+                }
+                Some("bow") => {
+                    let Some(d) = c.num() else {
+                        let (s, e) = c.span();
+                        return Err(bad(s, e, "`bow` takes a height", "expected a number", "`face stock.top bow 0.1 mm`: the plane's centre stands out by that much"));
+                    };
+                    c.unit(&["mm"]);
+                    let mut out = Vec::new();
+                    for f in &faces {
+                        if !matches!(g.faces[f.0].surface, Surface::Plane { .. }) {
+                            return Err(bad(
+                                vs,
+                                ve,
+                                &format!(
+                                    "`bow` bends planes; `{}` is not a plane",
+                                    g.faces[f.0].name
+                                ),
+                                "not a plane",
+                                "change other faces with `move`, `tilt` or `grow`",
+                            ));
+                        }
+                        out.push((
+                            *f,
+                            FaceChange {
+                                bow: d,
+                                ..FaceChange::default()
+                            },
+                        ));
+                    }
+                    out
+                }
+                Some("grow") => {
+                    let Some(d) = c.num() else {
+                        let (s, e) = c.span();
+                        return Err(bad(
+                            s,
+                            e,
+                            "`grow` takes a size change",
+                            "expected a number",
+                            "`feature bore grow 0.05 mm` grows a diameter or a slot's width",
+                        ));
+                    };
+                    c.unit(&["mm"]);
+                    grow(g, &faces, d).ok_or_else(|| bad(vs, ve, &format!("`{name}` has no size to grow"), "no size", "`grow` changes a cylinder's, cone's or sphere's diameter, or the width between two opposed planes"))?
+                }
+                _ => {
+                    return Err(bad(
+                        vs,
+                        ve,
+                        "a feature or face can `move`, `tilt`, `shift` or `grow`",
+                        "expected a change",
+                        USAGE,
+                    ))
+                }
+            };
+            for (f, ch) in change {
+                let cur = &mut dev.faces[f.0];
+                cur.motion = ch.motion * cur.motion;
+                cur.grow += ch.grow;
+                cur.bow += ch.bow;
+            }
+        }
+        _ => {
+            return Err(bad(
+                s0,
+                e0,
+                &format!("`{kind}` is not something a deviation changes"),
+                "expected `feature`, `face`, `part` or `setup`",
+                USAGE,
+            ))
+        }
+    }
+    if c.k < toks.len() {
+        let (s, e) = c.span();
+        return Err(bad(
+            s,
+            e,
+            "a deviation line goes on past its change",
+            "unexpected",
+            USAGE,
+        ));
+    }
+    Ok(())
+}
+
+/// A size change: curved faces grow in diameter; two opposed planes move apart (a
+/// slot's walls into the material, a tab's out of it).
+fn grow(g: &PartGeometry, faces: &[FaceId], d: f64) -> Option<Vec<(FaceId, FaceChange)>> {
+    let planes: Vec<(FaceId, P3, V3)> = faces
+        .iter()
+        .filter_map(|f| match g.faces[f.0].surface {
+            Surface::Plane { origin, normal } => Some((*f, origin, normal)),
+            _ => None,
+        })
+        .collect();
+    let mut out = Vec::new();
+    for f in faces {
+        match g.faces[f.0].surface {
+            Surface::Cylinder { .. } | Surface::Cone { .. } | Surface::Sphere { .. } => out.push((
+                *f,
+                FaceChange {
+                    motion: Isometry3::identity(),
+                    grow: d,
+                    bow: 0.0,
+                },
+            )),
+            Surface::Plane { origin, normal } => {
+                // Its opposite wall: a plane of the feature facing the other way.
+                let (_, o2, _) = planes.iter().find(|(_, _, n2)| n2.dot(&normal) < -0.999)?;
+                let inner = (o2 - origin).dot(&normal) > 0.0;
+                let s = if inner { -d / 2.0 } else { d / 2.0 };
+                out.push((
+                    *f,
+                    FaceChange {
+                        motion: Isometry3::from_parts(
+                            Translation3::from(normal * s),
+                            UnitQuaternion::identity(),
+                        ),
+                        grow: 0.0,
+                        bow: 0.0,
+                    },
+                ));
+            }
+            Surface::Freeform => return None,
+        }
+    }
+    (!out.is_empty()).then_some(out)
+}

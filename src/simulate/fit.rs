@@ -1,0 +1,387 @@
+//! Least-squares fits of measured points, as a CMM's software fits them: a plane by its
+//! covariance's smallest eigenvector, a cylinder, cone and sphere by Levenberg–Marquardt
+//! on the geometric distances, started from the nominal (which the program states) and
+//! parametrised about it so a handful of points converges in a few steps. Points on one
+//! circle fix no axis direction: the direction (and a cone's angle) then stay nominal.
+
+use crate::geometry::{P3, V3};
+use nalgebra::{DMatrix, DVector, Matrix3, SymmetricEigen};
+
+/// A fitted (or nominal) shape, in whatever frame its points are. Directions are unit
+/// vectors; `p` is a point of the plane or axis.
+#[allow(missing_docs)]
+#[derive(Debug, Clone, PartialEq)]
+pub enum Shape {
+    /// A point on the plane and its unit normal.
+    Plane { p: P3, n: V3 },
+    /// A point on the axis, the unit axis, the radius.
+    Cylinder { p: P3, a: V3, r: f64 },
+    /// The apex, the unit axis into the cone, the half angle (radians).
+    Cone { apex: P3, a: V3, half: f64 },
+    /// Centre and radius.
+    Sphere { c: P3, r: f64 },
+    /// One point and its vector.
+    Point { p: P3, n: V3 },
+    /// Two opposed planes: the centre plane's point and normal, and the width.
+    Parpln { p: P3, n: V3, width: f64 },
+    /// No analytic shape (a free-form surface): the points are the feature.
+    Surface,
+}
+
+impl Shape {
+    /// The shape moved by a rigid motion.
+    pub fn moved(&self, m: &nalgebra::Isometry3<f64>) -> Shape {
+        match self {
+            Shape::Plane { p, n } => Shape::Plane { p: m * p, n: m * n },
+            Shape::Cylinder { p, a, r } => Shape::Cylinder {
+                p: m * p,
+                a: m * a,
+                r: *r,
+            },
+            Shape::Cone { apex, a, half } => Shape::Cone {
+                apex: m * apex,
+                a: m * a,
+                half: *half,
+            },
+            Shape::Sphere { c, r } => Shape::Sphere { c: m * c, r: *r },
+            Shape::Point { p, n } => Shape::Point { p: m * p, n: m * n },
+            Shape::Parpln { p, n, width } => Shape::Parpln {
+                p: m * p,
+                n: m * n,
+                width: *width,
+            },
+            Shape::Surface => Shape::Surface,
+        }
+    }
+
+    /// Its direction: a plane's normal, an axis; none for spheres and surfaces.
+    pub fn direction(&self) -> Option<V3> {
+        match self {
+            Shape::Plane { n, .. } | Shape::Point { n, .. } | Shape::Parpln { n, .. } => Some(*n),
+            Shape::Cylinder { a, .. } | Shape::Cone { a, .. } => Some(*a),
+            _ => None,
+        }
+    }
+
+    /// Its location: a point of the plane or axis, the apex, the centre.
+    pub fn location(&self) -> Option<P3> {
+        match self {
+            Shape::Plane { p, .. }
+            | Shape::Point { p, .. }
+            | Shape::Parpln { p, .. }
+            | Shape::Cylinder { p, .. } => Some(*p),
+            Shape::Cone { apex, .. } => Some(*apex),
+            Shape::Sphere { c, .. } => Some(*c),
+            Shape::Surface => None,
+        }
+    }
+
+    /// Its size: a diameter, a width; none otherwise.
+    pub fn size(&self) -> Option<f64> {
+        match self {
+            Shape::Cylinder { r, .. } | Shape::Sphere { r, .. } => Some(2.0 * r),
+            Shape::Parpln { width, .. } => Some(*width),
+            _ => None,
+        }
+    }
+
+    /// Signed distance of `q` from the shape, positive on the side the normal or the
+    /// radius points to (outside a cylinder, cone or sphere; above a plane).
+    pub fn signed(&self, q: &P3) -> f64 {
+        match self {
+            Shape::Plane { p, n } | Shape::Point { p, n } => (q - p).dot(n),
+            Shape::Cylinder { p, a, r } => {
+                let d = q - p;
+                (d - a * d.dot(a)).norm() - r
+            }
+            Shape::Cone { apex, a, half } => {
+                let d = q - apex;
+                let h = d.dot(a);
+                let rr = (d - a * h).norm();
+                rr * half.cos() - h * half.sin()
+            }
+            Shape::Sphere { c, r } => (q - c).norm() - r,
+            Shape::Parpln { p, n, width } => (q - p).dot(n).abs() - width / 2.0,
+            Shape::Surface => 0.0,
+        }
+    }
+
+    /// The shape offset by `d` along its outward sense (`convex`: the radius grows
+    /// outward; a hole's inward). A plane moves along its normal.
+    pub fn offset(&self, d: f64, convex: bool) -> Shape {
+        let s = if convex { d } else { -d };
+        match self {
+            Shape::Plane { p, n } => Shape::Plane {
+                p: p + n * d,
+                n: *n,
+            },
+            Shape::Cylinder { p, a, r } => Shape::Cylinder {
+                p: *p,
+                a: *a,
+                r: r + s,
+            },
+            Shape::Sphere { c, r } => Shape::Sphere { c: *c, r: r + s },
+            Shape::Cone { apex, a, half } => Shape::Cone {
+                apex: apex - a * (s / half.sin().max(1e-9)),
+                a: *a,
+                half: *half,
+            },
+            other => other.clone(),
+        }
+    }
+}
+
+/// Two unit vectors across `a`.
+pub fn across(a: &V3) -> (V3, V3) {
+    let helper = if a.x.abs() < 0.9 { V3::x() } else { V3::y() };
+    let u = helper.cross(a).normalize();
+    (u, a.cross(&u))
+}
+
+/// The least-squares plane; its normal on the side of `near`.
+pub fn plane(points: &[P3], near: &V3) -> Option<Shape> {
+    if points.len() < 3 {
+        return None;
+    }
+    let c = points.iter().fold(V3::zeros(), |s, q| s + q.coords) / points.len() as f64;
+    let m = points.iter().fold(Matrix3::zeros(), |s, q| {
+        let d = q.coords - c;
+        s + d * d.transpose()
+    });
+    let e = SymmetricEigen::new(m);
+    let mut idx = [0usize, 1, 2];
+    idx.sort_by(|&a, &b| e.eigenvalues[a].total_cmp(&e.eigenvalues[b]));
+    // Collinear points leave two small eigenvalues: no plane.
+    if e.eigenvalues[idx[1]] <= 1e-12 * e.eigenvalues[idx[2]].max(1e-300) {
+        return None;
+    }
+    let mut n: V3 = e.eigenvectors.column(idx[0]).into_owned().normalize();
+    if n.dot(near) < 0.0 {
+        n = -n;
+    }
+    Some(Shape::Plane { p: P3::from(c), n })
+}
+
+/// Whether the points spread along `a` (more than one circle).
+fn spread_along(points: &[P3], a: &V3) -> bool {
+    let (lo, hi) = points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
+            let t = q.coords.dot(a);
+            (l.min(t), h.max(t))
+        });
+    hi - lo > 1e-3
+}
+
+/// Levenberg–Marquardt on `residuals(x, out)` from `x`, numeric Jacobian.
+fn lm(x: &mut DVector<f64>, n: usize, residuals: &dyn Fn(&DVector<f64>, &mut DVector<f64>)) {
+    let m = x.len();
+    let mut r = DVector::zeros(n);
+    let mut r2 = DVector::zeros(n);
+    residuals(x, &mut r);
+    let mut cost = r.norm_squared();
+    let mut lambda = 1e-3;
+    for _ in 0..100 {
+        let mut j = DMatrix::zeros(n, m);
+        for k in 0..m {
+            let h = 1e-7 * x[k].abs().max(1.0);
+            let mut xk = x.clone();
+            xk[k] += h;
+            residuals(&xk, &mut r2);
+            for i in 0..n {
+                j[(i, k)] = (r2[i] - r[i]) / h;
+            }
+        }
+        let jt = j.transpose();
+        let jtj = &jt * &j;
+        let g = &jt * &r;
+        let mut improved = false;
+        for _ in 0..12 {
+            let mut a = jtj.clone();
+            for k in 0..m {
+                a[(k, k)] += lambda * (jtj[(k, k)].max(1e-12));
+            }
+            let Some(step) = a.lu().solve(&(-&g)) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let xn = &*x + &step;
+            residuals(&xn, &mut r2);
+            let c2 = r2.norm_squared();
+            if c2.is_finite() && c2 <= cost {
+                let small = step.norm() < 1e-12 * (1.0 + x.norm());
+                *x = xn;
+                std::mem::swap(&mut r, &mut r2);
+                let done = small || cost - c2 <= 1e-15 * (1.0 + cost);
+                cost = c2;
+                lambda = (lambda / 10.0).max(1e-12);
+                improved = !done;
+                break;
+            }
+            lambda *= 10.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+}
+
+/// The least-squares cylinder started from `guess`.
+pub fn cylinder(points: &[P3], guess: &Shape) -> Option<Shape> {
+    let Shape::Cylinder { p, a, r } = guess else {
+        return None;
+    };
+    // About the points' centroid along the axis, for conditioning.
+    let mean = points.iter().fold(V3::zeros(), |s, q| s + q.coords) / points.len().max(1) as f64;
+    let p0 = p + a * (mean - p.coords).dot(a);
+    let (u, v) = across(a);
+    let tilt = spread_along(points, a) && points.len() >= 5;
+    if points.len() < 3 {
+        return None;
+    }
+    let shape = |x: &DVector<f64>| -> (P3, V3, f64) {
+        let o = p0 + u * x[0] + v * x[1];
+        let ax = if tilt {
+            (a + u * x[3] + v * x[4]).normalize()
+        } else {
+            *a
+        };
+        (o, ax, x[2])
+    };
+    let mut x = DVector::from_vec(if tilt {
+        vec![0.0, 0.0, *r, 0.0, 0.0]
+    } else {
+        vec![0.0, 0.0, *r]
+    });
+    lm(&mut x, points.len(), &|x, out| {
+        let (o, ax, rr) = shape(x);
+        for (i, q) in points.iter().enumerate() {
+            let d = q - o;
+            out[i] = (d - ax * d.dot(&ax)).norm() - rr;
+        }
+    });
+    let (o, ax, rr) = shape(&x);
+    (rr.is_finite() && rr > 0.0).then_some(Shape::Cylinder { p: o, a: ax, r: rr })
+}
+
+/// The least-squares cone started from `guess`.
+pub fn cone(points: &[P3], guess: &Shape) -> Option<Shape> {
+    let Shape::Cone { apex, a, half } = guess else {
+        return None;
+    };
+    if points.len() < 3 {
+        return None;
+    }
+    let (u, v) = across(a);
+    let tilt = spread_along(points, a) && points.len() >= 6;
+    let shape = |x: &DVector<f64>| -> (P3, V3, f64) {
+        let ap = apex + u * x[0] + v * x[1] + a * x[2];
+        if tilt {
+            ((ap), (a + u * x[3] + v * x[4]).normalize(), *half + x[5])
+        } else {
+            (ap, *a, *half)
+        }
+    };
+    let mut x = DVector::from_vec(if tilt { vec![0.0; 6] } else { vec![0.0; 3] });
+    lm(&mut x, points.len(), &|x, out| {
+        let (ap, ax, h) = shape(x);
+        for (i, q) in points.iter().enumerate() {
+            let d = q - ap;
+            let t = d.dot(&ax);
+            let rr = (d - ax * t).norm();
+            out[i] = rr * h.cos() - t * h.sin();
+        }
+    });
+    let (ap, ax, h) = shape(&x);
+    (h.is_finite() && h > 0.0 && h < std::f64::consts::FRAC_PI_2).then_some(Shape::Cone {
+        apex: ap,
+        a: ax,
+        half: h,
+    })
+}
+
+/// The least-squares sphere started from `guess`.
+pub fn sphere(points: &[P3], guess: &Shape) -> Option<Shape> {
+    let Shape::Sphere { c, r } = guess else {
+        return None;
+    };
+    if points.len() < 4 {
+        return None;
+    }
+    let mut x = DVector::from_vec(vec![0.0, 0.0, 0.0, *r]);
+    lm(&mut x, points.len(), &|x, out| {
+        let cc = c + V3::new(x[0], x[1], x[2]);
+        for (i, q) in points.iter().enumerate() {
+            out[i] = (q - cc).norm() - x[3];
+        }
+    });
+    let cc = c + V3::new(x[0], x[1], x[2]);
+    (x[3].is_finite() && x[3] > 0.0).then_some(Shape::Sphere { c: cc, r: x[3] })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cylinder_is_found_from_a_nominal_off_by_a_little() {
+        let truth = (
+            P3::new(1.0, 2.0, 0.0),
+            V3::new(0.01, 0.0, 1.0).normalize(),
+            5.0,
+        );
+        let (u, v) = across(&truth.1);
+        let mut pts = Vec::new();
+        for h in [0.0, 10.0] {
+            for k in 0..4 {
+                let t = k as f64 * std::f64::consts::FRAC_PI_2 + 0.3;
+                pts.push(truth.0 + truth.1 * h + (u * t.cos() + v * t.sin()) * truth.2);
+            }
+        }
+        let guess = Shape::Cylinder {
+            p: P3::origin(),
+            a: V3::z(),
+            r: 5.2,
+        };
+        let Some(Shape::Cylinder { p, a, r }) = cylinder(&pts, &guess) else {
+            panic!("no fit");
+        };
+        assert!((r - 5.0).abs() < 1e-9, "{r}");
+        assert!(a.dot(&truth.1).abs() > 1.0 - 1e-12);
+        assert!((p - truth.0).cross(&truth.1).norm() < 1e-9);
+    }
+
+    #[test]
+    fn a_sphere_and_a_plane_fit_their_points() {
+        let c = P3::new(3.0, -1.0, 2.0);
+        let pts: Vec<P3> = [
+            (1.0, 0.0, 0.0),
+            (0.0, 1.0, 0.0),
+            (0.0, 0.0, 1.0),
+            (-0.6, 0.0, 0.8),
+            (0.0, -0.6, 0.8),
+        ]
+        .iter()
+        .map(|&(x, y, z)| c + V3::new(x, y, z) * 7.0)
+        .collect();
+        let Some(Shape::Sphere { c: cc, r }) = sphere(
+            &pts,
+            &Shape::Sphere {
+                c: P3::new(3.5, -1.0, 2.0),
+                r: 6.0,
+            },
+        ) else {
+            panic!("no fit");
+        };
+        assert!((cc - c).norm() < 1e-9 && (r - 7.0).abs() < 1e-9);
+        let flat = [
+            P3::new(0.0, 0.0, 1.0),
+            P3::new(1.0, 0.0, 1.0),
+            P3::new(0.0, 1.0, 1.0),
+        ];
+        let Some(Shape::Plane { n, .. }) = plane(&flat, &V3::z()) else {
+            panic!("no plane");
+        };
+        assert!((n - V3::z()).norm() < 1e-12);
+    }
+}

@@ -1,0 +1,1400 @@
+//! The virtual CMM's interpreter: one pass over the program's statements.
+
+use super::deviation::{Bow, Deviations};
+use super::errors::SimError;
+use super::evaluate::{self, Measured, TolDef};
+use super::fit::{self, Shape};
+use super::report::{Report, Row};
+use super::{Input, Options};
+use crate::access::pose::{Blocker, Contact, Pose, Solid};
+use crate::access::{ProbeShape, Scene};
+use crate::dmis::{Program, Statement};
+use crate::geometry::{FaceId, Surface, P3, V3};
+use crate::model::{Model, Plan};
+use crate::plan::poses::Setups;
+use crate::source::Span;
+use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, Unit, UnitQuaternion};
+use parry3d_f64::query::{Ray, RayCast};
+use std::collections::BTreeMap;
+
+/// What the virtual CMM runs.
+const SUPPORTED: &str = "DMISMN, UNITS/MM, MODE, SNSET, SNSDEF, SNSLCT, FEAT, TOL, TEXT, PAUSE, RECALL, ROTATE, DATSET, TRANS, GOTO, MEAS, PTMEAS, ENDMES, CONST, DATDEF, OUTPUT, ENDFIL";
+
+/// The step of the contact search along a touch's vector (mm); the contact is then
+/// bisected to a nanometre.
+const SEARCH_STEP: f64 = 0.01;
+
+/// The plan (index into `model.plans`) that wrote `program`: the one whose name its
+/// `DMISMN` carries.
+pub fn plan_of(
+    model: &Model,
+    program: &Program,
+    file: crate::source::FileId,
+    text: &str,
+) -> Result<usize, SimError> {
+    let (name, at) = program
+        .statements
+        .iter()
+        .find_map(|s| match s {
+            Statement::Command {
+                major, params, at, ..
+            } if major == "DMISMN" => Some((
+                params
+                    .first()
+                    .map(|p| p.trim_matches('\'').to_string())
+                    .unwrap_or_default(),
+                *at,
+            )),
+            _ => None,
+        })
+        .unwrap_or_default();
+    let found = model
+        .plans
+        .iter()
+        .position(|p| crate::dmis::text::plain(&p.name, 60) == name);
+    found.ok_or_else(|| SimError::NoPlan {
+        span: line_span(file, text, at),
+        program: name,
+        plans: if model.plans.is_empty() {
+            "none".into()
+        } else {
+            model
+                .plans
+                .iter()
+                .map(|p| format!("`{}`", p.name))
+                .collect::<Vec<_>>()
+                .join(", ")
+        },
+    })
+}
+
+fn line_span(file: crate::source::FileId, text: &str, at: usize) -> Span {
+    let at = at.min(text.len());
+    let end = text[at..].find('\n').map_or(text.len(), |e| at + e);
+    Span::new(file, at, end.max(at))
+}
+
+/// A feature measured, in the machine frame of its setup.
+#[derive(Debug, Clone)]
+struct Stored {
+    m: Measured,
+    /// Its setup, from 1.
+    setup: usize,
+}
+
+/// The setup the part stands in.
+struct SetupCtx {
+    /// Part frame → machine.
+    place: Isometry3<f64>,
+    /// The ram direction in the part frame.
+    up: V3,
+    /// The table's height along `up` (part frame).
+    table: f64,
+    /// The fixture's solids (part frame).
+    solids: Vec<Solid>,
+}
+
+/// An open `MEAS` block.
+struct Block {
+    label: String,
+    word: String,
+    /// (nominal point, nominal vector — program frame —, tip centre and vector —
+    /// machine frame —, tip radius).
+    touches: Vec<(P3, V3, P3, V3, f64)>,
+    at: usize,
+}
+
+/// A nominal from `FEAT`: its shape (program frame) and whether it is convex.
+#[derive(Debug, Clone)]
+struct Nominal {
+    shape: Shape,
+    convex: bool,
+}
+
+/// A sensor: its probe (slot) and head angles.
+#[derive(Debug, Clone, Copy)]
+struct Sensor {
+    slot: usize,
+    a: f64,
+    b: f64,
+}
+
+/// splitmix64 with Box–Muller: a small, portable, seeded Gaussian source.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    fn gauss(&mut self) -> f64 {
+        let (u, v) = (self.next(), self.next());
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+    }
+}
+
+struct Machine<'a> {
+    input: &'a Input<'a>,
+    opts: Options,
+    plan: &'a Plan,
+    scene: Scene,
+    setups: Setups<'a>,
+    probes: Vec<ProbeShape>,
+    exact: Vec<V3>,
+    centre: P3,
+    apprch: f64,
+    retrct: f64,
+    search: f64,
+    manual: bool,
+    sensors: BTreeMap<String, Sensor>,
+    sensor: Option<Sensor>,
+    nominals: BTreeMap<String, Nominal>,
+    tols: BTreeMap<String, TolDef>,
+    /// Program → machine: the current alignment.
+    frame: Isometry3<f64>,
+    saved: BTreeMap<String, Isometry3<f64>>,
+    setup: Option<SetupCtx>,
+    /// Per setup, its latest alignment.
+    aligns: Vec<Isometry3<f64>>,
+    /// Between setups: after a `RECALL`, before the next `PAUSE`, alignments belong to
+    /// the setup to come.
+    between: bool,
+    actuals: BTreeMap<String, Stored>,
+    datums: BTreeMap<String, (Stored, String)>,
+    block: Option<Block>,
+    /// The tip centre (part frame), when known.
+    at: Option<P3>,
+    rng: Rng,
+    rows: Vec<Row>,
+    sizes: BTreeMap<String, (f64, f64, f64)>,
+    touches: usize,
+    moves: usize,
+}
+
+/// Runs the program on the virtual CMM; the first problem stops the run, as on a
+/// machine.
+pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> {
+    let k = plan_of(input.model, input.program, input.file, input.text).map_err(|e| vec![e])?;
+    let plan = &input.model.plans[k];
+    let cmm = &input.model.cmms[plan.cmm.0];
+    let setups = Setups::new(input.model, plan, input.geometry, input.fixtures);
+    let exact = setups.exact_dirs();
+    let (lo, hi) = input.geometry.bounds();
+    let mut m = Machine {
+        input,
+        opts: *opts,
+        plan,
+        scene: Scene::of_part(input.geometry),
+        setups,
+        probes: ProbeShape::of_cmm(input.model, cmm),
+        exact,
+        centre: P3::from((lo.coords + hi.coords) / 2.0),
+        apprch: 2.0,
+        retrct: 2.0,
+        search: 4.0,
+        manual: false,
+        sensors: BTreeMap::new(),
+        sensor: None,
+        nominals: BTreeMap::new(),
+        tols: BTreeMap::new(),
+        frame: Isometry3::identity(),
+        saved: BTreeMap::new(),
+        setup: None,
+        aligns: Vec::new(),
+        between: false,
+        actuals: BTreeMap::new(),
+        datums: BTreeMap::new(),
+        block: None,
+        at: None,
+        rng: Rng(opts.seed ^ 0x5EED_1A5E_D00D_F00D),
+        rows: Vec::new(),
+        sizes: BTreeMap::new(),
+        touches: 0,
+        moves: 0,
+    };
+    for s in &input.program.statements {
+        let Statement::Command {
+            label,
+            major,
+            params,
+            at,
+        } = s
+        else {
+            continue;
+        };
+        m.statement(label.as_ref(), major, params, *at)
+            .map_err(|e| vec![e])?;
+    }
+    Ok(Report {
+        program: input
+            .program
+            .commands("DMISMN")
+            .next()
+            .and_then(|p| p.first())
+            .map(|p| p.trim_matches('\'').to_string())
+            .unwrap_or_default(),
+        plan: plan.name.clone(),
+        part: input.model.parts[plan.part.0].name.clone(),
+        setups: m.aligns.len(),
+        touches: m.touches,
+        moves: m.moves,
+        noise: opts.noise,
+        seed: opts.seed,
+        rows: m.rows,
+    })
+}
+
+fn label_of(p: &str) -> Option<&str> {
+    let (_, rest) = p.split_once('(')?;
+    rest.strip_suffix(')')
+}
+
+fn nums(params: &[String]) -> Vec<f64> {
+    params
+        .iter()
+        .filter_map(|p| p.parse::<f64>().ok())
+        .collect()
+}
+
+impl Machine<'_> {
+    fn span(&self, at: usize) -> Span {
+        line_span(self.input.file, self.input.text, at)
+    }
+
+    fn bad(&self, at: usize, what: &str, help: &str) -> SimError {
+        SimError::BadStatement {
+            span: self.span(at),
+            what: what.into(),
+            help: help.into(),
+        }
+    }
+
+    fn statement(
+        &mut self,
+        label: Option<&(String, String)>,
+        major: &str,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let word = |k: usize| params.get(k).map(String::as_str).unwrap_or("");
+        match major {
+            "DMISMN" | "TEXT" | "ENDFIL" => {}
+            "UNITS" => {
+                if word(0) != "MM" {
+                    return Err(self.unsupported(at, &format!("UNITS/{}", params.join(","))));
+                }
+            }
+            "MODE" => {
+                self.manual =
+                    params.iter().any(|p| p == "MAN") && !params.iter().any(|p| p == "PROG");
+                self.at = None;
+            }
+            "SNSET" => {
+                let v = nums(&params[1.min(params.len())..]).first().copied();
+                match (word(0), v) {
+                    ("APPRCH", Some(v)) => self.apprch = v,
+                    ("RETRCT", Some(v)) => self.retrct = v,
+                    ("SEARCH", Some(v)) => self.search = v,
+                    ("CLRSRF", Some(_)) => {}
+                    _ => return Err(self.unsupported(at, &format!("SNSET/{}", params.join(",")))),
+                }
+            }
+            "SNSDEF" => {
+                let Some((_, l)) = label else {
+                    return Err(self.bad(
+                        at,
+                        "SNSDEF without a label",
+                        "write `S(label)=SNSDEF/…`",
+                    ));
+                };
+                let s = self.sensor_def(l, params, at)?;
+                self.sensors.insert(l.clone(), s);
+            }
+            "SNSLCT" => {
+                let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
+                let Some(s) = self.sensors.get(l).copied() else {
+                    return Err(self.bad(
+                        at,
+                        &format!("sensor `{l}` is not defined"),
+                        "define it with SNSDEF first",
+                    ));
+                };
+                self.sensor = Some(s);
+                self.at = None;
+            }
+            "FEAT" => {
+                let Some((_, l)) = label else {
+                    return Err(self.bad(at, "FEAT without a label", "write `F(label)=FEAT/…`"));
+                };
+                let n = nominal(params)
+                    .ok_or_else(|| self.unsupported(at, &format!("FEAT/{}", word(0))))?;
+                self.nominals.insert(l.clone(), n);
+            }
+            "TOL" => {
+                let Some((_, l)) = label else {
+                    return Err(self.bad(at, "TOL without a label", "write `T(label)=TOL/…`"));
+                };
+                let def = TolDef::parse(params)
+                    .ok_or_else(|| self.unsupported(at, &format!("TOL/{}", params.join(","))))?;
+                self.tols.insert(l.clone(), def);
+            }
+            "PAUSE" => self.start_setup(at)?,
+            "RECALL" => {
+                let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
+                self.frame = if l == "MCS" {
+                    Isometry3::identity()
+                } else {
+                    *self.saved.get(l).ok_or_else(|| {
+                        self.bad(
+                            at,
+                            &format!("alignment `{l}` is not defined"),
+                            "RECALL an alignment saved before",
+                        )
+                    })?
+                };
+                self.between = l == "MCS";
+                self.realigned(label);
+            }
+            "ROTATE" => {
+                let axis = match word(0) {
+                    "XAXIS" => V3::x(),
+                    "YAXIS" => V3::y(),
+                    "ZAXIS" => V3::z(),
+                    _ => return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(",")))),
+                };
+                let Some(angle) = params.get(1).and_then(|p| p.parse::<f64>().ok()) else {
+                    return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(","))));
+                };
+                let q =
+                    UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), angle.to_radians());
+                self.frame = Isometry3::from_parts(self.frame.translation, self.frame.rotation * q);
+                self.realigned(label);
+            }
+            "DATSET" => {
+                self.frame = self.datset(params, at)?;
+                self.realigned(label);
+            }
+            "TRANS" => {
+                let mut o = self.frame.translation.vector;
+                for pair in params.chunks(2) {
+                    let k = match pair[0].as_str() {
+                        "XORIG" => 0,
+                        "YORIG" => 1,
+                        "ZORIG" => 2,
+                        _ => {
+                            return Err(self.unsupported(at, &format!("TRANS/{}", params.join(","))))
+                        }
+                    };
+                    let v = pair
+                        .get(1)
+                        .and_then(|p| p.parse::<f64>().ok())
+                        .ok_or_else(|| {
+                            self.bad(at, "TRANS without a value", "write `TRANS/XORIG,value`")
+                        })?;
+                    o += self.frame.rotation * (V3::ith(k, 1.0) * v);
+                }
+                self.frame = Isometry3::from_parts(Translation3::from(o), self.frame.rotation);
+                self.realigned(label);
+            }
+            "GOTO" => {
+                let v = nums(params);
+                if v.len() != 3 {
+                    return Err(self.bad(at, "GOTO takes x, y, z", "write `GOTO/x,y,z`"));
+                }
+                if !self.manual {
+                    let q = self.frame * P3::new(v[0], v[1], v[2]);
+                    self.move_to(q, at, "moving here")?;
+                }
+            }
+            "MEAS" => {
+                let l = params
+                    .get(1)
+                    .and_then(|p| label_of(p))
+                    .unwrap_or("")
+                    .to_string();
+                self.block = Some(Block {
+                    label: l,
+                    word: word(0).to_string(),
+                    touches: Vec::new(),
+                    at,
+                });
+            }
+            "PTMEAS" => self.ptmeas(params, at)?,
+            "ENDMES" => self.endmes(at)?,
+            "CONST" => self.construct(params, at)?,
+            "DATDEF" => {
+                let Some((_, d)) = label else {
+                    return Err(self.bad(
+                        at,
+                        "DATDEF without a label",
+                        "write `DAT(A)=DATDEF/FA(label)`",
+                    ));
+                };
+                let l = params
+                    .first()
+                    .and_then(|p| label_of(p))
+                    .unwrap_or("")
+                    .to_string();
+                let f = self.actuals.get(&l).cloned().ok_or_else(|| {
+                    self.bad(
+                        at,
+                        &format!("feature `{l}` is not measured"),
+                        "measure a datum feature before DATDEF",
+                    )
+                })?;
+                self.datums.insert(d.clone(), (f, l));
+            }
+            "OUTPUT" => self.output(params, at)?,
+            other => return Err(self.unsupported(at, other)),
+        }
+        Ok(())
+    }
+
+    fn unsupported(&self, at: usize, what: &str) -> SimError {
+        SimError::Unsupported {
+            span: self.span(at),
+            what: what.to_string(),
+            supported: SUPPORTED.into(),
+        }
+    }
+
+    /// After a statement that sets the alignment: saved under its label, and the
+    /// setup's latest.
+    fn realigned(&mut self, label: Option<&(String, String)>) {
+        if let Some((_, l)) = label {
+            self.saved.insert(l.clone(), self.frame);
+        }
+        if self.between {
+            return;
+        }
+        if let Some(last) = self.aligns.last_mut() {
+            *last = self.frame;
+        }
+    }
+
+    /// `SNSDEF/PROBE,FIXED,CART,0,0,-len,0,0,1,diam` or `…,INDEX,POL,a,b,VEC,i,j,k,len,diam`:
+    /// the probe of the plan's machine with that tip and length (the label names it when
+    /// several match).
+    fn sensor_def(&self, label: &str, params: &[String], at: usize) -> Result<Sensor, SimError> {
+        let v = nums(params);
+        let (a, b) = if params.get(1).map(String::as_str) == Some("INDEX") {
+            (
+                v.first().copied().unwrap_or(0.0),
+                v.get(1).copied().unwrap_or(0.0),
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        let diam = v.last().copied().unwrap_or(0.0);
+        let len = if params.get(1).map(String::as_str) == Some("INDEX") {
+            v.get(v.len().wrapping_sub(2)).copied().unwrap_or(0.0)
+        } else {
+            v.get(2).map(|x| -x).unwrap_or(0.0)
+        };
+        let cmm = &self.input.model.cmms[self.plan.cmm.0];
+        let matching: Vec<usize> = self
+            .probes
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| {
+                (2.0 * p.tip_radius - diam).abs() < 2e-4 && (p.reach() - len).abs() < 2e-4
+            })
+            .map(|(k, _)| k)
+            .collect();
+        let by_name = matching.iter().copied().find(|&k| {
+            let mut l = crate::dmis::text::Labels::default();
+            let base = l.fresh("S", &cmm.probes[k].0);
+            label == base || label.starts_with(&format!("{base}_"))
+        });
+        match by_name.or(matching.first().copied()) {
+            Some(slot) => Ok(Sensor { slot, a, b }),
+            None => Err(SimError::UnknownSensor {
+                span: self.span(at),
+                label: label.to_string(),
+                cmm: cmm.name.clone(),
+                probes: cmm
+                    .probes
+                    .iter()
+                    .zip(&self.probes)
+                    .map(|((n, _), p)| {
+                        format!(
+                            "`{n}` (tip Ø{} mm, {} mm long)",
+                            crate::dmis::text::num(2.0 * p.tip_radius),
+                            crate::dmis::text::num(p.reach())
+                        )
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            }),
+        }
+    }
+
+    /// `PAUSE`: the operator places the part for the next setup, where the current frame
+    /// says, off by the deviations' placement.
+    fn start_setup(&mut self, at: usize) -> Result<(), SimError> {
+        let k = self.aligns.len() + 1;
+        let r = self.frame.rotation;
+        let up_raw = r.inverse() * V3::z();
+        // The direction the setup names, to the precision the program writes angles.
+        let up = self
+            .exact
+            .iter()
+            .copied()
+            .filter(|d| (d - up_raw).norm() < 1e-3)
+            .min_by(|a, b| (a - up_raw).norm().total_cmp(&(b - up_raw).norm()))
+            .unwrap_or(up_raw);
+        let Some(holder) = self.setups.holder(&up) else {
+            return Err(SimError::NoSetup {
+                span: self.span(at),
+                setup: k,
+                plan: self.plan.name.clone(),
+                up: format!("{:.4}, {:.4}, {:.4}", up.x, up.y, up.z),
+            });
+        };
+        let solids = self.setups.solids(&holder, &up);
+        let table = self.setups.table(&holder, &up, &solids);
+        let p = self.input.deviations.placement_of(k);
+        let nominal = self.frame;
+        let c = nominal * self.centre;
+        let turn =
+            UnitQuaternion::from_axis_angle(&Unit::new_normalize(V3::z()), p.turn.to_radians());
+        let shift = V3::new(p.shift[0], p.shift[1], 0.0);
+        // x ↦ turn·(x − c) + c + shift, about the vertical through the part's centre.
+        let d = Isometry3::from_parts(Translation3::from(c.coords - turn * c.coords + shift), turn);
+        self.setup = Some(SetupCtx {
+            place: d * nominal,
+            up,
+            table,
+            solids,
+        });
+        self.aligns.push(self.frame);
+        self.between = false;
+        self.at = None;
+        Ok(())
+    }
+
+    fn ctx(&self, at: usize) -> Result<&SetupCtx, SimError> {
+        self.setup.as_ref().ok_or_else(|| {
+            self.bad(
+                at,
+                "a touch or move before the first setup's PAUSE",
+                "place the part (TEXT/OPER, PAUSE) before measuring",
+            )
+        })
+    }
+
+    fn sensor(&self, at: usize) -> Result<Sensor, SimError> {
+        self.sensor.ok_or_else(|| {
+            self.bad(
+                at,
+                "a touch or move with no sensor selected",
+                "select one with SNSLCT",
+            )
+        })
+    }
+
+    /// The probe posed in the current setup (part frame).
+    fn pose<'p>(&'p self, ctx: &'p SetupCtx, s: Sensor) -> Pose<'p> {
+        let probe = &self.probes[s.slot];
+        let dir = match probe.head {
+            crate::access::pose::Head::Fixed => ctx.up,
+            crate::access::pose::Head::Indexable => {
+                (ctx.place.rotation.inverse() * crate::access::head_direction(s.a, s.b)).normalize()
+            }
+        };
+        Pose::new(&self.scene, probe, dir, ctx.up, ctx.table).with_fixture(&ctx.solids)
+    }
+
+    fn collision(&self, at: usize, b: Blocker, during: &str) -> SimError {
+        let (what, obstacle) = match b {
+            Blocker::Tip => ("tip".to_string(), "the part"),
+            Blocker::TipOnTable => ("tip".to_string(), "the table"),
+            Blocker::Component(c) => (c, "the part"),
+            Blocker::ComponentOnTable(c) => (c, "the table"),
+            Blocker::Fixture(c) => (c, "the fixture"),
+        };
+        SimError::Collision {
+            span: self.span(at),
+            what,
+            obstacle: obstacle.to_string(),
+            during: during.to_string(),
+        }
+    }
+
+    /// A move of the tip centre to `q` (machine frame).
+    fn move_to(&mut self, q: P3, at: usize, during: &str) -> Result<(), SimError> {
+        let ctx = self.ctx(at)?;
+        let s = self.sensor(at)?;
+        let qp = ctx.place.inverse() * q;
+        let pose = self.pose(ctx, s);
+        let r = match self.at {
+            Some(p) => pose.segment(&p, &qp),
+            None => pose.free(&qp),
+        };
+        if let Err(b) = r {
+            return Err(self.collision(at, b, during));
+        }
+        self.moves += 1;
+        self.at = Some(qp);
+        Ok(())
+    }
+
+    /// A touch: approach, search for the surface, record the tip centre.
+    fn ptmeas(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let v = nums(params);
+        if v.len() != 6 {
+            return Err(self.bad(
+                at,
+                "PTMEAS takes x, y, z and a vector",
+                "write `PTMEAS/CART,x,y,z,i,j,k`",
+            ));
+        }
+        if self.block.is_none() {
+            return Err(self.bad(
+                at,
+                "PTMEAS outside a MEAS block",
+                "put touches between MEAS and ENDMES",
+            ));
+        }
+        let p = P3::new(v[0], v[1], v[2]);
+        let n = V3::new(v[3], v[4], v[5])
+            .try_normalize(1e-9)
+            .ok_or_else(|| {
+                self.bad(
+                    at,
+                    "PTMEAS with a zero vector",
+                    "give the surface's outward vector",
+                )
+            })?;
+        let s = self.sensor(at)?;
+        let r = self.probes[s.slot].tip_radius;
+        let ctx = self.ctx(at)?;
+        // Where the touch is on the part: the operator touches the point shown on the
+        // part itself; the machine goes where the alignment puts it.
+        let (pp, np) = if self.manual {
+            (p, n)
+        } else {
+            let inv = ctx.place.inverse() * self.frame;
+            (inv * p, inv * n)
+        };
+        // By hand, the operator starts as near the surface as there is room for.
+        let mut appr = self.apprch;
+        if self.manual {
+            let a = self.apprch;
+            let tries = [
+                a,
+                2.0 * a,
+                4.0 * a,
+                8.0 * a,
+                a / 2.0,
+                a / 4.0,
+                a / 8.0,
+                a / 16.0,
+            ];
+            appr = tries
+                .into_iter()
+                .find(|&x| {
+                    let c = pp + np * (r + x);
+                    !matches!(
+                        self.search_surface(ctx, &c, &np, r, x + self.search),
+                        Found::Inside
+                    )
+                })
+                .unwrap_or(a);
+        }
+        let c0 = pp + np * (r + appr);
+        if !self.manual {
+            self.move_to(ctx.place * c0, at, "on the way to the approach point")?;
+        }
+        let ctx = self.ctx(at)?;
+        let travel = appr + self.search;
+        let (centre, contact) = match self.search_surface(ctx, &c0, &np, r, travel) {
+            Found::Contact(c, k) => (c, k),
+            Found::Inside => {
+                return Err(SimError::InsidePart {
+                    span: self.span(at),
+                })
+            }
+            Found::Nothing => {
+                return Err(SimError::NoSurface {
+                    span: self.span(at),
+                    travel: crate::dmis::text::num(travel),
+                })
+            }
+        };
+        if !self.manual {
+            let pose = self.pose(ctx, s);
+            if let Err(b) = pose.approach(&(pp + np * r), &np, self.apprch, contact) {
+                return Err(self.collision(at, b, "on the touch's approach"));
+            }
+        }
+        let place = ctx.place;
+        let nw = self.frame.rotation * n;
+        let noise = if self.opts.noise > 0.0 {
+            self.opts.noise * self.rng.gauss()
+        } else {
+            0.0
+        };
+        let cw = place * centre + nw * noise;
+        self.touches += 1;
+        self.at = (!self.manual).then(|| centre + np * self.retrct);
+        if let Some(b) = self.block.as_mut() {
+            b.touches.push((p, n, cw, nw, r));
+        }
+        Ok(())
+    }
+
+    /// The first contact of the tip ball moving from centre `c0` along `−n` (part
+    /// frame) within `travel`: the part's face the foot of the ball meets on the mesh,
+    /// found exactly on its actual surface; or the table.
+    fn search_surface(&self, ctx: &SetupCtx, c0: &P3, n: &V3, r: f64, travel: f64) -> Found {
+        let g = self.input.geometry;
+        let dev: &Deviations = self.input.deviations;
+        let mut best: Option<(f64, Contact)> = None;
+        if let Some(mesh) = self.scene.mesh() {
+            let foot = c0 - n * r;
+            let ray = Ray::new(foot, -n);
+            let hit =
+                mesh.cast_ray_and_get_normal(&Isometry3::identity(), &ray, travel + 1.0, false);
+            if let Some(hit) = hit {
+                let tri = match hit.feature {
+                    parry3d_f64::shape::FeatureId::Face(i) => i as usize % g.triangles.len().max(1),
+                    _ => 0,
+                };
+                let face = FaceId(g.tri_face.get(tri).copied().unwrap_or(0) as usize);
+                let surface = dev.surface(g, face);
+                let bow = dev.bow_of(g, face);
+                let t = match free_side(&surface, bow) {
+                    Some(sd) => {
+                        let gap = |t: f64| sd(&(c0 - n * t)) - r;
+                        // A plane above the approach point, or the ball there in the
+                        // part (a concave face's distance is that of the whole bore: an
+                        // approach point past a fillet's axis is in the open).
+                        let planar = matches!(surface, Surface::Plane { .. });
+                        if gap(0.0) <= 0.0 && (planar || self.scene.distance(c0) < r) {
+                            return Found::Inside;
+                        }
+                        first_root(&gap, travel)
+                    }
+                    None => {
+                        // Free-form: the foot meets the face's triangles, moved.
+                        let m = dev
+                            .faces
+                            .get(face.0)
+                            .map(|c| c.motion)
+                            .unwrap_or_else(Isometry3::identity);
+                        let local = Ray::new(m.inverse() * foot, m.inverse() * -n);
+                        mesh.cast_ray(&Isometry3::identity(), &local, travel + 1.0, false)
+                            .filter(|t| *t <= travel)
+                    }
+                };
+                if let Some(t) = t {
+                    best = Some((t, Contact::Part));
+                }
+            }
+        }
+        let rise = n.dot(&ctx.up);
+        if rise > 1e-9 {
+            let t = ((c0.coords.dot(&ctx.up)) - r - ctx.table) / rise;
+            if (0.0..=travel).contains(&t) && best.is_none_or(|(b, _)| t < b) {
+                best = Some((t, Contact::Table));
+            }
+        }
+        match best {
+            Some((t, k)) => Found::Contact(c0 - n * t, k),
+            None => Found::Nothing,
+        }
+    }
+
+    /// `ENDMES`: the block's feature fitted to the tip centres and offset by the tip.
+    fn endmes(&mut self, at: usize) -> Result<(), SimError> {
+        let Some(b) = self.block.take() else {
+            return Err(self.bad(at, "ENDMES without MEAS", "open the block with MEAS"));
+        };
+        let nominal = self.nominals.get(&b.label).cloned().ok_or_else(|| {
+            self.bad(
+                b.at,
+                &format!("feature `{}` has no nominal", b.label),
+                "define it with FEAT before measuring it",
+            )
+        })?;
+        let r = b.touches.first().map(|t| t.4).unwrap_or(0.0);
+        let centres: Vec<P3> = b.touches.iter().map(|t| t.2).collect();
+        let guess = nominal.shape.moved(&self.frame);
+        let fitted = match b.word.as_str() {
+            "PLANE" => {
+                let near = guess.direction().unwrap_or(V3::z());
+                match centres.len() {
+                    // The manual alignment's secondary and tertiary: a plane through
+                    // two points square to the nominal normal, or one point with it.
+                    1 | 2 => {
+                        let c = P3::from(
+                            centres.iter().fold(V3::zeros(), |s, q| s + q.coords)
+                                / centres.len() as f64,
+                        );
+                        let n = match centres[..] {
+                            [a, b] => {
+                                let l = (b - a).normalize();
+                                (near - l * near.dot(&l)).try_normalize(1e-9)
+                            }
+                            _ => Some(near),
+                        };
+                        n.map(|n| Shape::Plane { p: c - n * r, n })
+                    }
+                    _ => fit::plane(&centres, &near).map(|s| s.offset(-r, true)),
+                }
+            }
+            "CYLNDR" => fit::cylinder(&centres, &guess.offset(r, nominal.convex))
+                .map(|s| s.offset(-r, nominal.convex)),
+            "CONE" => fit::cone(&centres, &guess.offset(r, nominal.convex))
+                .map(|s| s.offset(-r, nominal.convex)),
+            "SPHERE" => fit::sphere(&centres, &guess.offset(r, nominal.convex))
+                .map(|s| s.offset(-r, nominal.convex)),
+            "POINT" => b.touches.first().map(|t| Shape::Point {
+                p: t.2 - t.3 * t.4,
+                n: t.3,
+            }),
+            "GSURF" => Some(Shape::Surface),
+            other => return Err(self.unsupported(b.at, &format!("MEAS/{other}"))),
+        };
+        let Some(shape) = fitted else {
+            return Err(self.bad(
+                b.at,
+                &format!(
+                    "{} touches fit no {} to feature `{}`",
+                    b.touches.len(),
+                    b.word.to_lowercase(),
+                    b.label
+                ),
+                "a plane needs 3 touches off a line, a cylinder or cone 3 on a circle, a sphere 4",
+            ));
+        };
+        let touches = b
+            .touches
+            .iter()
+            .map(|t| (t.0, t.1, t.2 - t.3 * t.4))
+            .collect();
+        let setup = self.aligns.len();
+        self.actuals.insert(
+            b.label,
+            Stored {
+                m: Measured {
+                    shape,
+                    touches,
+                    median: Vec::new(),
+                },
+                setup,
+            },
+        );
+        Ok(())
+    }
+
+    /// A stored feature in the program frame: through its setup's latest alignment.
+    fn in_program(&self, f: &Stored) -> Measured {
+        let a = self
+            .aligns
+            .get(f.setup.wrapping_sub(1))
+            .copied()
+            .unwrap_or_else(Isometry3::identity);
+        f.m.moved(&a.inverse())
+    }
+
+    /// A stored feature in the current setup's machine frame.
+    fn in_machine(&self, f: &Stored) -> Measured {
+        if f.setup == self.aligns.len() {
+            f.m.clone()
+        } else {
+            self.in_program(f).moved(&self.frame)
+        }
+    }
+
+    fn feature(&self, p: &str, at: usize) -> Result<(String, &Stored), SimError> {
+        let l = label_of(p).unwrap_or("").to_string();
+        match self.actuals.get(&l) {
+            Some(f) => Ok((l, f)),
+            None => Err(self.bad(
+                at,
+                &format!("feature `{l}` is not measured"),
+                "measure a feature before using it",
+            )),
+        }
+    }
+
+    /// `CONST/type,F(label),BF,FA(…),…`: a best fit over the sources' points, or a centre
+    /// plane from two walls (`PARPLN`), in the program frame.
+    fn construct(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let word = params.first().cloned().unwrap_or_default();
+        let label = params
+            .get(1)
+            .and_then(|p| label_of(p))
+            .unwrap_or("")
+            .to_string();
+        let nominal = self.nominals.get(&label).cloned().ok_or_else(|| {
+            self.bad(
+                at,
+                &format!("feature `{label}` has no nominal"),
+                "define it with FEAT first",
+            )
+        })?;
+        let mut sources = Vec::new();
+        for p in params.iter().skip(3) {
+            let (_, f) = self.feature(p, at)?;
+            sources.push(self.in_program(f));
+        }
+        let touches: Vec<(P3, V3, P3)> = sources
+            .iter()
+            .flat_map(|s| s.touches.iter().copied())
+            .collect();
+        let pts: Vec<P3> = touches.iter().map(|t| t.2).collect();
+        let (shape, median) = match word.as_str() {
+            "PARPLN" => {
+                let [a, b] = &sources[..] else {
+                    return Err(self.bad(
+                        at,
+                        "a centre plane takes two walls",
+                        "write `CONST/PARPLN,F(mid),BF,FA(wall1),FA(wall2)`",
+                    ));
+                };
+                let (Shape::Plane { p: pa, n: na }, Shape::Plane { p: pb, n: nb }) =
+                    (&a.shape, &b.shape)
+                else {
+                    return Err(self.bad(
+                        at,
+                        "a centre plane's walls must be planes",
+                        "construct it from two measured planes",
+                    ));
+                };
+                let Some(nn) = nominal.shape.direction() else {
+                    return Err(self.bad(
+                        at,
+                        "a centre plane's nominal has no normal",
+                        "define it as FEAT/PARPLN",
+                    ));
+                };
+                let mut n = (na - nb).normalize();
+                if n.dot(&nn) < 0.0 {
+                    n = -n;
+                }
+                let centroid = |m: &Measured| {
+                    P3::from(
+                        m.touches.iter().fold(V3::zeros(), |s, t| s + t.2.coords)
+                            / m.touches.len().max(1) as f64,
+                    )
+                };
+                let (ca, cb) = (centroid(a), centroid(b));
+                let qa = ca - nb * (ca - pb).dot(nb);
+                let qb = cb - na * (cb - pa).dot(na);
+                let width = ((qa - ca).norm() + (qb - cb).norm()) / 2.0;
+                let mid = P3::from((ca.coords + qa.coords + cb.coords + qb.coords) / 4.0);
+                let mut median = Vec::new();
+                for (m, p, nw) in [(a, pa, na), (b, pb, nb)] {
+                    let s0 = (mid - p).dot(&n) / nw.dot(&n);
+                    median.extend(m.touches.iter().map(|t| t.2 + nw * s0));
+                }
+                (Shape::Parpln { p: mid, n, width }, median)
+            }
+            "PLANE" => (
+                fit::plane(&pts, &nominal.shape.direction().unwrap_or(V3::z())),
+                vec![],
+            )
+                .into_shape(),
+            "CYLNDR" => (fit::cylinder(&pts, &nominal.shape), vec![]).into_shape(),
+            "CONE" => (fit::cone(&pts, &nominal.shape), vec![]).into_shape(),
+            "SPHERE" => (fit::sphere(&pts, &nominal.shape), vec![]).into_shape(),
+            other => return Err(self.unsupported(at, &format!("CONST/{other}"))),
+        };
+        if matches!(shape, Shape::Surface) && word != "GSURF" {
+            return Err(self.bad(
+                at,
+                &format!(
+                    "{} points fit no {} to feature `{label}`",
+                    pts.len(),
+                    word.to_lowercase()
+                ),
+                "a plane needs 3 points off a line, a cylinder 5, a sphere 4",
+            ));
+        }
+        let m = Measured {
+            shape,
+            touches,
+            median,
+        }
+        .moved(&self.frame);
+        let setup = self.aligns.len();
+        self.actuals.insert(label, Stored { m, setup });
+        Ok(())
+    }
+
+    /// `DATSET/FA(f),[-]XDIR,XORIG,…`: the frame whose axes and origin the features
+    /// give; what they leave free comes from the current frame.
+    fn datset(&self, params: &[String], at: usize) -> Result<Isometry3<f64>, SimError> {
+        let mut dirs: Vec<(usize, V3)> = Vec::new();
+        let mut origins: Vec<(usize, Shape)> = Vec::new();
+        let mut cur: Option<Measured> = None;
+        let mut nominal_dir: Option<V3> = None;
+        for p in params {
+            if p.starts_with("FA(") {
+                let (l, f) = self.feature(p, at)?;
+                cur = Some(self.in_machine(f));
+                nominal_dir = self
+                    .nominals
+                    .get(&l)
+                    .and_then(|n| n.shape.direction())
+                    .map(|d| self.frame.rotation * d);
+                continue;
+            }
+            let Some(f) = &cur else {
+                return Err(self.bad(
+                    at,
+                    "DATSET keyword before any feature",
+                    "write `DATSET/FA(label),ZDIR,ZORIG,…`",
+                ));
+            };
+            let axis = |c: char| "XYZ".find(c);
+            let w = p.trim_start_matches('-');
+            if let Some(k) = w
+                .strip_suffix("DIR")
+                .and_then(|a| a.chars().next())
+                .and_then(axis)
+            {
+                let Some(mut d) = f.shape.direction() else {
+                    return Err(self.bad(
+                        at,
+                        "a DATSET direction from a feature without one",
+                        "directions come from planes and axes",
+                    ));
+                };
+                if nominal_dir.is_some_and(|nd| nd.dot(&d) < 0.0) {
+                    d = -d;
+                }
+                dirs.push((k, if p.starts_with('-') { -d } else { d }));
+            } else if let Some(k) = w
+                .strip_suffix("ORIG")
+                .and_then(|a| a.chars().next())
+                .and_then(axis)
+            {
+                origins.push((k, f.shape.clone()));
+            } else {
+                return Err(self.unsupported(at, &format!("DATSET keyword {p}")));
+            }
+        }
+        let old = self.frame.rotation.to_rotation_matrix().into_inner();
+        let mut e: [Option<V3>; 3] = [None, None, None];
+        let mut order: Vec<usize> = Vec::new();
+        for (k, d) in &dirs {
+            if e[*k].is_some() {
+                continue;
+            }
+            let mut v = *d;
+            for j in &order {
+                let ej = e[*j].expect("set");
+                v -= ej * v.dot(&ej);
+            }
+            let Some(v) = v.try_normalize(1e-6) else {
+                return Err(self.bad(
+                    at,
+                    "DATSET directions are parallel",
+                    "the secondary direction must cross the primary",
+                ));
+            };
+            if order.len() < 2 {
+                e[*k] = Some(v);
+                order.push(*k);
+            }
+        }
+        // Free axes from the current frame, across the fixed ones.
+        for j in 0..3 {
+            if order.len() >= 2 {
+                break;
+            }
+            if e[j].is_some() {
+                continue;
+            }
+            let mut v: V3 = old.column(j).into_owned();
+            for i in &order {
+                let ei = e[*i].expect("set");
+                v -= ei * v.dot(&ei);
+            }
+            if let Some(v) = v.try_normalize(0.1) {
+                e[j] = Some(v);
+                order.push(j);
+            }
+        }
+        let third = (0..3).find(|j| e[*j].is_none()).unwrap_or(2);
+        let (a, b) = ((third + 1) % 3, (third + 2) % 3);
+        e[third] = Some(e[a].expect("two axes").cross(&e[b].expect("two axes")));
+        let axes = [e[0].expect("x"), e[1].expect("y"), e[2].expect("z")];
+        // Origin: along each axis an ORIG names, the feature's location (a plane's
+        // touched centroid, a point of an axis, a centre); along the others the old
+        // origin's.
+        let o_old = self.frame.translation.vector;
+        let mut m = Matrix3::zeros();
+        let mut rhs = V3::zeros();
+        for k in 0..3 {
+            let at = match origins.iter().find(|(j, _)| *j == k).map(|(_, s)| s) {
+                Some(Shape::Surface) => {
+                    return Err(self.bad(
+                        at,
+                        "a DATSET origin from a free-form surface",
+                        "origins come from planes, axes and centres",
+                    ))
+                }
+                Some(s) => s.location().map_or(o_old, |p| p.coords),
+                None => o_old,
+            };
+            m.set_row(k, &axes[k].transpose());
+            rhs[k] = axes[k].dot(&at);
+        }
+        let Some(o) = m.lu().solve(&rhs) else {
+            return Err(self.bad(
+                at,
+                "DATSET origins do not meet in a point",
+                "each origin must come from a feature across its axis",
+            ));
+        };
+        let r = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&axes));
+        Ok(Isometry3::from_parts(
+            Translation3::from(o),
+            UnitQuaternion::from_rotation_matrix(&r),
+        ))
+    }
+
+    /// `OUTPUT/FA(…)[,FA(…)],TA(t)`: the tolerance evaluated on its features as the
+    /// program measured them, its datums as `DATDEF` defined them.
+    fn output(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let Some(tl) = params
+            .iter()
+            .find(|p| p.starts_with("TA("))
+            .and_then(|p| label_of(p))
+        else {
+            // A feature output alone reports nothing to judge.
+            return Ok(());
+        };
+        let def = self.tols.get(tl).cloned().ok_or_else(|| {
+            self.bad(
+                at,
+                &format!("tolerance `{tl}` is not defined"),
+                "define it with TOL before OUTPUT",
+            )
+        })?;
+        let mut labels = Vec::new();
+        let mut measured = Vec::new();
+        for p in params.iter().filter(|p| p.starts_with("FA(")) {
+            let (l, f) = self.feature(p, at)?;
+            measured.push(self.in_program(f));
+            labels.push(l);
+        }
+        let mut noms = Vec::new();
+        for l in &labels {
+            noms.push(self.nominals.get(l).cloned().ok_or_else(|| {
+                self.bad(
+                    at,
+                    &format!("feature `{l}` has no nominal"),
+                    "define it with FEAT",
+                )
+            })?);
+        }
+        let targets: Vec<evaluate::Target> = measured
+            .iter()
+            .zip(&noms)
+            .zip(&labels)
+            .map(|((m, n), l)| evaluate::Target {
+                measured: m,
+                nominal: &n.shape,
+                convex: n.convex,
+                size: self.sizes.get(l).copied(),
+            })
+            .collect();
+        let mut datums = Vec::new();
+        for d in &def.datums {
+            let (f, l) = self.datums.get(d).ok_or_else(|| {
+                self.bad(
+                    at,
+                    &format!("datum `{d}` is not defined"),
+                    "define it with DATDEF before the tolerance's OUTPUT",
+                )
+            })?;
+            let n = self
+                .nominals
+                .get(l)
+                .map(|n| n.shape.clone())
+                .unwrap_or(Shape::Surface);
+            datums.push((self.in_program(f).shape, n));
+        }
+        let out = evaluate::evaluate(&def, &targets, &datums);
+        if def.word == "DIAM" && labels.len() == 1 && out.actual.is_finite() {
+            let (lo, hi) = def.limits.unwrap_or((0.0, 0.0));
+            self.sizes.insert(labels[0].clone(), (out.nominal, lo, hi));
+        }
+        self.rows.push(Row {
+            tolerance: tl.to_string(),
+            kind: def.word.clone(),
+            features: labels,
+            datums: def.datums.clone(),
+            outcome: out,
+        });
+        Ok(())
+    }
+}
+
+/// A fit's result as a shape, or [`Shape::Surface`] when it failed (reported by the
+/// caller).
+trait IntoShape {
+    fn into_shape(self) -> (Shape, Vec<P3>);
+}
+
+impl IntoShape for (Option<Shape>, Vec<P3>) {
+    fn into_shape(self) -> (Shape, Vec<P3>) {
+        (self.0.unwrap_or(Shape::Surface), self.1)
+    }
+}
+
+/// What a touch's search finds.
+enum Found {
+    Contact(P3, Contact),
+    Inside,
+    Nothing,
+}
+
+/// The distance from the surface on the solid's free side, as a function; `None` for
+/// a free-form face.
+/// A distance function of a point.
+type Distance = Box<dyn Fn(&P3) -> f64>;
+
+fn free_side(s: &Surface, bow: Option<Bow>) -> Option<Distance> {
+    let sign = |convex: bool| if convex { 1.0 } else { -1.0 };
+    Some(match s.clone() {
+        Surface::Plane { origin, normal } => Box::new(move |x: &P3| {
+            let lift = bow.map_or(0.0, |b| b.at(&normal, x));
+            (x - origin).dot(&normal) - lift
+        }),
+        Surface::Cylinder {
+            origin,
+            axis,
+            radius,
+            convex,
+        } => {
+            let k = sign(convex);
+            Box::new(move |x: &P3| {
+                let d = x - origin;
+                k * ((d - axis * d.dot(&axis)).norm() - radius)
+            })
+        }
+        Surface::Cone {
+            apex,
+            axis,
+            half_angle,
+            convex,
+        } => {
+            let k = sign(convex);
+            Box::new(move |x: &P3| {
+                let d = x - apex;
+                let h = d.dot(&axis);
+                let r = (d - axis * h).norm();
+                k * (r * half_angle.cos() - h * half_angle.sin())
+            })
+        }
+        Surface::Sphere {
+            center,
+            radius,
+            convex,
+        } => {
+            let k = sign(convex);
+            Box::new(move |x: &P3| k * ((x - center).norm() - radius))
+        }
+        Surface::Freeform => return None,
+    })
+}
+
+/// The first `t` in `[0, max]` where `gap` falls from positive to zero, by steps then
+/// bisection.
+fn first_root(gap: &dyn Fn(f64) -> f64, max: f64) -> Option<f64> {
+    let steps = (max / SEARCH_STEP).ceil().max(1.0) as usize;
+    let mut lo = 0.0;
+    let mut armed = gap(0.0) > 0.0;
+    for k in 1..=steps {
+        let hi = (k as f64 * SEARCH_STEP).min(max);
+        let g = gap(hi);
+        if !armed {
+            armed = g > 0.0;
+            lo = hi;
+            continue;
+        }
+        if g <= 0.0 {
+            let (mut a, mut b) = (lo, hi);
+            for _ in 0..60 {
+                let m = 0.5 * (a + b);
+                if gap(m) > 0.0 {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            return Some(0.5 * (a + b));
+        }
+        lo = hi;
+    }
+    None
+}
+
+/// A nominal from `FEAT` parameters.
+fn nominal(params: &[String]) -> Option<Nominal> {
+    let word = params.first()?.as_str();
+    let convex = !params.iter().any(|p| p == "INNER");
+    let v = nums(params);
+    let p = |k: usize| Some(P3::new(*v.get(k)?, *v.get(k + 1)?, *v.get(k + 2)?));
+    let d = |k: usize| V3::new(*v.get(k)?, *v.get(k + 1)?, *v.get(k + 2)?).try_normalize(1e-9);
+    let shape = match word {
+        "PLANE" => Shape::Plane { p: p(0)?, n: d(3)? },
+        "POINT" => Shape::Point { p: p(0)?, n: d(3)? },
+        "CYLNDR" => Shape::Cylinder {
+            p: p(0)?,
+            a: d(3)?,
+            r: v.get(6)? / 2.0,
+        },
+        "CONE" => Shape::Cone {
+            apex: p(0)?,
+            a: d(3)?,
+            half: (v.get(6)? / 2.0).to_radians(),
+        },
+        "SPHERE" => Shape::Sphere {
+            c: p(0)?,
+            r: v.get(3)? / 2.0,
+        },
+        "PARPLN" => Shape::Parpln {
+            p: p(0)?,
+            n: d(3)?,
+            width: *v.get(6)?,
+        },
+        "GSURF" => Shape::Surface,
+        _ => return None,
+    };
+    Some(Nominal { shape, convex })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_noise_is_the_same_for_a_seed() {
+        let (mut a, mut b) = (Rng(7), Rng(7));
+        let xs: Vec<f64> = (0..4).map(|_| a.gauss()).collect();
+        let ys: Vec<f64> = (0..4).map(|_| b.gauss()).collect();
+        assert_eq!(xs, ys);
+        let mut c = Rng(8);
+        assert_ne!(xs[0], c.gauss());
+    }
+
+    #[test]
+    fn the_root_is_bisected_to_the_contact() {
+        let t = first_root(&|t| 3.25 - t, 10.0).expect("a root");
+        assert!((t - 3.25).abs() < 1e-9);
+        assert!(first_root(&|t| 30.0 - t, 10.0).is_none());
+    }
+}

@@ -1,0 +1,273 @@
+//! The virtual CMM (`inspc simulate`) on the golden programs: at nominal every
+//! tolerance is in with deviations near zero; a deviation beyond one tolerance's zone
+//! makes exactly that tolerance fail; a part placed off on the table is found by the
+//! alignment and measures the same; every way a run stops is a diagnostic.
+
+use inspc::simulate::{Options, Report};
+use inspc::source::FsWorld;
+use std::path::{Path, PathBuf};
+
+/// Runs `program` against `spec` with the deviations `dev` (file text), or fails with
+/// the run's diagnostics.
+fn run(spec: &str, program: &str, dev: Option<&str>, opts: Options) -> Result<Report, Vec<String>> {
+    let dev_path = dev.map(|text| {
+        let dir = std::env::temp_dir().join(format!("inspc-sim-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let name = format!(
+            "{:x}.dev",
+            text.bytes()
+                .fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64)
+                    .wrapping_mul(0x100_0000_01b3))
+        );
+        let p = dir.join(name);
+        std::fs::write(&p, text).expect("write deviations");
+        p
+    });
+    let r = inspc::simulate(
+        &FsWorld,
+        Path::new(spec),
+        Path::new(program),
+        dev_path.as_deref(),
+        &opts,
+    );
+    match r.report {
+        Some(rep) => Ok(rep),
+        None => Err(r.checked.diagnostics.iter().map(|d| d.code()).collect()),
+    }
+}
+
+fn nominal(spec: &str, program: &str) -> Report {
+    run(spec, program, None, Options::default()).unwrap_or_else(|e| panic!("{program}: {e:?}"))
+}
+
+/// The labels of the tolerance outputs out of tolerance.
+fn failing(r: &Report) -> Vec<String> {
+    let mut v: Vec<String> = r
+        .rows
+        .iter()
+        .filter(|x| !x.pass())
+        .map(|x| x.tolerance.clone())
+        .collect();
+    v.dedup();
+    v
+}
+
+const CTC01: (&str, &str) = (
+    "tests/real/nist_ctc_01.insp",
+    "tests/cases/real_nist_ctc_01/program.dmi",
+);
+const F2: (&str, &str) = ("examples/f2.insp", "tests/cases/example_f2/program.dmi");
+
+/// Every golden program, run at nominal: all in, every deviation within 2 µm.
+#[test]
+fn every_golden_program_measures_its_part_in_tolerance() {
+    let quick = std::env::var_os("INSPC_QUICK").is_some();
+    let mut cases: Vec<PathBuf> = std::fs::read_dir("tests/cases")
+        .expect("cases")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.join("program.dmi").exists())
+        .collect();
+    cases.sort();
+    let mut checked = 0;
+    for dir in cases {
+        let case = std::fs::read_to_string(dir.join("case.txt")).unwrap_or_default();
+        if quick && case.lines().any(|l| l.trim() == "slow") {
+            continue;
+        }
+        let spec = case
+            .lines()
+            .find_map(|l| l.strip_prefix("spec "))
+            .map(|s| s.trim().to_string())
+            .unwrap_or_else(|| dir.join("main.insp").display().to_string());
+        let program = dir.join("program.dmi").display().to_string();
+        let r = nominal(&spec, &program);
+        assert!(!r.rows.is_empty(), "{program}: no tolerance output");
+        for row in &r.rows {
+            let o = &row.outcome;
+            // A size on a face no analytic surface fits (a free-form piece of a
+            // fillet) has no size to judge: reported, not failed.
+            if row.unjudged() && row.kind != "DIAM" {
+                continue;
+            }
+            assert!(
+                row.pass(),
+                "{program}: {} on {:?} is out at nominal: {o:?}",
+                row.tolerance,
+                row.features
+            );
+            // A distance whose PMI nominal differs from the model's reads that difference
+            // (and says so in its note).
+            if o.note
+                .as_deref()
+                .is_some_and(|n| n.contains("differs from the geometry"))
+            {
+                continue;
+            }
+            let near = if o.nominal == 0.0 {
+                o.actual
+            } else {
+                o.deviation()
+            };
+            assert!(
+                near.abs() < 2e-3,
+                "{program}: {} on {:?} reads {near} at nominal",
+                row.tolerance,
+                row.features
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked >= 10, "only {checked} programs simulated");
+}
+
+/// For each kind of tolerance on a real part, a deviation past its zone fails it and
+/// only it.
+#[test]
+fn a_deviation_fails_exactly_the_tolerance_it_targets() {
+    let (spec, program) = CTC01;
+    let cases = [
+        ("feature bore_1 grow 0.3 mm", "BORE_1_SIZE"),
+        ("feature pin_1 grow -0.2", "PIN_1_SIZE"),
+        ("feature slot_a move (0.5, 0, 0) mm", "POS_SLOT_A"),
+        ("feature corner move (0, -0.8, 0)", "PROF_CORNER"),
+        (
+            "feature notch_left tilt 1 deg about (0, 0, 1)",
+            "NOTCH_ANGLE",
+        ),
+    ];
+    for (dev, target) in cases {
+        let r = run(spec, program, Some(dev), Options::default())
+            .unwrap_or_else(|e| panic!("{dev}: {e:?}"));
+        assert_eq!(failing(&r), vec![target.to_string()], "{dev}\n{}", r.text());
+    }
+    let (spec, program) = F2;
+    let r = run(
+        spec,
+        program,
+        Some("feature large_slot tilt 0.4 about (0, 1, 0)"),
+        Options::default(),
+    )
+    .expect("runs");
+    assert_eq!(failing(&r), vec!["T1".to_string()], "{}", r.text());
+}
+
+/// A hole of a pattern located from datum A alone: its place still counts.
+#[test]
+fn a_hole_of_a_pattern_moved_fails_its_position() {
+    let r = run(
+        "examples/swiss_block.insp",
+        "tests/cases/example_swiss_block/program.dmi",
+        Some("face grid[12].wall move (0.08, 0, 0)"),
+        Options::default(),
+    )
+    .expect("runs");
+    let out: Vec<_> = r.rows.iter().filter(|x| !x.pass()).collect();
+    assert_eq!(out.len(), 1, "{}", r.text());
+}
+
+/// A part placed 5 mm and 3° off on the table is found by the alignment: every
+/// tolerance reads what it read in place, to 10 µm (the compensation's cosine errors
+/// and the search's bisection differ with the pose).
+#[test]
+fn a_part_placed_off_is_found_by_the_alignment() {
+    for (spec, program, dev) in [
+        (
+            CTC01.0,
+            CTC01.1,
+            "setup 1 move (5, 0) mm\nsetup 1 turn 3 deg\n",
+        ),
+        (F2.0, F2.1, "part move (5, 2) mm\npart turn 3\n"),
+    ] {
+        let base = nominal(spec, program);
+        let off = run(spec, program, Some(dev), Options::default())
+            .unwrap_or_else(|e| panic!("{program}: {e:?}"));
+        assert_eq!(base.rows.len(), off.rows.len());
+        for (a, b) in base.rows.iter().zip(&off.rows) {
+            assert!(
+                (a.outcome.actual - b.outcome.actual).abs() < 0.01,
+                "{program}: {} reads {} in place and {} off",
+                a.tolerance,
+                a.outcome.actual,
+                b.outcome.actual
+            );
+        }
+    }
+}
+
+/// Noise is reproducible from its seed and moves the readings.
+#[test]
+fn noise_is_the_same_for_a_seed() {
+    let (spec, program) = F2;
+    let opts = |seed| Options { noise: 0.002, seed };
+    let a = run(spec, program, None, opts(3)).expect("runs");
+    let b = run(spec, program, None, opts(3)).expect("runs");
+    let c = run(spec, program, None, opts(4)).expect("runs");
+    assert_eq!(a, b);
+    assert_ne!(a.rows, c.rows);
+    assert!(a
+        .rows
+        .iter()
+        .all(|r| r.outcome.actual > 0.0 && r.outcome.actual < 0.05));
+}
+
+/// Every way a run stops is a diagnostic with its code.
+#[test]
+fn every_stop_is_a_diagnostic() {
+    let (spec, program) = F2;
+    let text = std::fs::read_to_string(program).expect("program");
+    let dir = std::env::temp_dir().join(format!("inspc-sim-edit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let edited = |name: &str, from: &str, to: &str| -> String {
+        assert!(text.contains(from), "{from}");
+        let p = dir.join(name);
+        std::fs::write(&p, text.replacen(from, to, 1)).expect("write");
+        p.display().to_string()
+    };
+    let code = |spec: &str, program: &str, dev: Option<&str>| -> Vec<String> {
+        run(spec, program, dev, Options::default())
+            .err()
+            .unwrap_or_default()
+    };
+    // A move through the part.
+    let p = edited(
+        "crash.dmi",
+        "MEAS/PLANE,F(TOP),4\n",
+        "GOTO/60,30,20\nMEAS/PLANE,F(TOP),4\n",
+    );
+    assert_eq!(code(spec, &p, None), vec!["insp::simulate::collision"]);
+    // A part placed off along a direction the alignment leaves free.
+    assert_eq!(
+        code(spec, program, Some("part move (0, 40)")),
+        vec!["insp::simulate::no_surface"]
+    );
+    // A wall standing 3 mm proud of its nominal.
+    assert_eq!(
+        code(spec, program, Some("face large.left_wall shift 3")),
+        vec!["insp::simulate::inside_part"]
+    );
+    // Deviations that name nothing.
+    assert_eq!(
+        code(spec, program, Some("feature larg_slot move (1, 0, 0)")),
+        vec!["insp::simulate::bad_deviation"]
+    );
+    assert_eq!(
+        code(spec, program, Some("face stock.top grow 1")),
+        vec!["insp::simulate::bad_deviation"]
+    );
+    // A program of another plan, a probe the machine lacks, a statement it does not run,
+    // a setup nothing holds, a touch with no sensor.
+    let p = edited("other.dmi", "DMISMN/'F2_PLAN'", "DMISMN/'OTHER'");
+    assert_eq!(code(spec, &p, None), vec!["insp::simulate::no_plan"]);
+    let p = edited("sensor.dmi", "0,0,1,4\n", "0,0,1,7\n");
+    assert_eq!(code(spec, &p, None), vec!["insp::simulate::unknown_sensor"]);
+    let p = edited(
+        "call.dmi",
+        "MODE/PROG,MAN\n",
+        "MODE/PROG,MAN\nCALL/EXTERN,DME,'X'\n",
+    );
+    assert_eq!(code(spec, &p, None), vec!["insp::simulate::unsupported"]);
+    let p = edited("tilted.dmi", "PAUSE\n", "D(TILT)=ROTATE/XAXIS,45\nPAUSE\n");
+    assert_eq!(code(spec, &p, None), vec!["insp::simulate::no_setup"]);
+    let p = edited("nosensor.dmi", "SNSLCT/S(P1)\n", "");
+    assert_eq!(code(spec, &p, None), vec!["insp::simulate::bad_statement"]);
+}
