@@ -536,19 +536,7 @@ fn one_line(
                         Translation3::new(v[0], v[1], v[2]),
                         UnitQuaternion::identity(),
                     );
-                    faces
-                        .iter()
-                        .map(|f| {
-                            (
-                                *f,
-                                FaceChange {
-                                    motion: m,
-                                    grow: 0.0,
-                                    bow: 0.0,
-                                },
-                            )
-                        })
-                        .collect()
+                    rigid(&faces, m)
                 }
                 Some("tilt") => {
                     let Some(a) = c.num() else {
@@ -579,19 +567,7 @@ fn one_line(
                         Translation3::from(centroid.coords - r * centroid.coords),
                         r,
                     );
-                    faces
-                        .iter()
-                        .map(|f| {
-                            (
-                                *f,
-                                FaceChange {
-                                    motion: m,
-                                    grow: 0.0,
-                                    bow: 0.0,
-                                },
-                            )
-                        })
-                        .collect()
+                    rigid(&faces, m)
                 }
                 Some("shift") => {
                     let Some(d) = c.num() else {
@@ -707,6 +683,15 @@ fn one_line(
         ));
     }
     Ok(())
+}
+
+/// Every face moved by `m`.
+fn rigid(faces: &[FaceId], m: Isometry3<f64>) -> Vec<(FaceId, FaceChange)> {
+    let change = FaceChange {
+        motion: m,
+        ..FaceChange::default()
+    };
+    faces.iter().map(|f| (*f, change.clone())).collect()
 }
 
 /// A size change: curved faces grow in diameter; two opposed planes move apart (a
