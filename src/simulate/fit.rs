@@ -29,6 +29,59 @@ pub enum Shape {
 }
 
 impl Shape {
+    /// A face's analytic surface as a shape, with whether the solid is outside it (a
+    /// shaft rather than a hole); `None` for a free-form face.
+    pub fn of_surface(s: &crate::geometry::Surface) -> Option<(Shape, bool)> {
+        use crate::geometry::Surface;
+        Some(match s {
+            Surface::Plane { origin, normal } => (
+                Shape::Plane {
+                    p: *origin,
+                    n: *normal,
+                },
+                true,
+            ),
+            Surface::Cylinder {
+                origin,
+                axis,
+                radius,
+                convex,
+            } => (
+                Shape::Cylinder {
+                    p: *origin,
+                    a: *axis,
+                    r: *radius,
+                },
+                *convex,
+            ),
+            Surface::Cone {
+                apex,
+                axis,
+                half_angle,
+                convex,
+            } => (
+                Shape::Cone {
+                    apex: *apex,
+                    a: *axis,
+                    half: *half_angle,
+                },
+                *convex,
+            ),
+            Surface::Sphere {
+                center,
+                radius,
+                convex,
+            } => (
+                Shape::Sphere {
+                    c: *center,
+                    r: *radius,
+                },
+                *convex,
+            ),
+            Surface::Freeform => return None,
+        })
+    }
+
     /// The shape moved by a rigid motion.
     pub fn moved(&self, m: &nalgebra::Isometry3<f64>) -> Shape {
         match self {

@@ -1,6 +1,6 @@
 //! The virtual CMM's interpreter: one pass over the program's statements.
 
-use super::deviation::{Bow, Deviations};
+use super::deviation::Deviations;
 use super::errors::SimError;
 use super::evaluate::{self, Measured, TolDef};
 use super::fit::{self, Shape};
@@ -9,7 +9,7 @@ use super::{Input, Options};
 use crate::access::pose::{Blocker, Contact, Pose, Solid};
 use crate::access::{ProbeShape, Scene};
 use crate::dmis::{Program, Statement};
-use crate::geometry::{FaceId, Surface, P3, V3};
+use crate::geometry::{FaceId, P3, V3};
 use crate::model::{Model, Plan};
 use crate::plan::poses::Setups;
 use crate::source::Span;
@@ -769,13 +769,22 @@ impl Machine<'_> {
                 let face = FaceId(g.tri_face.get(tri).copied().unwrap_or(0) as usize);
                 let surface = dev.surface(g, face);
                 let bow = dev.bow_of(g, face);
-                let t = match free_side(&surface, bow) {
-                    Some(sd) => {
-                        let gap = |t: f64| sd(&(c0 - n * t)) - r;
+                let t = match Shape::of_surface(&surface) {
+                    Some((shape, convex)) => {
+                        // The distance on the solid's free side, less any bow.
+                        let k = if convex { 1.0 } else { -1.0 };
+                        let gap = |t: f64| {
+                            let x = c0 - n * t;
+                            let lift = match (bow, shape.direction()) {
+                                (Some(b), Some(normal)) => b.at(&normal, &x),
+                                _ => 0.0,
+                            };
+                            k * shape.signed(&x) - lift - r
+                        };
                         // A plane above the approach point, or the ball there in the
                         // part (a concave face's distance is that of the whole bore: an
                         // approach point past a fillet's axis is in the open).
-                        let planar = matches!(surface, Surface::Plane { .. });
+                        let planar = matches!(shape, Shape::Plane { .. });
                         if gap(0.0) <= 0.0 && (planar || self.scene.distance(c0) < r) {
                             return Found::Inside;
                         }
@@ -951,7 +960,7 @@ impl Machine<'_> {
             .flat_map(|s| s.touches.iter().copied())
             .collect();
         let pts: Vec<P3> = touches.iter().map(|t| t.2).collect();
-        let (shape, median) = match word.as_str() {
+        let fitted = match word.as_str() {
             "PARPLN" => {
                 let [a, b] = &sources[..] else {
                     return Err(self.bad(
@@ -996,19 +1005,17 @@ impl Machine<'_> {
                     let s0 = (mid - p).dot(&n) / nw.dot(&n);
                     median.extend(m.touches.iter().map(|t| t.2 + nw * s0));
                 }
-                (Shape::Parpln { p: mid, n, width }, median)
+                Some((Shape::Parpln { p: mid, n, width }, median))
             }
-            "PLANE" => (
-                fit::plane(&pts, &nominal.shape.direction().unwrap_or(V3::z())),
-                vec![],
-            )
-                .into_shape(),
-            "CYLNDR" => (fit::cylinder(&pts, &nominal.shape), vec![]).into_shape(),
-            "CONE" => (fit::cone(&pts, &nominal.shape), vec![]).into_shape(),
-            "SPHERE" => (fit::sphere(&pts, &nominal.shape), vec![]).into_shape(),
+            "PLANE" => {
+                fit::plane(&pts, &nominal.shape.direction().unwrap_or(V3::z())).map(|s| (s, vec![]))
+            }
+            "CYLNDR" => fit::cylinder(&pts, &nominal.shape).map(|s| (s, vec![])),
+            "CONE" => fit::cone(&pts, &nominal.shape).map(|s| (s, vec![])),
+            "SPHERE" => fit::sphere(&pts, &nominal.shape).map(|s| (s, vec![])),
             other => return Err(self.unsupported(at, &format!("CONST/{other}"))),
         };
-        if matches!(shape, Shape::Surface) && word != "GSURF" {
+        let Some((shape, median)) = fitted else {
             return Err(self.bad(
                 at,
                 &format!(
@@ -1018,7 +1025,7 @@ impl Machine<'_> {
                 ),
                 "a plane needs 3 points off a line, a cylinder 5, a sphere 4",
             ));
-        }
+        };
         let m = Measured {
             shape,
             touches,
@@ -1242,73 +1249,11 @@ impl Machine<'_> {
     }
 }
 
-/// A fit's result as a shape, or [`Shape::Surface`] when it failed (reported by the
-/// caller).
-trait IntoShape {
-    fn into_shape(self) -> (Shape, Vec<P3>);
-}
-
-impl IntoShape for (Option<Shape>, Vec<P3>) {
-    fn into_shape(self) -> (Shape, Vec<P3>) {
-        (self.0.unwrap_or(Shape::Surface), self.1)
-    }
-}
-
 /// What a touch's search finds.
 enum Found {
     Contact(P3, Contact),
     Inside,
     Nothing,
-}
-
-/// The distance from the surface on the solid's free side, as a function; `None` for
-/// a free-form face.
-/// A distance function of a point.
-type Distance = Box<dyn Fn(&P3) -> f64>;
-
-fn free_side(s: &Surface, bow: Option<Bow>) -> Option<Distance> {
-    let sign = |convex: bool| if convex { 1.0 } else { -1.0 };
-    Some(match s.clone() {
-        Surface::Plane { origin, normal } => Box::new(move |x: &P3| {
-            let lift = bow.map_or(0.0, |b| b.at(&normal, x));
-            (x - origin).dot(&normal) - lift
-        }),
-        Surface::Cylinder {
-            origin,
-            axis,
-            radius,
-            convex,
-        } => {
-            let k = sign(convex);
-            Box::new(move |x: &P3| {
-                let d = x - origin;
-                k * ((d - axis * d.dot(&axis)).norm() - radius)
-            })
-        }
-        Surface::Cone {
-            apex,
-            axis,
-            half_angle,
-            convex,
-        } => {
-            let k = sign(convex);
-            Box::new(move |x: &P3| {
-                let d = x - apex;
-                let h = d.dot(&axis);
-                let r = (d - axis * h).norm();
-                k * (r * half_angle.cos() - h * half_angle.sin())
-            })
-        }
-        Surface::Sphere {
-            center,
-            radius,
-            convex,
-        } => {
-            let k = sign(convex);
-            Box::new(move |x: &P3| k * ((x - center).norm() - radius))
-        }
-        Surface::Freeform => return None,
-    })
 }
 
 /// The first `t` in `[0, max]` where `gap` falls from positive to zero, by steps then
