@@ -728,8 +728,18 @@ impl Machine<'_> {
             }
         };
         if !self.manual {
+            // The tip stops at the actual surface: where that stands proud of the
+            // nominal (a moved face, or a frame off by a moved datum) the approach ends
+            // there, on the machine's first contact; where it lies deeper the search
+            // itself covered the way down from the nominal touch.
+            let nominal = pp + np * r;
+            let outer = if (centre - nominal).dot(&np) > 0.0 {
+                centre
+            } else {
+                nominal
+            };
             let pose = self.pose(ctx, s);
-            if let Err(b) = pose.approach(&(pp + np * r), &np, self.apprch, contact) {
+            if let Err(b) = pose.approach(&outer, &np, self.apprch, contact) {
                 return Err(self.collision(at, b, "on the touch's approach"));
             }
         }
