@@ -683,7 +683,36 @@ impl Writer<'_> {
                 ptmeas(&mut self.o, hlip, k);
             }
             self.o.stmt("ENDMES");
-            fa.push(format!("FA({label}),{}", step.keywords.join(",")));
+            // A direction is the `FEAT`'s: where the feature's nominal axis (its first
+            // face's) runs against the touched face's (the other half of a split bore),
+            // the keyword's sign turns with it.
+            let axis = |n: Option<&Nominal>| match n {
+                Some(Nominal::Surface(
+                    Surface::Cylinder { axis, .. } | Surface::Cone { axis, .. },
+                    _,
+                )) => Some(*axis),
+                _ => None,
+            };
+            let face = g
+                .blocks
+                .get(step.block)
+                .and_then(|b| nominal_of(self.input, b));
+            let against = matches!(
+                (axis(self.nominals.get(&label)), axis(face.as_ref())),
+                (Some(a), Some(b)) if a.dot(&b) < 0.0
+            );
+            let keywords: Vec<String> = step
+                .keywords
+                .iter()
+                .map(
+                    |k| match (against, k.ends_with("DIR"), k.strip_prefix('-')) {
+                        (true, true, Some(k)) => k.to_string(),
+                        (true, true, None) => format!("-{k}"),
+                        _ => k.clone(),
+                    },
+                )
+                .collect();
+            fa.push(format!("FA({label}),{}", keywords.join(",")));
         }
         let shifts: Vec<String> = al
             .trans

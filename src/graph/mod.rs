@@ -282,23 +282,38 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
 
 /// The strategy for a face: the override of the first feature (in declaration order)
 /// that has one and lists the face (`owners`, sorted), else the sampling's strategy for
-/// its surface type.
+/// its surface type, raised to [`FORM_POINTS`] on a plane whose flatness is toleranced.
 fn strategy_for(input: &Input, face: FaceId, owners: &[FeatureId]) -> Strategy {
-    owners
-        .iter()
-        .find_map(|f| {
-            input
-                .overrides
-                .iter()
-                .find(|(o, _)| o == f)
-                .map(|(_, s)| s.clone())
-        })
-        .unwrap_or_else(|| {
-            input
-                .sampling
-                .strategy(input.geometry.faces[face.0].surface.kind())
-        })
+    if let Some(s) = owners.iter().find_map(|f| {
+        input
+            .overrides
+            .iter()
+            .find(|(o, _)| o == f)
+            .map(|(_, s)| s.clone())
+    }) {
+        return s;
+    }
+    let kind = input.geometry.faces[face.0].surface.kind();
+    let base = input.sampling.strategy(kind);
+    let form = input.part.tolerances.iter().any(|t| {
+        matches!(t.kind, TolKind::Flatness | TolKind::Straightness)
+            && t.targets.iter().any(|f| owners.contains(f))
+    });
+    if !form || kind != SurfaceKind::Plane {
+        return base;
+    }
+    // Fan & Leu's 4 points fix a plane's place, not its form: four points at the corners
+    // of one rectangle lie on one plane whatever the face does between them (a bowed
+    // face reads flat). The sampler fills in points between them up to the count.
+    Strategy {
+        points: Some(base.points.unwrap_or(0).max(FORM_POINTS)),
+        ..base
+    }
 }
+
+/// The fewest points a plane whose flatness is toleranced gets unless the spec says
+/// otherwise for its feature: a 3 × 3 grid, the least that sees a face bow or twist.
+pub const FORM_POINTS: u32 = 9;
 
 /// The surface types a tolerance kind applies to; `None` for kinds that apply to any.
 fn surfaces_for(kind: TolKind) -> Option<&'static [SurfaceKind]> {

@@ -2,7 +2,9 @@
 //! the program cannot know where it is, so the operator touches a few points by hand —
 //! 3 on a primary plane, 2 on a secondary, 1 on a tertiary (3-2-1) — and `DATSET` builds
 //! the part's frame from them. Features are chosen among those the setup inspects:
-//! datum features first in datum order, then the largest faces; a plane qualifies when
+//! datum features first in datum order, then features no tolerance reads against a datum
+//! (a feature the frame is built on reads perfect in it), then the rest, the largest
+//! faces first in each; a plane qualifies when
 //! its normal is a part axis, a cylinder when its axis is, so that every feature maps
 //! onto `XDIR`/`YDIR`/`ZDIR` and `XORIG`/`YORIG`/`ZORIG`. A cylinder on the primary's
 //! axis (a bore in the primary face) can stand in for the secondary's origins, a sphere
@@ -12,6 +14,7 @@
 use super::{Hlip, SetupPath};
 use crate::access::Contact;
 use crate::geometry::{Surface, P3, V3};
+use crate::model::FeatureId;
 use crate::plan::Input;
 
 /// A setup's alignment.
@@ -85,7 +88,18 @@ impl Shape {
 /// Chooses the alignment of one setup from its groups' blocks.
 pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
     let geometry = input.geometry;
-    // Candidates: (rank, -area, group, block, shape, points in tour order).
+    // Features whose tolerances refer to datums: aligned on, such a feature sets the
+    // frame its own tolerance is read in (moved, it would read perfect).
+    let part = &input.model.parts[input.plan.part.0];
+    let referenced: Vec<FeatureId> = part
+        .tolerances
+        .iter()
+        .filter(|t| !t.datums.is_empty())
+        .flat_map(|t| t.targets.iter().copied())
+        .collect();
+    // Candidates: (rank, -area, group, block, shape, points in tour order); the rank is
+    // datum features first in datum order, then features no tolerance reads against
+    // datums, then the rest.
     let mut cands = Vec::new();
     for (gi, g) in sp.groups.iter().enumerate() {
         for (bi, b) in g.blocks.iter().enumerate() {
@@ -122,7 +136,11 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
                 }
             };
             let Some(shape) = shape else { continue };
-            let rank = b.datum.map_or(usize::MAX, |d| d.0);
+            let rank = match (b.datum, b.feature) {
+                (Some(d), _) => (0, d.0),
+                (None, Some(f)) if referenced.contains(&f) => (2, 0),
+                _ => (1, 0),
+            };
             let area = f.map_or(0.0, |f| f.area);
             cands.push((rank, -area, gi, bi, shape, points));
         }
@@ -138,11 +156,13 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
     let mut dirs: Vec<usize> = Vec::new();
     let mut origins = [false; 3];
     let mut used = vec![false; cands.len()];
-    let spread = |pts: &[usize], n: usize| -> Option<Vec<usize>> {
+    // `n` of `pts`, each as far as it can be from those chosen before (positions seen
+    // through `view`: a bore's points are spread by their angle about its axis).
+    let spread_by = |pts: &[usize], n: usize, view: &dyn Fn(&P3) -> P3| -> Option<Vec<usize>> {
         if pts.len() < n {
             return None;
         }
-        let pos = |k: usize| hlip.points[k].position;
+        let pos = |k: usize| view(&hlip.points[k].position);
         let mut chosen = vec![pts[0]];
         while chosen.len() < n {
             let next = pts
@@ -161,9 +181,49 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
         }
         Some(chosen)
     };
-    // Primary, secondary, tertiary: three passes over the candidates.
+    let spread = |pts: &[usize], n: usize| spread_by(pts, n, &|p: &P3| *p);
+    // A bore touched by hand: circles of `per_level` points at `levels` heights along
+    // its axis (most-touched heights first), each circle's points spread round it; the
+    // points of one height alone say nothing of the centre across them.
+    let round = |pts: &[usize], axis: usize, levels: usize, per_level: usize| {
+        let mut by_level: Vec<(i64, Vec<usize>)> = Vec::new();
+        for &k in pts {
+            let h = (hlip.points[k].position[axis] * 1e3).round() as i64;
+            match by_level.iter_mut().find(|(x, _)| *x == h) {
+                Some((_, v)) => v.push(k),
+                None => by_level.push((h, vec![k])),
+            }
+        }
+        by_level.sort_by(|a, b| b.1.len().cmp(&a.1.len()).then(a.0.cmp(&b.0)));
+        let flat = |p: &P3| {
+            let mut q = *p;
+            q[axis] = 0.0;
+            q
+        };
+        let mut out = Vec::new();
+        for (_, at) in by_level.iter().take(levels) {
+            out.extend(spread_by(at, per_level.min(at.len()).max(3), &flat)?);
+        }
+        (by_level.len() >= levels).then_some(out)
+    };
+    let is_datum = |ci: usize| cands[ci].0 .0 == 0;
+    let datum_bore = |primary: usize| {
+        cands.iter().any(|c| {
+            c.0 .0 == 0
+                && c.5.len() >= 4
+                && matches!(c.4, Shape::Cylinder { axis, .. } if axis == primary)
+        })
+    };
+    // A secondary plane fixes the turn about the primary that a bore cannot: planes are
+    // tried first there, whatever their rank.
+    let passes = |stage: usize| if stage == 1 { 2 } else { 1 };
     for stage in 0..3 {
-        for (ci, (_, _, gi, bi, shape, pts)) in cands.iter().enumerate() {
+        let order = (0..passes(stage)).flat_map(|pass| {
+            cands.iter().enumerate().filter(move |(_, c)| {
+                passes(stage) == 1 || (pass == 0) == matches!(c.4, Shape::Plane { .. })
+            })
+        });
+        for (ci, (_, _, gi, bi, shape, pts)) in order {
             if used[ci] {
                 continue;
             }
@@ -179,6 +239,16 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
                         vec![*axis],
                         Some(*axis),
                     ),
+                    // A plane that is no datum gives only its direction where a datum
+                    // bore along the primary will place the origins across it.
+                    (1, Shape::Plane { axis, positive, .. })
+                        if !dirs.contains(axis)
+                            && dirs.len() == 1
+                            && !is_datum(ci)
+                            && datum_bore(dirs[0]) =>
+                    {
+                        (vec![dir_word(*axis, *positive)], 2, vec![], Some(*axis))
+                    }
                     (1, Shape::Plane { axis, positive, .. })
                         if !dirs.contains(axis) && dirs.len() == 1 =>
                     {
@@ -193,6 +263,12 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
                         (vec![orig_word(*axis)], 1, vec![*axis], None)
                     }
                     (1, Shape::Cylinder { axis, .. }) if dirs == [*axis] => {
+                        let o = free(Some(*axis));
+                        (o.iter().map(|&k| orig_word(k)).collect(), 4, o, None)
+                    }
+                    // A bore along one of the directions places the origins left free
+                    // across it (a plane and its edge, then a hole for the last one).
+                    (2, Shape::Cylinder { axis, .. }) if dirs.contains(axis) => {
                         let o = free(Some(*axis));
                         (o.iter().map(|&k| orig_word(k)).collect(), 4, o, None)
                     }
@@ -225,6 +301,7 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
                         _ => None,
                     }
                 }
+                (_, Shape::Cylinder { axis, .. }, _) => round(pts, *axis, 1, n),
                 _ => spread(pts, n),
             };
             let Some(points) = points else {
@@ -268,7 +345,12 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
             if pts.len() < need {
                 continue;
             }
-            let Some(points) = spread(pts, 4.min(pts.len())) else {
+            let points = match shape {
+                // Its direction needs two circles.
+                Shape::Cylinder { axis, .. } => round(pts, *axis, 2, 3),
+                _ => spread(pts, 4.min(pts.len())),
+            };
+            let Some(points) = points else {
                 continue;
             };
             if let Shape::Cylinder { axis, .. } = shape {

@@ -22,6 +22,23 @@ pub enum PathError {
         orient: String,
         blocker: String,
     },
+    #[error("tolerance `{tolerance}` reads `{feature}` as measured in setup {setup}, whose alignment stands on `{feature}` itself: a misplaced `{feature}` reads in place")]
+    #[diagnostic(
+        code(insp::path::self_aligned),
+        severity(Warning),
+        help("{datums} measured in setup {setup}, so the setup's frame, which `{feature}` fixes, stands in for them; make a datum feature reachable in that setup (a fixture, another pose) or measure `{feature}` where its datums are")
+    )]
+    SelfAligned {
+        #[label("read against the frame `{feature}` sets")]
+        span: Span,
+        tolerance: String,
+        feature: String,
+        setup: usize,
+        datums: String,
+    },
 }
 
-crate::located!(PathError { NoPath });
+crate::located!(PathError {
+    NoPath,
+    SelfAligned
+});

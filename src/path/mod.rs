@@ -33,7 +33,7 @@ use crate::access::pose::{Contact, Head, Pose};
 use crate::access::{ProbeShape, Scene};
 use crate::diag::Diagnostics;
 use crate::geometry::{FaceId, P3, V3};
-use crate::model::{DatumId, FeatureId, Motion, SlotId, ToleranceId};
+use crate::model::{DatumId, FeatureId, Motion, SlotId, TolKind, ToleranceId};
 use crate::plan::{Hlip, Input, Names};
 use rayon::prelude::*;
 use roadmap::Roadmap;
@@ -196,7 +196,12 @@ pub fn plan(
         return None;
     }
     match join(input, hlip, &scene, &groups, outs) {
-        Ok(llip) => Some(llip),
+        Ok(llip) => {
+            for sp in &llip.setups {
+                self_aligned(input, sp, diags);
+            }
+            Some(llip)
+        }
         Err(e) => {
             diags.push(*e);
             None
@@ -721,4 +726,64 @@ fn lift(pose: &Pose, x: &P3, g: &GroupIn) -> (Option<Vec<P3>>, usize) {
         })
     });
     (found, checks)
+}
+
+/// Warns of each tolerance read against a setup's frame that one of its own features
+/// fixes: the feature is one the alignment stands on, and the tolerance's datums are not
+/// all measured in that setup (were they, the datum reference frame would be built from
+/// them and the alignment would not matter).
+fn self_aligned(input: &Input, sp: &SetupPath, diags: &mut Diagnostics) {
+    let part = &input.model.parts[input.plan.part.0];
+    let measured: Vec<FeatureId> = sp
+        .groups
+        .iter()
+        .flat_map(|g| g.blocks.iter().filter_map(|b| b.feature))
+        .collect();
+    let mut warned: Vec<usize> = Vec::new();
+    for step in &sp.alignment.steps {
+        let Some(b) = sp
+            .groups
+            .get(step.group)
+            .and_then(|g| g.blocks.get(step.block))
+        else {
+            continue;
+        };
+        let (Some(f), None) = (b.feature, b.datum) else {
+            continue;
+        };
+        for (ti, t) in part.tolerances.iter().enumerate() {
+            if t.datums.is_empty() || !t.targets.contains(&f) || warned.contains(&ti) {
+                continue;
+            }
+            // An orientation reads no origin.
+            let orientation = matches!(
+                t.kind,
+                TolKind::Perpendicularity | TolKind::Parallelism | TolKind::Angularity
+            );
+            if orientation && !step.keywords.iter().any(|k| k.ends_with("DIR")) {
+                continue;
+            }
+            let datum_features = t.datums.iter().map(|d| part.datums[d.datum.0].feature);
+            if datum_features.clone().all(|d| measured.contains(&d)) {
+                continue;
+            }
+            warned.push(ti);
+            diags.push(PathError::SelfAligned {
+                span: t.span,
+                tolerance: t.name.clone(),
+                feature: part.features[f.0].name.clone(),
+                setup: sp.setup + 1,
+                datums: match &t.datums[..] {
+                    [d] => format!("datum {} is not", part.datums[d.datum.0].name),
+                    ds => format!(
+                        "datums {} are not all",
+                        ds.iter()
+                            .map(|d| part.datums[d.datum.0].name.clone())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                },
+            });
+        }
+    }
 }

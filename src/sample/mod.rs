@@ -7,7 +7,8 @@
 //! [`Sampler::margin`] from that boundary. Strategies:
 //!
 //! - **Fan & Leu** (1998): a plane gets 4 points inset by a fifth of each side of its
-//!   minimum-area rectangle; past an aspect ratio of 4, points 2 and 4 move inward by a
+//!   minimum-area rectangle (a plane whose flatness is toleranced gets more: the graph
+//!   asks for 9, and the rest are Hammersley candidates each farthest from those chosen); past an aspect ratio of 4, points 2 and 4 move inward by a
 //!   quarter of the inner rectangle's length. A cylinder or cone gets 4 points on each of
 //!   two circles at h₁ = r + (H − 2r)/5 and h₂ = r + 4(H − 2r)/5, r being the margin. A
 //!   point that falls outside the face or into a hole moves by the diagonal or normal
@@ -107,7 +108,13 @@ impl<'a> Sampler<'a> {
             margin,
         };
         match (strategy.method, &f.surface) {
-            (SampleMethod::FanLeu, Surface::Plane { .. }) => place.fan_leu_plane(strategy.inset),
+            (SampleMethod::FanLeu, Surface::Plane { .. }) => {
+                let mut pts = place.fan_leu_plane(strategy.inset);
+                if let Some(n) = strategy.points {
+                    place.fill(&mut pts, n as usize);
+                }
+                pts
+            }
             (SampleMethod::FanLeu, Surface::Cylinder { .. } | Surface::Cone { .. }) => {
                 place.fan_leu_round(strategy.points.map_or(4, |n| n.div_ceil(2).max(1)) as usize)
             }
@@ -338,6 +345,33 @@ impl Place<'_, '_> {
     }
 
     /// Uniform grids or Hammersley sequences, denser until `n` points are accepted.
+    /// Adds points to `pts` up to `n`, each the Hammersley candidate farthest from the
+    /// points it joins: a plane's form read between Fan & Leu's corners.
+    fn fill(&self, pts: &mut Vec<Fpoint>, n: usize) {
+        if pts.len() >= n {
+            return;
+        }
+        // Inside Fan & Leu's inset: a point by an edge may be one the probe reaches
+        // only along the table.
+        let mut cands = self.pool(SampleMethod::Hammersley, 8 * n, Some(Inset::Fraction(0.2)));
+        while pts.len() < n && !cands.is_empty() {
+            let gap = |c: &Fpoint| {
+                pts.iter()
+                    .map(|p| (p.position - c.position).norm())
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let (k, d) = cands
+                .iter()
+                .enumerate()
+                .map(|(k, c)| (k, gap(c)))
+                .fold((0, f64::NEG_INFINITY), |b, x| if x.1 > b.1 { x } else { b });
+            if d < 1e-6 {
+                break;
+            }
+            pts.push(cands.swap_remove(k));
+        }
+    }
+
     fn pool(&self, method: SampleMethod, n: usize, inset: Option<Inset>) -> Vec<Fpoint> {
         let c = self.chart;
         let (eu, ev) = c.extent_mm();

@@ -180,6 +180,8 @@ fn every_catalogue_example_reports_its_code() {
         files.extend(e.files.iter().map(|(n, b)| (n.as_str(), b.as_slice())));
         let diags = if e.code.starts_with("insp::plan::") {
             common::plan_files(&files)
+        } else if e.code.starts_with("insp::path::") {
+            common::build_files(&files)
         } else {
             common::check_files(&files)
         };

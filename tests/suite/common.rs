@@ -107,25 +107,38 @@ impl Drop for Diags {
 
 /// Checks `files` (path, contents) in memory; the first file is the root.
 pub fn check_files(files: &[(&str, &[u8])]) -> Diags {
-    Diags::new(run_files(files, false))
+    Diags::new(run_files(files, Stage::Graph))
 }
 
 /// [`check_files`] through the planner too.
 #[allow(dead_code)]
 pub fn plan_files(files: &[(&str, &[u8])]) -> Diags {
-    Diags::new(run_files(files, true))
+    Diags::new(run_files(files, Stage::Plan))
 }
 
-fn run_files(files: &[(&str, &[u8])], plan: bool) -> Vec<Flat> {
+/// Diagnostics of the whole build (paths and program) over in-memory files.
+pub fn build_files(files: &[(&str, &[u8])]) -> Diags {
+    Diags::new(run_files(files, Stage::Build))
+}
+
+#[derive(PartialEq)]
+enum Stage {
+    Graph,
+    Plan,
+    Build,
+}
+
+fn run_files(files: &[(&str, &[u8])], stage: Stage) -> Vec<Flat> {
     let mut world = MemoryWorld::new();
     for (p, c) in files {
         world.insert(p, c.to_vec());
     }
     let roots = [PathBuf::from(files[0].0)];
-    let checked = if plan {
-        inspc::plans(&world, &roots, &inspc::plan::PlanOptions::default()).0
-    } else {
-        inspc::measurement_graphs(&world, &roots).0
+    let opts = inspc::plan::PlanOptions::default();
+    let checked = match stage {
+        Stage::Build => inspc::build(&world, &roots, &opts, &|_, _, _| {}).0,
+        Stage::Plan => inspc::plans(&world, &roots, &opts).0,
+        Stage::Graph => inspc::measurement_graphs(&world, &roots).0,
     };
     checked
         .diagnostics

@@ -151,6 +151,65 @@ fn a_deviation_fails_exactly_the_tolerance_it_targets() {
     assert_eq!(failing(&r), vec!["T1".to_string()], "{}", r.text());
 }
 
+/// The same on the other real parts, one deviation per kind of tolerance: size, form
+/// (a bowed face, which four corner points cannot see), orientation, location, profile.
+/// A tolerance whose nominal lies on one of its limits (`35 +0 -0.2`) reads in or out
+/// by a micrometre at nominal already, so only the targets are asked to change there.
+#[test]
+fn deviations_on_real_parts_fail_exactly_their_tolerances() {
+    if std::env::var_os("INSPC_QUICK").is_some() {
+        return;
+    }
+    // A bowed face_15 fails both tolerances it carries (flatness of f15_248, profile of f15).
+    let cases: [(&str, &str, &[&str]); 7] = [
+        ("ctc_01", "feature top bow 1.2", &["FLAT_A"]),
+        ("ctc_02", "feature f484 grow 0.12", &["SIZE_F484"]),
+        (
+            "ctc_02",
+            "feature datum_h tilt 0.5 about (1, 0, 0)",
+            &["PERP_DATUM_H"],
+        ),
+        (
+            "ctc_02",
+            "feature datum_j move (0.2, 0, 0)",
+            &["POS_DATUM_J"],
+        ),
+        ("ctc_02", "feature f232 move (0, 0, -1.5)", &["PROF_F232"]),
+        (
+            "ftc_08",
+            "feature f15_248 bow 1.5",
+            &["FLAT_F15_248", "PROF_F15"],
+        ),
+        ("ftc_08", "feature f19_20 move (0.4, 0, 0)", &["POS_F19_20"]),
+    ];
+    for (part, dev, targets) in cases {
+        let spec = format!("tests/real/nist_{part}.insp");
+        let program = format!("tests/cases/real_nist_{part}/program.dmi");
+        let base = nominal(&spec, &program);
+        let edge: Vec<&str> = base
+            .rows
+            .iter()
+            .filter(|r| {
+                let o = &r.outcome;
+                o.note.is_none()
+                    && (o.limits.0.abs() < 1e-9 || o.limits.1.abs() < 1e-9)
+                    && o.nominal != 0.0
+            })
+            .map(|r| r.tolerance.as_str())
+            .collect();
+        let r = run(&spec, &program, Some(dev), Options::default())
+            .unwrap_or_else(|e| panic!("{part}, {dev}: {e:?}"));
+        let mut out: Vec<String> = failing(&r)
+            .into_iter()
+            .filter(|t| targets.contains(&t.as_str()) || !edge.contains(&t.as_str()))
+            .collect();
+        out.sort();
+        let mut want: Vec<String> = targets.iter().map(|t| t.to_string()).collect();
+        want.sort();
+        assert_eq!(out, want, "{part}, {dev}\n{}", r.text());
+    }
+}
+
 /// A hole of a pattern located from datum A alone: its place still counts.
 #[test]
 fn a_hole_of_a_pattern_moved_fails_its_position() {
