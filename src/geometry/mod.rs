@@ -96,6 +96,48 @@ const SAME_SURFACE_DEG: f64 = 0.1;
 const SAME_SURFACE_MM: f64 = 0.02;
 
 impl Surface {
+    /// The surface under a rigid motion `m`.
+    pub fn moved(&self, m: &nalgebra::Isometry3<f64>) -> Surface {
+        match self.clone() {
+            Surface::Plane { origin, normal } => Surface::Plane {
+                origin: m * origin,
+                normal: m * normal,
+            },
+            Surface::Cylinder {
+                origin,
+                axis,
+                radius,
+                convex,
+            } => Surface::Cylinder {
+                origin: m * origin,
+                axis: m * axis,
+                radius,
+                convex,
+            },
+            Surface::Cone {
+                apex,
+                axis,
+                half_angle,
+                convex,
+            } => Surface::Cone {
+                apex: m * apex,
+                axis: m * axis,
+                half_angle,
+                convex,
+            },
+            Surface::Sphere {
+                center,
+                radius,
+                convex,
+            } => Surface::Sphere {
+                center: m * center,
+                radius,
+                convex,
+            },
+            Surface::Freeform => Surface::Freeform,
+        }
+    }
+
     /// Whether two faces' surfaces are one surface (the halves of a bore, the pieces of
     /// a plane the CAD split): same type, sense and shape, an axis either way for a
     /// cylinder. Free-form faces are never one surface.

@@ -168,44 +168,7 @@ impl Prim {
             *v = m * *v;
         }
         for s in &mut self.surfaces {
-            *s = match s.clone() {
-                Surface::Plane { origin, normal } => Surface::Plane {
-                    origin: m * origin,
-                    normal: m * normal,
-                },
-                Surface::Cylinder {
-                    origin,
-                    axis,
-                    radius,
-                    convex,
-                } => Surface::Cylinder {
-                    origin: m * origin,
-                    axis: m * axis,
-                    radius,
-                    convex,
-                },
-                Surface::Cone {
-                    apex,
-                    axis,
-                    half_angle,
-                    convex,
-                } => Surface::Cone {
-                    apex: m * apex,
-                    axis: m * axis,
-                    half_angle,
-                    convex,
-                },
-                Surface::Sphere {
-                    center,
-                    radius,
-                    convex,
-                } => Surface::Sphere {
-                    center: m * center,
-                    radius,
-                    convex,
-                },
-                Surface::Freeform => Surface::Freeform,
-            };
+            *s = s.moved(m);
         }
     }
 }

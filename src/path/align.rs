@@ -4,11 +4,12 @@
 //! the part's frame from them. Features are chosen among those the setup inspects:
 //! datum features first in datum order, then features no tolerance reads against a datum
 //! (a feature the frame is built on reads perfect in it), then the rest, the largest
-//! faces first in each; a plane qualifies when
-//! its normal is a part axis, a cylinder when its axis is, so that every feature maps
-//! onto `XDIR`/`YDIR`/`ZDIR` and `XORIG`/`YORIG`/`ZORIG`. A cylinder on the primary's
-//! axis (a bore in the primary face) can stand in for the secondary's origins, a sphere
-//! gives all three. Whatever the features leave free is named in [`Alignment::missing`]
+//! faces first in each; a plane qualifies when its normal is a part axis, a cylinder
+//! when its axis is, so that every feature maps onto `XDIR`/`YDIR`/`ZDIR` and
+//! `XORIG`/`YORIG`/`ZORIG`. A secondary plane comes before a bore (it fixes the turn);
+//! a cylinder along a fixed direction (a bore in the primary face) can stand in for the
+//! origins across it, and where a datum bore will, a non-datum secondary plane gives
+//! only its direction; a sphere gives all three origins. Whatever the features leave free is named in [`Alignment::missing`]
 //! and becomes an operator instruction.
 
 use super::{Hlip, SetupPath};

@@ -763,8 +763,10 @@ fn self_aligned(input: &Input, sp: &SetupPath, diags: &mut Diagnostics) {
             if orientation && !step.keywords.iter().any(|k| k.ends_with("DIR")) {
                 continue;
             }
-            let datum_features = t.datums.iter().map(|d| part.datums[d.datum.0].feature);
-            if datum_features.clone().all(|d| measured.contains(&d)) {
+            if t.datums
+                .iter()
+                .all(|d| measured.contains(&part.datums[d.datum.0].feature))
+            {
                 continue;
             }
             warned.push(ti);

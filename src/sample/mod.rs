@@ -7,9 +7,10 @@
 //! [`Sampler::margin`] from that boundary. Strategies:
 //!
 //! - **Fan & Leu** (1998): a plane gets 4 points inset by a fifth of each side of its
-//!   minimum-area rectangle (a plane whose flatness is toleranced gets more: the graph
-//!   asks for 9, and the rest are Hammersley candidates each farthest from those chosen); past an aspect ratio of 4, points 2 and 4 move inward by a
-//!   quarter of the inner rectangle's length. A cylinder or cone gets 4 points on each of
+//!   minimum-area rectangle; past an aspect ratio of 4, points 2 and 4 move inward by a
+//!   quarter of the inner rectangle's length. A plane whose flatness is toleranced gets
+//!   more (the graph asks for 9): the rest are Hammersley candidates inside the inset,
+//!   each farthest from those chosen. A cylinder or cone gets 4 points on each of
 //!   two circles at h₁ = r + (H − 2r)/5 and h₂ = r + 4(H − 2r)/5, r being the margin. A
 //!   point that falls outside the face or into a hole moves by the diagonal or normal
 //!   zig-zag search until it is inside. Spheres and free-form faces, which the rules do

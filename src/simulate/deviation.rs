@@ -139,50 +139,44 @@ impl Deviations {
         let Some(c) = self.faces.get(f.0) else {
             return nominal.clone();
         };
-        let m = &c.motion;
         let half = c.grow / 2.0;
-        match nominal {
-            Surface::Plane { origin, normal } => Surface::Plane {
-                origin: m * origin,
-                normal: m * normal,
-            },
+        // Grown in place, then moved.
+        let grown = match nominal.clone() {
             Surface::Cylinder {
                 origin,
                 axis,
                 radius,
                 convex,
             } => Surface::Cylinder {
-                origin: m * origin,
-                axis: m * axis,
+                origin,
+                axis,
                 radius: radius + half,
-                convex: *convex,
+                convex,
             },
+            // Every diameter grows by `grow`: the apex moves back along the axis.
             Surface::Cone {
                 apex,
                 axis,
                 half_angle,
                 convex,
-            } => {
-                // Every diameter grows by `grow`: the apex moves back along the axis.
-                let back = half / half_angle.tan().max(1e-9);
-                Surface::Cone {
-                    apex: m * (apex - axis * back),
-                    axis: m * axis,
-                    half_angle: *half_angle,
-                    convex: *convex,
-                }
-            }
+            } => Surface::Cone {
+                apex: apex - axis * (half / half_angle.tan().max(1e-9)),
+                axis,
+                half_angle,
+                convex,
+            },
             Surface::Sphere {
                 center,
                 radius,
                 convex,
             } => Surface::Sphere {
-                center: m * center,
+                center,
                 radius: radius + half,
-                convex: *convex,
+                convex,
             },
-            Surface::Freeform => Surface::Freeform,
-        }
+            other => other,
+        };
+        grown.moved(&c.motion)
     }
 }
 

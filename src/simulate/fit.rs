@@ -279,29 +279,53 @@ fn lm(x: &mut DVector<f64>, n: usize, residuals: &dyn Fn(&DVector<f64>, &mut DVe
     }
 }
 
-/// The algebraic (Kåsa) circle of points in a plane: x² + y² + D·x + E·y + F = 0 solved
-/// by least squares; its centre and radius, or none for points on a line.
-fn algebraic(pts: &[[f64; 2]]) -> Option<(f64, f64, f64)> {
-    if pts.len() < 3 {
-        return None;
+/// Where a circle (`D` = 2) or sphere (`D` = 3) fit starts, as an offset of the centre
+/// from the nominal's and a radius: the points' own algebraic (Kåsa) circle or sphere,
+/// |x|² + D·x + G = 0 solved by least squares, where it fits them better than the
+/// nominal does; else the nominal. A part placed millimetres off puts a small bore's
+/// nominal outside it, where the descent runs away; points at two places round a
+/// circle (a fillet touched at two angles) leave the algebraic one undetermined.
+fn start<const D: usize>(pts: &[[f64; D]], nominal_r: f64) -> ([f64; D], f64) {
+    let nominal = ([0.0; D], nominal_r);
+    let cost = |(c, r): &([f64; D], f64)| -> f64 {
+        pts.iter()
+            .map(|q| {
+                let d: f64 = (0..D).map(|k| (q[k] - c[k]).powi(2)).sum();
+                (d.sqrt() - r).powi(2)
+            })
+            .sum()
+    };
+    if pts.len() <= D {
+        return nominal;
     }
-    let mut a = DMatrix::zeros(pts.len(), 3);
+    let mut a = DMatrix::zeros(pts.len(), D + 1);
     let mut b = DVector::zeros(pts.len());
-    for (i, [x, y]) in pts.iter().enumerate() {
-        a.set_row(i, &nalgebra::RowDVector::from_row_slice(&[*x, *y, 1.0]));
-        b[i] = -(x * x + y * y);
+    for (i, q) in pts.iter().enumerate() {
+        for k in 0..D {
+            a[(i, k)] = q[k];
+        }
+        a[(i, D)] = 1.0;
+        b[i] = -q.iter().map(|x| x * x).sum::<f64>();
     }
     let svd = a.svd(true, true);
     let s = &svd.singular_values;
-    // Points at two places round the circle (a fillet touched at two angles) leave it
-    // undetermined.
     if s.min() <= 1e-4 * s.max() {
-        return None;
+        return nominal;
     }
-    let sol = svd.solve(&b, 1e-12).ok()?;
-    let (cx, cy) = (-sol[0] / 2.0, -sol[1] / 2.0);
-    let rr = cx * cx + cy * cy - sol[2];
-    (rr > 0.0 && rr.is_finite()).then(|| (cx, cy, rr.sqrt()))
+    let Ok(sol) = svd.solve(&b, 1e-12) else {
+        return nominal;
+    };
+    let c: [f64; D] = std::array::from_fn(|k| -sol[k] / 2.0);
+    let rr = c.iter().map(|x| x * x).sum::<f64>() - sol[D];
+    if !(rr > 0.0 && rr.is_finite()) {
+        return nominal;
+    }
+    let own = (c, rr.sqrt());
+    if cost(&own) + 1e-9 * (pts.len() as f64) < cost(&nominal) {
+        own
+    } else {
+        nominal
+    }
 }
 
 /// The least-squares cylinder started from `guess`.
@@ -326,28 +350,14 @@ pub fn cylinder(points: &[P3], guess: &Shape) -> Option<Shape> {
         };
         (o, ax, x[2])
     };
-    // Started from the points' own circle (a part placed millimetres off puts a small
-    // bore's nominal outside it, where the descent runs away), else the nominal.
-    let (x0, y0, r0) = {
-        let flat: Vec<[f64; 2]> = points
-            .iter()
-            .map(|q| {
-                let d = q - p0;
-                [d.dot(&u), d.dot(&v)]
-            })
-            .collect();
-        // The points' circle only where it fits them better than the nominal does: a
-        // fillet's few points on a short arc leave the algebraic circle loose.
-        let cost = |(x, y, rr): (f64, f64, f64)| -> f64 {
-            flat.iter()
-                .map(|[a, b]| ((a - x).hypot(b - y) - rr).powi(2))
-                .sum()
-        };
-        match algebraic(&flat) {
-            Some(c) if cost(c) + 1e-9 * (flat.len() as f64) < cost((0.0, 0.0, *r)) => c,
-            _ => (0.0, 0.0, *r),
-        }
-    };
+    let flat: Vec<[f64; 2]> = points
+        .iter()
+        .map(|q| {
+            let d = q - p0;
+            [d.dot(&u), d.dot(&v)]
+        })
+        .collect();
+    let ([x0, y0], r0) = start(&flat, *r);
     let mut x = DVector::from_vec(if tilt {
         vec![x0, y0, r0, 0.0, 0.0]
     } else {
@@ -408,33 +418,9 @@ pub fn sphere(points: &[P3], guess: &Shape) -> Option<Shape> {
     if points.len() < 4 {
         return None;
     }
-    let mut x = DVector::from_vec(vec![0.0, 0.0, 0.0, *r]);
-    // The points' own sphere as the start (x² + y² + z² + D·x + E·y + F·z + G = 0).
-    let mut a = DMatrix::zeros(points.len(), 4);
-    let mut b = DVector::zeros(points.len());
-    for (i, q) in points.iter().enumerate() {
-        let d = q - c;
-        a.set_row(
-            i,
-            &nalgebra::RowDVector::from_row_slice(&[d.x, d.y, d.z, 1.0]),
-        );
-        b[i] = -d.norm_squared();
-    }
-    if let Ok(sol) = a.svd(true, true).solve(&b, 1e-12) {
-        let (cx, cy, cz) = (-sol[0] / 2.0, -sol[1] / 2.0, -sol[2] / 2.0);
-        let rr = cx * cx + cy * cy + cz * cz - sol[3];
-        let cost = |cc: V3, rr: f64| -> f64 {
-            points
-                .iter()
-                .map(|q| ((q - c - cc).norm() - rr).powi(2))
-                .sum()
-        };
-        let own = V3::new(cx, cy, cz);
-        let tie = 1e-9 * points.len() as f64;
-        if rr > 0.0 && rr.is_finite() && cost(own, rr.sqrt()) + tie < cost(V3::zeros(), *r) {
-            x = DVector::from_vec(vec![cx, cy, cz, rr.sqrt()]);
-        }
-    }
+    let around: Vec<[f64; 3]> = points.iter().map(|q| (q - c).into()).collect();
+    let ([cx, cy, cz], r0) = start(&around, *r);
+    let mut x = DVector::from_vec(vec![cx, cy, cz, r0]);
     lm(&mut x, points.len(), &|x, out| {
         let cc = c + V3::new(x[0], x[1], x[2]);
         for (i, q) in points.iter().enumerate() {
