@@ -248,6 +248,11 @@ struct Writer<'a> {
     outputs: std::collections::BTreeSet<String>,
     /// Per feature of two opposed planes, its constructed `PARPLN` and the two surfaces.
     pairs: BTreeMap<FeatureId, (String, [usize; 2])>,
+    /// Per datum feature of parallel bores or pins (a pattern), its `PATERN` and the
+    /// members' surfaces.
+    patterns: BTreeMap<FeatureId, (String, Vec<usize>)>,
+    /// Per surface, the setup it was last completed in.
+    done_in: BTreeMap<usize, usize>,
     /// The surfaces complete so far.
     done: std::collections::BTreeSet<usize>,
     /// Tolerances recorded before all their surfaces were complete.
@@ -286,6 +291,8 @@ pub fn write(input: &Input) -> String {
         surfs: Vec::new(),
         points: BTreeMap::new(),
         pairs: BTreeMap::new(),
+        patterns: BTreeMap::new(),
+        done_in: BTreeMap::new(),
         realign: None,
         outputs: std::collections::BTreeSet::new(),
         done: std::collections::BTreeSet::new(),
@@ -519,6 +526,49 @@ impl Writer<'_> {
             });
         }
         self.centre_planes();
+        self.datum_patterns();
+    }
+
+    /// A datum feature of several parallel bores or pins (a pattern of holes) is one
+    /// datum: `FEAT/PATERN` of its members, constructed once all of them are measured in
+    /// a setup, so `DATDEF` names the pattern (its centre, axis and clocking), not the
+    /// first hole.
+    fn datum_patterns(&mut self) {
+        let part = self.names.part();
+        let cos = (0.1f64).to_radians().cos();
+        let mut by_feature: BTreeMap<FeatureId, Vec<usize>> = BTreeMap::new();
+        for (k, s) in self.surfs.iter().enumerate() {
+            if let Some(f) = s.feature {
+                if !s.full.is_empty() && part.datums.iter().any(|d| d.feature == f) {
+                    by_feature.entry(f).or_default().push(k);
+                }
+            }
+        }
+        for (f, surfs) in by_feature {
+            if surfs.len() < 2 || self.pairs.contains_key(&f) {
+                continue;
+            }
+            let axes: Option<Vec<V3>> = surfs
+                .iter()
+                .map(|&k| match self.nominals.get(&self.surfs[k].full) {
+                    Some(Nominal::Surface(Surface::Cylinder { axis, .. }, _)) => Some(*axis),
+                    _ => None,
+                })
+                .collect();
+            let Some(axes) = axes else { continue };
+            if axes.iter().any(|a| a.dot(&axes[0]).abs() < cos) {
+                continue;
+            }
+            let name = self.names.feature(Some(f)).to_string();
+            let label = self.labels.fresh("F", &name);
+            let members: Vec<String> = surfs
+                .iter()
+                .map(|&k| format!("F({})", self.surfs[k].full))
+                .collect();
+            self.o
+                .stmt(&format!("F({label})=FEAT/PATERN,{}", members.join(",")));
+            self.patterns.insert(f, (label, surfs));
+        }
     }
 
     /// A feature made of two opposed parallel planes (a slot, a tab) is a feature of
@@ -834,6 +884,7 @@ impl Writer<'_> {
                 continue;
             };
             self.done.insert(surf);
+            self.done_in.insert(surf, si);
             if let Some(r) = self.realign.as_mut() {
                 r.measured.insert(done.clone());
             }
@@ -854,9 +905,23 @@ impl Writer<'_> {
             if !list.contains(&done) {
                 list.push(done.clone());
             }
-            if let Some(d) = b.datum {
+            // A datum pattern is its datum once every member is measured in this setup.
+            let mut datum_label = Some(done.clone());
+            if let Some((pat, members)) = b.feature.and_then(|f| self.patterns.get(&f)).cloned() {
+                datum_label = None;
+                if members.iter().all(|m| self.done_in.get(m) == Some(&si)) {
+                    let fa: Vec<String> = members
+                        .iter()
+                        .map(|m| format!("FA({})", self.surfs[*m].full))
+                        .collect();
+                    self.o
+                        .stmt(&format!("CONST/PATERN,F({pat}),BF,{}", fa.join(",")));
+                    datum_label = Some(pat);
+                }
+            }
+            if let (Some(d), Some(l)) = (b.datum, datum_label) {
                 if !datums_here.iter().any(|(x, _)| *x == d) {
-                    datums_here.push((d, done.clone()));
+                    datums_here.push((d, l));
                 }
             }
             in_group.push(done);

@@ -4,7 +4,8 @@
 //! the part's frame from them. Features are chosen among those the setup inspects:
 //! datum features first in datum order, then features no tolerance reads against a datum
 //! (a feature the frame is built on reads perfect in it), then the rest, the largest
-//! faces first in each; a plane qualifies when its normal is a part axis, a cylinder
+//! faces first in each; a plane parallel to the table ranks with the datum the part
+//! rests on; a plane qualifies when its normal is a part axis, a cylinder
 //! when its axis is, so that every feature maps onto `XDIR`/`YDIR`/`ZDIR` and
 //! `XORIG`/`YORIG`/`ZORIG`. A secondary plane comes before a bore (it fixes the turn);
 //! a cylinder along a fixed direction (a bore in the primary face) can stand in for the
@@ -15,6 +16,7 @@
 use super::{Hlip, SetupPath};
 use crate::access::Contact;
 use crate::geometry::{Surface, P3, V3};
+use crate::graph::Node;
 use crate::model::FeatureId;
 use crate::plan::Input;
 
@@ -86,6 +88,35 @@ impl Shape {
     }
 }
 
+/// The first datum (index into the part's datums) with a planar face resting on the
+/// table: outward normal straight down, its plane at the table's height.
+fn resting_datum(input: &Input, up: V3, table: f64) -> Option<usize> {
+    let part = &input.model.parts[input.plan.part.0];
+    let graph = input.graph;
+    let rests = |feature: FeatureId| {
+        graph.nodes().any(|(i, n)| {
+            matches!(n, Node::Feature { feature: f, .. } if *f == feature)
+                && graph
+                    .children(i)
+                    .iter()
+                    .any(|(c, _)| match &graph.graph[*c] {
+                        Node::Face { face, .. } => match input.geometry.faces.get(face.0) {
+                            Some(f) => match &f.surface {
+                                Surface::Plane { origin, normal } => {
+                                    normal.dot(&up) < -1.0 + 1e-9
+                                        && (origin.coords.dot(&up) - table).abs() < 1e-2
+                                }
+                                _ => false,
+                            },
+                            None => false,
+                        },
+                        _ => false,
+                    })
+        })
+    };
+    part.datums.iter().position(|d| rests(d.feature))
+}
+
 /// Chooses the alignment of one setup from its groups' blocks.
 pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
     let geometry = input.geometry;
@@ -98,6 +129,13 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
         .filter(|t| !t.datums.is_empty())
         .flat_map(|t| t.targets.iter().copied())
         .collect();
+    // The first datum (in datum order) whose plane the part rests on: the table stands
+    // in for it, so a plane parallel to the table ranks with it. Aligned on such a
+    // plane, the frame turns with the datum the part sits on, not with a side face a
+    // tilt of which would swing the far end of the part into the probe.
+    let setup = &hlip.setups[sp.setup];
+    let resting = resting_datum(input, setup.up, setup.table);
+    let vertical = axis_of(&setup.up).map(|(k, _)| k);
     // Candidates: (rank, -area, group, block, shape, points in tour order); the rank is
     // datum features first in datum order, then features no tolerance reads against
     // datums, then the rest.
@@ -137,11 +175,18 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
                 }
             };
             let Some(shape) = shape else { continue };
-            let rank = match (b.datum, b.feature) {
-                (Some(d), _) => (0, d.0),
-                (None, Some(f)) if referenced.contains(&f) => (2, 0),
-                _ => (1, 0),
+            // (class, datum, stands in for it): the datum itself before a plane parallel
+            // to the one it rests on.
+            let mut rank = match (b.datum, b.feature) {
+                (Some(d), _) => (0, d.0, 0),
+                (None, Some(f)) if referenced.contains(&f) => (2, 0, 0),
+                _ => (1, 0, 0),
             };
+            if let (Some(r), Shape::Plane { axis, .. }) = (resting, &shape) {
+                if Some(*axis) == vertical {
+                    rank = rank.min((0, r, 1));
+                }
+            }
             let area = f.map_or(0.0, |f| f.area);
             cands.push((rank, -area, gi, bi, shape, points));
         }

@@ -191,6 +191,36 @@ pub fn across(a: &V3) -> (V3, V3) {
     (u, a.cross(&u))
 }
 
+/// A pattern of parallel bores or pins as one axis: the members' mean direction,
+/// through the centroid of their axes (each taken where it crosses the plane across
+/// the first), the mean radius; `None` unless every member is a cylinder.
+pub fn pattern(members: &[Shape]) -> Option<Shape> {
+    let cyl: Vec<(P3, V3, f64)> = members
+        .iter()
+        .map(|m| match m {
+            Shape::Cylinder { p, a, r } => Some((*p, *a, *r)),
+            _ => None,
+        })
+        .collect::<Option<_>>()?;
+    let (p0, a0, _) = *cyl.first()?;
+    let a = cyl
+        .iter()
+        .fold(V3::zeros(), |s, (_, a, _)| {
+            s + if a.dot(&a0) < 0.0 { -a } else { *a }
+        })
+        .try_normalize(1e-9)?;
+    let n = cyl.len() as f64;
+    let c = cyl.iter().fold(V3::zeros(), |s, (p, _, _)| {
+        s + (p - a * (p - p0).dot(&a)).coords
+    }) / n;
+    let r = cyl.iter().map(|x| x.2).sum::<f64>() / n;
+    Some(Shape::Cylinder {
+        p: P3::from(c),
+        a,
+        r,
+    })
+}
+
 /// The least-squares plane; its normal on the side of `near`.
 pub fn plane(points: &[P3], near: &V3) -> Option<Shape> {
     if points.len() < 3 {

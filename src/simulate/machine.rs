@@ -14,7 +14,8 @@ use crate::model::{Model, Plan};
 use crate::plan::poses::Setups;
 use crate::source::Span;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, Unit, UnitQuaternion};
-use parry3d_f64::query::{Ray, RayCast};
+use parry3d_f64::query::{cast_shapes, PointQuery, Ray, RayCast, ShapeCastOptions};
+use parry3d_f64::shape::Ball;
 use std::collections::BTreeMap;
 
 /// What the virtual CMM runs.
@@ -81,6 +82,9 @@ struct Stored {
     /// Its setup, from 1.
     setup: usize,
 }
+
+/// A measured feature and its label.
+type Labelled = (Stored, String);
 
 /// The setup the part stands in.
 struct SetupCtx {
@@ -165,7 +169,10 @@ struct Machine<'a> {
     /// the setup to come.
     between: bool,
     actuals: BTreeMap<String, Stored>,
-    datums: BTreeMap<String, (Stored, String)>,
+    /// Per datum label: the feature `DATDEF` names and, for a pattern, its members.
+    datums: BTreeMap<String, (Stored, String, Vec<Labelled>)>,
+    /// Per pattern (`FEAT/PATERN`), its members' labels.
+    patterns: BTreeMap<String, Vec<String>>,
     block: Option<Block>,
     /// The tip centre (part frame), when known.
     at: Option<P3>,
@@ -209,6 +216,7 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         between: false,
         actuals: BTreeMap::new(),
         datums: BTreeMap::new(),
+        patterns: BTreeMap::new(),
         block: None,
         at: None,
         rng: Rng(opts.seed ^ 0x5EED_1A5E_D00D_F00D),
@@ -331,9 +339,37 @@ impl Machine<'_> {
                 let Some((_, l)) = label else {
                     return Err(self.bad(at, "FEAT without a label", "write `F(label)=FEAT/…`"));
                 };
-                let n = nominal(params)
-                    .ok_or_else(|| self.unsupported(at, &format!("FEAT/{}", word(0))))?;
-                self.nominals.insert(l.clone(), n);
+                if word(0) == "PATERN" {
+                    let members: Vec<String> = params[1..]
+                        .iter()
+                        .filter_map(|p| label_of(p))
+                        .map(str::to_string)
+                        .collect();
+                    let shapes: Vec<Shape> = members
+                        .iter()
+                        .filter_map(|m| self.nominals.get(m).map(|n| n.shape.clone()))
+                        .collect();
+                    let shape = (shapes.len() == members.len())
+                        .then(|| fit::pattern(&shapes))
+                        .flatten()
+                        .ok_or_else(|| {
+                            self.bad(
+                                at,
+                                "a pattern's members must be cylinders defined before it",
+                                "write `F(p)=FEAT/PATERN,F(bore1),F(bore2),…` after their FEATs",
+                            )
+                        })?;
+                    let convex = members
+                        .first()
+                        .and_then(|m| self.nominals.get(m))
+                        .is_some_and(|n| n.convex);
+                    self.nominals.insert(l.clone(), Nominal { shape, convex });
+                    self.patterns.insert(l.clone(), members);
+                } else {
+                    let n = nominal(params)
+                        .ok_or_else(|| self.unsupported(at, &format!("FEAT/{}", word(0))))?;
+                    self.nominals.insert(l.clone(), n);
+                }
             }
             "TOL" => {
                 let Some((_, l)) = label else {
@@ -447,7 +483,14 @@ impl Machine<'_> {
                         "measure a datum feature before DATDEF",
                     )
                 })?;
-                self.datums.insert(d.clone(), (f, l));
+                let members = self
+                    .patterns
+                    .get(&l)
+                    .into_iter()
+                    .flatten()
+                    .filter_map(|m| Some((self.actuals.get(m).cloned()?, m.clone())))
+                    .collect();
+                self.datums.insert(d.clone(), (f, l, members));
             }
             "OUTPUT" => self.output(params, at)?,
             other => return Err(self.unsupported(at, other)),
@@ -713,8 +756,8 @@ impl Machine<'_> {
         }
         let ctx = self.ctx(at)?;
         let travel = appr + self.search;
-        let (centre, contact) = match self.search_surface(ctx, &c0, &np, r, travel) {
-            Found::Contact(c, k) => (c, k),
+        let (centre, contact, touched) = match self.search_surface(ctx, &c0, &np, r, travel) {
+            Found::Contact(c, k, f) => (c, k, f),
             Found::Inside => {
                 return Err(SimError::InsidePart {
                     span: self.span(at),
@@ -733,11 +776,20 @@ impl Machine<'_> {
             // there, on the machine's first contact; where it lies deeper the search
             // itself covered the way down from the nominal touch.
             let nominal = pp + np * r;
-            let outer = if (centre - nominal).dot(&np) > 0.0 {
+            let mut outer = if (centre - nominal).dot(&np) > 0.0 {
                 centre
             } else {
                 nominal
             };
+            // The scene is the nominal part: where the touched face itself lies deeper
+            // (tilted, or the frame off), the ball is nearer its nominal triangles than
+            // a tip is allowed to be, and no material is there. The check starts where
+            // the ball clears them.
+            if let Some((face, d)) = self.nearest_face(&outer) {
+                if Some(face) == touched && d < r {
+                    outer += np * (r - d);
+                }
+            }
             let pose = self.pose(ctx, s);
             if let Err(b) = pose.approach(&outer, &np, self.apprch, contact) {
                 return Err(self.collision(at, b, "on the touch's approach"));
@@ -759,6 +811,18 @@ impl Machine<'_> {
         Ok(())
     }
 
+    /// The part's face nearest `x` (part frame) on the nominal mesh, and its distance.
+    fn nearest_face(&self, x: &P3) -> Option<(FaceId, f64)> {
+        let mesh = self.scene.mesh()?;
+        let g = self.input.geometry;
+        let (proj, feature) = mesh.project_local_point_and_get_feature(x);
+        let parry3d_f64::shape::FeatureId::Face(i) = feature else {
+            return None;
+        };
+        let face = FaceId(*g.tri_face.get(i as usize % g.triangles.len().max(1))? as usize);
+        Some((face, (proj.point - x).norm()))
+    }
+
     /// The first contact of the tip ball moving from centre `c0` along `−n` (part
     /// frame) within `travel`: the part's face the foot of the ball meets on the mesh,
     /// found exactly on its actual surface; or the table.
@@ -766,6 +830,7 @@ impl Machine<'_> {
         let g = self.input.geometry;
         let dev: &Deviations = self.input.deviations;
         let mut best: Option<(f64, Contact)> = None;
+        let mut touched = None;
         if let Some(mesh) = self.scene.mesh() {
             let foot = c0 - n * r;
             let ray = Ray::new(foot, -n);
@@ -801,19 +866,36 @@ impl Machine<'_> {
                         first_root(&gap, travel)
                     }
                     None => {
-                        // Free-form: the foot meets the face's triangles, moved.
+                        // Free-form: the ball swept against the triangles, moved with
+                        // the face. Not the foot's ray: off the programmed point in a
+                        // fillet, the ball meets the facets beside the foot first.
                         let m = dev
                             .faces
                             .get(face.0)
                             .map(|c| c.motion)
                             .unwrap_or_else(Isometry3::identity);
-                        let local = Ray::new(m.inverse() * foot, m.inverse() * -n);
-                        mesh.cast_ray(&Isometry3::identity(), &local, travel + 1.0, false)
+                        let at = Isometry3::from_parts(
+                            Translation3::from((m.inverse() * c0).coords),
+                            UnitQuaternion::identity(),
+                        );
+                        let hit = cast_shapes(
+                            &at,
+                            &(m.inverse() * -n),
+                            &Ball::new(r),
+                            &Isometry3::identity(),
+                            &V3::zeros(),
+                            mesh,
+                            ShapeCastOptions::with_max_time_of_impact(travel),
+                        );
+                        hit.ok()
+                            .flatten()
+                            .map(|h| h.time_of_impact)
                             .filter(|t| *t <= travel)
                     }
                 };
                 if let Some(t) = t {
                     best = Some((t, Contact::Part));
+                    touched = Some(face);
                 }
             }
         }
@@ -822,10 +904,11 @@ impl Machine<'_> {
             let t = ((c0.coords.dot(&ctx.up)) - r - ctx.table) / rise;
             if (0.0..=travel).contains(&t) && best.is_none_or(|(b, _)| t < b) {
                 best = Some((t, Contact::Table));
+                touched = None;
             }
         }
         match best {
-            Some((t, k)) => Found::Contact(c0 - n * t, k),
+            Some((t, k)) => Found::Contact(c0 - n * t, k, touched),
             None => Found::Nothing,
         }
     }
@@ -1021,6 +1104,10 @@ impl Machine<'_> {
                 fit::plane(&pts, &nominal.shape.direction().unwrap_or(V3::z())).map(|s| (s, vec![]))
             }
             "CYLNDR" => fit::cylinder(&pts, &nominal.shape).map(|s| (s, vec![])),
+            "PATERN" => {
+                let shapes: Vec<Shape> = sources.iter().map(|m| m.shape.clone()).collect();
+                fit::pattern(&shapes).map(|s| (s, vec![]))
+            }
             "CONE" => fit::cone(&pts, &nominal.shape).map(|s| (s, vec![])),
             "SPHERE" => fit::sphere(&pts, &nominal.shape).map(|s| (s, vec![])),
             other => return Err(self.unsupported(at, &format!("CONST/{other}"))),
@@ -1229,7 +1316,7 @@ impl Machine<'_> {
             .collect();
         let mut datums = Vec::new();
         for d in &def.datums {
-            let (f, l) = self.datums.get(d).ok_or_else(|| {
+            let (f, l, members) = self.datums.get(d).ok_or_else(|| {
                 self.bad(
                     at,
                     &format!("datum `{d}` is not defined"),
@@ -1242,6 +1329,11 @@ impl Machine<'_> {
                 .map(|n| n.shape.clone())
                 .unwrap_or(Shape::Surface);
             datums.push((self.in_program(f).shape, n));
+            // A pattern's members after its axis: they give its clocking.
+            for (m, ml) in members {
+                let n = self.nominals.get(ml).map(|n| n.shape.clone());
+                datums.push((self.in_program(m).shape, n.unwrap_or(Shape::Surface)));
+            }
         }
         let out = evaluate::evaluate(&def, &targets, &datums);
         if def.word == "DIAM" && labels.len() == 1 && out.actual.is_finite() {
@@ -1261,7 +1353,8 @@ impl Machine<'_> {
 
 /// What a touch's search finds.
 enum Found {
-    Contact(P3, Contact),
+    /// The tip centre at contact, what it touched, and the part's face it touched.
+    Contact(P3, Contact, Option<FaceId>),
     Inside,
     Nothing,
 }
