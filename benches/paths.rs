@@ -101,6 +101,6 @@ fn path_stage(bencher: divan::Bencher, spec: &str) {
     let hlip = p.hlip.as_ref().unwrap();
     bencher.bench_local(|| {
         let mut diags = inspc::diag::Diagnostics::new();
-        inspc::path::plan(&input, hlip, &|_, _| {}, &mut diags).unwrap()
+        inspc::path::plan(&input, hlip, &|_, _| {}, &mut diags, &mut Vec::new()).unwrap()
     });
 }

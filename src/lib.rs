@@ -272,9 +272,27 @@ fn plans_of(
     graphs: &[Graphed],
     opts: &plan::PlanOptions,
 ) -> Vec<Planned> {
+    let (out, each) = plan_each(checked, parts, graphs, opts);
+    let mut all = diag::Diagnostics::new();
+    for d in each {
+        all.extend(d);
+    }
+    checked.absorb(all);
+    out
+}
+
+/// [`plans_of`], keeping each plan's own diagnostics apart (the path stage may plan it
+/// again); the others join `checked`.
+fn plan_each(
+    checked: &mut Checked,
+    parts: &[Option<PartData>],
+    graphs: &[Graphed],
+    opts: &plan::PlanOptions,
+) -> (Vec<Planned>, Vec<diag::Diagnostics>) {
     let mut out = Vec::new();
+    let mut each = Vec::new();
     if checked.has_errors() {
-        return out;
+        return (out, each);
     }
     let mut diags = diag::Diagnostics::new();
     let model = &checked.model;
@@ -301,11 +319,13 @@ fn plans_of(
             fixtures: &data.fixtures,
             graph: &g.graph,
         };
-        let hlip = plan::plan(&input, opts, &mut diags);
+        let mut own = diag::Diagnostics::new();
+        let hlip = plan::plan(&input, opts, &mut own);
         out.push(Planned { plan: k, hlip });
+        each.push(own);
     }
     checked.absorb(diags);
-    out
+    (out, each)
 }
 
 /// One plan built: its HLIP, its paths and its DMIS program.
@@ -408,12 +428,17 @@ pub fn run(
         return run;
     }
     progress("planning", 0, 1);
-    let planned = plans_of(&mut run.checked, &run.parts, &run.graphs, opts);
+    let (planned, each) = plan_each(&mut run.checked, &run.parts, &run.graphs, opts);
     lap(&mut run.timings, "plan");
-    if run.checked.has_errors() {
+    if run.checked.has_errors() || each.iter().any(|d| d.has_errors()) {
+        let mut all = diag::Diagnostics::new();
+        for d in each {
+            all.extend(d);
+        }
+        run.checked.absorb(all);
         return run;
     }
-    let paths = paths_of(&mut run, planned, progress);
+    let paths = paths_of(&mut run, planned, each, opts, progress);
     lap(&mut run.timings, "paths");
     if run.checked.has_errors() {
         return run;
@@ -424,15 +449,31 @@ pub fn run(
     run
 }
 
+/// How many times a plan whose touches the path stage cannot reach is planned again.
+const REPLANS: usize = 3;
+
 /// The plan, part and moves of each plan whose paths were planned.
 type Pathed = Vec<(usize, usize, plan::Hlip, path::Llip)>;
 
 /// The path stage over the plans (see [`run`]).
-fn paths_of(run: &mut Run, planned: Vec<Planned>, progress: Progress) -> Pathed {
+///
+/// A touch no collision-free move reaches sends its plan back to the planner with that
+/// configuration failing validation (at most [`REPLANS`] times): generate-and-test with
+/// the path stage as one more test. The diagnostics of the last try are kept.
+fn paths_of(
+    run: &mut Run,
+    planned: Vec<Planned>,
+    each: Vec<diag::Diagnostics>,
+    opts: &plan::PlanOptions,
+    progress: Progress,
+) -> Pathed {
     let mut diags = diag::Diagnostics::new();
     let mut paths = Vec::new();
-    for p in planned {
-        let Some(hlip) = p.hlip else { continue };
+    for (p, mut own) in planned.into_iter().zip(each) {
+        let Some(mut hlip) = p.hlip else {
+            diags.extend(own);
+            continue;
+        };
         let plan = &run.checked.model.plans[p.plan];
         let Some(g) = run
             .graphs
@@ -452,8 +493,39 @@ fn paths_of(run: &mut Run, planned: Vec<Planned>, progress: Progress) -> Pathed 
             graph: &g.graph,
         };
         let report = |done: usize, total: usize| progress("paths", done, total);
-        if let Some(llip) = path::plan(&input, &hlip, &report, &mut diags) {
-            paths.push((p.plan, g.part, hlip, llip));
+        let mut bans_all: Vec<plan::Ban> = Vec::new();
+        for attempt in 0..=REPLANS {
+            let mut moves = diag::Diagnostics::new();
+            let mut bans = Vec::new();
+            let llip = path::plan(&input, &hlip, &report, &mut moves, &mut bans);
+            if let Some(llip) = llip {
+                diags.extend(own);
+                diags.extend(moves);
+                paths.push((p.plan, g.part, hlip, llip));
+                break;
+            }
+            if bans.is_empty() || attempt == REPLANS {
+                diags.extend(own);
+                diags.extend(moves);
+                break;
+            }
+            bans_all.extend(bans);
+            let again = plan::PlanOptions {
+                bans: bans_all.clone(),
+                ..opts.clone()
+            };
+            let mut replanned = diag::Diagnostics::new();
+            match plan::plan(&input, &again, &mut replanned) {
+                Some(h) => {
+                    hlip = h;
+                    own = replanned;
+                }
+                None => {
+                    diags.extend(replanned);
+                    diags.extend(moves);
+                    break;
+                }
+            }
         }
     }
     run.checked.absorb(diags);

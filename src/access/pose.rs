@@ -69,6 +69,8 @@ pub enum Blocker {
     ComponentOnTable(String),
     /// A named component (or the tip) meets the fixture holding the part.
     Fixture(String),
+    /// The touch is clear, but the path stage found no collision-free move to it.
+    Path,
 }
 
 impl std::fmt::Display for Blocker {
@@ -79,6 +81,7 @@ impl std::fmt::Display for Blocker {
             Blocker::Component(c) => write!(f, "the {c}"),
             Blocker::ComponentOnTable(c) => write!(f, "the {c} (on the table)"),
             Blocker::Fixture(c) => write!(f, "the {c} (on the fixture)"),
+            Blocker::Path => write!(f, "no collision-free move (on the way to it)"),
         }
     }
 }

@@ -34,7 +34,7 @@ use crate::access::{ProbeShape, Scene};
 use crate::diag::Diagnostics;
 use crate::geometry::{FaceId, P3, V3};
 use crate::model::{DatumId, FeatureId, Motion, SlotId, TolKind, ToleranceId};
-use crate::plan::{Hlip, Input, Names};
+use crate::plan::{Ban, Hlip, Input, Names};
 use rayon::prelude::*;
 use roadmap::Roadmap;
 
@@ -160,12 +160,14 @@ struct GroupOut {
 }
 
 /// Plans every move of `hlip`. `None` after pushing diagnostics when some move cannot
-/// be made collision-free.
+/// be made collision-free; `bans` then gets the configurations of the touches no move
+/// reached, for the planner to fail in validation on another try.
 pub fn plan(
     input: &Input,
     hlip: &Hlip,
     progress: &(dyn Fn(usize, usize) + Sync),
     diags: &mut Diagnostics,
+    bans: &mut Vec<Ban>,
 ) -> Option<Llip> {
     let motion = input.plan.motion;
     let probes = ProbeShape::of_cmm(input.model, &input.model.cmms[input.plan.cmm.0]);
@@ -174,7 +176,7 @@ pub fn plan(
     let standoff = motion.prehit.max(motion.retract);
     let total = groups.len();
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let results: Vec<Result<GroupOut, Box<PathError>>> = groups
+    let results: Vec<Result<GroupOut, Unreached>> = groups
         .par_iter()
         .map(|g| {
             let r = plan_group(input, hlip, &scene, g, standoff);
@@ -189,7 +191,10 @@ pub fn plan(
     for r in results {
         match r {
             Ok(o) => outs.push(o),
-            Err(e) => diags.push(*e),
+            Err(e) => {
+                diags.push(*e.error);
+                bans.extend(e.bans);
+            }
         }
     }
     if outs.len() < total {
@@ -203,7 +208,8 @@ pub fn plan(
             Some(llip)
         }
         Err(e) => {
-            diags.push(*e);
+            diags.push(*e.error);
+            bans.extend(e.bans);
             None
         }
     }
@@ -343,7 +349,7 @@ fn join(
     scene: &Scene,
     groups: &[GroupIn],
     outs: Vec<GroupOut>,
-) -> Result<Llip, Box<PathError>> {
+) -> Result<Llip, Unreached> {
     let motion = input.plan.motion;
     let total = groups.len();
     let mut setups: Vec<SetupPath> = Vec::new();
@@ -370,7 +376,8 @@ fn join(
                     .and_then(|_| pose.segment(&across, &entry[0]));
                 if let Err(blocker) = moves {
                     let b = &o.blocks[0];
-                    return Err(Box::new(no_path(input, b, g, &blocker.to_string())));
+                    let points = b.touches.iter().map(|t| t.point).collect();
+                    return Err(no_path(input, b, g, &blocker.to_string(), points));
                 }
                 entry.insert(0, across);
             }
@@ -452,12 +459,35 @@ fn polyline(pts: &[P3]) -> f64 {
     pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
 }
 
-/// The diagnostic for a block no move reaches; `blocker` says what hits.
-fn no_path(input: &Input, b: &BlockPath, g: &GroupIn, blocker: &str) -> PathError {
+/// A block no move reaches: the diagnostic, and the configurations of its points that
+/// the planner should not offer again.
+pub(crate) struct Unreached {
+    error: Box<PathError>,
+    bans: Vec<Ban>,
+}
+
+/// The diagnostic for a block no move reaches; `blocker` says what hits, `points` which
+/// of its touches (indices into [`Hlip::points`]) cannot be reached.
+fn no_path(
+    input: &Input,
+    b: &BlockPath,
+    g: &GroupIn,
+    blocker: &str,
+    points: Vec<usize>,
+) -> Unreached {
     let names = Names::new(input.model, input.geometry, input.plan_id());
     let part = names.part();
     let feature = b.feature.map(|f| &part.features[f.0]);
-    PathError::NoPath {
+    let bans = points
+        .into_iter()
+        .map(|point| Ban {
+            point,
+            probe: g.slot.0,
+            up: g.up,
+            dir: g.dir,
+        })
+        .collect();
+    let error = Box::new(PathError::NoPath {
         span: feature.map_or(part.span, |f| f.span),
         face: names.face(b.face).to_string(),
         feature: names.feature(b.feature).to_string(),
@@ -471,7 +501,8 @@ fn no_path(input: &Input, b: &BlockPath, g: &GroupIn, blocker: &str) -> PathErro
             Head::Fixed => String::new(),
         },
         blocker: blocker.to_string(),
-    }
+    });
+    Unreached { error, bans }
 }
 
 /// Plans one group: roadmap, tour, entry and exit.
@@ -481,7 +512,7 @@ fn plan_group(
     scene: &Scene,
     g: &GroupIn,
     standoff: f64,
-) -> Result<GroupOut, Box<PathError>> {
+) -> Result<GroupOut, Unreached> {
     let full = input.plan.motion.margin;
     let mut pose = Pose::new(scene, g.probe, g.dir, g.up, g.table)
         .with_fixture(g.fixture)
@@ -546,8 +577,15 @@ fn plan_group(
         g.height,
     );
     let added = map.build(face_points).map_err(|d| {
-        let (bi, _) = owner[d.goal];
-        Box::new(no_path(input, &g.blocks[bi], g, &d.blocker.to_string()))
+        let (bi, ti) = owner[d.goal];
+        let b = &g.blocks[bi];
+        no_path(
+            input,
+            b,
+            g,
+            &d.blocker.to_string(),
+            vec![b.touches[ti].point],
+        )
     })?;
     let paths = map.shortest_paths();
     // The way up from each goal to the clearance plane.
@@ -623,13 +661,16 @@ fn plan_group(
         .copied()
         .unwrap_or(0);
     let Some(entry_up) = lifts[first].clone() else {
-        let (bi, _) = owner[first];
-        return Err(Box::new(no_path(
+        let (bi, ti) = owner[first];
+        let b = &g.blocks[bi];
+        let points = vec![b.touches[ti].point];
+        return Err(no_path(
             input,
-            &g.blocks[bi],
+            b,
             g,
             "the way up to the clearance plane",
-        )));
+            points,
+        ));
     };
     let mut entry: Vec<P3> = entry_up.into_iter().rev().collect();
     if entry.is_empty() {

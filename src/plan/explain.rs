@@ -223,6 +223,9 @@ pub(super) fn report_left_out(
         Blocker::Fixture(_) => {
             "another fixture, or a setup on the table, leaves this face free; `inspc plan --explain-setups` lists them"
         }
+        Blocker::Path => {
+            "a longer stylus, another orientation or a larger `motion { clearance }` may open a way to it"
+        }
     };
     diags.push(PlanError::PointsLeftOut {
         span: feature.map_or(part.span, |f| f.span),
@@ -241,6 +244,7 @@ pub(super) fn report_left_out(
                 format!("the {c} of probe {probe} comes too near the table")
             }
             Blocker::Fixture(c) => format!("the {c} of probe {probe} meets the fixture"),
+            Blocker::Path => format!("no collision-free move brings probe {probe} to it"),
         },
         help: help.into(),
     });

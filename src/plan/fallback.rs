@@ -70,7 +70,7 @@ impl Fallback {
         let mut moved: BTreeMap<(usize, usize, usize, usize), Vec<usize>> = BTreeMap::new();
         let mut still: BTreeMap<FaceId, (usize, usize, Blocker)> = BTreeMap::new();
         for (pip, from) in origin {
-            match relocate(k, m, &pip, &setups, &used) {
+            match relocate(k, m, &pip, &setups, &used, &opts.bans) {
                 Some((s, p, o)) => moved.entry((from, s, p, o)).or_default().push(pip.point),
                 None => {
                     let face = k.points[pip.point].face;
@@ -129,6 +129,7 @@ fn relocate(
     pip: &Pip,
     setups: &BTreeSet<usize>,
     used: &BTreeSet<(usize, usize, usize)>,
+    bans: &[super::Ban],
 ) -> Option<(usize, usize, usize)> {
     if pip.point >= k.graph_points {
         return None;
@@ -160,6 +161,6 @@ fn relocate(
                 setup: s,
                 orient: o,
             };
-            validate::check(k, m, &try_, &up, held).is_ok()
+            validate::check(k, m, &try_, &up, held, bans).is_ok()
         })
 }

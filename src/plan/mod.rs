@@ -58,6 +58,35 @@ pub struct PlanOptions {
     pub exact_budget: usize,
     /// Tolerances the plan cannot measure are warnings, not errors.
     pub allow_unmeasured: bool,
+    /// Configurations the path stage found no move to: validation fails them.
+    pub bans: Vec<Ban>,
+}
+
+/// A touch configuration the path stage could not reach: the point (index into
+/// [`Hlip::points`]), the probe (rack index), the setup's up direction and the probe's
+/// direction, both in the part frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ban {
+    /// The point.
+    pub point: usize,
+    /// The probe's rack index.
+    pub probe: usize,
+    /// The setup: the part direction facing the ram.
+    pub up: V3,
+    /// The probe direction, tip to head.
+    pub dir: V3,
+}
+
+impl Ban {
+    /// Whether the configuration is this one (directions to within the plan's
+    /// quantisation, [`STEPS_PER_MM`]).
+    pub(crate) fn is(&self, point: usize, probe: usize, up: &V3, dir: &V3) -> bool {
+        let eps = 10.0 / STEPS_PER_MM;
+        self.point == point
+            && self.probe == probe
+            && (self.up - up).norm() < eps
+            && (self.dir - dir).norm() < eps
+    }
 }
 
 impl Default for PlanOptions {
@@ -67,6 +96,7 @@ impl Default for PlanOptions {
             max_iterations: 40,
             exact_budget: 200_000,
             allow_unmeasured: false,
+            bans: Vec::new(),
         }
     }
 }
@@ -425,7 +455,10 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
             .collect();
         let checked: Vec<(Pip, Result<(), _>)> = pips
             .par_iter()
-            .map(|(p, up)| (*p, validate::check(&k, &machine, p, up, &held[&p.setup])))
+            .map(|(p, up)| {
+                let r = validate::check(&k, &machine, p, up, &held[&p.setup], &opts.bans);
+                (*p, r)
+            })
             .collect();
         let mut invalid = Vec::new();
         let mut left: BTreeSet<Pip> = BTreeSet::new();

@@ -27,6 +27,7 @@ pub(crate) fn check(
     pip: &Pip,
     up: &V3,
     held: &Held,
+    bans: &[super::Ban],
 ) -> Result<(), Blocker> {
     let dir = if m.head.indexable() {
         let (a, b) = m.grid[pip.orient];
@@ -34,5 +35,8 @@ pub(crate) fn check(
     } else {
         *up
     };
+    if bans.iter().any(|b| b.is(pip.point, pip.probe, up, &dir)) {
+        return Err(Blocker::Path);
+    }
     k.pose_check(m, pip.point, pip.probe, dir, *up, held)
 }

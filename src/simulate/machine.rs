@@ -660,6 +660,7 @@ impl Machine<'_> {
             Blocker::Component(c) => (c, "the part"),
             Blocker::ComponentOnTable(c) => (c, "the table"),
             Blocker::Fixture(c) => (c, "the fixture"),
+            Blocker::Path => ("probe".to_string(), "the part"),
         };
         SimError::Collision {
             span: self.span(at),

@@ -16,6 +16,7 @@ mod geometry_props;
 mod grammar;
 mod mesh_fuzz;
 mod no_panic;
+mod replan;
 mod sampling;
 mod simulate;
 mod tours;
