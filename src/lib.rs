@@ -53,6 +53,15 @@ impl Checked {
         self.diagnostics = all.sorted();
     }
 
+    /// [`Checked::absorb`] for several stages' (or plans') diagnostics at once.
+    fn absorb_all(&mut self, later: Vec<diag::Diagnostics>) {
+        let mut all = diag::Diagnostics::new();
+        for d in later {
+            all.extend(d);
+        }
+        self.absorb(all);
+    }
+
     /// Every file the run read or will read: the specs it loaded and the meshes their
     /// parts name. No output may replace one of them.
     pub fn inputs(&self) -> Vec<PathBuf> {
@@ -273,11 +282,7 @@ fn plans_of(
     opts: &plan::PlanOptions,
 ) -> Vec<Planned> {
     let (out, each) = plan_each(checked, parts, graphs, opts);
-    let mut all = diag::Diagnostics::new();
-    for d in each {
-        all.extend(d);
-    }
-    checked.absorb(all);
+    checked.absorb_all(each);
     out
 }
 
@@ -431,11 +436,7 @@ pub fn run(
     let (planned, each) = plan_each(&mut run.checked, &run.parts, &run.graphs, opts);
     lap(&mut run.timings, "plan");
     if run.checked.has_errors() || each.iter().any(|d| d.has_errors()) {
-        let mut all = diag::Diagnostics::new();
-        for d in each {
-            all.extend(d);
-        }
-        run.checked.absorb(all);
+        run.checked.absorb_all(each);
         return run;
     }
     let paths = paths_of(&mut run, planned, each, opts, progress);
@@ -498,15 +499,12 @@ fn paths_of(
             let mut moves = diag::Diagnostics::new();
             let mut bans = Vec::new();
             let llip = path::plan(&input, &hlip, &report, &mut moves, &mut bans);
-            if let Some(llip) = llip {
+            if llip.is_some() || bans.is_empty() || attempt == REPLANS {
                 diags.extend(own);
                 diags.extend(moves);
-                paths.push((p.plan, g.part, hlip, llip));
-                break;
-            }
-            if bans.is_empty() || attempt == REPLANS {
-                diags.extend(own);
-                diags.extend(moves);
+                if let Some(llip) = llip {
+                    paths.push((p.plan, g.part, hlip, llip));
+                }
                 break;
             }
             bans_all.extend(bans);

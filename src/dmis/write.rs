@@ -536,16 +536,10 @@ impl Writer<'_> {
     fn datum_patterns(&mut self) {
         let part = self.names.part();
         let cos = (0.1f64).to_radians().cos();
-        let mut by_feature: BTreeMap<FeatureId, Vec<usize>> = BTreeMap::new();
-        for (k, s) in self.surfs.iter().enumerate() {
-            if let Some(f) = s.feature {
-                if !s.full.is_empty() && part.datums.iter().any(|d| d.feature == f) {
-                    by_feature.entry(f).or_default().push(k);
-                }
-            }
-        }
-        for (f, surfs) in by_feature {
-            if surfs.len() < 2 || self.pairs.contains_key(&f) {
+        for (f, mut surfs) in self.surfaces_by_feature() {
+            surfs.retain(|&k| !self.surfs[k].full.is_empty());
+            let datum = part.datums.iter().any(|d| d.feature == f);
+            if !datum || surfs.len() < 2 || self.pairs.contains_key(&f) {
                 continue;
             }
             let axes: Option<Vec<V3>> = surfs
@@ -571,18 +565,23 @@ impl Writer<'_> {
         }
     }
 
+    /// Per feature, its surfaces (indices into `surfs`) in program order.
+    fn surfaces_by_feature(&self) -> BTreeMap<FeatureId, Vec<usize>> {
+        let mut out: BTreeMap<FeatureId, Vec<usize>> = BTreeMap::new();
+        for (k, s) in self.surfs.iter().enumerate() {
+            if let Some(f) = s.feature {
+                out.entry(f).or_default().push(k);
+            }
+        }
+        out
+    }
+
     /// A feature made of two opposed parallel planes (a slot, a tab) is a feature of
     /// size: its width, position, symmetry and orientation belong to the pair, a
     /// `FEAT/PARPLN` constructed from the two walls once both are measured.
     fn centre_planes(&mut self) {
         let cos = (0.1f64).to_radians().cos();
-        let mut by_feature: BTreeMap<FeatureId, Vec<usize>> = BTreeMap::new();
-        for (k, s) in self.surfs.iter().enumerate() {
-            if let Some(f) = s.feature {
-                by_feature.entry(f).or_default().push(k);
-            }
-        }
-        for (f, surfs) in by_feature {
+        for (f, surfs) in self.surfaces_by_feature() {
             let [a, b] = surfs[..] else { continue };
             // Each wall's centre, a point of its plane and its normal.
             let plane = |k: usize| match self.nominals.get(&self.surfs[k].full) {

@@ -93,25 +93,19 @@ impl Shape {
 fn resting_datum(input: &Input, up: V3, table: f64) -> Option<usize> {
     let part = &input.model.parts[input.plan.part.0];
     let graph = input.graph;
+    let on_table = |face: &crate::geometry::FaceId| {
+        matches!(
+            input.geometry.faces.get(face.0).map(|f| &f.surface),
+            Some(Surface::Plane { origin, normal })
+                if normal.dot(&up) < -1.0 + 1e-9 && (origin.coords.dot(&up) - table).abs() < 1e-2
+        )
+    };
     let rests = |feature: FeatureId| {
         graph.nodes().any(|(i, n)| {
             matches!(n, Node::Feature { feature: f, .. } if *f == feature)
-                && graph
-                    .children(i)
-                    .iter()
-                    .any(|(c, _)| match &graph.graph[*c] {
-                        Node::Face { face, .. } => match input.geometry.faces.get(face.0) {
-                            Some(f) => match &f.surface {
-                                Surface::Plane { origin, normal } => {
-                                    normal.dot(&up) < -1.0 + 1e-9
-                                        && (origin.coords.dot(&up) - table).abs() < 1e-2
-                                }
-                                _ => false,
-                            },
-                            None => false,
-                        },
-                        _ => false,
-                    })
+                && graph.children(i).iter().any(
+                    |(c, _)| matches!(&graph.graph[*c], Node::Face { face, .. } if on_table(face)),
+                )
         })
     };
     part.datums.iter().position(|d| rests(d.feature))

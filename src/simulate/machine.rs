@@ -169,8 +169,9 @@ struct Machine<'a> {
     /// the setup to come.
     between: bool,
     actuals: BTreeMap<String, Stored>,
-    /// Per datum label: the feature `DATDEF` names and, for a pattern, its members.
-    datums: BTreeMap<String, (Stored, String, Vec<Labelled>)>,
+    /// Per datum label: the feature `DATDEF` names and, for a pattern, its members
+    /// after it (they give its clocking).
+    datums: BTreeMap<String, Vec<Labelled>>,
     /// Per pattern (`FEAT/PATERN`), its members' labels.
     patterns: BTreeMap<String, Vec<String>>,
     block: Option<Block>,
@@ -483,14 +484,15 @@ impl Machine<'_> {
                         "measure a datum feature before DATDEF",
                     )
                 })?;
-                let members = self
+                let members: Vec<Labelled> = self
                     .patterns
                     .get(&l)
                     .into_iter()
                     .flatten()
                     .filter_map(|m| Some((self.actuals.get(m).cloned()?, m.clone())))
                     .collect();
-                self.datums.insert(d.clone(), (f, l, members));
+                let all = std::iter::once((f, l)).chain(members).collect();
+                self.datums.insert(d.clone(), all);
             }
             "OUTPUT" => self.output(params, at)?,
             other => return Err(self.unsupported(at, other)),
@@ -830,8 +832,7 @@ impl Machine<'_> {
     fn search_surface(&self, ctx: &SetupCtx, c0: &P3, n: &V3, r: f64, travel: f64) -> Found {
         let g = self.input.geometry;
         let dev: &Deviations = self.input.deviations;
-        let mut best: Option<(f64, Contact)> = None;
-        let mut touched = None;
+        let mut best: Option<(f64, Contact, Option<FaceId>)> = None;
         if let Some(mesh) = self.scene.mesh() {
             let foot = c0 - n * r;
             let ray = Ray::new(foot, -n);
@@ -895,21 +896,19 @@ impl Machine<'_> {
                     }
                 };
                 if let Some(t) = t {
-                    best = Some((t, Contact::Part));
-                    touched = Some(face);
+                    best = Some((t, Contact::Part, Some(face)));
                 }
             }
         }
         let rise = n.dot(&ctx.up);
         if rise > 1e-9 {
             let t = ((c0.coords.dot(&ctx.up)) - r - ctx.table) / rise;
-            if (0.0..=travel).contains(&t) && best.is_none_or(|(b, _)| t < b) {
-                best = Some((t, Contact::Table));
-                touched = None;
+            if (0.0..=travel).contains(&t) && best.is_none_or(|(b, ..)| t < b) {
+                best = Some((t, Contact::Table, None));
             }
         }
         match best {
-            Some((t, k)) => Found::Contact(c0 - n * t, k, touched),
+            Some((t, k, face)) => Found::Contact(c0 - n * t, k, face),
             None => Found::Nothing,
         }
     }
@@ -1317,23 +1316,16 @@ impl Machine<'_> {
             .collect();
         let mut datums = Vec::new();
         for d in &def.datums {
-            let (f, l, members) = self.datums.get(d).ok_or_else(|| {
+            let features = self.datums.get(d).ok_or_else(|| {
                 self.bad(
                     at,
                     &format!("datum `{d}` is not defined"),
                     "define it with DATDEF before the tolerance's OUTPUT",
                 )
             })?;
-            let n = self
-                .nominals
-                .get(l)
-                .map(|n| n.shape.clone())
-                .unwrap_or(Shape::Surface);
-            datums.push((self.in_program(f).shape, n));
-            // A pattern's members after its axis: they give its clocking.
-            for (m, ml) in members {
-                let n = self.nominals.get(ml).map(|n| n.shape.clone());
-                datums.push((self.in_program(m).shape, n.unwrap_or(Shape::Surface)));
+            for (f, l) in features {
+                let n = self.nominals.get(l).map(|n| n.shape.clone());
+                datums.push((self.in_program(f).shape, n.unwrap_or(Shape::Surface)));
             }
         }
         let out = evaluate::evaluate(&def, &targets, &datums);
