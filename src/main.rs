@@ -757,7 +757,9 @@ fn faces(file: &std::path::Path, segment: bool, units: &str, format: TableFormat
                 );
                 let span = inspc::source::Span::new(id, 0, file.to_string_lossy().len());
                 let mut diags = inspc::diag::Diagnostics::new();
-                diags.push(e.at(span, file));
+                for d in e.at(span, file) {
+                    diags.push(d);
+                }
                 print_diagnostics(&sources, &diags.sorted());
                 return ExitCode::from(1);
             }

@@ -83,6 +83,85 @@ pub enum GeometryError {
         part: String,
         gap: String,
     },
+    #[error("STEP file `{path}` is not valid Part 21 text: line {line}: {message}")]
+    #[diagnostic(
+        code(insp::geometry::step_syntax),
+        help("the file is cut short or was edited by hand; re-export it from the CAD system")
+    )]
+    StepSyntax {
+        #[label("this STEP file")]
+        span: Span,
+        path: String,
+        line: usize,
+        message: String,
+    },
+    #[error("STEP file `{path}` holds no solid")]
+    #[diagnostic(
+        code(insp::geometry::step_no_solid),
+        help("export the part as a solid (MANIFOLD_SOLID_BREP); a file of PMI, wireframe or tessellated shapes only has no faces to inspect")
+    )]
+    StepNoSolid {
+        #[label("this STEP file")]
+        span: Span,
+        path: String,
+    },
+    #[error("STEP file `{path}` is incomplete: {reason}")]
+    #[diagnostic(
+        code(insp::geometry::step_missing_entity),
+        help("an instance the B-rep needs is not in the file: it was cut short or corrupted; re-export it")
+    )]
+    StepMissing {
+        #[label("this STEP file")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("STEP file `{path}` has a malformed instance: {reason}")]
+    #[diagnostic(
+        code(insp::geometry::step_malformed),
+        help("the instance's parameters do not fit its type; re-export the file, or report the exporting CAD system")
+    )]
+    StepMalformed {
+        #[label("this STEP file")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("STEP file `{path}`: {reason}")]
+    #[diagnostic(
+        code(insp::geometry::step_unsupported),
+        help("inspc evaluates planes, cylinders, cones, spheres, tori and B-spline surfaces, and lines, circles, ellipses, B-spline curves and polylines; export this geometry as B-splines")
+    )]
+    StepUnsupported {
+        #[label("this STEP file")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("STEP file `{path}`: {reason}")]
+    #[diagnostic(
+        code(insp::geometry::step_unit),
+        help("inspc reads SI length units with their prefixes and conversion-based units such as the inch, assigned by the context of the solid's representation")
+    )]
+    StepUnit {
+        #[label("this STEP file")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("face_{face} (#{id}) of STEP file `{path}` cannot be meshed: {reason}")]
+    #[diagnostic(
+        code(insp::geometry::step_face),
+        help("the face is kept out of nothing: a part with a hole in its mesh cannot be planned; repair the face in the CAD system (its bounds and surface must agree) and re-export")
+    )]
+    StepFace {
+        #[label("this STEP file")]
+        span: Span,
+        path: String,
+        face: usize,
+        id: u64,
+        reason: String,
+    },
     #[error("mesh `{path}` is too large: {reason}")]
     #[diagnostic(
         code(insp::geometry::mesh_too_large),
@@ -158,6 +237,13 @@ crate::located!(GeometryError {
     FixtureMissesPart,
     SeveralBodies,
     MeshTooLarge,
+    StepSyntax,
+    StepNoSolid,
+    StepMissing,
+    StepMalformed,
+    StepUnsupported,
+    StepUnit,
+    StepFace,
     BooleanFailed,
     MissesPart,
     FaceGone,
@@ -177,18 +263,51 @@ pub enum MeshError {
     NotClosed(String),
     /// Over the size limit.
     TooLarge(String),
+    /// A STEP file that cannot be read or meshed.
+    Step(super::step::StepError),
 }
 
 impl MeshError {
-    /// The diagnostic, pointing at the spec's mesh path.
-    pub fn at(self, span: Span, path: &std::path::Path) -> GeometryError {
+    /// The diagnostics, pointing at the spec's mesh path: one, or one per face of a
+    /// STEP file that could not be meshed.
+    pub fn at(self, span: Span, path: &std::path::Path) -> Vec<GeometryError> {
+        use super::step::StepError as S;
         let path = shown_path(path);
-        match self {
+        vec![match self {
             MeshError::Unreadable(reason) => GeometryError::MeshUnreadable { span, path, reason },
             MeshError::Corrupt(reason) => GeometryError::MeshCorrupt { span, path, reason },
             MeshError::NotClosed(reason) => GeometryError::MeshNotClosed { span, path, reason },
             MeshError::TooLarge(reason) => GeometryError::MeshTooLarge { span, path, reason },
-        }
+            MeshError::Step(S::Faces(list)) => {
+                return list
+                    .into_iter()
+                    .map(|(face, id, reason)| GeometryError::StepFace {
+                        span,
+                        path: path.clone(),
+                        face,
+                        id,
+                        reason,
+                    })
+                    .collect()
+            }
+            MeshError::Step(e) => {
+                let reason = e.to_string();
+                match e {
+                    S::Syntax { line, message } => GeometryError::StepSyntax {
+                        span,
+                        path,
+                        line,
+                        message,
+                    },
+                    S::NoSolid => GeometryError::StepNoSolid { span, path },
+                    S::Missing { .. } => GeometryError::StepMissing { span, path, reason },
+                    S::Malformed { .. } => GeometryError::StepMalformed { span, path, reason },
+                    S::Unsupported { .. } => GeometryError::StepUnsupported { span, path, reason },
+                    S::Unit(_) => GeometryError::StepUnit { span, path, reason },
+                    S::Faces(_) => unreachable!("handled above"),
+                }
+            }
+        }]
     }
 }
 

@@ -1,4 +1,4 @@
-//! Reading STL (binary and ASCII) and OBJ meshes, welding coincident vertices and
+//! Reading STL (binary and ASCII) and OBJ meshes (and STEP parts, through `step`), welding coincident vertices and
 //! checking that the result is a (nearly) closed solid.
 
 use super::errors::MeshError;
@@ -25,6 +25,9 @@ pub struct RawMesh {
     pub open_edges: usize,
     /// Edges used by more than two triangles.
     pub nonmanifold_edges: usize,
+    /// Per group, its exact surface when the file gives one (STEP); empty for meshes,
+    /// whose surfaces are fitted.
+    pub exact: Vec<super::Surface>,
 }
 
 /// Reads a mesh file through the world, scaling by `unit_mm`.
@@ -36,6 +39,9 @@ pub fn read_mesh(world: &dyn World, path: &Path, unit_mm: f64) -> Result<RawMesh
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
+    if ext == "stp" || ext == "step" {
+        return super::step::read(&bytes, super::step::RESOLUTION).map(|p| p.mesh);
+    }
     let (positions, faces, tri_group, groups) = if ext == "obj" {
         parse_obj(&bytes)?
     } else {
@@ -176,7 +182,7 @@ fn parse_obj(bytes: &[u8]) -> Result<Parsed, MeshError> {
 /// Merges coincident vertices (to 1e-6 mm), drops degenerate triangles and counts open
 /// and non-manifold edges; a mesh with more than a tenth of its edges defective is not
 /// a solid at all.
-fn weld(
+pub(super) fn weld(
     positions: Vec<[f64; 3]>,
     faces: Vec<[usize; 3]>,
     tri_group: Vec<u32>,
@@ -237,5 +243,6 @@ fn weld(
         groups,
         open_edges,
         nonmanifold_edges,
+        exact: Vec::new(),
     })
 }

@@ -22,6 +22,7 @@ mod query;
 mod report;
 pub mod segment;
 mod select;
+pub mod step;
 
 pub use errors::GeometryError;
 pub use fixture::{place_fixture, FixtureMesh, CONTACT_MM};
@@ -434,7 +435,9 @@ pub(crate) fn read_reported(
     let raw = match read_mesh(world, path, unit_mm) {
         Ok(m) => m,
         Err(e) => {
-            diags.push(e.at(span, path));
+            for d in e.at(span, path) {
+                diags.push(d);
+            }
             return None;
         }
     };

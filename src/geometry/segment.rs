@@ -70,7 +70,14 @@ fn assemble(
         for &t in tris {
             tri_face[t as usize] = k as u32;
         }
-        let f = fit_face(m, tris, normals, tol);
+        // A STEP face's surface is the file's; a mesh face's is fitted.
+        let f = match m.exact.get(k) {
+            Some(surface) => fit::Fit {
+                surface: surface.clone(),
+                rms: 0.0,
+            },
+            None => fit_face(m, tris, normals, tol),
+        };
         rms.push(f.rms);
         specs.push((names[k].clone(), f.surface));
     }

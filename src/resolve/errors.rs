@@ -339,10 +339,10 @@ pub enum ResolveError {
     #[error("unsupported mesh format `{ext}`")]
     #[diagnostic(
         code(insp::resolve::mesh_format),
-        help("inspc reads STL (binary or ASCII) and OBJ files")
+        help("inspc reads STL (binary or ASCII), OBJ and STEP (.stp, .step) files")
     )]
     MeshFormat {
-        #[label("not .stl or .obj")]
+        #[label("not .stl, .obj or .stp")]
         span: Span,
         ext: String,
     },

@@ -415,14 +415,14 @@ fn mesh(
     })
 }
 
-/// The full path of a mesh file a spec names (relative to the spec's folder): an STL or
-/// OBJ file that exists. A missing file is reported and still gives its path.
+/// The full path of a mesh file a spec names (relative to the spec's folder): an STL,
+/// OBJ or STEP file that exists. A missing file is reported and still gives its path.
 pub(super) fn mesh_file(r: &Resolver, cx: &mut Cx, path: &ast::Str) -> Option<std::path::PathBuf> {
     let ext = std::path::Path::new(&path.value)
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    if ext != "stl" && ext != "obj" {
+    if !matches!(ext.as_str(), "stl" | "obj" | "stp" | "step") {
         cx.err(E::MeshFormat {
             span: path.span,
             ext: if ext.is_empty() {

@@ -19,4 +19,5 @@ mod no_panic;
 mod replan;
 mod sampling;
 mod simulate;
+mod step;
 mod tours;

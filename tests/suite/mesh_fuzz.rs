@@ -141,7 +141,7 @@ proptest! {
         let n = vertices.len() as u32;
         let triangles: Vec<[u32; 3]> = tris.iter().map(|&(a, b, c, _)| [a % n, b % n, c % n]).collect();
         let tri_group: Vec<u32> = tris.iter().map(|t| t.3).collect();
-        let raw = RawMesh { vertices, triangles, tri_group, groups: vec!["a".into(), "b".into(), "c".into()], open_edges: 0, nonmanifold_edges: 0 };
+        let raw = RawMesh { vertices, triangles, tri_group, groups: vec!["a".into(), "b".into(), "c".into()], open_edges: 0, nonmanifold_edges: 0, exact: vec![] };
         segment_and_sample(&raw);
     }
 }
@@ -149,4 +149,32 @@ proptest! {
 #[test]
 fn the_cube_itself_samples() {
     run("m.obj", cube_obj().into_bytes());
+}
+
+/// The NIST CTC 01 STEP file, read once for the corruption cases.
+fn ctc_01_step() -> &'static [u8] {
+    static BYTES: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    BYTES.get_or_init(|| {
+        crate::common::require_shared_parts();
+        std::fs::read("../shared/parts/nist_ctc_01_asme1_ap242-e1.stp").unwrap()
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// A real STEP file cut short anywhere, or with bytes overwritten (digits, signs,
+    /// `#`, `(`, `;`, letters), is read or refused, never a panic or a hang.
+    #[test]
+    fn corrupted_step(cut in any::<prop::sample::Index>(), edits in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(b"0123456789-.#();,E$*'AZ ".to_vec())), 0..6), truncate in any::<bool>()) {
+        let mut bytes = ctc_01_step().to_vec();
+        for (at, b) in edits {
+            let i = at.index(bytes.len());
+            bytes[i] = b;
+        }
+        if truncate {
+            bytes.truncate(cut.index(bytes.len()));
+        }
+        run("part.stp", bytes);
+    }
 }

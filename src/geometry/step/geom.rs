@@ -1,0 +1,579 @@
+//! The exact curves and surfaces of a STEP B-rep: evaluation, and for surfaces the
+//! inverse map from a point to its parameters, which tessellation triangulates in.
+//!
+//! Every surface is parametrised so that `S_u × S_v` points along STEP's natural normal
+//! (away from a cylinder's, cone's, sphere's or torus's axis or centre); angles are
+//! radians, lengths millimetres.
+
+use crate::geometry::{P3, V3};
+use std::f64::consts::{FRAC_PI_2, TAU};
+
+/// A right-handed orthonormal frame (STEP's `AXIS2_PLACEMENT_3D`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// Origin.
+    pub o: P3,
+    /// Reference direction.
+    pub x: V3,
+    /// `z × x`.
+    pub y: V3,
+    /// Axis.
+    pub z: V3,
+}
+
+impl Frame {
+    /// The frame from an origin, an axis and a reference direction (either may be
+    /// missing: STEP's defaults apply).
+    pub fn new(o: P3, axis: Option<V3>, reference: Option<V3>) -> Option<Frame> {
+        let z = axis.unwrap_or(V3::z()).try_normalize(1e-12)?;
+        let guess = reference.unwrap_or(if z.x.abs() < 0.9 { V3::x() } else { V3::y() });
+        let x = (guess - z * guess.dot(&z)).try_normalize(1e-12)?;
+        Some(Frame {
+            o,
+            x,
+            y: z.cross(&x),
+            z,
+        })
+    }
+
+    /// Local coordinates of `p`.
+    fn local(&self, p: &P3) -> V3 {
+        let d = p - self.o;
+        V3::new(d.dot(&self.x), d.dot(&self.y), d.dot(&self.z))
+    }
+
+    fn at(&self, x: f64, y: f64, z: f64) -> P3 {
+        self.o + self.x * x + self.y * y + self.z * z
+    }
+}
+
+/// The highest B-spline degree read (CAD systems write up to 9 or so).
+pub const MAX_DEGREE: usize = 15;
+
+/// A non-uniform rational B-spline in any number of parameters' worth of control points:
+/// one knot vector and degree per direction (used for curves and surfaces).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Knots {
+    /// Degree.
+    pub degree: usize,
+    /// The full knot vector (multiplicities expanded).
+    pub knots: Vec<f64>,
+}
+
+impl Knots {
+    /// The knot vector from STEP's distinct knots and multiplicities; `None` when it
+    /// does not fit `n` control points of this degree.
+    pub fn new(degree: usize, mults: &[i64], values: &[f64], n: usize) -> Option<Knots> {
+        if mults.len() != values.len() || degree == 0 || degree > MAX_DEGREE {
+            return None;
+        }
+        let mut knots = Vec::new();
+        for (m, v) in mults.iter().zip(values) {
+            if *m < 1 {
+                return None;
+            }
+            knots.extend(std::iter::repeat_n(*v, *m as usize));
+        }
+        if knots.len() != n + degree + 1 || knots.windows(2).any(|w| w[1] < w[0]) {
+            return None;
+        }
+        Some(Knots { degree, knots })
+    }
+
+    /// The parameter range.
+    pub fn range(&self) -> (f64, f64) {
+        let n = self.knots.len() - self.degree - 1;
+        (self.knots[self.degree], self.knots[n])
+    }
+
+    /// The span index `k` with `knots[k] ≤ t < knots[k+1]`, clamped to the range.
+    fn span(&self, t: f64) -> usize {
+        let n = self.knots.len() - self.degree - 1;
+        let p = self.degree;
+        if t >= self.knots[n] {
+            let mut k = n - 1;
+            while k > p && self.knots[k] >= self.knots[k + 1] {
+                k -= 1;
+            }
+            return k;
+        }
+        let mut k = p;
+        while k + 1 < n && self.knots[k + 1] <= t {
+            k += 1;
+        }
+        k
+    }
+
+    /// The distinct knots inside the range, with the ends.
+    pub fn breaks(&self) -> Vec<f64> {
+        let (a, b) = self.range();
+        let mut out: Vec<f64> = self
+            .knots
+            .iter()
+            .copied()
+            .filter(|k| *k >= a && *k <= b)
+            .collect();
+        out.dedup();
+        out
+    }
+
+    /// The basis functions' non-zero values at `t`: (first index, values; the first
+    /// `degree + 1` are used).
+    fn basis(&self, t: f64) -> (usize, [f64; MAX_DEGREE + 1]) {
+        let p = self.degree;
+        let k = self.span(t);
+        let (a, b) = self.range();
+        let t = t.clamp(a, b);
+        let u = &self.knots;
+        let mut n = [0.0; MAX_DEGREE + 1];
+        let mut left = [0.0; MAX_DEGREE + 1];
+        let mut right = [0.0; MAX_DEGREE + 1];
+        n[0] = 1.0;
+        for j in 1..=p {
+            left[j] = t - u[k + 1 - j];
+            right[j] = u[k + j] - t;
+            let mut saved = 0.0;
+            for r in 0..j {
+                let den = right[r + 1] + left[j - r];
+                let temp = if den.abs() > 0.0 { n[r] / den } else { 0.0 };
+                n[r] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            n[j] = saved;
+        }
+        (k - p, n)
+    }
+}
+
+/// A B-spline curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BSplineCurve {
+    /// Knots and degree.
+    pub knots: Knots,
+    /// Control points.
+    pub points: Vec<P3>,
+    /// Weights (all 1 for a non-rational curve).
+    pub weights: Vec<f64>,
+}
+
+impl BSplineCurve {
+    /// The point at `t`.
+    pub fn eval(&self, t: f64) -> P3 {
+        let (first, n) = self.knots.basis(t);
+        let mut sum = V3::zeros();
+        let mut w = 0.0;
+        for (j, b) in n[..=self.knots.degree].iter().enumerate() {
+            let i = first + j;
+            sum += self.points[i].coords * (b * self.weights[i]);
+            w += b * self.weights[i];
+        }
+        P3::from(sum / w)
+    }
+}
+
+/// A B-spline surface.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BSplineSurface {
+    /// Knots along u (the first index of `points`).
+    pub u: Knots,
+    /// Knots along v.
+    pub v: Knots,
+    /// Control points, `points[i][j]` for u index i, v index j.
+    pub points: Vec<Vec<P3>>,
+    /// Weights, shaped as `points`.
+    pub weights: Vec<Vec<f64>>,
+    /// Whether the surface closes on itself along u and along v (a revolved profile).
+    pub closed: [bool; 2],
+}
+
+impl BSplineSurface {
+    /// The point at `(u, v)`.
+    pub fn eval(&self, u: f64, v: f64) -> P3 {
+        let wrap = |t: f64, k: &Knots, closed: bool| {
+            let (a, b) = k.range();
+            if closed {
+                a + (t - a).rem_euclid(b - a)
+            } else {
+                t
+            }
+        };
+        let (fu, nu) = self.u.basis(wrap(u, &self.u, self.closed[0]));
+        let (fv, nv) = self.v.basis(wrap(v, &self.v, self.closed[1]));
+        let mut sum = V3::zeros();
+        let mut w = 0.0;
+        for (a, bu) in nu[..=self.u.degree].iter().enumerate() {
+            for (b, bv) in nv[..=self.v.degree].iter().enumerate() {
+                let (i, j) = (fu + a, fv + b);
+                let k = bu * bv * self.weights[i][j];
+                sum += self.points[i][j].coords * k;
+                w += k;
+            }
+        }
+        P3::from(sum / w)
+    }
+}
+
+/// An edge's curve.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Curve {
+    /// A straight line (the edge runs between its vertices).
+    Line,
+    /// A circle in the frame's xy plane, parametrised by angle from x.
+    Circle(Frame, f64),
+    /// An ellipse: semi-axes along x and y.
+    Ellipse(Frame, f64, f64),
+    /// A B-spline curve.
+    BSpline(BSplineCurve),
+    /// A polyline through these points.
+    Polyline(Vec<P3>),
+}
+
+impl Curve {
+    /// The point at parameter `t` (not for lines and polylines).
+    pub fn eval(&self, t: f64) -> P3 {
+        match self {
+            Curve::Circle(f, r) => f.at(r * t.cos(), r * t.sin(), 0.0),
+            Curve::Ellipse(f, a, b) => f.at(a * t.cos(), b * t.sin(), 0.0),
+            Curve::BSpline(c) => c.eval(t),
+            Curve::Line | Curve::Polyline(_) => P3::origin(),
+        }
+    }
+
+    /// The parameter of (the point of the curve nearest) `p`.
+    pub fn param(&self, p: &P3) -> f64 {
+        match self {
+            Curve::Circle(f, _) => {
+                let l = f.local(p);
+                l.y.atan2(l.x)
+            }
+            Curve::Ellipse(f, a, b) => {
+                let l = f.local(p);
+                (l.y / b).atan2(l.x / a)
+            }
+            Curve::BSpline(c) => nearest_param(|t| c.eval(t), c.knots.range(), p),
+            Curve::Line | Curve::Polyline(_) => 0.0,
+        }
+    }
+}
+
+/// The parameter in `range` whose point is nearest `p`: a dense scan, then golden-section
+/// refinement around the best sample.
+pub fn nearest_param(f: impl Fn(f64) -> P3, (a, b): (f64, f64), p: &P3) -> f64 {
+    const N: usize = 64;
+    let d = |t: f64| (f(t) - p).norm_squared();
+    let step = (b - a) / N as f64;
+    let (mut best, mut bd) = (a, f64::INFINITY);
+    for i in 0..=N {
+        let t = a + step * i as f64;
+        let dt = d(t);
+        if dt < bd {
+            bd = dt;
+            best = t;
+        }
+    }
+    let (mut lo, mut hi) = ((best - step).max(a), (best + step).min(b));
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..60 {
+        let m1 = hi - g * (hi - lo);
+        let m2 = lo + g * (hi - lo);
+        if d(m1) < d(m2) {
+            hi = m2;
+        } else {
+            lo = m1;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// A face's surface.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Surf {
+    /// A plane through the frame's origin with normal z.
+    Plane(Frame),
+    /// A cylinder of this radius about the frame's z axis.
+    Cylinder(Frame, f64),
+    /// A cone: radius at the origin, semi-angle (radians), opening along z.
+    Cone(Frame, f64, f64),
+    /// A sphere about the origin.
+    Sphere(Frame, f64),
+    /// A torus about z: major and minor radius.
+    Torus(Frame, f64, f64),
+    /// A B-spline surface.
+    BSpline(Box<BSplineSurface>),
+}
+
+impl Surf {
+    /// The point at `(u, v)`.
+    pub fn eval(&self, u: f64, v: f64) -> P3 {
+        match self {
+            Surf::Plane(f) => f.at(u, v, 0.0),
+            Surf::Cylinder(f, r) => f.at(r * u.cos(), r * u.sin(), v),
+            Surf::Cone(f, r, a) => {
+                let rr = r + v * a.tan();
+                f.at(rr * u.cos(), rr * u.sin(), v)
+            }
+            Surf::Sphere(f, r) => f.at(r * v.cos() * u.cos(), r * v.cos() * u.sin(), r * v.sin()),
+            Surf::Torus(f, big, small) => {
+                let rr = big + small * v.cos();
+                f.at(rr * u.cos(), rr * u.sin(), small * v.sin())
+            }
+            Surf::BSpline(s) => s.eval(u, v),
+        }
+    }
+
+    /// The parameters of `p` (on or near the surface); angles in (-π, π]. For a
+    /// B-spline, `hint` (a nearby parameter pair) starts the search when given.
+    pub fn param(&self, p: &P3, hint: Option<(f64, f64)>) -> (f64, f64) {
+        match self {
+            Surf::Plane(f) => {
+                let l = f.local(p);
+                (l.x, l.y)
+            }
+            Surf::Cylinder(f, _) | Surf::Cone(f, _, _) => {
+                let l = f.local(p);
+                (l.y.atan2(l.x), l.z)
+            }
+            Surf::Sphere(f, _) => {
+                let l = f.local(p);
+                let rho = (l.x * l.x + l.y * l.y).sqrt();
+                (l.y.atan2(l.x), l.z.atan2(rho))
+            }
+            Surf::Torus(f, big, _) => {
+                let l = f.local(p);
+                let rho = (l.x * l.x + l.y * l.y).sqrt();
+                (l.y.atan2(l.x), l.z.atan2(rho - big))
+            }
+            Surf::BSpline(s) => bspline_param(s, p, hint),
+        }
+    }
+
+    /// The distance from `p` to the surface; `hint` (parameters near the foot) starts a
+    /// B-spline's search.
+    pub fn distance(&self, p: &P3, hint: (f64, f64)) -> f64 {
+        let local = |f: &Frame| f.local(p);
+        match self {
+            Surf::Plane(f) => local(f).z.abs(),
+            Surf::Cylinder(f, r) => {
+                let l = local(f);
+                ((l.x * l.x + l.y * l.y).sqrt() - r).abs()
+            }
+            Surf::Cone(f, r, a) => {
+                let l = local(f);
+                let rho = (l.x * l.x + l.y * l.y).sqrt();
+                ((rho - r - l.z * a.tan()) * a.cos()).abs()
+            }
+            Surf::Sphere(f, r) => (local(f).norm() - r).abs(),
+            Surf::Torus(f, big, small) => {
+                let l = local(f);
+                let rho = (l.x * l.x + l.y * l.y).sqrt();
+                ((rho - big).hypot(l.z) - small).abs()
+            }
+            Surf::BSpline(s) => {
+                let (u, v) = bspline_param(s, p, Some(hint));
+                (s.eval(u, v) - p).norm()
+            }
+        }
+    }
+
+    /// The period of u (an angle), if it has one.
+    pub fn u_period(&self) -> Option<f64> {
+        match self {
+            Surf::Plane(_) => None,
+            Surf::BSpline(s) => s.closed[0].then(|| s.u.range().1 - s.u.range().0),
+            _ => Some(TAU),
+        }
+    }
+
+    /// The period of v: a torus's tube angle.
+    pub fn v_period(&self) -> Option<f64> {
+        match self {
+            Surf::Torus(..) => Some(TAU),
+            Surf::BSpline(s) => s.closed[1].then(|| s.v.range().1 - s.v.range().0),
+            _ => None,
+        }
+    }
+
+    /// The values of v where u is undefined: a sphere's poles, a cone's apex.
+    pub fn poles(&self) -> Vec<f64> {
+        match self {
+            Surf::Sphere(..) => vec![-FRAC_PI_2, FRAC_PI_2],
+            Surf::Cone(_, r, a) => vec![-r / a.tan()],
+            _ => vec![],
+        }
+    }
+
+    /// Whether `v` is at a pole (where u is undefined).
+    pub fn at_pole(&self, p: &P3, v: f64) -> bool {
+        match self {
+            Surf::Sphere(_, r) => (FRAC_PI_2 - v.abs()) * r < 1e-7,
+            Surf::Cone(f, ..) => {
+                let l = f.local(p);
+                (l.x * l.x + l.y * l.y).sqrt() < 1e-7
+            }
+            _ => false,
+        }
+    }
+
+    /// Millimetres per unit of u and v about `(u, v)`, so that triangulating in scaled
+    /// parameters gives well-shaped triangles.
+    pub fn scale(&self, u: f64, v: f64) -> (f64, f64) {
+        match self {
+            Surf::Plane(_) => (1.0, 1.0),
+            Surf::Cylinder(_, r) => (*r, 1.0),
+            Surf::Cone(_, r, a) => ((r + v * a.tan()).abs().max(1e-3), 1.0 / a.cos()),
+            Surf::Sphere(_, r) => ((r * v.cos()).abs().max(1e-3), *r),
+            Surf::Torus(_, big, small) => ((big + small * v.cos()).abs().max(1e-3), *small),
+            Surf::BSpline(s) => {
+                let h = 1e-4;
+                let du = (s.eval(u + h, v) - s.eval(u - h, v)).norm() / (2.0 * h);
+                let dv = (s.eval(u, v + h) - s.eval(u, v - h)).norm() / (2.0 * h);
+                (du.max(1e-3), dv.max(1e-3))
+            }
+        }
+    }
+
+    /// The unit natural normal at the surface point `p` (parameters `(u, v)`):
+    /// exact for the analytic surfaces, by finite differences for B-splines; `None`
+    /// where it is undefined (on an axis, at an apex, where a B-spline degenerates).
+    pub fn normal(&self, p: &P3, u: f64, v: f64) -> Option<V3> {
+        let radial = |f: &Frame| {
+            let l = f.local(p);
+            (f.x * l.x + f.y * l.y).try_normalize(1e-9)
+        };
+        match self {
+            Surf::Plane(f) => Some(f.z),
+            Surf::Cylinder(f, _) => radial(f),
+            Surf::Cone(f, _, a) => radial(f).map(|r| r * a.cos() - f.z * a.sin()),
+            Surf::Sphere(f, _) => (p - f.o).try_normalize(1e-9),
+            Surf::Torus(f, big, _) => {
+                let r = radial(f)?;
+                (p - (f.o + r * *big)).try_normalize(1e-9)
+            }
+            Surf::BSpline(_) => {
+                let h = 1e-6;
+                let su = self.eval(u + h, v) - self.eval(u - h, v);
+                let sv = self.eval(u, v + h) - self.eval(u, v - h);
+                su.cross(&sv).try_normalize(1e-14)
+            }
+        }
+    }
+}
+
+/// Projects `p` onto a B-spline surface: the best point of a grid (or the hint), then
+/// Gauss-Newton steps inside the parameter box.
+fn bspline_param(s: &BSplineSurface, p: &P3, hint: Option<(f64, f64)>) -> (f64, f64) {
+    let (u0, u1) = s.u.range();
+    let (v0, v1) = s.v.range();
+    let d = |u: f64, v: f64| (s.eval(u, v) - p).norm_squared();
+    let (mut u, mut v) = match hint {
+        Some(h) => h,
+        None => {
+            const N: usize = 24;
+            let mut best = (u0, v0, f64::INFINITY);
+            for i in 0..=N {
+                for j in 0..=N {
+                    let uu = u0 + (u1 - u0) * i as f64 / N as f64;
+                    let vv = v0 + (v1 - v0) * j as f64 / N as f64;
+                    let dd = d(uu, vv);
+                    if dd < best.2 {
+                        best = (uu, vv, dd);
+                    }
+                }
+            }
+            (best.0, best.1)
+        }
+    };
+    let steps = if hint.is_some() { 4 } else { 30 };
+    for _ in 0..steps {
+        let h = 1e-7 * (1.0 + (u1 - u0).abs().max((v1 - v0).abs()));
+        let q = s.eval(u, v);
+        let su = (s.eval(u + h, v) - s.eval(u - h, v)) / (2.0 * h);
+        let sv = (s.eval(u, v + h) - s.eval(u, v - h)) / (2.0 * h);
+        let r = p - q;
+        let (a, b, c) = (su.dot(&su), su.dot(&sv), sv.dot(&sv));
+        let (e, f) = (su.dot(&r), sv.dot(&r));
+        let det = a * c - b * b;
+        if det.abs() < 1e-30 {
+            break;
+        }
+        let du = (c * e - b * f) / det;
+        let dv = (a * f - b * e) / det;
+        // Along a closed direction the parameter wraps; along an open one it stays in range.
+        let keep = |x: f64, a: f64, b: f64, closed: bool| {
+            if closed {
+                a + (x - a).rem_euclid(b - a)
+            } else {
+                x.clamp(a, b)
+            }
+        };
+        let nu = keep(u + du, u0, u1, s.closed[0]);
+        let nv = keep(v + dv, v0, v1, s.closed[1]);
+        let done = (nu - u).abs() < 1e-12 && (nv - v).abs() < 1e-12;
+        u = nu;
+        v = nv;
+        if done {
+            break;
+        }
+    }
+    (u, v)
+}
+
+/// `a` shifted by whole periods to lie within half a period of `near`.
+pub fn unwrap_near(a: f64, near: f64, period: f64) -> f64 {
+    a + ((near - a) / period).round() * period
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn surfaces_invert_their_own_points() {
+        let f = Frame::new(P3::new(1.0, 2.0, 3.0), Some(V3::new(0.0, 1.0, 1.0)), None).unwrap();
+        for s in [
+            Surf::Plane(f),
+            Surf::Cylinder(f, 4.0),
+            Surf::Cone(f, 4.0, 0.3),
+            Surf::Sphere(f, 4.0),
+            Surf::Torus(f, 10.0, 2.0),
+        ] {
+            for (u, v) in [(0.3, 0.2), (-2.0, 1.0), (3.0, -0.5)] {
+                let p = s.eval(u, v);
+                let (a, b) = s.param(&p, None);
+                let q = s.eval(a, b);
+                assert!((p - q).norm() < 1e-9, "{s:?} at {u},{v}");
+                // The natural normal points away from the axis or centre.
+                // The normal is the parametrisation's: along S_u × S_v.
+                let h = 1e-6;
+                let su = s.eval(u + h, v) - s.eval(u - h, v);
+                let sv = s.eval(u, v + h) - s.eval(u, v - h);
+                let n = s.normal(&p, u, v).unwrap();
+                assert!(
+                    su.cross(&sv).normalize().dot(&n) > 0.999,
+                    "{s:?} at {u},{v}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_rational_quadratic_is_a_circle() {
+        // A quarter circle of radius 2 as a rational quadratic B-spline.
+        let w = std::f64::consts::FRAC_1_SQRT_2;
+        let c = BSplineCurve {
+            knots: Knots::new(2, &[3, 3], &[0.0, 1.0], 3).unwrap(),
+            points: vec![
+                P3::new(2.0, 0.0, 0.0),
+                P3::new(2.0, 2.0, 0.0),
+                P3::new(0.0, 2.0, 0.0),
+            ],
+            weights: vec![1.0, w, 1.0],
+        };
+        for i in 0..=10 {
+            let p = c.eval(i as f64 / 10.0);
+            assert!((p.coords.norm() - 2.0).abs() < 1e-12);
+        }
+        let t = Curve::BSpline(c.clone()).param(&c.eval(0.37));
+        assert!((t - 0.37).abs() < 1e-7);
+    }
+}

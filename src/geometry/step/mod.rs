@@ -1,0 +1,186 @@
+//! STEP parts (AP203, AP214, AP242): the B-rep of the file's solid, each face with its
+//! exact surface, tessellated to a stated chord tolerance.
+//!
+//! `p21.rs` reads the exchange file's instances, `brep.rs` the faces, edges and units,
+//! `geom.rs` evaluates the curves and surfaces, `tess.rs` meshes them. [`read`] is the
+//! entry point: bytes in, a [`RawMesh`] out whose groups are the faces (`face_<n>`,
+//! numbered from 1 in shell order, as the reference meshes of `../shared/parts/` name
+//! them) with their exact surfaces beside.
+//!
+//! **Architecture Invariant:** a face that cannot be meshed is an error naming its
+//! instance number, never a silently missing face: a hole in the mesh would let the
+//! accessibility analysis see through the part.
+
+mod brep;
+mod geom;
+mod p21;
+mod tess;
+
+pub use tess::Resolution;
+
+use super::mesh_io::{weld, RawMesh};
+use super::{Surface, P3};
+use crate::geometry::errors::MeshError;
+
+/// The resolution parts are meshed at: the reference meshes' (OpenCASCADE, linear
+/// deflection 0.1 mm, angular 0.5 rad), so that a STEP part plans as its mesh did.
+pub const RESOLUTION: Resolution = Resolution {
+    chord_mm: 0.1,
+    angle_rad: 0.5,
+};
+
+/// Why a STEP file could not be read.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepError {
+    /// Not valid Part 21 text.
+    Syntax {
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// No solid or sheet body.
+    NoSolid,
+    /// A reference to an instance the file does not define.
+    Missing {
+        /// The missing instance.
+        id: u64,
+        /// The instance that refers to it.
+        from: Option<u64>,
+    },
+    /// An instance whose parameters are not what its type needs.
+    Malformed {
+        /// The instance.
+        id: u64,
+        /// Its line.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A curve or surface type inspc does not evaluate.
+    Unsupported {
+        /// The instance.
+        id: u64,
+        /// Its line.
+        line: usize,
+        /// `surface SURFACE_OF_REVOLUTION`.
+        what: String,
+    },
+    /// The length or angle unit cannot be determined.
+    Unit(String),
+    /// Faces that could not be meshed: (1-based face number, instance, why).
+    Faces(Vec<(usize, u64, String)>),
+}
+
+impl std::fmt::Display for StepError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StepError::Syntax { line, message } => write!(f, "line {line}: {message}"),
+            StepError::NoSolid => write!(
+                f,
+                "it holds no solid (MANIFOLD_SOLID_BREP) and no sheet body"
+            ),
+            StepError::Missing {
+                id,
+                from: Some(from),
+            } => {
+                write!(f, "#{from} refers to #{id}, which the file does not define")
+            }
+            StepError::Missing { id, from: None } => {
+                write!(f, "#{id} is referred to but not defined")
+            }
+            StepError::Malformed { id, line, message } => {
+                write!(f, "#{id} (line {line}): {message}")
+            }
+            StepError::Unsupported { id, line, what } => {
+                write!(
+                    f,
+                    "#{id} (line {line}) is a {what}, which inspc does not evaluate"
+                )
+            }
+            StepError::Unit(m) => write!(f, "{m}"),
+            StepError::Faces(list) => {
+                let (n, id, why) = &list[0];
+                write!(f, "face_{n} (#{id}) cannot be meshed: {why}")?;
+                if list.len() > 1 {
+                    write!(f, " (and {} more faces)", list.len() - 1)?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// A STEP part read and meshed.
+#[derive(Debug, Clone)]
+pub struct StepPart {
+    /// The mesh, one group per face.
+    pub mesh: RawMesh,
+    /// Each face's instance number.
+    pub face_ids: Vec<u64>,
+    /// The file's length unit as named, and its size in millimetres.
+    pub unit: (String, f64),
+    /// Faces of sheet (open-shell) bodies, last in the numbering.
+    pub sheet_faces: usize,
+}
+
+/// Reads a STEP file's solid and meshes it.
+pub fn read(bytes: &[u8], res: Resolution) -> Result<StepPart, MeshError> {
+    let step = |e: StepError| MeshError::Step(e);
+    let file = p21::parse(bytes).map_err(|e| {
+        step(StepError::Syntax {
+            line: e.line,
+            message: e.message,
+        })
+    })?;
+    let b = brep::read(&file).map_err(step)?;
+    let (soup, failures) = tess::tessellate(&b, res);
+    if !failures.is_empty() {
+        return Err(step(StepError::Faces(
+            failures
+                .into_iter()
+                .map(|f| (f.index + 1, f.id, f.reason))
+                .collect(),
+        )));
+    }
+    let groups: Vec<String> = (1..=b.faces.len()).map(|n| format!("face_{n}")).collect();
+    let mut mesh = weld(soup.positions, soup.triangles, soup.tri_face, groups, 1.0)?;
+    mesh.exact = b.faces.iter().map(exact_surface).collect();
+    Ok(StepPart {
+        mesh,
+        face_ids: b.faces.iter().map(|f| f.id).collect(),
+        unit: (b.unit_name, b.unit_mm),
+        sheet_faces: b.sheet_faces,
+    })
+}
+
+/// The planner's view of a face's surface: planes, cylinders, cones and spheres exactly,
+/// with the face's outward sense; tori and B-splines as free-form.
+fn exact_surface(face: &brep::Face) -> Surface {
+    use geom::Surf;
+    let out = face.same_sense;
+    match &face.surface {
+        Surf::Plane(f) => Surface::Plane {
+            origin: f.o,
+            normal: if out { f.z } else { -f.z },
+        },
+        Surf::Cylinder(f, r) => Surface::Cylinder {
+            origin: f.o,
+            axis: f.z,
+            radius: *r,
+            convex: out,
+        },
+        Surf::Cone(f, r, a) => Surface::Cone {
+            apex: P3::from(f.o - f.z * (r / a.tan())),
+            axis: f.z,
+            half_angle: *a,
+            convex: out,
+        },
+        Surf::Sphere(f, r) => Surface::Sphere {
+            center: f.o,
+            radius: *r,
+            convex: out,
+        },
+        Surf::Torus(..) | Surf::BSpline(_) => Surface::Freeform,
+    }
+}

@@ -1,0 +1,824 @@
+//! Tessellation of a B-rep to a chord tolerance, face by face.
+//!
+//! Every edge is cut into a polyline once (so the two faces that share it share its
+//! points and the mesh closes). A face's bounds are mapped into the surface's parameter
+//! plane, scaled to millimetres, and triangulated there with a constrained Delaunay
+//! triangulation (spade); triangles outside the bounds are dropped, and on a curved
+//! surface points are added inside until every triangle lies within the chord tolerance
+//! of the surface and turns by no more than the angle limit.
+//!
+//! Periodic surfaces: a bound is unwrapped along the loop; a face bounded by two loops
+//! that each go once round (a band of a bore with no seam edge) is cut along a line
+//! between them; a face bounded by one such loop (a spherical cap, a cone to its apex)
+//! is closed at the pole on its side.
+
+use super::brep::{Bound, Brep, Edge, Face};
+use super::geom::{unwrap_near, Curve, Surf};
+use crate::geometry::{P3, V3};
+use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation};
+use std::f64::consts::TAU;
+
+/// How fine the mesh is.
+#[derive(Debug, Clone, Copy)]
+pub struct Resolution {
+    /// Largest distance between a triangle and the surface (mm).
+    pub chord_mm: f64,
+    /// Largest turn of the normal across a triangle or an edge segment (radians).
+    pub angle_rad: f64,
+}
+
+/// How much longer than wide a triangle may come out along a cylinder's or cone's
+/// straight lines, where the surface does not curve.
+const RULED_STRETCH: f64 = 8.0;
+
+/// The mesh of a B-rep: triangle corners per face, not yet welded.
+#[derive(Debug, Default)]
+pub struct Soup {
+    /// Corner positions (mm).
+    pub positions: Vec<[f64; 3]>,
+    /// Triangles into `positions`, counter-clockwise from outside.
+    pub triangles: Vec<[usize; 3]>,
+    /// The face (index into the B-rep's faces) of each triangle.
+    pub tri_face: Vec<u32>,
+}
+
+/// A face that could not be tessellated.
+#[derive(Debug, Clone)]
+pub struct FaceFailure {
+    /// Index of the face (0-based, shell order).
+    pub index: usize,
+    /// Its instance number.
+    pub id: u64,
+    /// Why.
+    pub reason: String,
+}
+
+/// Tessellates every face; the failures are every face that could not be meshed.
+pub fn tessellate(b: &Brep, res: Resolution) -> (Soup, Vec<FaceFailure>) {
+    let edges: Vec<Vec<P3>> = b.edges.iter().map(|e| edge_points(e, res)).collect();
+    let mut soup = Soup::default();
+    let mut failures = Vec::new();
+    for (index, face) in b.faces.iter().enumerate() {
+        match face_mesh(face, &edges, res) {
+            Ok(tris) => {
+                for t in tris {
+                    let base = soup.positions.len();
+                    soup.positions.extend(t.iter().map(|p| [p.x, p.y, p.z]));
+                    soup.triangles.push([base, base + 1, base + 2]);
+                    soup.tri_face.push(index as u32);
+                }
+            }
+            Err(reason) => failures.push(FaceFailure {
+                index,
+                id: face.id,
+                reason,
+            }),
+        }
+    }
+    (soup, failures)
+}
+
+/// The segment count for an arc of `sweep` radians on radius `r`.
+fn arc_segments(sweep: f64, r: f64, res: Resolution) -> usize {
+    let chord_step = if res.chord_mm < r {
+        2.0 * (1.0 - res.chord_mm / r).acos()
+    } else {
+        res.angle_rad
+    };
+    let step = chord_step.min(res.angle_rad).max(1e-3);
+    ((sweep.abs() / step).ceil() as usize).max(1)
+}
+
+/// An edge as a polyline from its start vertex to its end vertex.
+fn edge_points(e: &Edge, res: Resolution) -> Vec<P3> {
+    let closed = (e.start - e.end).norm() < 1e-9;
+    let mut pts = match &e.curve {
+        Curve::Line => vec![e.start, e.end],
+        Curve::Polyline(p) => {
+            let mut p = p.clone();
+            if !e.same_sense {
+                p.reverse();
+            }
+            p
+        }
+        Curve::Circle(_, r) | Curve::Ellipse(_, r, _) => {
+            let r = match &e.curve {
+                Curve::Ellipse(_, a, b) => a.max(*b),
+                _ => *r,
+            };
+            let t0 = e.curve.param(&e.start);
+            let mut t1 = e.curve.param(&e.end);
+            if e.same_sense {
+                while t1 <= t0 + 1e-9 {
+                    t1 += TAU;
+                }
+                if !closed && t1 - t0 > TAU - 1e-9 {
+                    t1 -= TAU;
+                }
+            } else {
+                while t1 >= t0 - 1e-9 {
+                    t1 -= TAU;
+                }
+                if !closed && t0 - t1 > TAU - 1e-9 {
+                    t1 += TAU;
+                }
+            }
+            let n = arc_segments(t1 - t0, r, res);
+            (0..=n)
+                .map(|k| e.curve.eval(t0 + (t1 - t0) * k as f64 / n as f64))
+                .collect()
+        }
+        Curve::BSpline(c) => {
+            let (a, b) = c.knots.range();
+            let near = |p: &P3, t: f64| (c.eval(t) - p).norm() < 1e-6;
+            let (ts, te) = if closed && near(&e.start, a) && near(&e.start, b) {
+                if e.same_sense {
+                    (a, b)
+                } else {
+                    (b, a)
+                }
+            } else {
+                let find = |p: &P3| {
+                    if near(p, a) {
+                        a
+                    } else if near(p, b) {
+                        b
+                    } else {
+                        e.curve.param(p)
+                    }
+                };
+                (find(&e.start), find(&e.end))
+            };
+            let (lo, hi) = (ts.min(te), ts.max(te));
+            let mut knots: Vec<f64> = c.knots.breaks();
+            knots.retain(|k| *k > lo && *k < hi);
+            let mut stops = vec![lo];
+            stops.extend(knots);
+            stops.push(hi);
+            let mut params = vec![lo];
+            for w in stops.windows(2) {
+                refine_curve(&|t| c.eval(t), w[0], w[1], res, 0, &mut params);
+            }
+            let mut p: Vec<P3> = params.iter().map(|&t| c.eval(t)).collect();
+            if ts > te {
+                p.reverse();
+            }
+            p
+        }
+    };
+    // The ends are the vertices exactly, so that edges meeting there share a point.
+    if let Some(first) = pts.first_mut() {
+        *first = e.start;
+    }
+    if let Some(last) = pts.last_mut() {
+        *last = e.end;
+    }
+    if pts.len() < 2 {
+        pts = vec![e.start, e.end];
+    }
+    pts
+}
+
+/// Appends the parameters after `a` up to `b`, splitting where the curve leaves the
+/// chord by more than the tolerance or turns by more than the angle limit.
+fn refine_curve(
+    f: &dyn Fn(f64) -> P3,
+    a: f64,
+    b: f64,
+    res: Resolution,
+    depth: usize,
+    out: &mut Vec<f64>,
+) {
+    let (pa, pb) = (f(a), f(b));
+    let m = 0.5 * (a + b);
+    let pm = f(m);
+    let chord = pb - pa;
+    // The curve's distance from the chord at a quarter, the middle and three quarters
+    // (a span of a B-spline can bend twice).
+    let from_chord = |p: P3| {
+        if chord.norm() > 1e-12 {
+            (p - pa).cross(&chord).norm() / chord.norm()
+        } else {
+            (p - pa).norm()
+        }
+    };
+    let off = [0.25, 0.5, 0.75]
+        .iter()
+        .map(|k| from_chord(if *k == 0.5 { pm } else { f(a + (b - a) * k) }))
+        .fold(0.0, f64::max);
+    let turn = (pm - pa).angle(&(pb - pm));
+    // Depth and count limits keep a corrupt curve from taking the memory.
+    if depth < 14 && out.len() < 100_000 && (off > res.chord_mm || turn > res.angle_rad) {
+        refine_curve(f, a, m, res, depth + 1, out);
+        refine_curve(f, m, b, res, depth + 1, out);
+    } else {
+        out.push(b);
+    }
+}
+
+/// A point of a face's parameter-plane polygon: scaled (u, v), and the 3D point when
+/// it is a boundary point (so boundary points are shared exactly with the neighbours).
+#[derive(Debug, Clone, Copy)]
+struct Pt {
+    uv: [f64; 2],
+    xyz: P3,
+}
+
+/// One bound in the parameter plane, unscaled, with how many times it goes round in u
+/// and in v.
+struct Loop {
+    pts: Vec<Pt>,
+    wraps: [i64; 2],
+}
+
+fn face_mesh(face: &Face, edges: &[Vec<P3>], res: Resolution) -> Result<Vec<[P3; 3]>, String> {
+    let s = &face.surface;
+    let periods = [s.u_period(), s.v_period()];
+    let mut loops = Vec::new();
+    let mut hint = None;
+    for bound in &face.bounds {
+        let pts3: Vec<P3> = match bound {
+            Bound::Vertex => continue,
+            Bound::Edges(list) => {
+                let mut pts: Vec<P3> = Vec::new();
+                for &(e, forward) in list {
+                    let mut p = edges[e].clone();
+                    if !forward {
+                        p.reverse();
+                    }
+                    if pts.last().is_some_and(|l| (l - p[0]).norm() < 1e-9) {
+                        pts.pop();
+                    }
+                    pts.extend(p);
+                }
+                if pts.len() > 1 && (pts[0] - pts[pts.len() - 1]).norm() < 1e-9 {
+                    pts.pop();
+                }
+                pts
+            }
+        };
+        if pts3.len() < 2 {
+            continue;
+        }
+        loops.push(param_loop(s, &pts3, periods, &mut hint));
+    }
+    if loops.is_empty() {
+        return Err("it has no bound with edges".into());
+    }
+    let sense = if face.same_sense { 1.0 } else { -1.0 };
+    let polygons = close_loops(s, loops, periods, sense, res)?;
+
+    // One scale for the whole face, taken at the mean of its bound points. Along a
+    // ruled surface's straight lines (a cylinder's or cone's v) a triangle may be longer:
+    // the plane is squeezed along v so that Delaunay triangles come out long and thin.
+    let m = mean(&polygons.concat());
+    let (su, mut sv) = s.scale(m[0], m[1]);
+    if matches!(s, Surf::Cylinder(..) | Surf::Cone(..)) {
+        sv /= RULED_STRETCH;
+    }
+    let scaled = |uv: [f64; 2]| [uv[0] * su, uv[1] * sv];
+    let unscale = |q: [f64; 2]| [q[0] / su, q[1] / sv];
+
+    let mut cdt: ConstrainedDelaunayTriangulation<Vert> = ConstrainedDelaunayTriangulation::new();
+    for poly in &polygons {
+        let mut handles = Vec::new();
+        for p in poly {
+            let q = scaled(p.uv);
+            let h = cdt
+                .insert(Vert {
+                    pos: Point2::new(q[0], q[1]),
+                    xyz: p.xyz,
+                })
+                .map_err(|e| format!("a bound point cannot be triangulated ({e:?})"))?;
+            if handles.last() != Some(&h) {
+                handles.push(h);
+            }
+        }
+        if handles.len() > 1 && handles[0] == handles[handles.len() - 1] {
+            handles.pop();
+        }
+        for k in 0..handles.len() {
+            let (a, b) = (handles[k], handles[(k + 1) % handles.len()]);
+            if a != b && !cdt.exists_constraint(a, b) && cdt.try_add_constraint(a, b).is_empty() {
+                return Err(
+                    "its bounds cross each other in the surface's parameters (a self-intersecting \
+                     or mis-oriented loop)"
+                        .into(),
+                );
+            }
+        }
+    }
+
+    let eval = |q: [f64; 2]| {
+        let uv = unscale(q);
+        s.eval(uv[0], uv[1])
+    };
+
+    // Refine curved faces: add the centroid of every triangle that strays from the
+    // surface or turns too much.
+    if !matches!(s, Surf::Plane(_)) {
+        let mut budget = 200_000usize;
+        // Triangles (by their corners) already found close enough: a later round
+        // leaves most of them as they are.
+        let mut good: std::collections::HashSet<[usize; 3]> = std::collections::HashSet::new();
+        for _round in 0..24 {
+            let mut add = Vec::new();
+            let inside = inside_faces(&cdt);
+            for f in cdt.inner_faces() {
+                if !inside[f.fix().index()] {
+                    continue;
+                }
+                let mut key = f.vertices().map(|v| v.fix().index());
+                key.sort_unstable();
+                if good.contains(&key) {
+                    continue;
+                }
+                let vs = f.vertices();
+                let q = vs.map(|v| [v.position().x, v.position().y]);
+                let c = [
+                    (q[0][0] + q[1][0] + q[2][0]) / 3.0,
+                    (q[0][1] + q[1][1] + q[2][1]) / 3.0,
+                ];
+                let x = vs.map(|v| v.data().xyz);
+                if (x[1] - x[0]).cross(&(x[2] - x[0])).norm() < 1e-12 {
+                    // Two corners on one pole: nothing to refine.
+                    continue;
+                }
+                // The chord error: how far the flat triangle's centroid and edge
+                // midpoints lie from the surface.
+                let off = |flat: P3, at: [f64; 2]| {
+                    let uv = unscale(at);
+                    s.distance(&flat, (uv[0], uv[1]))
+                };
+                let flat = P3::from((x[0].coords + x[1].coords + x[2].coords) / 3.0);
+                let mut far = off(flat, c) > res.chord_mm;
+                if !far {
+                    for k in 0..3 {
+                        let m = [
+                            (q[k][0] + q[(k + 1) % 3][0]) / 2.0,
+                            (q[k][1] + q[(k + 1) % 3][1]) / 2.0,
+                        ];
+                        let mid = P3::from((x[k].coords + x[(k + 1) % 3].coords) / 2.0);
+                        if off(mid, m) > res.chord_mm {
+                            far = true;
+                            break;
+                        }
+                    }
+                }
+                if !far {
+                    let n: Vec<Option<V3>> = (0..3)
+                        .map(|k| {
+                            let uv = unscale(q[k]);
+                            s.normal(&x[k], uv[0], uv[1])
+                        })
+                        .collect();
+                    if let (Some(a), Some(b), Some(c2)) = (n[0], n[1], n[2]) {
+                        far = a.angle(&b) > res.angle_rad
+                            || b.angle(&c2) > res.angle_rad
+                            || a.angle(&c2) > res.angle_rad;
+                    }
+                }
+                if !far {
+                    good.insert(key);
+                } else {
+                    // Split the longest edge where it is not a bound (a Delaunay
+                    // refinement keeps triangles well shaped); else add the centroid.
+                    let es = f.adjacent_edges();
+                    let longest = es
+                        .iter()
+                        .max_by(|a, b| a.length_2().total_cmp(&b.length_2()))
+                        .filter(|e| !e.is_constraint_edge());
+                    match longest {
+                        Some(e) => {
+                            let [a, b] = e.positions();
+                            add.push([(a.x + b.x) / 2.0, (a.y + b.y) / 2.0]);
+                        }
+                        None => add.push(c),
+                    }
+                }
+            }
+            if add.is_empty() {
+                break;
+            }
+            if add.len() > budget {
+                return Err(format!(
+                    "it needs more than {} points inside to meet the chord tolerance",
+                    200_000
+                ));
+            }
+            budget -= add.len();
+            for c in add {
+                let xyz = eval(c);
+                cdt.insert(Vert {
+                    pos: Point2::new(c[0], c[1]),
+                    xyz,
+                })
+                .map_err(|e| format!("an inner point cannot be triangulated ({e:?})"))?;
+            }
+        }
+    }
+
+    let mut out = Vec::new();
+    let inside = inside_faces(&cdt);
+    for f in cdt.inner_faces() {
+        if !inside[f.fix().index()] {
+            continue;
+        }
+        let vs = f.vertices();
+        let q = vs.map(|v| [v.position().x, v.position().y]);
+        let area2 =
+            (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
+        let x = vs.map(|v| v.data().xyz);
+        // Counter-clockwise in the (scaled) parameters is along the natural normal.
+        if area2 * sense > 0.0 {
+            out.push([x[0], x[1], x[2]]);
+        } else {
+            out.push([x[0], x[2], x[1]]);
+        }
+    }
+    if out.is_empty() {
+        return Err("no triangle lies inside its bounds".into());
+    }
+    Ok(out)
+}
+
+/// Which faces of the triangulation lie inside the bounds, by face index: a face is
+/// inside when every path to the outer face crosses an odd number of bound edges
+/// (a breadth-first search that counts crossings). Unlike a point-in-polygon test at a
+/// centroid, this holds for the slivers between nearly collinear bound points.
+fn inside_faces(cdt: &ConstrainedDelaunayTriangulation<Vert>) -> Vec<bool> {
+    let n = cdt.num_all_faces();
+    let mut depth = vec![usize::MAX; n];
+    let mut queue = std::collections::VecDeque::new();
+    depth[0] = 0;
+    // Faces on the hull first: entered from the outer face.
+    for f in cdt.inner_faces() {
+        for e in f.adjacent_edges() {
+            if e.rev().face().is_outer() {
+                let d = usize::from(e.is_constraint_edge());
+                let i = f.fix().index();
+                if d < depth[i] {
+                    depth[i] = d;
+                    if d == 0 {
+                        queue.push_front(i);
+                    } else {
+                        queue.push_back(i);
+                    }
+                }
+            }
+        }
+    }
+    // Fixed handles by index (spade numbers the outer face 0, inner faces from 1).
+    let mut handle = vec![None; n];
+    for f in cdt.inner_faces() {
+        handle[f.fix().index()] = Some(f.fix());
+    }
+    while let Some(i) = queue.pop_front() {
+        let Some(h) = handle[i] else { continue };
+        let f = cdt.face(h);
+        for e in f.adjacent_edges() {
+            let g = e.rev().face();
+            if g.is_outer() {
+                continue;
+            }
+            let j = g.fix().index();
+            let d = depth[i] + usize::from(e.is_constraint_edge());
+            if d < depth[j] {
+                depth[j] = d;
+                if d == depth[i] {
+                    queue.push_front(j);
+                } else {
+                    queue.push_back(j);
+                }
+            }
+        }
+    }
+    depth
+        .iter()
+        .map(|d| *d != usize::MAX && d % 2 == 1)
+        .collect()
+}
+
+/// A triangulation vertex: its scaled parameters and its 3D point.
+#[derive(Debug, Clone, Copy)]
+struct Vert {
+    pos: Point2<f64>,
+    xyz: P3,
+}
+
+impl HasPosition for Vert {
+    type Scalar = f64;
+    fn position(&self) -> Point2<f64> {
+        self.pos
+    }
+}
+
+/// A bound's points in the parameter plane, unwrapped along the loop. A point at a
+/// pole (where u is undefined) becomes two, with the u of the points before and after
+/// it: the bound runs along the pole between them. A bound through a pole starts there,
+/// so that the pole segment closes it and it goes round zero times in u.
+fn param_loop(
+    s: &Surf,
+    pts: &[P3],
+    periods: [Option<f64>; 2],
+    hint: &mut Option<(f64, f64)>,
+) -> Loop {
+    let n = pts.len();
+    let mut raw: Vec<(f64, f64)> = pts
+        .iter()
+        .map(|p| {
+            let uv = s.param(p, *hint);
+            if matches!(s, Surf::BSpline(_)) {
+                *hint = Some(uv);
+            }
+            uv
+        })
+        .collect();
+    let mut pts = pts.to_vec();
+    let pole: Vec<bool> = pts
+        .iter()
+        .zip(&raw)
+        .map(|(p, uv)| s.at_pole(p, uv.1))
+        .collect();
+    let first_pole = pole.iter().position(|&b| b);
+    let mut pole = pole;
+    if let Some(k) = first_pole {
+        raw.rotate_left(k);
+        pts.rotate_left(k);
+        pole.rotate_left(k);
+    }
+    let unwrap = |uv: (f64, f64), prev: Option<[f64; 2]>| {
+        let mut q = [uv.0, uv.1];
+        if let Some(pr) = prev {
+            for (k, per) in periods.iter().enumerate() {
+                if let Some(per) = per {
+                    q[k] = unwrap_near(q[k], pr[k], *per);
+                }
+            }
+        }
+        q
+    };
+    let mut out: Vec<Pt> = Vec::new();
+    let mut prev: Option<[f64; 2]> = None;
+    for i in 0..n {
+        if !pole[i] {
+            let q = unwrap(raw[i], prev);
+            out.push(Pt { uv: q, xyz: pts[i] });
+            prev = Some(q);
+            continue;
+        }
+        let v = raw[i].1;
+        if let Some(pr) = prev {
+            out.push(Pt {
+                uv: [pr[0], v],
+                xyz: pts[i],
+            });
+        }
+        if let Some(j) = (i + 1..n).find(|&j| !pole[j]) {
+            let u = unwrap(raw[j], prev)[0];
+            if let Some(pr) = prev {
+                along_pole(&mut out, pr[0], u, v, pts[i]);
+            }
+            let q = [u, v];
+            out.push(Pt { uv: q, xyz: pts[i] });
+            prev = Some(q);
+        }
+    }
+    if first_pole.is_some() {
+        // The pole again, with the last point's u: the segment back to the start runs
+        // along the pole.
+        if let (Some(last), Some(first)) =
+            (out.last().map(|p| p.uv[0]), out.first().map(|p| p.uv[0]))
+        {
+            out.push(Pt {
+                uv: [last, raw[0].1],
+                xyz: pts[0],
+            });
+            along_pole(&mut out, last, first, raw[0].1, pts[0]);
+        }
+    }
+    dedup(&mut out);
+    // How many times the loop goes round: the step from the last point back to the first.
+    let mut wraps = [0i64; 2];
+    if let (Some(first), Some(last)) = (out.first(), out.last()) {
+        for (k, per) in periods.iter().enumerate() {
+            if let Some(per) = per {
+                if k == 0 && first_pole.is_some() {
+                    continue;
+                }
+                let back = unwrap_near(first.uv[k], last.uv[k], *per);
+                wraps[k] = ((back - first.uv[k]) / per).round() as i64;
+            }
+        }
+    }
+    Loop { pts: out, wraps }
+}
+
+/// Points along a pole from `u0` to `u1` (both ends left out), a tenth of a radian
+/// apart: the triangles that meet the pole stay narrow, so that refinement near it ends.
+fn along_pole(out: &mut Vec<Pt>, u0: f64, u1: f64, v: f64, xyz: P3) {
+    let n = ((u1 - u0).abs() / 0.1).ceil().min(10_000.0) as usize;
+    for k in 1..n {
+        out.push(Pt {
+            uv: [u0 + (u1 - u0) * k as f64 / n as f64, v],
+            xyz,
+        });
+    }
+}
+
+/// Drops repeated points and spikes (a segment walked out and straight back, as a seam
+/// edge used twice next to a pole).
+fn dedup(pts: &mut Vec<Pt>) {
+    let same =
+        |a: &Pt, b: &Pt| (a.uv[0] - b.uv[0]).abs() < 1e-12 && (a.uv[1] - b.uv[1]).abs() < 1e-12;
+    let mut changed = true;
+    while changed && pts.len() > 2 {
+        changed = false;
+        let n = pts.len();
+        for i in 0..n {
+            let (a, b) = (&pts[i], &pts[(i + 1) % n]);
+            if same(a, b) {
+                pts.remove((i + 1) % n);
+                changed = true;
+                break;
+            }
+            let c = &pts[(i + 2) % n];
+            if n > 3 && same(a, c) {
+                // a → b → a: drop b and the second a.
+                let (j, k) = ((i + 1) % n, (i + 2) % n);
+                let (hi, lo) = (j.max(k), j.min(k));
+                pts.remove(hi);
+                pts.remove(lo);
+                changed = true;
+                break;
+            }
+        }
+    }
+}
+
+/// Turns the face's loops into closed polygons of the parameter plane: ordinary loops
+/// shifted by whole periods next to the first loop, two loops going round joined by a
+/// cut, one loop going round closed at the pole on the face's side.
+fn close_loops(
+    s: &Surf,
+    loops: Vec<Loop>,
+    periods: [Option<f64>; 2],
+    sense: f64,
+    res: Resolution,
+) -> Result<Vec<Vec<Pt>>, String> {
+    let (round, plain): (Vec<Loop>, Vec<Loop>) = loops.into_iter().partition(|l| l.wraps != [0, 0]);
+    let mut polygons: Vec<Vec<Pt>> = Vec::new();
+    match round.len() {
+        0 => {}
+        1 => {
+            let l = &round[0];
+            if l.wraps[1] != 0 || l.wraps[0].abs() != 1 {
+                return Err("a bound goes round the surface in a way inspc cannot close".into());
+            }
+            let dir = l.wraps[0] as f64;
+            // The face lies left of its bounds seen from its normal: toward +v when the
+            // loop runs toward +u along the natural normal.
+            let toward = dir * sense;
+            let pole = s
+                .poles()
+                .into_iter()
+                .filter(|p| (p - l.pts[0].uv[1]) * toward > 0.0)
+                .min_by(|a, b| {
+                    (a - l.pts[0].uv[1])
+                        .abs()
+                        .total_cmp(&(b - l.pts[0].uv[1]).abs())
+                })
+                .ok_or(
+                    "a single bound goes round the surface and there is no pole to close it at",
+                )?;
+            let mut poly = l.pts.clone();
+            let first = poly[0];
+            let per = periods[0].unwrap_or(TAU);
+            let end_u = first.uv[0] + dir * per;
+            let xyz_pole = s.eval(first.uv[0], pole);
+            poly.push(Pt {
+                uv: [end_u, first.uv[1]],
+                xyz: first.xyz,
+            });
+            poly.push(Pt {
+                uv: [end_u, pole],
+                xyz: xyz_pole,
+            });
+            along_pole(&mut poly, end_u, first.uv[0], pole, xyz_pole);
+            poly.push(Pt {
+                uv: [first.uv[0], pole],
+                xyz: xyz_pole,
+            });
+            polygons.push(poly);
+        }
+        2 => {
+            let k = if round[0].wraps[0] != 0 { 0 } else { 1 };
+            let per = periods[k].unwrap_or(TAU);
+            if round
+                .iter()
+                .any(|l| l.wraps[k].abs() != 1 || l.wraps[1 - k] != 0)
+            {
+                return Err("two bounds go round the surface in different ways".into());
+            }
+            // Both loops made to run toward +k; the band is A forward, then B backward.
+            let forward = |l: &Loop| {
+                let mut p = l.pts.clone();
+                if l.wraps[k] < 0 {
+                    p.reverse();
+                }
+                p
+            };
+            let a = forward(&round[0]);
+            let mut b = forward(&round[1]);
+            // B starts where it is nearest A's start, shifted into A's period.
+            let a0 = a[0].uv[k];
+            let (start, _) = b
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let d = unwrap_near(p.uv[k], a0, per) - a0;
+                    (i, d.abs())
+                })
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .unwrap_or((0, 0.0));
+            b.rotate_left(start);
+            let mut b2 = Vec::with_capacity(b.len());
+            let mut prev = a0;
+            for p in &b {
+                let mut q = *p;
+                q.uv[k] = unwrap_near(q.uv[k], prev, per);
+                prev = q.uv[k];
+                b2.push(q);
+            }
+            // A: a[0] .. a[n-1], then a[0] again one period on; B likewise, walked back.
+            // The cut from A's start to B's start is a curve on the surface (a
+            // meridian of a torus, a profile of a revolved B-spline): it is cut into
+            // segments like an edge, the same on both of its sides.
+            let (from, to) = (a[0], b2[0]);
+            let mut ts = vec![0.0];
+            let at = |t: f64| {
+                s.eval(
+                    from.uv[0] + (to.uv[0] - from.uv[0]) * t,
+                    from.uv[1] + (to.uv[1] - from.uv[1]) * t,
+                )
+            };
+            refine_curve(&at, 0.0, 1.0, res, 0, &mut ts);
+            let cut = |shift: f64, t: f64| {
+                let mut uv = [
+                    from.uv[0] + (to.uv[0] - from.uv[0]) * t,
+                    from.uv[1] + (to.uv[1] - from.uv[1]) * t,
+                ];
+                uv[k] += shift;
+                Pt { uv, xyz: at(t) }
+            };
+            let inner = &ts[1..ts.len() - 1];
+            let mut poly = a.clone();
+            let mut a_end = a[0];
+            a_end.uv[k] += per;
+            poly.push(a_end);
+            poly.extend(inner.iter().map(|&t| cut(per, t)));
+            let mut b_end = b2[0];
+            b_end.uv[k] += per;
+            poly.push(b_end);
+            poly.extend(b2.iter().rev().copied());
+            poly.extend(inner.iter().rev().map(|&t| cut(0.0, t)));
+            polygons.push(poly);
+        }
+        _ => return Err(format!("{} bounds go round the surface", round.len())),
+    }
+    // Ordinary loops: shift each next to the first polygon (or the first of them).
+    let anchor = polygons
+        .first()
+        .map(|p| mean(p))
+        .or_else(|| plain.first().map(|l| mean(&l.pts)))
+        .unwrap_or([0.0, 0.0]);
+    for l in plain {
+        let m = mean(&l.pts);
+        let mut shift = [0.0; 2];
+        for (k, per) in periods.iter().enumerate() {
+            if let Some(per) = per {
+                shift[k] = unwrap_near(m[k], anchor[k], *per) - m[k];
+            }
+        }
+        polygons.push(
+            l.pts
+                .iter()
+                .map(|p| Pt {
+                    uv: [p.uv[0] + shift[0], p.uv[1] + shift[1]],
+                    xyz: p.xyz,
+                })
+                .collect(),
+        );
+    }
+    Ok(polygons)
+}
+
+fn mean(pts: &[Pt]) -> [f64; 2] {
+    let n = pts.len().max(1) as f64;
+    let (mut u, mut v) = (0.0, 0.0);
+    for p in pts {
+        u += p.uv[0];
+        v += p.uv[1];
+    }
+    [u / n, v / n]
+}

@@ -1,0 +1,163 @@
+//! STEP parts: the four NIST files read from their B-rep, checked against the reference
+//! meshes in ../shared/parts/ (made from the same files by OpenCASCADE): every face,
+//! its surface type and area, the mesh closed, every triangle within the chord
+//! tolerance of its exact surface, the file's unit applied.
+
+use crate::common::require_shared_parts;
+use inspc::geometry::step::{read, RESOLUTION};
+use inspc::geometry::{segment, PartGeometry, Surface};
+use inspc::model::SurfaceKind;
+use inspc::source::FsWorld;
+use std::path::Path;
+
+fn step_part(part: &str) -> (inspc::geometry::step::StepPart, PartGeometry) {
+    require_shared_parts();
+    let bytes = std::fs::read(format!("../shared/parts/nist_{part}_asme1_ap242-e1.stp")).unwrap();
+    let p = read(&bytes, RESOLUTION).unwrap_or_else(|e| panic!("{part}: {e:?}"));
+    let g = segment::from_groups(&p.mesh);
+    (p, g)
+}
+
+fn obj_part(part: &str) -> PartGeometry {
+    let path = format!("../shared/parts/nist_{part}_asme1_ap242-e1.obj");
+    let raw = inspc::geometry::read_mesh(&FsWorld, Path::new(&path), 1.0).unwrap();
+    segment::from_groups(&raw)
+}
+
+/// For each reference face, the STEP face it is: the same number where the reference
+/// mesh kept the file's face order, else the nearest by centroid and area.
+fn matched(s: &PartGeometry, o: &PartGeometry, by_number: bool) -> Vec<usize> {
+    o.faces
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            if by_number {
+                return i;
+            }
+            (0..s.faces.len())
+                .min_by(|&a, &b| {
+                    let d = |j: usize| {
+                        let g = &s.faces[j];
+                        (g.centroid - f.centroid).norm() + (g.area - f.area).abs() / f.area.max(1.0)
+                    };
+                    d(a).total_cmp(&d(b))
+                })
+                .unwrap()
+        })
+        .collect()
+}
+
+/// Whether the exact surface may differ in kind from the reference mesh's fitted one:
+/// a nearly flat cone fits a plane or a cylinder, a toroidal cap a sphere.
+fn fit_may_differ(exact: SurfaceKind, fitted: SurfaceKind) -> bool {
+    matches!(
+        (exact, fitted),
+        (
+            SurfaceKind::Cone,
+            SurfaceKind::Plane | SurfaceKind::Cylinder
+        ) | (SurfaceKind::Freeform, SurfaceKind::Sphere)
+    )
+}
+
+fn check(part: &str, by_number: bool, unit: &str) {
+    let (p, s) = step_part(part);
+    let o = obj_part(part);
+    assert_eq!(s.faces.len(), o.faces.len(), "{part}: face count");
+    assert_eq!(p.unit.0, unit, "{part}: the file's length unit");
+    assert_eq!(p.mesh.nonmanifold_edges, 0, "{part}: non-manifold edges");
+    if p.sheet_faces == 0 {
+        assert_eq!(p.mesh.open_edges, 0, "{part}: a solid's mesh is closed");
+    }
+    let map = matched(&s, &o, by_number);
+    let mut targets = map.clone();
+    targets.sort_unstable();
+    targets.dedup();
+    assert_eq!(
+        targets.len(),
+        o.faces.len(),
+        "{part}: one STEP face per reference face"
+    );
+    for (i, &j) in map.iter().enumerate() {
+        let (a, b) = (&o.faces[i], &s.faces[j]);
+        assert!(
+            (a.area - b.area).abs() <= 0.02 * a.area + 0.5,
+            "{part}: {} area {} against the reference {}",
+            b.name,
+            b.area,
+            a.area
+        );
+        assert!(
+            (a.centroid - b.centroid).norm() <= 0.7,
+            "{part}: {} centroid off by {}",
+            b.name,
+            (a.centroid - b.centroid).norm()
+        );
+        let (ek, fk) = (b.surface.kind(), a.surface.kind());
+        assert!(
+            ek == fk || fit_may_differ(ek, fk),
+            "{part}: {} is a {ek:?}, the reference fits a {fk:?}",
+            b.name
+        );
+    }
+    // The chord tolerance holds on every analytic face: each triangle's centroid and
+    // edge midpoints lie within it of the exact surface.
+    let tol = RESOLUTION.chord_mm + 1e-6;
+    for f in &s.faces {
+        if matches!(f.surface, Surface::Freeform) {
+            continue;
+        }
+        for &t in &f.triangles {
+            let [a, b, c] = s.triangles[t as usize].map(|i| s.vertices[i as usize]);
+            for q in [
+                (a.coords + b.coords + c.coords) / 3.0,
+                (a.coords + b.coords) / 2.0,
+                (b.coords + c.coords) / 2.0,
+                (c.coords + a.coords) / 2.0,
+            ] {
+                let d = f.surface.distance(&q.into()).unwrap();
+                assert!(
+                    d <= tol,
+                    "{part}: a triangle of {} is {d} mm off its surface",
+                    f.name
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn nist_ctc_01_from_step() {
+    check("ctc_01", true, "mm");
+}
+
+#[test]
+fn nist_ctc_02_from_step() {
+    // Its reference mesh numbers faces in OpenCASCADE's order, not the file's.
+    check("ctc_02", false, "mm");
+}
+
+#[test]
+fn nist_ftc_06_from_step() {
+    check("ftc_06", true, "mm");
+}
+
+#[test]
+fn nist_ftc_08_from_step() {
+    // In inches; its last face is a sheet body's (an open shell beside the solid).
+    check("ftc_08", true, "inch");
+    let (p, _) = step_part("ftc_08");
+    assert_eq!(p.sheet_faces, 1);
+    assert_eq!(p.unit.1, 25.4);
+}
+
+#[test]
+fn every_face_keeps_its_instance_number() {
+    let (p, _) = step_part("ctc_01");
+    assert_eq!(p.face_ids.len(), 117);
+    // The first face of the closed shell.
+    assert_eq!(p.face_ids[0], 764);
+    let mut ids = p.face_ids.clone();
+    ids.sort_unstable();
+    ids.dedup();
+    assert_eq!(ids.len(), 117);
+}
