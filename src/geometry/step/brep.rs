@@ -548,22 +548,43 @@ impl<'a> Reader<'a> {
             .collect()
     }
 
-    fn bspline_curve(&self, id: u64, inst: &Instance) -> Result<BSplineCurve, StepError> {
-        // Simple form: all in B_SPLINE_CURVE_WITH_KNOTS after the name; complex form:
-        // B_SPLINE_CURVE holds degree and points, ..._WITH_KNOTS the knots.
-        let wk = inst.record("B_SPLINE_CURVE_WITH_KNOTS").unwrap();
-        let (head, knots): (&[Param], &[Param]) = match inst.record("B_SPLINE_CURVE") {
-            Some(b) => (&b.params[..], &wk.params[..]),
-            None if wk.params.len() >= 8 => (&wk.params[1..6], &wk.params[6..]),
-            None => return Err(self.bad(id, "B_SPLINE_CURVE_WITH_KNOTS has too few parameters")),
+    /// A B-spline's own parameters (degree, control points, form, closure; `head` of
+    /// them) and its knot parameters (`tail`): in the simple form both follow the name in
+    /// `…_WITH_KNOTS`; in the complex form `base` holds the first, `…_WITH_KNOTS` the
+    /// second.
+    fn bspline_parts<'r>(
+        &self,
+        id: u64,
+        inst: &'r Instance,
+        base: &str,
+        head: usize,
+        tail: usize,
+    ) -> Result<(&'r [Param], &'r [Param]), StepError> {
+        let with_knots = format!("{base}_WITH_KNOTS");
+        let too_few = || self.bad(id, format!("{with_knots} has too few parameters"));
+        let wk = inst.record(&with_knots).ok_or_else(too_few)?;
+        let (h, k): (&[Param], &[Param]) = match inst.record(base) {
+            Some(b) => (&b.params, &wk.params),
+            None if wk.params.len() > head => (&wk.params[1..=head], &wk.params[head + 1..]),
+            None => return Err(too_few()),
         };
-        if head.len() < 2 || knots.len() < 2 {
-            return Err(self.bad(id, "a B-spline curve has too few parameters"));
+        // The knot parameters end in the knot type, which is not read.
+        if h.len() < head || k.len() + 1 < tail {
+            return Err(too_few());
         }
-        let degree = match head[0] {
-            Param::Int(d) if d >= 1 => d as usize,
-            _ => return Err(self.bad(id, "a B-spline degree must be a positive integer")),
-        };
+        Ok((h, k))
+    }
+
+    fn degree(&self, id: u64, p: &Param) -> Result<usize, StepError> {
+        match p {
+            Param::Int(d) if *d >= 1 => Ok(*d as usize),
+            _ => Err(self.bad(id, "a B-spline degree must be a positive integer")),
+        }
+    }
+
+    fn bspline_curve(&self, id: u64, inst: &Instance) -> Result<BSplineCurve, StepError> {
+        let (head, knots) = self.bspline_parts(id, inst, "B_SPLINE_CURVE", 5, 3)?;
+        let degree = self.degree(id, &head[0])?;
         let points = self.points(
             id,
             head[1]
@@ -633,20 +654,8 @@ impl<'a> Reader<'a> {
     }
 
     fn bspline_surface(&self, id: u64, inst: &Instance) -> Result<BSplineSurface, StepError> {
-        let wk = inst.record("B_SPLINE_SURFACE_WITH_KNOTS").unwrap();
-        let (head, knots): (&[Param], &[Param]) = match inst.record("B_SPLINE_SURFACE") {
-            Some(b) => (&b.params[..], &wk.params[..]),
-            None if wk.params.len() >= 12 => (&wk.params[1..8], &wk.params[8..]),
-            None => return Err(self.bad(id, "B_SPLINE_SURFACE_WITH_KNOTS has too few parameters")),
-        };
-        if head.len() < 3 || knots.len() < 4 {
-            return Err(self.bad(id, "a B-spline surface has too few parameters"));
-        }
-        let deg = |p: &Param| match p {
-            Param::Int(d) if *d >= 1 => Ok(*d as usize),
-            _ => Err(self.bad(id, "a B-spline degree must be a positive integer")),
-        };
-        let (du, dv) = (deg(&head[0])?, deg(&head[1])?);
+        let (head, knots) = self.bspline_parts(id, inst, "B_SPLINE_SURFACE", 7, 5)?;
+        let (du, dv) = (self.degree(id, &head[0])?, self.degree(id, &head[1])?);
         let rows = head[2]
             .list()
             .ok_or_else(|| self.bad(id, "control points expected"))?;
