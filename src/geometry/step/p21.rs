@@ -109,7 +109,7 @@ impl Instance {
         self.records.iter().find(|r| r.name == name)
     }
 
-    /// The type of a simple instance; for a complex one, the first of `names` it has.
+    /// Whether the instance has a record of type `name` (simple or complex).
     pub fn is(&self, name: &str) -> bool {
         self.record(name).is_some()
     }
