@@ -126,17 +126,16 @@ pub struct StepPart {
 
 /// Reads a STEP file's solid and meshes it.
 pub fn read(bytes: &[u8], res: Resolution) -> Result<StepPart, MeshError> {
-    let step = |e: StepError| MeshError::Step(e);
     let file = p21::parse(bytes).map_err(|e| {
-        step(StepError::Syntax {
+        MeshError::Step(StepError::Syntax {
             line: e.line,
             message: e.message,
         })
     })?;
-    let b = brep::read(&file).map_err(step)?;
+    let b = brep::read(&file).map_err(MeshError::Step)?;
     let (soup, failures) = tess::tessellate(&b, res);
     if !failures.is_empty() {
-        return Err(step(StepError::Faces(
+        return Err(MeshError::Step(StepError::Faces(
             failures
                 .into_iter()
                 .map(|f| (f.index + 1, f.id, f.reason))

@@ -189,7 +189,19 @@ fn refine_curve(
     depth: usize,
     out: &mut Vec<f64>,
 ) {
-    let (pa, pb) = (f(a), f(b));
+    split_curve(f, (a, f(a)), (b, f(b)), res, depth, out);
+}
+
+/// [`refine_curve`] with the ends' points known, so that each split evaluates the
+/// curve only at its new parameters.
+fn split_curve(
+    f: &dyn Fn(f64) -> P3,
+    (a, pa): (f64, P3),
+    (b, pb): (f64, P3),
+    res: Resolution,
+    depth: usize,
+    out: &mut Vec<f64>,
+) {
     let m = 0.5 * (a + b);
     let pm = f(m);
     let chord = pb - pa;
@@ -202,15 +214,15 @@ fn refine_curve(
             (p - pa).norm()
         }
     };
-    let off = [0.25, 0.5, 0.75]
-        .iter()
-        .map(|k| from_chord(if *k == 0.5 { pm } else { f(a + (b - a) * k) }))
+    let off = [pm, f(a + (b - a) * 0.25), f(a + (b - a) * 0.75)]
+        .into_iter()
+        .map(from_chord)
         .fold(0.0, f64::max);
     let turn = (pm - pa).angle(&(pb - pm));
     // Depth and count limits keep a corrupt curve from taking the memory.
     if depth < 14 && out.len() < 100_000 && (off > res.chord_mm || turn > res.angle_rad) {
-        refine_curve(f, a, m, res, depth + 1, out);
-        refine_curve(f, m, b, res, depth + 1, out);
+        split_curve(f, (a, pa), (m, pm), res, depth + 1, out);
+        split_curve(f, (m, pm), (b, pb), res, depth + 1, out);
     } else {
         out.push(b);
     }
