@@ -24,7 +24,7 @@ pub mod segment;
 mod select;
 pub mod step;
 
-pub use errors::GeometryError;
+pub use errors::{GeometryError, MeshError};
 pub use fixture::{place_fixture, FixtureMesh, CONTACT_MM};
 pub use mesh_io::{read_mesh, RawMesh};
 pub use query::{edge_triangles, line_triangle, segment_distance, FaceIndex};

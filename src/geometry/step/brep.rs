@@ -12,6 +12,8 @@ use std::collections::HashMap;
 /// An edge: its end vertices, its curve, and whether it runs along the curve's sense.
 #[derive(Debug, Clone)]
 pub struct Edge {
+    /// The `EDGE_CURVE`'s instance number.
+    pub id: u64,
     /// Start vertex (mm).
     pub start: P3,
     /// End vertex (mm).
@@ -177,7 +179,7 @@ fn units(f: &P21, item: u64) -> Result<(f64, String, f64), StepError> {
 
 /// The size of a unit in `base` units scaled by `base_scale` (mm for `METRE`), and its
 /// name: an SI unit with its prefix, or a conversion-based unit (an inch as 25.4 mm).
-fn unit_factor(
+pub(super) fn unit_factor(
     f: &P21,
     inst: &Instance,
     base: &str,
@@ -464,6 +466,7 @@ impl<'a> Reader<'a> {
         let curve = self.curve(self.reference(id, rec, 3)?, id)?;
         let same_sense = self.boolean(id, rec, 4)?;
         self.edges.push(Edge {
+            id,
             start,
             end,
             curve,

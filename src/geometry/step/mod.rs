@@ -14,6 +14,7 @@
 mod brep;
 mod geom;
 mod p21;
+pub mod pmi;
 mod tess;
 
 pub use tess::Resolution;
@@ -122,6 +123,8 @@ pub struct StepPart {
     pub unit: (String, f64),
     /// Faces of sheet (open-shell) bodies, last in the numbering.
     pub sheet_faces: usize,
+    /// The semantic PMI, linked to the faces' 0-based indices.
+    pub pmi: pmi::Pmi,
 }
 
 /// Reads a STEP file's solid and meshes it.
@@ -145,12 +148,120 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<StepPart, MeshError> {
     let groups: Vec<String> = (1..=b.faces.len()).map(|n| format!("face_{n}")).collect();
     let mut mesh = weld(soup.positions, soup.triangles, soup.tri_face, groups, 1.0)?;
     mesh.exact = b.faces.iter().map(exact_surface).collect();
+    let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
+    let mut pmi = pmi::read(&file, &face_ids, &edge_faces(&b), b.unit_mm);
+    locate_targets(&mut pmi, &mesh);
     Ok(StepPart {
+        pmi,
         mesh,
-        face_ids: b.faces.iter().map(|f| f.id).collect(),
+        face_ids,
         unit: (b.unit_name, b.unit_mm),
         sheet_faces: b.sheet_faces,
     })
+}
+
+/// Each edge's faces: the curved ones where it bounds any, else all.
+fn edge_faces(b: &brep::Brep) -> std::collections::HashMap<u64, Vec<usize>> {
+    let mut all: std::collections::HashMap<u64, Vec<usize>> = Default::default();
+    for (i, f) in b.faces.iter().enumerate() {
+        for bound in &f.bounds {
+            if let brep::Bound::Edges(edges) = bound {
+                for (e, _) in edges {
+                    let faces = all.entry(b.edges[*e].id).or_default();
+                    if !faces.contains(&i) {
+                        faces.push(i);
+                    }
+                }
+            }
+        }
+    }
+    let curved = |i: &usize| !matches!(b.faces[*i].surface, geom::Surf::Plane(_));
+    for faces in all.values_mut() {
+        if faces.iter().any(curved) {
+            faces.retain(curved);
+        }
+    }
+    all
+}
+
+/// How far a datum target's point may lie from the face it is found on (mm): the
+/// tessellation's chord and then some.
+const TARGET_REACH_MM: f64 = 0.5;
+
+/// Datums the file sets up by targets placed on supplemental geometry only: each target
+/// point is located on the part, and the faces it lands on become the datum's, marked as
+/// located so that callers say so.
+fn locate_targets(p: &mut pmi::Pmi, mesh: &RawMesh) {
+    use std::collections::BTreeSet;
+    let mut notes = Vec::new();
+    for d in p.datums.iter_mut().filter(|d| d.faces.is_empty()) {
+        let stated: Vec<_> = d.targets.iter().flat_map(|t| &t.points).collect();
+        let model: Vec<_> = d
+            .targets
+            .iter()
+            .flat_map(|t| &t.model_unit_points)
+            .collect();
+        if stated.is_empty() {
+            continue;
+        }
+        let (mut faces, mut missed) = faces_under(&stated, mesh);
+        if missed > 0 && !model.is_empty() {
+            let (f2, m2) = faces_under(&model, mesh);
+            if m2 < missed {
+                notes.push(format!(
+                    "datum {}: its targets' sizes, in the unit they state, put them off the part; they are read in the model's unit",
+                    d.letter
+                ));
+                (faces, missed) = (f2, m2);
+            }
+        }
+        if faces.is_empty() {
+            notes.push(format!(
+                "datum {} is set up by targets that lie on no face",
+                d.letter
+            ));
+            continue;
+        }
+        if missed > 0 {
+            notes.push(format!(
+                "datum {}: {missed} point(s) of its targets lie on no face",
+                d.letter
+            ));
+        }
+        d.faces = faces
+            .into_iter()
+            .collect::<BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        d.located = true;
+    }
+    p.notes.extend(notes);
+}
+
+/// The faces a set of points lies on (each point's nearest face within
+/// [`TARGET_REACH_MM`]), and how many points lie on none.
+fn faces_under(points: &[&[f64; 3]], mesh: &RawMesh) -> (Vec<usize>, usize) {
+    use parry3d_f64::query::PointQuery;
+    use parry3d_f64::shape::Triangle;
+    let mut faces = Vec::new();
+    let mut missed = 0;
+    for pt in points {
+        let q = P3::new(pt[0], pt[1], pt[2]);
+        let best = mesh
+            .triangles
+            .iter()
+            .zip(&mesh.tri_group)
+            .map(|(t, g)| {
+                let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
+                (Triangle::new(a, b, c).distance_to_local_point(&q, true), *g)
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        match best {
+            Some((dist, g)) if dist <= TARGET_REACH_MM => faces.push(g as usize),
+            _ => missed += 1,
+        }
+    }
+    (faces, missed)
 }
 
 /// The planner's view of a face's surface: planes, cylinders, cones and spheres exactly,

@@ -1,0 +1,868 @@
+//! Semantic PMI: the datums, geometric tolerances and dimensions an AP242 file states,
+//! each linked to the B-rep faces it applies to.
+//!
+//! The links run `GEOMETRIC_ITEM_SPECIFIC_USAGE` (or `ITEM_IDENTIFIED_REPRESENTATION_USAGE`)
+//! → `SHAPE_ASPECT` → `ADVANCED_FACE`, through composite aspects
+//! (`SHAPE_ASPECT_RELATIONSHIP`, relating → related), datum features (the datum is the
+//! related side), datum targets (`FEATURE_FOR_DATUM_TARGET_RELATIONSHIP`) and dimensional
+//! sizes used as toleranced aspects. Reading never fails: what cannot be linked or read
+//! is a line in [`Pmi::notes`], so a caller can say so instead of guessing.
+
+use super::brep::unit_factor;
+use super::p21::{Instance, Param, P21};
+use crate::model::{Material, TolKind};
+use std::collections::{BTreeSet, HashMap};
+
+/// The PMI of a STEP file.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Pmi {
+    /// Datums, in the file's order.
+    pub datums: Vec<Datum>,
+    /// Geometric tolerances, in the file's order.
+    pub tolerances: Vec<GeoTolerance>,
+    /// Dimensions (sizes and locations), in the file's order.
+    pub dimensions: Vec<Dimension>,
+    /// What could not be read or linked, one sentence each.
+    pub notes: Vec<String>,
+}
+
+/// A datum: its letter and the faces of its datum features (or targets).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Datum {
+    /// The `DATUM` instance.
+    pub id: u64,
+    /// `A`, `B`, …
+    pub letter: String,
+    /// 0-based face indices, sorted.
+    pub faces: Vec<usize>,
+    /// Datum targets that establish it.
+    pub targets: Vec<Target>,
+    /// Whether the faces were found by locating the targets on the part (the file links
+    /// the targets to supplemental geometry only).
+    pub located: bool,
+}
+
+/// A datum target: its kind, label and where it sits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Target {
+    /// `point`, `line`, `circle`, `circular curve`, `rectangle`, `area`.
+    pub kind: String,
+    /// `A1`.
+    pub label: String,
+    /// Points on the target (mm): its origin, and for lines, curves and areas points
+    /// along them; empty when the file places it nowhere.
+    pub points: Vec<[f64; 3]>,
+    /// The same points with the target's sizes read in the model's length unit, where
+    /// that differs from the unit the sizes state (some files write millimetre values
+    /// with an inch unit); empty otherwise.
+    pub model_unit_points: Vec<[f64; 3]>,
+}
+
+/// One compartment of a datum reference frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DatumRef {
+    /// One letter, or several for a common datum (`A-B`).
+    pub letters: Vec<String>,
+    /// Its material modifier, if any.
+    pub material: Option<Material>,
+    /// Other modifiers, lower case (`free state`, `translation`).
+    pub other: Vec<String>,
+}
+
+/// A geometric tolerance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GeoTolerance {
+    /// The tolerance's instance.
+    pub id: u64,
+    /// The name the file gives it (`Feature Control Frame (11)`).
+    pub name: String,
+    /// Its type; `None` for a bare `GEOMETRIC_TOLERANCE`.
+    pub kind: Option<TolKind>,
+    /// The zone's width, mm.
+    pub value_mm: f64,
+    /// A cylindrical (Ø) or spherical (SØ) zone.
+    pub diameter: bool,
+    /// The zone is spherical (SØ).
+    pub spherical: bool,
+    /// The material modifier on the toleranced feature.
+    pub material: Option<Material>,
+    /// Other modifiers, lower case (`tangent plane`, `free state`).
+    pub other: Vec<String>,
+    /// The datum reference frame, primary first.
+    pub datums: Vec<DatumRef>,
+    /// 0-based face indices of the toleranced feature, sorted.
+    pub faces: Vec<usize>,
+    /// For the lower segment of a composite frame: the upper segment's instance.
+    pub composite_of: Option<u64>,
+    /// An unequally disposed profile's displacement (mm).
+    pub unequal_mm: Option<f64>,
+}
+
+/// What a dimension measures.
+#[derive(Debug, Clone, PartialEq)]
+pub enum DimKind {
+    /// A size (`diameter`, `radius`, `thickness`, …), as the file names it.
+    Size(String),
+    /// A location between two features (`linear distance`, `angle`, …).
+    Location(String),
+}
+
+/// A dimension with its limits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dimension {
+    /// The `DIMENSIONAL_SIZE` or `DIMENSIONAL_LOCATION` instance.
+    pub id: u64,
+    /// Size or location.
+    pub kind: DimKind,
+    /// Whether the values are angles (degrees) rather than lengths (mm).
+    pub angular: bool,
+    /// The nominal value, if the file gives one.
+    pub nominal: Option<f64>,
+    /// Upper deviation (signed), if toleranced.
+    pub upper: Option<f64>,
+    /// Lower deviation (signed), if toleranced.
+    pub lower: Option<f64>,
+    /// A fit designation (`H7`), if the tolerance is one.
+    pub fit: Option<String>,
+    /// Faces of the size, or of the location's origin feature.
+    pub faces: Vec<usize>,
+    /// Faces of the location's target feature (empty for a size).
+    pub to_faces: Vec<usize>,
+}
+
+/// Geometric tolerance types by their AP242 entity.
+const KINDS: &[(&str, TolKind)] = &[
+    ("FLATNESS_TOLERANCE", TolKind::Flatness),
+    ("STRAIGHTNESS_TOLERANCE", TolKind::Straightness),
+    ("ROUNDNESS_TOLERANCE", TolKind::Circularity),
+    ("CYLINDRICITY_TOLERANCE", TolKind::Cylindricity),
+    ("LINE_PROFILE_TOLERANCE", TolKind::ProfileLine),
+    ("SURFACE_PROFILE_TOLERANCE", TolKind::ProfileSurface),
+    ("PERPENDICULARITY_TOLERANCE", TolKind::Perpendicularity),
+    ("PARALLELISM_TOLERANCE", TolKind::Parallelism),
+    ("ANGULARITY_TOLERANCE", TolKind::Angularity),
+    ("POSITION_TOLERANCE", TolKind::Position),
+    ("CONCENTRICITY_TOLERANCE", TolKind::Concentricity),
+    ("COAXIALITY_TOLERANCE", TolKind::Coaxiality),
+    ("SYMMETRY_TOLERANCE", TolKind::Symmetry),
+    ("CIRCULAR_RUNOUT_TOLERANCE", TolKind::CircularRunout),
+    ("TOTAL_RUNOUT_TOLERANCE", TolKind::TotalRunout),
+];
+
+/// The instance tables the links are followed through.
+struct Links<'a> {
+    f: &'a P21,
+    /// Face instance → 0-based face index.
+    face_index: HashMap<u64, usize>,
+    /// Edge instance → the faces it bounds, curved ones first (a hole named by its
+    /// rim is the hole).
+    edge_faces: &'a HashMap<u64, Vec<usize>>,
+    /// Aspect → the representation items a usage names for it.
+    usage: HashMap<u64, Vec<u64>>,
+    /// Relating aspect → related aspects (composites, derived features).
+    down: HashMap<u64, Vec<u64>>,
+    /// Related aspect → relating aspects (datum → its features and targets).
+    up: HashMap<u64, Vec<u64>>,
+    /// Property definition's subject → its shape representation (datum targets).
+    shape_of: HashMap<u64, u64>,
+    /// File length unit, mm (for a measure whose unit cannot be read).
+    unit_mm: f64,
+}
+
+/// Reads the PMI of a parsed file whose faces (in numbering order) are `faces`; an
+/// aspect named by an edge is the edge's curved faces, or all its faces when none is
+/// curved (`edge_faces`).
+pub fn read(f: &P21, faces: &[u64], edge_faces: &HashMap<u64, Vec<usize>>, unit_mm: f64) -> Pmi {
+    let mut l = Links {
+        f,
+        face_index: faces.iter().enumerate().map(|(i, id)| (*id, i)).collect(),
+        edge_faces,
+        usage: HashMap::new(),
+        down: HashMap::new(),
+        up: HashMap::new(),
+        shape_of: HashMap::new(),
+        unit_mm,
+    };
+    let mut subject_of: HashMap<u64, u64> = HashMap::new();
+    let mut shape_reps: Vec<(u64, u64)> = Vec::new();
+    let mut zones: HashMap<u64, String> = HashMap::new();
+    let mut composite: HashMap<u64, u64> = HashMap::new();
+    let mut nominal_of: HashMap<u64, u64> = HashMap::new();
+    let mut limits_of: HashMap<u64, u64> = HashMap::new();
+    for id in &f.order {
+        let inst = &f.instances[id];
+        let Some(r) = inst.records.first() else {
+            continue;
+        };
+        let p = &r.params;
+        match r.name.as_str() {
+            "GEOMETRIC_ITEM_SPECIFIC_USAGE" | "ITEM_IDENTIFIED_REPRESENTATION_USAGE"
+                if inst.records.len() == 1 =>
+            {
+                if let (Some(def), Some(item)) = (p.get(2).and_then(Param::reference), p.get(4)) {
+                    let entry = l.usage.entry(def).or_default();
+                    collect_refs(item, entry);
+                }
+            }
+            "SHAPE_ASPECT_RELATIONSHIP"
+            | "SHAPE_ASPECT_DERIVING_RELATIONSHIP"
+            | "FEATURE_FOR_DATUM_TARGET_RELATIONSHIP"
+                if inst.records.len() == 1 =>
+            {
+                if let (Some(a), Some(b)) = (
+                    p.get(2).and_then(Param::reference),
+                    p.get(3).and_then(Param::reference),
+                ) {
+                    l.down.entry(a).or_default().push(b);
+                    l.up.entry(b).or_default().push(a);
+                }
+            }
+            "TOLERANCE_ZONE" => {
+                let form = p
+                    .get(5)
+                    .and_then(Param::reference)
+                    .and_then(|z| f.instances.get(&z))
+                    .and_then(|z| z.record("TOLERANCE_ZONE_FORM"))
+                    .and_then(|z| z.params.first())
+                    .and_then(Param::string)
+                    .unwrap_or("")
+                    .to_string();
+                for t in p.get(4).and_then(Param::list).unwrap_or(&[]) {
+                    if let Some(t) = t.reference() {
+                        zones.insert(t, form.clone());
+                    }
+                }
+            }
+            "GEOMETRIC_TOLERANCE_RELATIONSHIP" => {
+                let is_composite = p.first().and_then(Param::string) == Some("composite");
+                if let (true, Some(upper), Some(lower)) = (
+                    is_composite,
+                    p.get(2).and_then(Param::reference),
+                    p.get(3).and_then(Param::reference),
+                ) {
+                    composite.insert(lower, upper);
+                }
+            }
+            "PROPERTY_DEFINITION" => {
+                if let Some(of) = p.get(2).and_then(Param::reference) {
+                    subject_of.insert(*id, of);
+                }
+            }
+            "SHAPE_DEFINITION_REPRESENTATION" => {
+                if let (Some(pd), Some(rep)) = (
+                    p.first().and_then(Param::reference),
+                    p.get(1).and_then(Param::reference),
+                ) {
+                    shape_reps.push((pd, rep));
+                }
+            }
+            "DIMENSIONAL_CHARACTERISTIC_REPRESENTATION" => {
+                if let (Some(d), Some(rep)) = (
+                    p.first().and_then(Param::reference),
+                    p.get(1).and_then(Param::reference),
+                ) {
+                    nominal_of.insert(d, rep);
+                }
+            }
+            "PLUS_MINUS_TOLERANCE" => {
+                if let (Some(range), Some(d)) = (
+                    p.first().and_then(Param::reference),
+                    p.get(1).and_then(Param::reference),
+                ) {
+                    limits_of.insert(d, range);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    // A target's placement: SHAPE_DEFINITION_REPRESENTATION(property, rep) with
+    // PROPERTY_DEFINITION(.., target).
+    for (pd, rep) in shape_reps {
+        if let Some(&subject) = subject_of.get(&pd) {
+            l.shape_of.insert(subject, rep);
+        }
+    }
+    let mut pmi = Pmi::default();
+    for id in &f.order {
+        let inst = &f.instances[id];
+        if inst.is("DATUM") {
+            pmi.datums.push(l.datum(*id, inst, &mut pmi.notes));
+        } else if inst.is("GEOMETRIC_TOLERANCE") || KINDS.iter().any(|(n, _)| inst.is(n)) {
+            if let Some(t) = l.tolerance(*id, inst, &zones, &composite, &mut pmi.notes) {
+                pmi.tolerances.push(t);
+            }
+        } else if let Some(d) = l.dimension(*id, inst, &nominal_of, &limits_of, &mut pmi.notes) {
+            pmi.dimensions.push(d);
+        }
+    }
+    pmi
+}
+
+/// The references in a usage's identified item: one, a list, or a typed set.
+fn collect_refs(p: &Param, out: &mut Vec<u64>) {
+    match p {
+        Param::Ref(r) => out.push(*r),
+        Param::List(v) | Param::Typed(_, v) => v.iter().for_each(|q| collect_refs(q, out)),
+        _ => {}
+    }
+}
+
+impl Links<'_> {
+    /// The faces of a shape aspect: what usages name for it and its members, through
+    /// composites, derived features, datum target features and dimensional sizes.
+    fn faces(&self, aspect: u64) -> Vec<usize> {
+        let mut seen = BTreeSet::new();
+        let mut out = BTreeSet::new();
+        let mut stack = vec![aspect];
+        while let Some(a) = stack.pop() {
+            if !seen.insert(a) || seen.len() > 10_000 {
+                continue;
+            }
+            for item in self.usage.get(&a).into_iter().flatten() {
+                if let Some(i) = self.face_index.get(item) {
+                    out.insert(*i);
+                } else if let Some(faces) = self.edge_faces.get(item) {
+                    out.extend(faces);
+                }
+            }
+            stack.extend(self.down.get(&a).into_iter().flatten());
+            let Some(inst) = self.f.instances.get(&a) else {
+                continue;
+            };
+            // A size is the faces it applies to; a datum target the feature it sits on.
+            if inst.is("DIMENSIONAL_SIZE") || inst.is("ANGULAR_SIZE") {
+                let applies = inst.records[0].params.first().and_then(Param::reference);
+                stack.extend(applies);
+            }
+            if inst.is("PLACED_DATUM_TARGET_FEATURE") || inst.is("DATUM_TARGET") {
+                stack.extend(self.up.get(&a).into_iter().flatten());
+            }
+        }
+        out.into_iter().collect()
+    }
+
+    fn datum(&self, id: u64, inst: &Instance, notes: &mut Vec<String>) -> Datum {
+        let letter = inst
+            .record("DATUM")
+            .and_then(|r| r.params.get(4))
+            .and_then(Param::string)
+            .unwrap_or("?")
+            .to_string();
+        let mut faces = BTreeSet::new();
+        let mut targets = Vec::new();
+        for &feature in self.up.get(&id).into_iter().flatten() {
+            let Some(fi) = self.f.instances.get(&feature) else {
+                continue;
+            };
+            if let Some(t) = fi.record("PLACED_DATUM_TARGET_FEATURE") {
+                let kind = t.params.get(1).and_then(Param::string).unwrap_or("target");
+                let n = t.params.get(4).and_then(Param::string).unwrap_or("");
+                let (points, model_unit_points) = self.target_points(feature, kind);
+                targets.push(Target {
+                    kind: kind.to_string(),
+                    label: format!("{letter}{n}"),
+                    points,
+                    model_unit_points,
+                });
+            }
+            faces.extend(self.faces(feature));
+        }
+        targets.sort_by(|a, b| a.label.cmp(&b.label));
+        if faces.is_empty() && targets.iter().all(|t| t.points.is_empty()) {
+            notes.push(format!("datum {letter} (#{id}) is linked to no face"));
+        }
+        Datum {
+            id,
+            letter,
+            faces: faces.into_iter().collect(),
+            targets,
+            located: false,
+        }
+    }
+
+    /// Points on a datum target, from its placement (origin, z normal, x along) and its
+    /// size parameters (`target diameter`, `target length`, `target width`), in mm; and
+    /// again with the sizes in the model's unit where their stated unit differs.
+    fn target_points(&self, target: u64, kind: &str) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+        let Some(rep) = self
+            .shape_of
+            .get(&target)
+            .and_then(|r| self.f.instances.get(r))
+        else {
+            return (Vec::new(), Vec::new());
+        };
+        let items = rep.records[0]
+            .params
+            .get(1)
+            .and_then(Param::list)
+            .unwrap_or(&[]);
+        let mut frame = None;
+        let mut size = HashMap::new();
+        let mut model_size = HashMap::new();
+        for item in items.iter().filter_map(Param::reference) {
+            let Some(i) = self.f.instances.get(&item) else {
+                continue;
+            };
+            if let Some(a) = i.record("AXIS2_PLACEMENT_3D") {
+                frame = self.placement(a.params.get(1), a.params.get(2), a.params.get(3));
+            } else if let Some(name) = i
+                .record("REPRESENTATION_ITEM")
+                .and_then(|r| r.params.first())
+                .and_then(Param::string)
+            {
+                if let Some((v, false)) = self.measure(item) {
+                    size.insert(name.to_string(), v);
+                    let raw = self.raw_value(item).map_or(v, |r| tidy(r * self.unit_mm));
+                    model_size.insert(name.to_string(), raw);
+                }
+            }
+        }
+        let Some((o, z, x)) = frame else {
+            return (Vec::new(), Vec::new());
+        };
+        let y = [
+            z[1] * x[2] - z[2] * x[1],
+            z[2] * x[0] - z[0] * x[2],
+            z[0] * x[1] - z[1] * x[0],
+        ];
+        let at = |a: f64, b: f64| {
+            [
+                o[0] + a * x[0] + b * y[0],
+                o[1] + a * x[1] + b * y[1],
+                o[2] + a * x[2] + b * y[2],
+            ]
+        };
+        let points = |size: &HashMap<String, f64>| {
+            let mut pts = Vec::new();
+            match kind {
+                "line" => {
+                    // A line target runs along x from its origin; its ends often sit
+                    // on an edge, so points inside it decide the face.
+                    let len = size.get("target length").copied().unwrap_or(0.0);
+                    pts.extend((0..4).map(|k| at(len * (f64::from(k) + 0.5) / 4.0, 0.0)));
+                }
+                "circle" | "circular curve" => {
+                    let r = size.get("target diameter").copied().unwrap_or(0.0) / 2.0;
+                    if kind == "circle" {
+                        pts.push(o);
+                    }
+                    pts.extend((0..8).map(|k| {
+                        let t = f64::from(k) * std::f64::consts::FRAC_PI_4;
+                        at(r * t.cos(), r * t.sin())
+                    }));
+                }
+                "rectangle" => {
+                    let (lx, ly) = (
+                        size.get("target length").copied().unwrap_or(0.0) / 2.0,
+                        size.get("target width").copied().unwrap_or(0.0) / 2.0,
+                    );
+                    pts.push(o);
+                    pts.extend([(-lx, -ly), (lx, -ly), (lx, ly), (-lx, ly)].map(|(a, b)| at(a, b)));
+                }
+                _ => pts.push(o),
+            }
+            pts
+        };
+        let stated = points(&size);
+        let model = if model_size == size {
+            Vec::new()
+        } else {
+            points(&model_size)
+        };
+        (stated, model)
+    }
+
+    /// A measure's number as written, without its unit.
+    fn raw_value(&self, id: u64) -> Option<f64> {
+        let inst = self.f.instances.get(&id)?;
+        inst.records
+            .iter()
+            .find(|r| r.params.len() >= 2 && r.params[1].reference().is_some())
+            .and_then(|r| r.params[0].real())
+    }
+
+    /// An axis placement's origin (mm) and unit z and x directions.
+    fn placement(
+        &self,
+        o: Option<&Param>,
+        z: Option<&Param>,
+        x: Option<&Param>,
+    ) -> Option<([f64; 3], [f64; 3], [f64; 3])> {
+        let coords = |p: Option<&Param>, name: &str| -> Option<[f64; 3]> {
+            let inst = self.f.instances.get(&p?.reference()?)?;
+            let v: Vec<f64> = inst
+                .record(name)?
+                .params
+                .get(1)?
+                .list()?
+                .iter()
+                .filter_map(Param::real)
+                .collect();
+            (v.len() == 3).then(|| [v[0], v[1], v[2]])
+        };
+        let o = coords(o, "CARTESIAN_POINT")?.map(|c| c * self.unit_mm);
+        let unit = |v: [f64; 3]| {
+            let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            (n > 1e-12).then(|| v.map(|c| c / n))
+        };
+        let z = coords(z, "DIRECTION")
+            .and_then(unit)
+            .unwrap_or([0.0, 0.0, 1.0]);
+        let x = coords(x, "DIRECTION")
+            .and_then(unit)
+            .unwrap_or(if z[0].abs() < 0.9 {
+                [1.0, 0.0, 0.0]
+            } else {
+                [0.0, 1.0, 0.0]
+            });
+        // x made perpendicular to z.
+        let d = x[0] * z[0] + x[1] * z[1] + x[2] * z[2];
+        let x = unit([x[0] - d * z[0], x[1] - d * z[1], x[2] - d * z[2]])?;
+        Some((o, z, x))
+    }
+
+    fn tolerance(
+        &self,
+        id: u64,
+        inst: &Instance,
+        zones: &HashMap<u64, String>,
+        composite: &HashMap<u64, u64>,
+        notes: &mut Vec<String>,
+    ) -> Option<GeoTolerance> {
+        let kind = KINDS.iter().find(|(n, _)| inst.is(n)).map(|(_, k)| *k);
+        // The common attributes: the GEOMETRIC_TOLERANCE record of a complex instance,
+        // else the one record of a simple subtype.
+        let base = inst
+            .record("GEOMETRIC_TOLERANCE")
+            .or_else(|| inst.records.first())?;
+        let name = base
+            .params
+            .first()
+            .and_then(Param::string)
+            .unwrap_or("")
+            .to_string();
+        let value_mm = base
+            .params
+            .get(2)
+            .and_then(Param::reference)
+            .and_then(|m| self.measure(m))
+            .map(|(v, _)| v);
+        let Some(value_mm) = value_mm else {
+            notes.push(format!(
+                "tolerance `{name}` (#{id}) has no value that can be read"
+            ));
+            return None;
+        };
+        let faces = base
+            .params
+            .get(3)
+            .and_then(Param::reference)
+            .map(|a| self.faces(a))
+            .unwrap_or_default();
+        let mut systems = Vec::new();
+        if let Some(r) = inst.record("GEOMETRIC_TOLERANCE_WITH_DATUM_REFERENCE") {
+            r.params
+                .first()
+                .into_iter()
+                .for_each(|p| collect_refs(p, &mut systems));
+        } else if inst.records.len() == 1 {
+            // A simple subtype with datums carries them as its fifth attribute.
+            base.params
+                .get(4)
+                .into_iter()
+                .for_each(|p| collect_refs(p, &mut systems));
+        }
+        let datums = self.datum_frame(&systems);
+        let mut material = None;
+        let mut other = Vec::new();
+        if let Some(r) = inst.record("GEOMETRIC_TOLERANCE_WITH_MODIFIERS") {
+            for m in r.params.first().and_then(Param::list).unwrap_or(&[]) {
+                match m.enumeration() {
+                    Some("MAXIMUM_MATERIAL_REQUIREMENT") => material = Some(Material::Mmc),
+                    Some("LEAST_MATERIAL_REQUIREMENT") => material = Some(Material::Lmc),
+                    Some(e) => other.push(e.to_lowercase().replace('_', " ")),
+                    None => {}
+                }
+            }
+        }
+        let unequal_mm = inst
+            .record("UNEQUALLY_DISPOSED_GEOMETRIC_TOLERANCE")
+            .and_then(|r| r.params.first())
+            .and_then(Param::reference)
+            .and_then(|m| self.measure(m))
+            .map(|(v, _)| v);
+        let zone = zones.get(&id).map(String::as_str);
+        if faces.is_empty() {
+            notes.push(format!("tolerance `{name}` (#{id}) is linked to no face"));
+        }
+        if kind.is_none() {
+            notes.push(format!(
+                "tolerance `{name}` (#{id}) states no type (a bare GEOMETRIC_TOLERANCE)"
+            ));
+        }
+        Some(GeoTolerance {
+            id,
+            name,
+            kind,
+            value_mm,
+            diameter: matches!(zone, Some("cylindrical or circular") | Some("spherical")),
+            spherical: zone == Some("spherical"),
+            material,
+            other,
+            datums,
+            faces,
+            composite_of: composite.get(&id).copied(),
+            unequal_mm,
+        })
+    }
+
+    /// The compartments of the datum systems (or old-style datum references) a
+    /// tolerance names, primary first.
+    fn datum_frame(&self, systems: &[u64]) -> Vec<DatumRef> {
+        let mut out = Vec::new();
+        let mut precedence = Vec::new();
+        for &s in systems {
+            let Some(inst) = self.f.instances.get(&s) else {
+                continue;
+            };
+            if let Some(r) = inst.record("DATUM_SYSTEM") {
+                for c in r.params.get(4).and_then(Param::list).unwrap_or(&[]) {
+                    if let Some(c) = c.reference().and_then(|c| self.f.instances.get(&c)) {
+                        if let Some(d) = self.compartment(c) {
+                            out.push(d);
+                        }
+                    }
+                }
+            } else if let Some(r) = inst.record("DATUM_REFERENCE") {
+                // AP214 style: (precedence, datum).
+                let p = r.params.first().and_then(Param::real).unwrap_or(0.0);
+                let letter = r
+                    .params
+                    .get(1)
+                    .and_then(Param::reference)
+                    .and_then(|d| self.letter(d));
+                if let Some(letter) = letter {
+                    precedence.push((
+                        p as i64,
+                        DatumRef {
+                            letters: vec![letter],
+                            material: None,
+                            other: Vec::new(),
+                        },
+                    ));
+                }
+            } else if let Some(d) = self.compartment(inst) {
+                out.push(d);
+            }
+        }
+        precedence.sort_by_key(|(p, _)| *p);
+        out.extend(precedence.into_iter().map(|(_, d)| d));
+        out
+    }
+
+    /// A datum reference compartment (or element): its datum or common datums and
+    /// modifiers.
+    fn compartment(&self, inst: &Instance) -> Option<DatumRef> {
+        let r = inst
+            .record("DATUM_REFERENCE_COMPARTMENT")
+            .or_else(|| inst.record("DATUM_REFERENCE_ELEMENT"))
+            .or_else(|| inst.record("GENERAL_DATUM_REFERENCE"))?;
+        let mut d = DatumRef {
+            letters: Vec::new(),
+            material: None,
+            other: Vec::new(),
+        };
+        match r.params.get(4) {
+            Some(Param::Ref(datum)) => d.letters.extend(self.letter(*datum)),
+            // A common datum: a list of elements, bare or as COMMON_DATUM_LIST((..)).
+            Some(p @ (Param::List(_) | Param::Typed(..))) => {
+                let mut elements = Vec::new();
+                collect_refs(p, &mut elements);
+                for e in elements {
+                    if let Some(sub) = self.f.instances.get(&e).and_then(|e| self.compartment(e)) {
+                        d.letters.extend(sub.letters);
+                        d.material = d.material.or(sub.material);
+                        d.other.extend(sub.other);
+                    }
+                }
+            }
+            _ => {}
+        }
+        let mut modifiers = Vec::new();
+        if let Some(p) = r.params.get(5) {
+            collect_enums(p, &mut modifiers);
+        }
+        for m in modifiers {
+            match m.as_str() {
+                "MAXIMUM_MATERIAL_REQUIREMENT" => d.material = Some(Material::Mmc),
+                "LEAST_MATERIAL_REQUIREMENT" => d.material = Some(Material::Lmc),
+                e => d.other.push(e.to_lowercase().replace('_', " ")),
+            }
+        }
+        (!d.letters.is_empty()).then_some(d)
+    }
+
+    fn letter(&self, datum: u64) -> Option<String> {
+        self.f
+            .instances
+            .get(&datum)?
+            .record("DATUM")?
+            .params
+            .get(4)
+            .and_then(Param::string)
+            .map(str::to_string)
+    }
+
+    fn dimension(
+        &self,
+        id: u64,
+        inst: &Instance,
+        nominal_of: &HashMap<u64, u64>,
+        limits_of: &HashMap<u64, u64>,
+        notes: &mut Vec<String>,
+    ) -> Option<Dimension> {
+        let r = inst.records.first()?;
+        let p = &r.params;
+        let (kind, faces, to_faces) = if inst.is("DIMENSIONAL_SIZE") || inst.is("ANGULAR_SIZE") {
+            let r = inst
+                .record("DIMENSIONAL_SIZE")
+                .or_else(|| inst.record("ANGULAR_SIZE"))?;
+            let name = r.params.get(1).and_then(Param::string).unwrap_or("size");
+            let faces = r
+                .params
+                .first()
+                .and_then(Param::reference)
+                .map(|a| self.faces(a))
+                .unwrap_or_default();
+            (DimKind::Size(name.to_string()), faces, Vec::new())
+        } else if inst.is("DIMENSIONAL_LOCATION") || inst.is("ANGULAR_LOCATION") {
+            let r = inst
+                .record("DIMENSIONAL_LOCATION")
+                .or_else(|| inst.record("ANGULAR_LOCATION"))
+                .unwrap_or(r);
+            let name = r
+                .params
+                .first()
+                .and_then(Param::string)
+                .unwrap_or("location");
+            let side = |i: usize| {
+                r.params
+                    .get(i)
+                    .and_then(Param::reference)
+                    .map(|a| self.faces(a))
+                    .unwrap_or_default()
+            };
+            (DimKind::Location(name.to_string()), side(2), side(3))
+        } else {
+            let _ = p;
+            return None;
+        };
+        let angular = inst.is("ANGULAR_SIZE") || inst.is("ANGULAR_LOCATION");
+        let mut nominal = None;
+        let mut upper = None;
+        let mut lower = None;
+        if let Some(rep) = nominal_of.get(&id).and_then(|r| self.f.instances.get(r)) {
+            let items = rep.records[0]
+                .params
+                .get(1)
+                .and_then(Param::list)
+                .unwrap_or(&[]);
+            for item in items.iter().filter_map(Param::reference) {
+                let Some(i) = self.f.instances.get(&item) else {
+                    continue;
+                };
+                let role = i
+                    .record("REPRESENTATION_ITEM")
+                    .and_then(|r| r.params.first())
+                    .and_then(Param::string)
+                    .unwrap_or("");
+                let v = self.measure(item).map(|(v, _)| v);
+                match role {
+                    "upper limit" => upper = v,
+                    "lower limit" => lower = v,
+                    _ if nominal.is_none() => nominal = v,
+                    _ => {}
+                }
+            }
+            if let (Some(n), Some(u), Some(l)) = (nominal, upper, lower) {
+                // Limits given as values: keep them as deviations from the nominal.
+                upper = Some(tidy(u - n));
+                lower = Some(tidy(l - n));
+            }
+        }
+        let mut fit = None;
+        if let Some(range) = limits_of.get(&id).and_then(|r| self.f.instances.get(r)) {
+            if let Some(tv) = range.record("TOLERANCE_VALUE") {
+                let bound = |i: usize| {
+                    tv.params
+                        .get(i)
+                        .and_then(Param::reference)
+                        .and_then(|m| self.measure(m))
+                        .map(|(v, _)| v)
+                };
+                lower = bound(0);
+                upper = bound(1);
+            } else if let Some(lf) = range.record("LIMITS_AND_FITS") {
+                let s = |i: usize| lf.params.get(i).and_then(Param::string).unwrap_or("");
+                fit = Some(format!("{}{}", s(1), s(2)).trim().to_string());
+            }
+        }
+        let dim = Dimension {
+            id,
+            kind,
+            angular,
+            nominal,
+            upper,
+            lower,
+            fit,
+            faces,
+            to_faces,
+        };
+        if dim.faces.is_empty() {
+            notes.push(format!("dimension #{id} is linked to no face"));
+        }
+        Some(dim)
+    }
+
+    /// A measure's value in mm (lengths) or degrees (plane angles), and whether it is
+    /// an angle.
+    fn measure(&self, id: u64) -> Option<(f64, bool)> {
+        let inst = self.f.instances.get(&id)?;
+        let r = inst.records.iter().find(|r| {
+            r.params.len() >= 2 && r.params[0].real().is_some() && r.params[1].reference().is_some()
+        })?;
+        let value = r.params[0].real()?;
+        let kind = match &r.params[0] {
+            Param::Typed(k, _) => k.as_str(),
+            _ => "",
+        };
+        let unit = r.params[1]
+            .reference()
+            .and_then(|u| self.f.instances.get(&u));
+        if kind.contains("ANGLE") {
+            let rad = unit
+                .and_then(|u| unit_factor(self.f, u, "RADIAN", 1.0, 0).ok())
+                .map_or(std::f64::consts::PI / 180.0, |(k, _)| k);
+            return Some((tidy(value * rad.to_degrees()), true));
+        }
+        let mm = unit
+            .and_then(|u| unit_factor(self.f, u, "METRE", 1000.0, 0).ok())
+            .map_or(self.unit_mm, |(k, _)| k);
+        Some((tidy(value * mm), false))
+    }
+}
+
+/// The enumerations in a modifier list (`SIMPLE_DATUM_REFERENCE_MODIFIER(.X.)`).
+fn collect_enums(p: &Param, out: &mut Vec<String>) {
+    match p {
+        Param::Enum(e) => out.push(e.clone()),
+        Param::List(v) | Param::Typed(_, v) => v.iter().for_each(|q| collect_enums(q, out)),
+        _ => {}
+    }
+}
+
+/// A converted value rounded to 1e-9 of its unit, so that 0.015 in reads 0.381 mm.
+fn tidy(x: f64) -> f64 {
+    (x * 1e9).round() / 1e9
+}
