@@ -10,6 +10,7 @@ pub mod diag;
 pub mod dmis;
 pub mod geometry;
 pub mod graph;
+pub mod import;
 pub mod load;
 pub mod model;
 pub mod path;

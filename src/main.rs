@@ -167,6 +167,16 @@ enum Command {
         /// The `.dmi` file.
         file: PathBuf,
     },
+    /// Writes a starter spec from a STEP file: the part read from its B-rep, a feature per
+    /// PMI feature, every datum, tolerance and size the language can express (a comment
+    /// for each it cannot), a CMM and probes sized to the part, and a plan.
+    Import {
+        /// The `.stp` or `.step` file.
+        file: PathBuf,
+        /// Where to write the spec (default: standard output).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
     /// Checks specs: parses, resolves names and units, checks values. Exits 1 on error.
     Check {
         /// The `.insp` files.
@@ -251,6 +261,7 @@ fn main() -> ExitCode {
             allow_unmeasured,
         } => build(&file, output, plan_json, &search.options(allow_unmeasured)),
         Command::Dmis { file } => read_dmis(&file),
+        Command::Import { file, output } => import(&file, output),
         Command::Simulate {
             program,
             spec,
@@ -715,6 +726,76 @@ fn graph(file: &std::path::Path, format: GraphFormat, points: bool) -> ExitCode 
     ExitCode::SUCCESS
 }
 
+/// Prints a mesh file's error, labelled on its path (the command line named it, no spec).
+fn mesh_error(file: &std::path::Path, e: inspc::geometry::MeshError) {
+    let mut sources = inspc::source::SourceMap::new();
+    let shown = file.to_string_lossy().into_owned();
+    let id = sources.add(shown.clone(), None, shown.clone());
+    let span = inspc::source::Span::new(id, 0, shown.len());
+    let mut diags = inspc::diag::Diagnostics::new();
+    for d in e.at(span, file) {
+        diags.push(d);
+    }
+    print_diagnostics(&sources, &diags.sorted());
+}
+
+/// `inspc import`: a spec from a STEP file, on stdout or written atomically.
+fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
+    use inspc::source::{FileKind, World};
+    let bytes = match FsWorld.read(file, FileKind::Mesh) {
+        Ok(b) => b,
+        Err(e) => {
+            mesh_error(file, inspc::geometry::MeshError::Unreadable(e.0));
+            return ExitCode::from(1);
+        }
+    };
+    let spec_dir = output
+        .as_deref()
+        .and_then(std::path::Path::parent)
+        .filter(|d| !d.as_os_str().is_empty())
+        .map_or_else(|| PathBuf::from("."), std::path::Path::to_path_buf);
+    let stem = file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let opts = inspc::import::ImportOptions {
+        step_path: cli::outputs::relative_to(file, &spec_dir),
+        part_name: inspc::import::identifier(&stem),
+    };
+    let imported = match inspc::import::import(&bytes, &opts) {
+        Ok(i) => i,
+        Err(e) => {
+            mesh_error(file, e);
+            return ExitCode::from(1);
+        }
+    };
+    match &output {
+        Some(path) => {
+            let out = cli::outputs::Output {
+                path: path.clone(),
+                bytes: imported.text.clone().into_bytes(),
+                what: "the spec",
+            };
+            if let Err(code) = commit(&[out], &[file.to_path_buf()]) {
+                return code;
+            }
+        }
+        None => print!("{}", imported.text),
+    }
+    let (d, dw) = imported.datums;
+    let (t, tw) = imported.tolerances;
+    let (s, sw) = imported.dimensions;
+    eprintln!(
+        "inspc: {} faces; datums {dw} of {d}, tolerances {tw} of {t}, sizes and locations {sw} of {s} written{}",
+        imported.faces,
+        output
+            .as_ref()
+            .map(|p| format!(" to {}", p.display()))
+            .unwrap_or_default()
+    );
+    ExitCode::SUCCESS
+}
+
 fn faces(file: &std::path::Path, segment: bool, units: &str, format: TableFormat) -> ExitCode {
     use inspc::geometry;
     let is_spec = file.extension().is_some_and(|e| e == "insp");
@@ -749,18 +830,7 @@ fn faces(file: &std::path::Path, segment: bool, units: &str, format: TableFormat
         let raw = match geometry::read_mesh(&FsWorld, file, unit_mm) {
             Ok(raw) => raw,
             Err(e) => {
-                let mut sources = inspc::source::SourceMap::new();
-                let id = sources.add(
-                    file.to_string_lossy().into_owned(),
-                    None,
-                    file.to_string_lossy().into_owned(),
-                );
-                let span = inspc::source::Span::new(id, 0, file.to_string_lossy().len());
-                let mut diags = inspc::diag::Diagnostics::new();
-                for d in e.at(span, file) {
-                    diags.push(d);
-                }
-                print_diagnostics(&sources, &diags.sorted());
+                mesh_error(file, e);
                 return ExitCode::from(1);
             }
         };

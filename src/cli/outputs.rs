@@ -38,6 +38,27 @@ fn resolved(path: &Path) -> PathBuf {
     }
 }
 
+/// `target` as a path relative to the folder `from` (both resolved), with `/`
+/// separators so that a spec reads the same on any machine; `target` as given when
+/// the two share no root.
+pub fn relative_to(target: &Path, from: &Path) -> String {
+    let t = resolved(target);
+    let f = std::fs::canonicalize(from).unwrap_or_else(|_| resolved(from));
+    let tc: Vec<_> = t.components().collect();
+    let fc: Vec<_> = f.components().collect();
+    let common = tc.iter().zip(&fc).take_while(|(a, b)| a == b).count();
+    if common == 0 {
+        return target.to_string_lossy().replace('\\', "/");
+    }
+    let mut parts: Vec<String> = vec!["..".to_string(); fc.len() - common];
+    parts.extend(
+        tc[common..]
+            .iter()
+            .map(|c| c.as_os_str().to_string_lossy().into_owned()),
+    );
+    parts.join("/")
+}
+
 /// The error for `path`, filed under a source registered for it.
 fn filed(
     sources: &mut SourceMap,

@@ -23,6 +23,7 @@ mod tolerance;
 
 pub use errors::ResolveError;
 pub use props::length_unit_mm;
+pub use tolerance::{accepts, Accepts, Datums};
 
 use crate::diag::{suggest, Diagnostics};
 use crate::load::{ModuleId, Program};

@@ -9,11 +9,39 @@ use crate::model::*;
 use crate::source::Span;
 use crate::syntax::ast::{self, ValueKind};
 
-#[derive(Clone, Copy, PartialEq)]
-enum Datums {
+/// Whether a tolerance type takes a datum reference frame.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum Datums {
+    /// Form tolerances and sizes: never.
     Forbidden,
+    /// Profiles: with or without.
     Optional,
+    /// Orientation, location and runout: always.
     Required,
+}
+
+/// What the language accepts for one geometric tolerance type: datums, a material
+/// modifier on the feature, a Ø zone (for writers of specs, e.g. `inspc import`).
+#[derive(Clone, Copy, Debug)]
+pub struct Accepts {
+    /// Datums.
+    pub datums: Datums,
+    /// MMC/LMC on the toleranced feature.
+    pub material: bool,
+    /// A cylindrical zone.
+    pub dia: bool,
+    /// Its keyword.
+    pub keyword: &'static str,
+}
+
+/// The rules of a tolerance type, as [`lower`] checks them.
+pub fn accepts(kind: TolKind) -> Option<Accepts> {
+    RULES.iter().find(|r| r.kind == kind).map(|r| Accepts {
+        datums: r.datums,
+        material: r.material,
+        dia: r.dia,
+        keyword: r.name,
+    })
 }
 
 /// The rules of one tolerance type.

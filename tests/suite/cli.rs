@@ -748,3 +748,40 @@ fn control_characters_are_not_printed_raw() {
     assert!(!stderr.contains('\u{1b}'), "{stderr:?}");
     assert!(!stderr.contains('\u{202e}'), "{stderr:?}");
 }
+
+#[test]
+fn import_writes_a_spec_that_checks_and_reports_a_broken_file() {
+    crate::common::require_shared_parts();
+    let dir = std::env::temp_dir().join(format!("inspc_import_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = dir.join("ctc_01.insp");
+    let step = std::fs::canonicalize("../shared/parts/nist_ctc_01_asme1_ap242-e1.stp").unwrap();
+    let (code, out, err) = inspc(&[
+        "import",
+        step.to_str().unwrap(),
+        "-o",
+        spec.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.is_empty());
+    assert!(err.contains("datums 3 of 3, tolerances 6 of 6"), "{err}");
+    let text = std::fs::read_to_string(&spec).unwrap();
+    assert!(text.contains("datum B = datum_b"), "{text}");
+    let (code, _, err) = inspc(&["check", spec.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    // A truncated file: a diagnostic with its code, and nothing written.
+    let bytes = std::fs::read(&step).unwrap();
+    let broken = dir.join("broken.stp");
+    std::fs::write(&broken, &bytes[..bytes.len() / 3]).unwrap();
+    let out_spec = dir.join("broken.insp");
+    let (code, _, err) = inspc(&[
+        "import",
+        broken.to_str().unwrap(),
+        "-o",
+        out_spec.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains("insp::geometry::step_"), "{err}");
+    assert!(!out_spec.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

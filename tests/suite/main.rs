@@ -14,6 +14,7 @@ mod examples;
 mod fpoints;
 mod geometry_props;
 mod grammar;
+mod import;
 mod mesh_fuzz;
 mod no_panic;
 mod replan;

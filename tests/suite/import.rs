@@ -1,0 +1,253 @@
+//! CAD in, PMI and `inspc import`: the semantic PMI of the four NIST STEP files against
+//! the reference reading in `../shared/parts/*.pmi.json` (same tolerances, values, frames
+//! and faces; more links where the reference lost them), and the imported specs against
+//! their goldens in `tests/imported/` (bless with `INSPC_BLESS=1`): the same text twice,
+//! and every one checks clean.
+
+use crate::common::require_shared_parts;
+use inspc::geometry::step::{pmi::Pmi, read, RESOLUTION};
+use inspc::import::{identifier, import, ImportOptions};
+use inspc::model::TolKind;
+use serde_json::Value;
+use std::path::PathBuf;
+
+const PARTS: [&str; 4] = ["ctc_01", "ctc_02", "ftc_06", "ftc_08"];
+
+fn file(part: &str, ext: &str) -> String {
+    format!("../shared/parts/nist_{part}_asme1_ap242-e1.{ext}")
+}
+
+fn pmi(part: &str) -> Pmi {
+    require_shared_parts();
+    let bytes = std::fs::read(file(part, "stp")).unwrap();
+    read(&bytes, RESOLUTION).unwrap().pmi
+}
+
+fn reference(part: &str) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(file(part, "pmi.json")).unwrap()).unwrap()
+}
+
+fn kind_of(reference: &str) -> Option<TolKind> {
+    Some(match reference.trim_start_matches("GeomToleranceType_") {
+        "Flatness" => TolKind::Flatness,
+        "ProfileOfSurface" => TolKind::ProfileSurface,
+        "ProfileOfLine" => TolKind::ProfileLine,
+        "Perpendicularity" => TolKind::Perpendicularity,
+        "Parallelism" => TolKind::Parallelism,
+        "Position" => TolKind::Position,
+        _ => return None,
+    })
+}
+
+/// Tolerances in file order against the reference's, one for one: type, value, Ø zone,
+/// material modifier, datum letters, and faces wherever the reference has them (and the
+/// face numbering is the file's, `same_faces`).
+fn check_tolerances(part: &str, same_faces: bool) -> Pmi {
+    let p = pmi(part);
+    let r = reference(part);
+    let rt = r["tolerances"].as_array().unwrap();
+    assert_eq!(p.tolerances.len(), rt.len(), "{part}: tolerance count");
+    for (t, rt) in p.tolerances.iter().zip(rt) {
+        let what = format!("{part}: `{}`", t.name);
+        assert_eq!(
+            t.kind,
+            kind_of(rt["type"].as_str().unwrap()),
+            "{what}: type"
+        );
+        assert!(
+            (t.value_mm - rt["value"].as_f64().unwrap()).abs() < 1e-6,
+            "{what}: value {}",
+            t.value_mm
+        );
+        // The reference reads no spherical zone (SØ); the file states one.
+        assert_eq!(
+            t.diameter && !t.spherical,
+            rt["zone"] == "GeomToleranceTypeValue_Diameter",
+            "{what}: Ø zone"
+        );
+        let material = match rt["material"].as_str().unwrap() {
+            "GeomToleranceMatReqModif_M" => Some(inspc::model::Material::Mmc),
+            "GeomToleranceMatReqModif_L" => Some(inspc::model::Material::Lmc),
+            _ => None,
+        };
+        assert_eq!(t.material, material, "{what}: material modifier");
+        // The reference lists a datum once per reference to it (targets repeat it).
+        let mut letters: Vec<String> = rt["datums"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|d| d.as_str().unwrap().to_string())
+            .collect();
+        letters.dedup();
+        // It also flattens a common datum (E-F) into its letters.
+        let ours: Vec<String> = t.datums.iter().flat_map(|d| d.letters.clone()).collect();
+        assert_eq!(ours, letters, "{what}: datums");
+        let faces: Vec<usize> = rt["faces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_u64().unwrap() as usize - 1)
+            .collect();
+        if faces.is_empty() {
+            continue;
+        }
+        if same_faces {
+            assert_eq!(t.faces, faces, "{what}: faces");
+        } else {
+            assert_eq!(t.faces.len(), faces.len(), "{what}: face count");
+        }
+    }
+    p
+}
+
+/// Datums: the reference's faces where it has them; and every datum linked.
+fn check_datums(part: &str, p: &Pmi) {
+    let r = reference(part);
+    for rd in r["datums"].as_array().unwrap() {
+        let letter = rd["name"].as_str().unwrap();
+        let d = p
+            .datums
+            .iter()
+            .find(|d| d.letter == letter)
+            .unwrap_or_else(|| panic!("{part}: datum {letter} not read"));
+        let faces: Vec<usize> = rd["faces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_u64().unwrap() as usize - 1)
+            .collect();
+        if !faces.is_empty() {
+            assert_eq!(d.faces.len(), faces.len(), "{part}: datum {letter}");
+        }
+        assert!(!d.faces.is_empty(), "{part}: datum {letter} has no faces");
+    }
+}
+
+#[test]
+fn ctc_01_pmi_matches_the_reference_and_links_datums_b_and_c() {
+    let p = check_tolerances("ctc_01", true);
+    check_datums("ctc_01", &p);
+    // The reference lost B and C; the file links them (ITEM_IDENTIFIED_REPRESENTATION_
+    // USAGE) to the two Ø35 bores.
+    let faces = |l: &str| {
+        p.datums
+            .iter()
+            .find(|d| d.letter == l)
+            .unwrap()
+            .faces
+            .clone()
+    };
+    assert_eq!(faces("A"), vec![97]);
+    assert_eq!(faces("B"), vec![89, 90]);
+    assert_eq!(faces("C"), vec![75, 76]);
+    // Sizes: nominal and limits, signed.
+    let size = p
+        .dimensions
+        .iter()
+        .find(|d| d.faces == vec![89, 90] && d.nominal.is_some())
+        .unwrap();
+    assert_eq!(
+        (size.nominal, size.upper, size.lower),
+        (Some(35.0), Some(0.0), Some(-0.2))
+    );
+    let angle = p.dimensions.iter().find(|d| d.angular).unwrap();
+    assert_eq!(
+        (angle.nominal, angle.upper, angle.lower),
+        (Some(60.0), Some(0.5), Some(-0.5))
+    );
+}
+
+#[test]
+fn ftc_08_pmi_in_inches_reads_in_mm_with_composite_frames() {
+    let p = check_tolerances("ftc_08", true);
+    check_datums("ftc_08", &p);
+    assert_eq!(p.datums.len(), 11);
+    // Six composite frames: each lower segment points at its upper one.
+    assert_eq!(
+        p.tolerances
+            .iter()
+            .filter(|t| t.composite_of.is_some())
+            .count(),
+        6
+    );
+    let d = p
+        .dimensions
+        .iter()
+        .find(|d| d.faces == vec![66, 67])
+        .unwrap();
+    assert_eq!(
+        (d.nominal, d.upper, d.lower),
+        (Some(6.35), Some(0.1524), Some(-0.0254))
+    );
+}
+
+#[test]
+fn ftc_06_pmi_locates_datums_set_up_by_targets() {
+    let p = check_tolerances("ftc_06", true);
+    check_datums("ftc_06", &p);
+    // G, H, J and K are set up by targets on supplemental geometry only: each is located
+    // on the faces its targets lie on, and marked so.
+    for (letter, faces) in [
+        ("H", vec![60, 61]),
+        ("G", vec![123, 124]),
+        ("K", vec![48, 52]),
+        ("J", vec![37, 41]),
+    ] {
+        let d = p.datums.iter().find(|d| d.letter == letter).unwrap();
+        assert!(d.located, "datum {letter}");
+        assert_eq!(d.faces, faces, "datum {letter}");
+    }
+}
+
+#[test]
+fn ctc_02_pmi_links_what_the_reference_lost() {
+    // Its reference numbers faces in OpenCASCADE's order: counts only.
+    let p = check_tolerances("ctc_02", false);
+    check_datums("ctc_02", &p);
+    let unlinked: Vec<&str> = p
+        .tolerances
+        .iter()
+        .filter(|t| t.faces.is_empty())
+        .map(|t| t.name.as_str())
+        .collect();
+    // One profile of a line names a curve of the drawing, not the part.
+    assert_eq!(unlinked, vec!["Feature Control Frame (14)"]);
+    assert!(p.notes.iter().any(|n| n.contains("(14)")));
+}
+
+fn imported(part: &str) -> String {
+    require_shared_parts();
+    let bytes = std::fs::read(file(part, "stp")).unwrap();
+    let opts = ImportOptions {
+        step_path: format!("../../{}", file(part, "stp")),
+        part_name: identifier(&format!("nist_{part}_asme1_ap242-e1")),
+    };
+    import(&bytes, &opts).unwrap().text
+}
+
+#[test]
+fn imported_specs_match_their_goldens_and_import_twice_the_same() {
+    for part in PARTS {
+        let text = imported(part);
+        assert_eq!(text, imported(part), "{part}: importing twice");
+        let golden = PathBuf::from(format!("tests/imported/nist_{part}.insp"));
+        if std::env::var_os("INSPC_BLESS").is_some() {
+            std::fs::write(&golden, &text).unwrap();
+            continue;
+        }
+        let expected = std::fs::read_to_string(&golden)
+            .unwrap_or_else(|_| panic!("{}: missing; bless it", golden.display()));
+        assert!(
+            text == expected,
+            "{part}: the imported spec differs from {} (bless with INSPC_BLESS=1)",
+            golden.display()
+        );
+        let checked = inspc::check(&inspc::source::FsWorld, std::slice::from_ref(&golden));
+        assert!(
+            !checked.has_errors(),
+            "{}: {:?}",
+            golden.display(),
+            checked.diagnostics
+        );
+    }
+}
