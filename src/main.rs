@@ -762,7 +762,13 @@ fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
         step_path: cli::outputs::relative_to(file, &spec_dir),
         part_name: inspc::import::identifier(&stem),
     };
-    let imported = match inspc::import::import(&bytes, &opts) {
+    let inspc::import::Imported {
+        text,
+        faces,
+        datums: (d, dw),
+        tolerances: (t, tw),
+        dimensions: (s, sw),
+    } = match inspc::import::import(&bytes, &opts) {
         Ok(i) => i,
         Err(e) => {
             mesh_error(file, e);
@@ -773,21 +779,17 @@ fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
         Some(path) => {
             let out = cli::outputs::Output {
                 path: path.clone(),
-                bytes: imported.text.clone().into_bytes(),
+                bytes: text.into_bytes(),
                 what: "the spec",
             };
             if let Err(code) = commit(&[out], &[file.to_path_buf()]) {
                 return code;
             }
         }
-        None => print!("{}", imported.text),
+        None => print!("{text}"),
     }
-    let (d, dw) = imported.datums;
-    let (t, tw) = imported.tolerances;
-    let (s, sw) = imported.dimensions;
     eprintln!(
-        "inspc: {} faces; datums {dw} of {d}, tolerances {tw} of {t}, sizes and locations {sw} of {s} written{}",
-        imported.faces,
+        "inspc: {faces} faces; datums {dw} of {d}, tolerances {tw} of {t}, sizes and locations {sw} of {s} written{}",
         output
             .as_ref()
             .map(|p| format!(" to {}", p.display()))

@@ -465,15 +465,10 @@ fn write_spec(part: &StepPart, opts: &ImportOptions) -> Imported {
         &tol_lines,
         &dim_lines,
     );
-    let datums_written = datum_lines
-        .iter()
-        .filter(|l| l.trim_start().starts_with("datum "))
-        .count()
-        - frames.common.len();
     Imported {
         text,
         faces: part.face_ids.len(),
-        datums: (seen_letters.len(), datums_written),
+        datums: (seen_letters.len(), frames.datum_feature.len()),
         tolerances: (p.tolerances.len(), written_tols),
         dimensions: (p.dimensions.len(), written_dims),
     }
@@ -483,7 +478,7 @@ fn write_spec(part: &StepPart, opts: &ImportOptions) -> Imported {
 /// for narrow slots and small holes (the shorter one when the part's smallest hole is
 /// under 6 mm, where a long thin stylus bends and collides), a long Ø3 stylus for
 /// reach, and an extension when the part is taller than that stylus reaches.
-fn rack(part: &StepPart) -> Vec<(&'static str, &'static str)> {
+fn rack(part: &StepPart, size: [f64; 3]) -> Vec<(&'static str, &'static str)> {
     let smallest_hole = part
         .mesh
         .exact
@@ -497,8 +492,7 @@ fn rack(part: &StepPart) -> Vec<(&'static str, &'static str)> {
             _ => None,
         })
         .fold(f64::INFINITY, f64::min);
-    let (lo, hi) = bbox(part);
-    let extent = (0..3).map(|i| hi[i] - lo[i]).fold(0.0, f64::max);
+    let extent = size.into_iter().fold(0.0, f64::max);
     let small = if smallest_hole < 6.0 {
         "TP20_D1_L10"
     } else {
@@ -511,7 +505,8 @@ fn rack(part: &StepPart) -> Vec<(&'static str, &'static str)> {
     rack
 }
 
-fn bbox(part: &StepPart) -> ([f64; 3], [f64; 3]) {
+/// The part's extent along x, y and z (mm).
+fn size(part: &StepPart) -> [f64; 3] {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for v in &part.mesh.vertices {
@@ -520,7 +515,7 @@ fn bbox(part: &StepPart) -> ([f64; 3], [f64; 3]) {
             hi[i] = hi[i].max(v[i]);
         }
     }
-    (lo, hi)
+    [0, 1, 2].map(|i| hi[i] - lo[i])
 }
 
 fn render(
@@ -533,8 +528,8 @@ fn render(
     dim_lines: &[String],
 ) -> String {
     let mut s = String::new();
-    let (lo, hi) = bbox(part);
-    let size: Vec<String> = (0..3).map(|i| fmt_num((hi[i] - lo[i]).round())).collect();
+    let extent = size(part);
+    let size = extent.map(|x| fmt_num(x.round()));
     let _ = writeln!(s, "// Written by `inspc import` from {}.", opts.step_path);
     let _ = writeln!(
         s,
@@ -555,7 +550,7 @@ fn render(
             let _ = writeln!(s, "//   - {n}");
         }
     }
-    let rack = rack(part);
+    let rack = rack(part, extent);
     let _ = writeln!(s, "\nuse std::heads::PH10MQ");
     let probes: Vec<&str> = rack.iter().map(|(_, p)| *p).collect();
     let _ = writeln!(s, "use std::probes::{{{}}}", probes.join(", "));
@@ -604,8 +599,7 @@ fn render(
     }
     let _ = writeln!(s, "}}");
 
-    let table =
-        |i: usize, min: f64| fmt_num(min.max(((hi[i] - lo[i]) * 2.5 / 100.0).ceil() * 100.0));
+    let table = |i: usize, min: f64| fmt_num(min.max((extent[i] * 2.5 / 100.0).ceil() * 100.0));
     let _ = writeln!(
         s,
         "\n// A bridge CMM whose table holds the part in any pose, an indexable head and a rack\n// sized to the part's smallest holes and its height."

@@ -22,6 +22,7 @@ pub use tess::Resolution;
 use super::mesh_io::{weld, RawMesh};
 use super::{Surface, P3};
 use crate::geometry::errors::MeshError;
+use std::collections::{BTreeSet, HashMap};
 
 /// The resolution parts are meshed at: the reference meshes' (OpenCASCADE, linear
 /// deflection 0.1 mm, angular 0.5 rad), so that a STEP part plans as its mesh did.
@@ -161,8 +162,8 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<StepPart, MeshError> {
 }
 
 /// Each edge's faces: the curved ones where it bounds any, else all.
-fn edge_faces(b: &brep::Brep) -> std::collections::HashMap<u64, Vec<usize>> {
-    let mut all: std::collections::HashMap<u64, Vec<usize>> = Default::default();
+fn edge_faces(b: &brep::Brep) -> HashMap<u64, Vec<usize>> {
+    let mut all: HashMap<u64, Vec<usize>> = HashMap::new();
     for (i, f) in b.faces.iter().enumerate() {
         for bound in &f.bounds {
             if let brep::Bound::Edges(edges) = bound {
@@ -192,7 +193,6 @@ const TARGET_REACH_MM: f64 = 0.5;
 /// point is located on the part, and the faces it lands on become the datum's, marked as
 /// located so that callers say so.
 fn locate_targets(p: &mut pmi::Pmi, mesh: &RawMesh) {
-    use std::collections::BTreeSet;
     let mut notes = Vec::new();
     for d in p.datums.iter_mut().filter(|d| d.faces.is_empty()) {
         let stated: Vec<_> = d.targets.iter().flat_map(|t| &t.points).collect();
@@ -228,11 +228,7 @@ fn locate_targets(p: &mut pmi::Pmi, mesh: &RawMesh) {
                 d.letter
             ));
         }
-        d.faces = faces
-            .into_iter()
-            .collect::<BTreeSet<_>>()
-            .into_iter()
-            .collect();
+        d.faces = faces.into_iter().collect();
         d.located = true;
     }
     p.notes.extend(notes);
@@ -240,10 +236,10 @@ fn locate_targets(p: &mut pmi::Pmi, mesh: &RawMesh) {
 
 /// The faces a set of points lies on (each point's nearest face within
 /// [`TARGET_REACH_MM`]), and how many points lie on none.
-fn faces_under(points: &[&[f64; 3]], mesh: &RawMesh) -> (Vec<usize>, usize) {
+fn faces_under(points: &[&[f64; 3]], mesh: &RawMesh) -> (BTreeSet<usize>, usize) {
     use parry3d_f64::query::PointQuery;
     use parry3d_f64::shape::Triangle;
-    let mut faces = Vec::new();
+    let mut faces = BTreeSet::new();
     let mut missed = 0;
     for pt in points {
         let q = P3::new(pt[0], pt[1], pt[2]);
@@ -257,7 +253,9 @@ fn faces_under(points: &[&[f64; 3]], mesh: &RawMesh) -> (Vec<usize>, usize) {
             })
             .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         match best {
-            Some((dist, g)) if dist <= TARGET_REACH_MM => faces.push(g as usize),
+            Some((dist, g)) if dist <= TARGET_REACH_MM => {
+                faces.insert(g as usize);
+            }
             _ => missed += 1,
         }
     }

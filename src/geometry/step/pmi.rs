@@ -154,8 +154,8 @@ struct Links<'a> {
     f: &'a P21,
     /// Face instance → 0-based face index.
     face_index: HashMap<u64, usize>,
-    /// Edge instance → the faces it bounds, curved ones first (a hole named by its
-    /// rim is the hole).
+    /// Edge instance → the faces it names: its curved faces when it bounds any (a hole
+    /// named by its rim is the hole), else all.
     edge_faces: &'a HashMap<u64, Vec<usize>>,
     /// Aspect → the representation items a usage names for it.
     usage: HashMap<u64, Vec<u64>>,
@@ -165,6 +165,14 @@ struct Links<'a> {
     up: HashMap<u64, Vec<u64>>,
     /// Property definition's subject → its shape representation (datum targets).
     shape_of: HashMap<u64, u64>,
+    /// Tolerance → its zone's form (`cylindrical or circular`, `spherical`).
+    zones: HashMap<u64, String>,
+    /// Lower segment of a composite frame → its upper segment.
+    composite: HashMap<u64, u64>,
+    /// Dimension → the representation of its nominal value.
+    nominal_of: HashMap<u64, u64>,
+    /// Dimension → its plus-minus range.
+    limits_of: HashMap<u64, u64>,
     /// File length unit, mm (for a measure whose unit cannot be read).
     unit_mm: f64,
 }
@@ -181,25 +189,26 @@ pub fn read(f: &P21, faces: &[u64], edge_faces: &HashMap<u64, Vec<usize>>, unit_
         down: HashMap::new(),
         up: HashMap::new(),
         shape_of: HashMap::new(),
+        zones: HashMap::new(),
+        composite: HashMap::new(),
+        nominal_of: HashMap::new(),
+        limits_of: HashMap::new(),
         unit_mm,
     };
     let mut subject_of: HashMap<u64, u64> = HashMap::new();
     let mut shape_reps: Vec<(u64, u64)> = Vec::new();
-    let mut zones: HashMap<u64, String> = HashMap::new();
-    let mut composite: HashMap<u64, u64> = HashMap::new();
-    let mut nominal_of: HashMap<u64, u64> = HashMap::new();
-    let mut limits_of: HashMap<u64, u64> = HashMap::new();
     for id in &f.order {
         let inst = &f.instances[id];
         let Some(r) = inst.records.first() else {
             continue;
         };
         let p = &r.params;
+        let at = |i: usize| p.get(i).and_then(Param::reference);
         match r.name.as_str() {
             "GEOMETRIC_ITEM_SPECIFIC_USAGE" | "ITEM_IDENTIFIED_REPRESENTATION_USAGE"
                 if inst.records.len() == 1 =>
             {
-                if let (Some(def), Some(item)) = (p.get(2).and_then(Param::reference), p.get(4)) {
+                if let (Some(def), Some(item)) = (at(2), p.get(4)) {
                     let entry = l.usage.entry(def).or_default();
                     collect_refs(item, entry);
                 }
@@ -209,18 +218,13 @@ pub fn read(f: &P21, faces: &[u64], edge_faces: &HashMap<u64, Vec<usize>>, unit_
             | "FEATURE_FOR_DATUM_TARGET_RELATIONSHIP"
                 if inst.records.len() == 1 =>
             {
-                if let (Some(a), Some(b)) = (
-                    p.get(2).and_then(Param::reference),
-                    p.get(3).and_then(Param::reference),
-                ) {
+                if let (Some(a), Some(b)) = (at(2), at(3)) {
                     l.down.entry(a).or_default().push(b);
                     l.up.entry(b).or_default().push(a);
                 }
             }
             "TOLERANCE_ZONE" => {
-                let form = p
-                    .get(5)
-                    .and_then(Param::reference)
+                let form = at(5)
                     .and_then(|z| f.instances.get(&z))
                     .and_then(|z| z.record("TOLERANCE_ZONE_FORM"))
                     .and_then(|z| z.params.first())
@@ -229,47 +233,34 @@ pub fn read(f: &P21, faces: &[u64], edge_faces: &HashMap<u64, Vec<usize>>, unit_
                     .to_string();
                 for t in p.get(4).and_then(Param::list).unwrap_or(&[]) {
                     if let Some(t) = t.reference() {
-                        zones.insert(t, form.clone());
+                        l.zones.insert(t, form.clone());
                     }
                 }
             }
             "GEOMETRIC_TOLERANCE_RELATIONSHIP" => {
                 let is_composite = p.first().and_then(Param::string) == Some("composite");
-                if let (true, Some(upper), Some(lower)) = (
-                    is_composite,
-                    p.get(2).and_then(Param::reference),
-                    p.get(3).and_then(Param::reference),
-                ) {
-                    composite.insert(lower, upper);
+                if let (true, Some(upper), Some(lower)) = (is_composite, at(2), at(3)) {
+                    l.composite.insert(lower, upper);
                 }
             }
             "PROPERTY_DEFINITION" => {
-                if let Some(of) = p.get(2).and_then(Param::reference) {
+                if let Some(of) = at(2) {
                     subject_of.insert(*id, of);
                 }
             }
             "SHAPE_DEFINITION_REPRESENTATION" => {
-                if let (Some(pd), Some(rep)) = (
-                    p.first().and_then(Param::reference),
-                    p.get(1).and_then(Param::reference),
-                ) {
+                if let (Some(pd), Some(rep)) = (at(0), at(1)) {
                     shape_reps.push((pd, rep));
                 }
             }
             "DIMENSIONAL_CHARACTERISTIC_REPRESENTATION" => {
-                if let (Some(d), Some(rep)) = (
-                    p.first().and_then(Param::reference),
-                    p.get(1).and_then(Param::reference),
-                ) {
-                    nominal_of.insert(d, rep);
+                if let (Some(d), Some(rep)) = (at(0), at(1)) {
+                    l.nominal_of.insert(d, rep);
                 }
             }
             "PLUS_MINUS_TOLERANCE" => {
-                if let (Some(range), Some(d)) = (
-                    p.first().and_then(Param::reference),
-                    p.get(1).and_then(Param::reference),
-                ) {
-                    limits_of.insert(d, range);
+                if let (Some(range), Some(d)) = (at(0), at(1)) {
+                    l.limits_of.insert(d, range);
                 }
             }
             _ => {}
@@ -287,12 +278,12 @@ pub fn read(f: &P21, faces: &[u64], edge_faces: &HashMap<u64, Vec<usize>>, unit_
     for id in &f.order {
         let inst = &f.instances[id];
         if inst.is("DATUM") {
-            pmi.datums.push(l.datum(*id, inst, &mut pmi.notes));
+            pmi.datums.push(l.datum(*id, &mut pmi.notes));
         } else if inst.is("GEOMETRIC_TOLERANCE") || KINDS.iter().any(|(n, _)| inst.is(n)) {
-            if let Some(t) = l.tolerance(*id, inst, &zones, &composite, &mut pmi.notes) {
+            if let Some(t) = l.tolerance(*id, inst, &mut pmi.notes) {
                 pmi.tolerances.push(t);
             }
-        } else if let Some(d) = l.dimension(*id, inst, &nominal_of, &limits_of, &mut pmi.notes) {
+        } else if let Some(d) = l.dimension(*id, inst, &mut pmi.notes) {
             pmi.dimensions.push(d);
         }
     }
@@ -342,13 +333,17 @@ impl Links<'_> {
         out.into_iter().collect()
     }
 
-    fn datum(&self, id: u64, inst: &Instance, notes: &mut Vec<String>) -> Datum {
-        let letter = inst
-            .record("DATUM")
-            .and_then(|r| r.params.get(4))
-            .and_then(Param::string)
-            .unwrap_or("?")
-            .to_string();
+    /// The faces of the aspect a record's parameter `i` refers to (none when absent).
+    fn faces_at(&self, params: &[Param], i: usize) -> Vec<usize> {
+        params
+            .get(i)
+            .and_then(Param::reference)
+            .map(|a| self.faces(a))
+            .unwrap_or_default()
+    }
+
+    fn datum(&self, id: u64, notes: &mut Vec<String>) -> Datum {
+        let letter = self.letter(id).unwrap_or_else(|| "?".into());
         let mut faces = BTreeSet::new();
         let mut targets = Vec::new();
         for &feature in self.up.get(&id).into_iter().flatten() {
@@ -522,14 +517,7 @@ impl Links<'_> {
         Some((o, z, x))
     }
 
-    fn tolerance(
-        &self,
-        id: u64,
-        inst: &Instance,
-        zones: &HashMap<u64, String>,
-        composite: &HashMap<u64, u64>,
-        notes: &mut Vec<String>,
-    ) -> Option<GeoTolerance> {
+    fn tolerance(&self, id: u64, inst: &Instance, notes: &mut Vec<String>) -> Option<GeoTolerance> {
         let kind = KINDS.iter().find(|(n, _)| inst.is(n)).map(|(_, k)| *k);
         // The common attributes: the GEOMETRIC_TOLERANCE record of a complex instance,
         // else the one record of a simple subtype.
@@ -554,12 +542,7 @@ impl Links<'_> {
             ));
             return None;
         };
-        let faces = base
-            .params
-            .get(3)
-            .and_then(Param::reference)
-            .map(|a| self.faces(a))
-            .unwrap_or_default();
+        let faces = self.faces_at(&base.params, 3);
         let mut systems = Vec::new();
         if let Some(r) = inst.record("GEOMETRIC_TOLERANCE_WITH_DATUM_REFERENCE") {
             r.params
@@ -577,14 +560,12 @@ impl Links<'_> {
         let mut material = None;
         let mut other = Vec::new();
         if let Some(r) = inst.record("GEOMETRIC_TOLERANCE_WITH_MODIFIERS") {
-            for m in r.params.first().and_then(Param::list).unwrap_or(&[]) {
-                match m.enumeration() {
-                    Some("MAXIMUM_MATERIAL_REQUIREMENT") => material = Some(Material::Mmc),
-                    Some("LEAST_MATERIAL_REQUIREMENT") => material = Some(Material::Lmc),
-                    Some(e) => other.push(e.to_lowercase().replace('_', " ")),
-                    None => {}
-                }
-            }
+            let mut modifiers = Vec::new();
+            r.params
+                .first()
+                .into_iter()
+                .for_each(|p| collect_enums(p, &mut modifiers));
+            sort_modifiers(&modifiers, &mut material, &mut other);
         }
         let unequal_mm = inst
             .record("UNEQUALLY_DISPOSED_GEOMETRIC_TOLERANCE")
@@ -592,7 +573,7 @@ impl Links<'_> {
             .and_then(Param::reference)
             .and_then(|m| self.measure(m))
             .map(|(v, _)| v);
-        let zone = zones.get(&id).map(String::as_str);
+        let zone = self.zones.get(&id).map(String::as_str);
         if faces.is_empty() {
             notes.push(format!("tolerance `{name}` (#{id}) is linked to no face"));
         }
@@ -612,7 +593,7 @@ impl Links<'_> {
             other,
             datums,
             faces,
-            composite_of: composite.get(&id).copied(),
+            composite_of: self.composite.get(&id).copied(),
             unequal_mm,
         })
     }
@@ -693,13 +674,7 @@ impl Links<'_> {
         if let Some(p) = r.params.get(5) {
             collect_enums(p, &mut modifiers);
         }
-        for m in modifiers {
-            match m.as_str() {
-                "MAXIMUM_MATERIAL_REQUIREMENT" => d.material = Some(Material::Mmc),
-                "LEAST_MATERIAL_REQUIREMENT" => d.material = Some(Material::Lmc),
-                e => d.other.push(e.to_lowercase().replace('_', " ")),
-            }
-        }
+        sort_modifiers(&modifiers, &mut d.material, &mut d.other);
         (!d.letters.is_empty()).then_some(d)
     }
 
@@ -714,55 +689,37 @@ impl Links<'_> {
             .map(str::to_string)
     }
 
-    fn dimension(
-        &self,
-        id: u64,
-        inst: &Instance,
-        nominal_of: &HashMap<u64, u64>,
-        limits_of: &HashMap<u64, u64>,
-        notes: &mut Vec<String>,
-    ) -> Option<Dimension> {
-        let r = inst.records.first()?;
-        let p = &r.params;
-        let (kind, faces, to_faces) = if inst.is("DIMENSIONAL_SIZE") || inst.is("ANGULAR_SIZE") {
-            let r = inst
-                .record("DIMENSIONAL_SIZE")
-                .or_else(|| inst.record("ANGULAR_SIZE"))?;
+    fn dimension(&self, id: u64, inst: &Instance, notes: &mut Vec<String>) -> Option<Dimension> {
+        let (kind, faces, to_faces) = if let Some(r) = inst
+            .record("DIMENSIONAL_SIZE")
+            .or_else(|| inst.record("ANGULAR_SIZE"))
+        {
             let name = r.params.get(1).and_then(Param::string).unwrap_or("size");
-            let faces = r
-                .params
-                .first()
-                .and_then(Param::reference)
-                .map(|a| self.faces(a))
-                .unwrap_or_default();
+            let faces = self.faces_at(&r.params, 0);
             (DimKind::Size(name.to_string()), faces, Vec::new())
-        } else if inst.is("DIMENSIONAL_LOCATION") || inst.is("ANGULAR_LOCATION") {
-            let r = inst
-                .record("DIMENSIONAL_LOCATION")
-                .or_else(|| inst.record("ANGULAR_LOCATION"))
-                .unwrap_or(r);
+        } else if let Some(r) = inst
+            .record("DIMENSIONAL_LOCATION")
+            .or_else(|| inst.record("ANGULAR_LOCATION"))
+        {
             let name = r
                 .params
                 .first()
                 .and_then(Param::string)
                 .unwrap_or("location");
-            let side = |i: usize| {
-                r.params
-                    .get(i)
-                    .and_then(Param::reference)
-                    .map(|a| self.faces(a))
-                    .unwrap_or_default()
-            };
-            (DimKind::Location(name.to_string()), side(2), side(3))
+            let (from, to) = (self.faces_at(&r.params, 2), self.faces_at(&r.params, 3));
+            (DimKind::Location(name.to_string()), from, to)
         } else {
-            let _ = p;
             return None;
         };
         let angular = inst.is("ANGULAR_SIZE") || inst.is("ANGULAR_LOCATION");
         let mut nominal = None;
         let mut upper = None;
         let mut lower = None;
-        if let Some(rep) = nominal_of.get(&id).and_then(|r| self.f.instances.get(r)) {
+        if let Some(rep) = self
+            .nominal_of
+            .get(&id)
+            .and_then(|r| self.f.instances.get(r))
+        {
             let items = rep.records[0]
                 .params
                 .get(1)
@@ -792,7 +749,11 @@ impl Links<'_> {
             }
         }
         let mut fit = None;
-        if let Some(range) = limits_of.get(&id).and_then(|r| self.f.instances.get(r)) {
+        if let Some(range) = self
+            .limits_of
+            .get(&id)
+            .and_then(|r| self.f.instances.get(r))
+        {
             if let Some(tv) = range.record("TOLERANCE_VALUE") {
                 let bound = |i: usize| {
                     tv.params
@@ -850,6 +811,18 @@ impl Links<'_> {
             .and_then(|u| unit_factor(self.f, u, "METRE", 1000.0, 0).ok())
             .map_or(self.unit_mm, |(k, _)| k);
         Some((tidy(value * mm), false))
+    }
+}
+
+/// Modifiers by their enumeration: the material ones to `material`, the rest, in words,
+/// to `other` (`tangent plane`, `free state`).
+fn sort_modifiers(modifiers: &[String], material: &mut Option<Material>, other: &mut Vec<String>) {
+    for m in modifiers {
+        match m.as_str() {
+            "MAXIMUM_MATERIAL_REQUIREMENT" => *material = Some(Material::Mmc),
+            "LEAST_MATERIAL_REQUIREMENT" => *material = Some(Material::Lmc),
+            e => other.push(e.to_lowercase().replace('_', " ")),
+        }
     }
 }
 
