@@ -167,11 +167,11 @@ enum Command {
         /// The `.dmi` file.
         file: PathBuf,
     },
-    /// Writes a starter spec from a STEP file: the part read from its B-rep, a feature per
+    /// Writes a starter spec from a STEP or QIF file: the part read from its B-rep, a feature per
     /// PMI feature, every datum, tolerance and size the language can express (a comment
     /// for each it cannot), a CMM and probes sized to the part, and a plan.
     Import {
-        /// The `.stp` or `.step` file.
+        /// The `.stp`, `.step` or `.qif` file.
         file: PathBuf,
         /// Where to write the spec (default: standard output).
         #[arg(short, long)]
@@ -739,7 +739,7 @@ fn mesh_error(file: &std::path::Path, e: inspc::geometry::MeshError) {
     print_diagnostics(&sources, &diags.sorted());
 }
 
-/// `inspc import`: a spec from a STEP file, on stdout or written atomically.
+/// `inspc import`: a spec from a STEP or QIF file, on stdout or written atomically.
 fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
     use inspc::source::{FileKind, World};
     let bytes = match FsWorld.read(file, FileKind::Mesh) {
@@ -759,7 +759,7 @@ fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     let opts = inspc::import::ImportOptions {
-        step_path: cli::outputs::relative_to(file, &spec_dir),
+        cad_path: cli::outputs::relative_to(file, &spec_dir),
         part_name: inspc::import::identifier(&stem),
     };
     let inspc::import::Imported {

@@ -162,6 +162,98 @@ pub enum GeometryError {
         id: u64,
         reason: String,
     },
+    #[error("QIF file `{path}` is not well-formed XML: line {line}: {message}")]
+    #[diagnostic(
+        code(insp::geometry::qif_syntax),
+        help(
+            "the file is cut short or was edited by hand; re-export it from the CAD or MBD system"
+        )
+    )]
+    QifSyntax {
+        #[label("this QIF file")]
+        span: Span,
+        path: String,
+        line: usize,
+        message: String,
+    },
+    #[error("QIF file `{path}` is not a QIF 3 document: {reason}")]
+    #[diagnostic(
+        code(insp::geometry::qif_version),
+        help("inspc reads QIF 3.x MBD documents (versionQIF=\"3.…\"); export the part as QIF 3, or as STEP AP242")
+    )]
+    QifVersion {
+        #[label("this QIF file")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("QIF file `{path}` holds no solid")]
+    #[diagnostic(
+        code(insp::geometry::qif_no_solid),
+        help("export the part with its B-rep (Product/TopologySet with a SOLID body); a QIF file of characteristics or results only has no faces to inspect")
+    )]
+    QifNoSolid {
+        #[label("this QIF file")]
+        span: Span,
+        path: String,
+    },
+    #[error("QIF file `{path}` is incomplete: {reason}")]
+    #[diagnostic(
+        code(insp::geometry::qif_missing_entity),
+        help("an element the B-rep needs is not in the file: it was cut short or corrupted; re-export it")
+    )]
+    QifMissing {
+        #[label("this QIF file")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("QIF file `{path}` has a malformed element: {reason}")]
+    #[diagnostic(
+        code(insp::geometry::qif_malformed),
+        help("the element's content does not fit its type; re-export the file, or report the exporting system")
+    )]
+    QifMalformed {
+        #[label("this QIF file")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("QIF file `{path}`: {reason}")]
+    #[diagnostic(
+        code(insp::geometry::qif_unsupported),
+        help("inspc evaluates QIF planes, cylinders, cones, spheres and tori, and segments, circular arcs, NURBS, polylines and aggregates of them; export the part as STEP AP242 for other surfaces")
+    )]
+    QifUnsupported {
+        #[label("this QIF file")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("QIF file `{path}`: {reason}")]
+    #[diagnostic(
+        code(insp::geometry::qif_unit),
+        help("inspc reads the primary linear unit of FileUnits: a conversion factor to metres, or mm, cm, m, inch or ft by name")
+    )]
+    QifUnit {
+        #[label("this QIF file")]
+        span: Span,
+        path: String,
+        reason: String,
+    },
+    #[error("face_{face} (id {id}) of QIF file `{path}` cannot be meshed: {reason}")]
+    #[diagnostic(
+        code(insp::geometry::qif_face),
+        help("the face is kept out of nothing: a part with a hole in its mesh cannot be planned; repair the face (its loops and surface must agree) and re-export")
+    )]
+    QifFace {
+        #[label("this QIF file")]
+        span: Span,
+        path: String,
+        face: usize,
+        id: u64,
+        reason: String,
+    },
     #[error("mesh `{path}` is too large: {reason}")]
     #[diagnostic(
         code(insp::geometry::mesh_too_large),
@@ -244,6 +336,14 @@ crate::located!(GeometryError {
     StepUnsupported,
     StepUnit,
     StepFace,
+    QifSyntax,
+    QifVersion,
+    QifNoSolid,
+    QifMissing,
+    QifMalformed,
+    QifUnsupported,
+    QifUnit,
+    QifFace,
     BooleanFailed,
     MissesPart,
     FaceGone,
@@ -265,12 +365,15 @@ pub enum MeshError {
     TooLarge(String),
     /// A STEP file that cannot be read or meshed.
     Step(super::step::StepError),
+    /// A QIF file that cannot be read or meshed.
+    Qif(super::qif::QifError),
 }
 
 impl MeshError {
     /// The diagnostics, pointing at the spec's mesh path: one, or one per face of a
     /// STEP file that could not be meshed.
     pub fn at(self, span: Span, path: &std::path::Path) -> Vec<GeometryError> {
+        use super::qif::QifError as Q;
         use super::step::StepError as S;
         let path = shown_path(path);
         vec![match self {
@@ -305,6 +408,36 @@ impl MeshError {
                     S::Unsupported { .. } => GeometryError::StepUnsupported { span, path, reason },
                     S::Unit(_) => GeometryError::StepUnit { span, path, reason },
                     S::Faces(_) => unreachable!("handled above"),
+                }
+            }
+            MeshError::Qif(Q::Faces(list)) => {
+                return list
+                    .into_iter()
+                    .map(|(face, id, reason)| GeometryError::QifFace {
+                        span,
+                        path: path.clone(),
+                        face,
+                        id,
+                        reason,
+                    })
+                    .collect()
+            }
+            MeshError::Qif(e) => {
+                let reason = e.to_string();
+                match e {
+                    Q::Syntax { line, message } => GeometryError::QifSyntax {
+                        span,
+                        path,
+                        line,
+                        message,
+                    },
+                    Q::Version(_) => GeometryError::QifVersion { span, path, reason },
+                    Q::NoSolid => GeometryError::QifNoSolid { span, path },
+                    Q::Missing { .. } => GeometryError::QifMissing { span, path, reason },
+                    Q::Malformed { .. } => GeometryError::QifMalformed { span, path, reason },
+                    Q::Unsupported { .. } => GeometryError::QifUnsupported { span, path, reason },
+                    Q::Unit(_) => GeometryError::QifUnit { span, path, reason },
+                    Q::Faces(_) => unreachable!("handled above"),
                 }
             }
         }]

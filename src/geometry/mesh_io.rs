@@ -1,4 +1,4 @@
-//! Reading STL (binary and ASCII) and OBJ meshes (and STEP parts, through `step`), welding coincident vertices and
+//! Reading STL (binary and ASCII) and OBJ meshes (and STEP and QIF parts, through `step` and `qif`), welding coincident vertices and
 //! checking that the result is a (nearly) closed solid.
 
 use super::errors::MeshError;
@@ -41,6 +41,9 @@ pub fn read_mesh(world: &dyn World, path: &Path, unit_mm: f64) -> Result<RawMesh
         .unwrap_or_default();
     if ext == "stp" || ext == "step" {
         return super::step::read(&bytes, super::step::RESOLUTION).map(|p| p.mesh);
+    }
+    if ext == "qif" {
+        return super::qif::read(&bytes, super::step::RESOLUTION).map(|p| p.mesh);
     }
     let (positions, faces, tri_group, groups) = if ext == "obj" {
         parse_obj(&bytes)?

@@ -18,6 +18,7 @@ pub mod fit;
 mod fixture;
 mod mesh_io;
 mod primitives;
+pub mod qif;
 mod query;
 mod report;
 pub mod segment;

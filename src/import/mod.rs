@@ -1,4 +1,4 @@
-//! `inspc import`: a starter spec written from a STEP file's B-rep and semantic PMI.
+//! `inspc import`: a starter spec written from a STEP or QIF file's B-rep and semantic PMI.
 //!
 //! Entry point [`import`]: the file's bytes in, the text of an `.insp` spec out. The spec
 //! names the STEP file as its part, declares one feature per PMI feature (the faces a
@@ -12,7 +12,7 @@
 //! reference rules resolve enforces (a datum feature never referenced by its own
 //! tolerance, a datum once per frame) before it is written; what fails is a comment.
 
-use crate::geometry::step::{self, pmi, StepPart};
+use crate::geometry::step::{self, pmi, CadPart};
 use crate::geometry::MeshError;
 use crate::geometry::Surface;
 use crate::model::{fmt_num, Material, TolKind};
@@ -23,8 +23,9 @@ use std::fmt::Write;
 /// What to write where the spec refers outside itself.
 #[derive(Debug, Clone)]
 pub struct ImportOptions {
-    /// The STEP file as the spec should name it (relative to the spec's folder).
-    pub step_path: String,
+    /// The STEP or QIF file as the spec should name it (relative to the spec's
+    /// folder); its extension says which it is.
+    pub cad_path: String,
     /// The part's name (an identifier).
     pub part_name: String,
 }
@@ -142,9 +143,14 @@ pub fn identifier(stem: &str) -> String {
     id
 }
 
-/// Reads a STEP file and writes a spec for it.
+/// Reads a STEP or QIF file (by `opts.cad_path`'s extension) and writes a spec for it.
 pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Imported, MeshError> {
-    let part = step::read(bytes, step::RESOLUTION)?;
+    let qif = opts.cad_path.to_ascii_lowercase().ends_with(".qif");
+    let part = if qif {
+        crate::geometry::qif::read(bytes, step::RESOLUTION)?
+    } else {
+        step::read(bytes, step::RESOLUTION)?
+    };
     Ok(write_spec(&part, opts))
 }
 
@@ -210,8 +216,44 @@ fn limits(nominal: f64, upper: f64, lower: f64, unit: &str) -> String {
     )
 }
 
-fn write_spec(part: &StepPart, opts: &ImportOptions) -> Imported {
-    let p = &part.pmi;
+/// The PMI without the faces of sheet bodies: an open surface the file carries beside
+/// its solid (construction geometry) is no material a probe can touch. What loses faces
+/// says so in the notes.
+fn solid_pmi(part: &CadPart) -> pmi::Pmi {
+    let mut p = part.pmi.clone();
+    let solid = part.face_ids.len() - part.sheet_faces;
+    let mut notes = Vec::new();
+    let mut keep = |faces: &mut Vec<usize>, what: String| {
+        let before = faces.len();
+        faces.retain(|f| *f < solid);
+        if faces.len() < before {
+            notes.push(format!(
+                "{what}: its sheet (construction) face{} left out",
+                if before - faces.len() == 1 {
+                    " is"
+                } else {
+                    "s are"
+                }
+            ));
+        }
+    };
+    for d in &mut p.datums {
+        keep(&mut d.faces, format!("datum {}", d.letter));
+    }
+    for t in &mut p.tolerances {
+        keep(&mut t.faces, format!("`{}`", t.name));
+    }
+    for d in &mut p.dimensions {
+        keep(&mut d.faces, format!("dimension #{}", d.id));
+        keep(&mut d.to_faces, format!("dimension #{}", d.id));
+    }
+    p.notes.extend(notes);
+    p
+}
+
+fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
+    let solid = solid_pmi(part);
+    let p = &solid;
     let mut feats = Features {
         by_faces: BTreeMap::new(),
         order: Vec::new(),
@@ -458,6 +500,7 @@ fn write_spec(part: &StepPart, opts: &ImportOptions) -> Imported {
 
     let text = render(
         part,
+        &p.notes,
         opts,
         &feats,
         &datum_lines,
@@ -478,7 +521,7 @@ fn write_spec(part: &StepPart, opts: &ImportOptions) -> Imported {
 /// for narrow slots and small holes (the shorter one when the part's smallest hole is
 /// under 6 mm, where a long thin stylus bends and collides), a long Ø3 stylus for
 /// reach, and an extension when the part is taller than that stylus reaches.
-fn rack(part: &StepPart, size: [f64; 3]) -> Vec<(&'static str, &'static str)> {
+fn rack(part: &CadPart, size: [f64; 3]) -> Vec<(&'static str, &'static str)> {
     let smallest_hole = part
         .mesh
         .exact
@@ -506,7 +549,7 @@ fn rack(part: &StepPart, size: [f64; 3]) -> Vec<(&'static str, &'static str)> {
 }
 
 /// The part's extent along x, y and z (mm).
-fn size(part: &StepPart) -> [f64; 3] {
+fn size(part: &CadPart) -> [f64; 3] {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for v in &part.mesh.vertices {
@@ -518,8 +561,10 @@ fn size(part: &StepPart) -> [f64; 3] {
     [0, 1, 2].map(|i| hi[i] - lo[i])
 }
 
+#[allow(clippy::too_many_arguments)]
 fn render(
-    part: &StepPart,
+    part: &CadPart,
+    notes: &[String],
     opts: &ImportOptions,
     feats: &Features,
     datum_lines: &[String],
@@ -530,7 +575,7 @@ fn render(
     let mut s = String::new();
     let extent = size(part);
     let size = extent.map(|x| fmt_num(x.round()));
-    let _ = writeln!(s, "// Written by `inspc import` from {}.", opts.step_path);
+    let _ = writeln!(s, "// Written by `inspc import` from {}.", opts.cad_path);
     let _ = writeln!(
         s,
         "// {} faces (`face_<n>` in the file's shell order), {} × {} × {} mm; the file's unit is {}.",
@@ -544,9 +589,9 @@ fn render(
         s,
         "// The datums, tolerances and sizes are the file's semantic PMI; what the language cannot say is a comment."
     );
-    if !part.pmi.notes.is_empty() {
+    if !notes.is_empty() {
         let _ = writeln!(s, "//\n// The PMI as read:");
-        for n in &part.pmi.notes {
+        for n in notes {
             let _ = writeln!(s, "//   - {n}");
         }
     }
@@ -560,10 +605,10 @@ fn render(
     let _ = writeln!(s, "\npart {} {{", opts.part_name);
     let _ = writeln!(
         s,
-        "    // Quantities below are in mm; the STEP file's own unit applies to its geometry."
+        "    // Quantities below are in mm; the file's own unit applies to its geometry."
     );
     let _ = writeln!(s, "    units mm");
-    let _ = writeln!(s, "    mesh \"{}\"", opts.step_path);
+    let _ = writeln!(s, "    mesh \"{}\"", opts.cad_path);
     if !feats.order.is_empty() {
         s.push('\n');
     }

@@ -339,10 +339,10 @@ pub enum ResolveError {
     #[error("unsupported mesh format `{ext}`")]
     #[diagnostic(
         code(insp::resolve::mesh_format),
-        help("inspc reads STL (binary or ASCII), OBJ and STEP (.stp, .step) files")
+        help("inspc reads STL (binary or ASCII), OBJ, STEP (.stp, .step) and QIF 3 (.qif) files")
     )]
     MeshFormat {
-        #[label("not .stl, .obj or .stp")]
+        #[label("not .stl, .obj, .stp or .qif")]
         span: Span,
         ext: String,
     },

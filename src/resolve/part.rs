@@ -422,7 +422,7 @@ pub(super) fn mesh_file(r: &Resolver, cx: &mut Cx, path: &ast::Str) -> Option<st
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    if !matches!(ext.as_str(), "stl" | "obj" | "stp" | "step") {
+    if !matches!(ext.as_str(), "stl" | "obj" | "stp" | "step" | "qif") {
         cx.err(E::MeshFormat {
             span: path.span,
             ext: if ext.is_empty() {

@@ -219,7 +219,7 @@ fn imported(part: &str) -> String {
     require_shared_parts();
     let bytes = std::fs::read(file(part, "stp")).unwrap();
     let opts = ImportOptions {
-        step_path: format!("../../{}", file(part, "stp")),
+        cad_path: format!("../../{}", file(part, "stp")),
         part_name: identifier(&format!("nist_{part}_asme1_ap242-e1")),
     };
     import(&bytes, &opts).unwrap().text

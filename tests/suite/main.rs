@@ -17,6 +17,7 @@ mod grammar;
 mod import;
 mod mesh_fuzz;
 mod no_panic;
+mod qif;
 mod replan;
 mod sampling;
 mod simulate;

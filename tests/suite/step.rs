@@ -10,7 +10,7 @@ use inspc::model::SurfaceKind;
 use inspc::source::FsWorld;
 use std::path::Path;
 
-fn step_part(part: &str) -> (inspc::geometry::step::StepPart, PartGeometry) {
+fn step_part(part: &str) -> (inspc::geometry::step::CadPart, PartGeometry) {
     require_shared_parts();
     let bytes = std::fs::read(format!("../shared/parts/nist_{part}_asme1_ap242-e1.stp")).unwrap();
     let p = read(&bytes, RESOLUTION).unwrap_or_else(|e| panic!("{part}: {e:?}"));

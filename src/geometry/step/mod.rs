@@ -11,11 +11,11 @@
 //! instance number, never a silently missing face: a hole in the mesh would let the
 //! accessibility analysis see through the part.
 
-mod brep;
-mod geom;
+pub(super) mod brep;
+pub(super) mod geom;
 mod p21;
 pub mod pmi;
-mod tess;
+pub(super) mod tess;
 
 pub use tess::Resolution;
 
@@ -113,12 +113,12 @@ impl std::fmt::Display for StepError {
     }
 }
 
-/// A STEP part read and meshed.
+/// A CAD part (STEP or QIF) read and meshed.
 #[derive(Debug, Clone)]
-pub struct StepPart {
+pub struct CadPart {
     /// The mesh, one group per face.
     pub mesh: RawMesh,
-    /// Each face's instance number.
+    /// Each face's instance number (STEP) or id (QIF).
     pub face_ids: Vec<u64>,
     /// The file's length unit as named, and its size in millimetres.
     pub unit: (String, f64),
@@ -129,7 +129,7 @@ pub struct StepPart {
 }
 
 /// Reads a STEP file's solid and meshes it.
-pub fn read(bytes: &[u8], res: Resolution) -> Result<StepPart, MeshError> {
+pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
     let file = p21::parse(bytes).map_err(|e| {
         MeshError::Step(StepError::Syntax {
             line: e.line,
@@ -137,22 +137,14 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<StepPart, MeshError> {
         })
     })?;
     let b = brep::read(&file).map_err(MeshError::Step)?;
-    let (soup, failures) = tess::tessellate(&b, res);
-    if !failures.is_empty() {
-        return Err(MeshError::Step(StepError::Faces(
-            failures
-                .into_iter()
-                .map(|f| (f.index + 1, f.id, f.reason))
-                .collect(),
-        )));
-    }
-    let groups: Vec<String> = (1..=b.faces.len()).map(|n| format!("face_{n}")).collect();
-    let mut mesh = weld(soup.positions, soup.triangles, soup.tri_face, groups, 1.0)?;
-    mesh.exact = b.faces.iter().map(exact_surface).collect();
+    let mesh = mesh_brep(&b, res).map_err(|e| match e {
+        MeshFailure::Faces(list) => MeshError::Step(StepError::Faces(list)),
+        MeshFailure::Mesh(e) => e,
+    })?;
     let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
     let mut pmi = pmi::read(&file, &face_ids, &edge_faces(&b), b.unit_mm);
     locate_targets(&mut pmi, &mesh);
-    Ok(StepPart {
+    Ok(CadPart {
         pmi,
         mesh,
         face_ids,
@@ -161,8 +153,35 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<StepPart, MeshError> {
     })
 }
 
+/// Why a B-rep could not be meshed.
+pub(super) enum MeshFailure {
+    /// Faces that could not be tessellated: (1-based face number, id, why).
+    Faces(Vec<(usize, u64, String)>),
+    /// The welded mesh is not a mesh.
+    Mesh(MeshError),
+}
+
+/// Tessellates a B-rep and welds it: one group per face (`face_<n>`), each with its
+/// exact surface.
+pub(super) fn mesh_brep(b: &brep::Brep, res: Resolution) -> Result<RawMesh, MeshFailure> {
+    let (soup, failures) = tess::tessellate(b, res);
+    if !failures.is_empty() {
+        return Err(MeshFailure::Faces(
+            failures
+                .into_iter()
+                .map(|f| (f.index + 1, f.id, f.reason))
+                .collect(),
+        ));
+    }
+    let groups: Vec<String> = (1..=b.faces.len()).map(|n| format!("face_{n}")).collect();
+    let mut mesh = weld(soup.positions, soup.triangles, soup.tri_face, groups, 1.0)
+        .map_err(MeshFailure::Mesh)?;
+    mesh.exact = b.faces.iter().map(exact_surface).collect();
+    Ok(mesh)
+}
+
 /// Each edge's faces: the curved ones where it bounds any, else all.
-fn edge_faces(b: &brep::Brep) -> HashMap<u64, Vec<usize>> {
+pub(super) fn edge_faces(b: &brep::Brep) -> HashMap<u64, Vec<usize>> {
     let mut all: HashMap<u64, Vec<usize>> = HashMap::new();
     for (i, f) in b.faces.iter().enumerate() {
         for bound in &f.bounds {

@@ -1,0 +1,337 @@
+//! QIF 3 MBD parts: the B-rep of the document's solid body with each face's exact
+//! surface, meshed by the STEP reader's tessellator, and the document's PMI (datums,
+//! reference frames, characteristics, sizes) linked to the faces.
+//!
+//! `xml.rs` reads the document into an element tree, `brep.rs` the faces, edges and
+//! surfaces, `pmi.rs` the features and characteristics. [`read`] is the entry point:
+//! bytes in, a [`CadPart`] out whose groups are the faces (`face_<n>`, numbered from 1 in
+//! the body's shell order).
+//!
+//! Unknown elements are skipped. A document of another QIF major version, a face that
+//! cannot be meshed, a reference to a missing id: each is an error naming what is wrong,
+//! never a silently missing face.
+
+mod brep;
+mod pmi;
+mod xml;
+
+use super::errors::MeshError;
+use super::step::{self, CadPart, MeshFailure, Resolution};
+use std::collections::HashMap;
+
+/// Why a QIF file could not be read.
+#[derive(Debug, Clone, PartialEq)]
+pub enum QifError {
+    /// Not well-formed XML.
+    Syntax {
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// Not a QIF 3 document: the version it states, or what it is instead.
+    Version(String),
+    /// No solid or visible sheet body with faces.
+    NoSolid,
+    /// A reference to an id the document does not define.
+    Missing {
+        /// The missing id.
+        id: u64,
+        /// The element that refers to it.
+        from: Option<u64>,
+        /// That element's line.
+        line: usize,
+    },
+    /// An element whose content is not what its type needs.
+    Malformed {
+        /// Its id.
+        id: Option<u64>,
+        /// Its name.
+        element: String,
+        /// Its line.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A curve or surface type inspc does not evaluate.
+    Unsupported {
+        /// The element's id.
+        id: Option<u64>,
+        /// Its line.
+        line: usize,
+        /// `surface Nurbs23`.
+        what: String,
+    },
+    /// The length unit cannot be determined.
+    Unit(String),
+    /// Faces that could not be meshed: (1-based face number, id, why).
+    Faces(Vec<(usize, u64, String)>),
+}
+
+impl std::fmt::Display for QifError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            QifError::Syntax { line, message } => write!(f, "line {line}: {message}"),
+            QifError::Version(v) => write!(f, "{v}"),
+            QifError::NoSolid => write!(f, "it holds no solid body with faces"),
+            QifError::Missing { id, from, line } => match from {
+                Some(from) => write!(
+                    f,
+                    "element {from} (line {line}) refers to id {id}, which the file does not define"
+                ),
+                None => write!(
+                    f,
+                    "line {line} refers to id {id}, which the file does not define"
+                ),
+            },
+            QifError::Malformed {
+                id,
+                element,
+                line,
+                message,
+            } => match id {
+                Some(id) => write!(f, "<{element}> {id} (line {line}): {message}"),
+                None => write!(f, "<{element}> (line {line}): {message}"),
+            },
+            QifError::Unsupported { id, line, what } => match id {
+                Some(id) => write!(
+                    f,
+                    "element {id} (line {line}) is a {what}, which inspc does not evaluate"
+                ),
+                None => write!(
+                    f,
+                    "line {line} holds a {what}, which inspc does not evaluate"
+                ),
+            },
+            QifError::Unit(m) => write!(f, "{m}"),
+            QifError::Faces(list) => {
+                let (n, id, why) = &list[0];
+                write!(f, "face_{n} (id {id}) cannot be meshed: {why}")?;
+                if list.len() > 1 {
+                    write!(f, " (and {} more faces)", list.len() - 1)?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// Millimetres per unit of a `LinearUnit` element: its conversion factor to metres, or
+/// a unit known by name.
+fn unit_mm(u: &xml::Node) -> Option<f64> {
+    if let Some(f) = u.at(&["UnitConversion", "Factor"]) {
+        let x: f64 = f.text.trim().parse().ok()?;
+        let si = u.text_at(&["SIUnitName"]).map(str::trim).unwrap_or("meter");
+        return (x > 0.0 && x.is_finite() && matches!(si, "meter" | "metre")).then_some(x * 1000.0);
+    }
+    named_unit_mm(u.text_at(&["UnitName"])?.trim())
+}
+
+/// Millimetres per unit of a length unit known by name.
+fn named_unit_mm(name: &str) -> Option<f64> {
+    match name {
+        "mm" | "millimeter" | "millimetre" => Some(1.0),
+        "cm" | "centimeter" | "centimetre" => Some(10.0),
+        "m" | "meter" | "metre" => Some(1000.0),
+        "um" | "micrometer" | "micron" => Some(0.001),
+        "in" | "inch" => Some(25.4),
+        "ft" | "foot" | "feet" => Some(304.8),
+        _ => None,
+    }
+}
+
+/// Reads a QIF document's solid and PMI, and meshes the solid.
+pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
+    let q = |e| MeshError::Qif(e);
+    let root = xml::parse(bytes).map_err(|e| {
+        q(QifError::Syntax {
+            line: e.line,
+            message: e.message,
+        })
+    })?;
+    if root.name != "QIFDocument" {
+        return Err(q(QifError::Version(format!(
+            "its root element is <{}>, not <QIFDocument>",
+            root.name
+        ))));
+    }
+    match root.attr("versionQIF").map(str::trim) {
+        Some(v) if v == "3" || v.starts_with("3.") => {}
+        Some(v) => {
+            return Err(q(QifError::Version(format!(
+                "it is a QIF {v} document; inspc reads QIF 3"
+            ))))
+        }
+        None => {
+            return Err(q(QifError::Version(
+                "it states no QIF version (versionQIF)".into(),
+            )))
+        }
+    }
+    let unit = root
+        .at(&["FileUnits", "PrimaryUnits", "LinearUnit"])
+        .ok_or_else(|| {
+            q(QifError::Unit(
+                "it states no length unit (FileUnits/PrimaryUnits/LinearUnit)".into(),
+            ))
+        })?;
+    let unit_name = unit.text_at(&["UnitName"]).unwrap_or("").trim().to_string();
+    let file_mm = unit_mm(unit).ok_or_else(|| {
+        q(QifError::Unit(format!(
+            "its length unit `{unit_name}` has no conversion to metres inspc can read"
+        )))
+    })?;
+    // The product's geometry may be drawn at a scale (`<ScaleCoefficient>2`): the part
+    // is the geometry divided by it.
+    let scale = match root.text_at(&["Product", "Header", "ScaleCoefficient"]) {
+        Some(t) => match t.trim().parse::<f64>() {
+            Ok(s) if s > 0.0 && s.is_finite() => s,
+            _ => {
+                return Err(q(QifError::Unit(format!(
+                    "its scale coefficient `{}` is not a positive number",
+                    t.trim()
+                ))))
+            }
+        },
+        None => 1.0,
+    };
+    // PMI values are in the PMI's own unit where the file names one.
+    let value_unit = match root.at(&["FileUnits", "PrimaryUnits", "PMILinearUnit"]) {
+        Some(u) => unit_mm(u).ok_or_else(|| {
+            q(QifError::Unit(format!(
+                "its PMI length unit `{}` has no conversion to metres inspc can read",
+                u.text_at(&["UnitName"]).unwrap_or("").trim()
+            )))
+        })?,
+        None => file_mm,
+    };
+    let doc = brep::Doc {
+        ids: xml::index(&root),
+        unit: file_mm / scale,
+        value_unit,
+    };
+    let mut b = brep::read(&doc, &root).map_err(q)?;
+    b.unit_name = unit_name.clone();
+    orient(&mut b, res).map_err(q)?;
+    let mesh = step::mesh_brep(&b, res).map_err(|e| match e {
+        MeshFailure::Faces(list) => q(QifError::Faces(list)),
+        MeshFailure::Mesh(e) => e,
+    })?;
+    let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
+    let edge_faces: HashMap<u64, Vec<usize>> = step::edge_faces(&b);
+    let pmi = pmi::read(&doc, &root, &face_ids, &edge_faces);
+    Ok(CadPart {
+        pmi,
+        mesh,
+        face_ids,
+        unit: (unit_name, file_mm),
+        sheet_faces: b.sheet_faces,
+    })
+}
+
+/// Gives each face its sense and bounds in the STEP reader's terms (the face lies left
+/// of its bounds seen from outside).
+///
+/// QIF states no sense: a face's loops run counter-clockwise in its surface's
+/// parameters whichever side the material is on (so they are read as-is first), and a
+/// face faces out or in as the solid has it. The senses are found from the topology: an
+/// edge between two faces is walked in opposite directions by their bounds once both
+/// are oriented, so one face's choice fixes its neighbours', across each connected shell;
+/// a shell whose volume then comes out negative is turned inside out.
+fn orient(b: &mut step::brep::Brep, res: Resolution) -> Result<(), QifError> {
+    use step::brep::Bound;
+    let edges = step::tess::edge_polylines(b, res);
+    let natural: Vec<bool> = b
+        .faces
+        .iter()
+        .map(|f| step::tess::bound_sense(f, &edges).unwrap_or(true))
+        .collect();
+    let mut uses: Vec<Vec<(usize, bool)>> = vec![Vec::new(); b.edges.len()];
+    for (i, f) in b.faces.iter().enumerate() {
+        for bound in &f.bounds {
+            if let Bound::Edges(list) = bound {
+                for &(e, fwd) in list {
+                    uses[e].push((i, fwd));
+                }
+            }
+        }
+    }
+    // flip[f]: whether the face's bounds are walked backwards to obey the rule.
+    let n = b.faces.len();
+    let mut flip: Vec<Option<bool>> = vec![None; n];
+    let mut shell = vec![0usize; n];
+    let mut shells = 0;
+    for seed in 0..n {
+        if flip[seed].is_some() {
+            continue;
+        }
+        flip[seed] = Some(false);
+        shell[seed] = shells;
+        let mut queue = std::collections::VecDeque::from([seed]);
+        while let Some(f) = queue.pop_front() {
+            let ff = flip[f].unwrap_or(false);
+            for bound in &b.faces[f].bounds {
+                let Bound::Edges(list) = bound else { continue };
+                for &(e, fwd) in list {
+                    let others: Vec<(usize, bool)> =
+                        uses[e].iter().copied().filter(|(g, _)| *g != f).collect();
+                    let [(g, gfwd)] = others.as_slice() else {
+                        continue;
+                    };
+                    // Walked as `fwd ^ ff` here; the neighbour must walk it the other way.
+                    let want = *gfwd ^ !(fwd ^ ff);
+                    match flip[*g] {
+                        None => {
+                            flip[*g] = Some(want);
+                            shell[*g] = shells;
+                            queue.push_back(*g);
+                        }
+                        Some(have) if have != want => {
+                            return Err(QifError::Faces(vec![(
+                                g + 1,
+                                b.faces[*g].id,
+                                format!(
+                                    "its bounds and face_{}'s walk their shared edge {} the same way whichever way the faces are turned: the shell is not orientable",
+                                    f + 1,
+                                    b.edges[e].id
+                                ),
+                            )]));
+                        }
+                        Some(_) => {}
+                    }
+                }
+            }
+        }
+        shells += 1;
+    }
+    let turn = |face: &mut step::brep::Face| {
+        face.same_sense = !face.same_sense;
+        for bound in &mut face.bounds {
+            if let Bound::Edges(list) = bound {
+                list.reverse();
+                for (_, fwd) in list.iter_mut() {
+                    *fwd = !*fwd;
+                }
+            }
+        }
+    };
+    for (i, face) in b.faces.iter_mut().enumerate() {
+        face.same_sense = natural[i];
+        if flip[i] == Some(true) {
+            turn(face);
+        }
+    }
+    // Each shell outward: its enclosed volume positive.
+    let (soup, _) = step::tess::tessellate(b, res);
+    let mut volume = vec![0.0; shells];
+    for (t, f) in soup.triangles.iter().zip(&soup.tri_face) {
+        let [a, bb, c] = t.map(|i| crate::geometry::V3::from(soup.positions[i]));
+        volume[shell[*f as usize]] += a.dot(&bb.cross(&c)) / 6.0;
+    }
+    for (i, face) in b.faces.iter_mut().enumerate() {
+        if volume[shell[i]] < 0.0 {
+            turn(face);
+        }
+    }
+    Ok(())
+}

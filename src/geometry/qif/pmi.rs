@@ -1,0 +1,522 @@
+//! The PMI of a QIF document in the same terms as the STEP reader's: datums (from
+//! feature nominals or datum targets), geometric characteristics with their datum
+//! reference frames, and sizes and distances with their limits, each linked to faces.
+//!
+//! QIF links a characteristic nominal to feature nominals, and a feature nominal to the
+//! topology by `EntityInternalIds`: faces, or edges (a hole named by its rim is its
+//! curved faces, as in the STEP reader). Reading never fails; what cannot be linked is a
+//! note.
+
+use super::brep::Doc;
+use super::xml::Node;
+use crate::geometry::step::pmi::{Datum, DatumRef, DimKind, Dimension, GeoTolerance, Pmi, Target};
+use crate::model::{Material, TolKind};
+use std::collections::{BTreeSet, HashMap};
+
+/// Geometric characteristics by their QIF element, without `CharacteristicDefinition`.
+const KINDS: &[(&str, TolKind)] = &[
+    ("Flatness", TolKind::Flatness),
+    ("Straightness", TolKind::Straightness),
+    ("Circularity", TolKind::Circularity),
+    ("Cylindricity", TolKind::Cylindricity),
+    ("LineProfile", TolKind::ProfileLine),
+    ("SurfaceProfile", TolKind::ProfileSurface),
+    ("SurfaceProfileNonUniform", TolKind::ProfileSurface),
+    ("Perpendicularity", TolKind::Perpendicularity),
+    ("Parallelism", TolKind::Parallelism),
+    ("Angularity", TolKind::Angularity),
+    ("Position", TolKind::Position),
+    ("Concentricity", TolKind::Concentricity),
+    ("Coaxiality", TolKind::Coaxiality),
+    ("Symmetry", TolKind::Symmetry),
+    ("CircularRunout", TolKind::CircularRunout),
+    ("TotalRunout", TolKind::TotalRunout),
+];
+
+/// Sizes by their QIF element, as the STEP reader names them.
+const SIZES: &[(&str, &str, bool)] = &[
+    ("Diameter", "diameter", false),
+    ("Radius", "radius", false),
+    ("SphericalDiameter", "spherical diameter", false),
+    ("SphericalRadius", "spherical radius", false),
+    ("Width", "width", false),
+    ("Length", "length", false),
+    ("Height", "height", false),
+    ("Depth", "depth", false),
+    ("Thickness", "thickness", false),
+    ("Angle", "angle", true),
+];
+
+/// Locations between two features, as the STEP reader names them.
+const LOCATIONS: &[(&str, &str, bool)] = &[
+    ("DistanceBetween", "linear distance", false),
+    ("DistanceFrom", "linear distance", false),
+    ("AngleBetween", "angle", true),
+    ("AngleFrom", "angle", true),
+];
+
+struct Reader<'a> {
+    d: &'a Doc<'a>,
+    /// Face id → 0-based face index.
+    face_index: HashMap<u64, usize>,
+    /// Edge id → the faces it names.
+    edge_faces: &'a HashMap<u64, Vec<usize>>,
+    /// Length unit name → millimetres.
+    units: HashMap<String, f64>,
+    notes: Vec<String>,
+}
+
+/// Reads the PMI of a document whose faces (in numbering order) have the ids `faces`.
+pub fn read(d: &Doc, root: &Node, faces: &[u64], edge_faces: &HashMap<u64, Vec<usize>>) -> Pmi {
+    let mut r = Reader {
+        d,
+        face_index: faces.iter().enumerate().map(|(i, id)| (*id, i)).collect(),
+        edge_faces,
+        units: length_units(root),
+        notes: Vec::new(),
+    };
+    let mut pmi = Pmi::default();
+    let mut letters: HashMap<u64, String> = HashMap::new();
+    let targets: HashMap<u64, &Node> = root
+        .child("DatumTargetDefinitions")
+        .map(|t| {
+            t.children
+                .iter()
+                .filter_map(|n| Some((n.id()?, n)))
+                .collect()
+        })
+        .unwrap_or_default();
+    for dd in root
+        .child("DatumDefinitions")
+        .into_iter()
+        .flat_map(|n| n.all("DatumDefinition"))
+    {
+        let letter = dd.text_at(&["DatumLabel"]).unwrap_or("").trim().to_string();
+        let id = dd.id().unwrap_or(0);
+        letters.insert(id, letter.clone());
+        let mut faces = BTreeSet::new();
+        for f in Doc::id_list(dd, "FeatureNominalIds") {
+            faces.extend(r.feature_faces(f, &format!("datum {letter}")));
+        }
+        let mut tlist = Vec::new();
+        for t in Doc::id_list(dd, "DatumTargetIds") {
+            let Some(tn) = targets.get(&t) else {
+                r.notes
+                    .push(format!("datum {letter}: target {t} is not in the file"));
+                continue;
+            };
+            if let Some(f) = tn
+                .text_at(&["FeatureNominalId"])
+                .and_then(|x| x.trim().parse().ok())
+            {
+                faces.extend(r.feature_faces(f, &format!("datum {letter}")));
+            }
+            tlist.push(r.target(tn));
+        }
+        if faces.is_empty() {
+            r.notes.push(format!("datum {letter} is linked to no face"));
+        }
+        pmi.datums.push(Datum {
+            id,
+            letter,
+            faces: faces.into_iter().collect(),
+            targets: tlist,
+            located: false,
+        });
+    }
+    let frames: HashMap<u64, Vec<DatumRef>> = root
+        .child("DatumReferenceFrames")
+        .into_iter()
+        .flat_map(|n| n.all("DatumReferenceFrame"))
+        .filter_map(|f| Some((f.id()?, frame(f, &letters))))
+        .collect();
+
+    let defs: HashMap<u64, &Node> = root
+        .at(&["Characteristics", "CharacteristicDefinitions"])
+        .map(|n| {
+            n.children
+                .iter()
+                .filter_map(|c| Some((c.id()?, c)))
+                .collect()
+        })
+        .unwrap_or_default();
+    let nominals = root
+        .at(&["Characteristics", "CharacteristicNominals"])
+        .map(|n| n.children.as_slice())
+        .unwrap_or_default();
+    for nom in nominals {
+        let Some(kind) = nom.name.strip_suffix("CharacteristicNominal") else {
+            continue;
+        };
+        let name = nom.text_at(&["Name"]).unwrap_or(kind).trim().to_string();
+        let id = nom.id().unwrap_or(0);
+        let Some(def) = nom
+            .text_at(&["CharacteristicDefinitionId"])
+            .and_then(|t| t.trim().parse().ok())
+            .and_then(|i| defs.get(&i))
+        else {
+            r.notes
+                .push(format!("{name}: its definition is not in the file"));
+            continue;
+        };
+        let feats = Doc::id_list(nom, "FeatureNominalIds");
+        if let Some((_, tk)) = KINDS.iter().find(|(k, _)| *k == kind) {
+            let faces: BTreeSet<usize> = feats
+                .iter()
+                .flat_map(|f| r.feature_faces(*f, &name))
+                .collect();
+            let faces: Vec<usize> = faces.into_iter().collect();
+            let upper = r.tolerance(id, &name, *tk, def, &frames, faces.clone());
+            pmi.tolerances.push(upper);
+            if let Some(lower) = def
+                .children
+                .iter()
+                .find(|c| c.name.starts_with("SecondCompositeSegment"))
+            {
+                let mut t = r.tolerance(
+                    id,
+                    &format!("{name} (lower segment)"),
+                    *tk,
+                    lower,
+                    &frames,
+                    faces,
+                );
+                t.composite_of = Some(id);
+                pmi.tolerances.push(t);
+            }
+        } else if let Some((_, label, angular)) = SIZES.iter().find(|(k, _, _)| *k == kind) {
+            let faces: Vec<usize> = feats
+                .iter()
+                .flat_map(|f| r.feature_faces(*f, &name))
+                .collect::<BTreeSet<usize>>()
+                .into_iter()
+                .collect();
+            // The angle of a feature of two planes (a V) is the angle between them, as
+            // STEP files state it.
+            let (kind, from, to) = match (*label, faces.as_slice()) {
+                ("angle", [a, rest @ ..]) if !rest.is_empty() => (
+                    DimKind::Location("angle".to_string()),
+                    vec![*a],
+                    rest.to_vec(),
+                ),
+                _ => (DimKind::Size(label.to_string()), faces, Vec::new()),
+            };
+            pmi.dimensions
+                .push(r.dimension(id, kind, *angular, nom, def, from, to));
+        } else if let Some((_, label, angular)) = LOCATIONS.iter().find(|(k, _, _)| *k == kind) {
+            let (from, to) = match feats.as_slice() {
+                [a, b, ..] => (r.feature_faces(*a, &name), r.feature_faces(*b, &name)),
+                [a] => (r.feature_faces(*a, &name), BTreeSet::new()),
+                [] => (BTreeSet::new(), BTreeSet::new()),
+            };
+            pmi.dimensions.push(r.dimension(
+                id,
+                DimKind::Location(label.to_string()),
+                *angular,
+                nom,
+                def,
+                from.into_iter().collect(),
+                to.into_iter().collect(),
+            ));
+        } else {
+            r.notes.push(format!(
+                "{name}: a {kind} characteristic, which inspc does not read"
+            ));
+        }
+    }
+    pmi.notes = r.notes;
+    pmi
+}
+
+/// The length units the document names, in millimetres.
+fn length_units(root: &Node) -> HashMap<String, f64> {
+    let mut out = HashMap::new();
+    let Some(fu) = root.child("FileUnits") else {
+        return out;
+    };
+    let mut all = Vec::new();
+    fu.walk(&mut all);
+    for u in all
+        .into_iter()
+        .filter(|n| n.name == "LinearUnit" || n.name == "PMILinearUnit")
+    {
+        let Some(name) = u.text_at(&["UnitName"]) else {
+            continue;
+        };
+        if let Some(mm) = super::unit_mm(u) {
+            out.insert(name.trim().to_string(), mm);
+        }
+    }
+    out
+}
+
+/// One datum reference frame, primary first.
+fn frame(f: &Node, letters: &HashMap<u64, String>) -> Vec<DatumRef> {
+    let mut out: Vec<(i64, DatumRef)> = Vec::new();
+    let Some(ds) = f.child("Datums") else {
+        return Vec::new();
+    };
+    for (k, d) in ds.all("Datum").enumerate() {
+        let rank = match d.text_at(&["Precedence", "PrecedenceEnum"]).map(str::trim) {
+            Some("PRIMARY") => 0,
+            Some("SECONDARY") => 1,
+            Some("TERTIARY") => 2,
+            _ => 3 + k as i64,
+        };
+        let simple = |s: &Node| -> (Option<String>, Option<Material>) {
+            let letter = s
+                .text_at(&["DatumDefinitionId"])
+                .and_then(|t| t.trim().parse::<u64>().ok())
+                .and_then(|i| letters.get(&i).cloned());
+            (letter, material(s.text_at(&["MaterialModifier"])))
+        };
+        let r = if let Some(s) = d.child("SimpleDatum") {
+            let (l, m) = simple(s);
+            DatumRef {
+                letters: l.into_iter().collect(),
+                material: m,
+                other: Vec::new(),
+            }
+        } else if let Some(c) = d.child("CompoundDatum") {
+            let parts: Vec<_> = c
+                .all("Datum")
+                .filter_map(|x| x.child("SimpleDatum"))
+                .map(simple)
+                .collect();
+            DatumRef {
+                letters: parts.iter().filter_map(|p| p.0.clone()).collect(),
+                material: parts.iter().find_map(|p| p.1),
+                other: Vec::new(),
+            }
+        } else {
+            continue;
+        };
+        out.push((rank, r));
+    }
+    out.sort_by_key(|(rank, _)| *rank);
+    out.into_iter().map(|(_, r)| r).collect()
+}
+
+fn material(m: Option<&str>) -> Option<Material> {
+    match m.map(str::trim) {
+        Some("MAXIMUM") => Some(Material::Mmc),
+        Some("LEAST") => Some(Material::Lmc),
+        Some("REGARDLESS") => Some(Material::Rfs),
+        _ => None,
+    }
+}
+
+impl Reader<'_> {
+    /// The faces of a feature nominal (through compound features), noting one that
+    /// names nothing on the part.
+    fn feature_faces(&mut self, id: u64, who: &str) -> BTreeSet<usize> {
+        let mut out = BTreeSet::new();
+        let mut seen = BTreeSet::new();
+        self.collect(id, &mut out, &mut seen);
+        if out.is_empty() {
+            self.notes.push(format!(
+                "{who}: feature {id} is linked to no face of the part"
+            ));
+        }
+        out
+    }
+
+    fn collect(&self, id: u64, out: &mut BTreeSet<usize>, seen: &mut BTreeSet<u64>) {
+        if !seen.insert(id) {
+            return;
+        }
+        let Some(n) = self.d.ids.get(&id) else {
+            return;
+        };
+        if let Some(i) = self.face_index.get(&id) {
+            out.insert(*i);
+            return;
+        }
+        if let Some(fs) = self.edge_faces.get(&id) {
+            out.extend(fs.iter().copied());
+            return;
+        }
+        for e in Doc::id_list(n, "EntityInternalIds") {
+            self.collect(e, out, seen);
+        }
+        for f in Doc::id_list(n, "FeatureNominalIds") {
+            self.collect(f, out, seen);
+        }
+    }
+
+    /// A length value in millimetres, through its `linearUnit` attribute (else the
+    /// file's unit).
+    fn length(&mut self, n: &Node) -> Option<f64> {
+        let x: f64 = n.text.trim().parse().ok().filter(|x: &f64| x.is_finite())?;
+        let unit = match n.attr("linearUnit") {
+            Some(u) => match self
+                .units
+                .get(u.trim())
+                .copied()
+                .or_else(|| super::named_unit_mm(u.trim()))
+            {
+                Some(mm) => mm,
+                None => {
+                    self.notes.push(format!(
+                        "a value in `{u}`, a unit the file does not define, is read in the file's unit"
+                    ));
+                    self.d.value_unit
+                }
+            },
+            None => self.d.value_unit,
+        };
+        Some(x * unit)
+    }
+
+    fn target(&self, t: &Node) -> Target {
+        let label = t
+            .text_at(&["DatumTargetLabel"])
+            .unwrap_or("")
+            .trim()
+            .to_string();
+        let zone = t
+            .text_at(&["TargetZoneId"])
+            .and_then(|z| z.trim().parse().ok())
+            .and_then(|z| self.d.ids.get(&z).copied());
+        let mut points = Vec::new();
+        let kind = match zone {
+            Some(z) => {
+                let mut all = Vec::new();
+                z.walk(&mut all);
+                for n in all {
+                    if matches!(
+                        n.name.as_str(),
+                        "StartPoint" | "EndPoint" | "Point" | "Location" | "Center"
+                    ) {
+                        if let Some(v) = n.numbers().filter(|v| v.len() == 3) {
+                            points.push([v[0], v[1], v[2]].map(|c| c * self.d.unit));
+                        }
+                    }
+                }
+                let k = z
+                    .name
+                    .trim_start_matches("FeatureZone")
+                    .to_ascii_lowercase();
+                if k.contains("line") {
+                    "line".to_string()
+                } else if k.contains("point") {
+                    "point".to_string()
+                } else if k.contains("circ") {
+                    "circle".to_string()
+                } else {
+                    "area".to_string()
+                }
+            }
+            None => "area".to_string(),
+        };
+        Target {
+            kind,
+            label,
+            points,
+            model_unit_points: Vec::new(),
+        }
+    }
+
+    fn tolerance(
+        &mut self,
+        id: u64,
+        name: &str,
+        kind: TolKind,
+        def: &Node,
+        frames: &HashMap<u64, Vec<DatumRef>>,
+        faces: Vec<usize>,
+    ) -> GeoTolerance {
+        let value = def.child("ToleranceValue").and_then(|v| self.length(v));
+        if value.is_none() {
+            self.notes
+                .push(format!("{name}: its tolerance value cannot be read"));
+        }
+        let zone = def.child("ZoneShape").and_then(|z| z.children.first());
+        let zone = zone.map(|z| z.name.as_str()).unwrap_or("");
+        let mut other = Vec::new();
+        if def.text_at(&["FreeState"]).map(str::trim) == Some("true") {
+            other.push("free state".to_string());
+        }
+        if def.text_at(&["TangentPlane"]).map(str::trim) == Some("true") {
+            other.push("tangent plane".to_string());
+        }
+        let datums = match def
+            .text_at(&["DatumReferenceFrameId"])
+            .and_then(|t| t.trim().parse::<u64>().ok())
+        {
+            Some(f) => match frames.get(&f) {
+                Some(d) => d.clone(),
+                None => {
+                    self.notes.push(format!(
+                        "{name}: its datum reference frame {f} is not in the file"
+                    ));
+                    Vec::new()
+                }
+            },
+            None => Vec::new(),
+        };
+        GeoTolerance {
+            id,
+            name: name.to_string(),
+            kind: Some(kind),
+            value_mm: value.unwrap_or(0.0),
+            diameter: zone == "DiametricalZone" || zone == "SphericalZone",
+            spherical: zone == "SphericalZone",
+            material: material(def.text_at(&["MaterialCondition"])),
+            other,
+            datums,
+            faces,
+            composite_of: None,
+            unequal_mm: None,
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn dimension(
+        &mut self,
+        id: u64,
+        kind: DimKind,
+        angular: bool,
+        nom: &Node,
+        def: &Node,
+        faces: Vec<usize>,
+        to_faces: Vec<usize>,
+    ) -> Dimension {
+        let value = |r: &mut Self, n: &Node| -> Option<f64> {
+            if angular {
+                n.text.trim().parse().ok().filter(|x: &f64| x.is_finite())
+            } else {
+                r.length(n)
+            }
+        };
+        let nominal = nom.child("TargetValue").and_then(|v| value(self, v));
+        let (mut upper, mut lower) = (None, None);
+        if let Some(t) = def.child("Tolerance") {
+            let hi = t.child("MaxValue").and_then(|v| value(self, v));
+            let lo = t.child("MinValue").and_then(|v| value(self, v));
+            let limit = t.text_at(&["DefinedAsLimit"]).map(str::trim) == Some("true");
+            match (hi, lo, nominal) {
+                (Some(h), Some(l), Some(n)) if limit => {
+                    upper = Some(h - n);
+                    lower = Some(l - n);
+                }
+                (Some(h), Some(l), _) if !limit => {
+                    upper = Some(h);
+                    lower = Some(l);
+                }
+                _ => {}
+            }
+        }
+        Dimension {
+            id,
+            kind,
+            angular,
+            nominal,
+            upper,
+            lower,
+            fit: None,
+            faces,
+            to_faces,
+        }
+    }
+}
