@@ -228,3 +228,49 @@ pub fn cases(dir: &str, min: usize) -> Vec<PathBuf> {
     );
     cases
 }
+
+/// An imported spec against its golden (written instead under `INSPC_BLESS`), which must
+/// check clean.
+pub fn check_imported_golden(text: &str, golden: &std::path::Path) {
+    if std::env::var_os("INSPC_BLESS").is_some() {
+        std::fs::write(golden, text).unwrap();
+        return;
+    }
+    let expected = std::fs::read_to_string(golden)
+        .unwrap_or_else(|_| panic!("{}: missing; bless it", golden.display()));
+    assert!(
+        text == expected,
+        "the imported spec differs from {} (bless with INSPC_BLESS=1)",
+        golden.display()
+    );
+    let checked = inspc::check(&inspc::source::FsWorld, &[golden.to_path_buf()]);
+    assert!(
+        !checked.has_errors(),
+        "{}: {:?}",
+        golden.display(),
+        checked.diagnostics
+    );
+}
+
+/// For each face of `a`, the face of `b` nearest by centroid and relative area: how two
+/// readings of one part (STEP and QIF, STEP and a reference mesh) are matched when they
+/// number faces differently.
+pub fn nearest_faces(
+    a: &inspc::geometry::PartGeometry,
+    b: &inspc::geometry::PartGeometry,
+) -> Vec<usize> {
+    a.faces
+        .iter()
+        .map(|f| {
+            (0..b.faces.len())
+                .min_by(|&x, &y| {
+                    let d = |j: usize| {
+                        let g = &b.faces[j];
+                        (g.centroid - f.centroid).norm() + (g.area - f.area).abs() / f.area.max(1.0)
+                    };
+                    d(x).total_cmp(&d(y))
+                })
+                .unwrap()
+        })
+        .collect()
+}

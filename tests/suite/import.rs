@@ -231,23 +231,6 @@ fn imported_specs_match_their_goldens_and_import_twice_the_same() {
         let text = imported(part);
         assert_eq!(text, imported(part), "{part}: importing twice");
         let golden = PathBuf::from(format!("tests/imported/nist_{part}.insp"));
-        if std::env::var_os("INSPC_BLESS").is_some() {
-            std::fs::write(&golden, &text).unwrap();
-            continue;
-        }
-        let expected = std::fs::read_to_string(&golden)
-            .unwrap_or_else(|_| panic!("{}: missing; bless it", golden.display()));
-        assert!(
-            text == expected,
-            "{part}: the imported spec differs from {} (bless with INSPC_BLESS=1)",
-            golden.display()
-        );
-        let checked = inspc::check(&inspc::source::FsWorld, std::slice::from_ref(&golden));
-        assert!(
-            !checked.has_errors(),
-            "{}: {:?}",
-            golden.display(),
-            checked.diagnostics
-        );
+        crate::common::check_imported_golden(&text, &golden);
     }
 }

@@ -32,20 +32,7 @@ fn read_both(part: &str, stem: &str) -> (CadPart, CadPart) {
 
 /// For each QIF face, the STEP face nearest by centroid and area.
 fn matched(q: &PartGeometry, s: &PartGeometry) -> Vec<usize> {
-    q.faces
-        .iter()
-        .map(|f| {
-            (0..s.faces.len())
-                .min_by(|&a, &b| {
-                    let d = |j: usize| {
-                        let g = &s.faces[j];
-                        (g.centroid - f.centroid).norm() + (g.area - f.area).abs() / f.area.max(1.0)
-                    };
-                    d(a).total_cmp(&d(b))
-                })
-                .unwrap()
-        })
-        .collect()
+    crate::common::nearest_faces(q, s)
 }
 
 /// Whether two exact surfaces face the same way (outward normal, convexity).
@@ -204,24 +191,7 @@ fn imported_qif_specs_match_their_goldens_and_check_clean() {
         let text = imported(stem);
         assert_eq!(text, imported(stem), "{part}: importing twice");
         let golden = PathBuf::from(format!("tests/imported/nist_{part}_qif.insp"));
-        if std::env::var_os("INSPC_BLESS").is_some() {
-            std::fs::write(&golden, &text).unwrap();
-            continue;
-        }
-        let expected = std::fs::read_to_string(&golden)
-            .unwrap_or_else(|_| panic!("{}: missing; bless it", golden.display()));
-        assert!(
-            text == expected,
-            "{part}: the imported spec differs from {} (bless with INSPC_BLESS=1)",
-            golden.display()
-        );
-        let checked = inspc::check(&inspc::source::FsWorld, std::slice::from_ref(&golden));
-        assert!(
-            !checked.has_errors(),
-            "{}: {:?}",
-            golden.display(),
-            checked.diagnostics
-        );
+        crate::common::check_imported_golden(&text, &golden);
     }
 }
 

@@ -27,24 +27,10 @@ fn obj_part(part: &str) -> PartGeometry {
 /// For each reference face, the STEP face it is: the same number where the reference
 /// mesh kept the file's face order, else the nearest by centroid and area.
 fn matched(s: &PartGeometry, o: &PartGeometry, by_number: bool) -> Vec<usize> {
-    o.faces
-        .iter()
-        .enumerate()
-        .map(|(i, f)| {
-            if by_number {
-                return i;
-            }
-            (0..s.faces.len())
-                .min_by(|&a, &b| {
-                    let d = |j: usize| {
-                        let g = &s.faces[j];
-                        (g.centroid - f.centroid).norm() + (g.area - f.area).abs() / f.area.max(1.0)
-                    };
-                    d(a).total_cmp(&d(b))
-                })
-                .unwrap()
-        })
-        .collect()
+    if by_number {
+        return (0..o.faces.len()).collect();
+    }
+    crate::common::nearest_faces(o, s)
 }
 
 /// Whether the exact surface may differ in kind from the reference mesh's fitted one:

@@ -907,7 +907,11 @@ mod sense_tests {
                     told += 1;
                 }
             }
-            assert!(told * 10 >= b.faces.len() * 9, "{part}: {told} of {}", b.faces.len());
+            assert!(
+                told * 10 >= b.faces.len() * 9,
+                "{part}: {told} of {}",
+                b.faces.len()
+            );
         }
     }
 }
