@@ -16,6 +16,7 @@ mod pmi;
 mod xml;
 
 use super::errors::MeshError;
+use super::mesh_io::RawMesh;
 use super::step::{self, CadPart, MeshFailure, Resolution};
 use std::collections::HashMap;
 
@@ -212,11 +213,17 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
     };
     let mut b = brep::read(&doc, &root).map_err(q)?;
     b.unit_name = unit_name.clone();
-    orient(&mut b, res).map_err(q)?;
-    let mesh = step::mesh_brep(&b, res).map_err(|e| match e {
-        MeshFailure::Faces(list) => q(QifError::Faces(list)),
-        MeshFailure::Mesh(e) => e,
-    })?;
+    let shell = orient(&mut b, res).map_err(q)?;
+    let mesh_of = |b: &step::brep::Brep| {
+        step::mesh_brep(b, res).map_err(|e| match e {
+            MeshFailure::Faces(list) => q(QifError::Faces(list)),
+            MeshFailure::Mesh(e) => e,
+        })
+    };
+    let mut mesh = mesh_of(&b)?;
+    if outward(&mut b, &mesh, &shell) {
+        mesh = mesh_of(&b)?;
+    }
     let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
     let edge_faces: HashMap<u64, Vec<usize>> = step::edge_faces(&b);
     let pmi = pmi::read(&doc, &root, &face_ids, &edge_faces);
@@ -236,9 +243,10 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
 /// parameters whichever side the material is on (so they are read as-is first), and a
 /// face faces out or in as the solid has it. The senses are found from the topology: an
 /// edge between two faces is walked in opposite directions by their bounds once both
-/// are oriented, so one face's choice fixes its neighbours', across each connected shell;
-/// a shell whose volume then comes out negative is turned inside out.
-fn orient(b: &mut step::brep::Brep, res: Resolution) -> Result<(), QifError> {
+/// are oriented, so one face's choice fixes its neighbours', across each connected shell.
+/// Returns each face's shell, for [`outward`] to turn a shell whose mesh comes out
+/// inside out.
+fn orient(b: &mut step::brep::Brep, res: Resolution) -> Result<Vec<usize>, QifError> {
     use step::brep::Bound;
     let edges = step::tess::edge_polylines(b, res);
     let natural: Vec<bool> = b
@@ -304,34 +312,43 @@ fn orient(b: &mut step::brep::Brep, res: Resolution) -> Result<(), QifError> {
         }
         shells += 1;
     }
-    let turn = |face: &mut step::brep::Face| {
-        face.same_sense = !face.same_sense;
-        for bound in &mut face.bounds {
-            if let Bound::Edges(list) = bound {
-                list.reverse();
-                for (_, fwd) in list.iter_mut() {
-                    *fwd = !*fwd;
-                }
-            }
-        }
-    };
     for (i, face) in b.faces.iter_mut().enumerate() {
         face.same_sense = natural[i];
         if flip[i] == Some(true) {
             turn(face);
         }
     }
-    // Each shell outward: its enclosed volume positive.
-    let (soup, _) = step::tess::tessellate(b, res);
-    let mut volume = vec![0.0; shells];
-    for (t, f) in soup.triangles.iter().zip(&soup.tri_face) {
-        let [a, bb, c] = t.map(|i| crate::geometry::V3::from(soup.positions[i]));
-        volume[shell[*f as usize]] += a.dot(&bb.cross(&c)) / 6.0;
+    Ok(shell)
+}
+
+/// A face turned over: the other sense, its bounds walked backwards.
+fn turn(face: &mut step::brep::Face) {
+    face.same_sense = !face.same_sense;
+    for bound in &mut face.bounds {
+        if let step::brep::Bound::Edges(list) = bound {
+            list.reverse();
+            for (_, fwd) in list.iter_mut() {
+                *fwd = !*fwd;
+            }
+        }
     }
+}
+
+/// Turns over, in the B-rep, every shell whose mesh encloses a negative volume;
+/// whether any was turned (then the B-rep is meshed again).
+fn outward(b: &mut step::brep::Brep, mesh: &RawMesh, shell: &[usize]) -> bool {
+    let shells = shell.iter().max().map_or(0, |m| m + 1);
+    let mut volume = vec![0.0; shells];
+    for (t, g) in mesh.triangles.iter().zip(&mesh.tri_group) {
+        let [a, bb, c] = t.map(|i| mesh.vertices[i as usize].coords);
+        volume[shell[*g as usize]] += a.dot(&bb.cross(&c)) / 6.0;
+    }
+    let mut turned = false;
     for (i, face) in b.faces.iter_mut().enumerate() {
         if volume[shell[i]] < 0.0 {
             turn(face);
+            turned = true;
         }
     }
-    Ok(())
+    turned
 }

@@ -161,11 +161,7 @@ pub fn read(d: &Doc, root: &Node, faces: &[u64], edge_faces: &HashMap<u64, Vec<u
         };
         let feats = Doc::id_list(nom, "FeatureNominalIds");
         if let Some((_, tk)) = KINDS.iter().find(|(k, _)| *k == kind) {
-            let faces: BTreeSet<usize> = feats
-                .iter()
-                .flat_map(|f| r.feature_faces(*f, &name))
-                .collect();
-            let faces: Vec<usize> = faces.into_iter().collect();
+            let faces = r.features_faces(&feats, &name);
             let upper = r.tolerance(id, &name, *tk, def, &frames, faces.clone());
             pmi.tolerances.push(upper);
             if let Some(lower) = def
@@ -185,12 +181,7 @@ pub fn read(d: &Doc, root: &Node, faces: &[u64], edge_faces: &HashMap<u64, Vec<u
                 pmi.tolerances.push(t);
             }
         } else if let Some((_, label, angular)) = SIZES.iter().find(|(k, _, _)| *k == kind) {
-            let faces: Vec<usize> = feats
-                .iter()
-                .flat_map(|f| r.feature_faces(*f, &name))
-                .collect::<BTreeSet<usize>>()
-                .into_iter()
-                .collect();
+            let faces = r.features_faces(&feats, &name);
             // The angle of a feature of two planes (a V) is the angle between them, as
             // STEP files state it.
             let (kind, from, to) = match (*label, faces.as_slice()) {
@@ -307,6 +298,15 @@ fn material(m: Option<&str>) -> Option<Material> {
 }
 
 impl Reader<'_> {
+    /// The faces of several feature nominals together, sorted.
+    fn features_faces(&mut self, ids: &[u64], who: &str) -> Vec<usize> {
+        let all: BTreeSet<usize> = ids
+            .iter()
+            .flat_map(|f| self.feature_faces(*f, who))
+            .collect();
+        all.into_iter().collect()
+    }
+
     /// The faces of a feature nominal (through compound features), noting one that
     /// names nothing on the part.
     fn feature_faces(&mut self, id: u64, who: &str) -> BTreeSet<usize> {
