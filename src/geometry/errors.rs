@@ -310,6 +310,15 @@ pub enum GeometryError {
         #[help]
         help: String,
     },
+    #[error("{what}")]
+    #[diagnostic(code(insp::geometry::unknown_file_face))]
+    UnknownFileFace {
+        #[label("no such face")]
+        span: Span,
+        what: String,
+        #[help]
+        help: String,
+    },
     #[error("no face matches this selector")]
     #[diagnostic(code(insp::geometry::no_match))]
     NoMatch {
@@ -349,6 +358,7 @@ crate::located!(GeometryError {
     FaceGone,
     UnknownGroup,
     UnknownSegment,
+    UnknownFileFace,
     NoMatch,
 });
 

@@ -28,6 +28,8 @@ pub struct RawMesh {
     /// Per group, its exact surface when the file gives one (STEP); empty for meshes,
     /// whose surfaces are fitted.
     pub exact: Vec<super::Surface>,
+    /// For a CAD file, each group's id in the file (`step_face`, `qif_face`).
+    pub cad: Option<super::CadFaces>,
 }
 
 /// Reads a mesh file through the world, scaling by `unit_mm`.
@@ -247,5 +249,6 @@ pub(super) fn weld(
         open_edges,
         nonmanifold_edges,
         exact: Vec::new(),
+        cad: None,
     })
 }

@@ -321,6 +321,18 @@ pub struct PartGeometry {
     /// For constructive parts, per face: whose face it is and the roles it answers to
     /// (`walls`, `left_wall`, …); empty for mesh parts.
     pub roles: Vec<(model::FaceSource, Vec<model::Role>)>,
+    /// For parts read from a CAD file, each face's id in the file.
+    pub cad: Option<CadFaces>,
+}
+
+/// The ids a CAD file gives its faces, one per face of the part in order: STEP instance
+/// numbers or QIF ids (what `step_face N` and `qif_face N` name).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CadFaces {
+    /// The kind of file.
+    pub kind: model::CadKind,
+    /// Per face, its id.
+    pub ids: Vec<u64>,
 }
 
 impl PartGeometry {
@@ -368,6 +380,7 @@ impl PartGeometry {
             tri_face,
             faces,
             roles: Vec::new(),
+            cad: None,
         }
     }
 

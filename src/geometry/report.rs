@@ -66,16 +66,29 @@ pub fn faces_table(title: &str, g: &PartGeometry) -> String {
         g.triangles.len(),
         g.vertices.len()
     );
+    // A CAD part's faces also show the file's own id (`step_face N`, `qif_face N`).
+    let file_id = |k: usize| match &g.cad {
+        Some(c) => format!("{:>9}  ", format!("#{}", c.ids[k])),
+        None => String::new(),
+    };
     let _ = writeln!(
         o,
-        "{:>4}  {:<20} {:<9} {:>12}  {:<28} surface",
-        "id", "name", "type", "area mm²", "centroid"
+        "{:>4}  {}{:<20} {:<9} {:>12}  {:<28} surface",
+        "id",
+        g.cad
+            .as_ref()
+            .map_or(String::new(), |c| format!("{:>9}  ", c.kind.keyword())),
+        "name",
+        "type",
+        "area mm²",
+        "centroid"
     );
     for (k, f) in g.faces.iter().enumerate().filter(|(_, f)| f.area > 0.0) {
         let _ = writeln!(
             o,
-            "{:>4}  {:<20} {:<9} {:>12}  {:<28} {}",
+            "{:>4}  {}{:<20} {:<9} {:>12}  {:<28} {}",
             k,
+            file_id(k),
             f.name,
             f.surface.kind().keyword(),
             r(f.area),
@@ -93,7 +106,7 @@ pub fn faces_json(g: &PartGeometry) -> Vec<serde_json::Value> {
         .enumerate()
         .filter(|(_, f)| f.area > 0.0)
         .map(|(k, f)| {
-            serde_json::json!({
+            let mut v = serde_json::json!({
                 "id": k,
                 "name": f.name,
                 "type": f.surface.kind().keyword(),
@@ -102,7 +115,11 @@ pub fn faces_json(g: &PartGeometry) -> Vec<serde_json::Value> {
                 "surface": describe(&f.surface),
                 "fit_rms": f.fit_rms,
                 "triangles": f.triangles.len(),
-            })
+            });
+            if let Some(c) = &g.cad {
+                v[c.kind.keyword()] = c.ids[k].into();
+            }
+            v
         })
         .collect()
 }

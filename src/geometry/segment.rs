@@ -100,7 +100,9 @@ pub fn from_groups(m: &RawMesh) -> PartGeometry {
     } else {
         m.groups.clone()
     };
-    assemble(m, regions, names, &normals)
+    let mut g = assemble(m, regions, names, &normals);
+    g.cad = m.cad.clone();
+    g
 }
 
 /// Faces found by segmentation, named `segment_1`, `segment_2`, … in the order of their

@@ -8,6 +8,19 @@ use crate::model::{FaceRef, FaceSource, Selector};
 /// Angle within which a selector's normal or axis matches (degrees).
 const SELECT_DEG: f64 = 5.0;
 
+/// The help for an id no face has: the nearest ids the file's faces do have.
+fn near_ids(ids: &[u64], id: u64) -> String {
+    let mut near: Vec<u64> = ids.to_vec();
+    near.sort_unstable_by_key(|&k| (k.abs_diff(id), k));
+    near.truncate(3);
+    near.sort_unstable();
+    let list: Vec<String> = near.iter().map(|k| format!("#{k}")).collect();
+    format!(
+        "the nearest face ids are {}; `inspc faces FILE` lists every face with its id",
+        list.join(", ")
+    )
+}
+
 /// The faces a reference names, in face order; reports references that name nothing.
 pub fn resolve_faces(g: &PartGeometry, r: &FaceRef, diags: &mut Diagnostics) -> Vec<FaceId> {
     let alive = |k: usize| g.faces[k].area > 0.0;
@@ -73,6 +86,44 @@ pub fn resolve_faces(g: &PartGeometry, r: &FaceRef, diags: &mut Diagnostics) -> 
                 diags.push(E::UnknownSegment {
                     span: *span,
                     segment: *n,
+                    help,
+                });
+            }
+            found
+        }
+        FaceRef::FileFace(kind, id, span) => {
+            let ids = g.cad.as_ref().filter(|c| c.kind == *kind);
+            let found: Vec<FaceId> = ids
+                .map(|c| {
+                    (0..c.ids.len())
+                        .filter(|&k| c.ids[k] == *id && alive(k))
+                        .map(FaceId)
+                        .collect()
+                })
+                .unwrap_or_default();
+            if found.is_empty() {
+                let (what, help) = match (ids, &g.cad) {
+                    (Some(c), _) => (
+                        format!("the {} file has no face #{id}", kind.file()),
+                        near_ids(&c.ids, *id),
+                    ),
+                    (None, Some(c)) => (
+                        format!(
+                            "`{}` names a {} face, but the part is read from a {} file",
+                            kind.keyword(),
+                            kind.file(),
+                            c.kind.file()
+                        ),
+                        format!("write `{} {id}`", c.kind.keyword()),
+                    ),
+                    (None, None) => (
+                        format!("`{}` names a face by its {} id, but the part is not read from a {} file", kind.keyword(), kind.file(), kind.file()),
+                        "name the face by `group \"…\"`, `segment N` or `select(…)`; `inspc faces MESH` lists them".into(),
+                    ),
+                };
+                diags.push(E::UnknownFileFace {
+                    span: *span,
+                    what,
                     help,
                 });
             }

@@ -217,8 +217,8 @@ fn limits(nominal: f64, upper: f64, lower: f64, unit: &str) -> String {
 }
 
 /// The PMI without the faces of sheet bodies: an open surface the file carries beside
-/// its solid (construction geometry) is no material a probe can touch. What loses faces
-/// says so in the notes.
+/// its solid (construction geometry) is no material a probe can touch, and the part's
+/// mesh leaves it out. What loses faces says so in the notes.
 fn solid_pmi(part: &CadPart) -> pmi::Pmi {
     let mut p = part.pmi.clone();
     let solid = part.face_ids.len() - part.sheet_faces;
@@ -510,7 +510,7 @@ fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
     );
     Imported {
         text,
-        faces: part.face_ids.len(),
+        faces: part.face_ids.len() - part.sheet_faces,
         datums: (seen_letters.len(), frames.datum_feature.len()),
         tolerances: (p.tolerances.len(), written_tols),
         dimensions: (p.dimensions.len(), written_dims),
@@ -579,12 +579,21 @@ fn render(
     let _ = writeln!(
         s,
         "// {} faces (`face_<n>` in the file's shell order), {} × {} × {} mm; the file's unit is {}.",
-        part.face_ids.len(),
+        part.face_ids.len() - part.sheet_faces,
         size[0],
         size[1],
         size[2],
         part.unit.0
     );
+    if part.sheet_faces > 0 {
+        let _ = writeln!(
+            s,
+            "// The file's {} sheet (construction) face{} beside the solid {} no material and left out.",
+            part.sheet_faces,
+            if part.sheet_faces == 1 { "" } else { "s" },
+            if part.sheet_faces == 1 { "is" } else { "are" },
+        );
+    }
     let _ = writeln!(
         s,
         "// The datums, tolerances and sizes are the file's semantic PMI; what the language cannot say is a comment."

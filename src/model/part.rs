@@ -2,6 +2,7 @@
 
 use super::Vec3;
 use crate::source::Span;
+pub use crate::syntax::ast::CadKind;
 
 /// Index into [`Part::features`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -413,6 +414,8 @@ pub enum FaceRef {
     Group(String, Span),
     /// A segment of an unlabelled mesh.
     Segment(u32, Span),
+    /// A CAD file's face by the file's own id.
+    FileFace(CadKind, u64, Span),
     /// A selector over a mesh's faces.
     Select(Selector, Span),
 }

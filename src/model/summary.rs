@@ -540,6 +540,7 @@ fn face_text(p: &Part, r: &FaceRef) -> String {
         } => format!("{}[{i}].{role}", p.ops[op.0].name),
         FaceRef::Group(g, _) => format!("group {g:?}"),
         FaceRef::Segment(n, _) => format!("segment {n}"),
+        FaceRef::FileFace(k, n, _) => format!("{} {n}", k.keyword()),
         FaceRef::Select(s, _) => format!("select{s:?}"),
     }
 }

@@ -8,7 +8,7 @@ use thiserror::Error;
 #[derive(Debug, Error, Diagnostic)]
 #[allow(missing_docs)]
 pub enum PathError {
-    #[error("no collision-free move reaches face `{face}` of feature `{feature}` with probe `{probe}`{orient}: {blocker} hits the part on the way")]
+    #[error("no collision-free move reaches face `{face}` of feature `{feature}` with probe `{probe}`{orient}: {why}")]
     #[diagnostic(
         code(insp::path::no_path),
         help("the touch itself is clear, but no path the local planner or the roadmap found gets there; a longer stylus, another orientation or a larger `motion {{ clearance }}` may open one")
@@ -20,7 +20,8 @@ pub enum PathError {
         feature: String,
         probe: String,
         orient: String,
-        blocker: String,
+        /// What hits the part on the way, in words.
+        why: String,
     },
     #[error("tolerance `{tolerance}` reads `{feature}` as measured in setup {setup}, whose alignment stands on `{feature}` itself: a misplaced `{feature}` reads in place")]
     #[diagnostic(

@@ -377,7 +377,8 @@ fn join(
                 if let Err(blocker) = moves {
                     let b = &o.blocks[0];
                     let points = b.touches.iter().map(|t| t.point).collect();
-                    return Err(no_path(input, b, g, &blocker.to_string(), points));
+                    let why = format!("{blocker} hits the part on the way");
+                    return Err(no_path(input, b, g, &why, points));
                 }
                 entry.insert(0, across);
             }
@@ -466,15 +467,9 @@ pub(crate) struct Unreached {
     bans: Vec<Ban>,
 }
 
-/// The diagnostic for a block no move reaches; `blocker` says what hits, `points` which
-/// of its touches (indices into [`Hlip::points`]) cannot be reached.
-fn no_path(
-    input: &Input,
-    b: &BlockPath,
-    g: &GroupIn,
-    blocker: &str,
-    points: Vec<usize>,
-) -> Unreached {
+/// The diagnostic for a block no move reaches; `why` says what hits, `points` which
+/// touches of the group (indices into [`Hlip::points`]) cannot be reached.
+fn no_path(input: &Input, b: &BlockPath, g: &GroupIn, why: &str, points: Vec<usize>) -> Unreached {
     let names = Names::new(input.model, input.geometry, input.plan_id());
     let part = names.part();
     let feature = b.feature.map(|f| &part.features[f.0]);
@@ -500,7 +495,7 @@ fn no_path(
             ),
             Head::Fixed => String::new(),
         },
-        blocker: blocker.to_string(),
+        why: why.to_string(),
     });
     Unreached { error, bans }
 }
@@ -576,15 +571,24 @@ fn plan_group(
         &input.geometry.vertices,
         g.height,
     );
+    // Every goal left out is banned at once, so the planner's next try does not walk
+    // the face's unreachable points one by one.
     let added = map.build(face_points).map_err(|d| {
-        let (bi, ti) = owner[d.goal];
-        let b = &g.blocks[bi];
+        let (bi, _) = owner[d.goal];
+        let point = |k: usize| {
+            let (bi, ti) = owner[k];
+            g.blocks[bi].touches[ti].point
+        };
+        let why = d.blocker.map_or_else(
+            || "every route the roadmap tried around the part is blocked".to_string(),
+            |b| format!("{b} hits the part on the way"),
+        );
         no_path(
             input,
-            b,
+            &g.blocks[bi],
             g,
-            &d.blocker.to_string(),
-            vec![b.touches[ti].point],
+            &why,
+            d.stray.iter().map(|&k| point(k)).collect(),
         )
     })?;
     let paths = map.shortest_paths();

@@ -55,13 +55,16 @@ pub struct Roadmap<'a> {
     pub checks: usize,
 }
 
-/// Why goals could not be connected: the first goal left out and what blocked it.
+/// Why goals could not be connected: the goals left out and what blocked the first.
 #[derive(Debug, Clone)]
 pub struct Disconnected {
-    /// The goal.
+    /// The first goal left out.
     pub goal: usize,
-    /// What hit on its straight move towards the nearest connected goal.
-    pub blocker: String,
+    /// Every goal left out, `goal` first.
+    pub stray: Vec<usize>,
+    /// What hit on `goal`'s straight move towards the nearest connected goal; `None`
+    /// when that move is clear but every route the roadmap tried is not.
+    pub blocker: Option<String>,
 }
 
 impl<'a> Roadmap<'a> {
@@ -341,8 +344,12 @@ impl<'a> Roadmap<'a> {
                     .copied();
                 let blocker = near
                     .and_then(|m| self.pose.segment(&self.nodes[goal], &self.nodes[m]).err())
-                    .map_or_else(|| "the part".into(), |b| b.to_string());
-                Err(Disconnected { goal, blocker })
+                    .map(|b| b.to_string());
+                Err(Disconnected {
+                    goal,
+                    stray,
+                    blocker,
+                })
             }
         }
     }
@@ -520,9 +527,18 @@ mod tests {
         ];
         let mut map = Roadmap::new(&pose, goals, V3::z(), &verts, 40.0);
         match map.build(|_| vec![P3::new(0.0, 5.0, 0.0)]) {
-            Err(Disconnected { goal, blocker }) => {
+            Err(Disconnected {
+                goal,
+                stray,
+                blocker,
+            }) => {
                 assert_eq!(goal, 0);
-                assert_eq!(blocker, "the tip", "the straight move out crosses the wall");
+                assert_eq!(stray, [0]);
+                assert_eq!(
+                    blocker.as_deref(),
+                    Some("the tip"),
+                    "the straight move out crosses the wall"
+                );
             }
             Ok(_) => panic!("a sealed goal was connected"),
         }

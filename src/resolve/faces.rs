@@ -54,6 +54,7 @@ fn same_face(a: &FaceRef, b: &FaceRef) -> bool {
         ) => s1 == s2 && r1 == r2,
         (FaceRef::Group(a, _), FaceRef::Group(b, _)) => a == b,
         (FaceRef::Segment(a, _), FaceRef::Segment(b, _)) => a == b,
+        (FaceRef::FileFace(k, a, _), FaceRef::FileFace(l, b, _)) => k == l && a == b,
         _ => false,
     }
 }
@@ -82,6 +83,13 @@ fn face_term(cx: &mut Cx, pc: &PartCx, t: &ast::FaceTerm, is_mesh: bool) -> Vec<
         ast::FaceTerm::Segment(n, span) => {
             if needs_mesh(cx, *span, "`segment`") {
                 vec![FaceRef::Segment(*n, *span)]
+            } else {
+                vec![]
+            }
+        }
+        ast::FaceTerm::FileFace(kind, n, span) => {
+            if needs_mesh(cx, *span, &format!("`{}`", kind.keyword())) {
+                vec![FaceRef::FileFace(*kind, u64::from(*n), *span)]
             } else {
                 vec![]
             }

@@ -358,6 +358,8 @@ pub enum FaceTerm {
     Group(Str),
     /// `segment 3`: a face found by segmenting an unlabelled mesh.
     Segment(u32, Span),
+    /// `step_face 1234` or `qif_face 56`: a CAD file's face by the file's own id.
+    FileFace(CadKind, u32, Span),
     /// `select(plane, normal +z, highest z)`
     Select(Vec<Arg>, Span),
 }
@@ -427,4 +429,31 @@ pub enum PlanStmt {
         /// The statement.
         span: Span,
     },
+}
+
+/// The kind of CAD file whose ids `step_face` and `qif_face` name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CadKind {
+    /// STEP: the face's instance number (`#1234`).
+    Step,
+    /// QIF: the face's `id`.
+    Qif,
+}
+
+impl CadKind {
+    /// The keyword that names a face of this kind of file.
+    pub fn keyword(self) -> &'static str {
+        match self {
+            CadKind::Step => "step_face",
+            CadKind::Qif => "qif_face",
+        }
+    }
+
+    /// The file kind, in words.
+    pub fn file(self) -> &'static str {
+        match self {
+            CadKind::Step => "STEP",
+            CadKind::Qif => "QIF",
+        }
+    }
 }

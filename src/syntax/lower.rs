@@ -382,6 +382,14 @@ impl L {
                     self.integer(&t.into_inner().nth(1).expect("segment id"))?,
                     tspan,
                 ),
+                Rule::file_face_ref => {
+                    let mut it = t.into_inner();
+                    let kind = match it.next().expect("keyword").as_rule() {
+                        Rule::kw_qif_face => CadKind::Qif,
+                        _ => CadKind::Step,
+                    };
+                    FaceTerm::FileFace(kind, self.integer(&it.next().expect("face id"))?, tspan)
+                }
                 Rule::select_ref => {
                     let mut it = t.into_inner();
                     it.next();

@@ -30,6 +30,8 @@ pub(crate) fn word(rule: Rule) -> Option<&'static str> {
         Rule::kw_tolerance => "`tolerance`",
         Rule::kw_group => "`group`",
         Rule::kw_segment => "`segment`",
+        Rule::kw_step_face => "`step_face`",
+        Rule::kw_qif_face => "`qif_face`",
         Rule::kw_select => "`select`",
         Rule::kw_prefer => "`prefer`",
         Rule::kw_forbid => "`forbid`",
@@ -55,9 +57,10 @@ pub(crate) fn word(rule: Rule) -> Option<&'static str> {
         | Rule::datum_stmt
         | Rule::frame_stmt
         | Rule::tolerance_stmt => "a part statement (`units`, `stock`, `mesh`, `cut`, `add`, `face`, `feature`, `datum`, `frame`, `tolerance`)",
-        Rule::face_expr | Rule::face_term => "a face (a name, `group \"…\"`, `segment N` or `select(…)`)",
+        Rule::face_expr | Rule::face_term => "a face (a name, `group \"…\"`, `segment N`, `step_face N` or `select(…)`)",
         Rule::group_ref => "`group \"…\"`",
         Rule::segment_ref => "`segment N`",
+        Rule::file_face_ref => "`step_face N` or `qif_face N`",
         Rule::select_ref => "`select(…)`",
         Rule::level => "a level (`required approachability` or `same_setup(T, *)`)",
         Rule::required_level => "`required approachability`",

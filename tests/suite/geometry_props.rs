@@ -181,6 +181,7 @@ proptest! {
             open_edges: 0,
             nonmanifold_edges: 0,
             exact: vec![],
+            cad: None,
         };
         let seg = segment::segment(&raw);
         let has_plane = |n: V3, offset: f64| seg.faces.iter().any(|f| matches!(f.surface, Surface::Plane { origin, normal } if normal.dot(&n) > 0.9998 && (origin.coords.dot(&n) - offset).abs() < 0.01));

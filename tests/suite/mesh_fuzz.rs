@@ -141,7 +141,7 @@ proptest! {
         let n = vertices.len() as u32;
         let triangles: Vec<[u32; 3]> = tris.iter().map(|&(a, b, c, _)| [a % n, b % n, c % n]).collect();
         let tri_group: Vec<u32> = tris.iter().map(|t| t.3).collect();
-        let raw = RawMesh { vertices, triangles, tri_group, groups: vec!["a".into(), "b".into(), "c".into()], open_edges: 0, nonmanifold_edges: 0, exact: vec![] };
+        let raw = RawMesh { vertices, triangles, tri_group, groups: vec!["a".into(), "b".into(), "c".into()], open_edges: 0, nonmanifold_edges: 0, exact: vec![], cad: None };
         segment_and_sample(&raw);
     }
 }

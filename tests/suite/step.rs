@@ -48,12 +48,18 @@ fn fit_may_differ(exact: SurfaceKind, fitted: SurfaceKind) -> bool {
 fn check(part: &str, by_number: bool, unit: &str) {
     let (p, s) = step_part(part);
     let o = obj_part(part);
-    assert_eq!(s.faces.len(), o.faces.len(), "{part}: face count");
+    // The reference mesh keeps sheet (construction) faces, last in the file's order; the
+    // part leaves them out.
+    assert_eq!(
+        s.faces.len() + p.sheet_faces,
+        o.faces.len(),
+        "{part}: face count"
+    );
+    let mut o = o;
+    o.faces.truncate(s.faces.len());
     assert_eq!(p.unit.0, unit, "{part}: the file's length unit");
     assert_eq!(p.mesh.nonmanifold_edges, 0, "{part}: non-manifold edges");
-    if p.sheet_faces == 0 {
-        assert_eq!(p.mesh.open_edges, 0, "{part}: a solid's mesh is closed");
-    }
+    assert_eq!(p.mesh.open_edges, 0, "{part}: a solid's mesh is closed");
     let map = matched(&s, &o, by_number);
     let mut targets = map.clone();
     targets.sort_unstable();
@@ -129,7 +135,8 @@ fn nist_ftc_06_from_step() {
 
 #[test]
 fn nist_ftc_08_from_step() {
-    // In inches; its last face is a sheet body's (an open shell beside the solid).
+    // In inches; its last face is a sheet body's (an open shell beside the solid), left
+    // out of the part.
     check("ftc_08", true, "inch");
     let (p, _) = step_part("ftc_08");
     assert_eq!(p.sheet_faces, 1);
@@ -146,4 +153,46 @@ fn every_face_keeps_its_instance_number() {
     ids.sort_unstable();
     ids.dedup();
     assert_eq!(ids.len(), 117);
+}
+
+/// `step_face N` names a face by its instance number: a flatness on CTC 01's #766 (face
+/// 3, the bottom plane) checks clean, on #764 (face 1, a bore half) it is on a cylinder;
+/// an id no face has, `qif_face` on a STEP part and `step_face` on a mesh are errors.
+#[test]
+fn faces_are_named_by_their_step_instance() {
+    require_shared_parts();
+    let stp = std::fs::read("../shared/parts/nist_ctc_01_asme1_ap242-e1.stp").unwrap();
+    let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
+    let check = |face: &str, mesh: &str| {
+        let spec = format!(
+            "part p {{ units mm, mesh \"{mesh}\", feature f = {face}, tolerance t = flatness(f, 0.1 mm) }}"
+        );
+        crate::common::check_files(&[
+            ("main.insp", spec.as_bytes()),
+            ("part.stp", &stp),
+            ("part.obj", obj),
+        ])
+    };
+    let d = check("step_face 766", "part.stp");
+    assert!(d.is_empty(), "{:?}", &d[..]);
+    let d = check("step_face 764", "part.stp");
+    assert_eq!(d.only().code, "insp::graph::wrong_surface");
+    let d = check("step_face 2", "part.stp");
+    let e = d.only();
+    assert_eq!(e.code, "insp::geometry::unknown_file_face");
+    assert_eq!(e.span_text, "step_face 2");
+    assert!(e.message.contains("no face #2"), "{}", e.message);
+    assert!(e.help.contains("#764"), "the nearest ids: {}", e.help);
+    let d = check("qif_face 766", "part.stp");
+    let e = d.only();
+    assert_eq!(e.code, "insp::geometry::unknown_file_face");
+    assert!(e.help.contains("step_face 766"), "{}", e.help);
+    let d = check("step_face 766", "part.obj");
+    let e = d.only();
+    assert_eq!(e.code, "insp::geometry::unknown_file_face");
+    assert!(
+        e.message.contains("not read from a STEP file"),
+        "{}",
+        e.message
+    );
 }

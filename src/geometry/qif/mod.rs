@@ -225,6 +225,10 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
         mesh = mesh_of(&b)?;
     }
     let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
+    mesh.cad = Some(crate::geometry::CadFaces {
+        kind: crate::model::CadKind::Qif,
+        ids: face_ids.clone(),
+    });
     let edge_faces: HashMap<u64, Vec<usize>> = step::edge_faces(&b);
     let pmi = pmi::read(&doc, &root, &face_ids, &edge_faces);
     Ok(CadPart {
@@ -232,7 +236,8 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
         mesh,
         face_ids,
         unit: (unit_name, file_mm),
-        sheet_faces: b.sheet_faces,
+        // Sheet bodies are read only when there is no solid: then they are the part.
+        sheet_faces: 0,
     })
 }
 

@@ -122,7 +122,9 @@ pub struct CadPart {
     pub face_ids: Vec<u64>,
     /// The file's length unit as named, and its size in millimetres.
     pub unit: (String, f64),
-    /// Faces of sheet (open-shell) bodies, last in the numbering.
+    /// Faces of sheet (open-shell) bodies beside a solid: construction geometry, last
+    /// in `face_ids` and left out of the mesh (no material a probe could touch or hit).
+    /// 0 when the file has sheet bodies only: those are the part.
     pub sheet_faces: usize,
     /// The semantic PMI, linked to the faces' 0-based indices.
     pub pmi: pmi::Pmi,
@@ -137,19 +139,32 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
         })
     })?;
     let b = brep::read(&file).map_err(MeshError::Step)?;
+    let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
+    let pmi_edges = edge_faces(&b);
+    let sheet_faces = if b.sheet_faces < b.faces.len() {
+        b.sheet_faces
+    } else {
+        0
+    };
+    let mut b = b;
+    b.faces.truncate(b.faces.len() - sheet_faces);
     let mesh = mesh_brep(&b, res).map_err(|e| match e {
         MeshFailure::Faces(list) => MeshError::Step(StepError::Faces(list)),
         MeshFailure::Mesh(e) => e,
     })?;
-    let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
-    let mut pmi = pmi::read(&file, &face_ids, &edge_faces(&b), b.unit_mm);
+    let mut mesh = mesh;
+    mesh.cad = Some(crate::geometry::CadFaces {
+        kind: crate::model::CadKind::Step,
+        ids: b.faces.iter().map(|f| f.id).collect(),
+    });
+    let mut pmi = pmi::read(&file, &face_ids, &pmi_edges, b.unit_mm);
     locate_targets(&mut pmi, &mesh);
     Ok(CadPart {
         pmi,
         mesh,
         face_ids,
         unit: (b.unit_name, b.unit_mm),
-        sheet_faces: b.sheet_faces,
+        sheet_faces,
     })
 }
 
