@@ -342,7 +342,7 @@ fn graph_prints_dot_mermaid_and_json() {
 fn graph_of_both_nist_parts() {
     common::require_shared_parts();
     for (spec, tolerances) in [
-        ("tests/real/nist_ctc_01.insp", 12),
+        ("tests/real/nist_ctc_01.insp", 14),
         ("tests/real/nist_ftc_08.insp", 42),
     ] {
         let (code, json, stderr) = inspc(&["graph", spec, "--format", "json"]);

@@ -111,7 +111,7 @@ fn every_stdlib_module_checks_clean() {
 
 #[test]
 fn the_nist_ctc_01_spec_checks_clean() {
-    let mesh = PathBuf::from("../shared/parts/nist_ctc_01_asme1_ap242-e1.obj");
+    let mesh = PathBuf::from("../shared/parts/nist_ctc_01_asme1_ap242-e1.stp");
     assert!(
         mesh.exists(),
         "the NIST parts are expected in ../shared/parts/ beside the repository, as CI has them"
@@ -120,8 +120,8 @@ fn the_nist_ctc_01_spec_checks_clean() {
     let part = &checked.model.parts[0];
     assert_eq!(
         part.tolerances.len(),
-        12,
-        "6 geometric tolerances and 6 toleranced sizes in the PMI"
+        14,
+        "6 geometric tolerances and 8 toleranced sizes in the PMI"
     );
     assert_eq!(
         part.datums
