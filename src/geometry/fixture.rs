@@ -57,7 +57,7 @@ pub fn place_fixture(
     else {
         return None;
     };
-    let raw = super::read_reported(world, path, *unit_mm, *span, diags)?;
+    let raw = super::read_reported(world, path, *unit_mm, super::step::RESOLUTION, *span, diags)?;
     let Ok(fixture_mesh) = TriMesh::new(raw.vertices.clone(), raw.triangles.clone()) else {
         diags.push(GeometryError::MeshCorrupt {
             span: *span,

@@ -32,8 +32,19 @@ pub struct RawMesh {
     pub cad: Option<super::CadFaces>,
 }
 
-/// Reads a mesh file through the world, scaling by `unit_mm`.
+/// Reads a mesh file through the world, scaling by `unit_mm`; a STEP or QIF part is
+/// meshed at the default resolution.
 pub fn read_mesh(world: &dyn World, path: &Path, unit_mm: f64) -> Result<RawMesh, MeshError> {
+    read_mesh_at(world, path, unit_mm, super::step::RESOLUTION)
+}
+
+/// [`read_mesh`], meshing a STEP or QIF part at `res`.
+pub fn read_mesh_at(
+    world: &dyn World,
+    path: &Path,
+    unit_mm: f64,
+    res: super::step::Resolution,
+) -> Result<RawMesh, MeshError> {
     let bytes = world
         .read(path, FileKind::Mesh)
         .map_err(|e| MeshError::Unreadable(e.0))?;
@@ -42,10 +53,10 @@ pub fn read_mesh(world: &dyn World, path: &Path, unit_mm: f64) -> Result<RawMesh
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     if ext == "stp" || ext == "step" {
-        return super::step::read(&bytes, super::step::RESOLUTION).map(|p| p.mesh);
+        return super::step::read(&bytes, res).map(|p| p.mesh);
     }
     if ext == "qif" {
-        return super::qif::read(&bytes, super::step::RESOLUTION).map(|p| p.mesh);
+        return super::qif::read(&bytes, res).map(|p| p.mesh);
     }
     let (positions, faces, tri_group, groups) = if ext == "obj" {
         parse_obj(&bytes)?

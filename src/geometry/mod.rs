@@ -419,15 +419,23 @@ pub fn build(
         Source::Mesh {
             path,
             unit_mm,
+            chord_mm,
             span,
         } => {
-            let raw = read_reported(world, path, *unit_mm, *span, diags)?;
+            let res = step::Resolution {
+                chord_mm: chord_mm.unwrap_or(step::RESOLUTION.chord_mm),
+                ..step::RESOLUTION
+            };
+            let raw = read_reported(world, path, *unit_mm, res, *span, diags)?;
             let uses_groups = part
                 .features
                 .iter()
                 .flat_map(|f| &f.faces)
                 .any(|r| matches!(r, model::FaceRef::Group(..)));
-            let geometry = if raw.groups.len() > 1 || (uses_groups && !raw.groups.is_empty()) {
+            let geometry = if raw.cad.is_some()
+                || raw.groups.len() > 1
+                || (uses_groups && !raw.groups.is_empty())
+            {
                 segment::from_groups(&raw)
             } else {
                 segment::segment(&raw)
@@ -443,10 +451,11 @@ pub(crate) fn read_reported(
     world: &dyn World,
     path: &std::path::Path,
     unit_mm: f64,
+    res: step::Resolution,
     span: crate::source::Span,
     diags: &mut Diagnostics,
 ) -> Option<RawMesh> {
-    let raw = match read_mesh(world, path, unit_mm) {
+    let raw = match mesh_io::read_mesh_at(world, path, unit_mm, res) {
         Ok(m) => m,
         Err(e) => {
             for d in e.at(span, path) {

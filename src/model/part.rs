@@ -52,8 +52,11 @@ pub enum Geometry {
     Mesh {
         /// The path as resolved against the spec's folder.
         path: std::path::PathBuf,
-        /// mm per file unit.
+        /// mm per file unit (STL, OBJ; a STEP or QIF file states its own).
         unit_mm: f64,
+        /// For a STEP or QIF file, the chord tolerance it is meshed to (mm), when the
+        /// spec gives one.
+        chord_mm: Option<f64>,
         /// Where the path was written.
         span: Span,
     },

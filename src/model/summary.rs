@@ -353,12 +353,26 @@ fn part_summary(o: &mut String, p: &Part) {
             format!("cylinder Ø{} × {}", fmt_num(*diameter), fmt_num(*height))
         }
         Geometry::Stock(Stock::Sphere { diameter }) => format!("sphere Ø{}", fmt_num(*diameter)),
-        Geometry::Mesh { path, unit_mm, .. } => {
+        Geometry::Mesh {
+            path,
+            unit_mm,
+            chord_mm,
+            ..
+        } => {
             let name = path
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default();
-            format!("mesh {name} (× {} mm)", fmt_num(*unit_mm))
+            let ext = path
+                .extension()
+                .map(|e| e.to_string_lossy().to_ascii_lowercase());
+            match ext.as_deref() {
+                Some("stp" | "step" | "qif") => format!(
+                    "CAD {name} (in the file's unit, chord {} mm)",
+                    fmt_num(chord_mm.unwrap_or(crate::geometry::step::RESOLUTION.chord_mm))
+                ),
+                _ => format!("mesh {name} (× {} mm)", fmt_num(*unit_mm)),
+            }
         }
     };
     let _ = writeln!(o, "part {}: {geometry}", p.name);

@@ -400,20 +400,54 @@ fn mesh(
     props: &[ast::Prop],
     part_unit: f64,
 ) -> Option<Geometry> {
-    let mut p = Props::new(cx, "a mesh", path.span, props);
-    let unit_mm = p
-        .get("units")
-        .and_then(|v| cx.name(v).cloned())
-        .and_then(|u| length_unit(cx, &u))
-        .unwrap_or(part_unit);
+    let ext = std::path::Path::new(&path.value)
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let cad = match ext.as_str() {
+        "stp" | "step" => Some("a STEP file (it states its own length unit)"),
+        "qif" => Some("a QIF file (it states its own length unit)"),
+        _ => None,
+    };
+    let mut p = Props::new(cx, cad.unwrap_or("a mesh"), path.span, props);
+    let mut unit_mm = part_unit;
+    let mut chord_mm = None;
+    if cad.is_some() {
+        // The B-rep is exact; the chord says how closely its mesh follows it.
+        chord_mm = p.get("chord").and_then(|v| {
+            let c = cx.positive(v, Dim::Length, "chord")?;
+            if !(MIN_CHORD_MM..=MAX_CHORD_MM).contains(&c) {
+                cx.err(E::OutOfRange {
+                    span: v.span,
+                    what: "the chord tolerance".into(),
+                    value: format!("{} mm", crate::model::fmt_num(c)),
+                    range: format!("{MIN_CHORD_MM} mm to {MAX_CHORD_MM} mm"),
+                    help: "0.1 mm (the default) follows the surfaces as the NIST reference meshes do; finer costs triangles, coarser misplaces points".into(),
+                });
+                return None;
+            }
+            Some(c)
+        });
+    } else {
+        unit_mm = p
+            .get("units")
+            .and_then(|v| cx.name(v).cloned())
+            .and_then(|u| length_unit(cx, &u))
+            .unwrap_or(part_unit);
+    }
     p.finish(cx);
     let full = mesh_file(r, cx, path)?;
     Some(Geometry::Mesh {
         path: full,
         unit_mm,
+        chord_mm,
         span: path.span,
     })
 }
+
+/// The finest and coarsest chord tolerance a CAD part may be meshed to (mm).
+const MIN_CHORD_MM: f64 = 0.01;
+const MAX_CHORD_MM: f64 = 1.0;
 
 /// The full path of a mesh file a spec names (relative to the spec's folder): an STL,
 /// OBJ or STEP file that exists. A missing file is reported and still gives its path.

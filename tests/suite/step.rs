@@ -196,3 +196,57 @@ fn faces_are_named_by_their_step_instance() {
         e.message
     );
 }
+
+/// `mesh "part.stp" { chord 0.05 mm }` meshes finer than the 0.1 mm default (every
+/// analytic triangle within the finer chord); a chord out of range and a `units` the
+/// file states itself are errors.
+#[test]
+fn a_spec_states_the_chord_tolerance() {
+    require_shared_parts();
+    let stp = std::fs::read("../shared/parts/nist_ctc_01_asme1_ap242-e1.stp").unwrap();
+    let fine = inspc::geometry::step::Resolution {
+        chord_mm: 0.05,
+        ..RESOLUTION
+    };
+    let (coarse, fine) = (
+        read(&stp, RESOLUTION).unwrap().mesh,
+        read(&stp, fine).unwrap().mesh,
+    );
+    assert!(
+        fine.triangles.len() > coarse.triangles.len() * 5 / 4,
+        "{} triangles at 0.05 mm, {} at 0.1 mm",
+        fine.triangles.len(),
+        coarse.triangles.len()
+    );
+    let g = segment::from_groups(&fine);
+    for f in g
+        .faces
+        .iter()
+        .filter(|f| !matches!(f.surface, Surface::Freeform))
+    {
+        for &t in &f.triangles {
+            let [a, b, c] = g.triangles[t as usize].map(|i| g.vertices[i as usize]);
+            let q = (a.coords + b.coords + c.coords) / 3.0;
+            let d = f.surface.distance(&q.into()).unwrap();
+            assert!(d <= 0.05 + 1e-6, "{}: {d} mm off at 0.05 mm", f.name);
+        }
+    }
+    let check = |block: &str| {
+        let spec = format!(
+            "part p {{ units mm\n mesh \"part.stp\" {{ {block} }}\n feature f = step_face 766 }}"
+        );
+        crate::common::check_files(&[("main.insp", spec.as_bytes()), ("part.stp", &stp)])
+    };
+    let d = check("chord 0.05 mm");
+    assert!(d.is_empty(), "{:?}", &d[..]);
+    let d = check("chord 5 mm");
+    assert_eq!(d.only().code, "insp::resolve::out_of_range");
+    let d = check("units inch");
+    let e = d.only();
+    assert_eq!(e.code, "insp::resolve::unknown_property");
+    assert!(
+        e.message.contains("states its own length unit"),
+        "{}",
+        e.message
+    );
+}
