@@ -221,7 +221,7 @@ fn limits(nominal: f64, upper: f64, lower: f64, unit: &str) -> String {
 /// mesh leaves it out. What loses faces says so in the notes.
 fn solid_pmi(part: &CadPart) -> pmi::Pmi {
     let mut p = part.pmi.clone();
-    let solid = part.face_ids.len() - part.sheet_faces;
+    let solid = part.solid_faces();
     let mut notes = Vec::new();
     let mut keep = |faces: &mut Vec<usize>, what: String| {
         let before = faces.len();
@@ -510,7 +510,7 @@ fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
     );
     Imported {
         text,
-        faces: part.face_ids.len() - part.sheet_faces,
+        faces: part.solid_faces(),
         datums: (seen_letters.len(), frames.datum_feature.len()),
         tolerances: (p.tolerances.len(), written_tols),
         dimensions: (p.dimensions.len(), written_dims),
@@ -579,7 +579,7 @@ fn render(
     let _ = writeln!(
         s,
         "// {} faces (`face_<n>` in the file's shell order), {} × {} × {} mm; the file's unit is {}.",
-        part.face_ids.len() - part.sheet_faces,
+        part.solid_faces(),
         size[0],
         size[1],
         size[2],

@@ -363,15 +363,12 @@ fn part_summary(o: &mut String, p: &Part) {
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default();
-            let ext = path
-                .extension()
-                .map(|e| e.to_string_lossy().to_ascii_lowercase());
-            match ext.as_deref() {
-                Some("stp" | "step" | "qif") => format!(
+            match CadKind::of_path(path) {
+                Some(_) => format!(
                     "CAD {name} (in the file's unit, chord {} mm)",
                     fmt_num(chord_mm.unwrap_or(crate::geometry::step::RESOLUTION.chord_mm))
                 ),
-                _ => format!("mesh {name} (× {} mm)", fmt_num(*unit_mm)),
+                None => format!("mesh {name} (× {} mm)", fmt_num(*unit_mm)),
             }
         }
     };

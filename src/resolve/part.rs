@@ -400,16 +400,10 @@ fn mesh(
     props: &[ast::Prop],
     part_unit: f64,
 ) -> Option<Geometry> {
-    let ext = std::path::Path::new(&path.value)
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    let cad = match ext.as_str() {
-        "stp" | "step" => Some("a STEP file (it states its own length unit)"),
-        "qif" => Some("a QIF file (it states its own length unit)"),
-        _ => None,
-    };
-    let mut p = Props::new(cx, cad.unwrap_or("a mesh"), path.span, props);
+    let cad = CadKind::of_path(std::path::Path::new(&path.value))
+        .map(|k| format!("a {} file (it states its own length unit)", k.file()));
+    let item = cad.clone().unwrap_or_else(|| "a mesh".into());
+    let mut p = Props::new(cx, item, path.span, props);
     let mut unit_mm = part_unit;
     let mut chord_mm = None;
     if cad.is_some() {

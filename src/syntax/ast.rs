@@ -441,6 +441,17 @@ pub enum CadKind {
 }
 
 impl CadKind {
+    /// The kind of CAD file a path names, by its extension (`.stp`, `.step`, `.qif`);
+    /// `None` for a mesh or anything else.
+    pub fn of_path(path: &std::path::Path) -> Option<CadKind> {
+        let ext = path.extension()?.to_string_lossy().to_ascii_lowercase();
+        match ext.as_str() {
+            "stp" | "step" => Some(CadKind::Step),
+            "qif" => Some(CadKind::Qif),
+            _ => None,
+        }
+    }
+
     /// The keyword that names a face of this kind of file.
     pub fn keyword(self) -> &'static str {
         match self {

@@ -215,7 +215,7 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
     b.unit_name = unit_name.clone();
     let shell = orient(&mut b, res).map_err(q)?;
     let mesh_of = |b: &step::brep::Brep| {
-        step::mesh_brep(b, res).map_err(|e| match e {
+        step::mesh_brep(b, res, crate::model::CadKind::Qif).map_err(|e| match e {
             MeshFailure::Faces(list) => q(QifError::Faces(list)),
             MeshFailure::Mesh(e) => e,
         })
@@ -225,10 +225,6 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
         mesh = mesh_of(&b)?;
     }
     let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
-    mesh.cad = Some(crate::geometry::CadFaces {
-        kind: crate::model::CadKind::Qif,
-        ids: face_ids.clone(),
-    });
     let edge_faces: HashMap<u64, Vec<usize>> = step::edge_faces(&b);
     let pmi = pmi::read(&doc, &root, &face_ids, &edge_faces);
     Ok(CadPart {

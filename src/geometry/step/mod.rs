@@ -130,6 +130,13 @@ pub struct CadPart {
     pub pmi: pmi::Pmi,
 }
 
+impl CadPart {
+    /// The faces of the part: those of `face_ids` before the sheet faces left out.
+    pub fn solid_faces(&self) -> usize {
+        self.face_ids.len() - self.sheet_faces
+    }
+}
+
 /// Reads a STEP file's solid and meshes it.
 pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
     let file = p21::parse(bytes).map_err(|e| {
@@ -138,7 +145,9 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
             message: e.message,
         })
     })?;
-    let b = brep::read(&file).map_err(MeshError::Step)?;
+    let mut b = brep::read(&file).map_err(MeshError::Step)?;
+    // The PMI may name sheet faces: it is read against every face, the mesh made of the
+    // solid's.
     let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
     let pmi_edges = edge_faces(&b);
     let sheet_faces = if b.sheet_faces < b.faces.len() {
@@ -146,17 +155,11 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
     } else {
         0
     };
-    let mut b = b;
     b.faces.truncate(b.faces.len() - sheet_faces);
-    let mesh = mesh_brep(&b, res).map_err(|e| match e {
+    let mesh = mesh_brep(&b, res, crate::model::CadKind::Step).map_err(|e| match e {
         MeshFailure::Faces(list) => MeshError::Step(StepError::Faces(list)),
         MeshFailure::Mesh(e) => e,
     })?;
-    let mut mesh = mesh;
-    mesh.cad = Some(crate::geometry::CadFaces {
-        kind: crate::model::CadKind::Step,
-        ids: b.faces.iter().map(|f| f.id).collect(),
-    });
     let mut pmi = pmi::read(&file, &face_ids, &pmi_edges, b.unit_mm);
     locate_targets(&mut pmi, &mesh);
     Ok(CadPart {
@@ -177,8 +180,12 @@ pub(super) enum MeshFailure {
 }
 
 /// Tessellates a B-rep and welds it: one group per face (`face_<n>`), each with its
-/// exact surface.
-pub(super) fn mesh_brep(b: &brep::Brep, res: Resolution) -> Result<RawMesh, MeshFailure> {
+/// exact surface and its id in the file (of `kind`).
+pub(super) fn mesh_brep(
+    b: &brep::Brep,
+    res: Resolution,
+    kind: crate::model::CadKind,
+) -> Result<RawMesh, MeshFailure> {
     let (soup, failures) = tess::tessellate(b, res);
     if !failures.is_empty() {
         return Err(MeshFailure::Faces(
@@ -192,6 +199,10 @@ pub(super) fn mesh_brep(b: &brep::Brep, res: Resolution) -> Result<RawMesh, Mesh
     let mut mesh = weld(soup.positions, soup.triangles, soup.tri_face, groups, 1.0)
         .map_err(MeshFailure::Mesh)?;
     mesh.exact = b.faces.iter().map(exact_surface).collect();
+    mesh.cad = Some(crate::geometry::CadFaces {
+        kind,
+        ids: b.faces.iter().map(|f| f.id).collect(),
+    });
     Ok(mesh)
 }
 
