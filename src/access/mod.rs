@@ -28,6 +28,7 @@ mod probe;
 mod raster;
 mod report;
 mod scene;
+mod swept;
 
 pub use cpu::pixels_for;
 pub use cubemap::{face_dir, face_uv, ones, Cell, CubeMap, Pixel};

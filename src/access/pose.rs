@@ -17,9 +17,7 @@ use crate::geometry::{P3, V3};
 use nalgebra::{Rotation3, Unit};
 use parry3d_f64::math::Isometry;
 use parry3d_f64::query::intersection_test;
-use parry3d_f64::shape::{
-    Capsule, ConvexPolyhedron, Cuboid, Cylinder, RoundShape, Shape, TriMesh, Triangle,
-};
+use parry3d_f64::shape::{Capsule, Cuboid, Cylinder, RoundShape, Shape, TriMesh, Triangle};
 
 /// The share of the tip radius the mesh may come closer than the radius at a contact:
 /// fpoints lie on the exact surface and a concave face's facets are up to the
@@ -543,23 +541,15 @@ impl<'a> Pose<'a> {
                 (End::Flat, _) => {
                     let (e1, e2) = crate::sample::perpendicular_basis(&part.dir);
                     let r = radius / (std::f64::consts::PI / DISC_SIDES as f64).cos();
-                    let mut pts = Vec::with_capacity(4 * DISC_SIDES);
+                    let mut points = Vec::with_capacity(2 * DISC_SIDES);
                     for k in 0..DISC_SIDES {
                         let t = std::f64::consts::TAU * k as f64 / DISC_SIDES as f64;
                         let e = (e1 * t.cos() + e2 * t.sin()) * r;
-                        pts.push(a0 + e);
-                        pts.push(b0 + e);
-                        if moving {
-                            pts.push(a0 + e + v);
-                            pts.push(b0 + e + v);
-                        }
+                        points.push(a0 + e);
+                        points.push(b0 + e);
                     }
-                    match ConvexPolyhedron::from_convex_hull(&pts) {
-                        Some(hull) => hits(&hull),
-                        // A hull parry cannot build (a degenerate move): test positions
-                        // along the move with the radius grown to cover the gaps.
-                        None => sampled(&a0, &b0, &v, radius, hits),
-                    }
+                    let v = if moving { v } else { V3::zeros() };
+                    hits(&super::swept::SweptHull { points, v })
                 }
             };
             if hit {
@@ -568,17 +558,6 @@ impl<'a> Pose<'a> {
         }
         Ok(())
     }
-}
-
-/// The fallback sweep: capsules every millimetre around the component's axis, radius
-/// grown by half a step (a capsule holds the flat-ended cylinder).
-fn sampled(a: &P3, b: &P3, v: &V3, radius: f64, hits: &dyn Fn(&dyn Shape) -> bool) -> bool {
-    let steps = v.norm().ceil().max(1.0) as usize;
-    let radius = radius + v.norm() / steps as f64 / 2.0;
-    (0..=steps).any(|s| {
-        let t = v * (s as f64 / steps as f64);
-        hits(&Capsule::new(a + t, b + t, radius))
-    })
 }
 
 /// A stand-off's key: its position to 0.1 µm (the plan's coordinates are quantised to
