@@ -168,6 +168,11 @@ impl CubeMap {
         self.bits[k / 64] >> (k % 64) & 1 == 1
     }
 
+    /// Whether the cell with bit index `k` (see [`CubeMap::index`]) is in the cone.
+    pub fn has_index(&self, k: usize) -> bool {
+        self.bits[k / 64] >> (k % 64) & 1 == 1
+    }
+
     /// Adds or removes a cell.
     pub fn set(&mut self, c: Cell, on: bool) {
         let k = self.index(c);

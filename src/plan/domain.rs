@@ -34,6 +34,9 @@ pub(crate) struct Machine {
     pub head: Head,
     /// The head's A/B grid (degrees); one (0, 0) for a fixed head.
     pub grid: Vec<(f64, f64)>,
+    /// The grid's probe directions in the machine frame (`access::head_direction`),
+    /// computed once: the planner asks for them per point, probe and setup.
+    pub grid_dirs: Vec<V3>,
     /// The grid orientations the plan allows.
     pub grid_allowed: Bits,
     /// Preference weights of grid orientations (0.5 when unspecified).
@@ -86,12 +89,17 @@ impl Machine {
                 }
             }
         }
+        let grid_dirs = grid
+            .iter()
+            .map(|&(a, b)| access::head_direction(a, b))
+            .collect();
         Machine {
             probes,
             costs,
             allowed,
             head: kind,
             grid,
+            grid_dirs,
             grid_allowed,
             grid_weight,
             a_max,
@@ -157,6 +165,10 @@ pub(crate) struct Knowledge<'a> {
     d1p: BTreeMap<(usize, usize, usize), Bits>,
     /// The second component's depth map per setup cell.
     second: BTreeMap<usize, SecondMap>,
+    /// Per setup cell, the cube-map bit index of each grid orientation's direction in
+    /// that setup's part frame: one `cell_of` per (setup, orientation) instead of one
+    /// per (point, probe, setup, orientation).
+    grid_cells: BTreeMap<usize, std::sync::Arc<[u32]>>,
     /// How many times the whole probe's cones were computed.
     pub acquired: usize,
 }
@@ -340,8 +352,26 @@ impl<'a> Knowledge<'a> {
             tables,
             d1p: BTreeMap::new(),
             second: BTreeMap::new(),
+            grid_cells: BTreeMap::new(),
             acquired: 0,
         }
+    }
+
+    /// The bit index, in the knowledge's cube maps, of each grid orientation's
+    /// direction in setup cell `s` (part direction `up`), computed once per setup.
+    fn grid_cells(&mut self, s: usize, up: &V3, machine: &Machine) -> std::sync::Arc<[u32]> {
+        if let Some(c) = self.grid_cells.get(&s) {
+            return c.clone();
+        }
+        let like = self.empty_cone();
+        let to_part = frame(up).inverse();
+        let cells: std::sync::Arc<[u32]> = machine
+            .grid_dirs
+            .iter()
+            .map(|d| like.index(like.cell_of(&(to_part * d))) as u32)
+            .collect();
+        self.grid_cells.insert(s, cells.clone());
+        cells
     }
 
     /// An empty cube map of the knowledge's shape.
@@ -482,8 +512,35 @@ impl<'a> Knowledge<'a> {
             .fold(0.0, f64::max);
         let height =
             self.points[f].tip_centre(probe.tip_radius).coords.dot(up) - self.table_height(s);
-        height >= probe.reach() + widest + access::pose::ORIENTATION_TABLE_MARGIN
-            || !self.candidates(f, p, s, up, machine).2.is_empty()
+        if height >= probe.reach() + widest + access::pose::ORIENTATION_TABLE_MARGIN {
+            return true;
+        }
+        // `candidates` without the list: the first orientation that passes will do.
+        let t0 = self.table_height(s);
+        let c = self.points[f].tip_centre(probe.tip_radius);
+        let to_part = frame(up).inverse();
+        let cells = self.grid_cells(s, up, machine);
+        let Some(d1) = self.dom.get(f).and_then(|d| d[p].d1.as_ref()) else {
+            return false;
+        };
+        // Every component's lowest point rises with cos A (the direction's component
+        // along `up`), so once an orientation at some A hits the table, every one at that
+        // A or more does: a point low in this setup is ruled out after one test, not 720.
+        let mut blocked_from = f64::INFINITY;
+        machine.grid_dirs.iter().enumerate().any(|(k, d)| {
+            let a = machine.grid[k].0;
+            if a >= blocked_from
+                || !Set::has(&machine.grid_allowed, k)
+                || !d1.has_index(cells[k] as usize)
+            {
+                return false;
+            }
+            let ok = above_table(probe, &c, &(to_part * d), up, t0);
+            if !ok {
+                blocked_from = a;
+            }
+            ok
+        })
     }
 
     /// The tip centre of probe `p` on point `f`, the grid's directions in the part frame of
@@ -498,15 +555,12 @@ impl<'a> Knowledge<'a> {
         machine: &Machine,
     ) -> (P3, Vec<V3>, Vec<usize>) {
         let t0 = self.table_height(s);
+        let cells = self.grid_cells(s, up, machine);
         let probe = &machine.probes[p];
         let point = &self.points[f];
         let c = point.tip_centre(probe.tip_radius);
         let to_part = frame(up).inverse();
-        let dirs: Vec<V3> = machine
-            .grid
-            .iter()
-            .map(|&(a, b)| to_part * access::head_direction(a, b))
-            .collect();
+        let dirs: Vec<V3> = machine.grid_dirs.iter().map(|d| to_part * d).collect();
         let table = f >= self.graph_points;
         // A table point's tip touches the table: its stylus comes as near as the stem
         // leaves (the move's own margin still holds), not the orientation margin.
@@ -515,11 +569,11 @@ impl<'a> Knowledge<'a> {
         } else {
             0.0
         };
-        let d1 = self.dom.get(f).and_then(|d| d[p].d1.clone());
+        let d1 = self.dom.get(f).and_then(|d| d[p].d1.as_ref());
         let candidates: Vec<usize> = (0..dirs.len())
             .filter(|&k| {
                 Set::has(&machine.grid_allowed, k)
-                    && (table || d1.as_ref().is_some_and(|d1| d1.contains(&dirs[k])))
+                    && (table || d1.is_some_and(|d1| d1.has_index(cells[k] as usize)))
                     && above_table(probe, &c, &dirs[k], up, t0 - table_slack)
                     && (!table || dirs[k].dot(&point.normal) > 0.2)
             })
