@@ -282,7 +282,7 @@ fn plans_of(
     graphs: &[Graphed],
     opts: &plan::PlanOptions,
 ) -> Vec<Planned> {
-    let (out, each) = plan_each(checked, parts, graphs, opts);
+    let (out, each, _) = plan_each(checked, parts, graphs, opts);
     checked.absorb_all(each);
     out
 }
@@ -294,11 +294,12 @@ fn plan_each(
     parts: &[Option<PartData>],
     graphs: &[Graphed],
     opts: &plan::PlanOptions,
-) -> (Vec<Planned>, Vec<diag::Diagnostics>) {
+) -> (Vec<Planned>, Vec<diag::Diagnostics>, Vec<plan::Memo>) {
     let mut out = Vec::new();
     let mut each = Vec::new();
+    let mut memos = Vec::new();
     if checked.has_errors() {
-        return (out, each);
+        return (out, each, memos);
     }
     let mut diags = diag::Diagnostics::new();
     let model = &checked.model;
@@ -326,12 +327,14 @@ fn plan_each(
             graph: &g.graph,
         };
         let mut own = diag::Diagnostics::new();
-        let hlip = plan::plan(&input, opts, &mut own);
+        let mut memo = plan::Memo::default();
+        let hlip = plan::plan_with(&input, opts, &mut memo, &mut own);
         out.push(Planned { plan: k, hlip });
         each.push(own);
+        memos.push(memo);
     }
     checked.absorb(diags);
-    (out, each)
+    (out, each, memos)
 }
 
 /// One plan built: its HLIP, its paths and its DMIS program.
@@ -434,13 +437,13 @@ pub fn run(
         return run;
     }
     progress("planning", 0, 1);
-    let (planned, each) = plan_each(&mut run.checked, &run.parts, &run.graphs, opts);
+    let (planned, each, memos) = plan_each(&mut run.checked, &run.parts, &run.graphs, opts);
     lap(&mut run.timings, "plan");
     if run.checked.has_errors() || each.iter().any(|d| d.has_errors()) {
         run.checked.absorb_all(each);
         return run;
     }
-    let paths = paths_of(&mut run, planned, each, opts, progress);
+    let paths = paths_of(&mut run, planned, each, memos, opts, progress);
     lap(&mut run.timings, "paths");
     if run.checked.has_errors() {
         return run;
@@ -466,12 +469,13 @@ fn paths_of(
     run: &mut Run,
     planned: Vec<Planned>,
     each: Vec<diag::Diagnostics>,
+    memos: Vec<plan::Memo>,
     opts: &plan::PlanOptions,
     progress: Progress,
 ) -> Pathed {
     let mut diags = diag::Diagnostics::new();
     let mut paths = Vec::new();
-    for (p, mut own) in planned.into_iter().zip(each) {
+    for ((p, mut own), mut memo) in planned.into_iter().zip(each).zip(memos) {
         let Some(mut hlip) = p.hlip else {
             diags.extend(own);
             continue;
@@ -514,7 +518,7 @@ fn paths_of(
                 ..opts.clone()
             };
             let mut replanned = diag::Diagnostics::new();
-            match plan::plan(&input, &again, &mut replanned) {
+            match plan::plan_with(&input, &again, &mut memo, &mut replanned) {
                 Some(h) => {
                     hlip = h;
                     own = replanned;

@@ -163,14 +163,29 @@ pub(crate) struct Knowledge<'a> {
     pub tables: Vec<TableAlt>,
     /// D1′ on the grid per (point, probe, setup cell).
     d1p: BTreeMap<(usize, usize, usize), Bits>,
-    /// The second component's depth map per setup cell.
-    second: BTreeMap<usize, SecondMap>,
+    /// Cones and depth maps computed before, and where new ones are kept.
+    memo: &'a mut Memo,
     /// Per setup cell, the cube-map bit index of each grid orientation's direction in
     /// that setup's part frame: one `cell_of` per (setup, orientation) instead of one
     /// per (point, probe, setup, orientation).
     grid_cells: BTreeMap<usize, std::sync::Arc<[u32]>>,
     /// How many times the whole probe's cones were computed.
     pub acquired: usize,
+}
+
+/// What one planning of an input computes that a later planning of the same input (a
+/// re-plan after the path stage bans a configuration) can reuse: the pure results only —
+/// cones of a point and probe, depth maps of a setup — never what learning changed. A
+/// memo belongs to one [`super::Input`]; the re-plan gives byte-identical knowledge
+/// without computing it again.
+#[derive(Default)]
+pub struct Memo {
+    /// The initial knowledge of every (graph point, probe).
+    initial: Option<Vec<Vec<Dom>>>,
+    /// The whole probe's cones per (point, probe).
+    cones: BTreeMap<(usize, usize), access::PointCones>,
+    /// The second component's depth map per setup cell.
+    second: BTreeMap<usize, SecondMap>,
 }
 
 /// The cells within `angle` radians of `axis`, in the shape of `like`.
@@ -235,6 +250,7 @@ impl<'a> Knowledge<'a> {
         table_faces: &[FaceId],
         setups: super::poses::Setups<'a>,
         opts: ConeOptions,
+        memo: &'a mut Memo,
     ) -> Knowledge<'a> {
         let realisable = setups.exact_dirs();
         let scene = Scene::of_part(geometry);
@@ -327,16 +343,23 @@ impl<'a> Knowledge<'a> {
             });
         }
         let graph_points = fpoints.len();
-        let dom: Vec<Vec<Dom>> = fpoints
-            .par_iter()
-            .map(|f| {
-                machine
-                    .probes
-                    .iter()
-                    .map(|p| initial(&scene, f, p, machine, &opts))
-                    .collect()
-            })
-            .collect();
+        let dom: Vec<Vec<Dom>> = match &memo.initial {
+            Some(dom) => dom.clone(),
+            None => {
+                let dom: Vec<Vec<Dom>> = fpoints
+                    .par_iter()
+                    .map(|f| {
+                        machine
+                            .probes
+                            .iter()
+                            .map(|p| initial(&scene, f, p, machine, &opts))
+                            .collect()
+                    })
+                    .collect();
+                memo.initial = Some(dom.clone());
+                dom
+            }
+        };
         Knowledge {
             setups,
             held: BTreeMap::new(),
@@ -351,7 +374,7 @@ impl<'a> Knowledge<'a> {
             setup_prefs,
             tables,
             d1p: BTreeMap::new(),
-            second: BTreeMap::new(),
+            memo,
             grid_cells: BTreeMap::new(),
             acquired: 0,
         }
@@ -461,7 +484,7 @@ impl<'a> Knowledge<'a> {
         let clear: Vec<bool> = if candidates.is_empty() {
             vec![]
         } else {
-            let map = self.second.entry(s).or_insert_with(|| {
+            let map = self.memo.second.entry(s).or_insert_with(|| {
                 let radius = machine
                     .probes
                     .iter()
@@ -667,18 +690,23 @@ impl<'a> Knowledge<'a> {
             d2_samples: D2_SAMPLES,
             ..self.opts.clone()
         };
+        let memo = &self.memo.cones;
         let computed: Vec<access::PointCones> = todo
             .par_iter()
-            .map(|&(f, p)| {
-                access::point_cones(
+            .map(|&(f, p)| match memo.get(&(f, p)) {
+                Some(cones) => cones.clone(),
+                None => access::point_cones(
                     &access::Cpu,
                     &self.scene,
                     &self.points[f],
                     &machine.probes[p],
                     &opts,
-                )
+                ),
             })
             .collect();
+        for (&pair, cones) in todo.iter().zip(&computed) {
+            self.memo.cones.entry(pair).or_insert_with(|| cones.clone());
+        }
         // Preferred directions the half-line allowed and the rasterized probe did not:
         // its grown pixels err on the blocked side, so test them exactly.
         let shape = self.empty_cone();

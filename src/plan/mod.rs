@@ -38,6 +38,7 @@ use crate::geometry::{FaceId, PartGeometry, V3};
 use crate::graph::{MeasurementGraph, Node};
 use crate::model::{Model, Plan, PlanId, SurfaceKind};
 use cluster::Strategy;
+pub use domain::Memo;
 use domain::{Knowledge, Machine};
 use explain::{face_name, report_face};
 use fallback::Fallback;
@@ -316,6 +317,18 @@ pub fn explain_setups(
 /// a search that never gets a plan to validate, are reported in `diags` and give `None`;
 /// a search that does not settle ends with the best plan found ([`fallback`]).
 pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Option<Hlip> {
+    plan_with(input, opts, &mut Memo::default(), diags)
+}
+
+/// [`plan`], keeping in `memo` the cones and depth maps it computes and reusing those a
+/// previous planning of the same `input` left there (the re-plans after the path stage's
+/// bans). The plan is the one [`plan`] gives.
+pub fn plan_with(
+    input: &Input,
+    opts: &PlanOptions,
+    memo: &mut Memo,
+    diags: &mut Diagnostics,
+) -> Option<Hlip> {
     let (model, plan, g) = (input.model, input.plan, input.graph);
     let hierarchy = &model.hierarchies[plan.hierarchy.0];
     let machine = Machine::new(model, plan);
@@ -354,6 +367,7 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
         &table_faces,
         setups,
         cone_opts,
+        memo,
     );
     let mut validated: BTreeSet<Pip> = BTreeSet::new();
     let mut last = String::from("no round was run");
