@@ -346,14 +346,29 @@ impl<'a> Knowledge<'a> {
         let dom: Vec<Vec<Dom>> = match &memo.initial {
             Some(dom) => dom.clone(),
             None => {
+                // The initial knowledge depends on a probe only through its tip's
+                // radius: probes sharing a tip size share it.
+                let same_tip: Vec<Option<usize>> = machine
+                    .probes
+                    .iter()
+                    .enumerate()
+                    .map(|(p, probe)| {
+                        machine.probes[..p]
+                            .iter()
+                            .position(|q| q.tip_radius == probe.tip_radius)
+                    })
+                    .collect();
                 let dom: Vec<Vec<Dom>> = fpoints
                     .par_iter()
                     .map(|f| {
-                        machine
-                            .probes
-                            .iter()
-                            .map(|p| initial(&scene, f, p, machine, &opts))
-                            .collect()
+                        let mut out: Vec<Dom> = Vec::with_capacity(machine.probes.len());
+                        for (p, probe) in machine.probes.iter().enumerate() {
+                            out.push(match same_tip[p] {
+                                Some(q) => out[q].clone(),
+                                None => initial(&scene, f, probe, machine, &opts),
+                            });
+                        }
+                        out
                     })
                     .collect();
                 memo.initial = Some(dom.clone());
