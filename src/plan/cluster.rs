@@ -314,64 +314,58 @@ pub fn min_hitting_set<S: Set>(w: &[&S], budget: usize) -> (usize, bool) {
     if greedy == lower {
         return (greedy, true);
     }
-    let mut best = greedy;
-    let mut nodes = 0usize;
-    let mut complete = true;
-    #[allow(clippy::too_many_arguments)]
-    fn search(
-        covered: &Bits,
-        depth: usize,
-        n: usize,
-        keep: &[Bits],
-        best: &mut usize,
-        nodes: &mut usize,
+    // The sets in branching order — fewest candidates hitting them first (the most
+    // constrained), ties by index — and each set's candidates in `keep` order: fixed
+    // for the whole search, so a node finds its branch without counting again.
+    let hitters: Vec<Vec<usize>> = (0..n)
+        .map(|i| (0..keep.len()).filter(|&c| keep[c].has(i)).collect())
+        .collect();
+    let mut branching: Vec<usize> = (0..n).collect();
+    branching.sort_by_key(|&i| (hitters[i].len(), i));
+    struct Search<'a> {
+        keep: &'a [Bits],
+        hitters: &'a [Vec<usize>],
+        order: &'a [usize],
+        best: usize,
+        nodes: usize,
         budget: usize,
-        complete: &mut bool,
-    ) {
-        *nodes += 1;
-        if *nodes > budget {
-            *complete = false;
-            return;
-        }
-        // Branch on the uncovered set the fewest candidates hit (most constrained).
-        let Some(first) = (0..n)
-            .filter(|&i| !covered.has(i))
-            .min_by_key(|&i| (keep.iter().filter(|c| c.has(i)).count(), i))
-        else {
-            *best = (*best).min(depth);
-            return;
-        };
-        if depth + 1 >= *best {
-            return;
-        }
-        for c in keep.iter().filter(|c| c.has(first)) {
-            search(
-                &covered.or(c),
-                depth + 1,
-                n,
-                keep,
-                best,
-                nodes,
-                budget,
-                complete,
-            );
-            if !*complete {
+        complete: bool,
+    }
+    impl Search<'_> {
+        fn run(&mut self, covered: &Bits, depth: usize) {
+            self.nodes += 1;
+            if self.nodes > self.budget {
+                self.complete = false;
                 return;
+            }
+            // Branch on the first uncovered set in branching order.
+            let Some(&first) = self.order.iter().find(|&&i| !covered.has(i)) else {
+                self.best = self.best.min(depth);
+                return;
+            };
+            if depth + 1 >= self.best {
+                return;
+            }
+            for &c in &self.hitters[first] {
+                self.run(&covered.or(&self.keep[c]), depth + 1);
+                if !self.complete {
+                    return;
+                }
             }
         }
     }
-    search(
-        &Bits::empty(n),
-        0,
-        n,
-        &keep,
-        &mut best,
-        &mut nodes,
+    let mut search = Search {
+        keep: &keep,
+        hitters: &hitters,
+        order: &branching,
+        best: greedy,
+        nodes: 0,
         budget,
-        &mut complete,
-    );
-    if complete {
-        (best, true)
+        complete: true,
+    };
+    search.run(&Bits::empty(n), 0);
+    if search.complete {
+        (search.best, true)
     } else {
         (lower, false)
     }
