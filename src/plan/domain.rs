@@ -242,6 +242,7 @@ impl<'a> Knowledge<'a> {
 
     /// The initial knowledge: half-line cones at every fpoint for every probe, table
     /// alternatives for datum faces that can rest on the table.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn new(
         plan: &Plan,
         machine: &Machine,
