@@ -15,7 +15,7 @@ use inspc::source::{FsWorld, MemoryWorld, World};
 use std::path::{Path, PathBuf};
 
 fn main() {
-    for spec in SPECS.iter().chain(EXAMPLES) {
+    for spec in SPECS.iter().copied().chain(examples()) {
         if !Path::new(spec).exists() {
             continue;
         }
@@ -42,15 +42,20 @@ const SPECS: [&str; 4] = [
     "tests/real/nist_ftc_08.insp",
 ];
 
-const EXAMPLES: &[&str] = &[
-    "examples/f2.insp",
-    "examples/f3_fixed.insp",
-    "examples/f3_indexed.insp",
-    "examples/f4.insp",
-    "examples/swiss_block.insp",
-    "examples/swiss_sphere_fixed.insp",
-    "examples/swiss_sphere_indexed.insp",
-];
+/// Every example, read from `examples/` (sorted), so a new one is timed too.
+fn examples() -> Vec<&'static str> {
+    let mut out: Vec<String> = std::fs::read_dir("examples")
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.path())
+                .filter(|p| p.extension().is_some_and(|x| x == "insp"))
+                .map(|p| p.to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    out.sort();
+    out.into_iter().map(|s| &*s.leak()).collect()
+}
 
 fn build(world: &dyn World, spec: &str) -> (bool, usize, inspc::Timings) {
     let (checked, built, t) = inspc::build(
@@ -68,7 +73,7 @@ fn nist(spec: &str) {
     assert!(!errors && built == 1, "{spec}");
 }
 
-#[divan::bench(args = EXAMPLES, sample_count = 3, sample_size = 1)]
+#[divan::bench(args = examples(), sample_count = 3, sample_size = 1)]
 fn example(spec: &str) {
     let (errors, _, _) = build(&FsWorld, spec);
     assert!(!errors, "{spec}");
