@@ -164,8 +164,7 @@ impl CubeMap {
 
     /// Whether a cell is in the cone.
     pub fn get(&self, c: Cell) -> bool {
-        let k = self.index(c);
-        self.bits[k / 64] >> (k % 64) & 1 == 1
+        self.has_index(self.index(c))
     }
 
     /// Whether the cell with bit index `k` (see [`CubeMap::index`]) is in the cone.

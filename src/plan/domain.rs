@@ -549,14 +549,13 @@ impl<'a> Knowledge<'a> {
             .chain(&probe.second)
             .map(|c| c.radius)
             .fold(0.0, f64::max);
-        let height =
-            self.points[f].tip_centre(probe.tip_radius).coords.dot(up) - self.table_height(s);
-        if height >= probe.reach() + widest + access::pose::ORIENTATION_TABLE_MARGIN {
+        let t0 = self.table_height(s);
+        let c = self.points[f].tip_centre(probe.tip_radius);
+        if c.coords.dot(up) - t0 >= probe.reach() + widest + access::pose::ORIENTATION_TABLE_MARGIN
+        {
             return true;
         }
         // `candidates` without the list: the first orientation that passes will do.
-        let t0 = self.table_height(s);
-        let c = self.points[f].tip_centre(probe.tip_radius);
         let to_part = frame(up).inverse();
         let cells = self.grid_cells(s, up, machine);
         let Some(d1) = self.dom.get(f).and_then(|d| d[p].d1.as_ref()) else {
