@@ -35,14 +35,76 @@ pub fn pixels_for(alpha: f64, n: u32) -> u32 {
     (alpha * n as f64 / MIN_STEP * 1.02).ceil().max(1.0) as u32
 }
 
+/// Where shadows are drawn: the base map (target 0, pixels as they are) and band k ≥ 1
+/// (pixels to grow k times). The CPU draws at once; the GPU backend records the polygons
+/// and rasterizes many components' shadows in one submission.
+pub(super) trait Canvas {
+    /// Marks the shadow of the convex polygon `q` (relative to the viewpoint, 3 to 12
+    /// corners) in `target`.
+    fn draw(&mut self, target: u32, q: &[V3], cov: Coverage);
+}
+
+/// The CPU's canvas: the maps themselves.
+pub(super) struct Maps {
+    /// Target 0.
+    pub base: CubeMap,
+    /// Target k at index k − 1.
+    pub bands: Vec<Option<CubeMap>>,
+}
+
+impl Maps {
+    pub fn new(n: u32, preferred: &[V3]) -> Maps {
+        Maps {
+            base: CubeMap::empty(n, preferred),
+            bands: Vec::new(),
+        }
+    }
+}
+
+impl Canvas for Maps {
+    fn draw(&mut self, target: u32, q: &[V3], cov: Coverage) {
+        let map = if target == 0 {
+            &mut self.base
+        } else {
+            let k = target as usize;
+            if self.bands.len() < k {
+                self.bands.resize(k, None);
+            }
+            let base = &self.base;
+            self.bands[k - 1].get_or_insert_with(|| base.empty_like())
+        };
+        shadow_polygon(map, q, cov);
+    }
+}
+
+/// What drawing left for [`finish`]: whether the component meets the scene in every
+/// direction, and the triangles a truncated half-line's preferred directions are tested
+/// against.
+pub(super) struct Drawn<'s> {
+    pub full: bool,
+    pub candidates: Vec<&'s Tri>,
+}
+
 /// Marks the directions in which `comp`, placed with its axis from `from`, meets the
 /// scene.
 pub fn blocked(scene: &Scene, from: &P3, comp: &Component, n: u32, preferred: &[V3]) -> CubeMap {
-    let mut base = CubeMap::empty(n, preferred);
+    let mut maps = Maps::new(n, preferred);
+    let drawn = draw(scene, from, comp, n, &mut maps);
+    finish(scene, from, comp, maps.base, maps.bands, &drawn)
+}
+
+/// Draws the shadows of the scene's triangles for `comp` at `from` (cube maps of
+/// resolution `n`), cheapest test first (see the module's documentation).
+pub(super) fn draw<'s>(
+    scene: &'s Scene,
+    from: &P3,
+    comp: &Component,
+    n: u32,
+    canvas: &mut impl Canvas,
+) -> Drawn<'s> {
     let r = comp.radius;
     let (near, far) = (comp.near(), comp.far());
     let from_tip = comp.a == 0.0;
-    let mut bands: Vec<Option<CubeMap>> = Vec::new();
     let mut candidates: Vec<&Tri> = Vec::new();
     let mut q = [V3::zeros(); 12];
     for t in &scene.tris {
@@ -66,7 +128,7 @@ pub fn blocked(scene: &Scene, from: &P3, comp: &Component, n: u32, preferred: &[
             for (k, v) in t.v.iter().enumerate() {
                 q[k] = v - from;
             }
-            shadow_polygon(&mut base, &q[..3], Coverage::Centres);
+            canvas.draw(0, &q[..3], Coverage::Centres);
             if near > 0.0 {
                 candidates.push(t);
             }
@@ -79,23 +141,45 @@ pub fn blocked(scene: &Scene, from: &P3, comp: &Component, n: u32, preferred: &[
         }
         if from_tip && dmin.max(near) > r {
             let k = pixels_for((r / dmin.max(near)).asin(), n);
-            if k > PRISM_PIXELS && t.normal != V3::zeros() && prism_shadow(&mut base, from, t, r, h)
-            {
+            if k > PRISM_PIXELS && t.normal != V3::zeros() && prism_shadow(canvas, from, t, r, h) {
                 continue;
             }
         }
-        if !grown_shadow(&mut base, &mut bands, from, comp, t.v, dmin, 0) {
-            base.fill_pixels();
-            base.fill_preferred();
-            return base;
+        if !grown_shadow(canvas, n, from, comp, t.v, dmin, 0) {
+            return Drawn {
+                full: true,
+                candidates,
+            };
         }
     }
+    Drawn {
+        full: false,
+        candidates,
+    }
+}
+
+/// The blocked map from the drawn shadows: ∪ₖ growₖ(bandₖ) added to the base, then the
+/// preferred directions.
+pub(super) fn finish(
+    scene: &Scene,
+    from: &P3,
+    comp: &Component,
+    mut base: CubeMap,
+    bands: Vec<Option<CubeMap>>,
+    drawn: &Drawn,
+) -> CubeMap {
+    if drawn.full {
+        base.fill_pixels();
+        base.fill_preferred();
+        return base;
+    }
+    let (r, near, far) = (comp.radius, comp.near(), comp.far());
     // ∪ₖ growₖ(bandₖ), growing each accumulated band once per step (Horner's scheme).
     let mut acc: Option<CubeMap> = None;
     for band in bands.into_iter().rev() {
         let mut m = match acc.take() {
             Some(a) => a.grow(),
-            None => CubeMap::empty(n, preferred),
+            None => base.empty_like(),
         };
         if let Some(b) = band {
             m.or_assign(&b);
@@ -111,7 +195,7 @@ pub fn blocked(scene: &Scene, from: &P3, comp: &Component, n: u32, preferred: &[
         let hit = if r == 0.0 && near == 0.0 {
             scene.cast_ray(from, &d, far).is_some_and(|t| t > 0.0)
         } else if r == 0.0 {
-            candidates.iter().any(|t| {
+            drawn.candidates.iter().any(|t| {
                 crate::geometry::line_triangle(from, &d, &t.v[0], &t.v[1], &t.v[2])
                     .is_some_and(|s| s > 0.0 && s >= near && s <= far)
             })
@@ -132,15 +216,15 @@ pub fn blocked(scene: &Scene, from: &P3, comp: &Component, n: u32, preferred: &[
 /// nearest distance is split, up to `MAX_SPLIT` times, and the pieces wholly inside are
 /// dropped. False when the component meets the triangle in every direction.
 fn grown_shadow(
-    base: &mut CubeMap,
-    bands: &mut Vec<Option<CubeMap>>,
+    canvas: &mut impl Canvas,
+    n: u32,
     from: &P3,
     comp: &Component,
     v: [P3; 3],
     dmin: f64,
     depth: u32,
 ) -> bool {
-    let (r, near, n) = (comp.radius, comp.near(), base.n());
+    let (r, near) = (comp.radius, comp.near());
     let reach = v.iter().map(|p| (p - from).norm()).fold(0.0, f64::max);
     if reach < near {
         return true;
@@ -160,7 +244,7 @@ fn grown_shadow(
         ];
         return parts.into_iter().all(|part| {
             let d = point_triangle_distance(from, &part);
-            d > comp.far() || grown_shadow(base, bands, from, comp, part, d, depth + 1)
+            d > comp.far() || grown_shadow(canvas, n, from, comp, part, d, depth + 1)
         });
     }
     let Some(alpha) = dilation(r, near, dmin, reach) else {
@@ -171,11 +255,7 @@ fn grown_shadow(
         return false;
     }
     let q = v.map(|p| p - from);
-    if bands.len() < k as usize {
-        bands.resize(k as usize, None);
-    }
-    let band = bands[k as usize - 1].get_or_insert_with(|| base.empty_like());
-    shadow_polygon(band, &q, Coverage::Cells);
+    canvas.draw(k, &q, Coverage::Cells);
     true
 }
 
@@ -203,7 +283,7 @@ fn dilation(r: f64, near: f64, dmin: f64, dmax: f64) -> Option<f64> {
 /// (six sides), and it reaches `r` to either side of the plane. Only the faces that face
 /// the viewpoint are drawn; they hide the rest. False, drawing nothing, when the
 /// viewpoint is inside the prism.
-fn prism_shadow(out: &mut CubeMap, from: &P3, t: &Tri, r: f64, h: f64) -> bool {
+fn prism_shadow(out: &mut impl Canvas, from: &P3, t: &Tri, r: f64, h: f64) -> bool {
     let nn = t.normal;
     let mut hex = [V3::zeros(); 6];
     for i in 0..3 {
@@ -235,12 +315,12 @@ fn prism_shadow(out: &mut CubeMap, from: &P3, t: &Tri, r: f64, h: f64) -> bool {
     let up = nn * (r * if h >= 0.0 { 1.0 } else { -1.0 });
     if above {
         let near: Vec<V3> = hex.iter().map(|p| p + up).collect();
-        shadow_polygon(out, &near, Coverage::Cells);
+        out.draw(0, &near, Coverage::Cells);
     }
     for k in 0..6 {
         if facing[k] {
             let (p, q) = (hex[k], hex[(k + 1) % 6]);
-            shadow_polygon(out, &[p + up, q + up, q - up, p - up], Coverage::Cells);
+            out.draw(0, &[p + up, q + up, q - up, p - up], Coverage::Cells);
         }
     }
     true
