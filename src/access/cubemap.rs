@@ -457,6 +457,27 @@ impl CubeMap {
         }
     }
 
+    /// A map shaped like this one whose pixels are the bits of `words` (32 to a word, in
+    /// pixel order: see [`CubeMap::words`]) and whose preferred directions are clear.
+    pub fn with_pixel_words(&self, words: &[u32]) -> CubeMap {
+        let mut out = self.empty_like();
+        let pixels = 6 * (self.n as usize) * (self.n as usize);
+        for (k, w) in out.bits.iter_mut().enumerate() {
+            let lo = words.get(2 * k).copied().unwrap_or(0) as u64;
+            let hi = words.get(2 * k + 1).copied().unwrap_or(0) as u64;
+            let first = 64 * k;
+            let keep = if first + 64 <= pixels {
+                u64::MAX
+            } else if first >= pixels {
+                0
+            } else {
+                row_mask(pixels - first)
+            };
+            *w = (lo | hi << 32) & keep;
+        }
+        out
+    }
+
     /// Adds pixels i0..=i1 of row `j` of a face.
     pub fn set_span(&mut self, face: u8, j: u32, i0: u32, i1: u32) {
         if i0 > i1 {

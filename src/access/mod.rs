@@ -9,7 +9,8 @@
 //! - [`ProbeShape`]: the spec's probe as tip ball plus [`Component`]s (stylus and
 //!   extensions as capsules, body, head and ram as cylinders);
 //! - [`Backend`]: computes one component's blocked directions; [`Cpu`] is the software
-//!   rasterizer, and the GPU backend will implement the same trait;
+//!   rasterizer, [`Gpu`] rasterizes the same shadow polygons with wgpu, many components
+//!   per submission;
 //! - the seed's family: the half-line GAC, grown and truncated half-lines (any
 //!   component), D1, D2 (weak GAC over dD1), D1′ for a chosen second-component
 //!   direction, feature cones as intersections, approach/retract cones.
@@ -22,6 +23,7 @@ mod cpu;
 mod cubemap;
 mod errors;
 mod exact;
+mod gpu;
 mod heightmap;
 pub mod pose;
 mod probe;
@@ -34,6 +36,7 @@ pub use cpu::pixels_for;
 pub use cubemap::{face_dir, face_uv, ones, Cell, CubeMap, Pixel};
 pub use errors::AccessError;
 pub use exact::{component_hits, refine};
+pub use gpu::Gpu;
 pub use pose::{Blocker, Contact, Head, Pose};
 pub use probe::{Component, End, ProbeShape};
 pub use raster::{shadow_polygon, Coverage};
@@ -44,8 +47,17 @@ use crate::geometry::{PartGeometry, P3, V3};
 use crate::sample::Fpoint;
 use rayon::prelude::*;
 
+/// One component placed at one point: a question for [`Backend::blocked_many`].
+#[derive(Debug, Clone, Copy)]
+pub struct Query<'a> {
+    /// Where the component's axis starts (the tip centre, or an articulation point).
+    pub from: P3,
+    /// The component.
+    pub comp: &'a Component,
+}
+
 /// Computes the directions one probe component is blocked in. The CPU rasterizer
-/// implements it; a GPU backend renders the same shadows.
+/// implements it; the GPU backend rasterizes the same shadows.
 pub trait Backend: Sync {
     /// The directions in which `comp`, with its axis starting at `from`, meets the scene.
     fn blocked(
@@ -56,6 +68,26 @@ pub trait Backend: Sync {
         n: u32,
         preferred: &[V3],
     ) -> CubeMap;
+
+    /// [`Backend::blocked`] for many queries, in their order.
+    fn blocked_many(
+        &self,
+        scene: &Scene,
+        queries: &[Query],
+        n: u32,
+        preferred: &[V3],
+    ) -> Vec<CubeMap> {
+        queries
+            .iter()
+            .map(|q| self.blocked(scene, &q.from, q.comp, n, preferred))
+            .collect()
+    }
+
+    /// Whether [`Backend::blocked_many`] pays over one query at a time, so callers
+    /// should gather their queries (the CPU stops early instead, once a cone is empty).
+    fn batches(&self) -> bool {
+        false
+    }
 }
 
 /// The software backend.
@@ -72,6 +104,36 @@ impl Backend for Cpu {
         preferred: &[V3],
     ) -> CubeMap {
         cpu::blocked(scene, from, comp, n, preferred)
+    }
+}
+
+/// Which backend computes the cones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BackendKind {
+    /// The software rasterizer: the reference, byte-identical on every machine.
+    #[default]
+    Cpu,
+    /// wgpu ([`Gpu`]), found once per process.
+    Gpu,
+}
+
+static GPU: std::sync::OnceLock<Result<Gpu, String>> = std::sync::OnceLock::new();
+
+/// The process's GPU backend, set up on first use, or why there is none.
+pub fn gpu() -> Result<&'static Gpu, String> {
+    GPU.get_or_init(Gpu::new).as_ref().map_err(Clone::clone)
+}
+
+impl BackendKind {
+    /// The backend itself; the GPU's when one was found, else the CPU's.
+    pub fn get(self) -> &'static dyn Backend {
+        match self {
+            BackendKind::Cpu => &Cpu,
+            BackendKind::Gpu => match gpu() {
+                Ok(g) => g,
+                Err(_) => &Cpu,
+            },
+        }
     }
 }
 

@@ -13,6 +13,7 @@ mod diagnostics;
 mod examples;
 mod fpoints;
 mod geometry_props;
+mod gpu;
 mod grammar;
 mod import;
 mod mesh_fuzz;
