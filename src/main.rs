@@ -45,6 +45,16 @@ enum TableFormat {
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum BackendArg {
+    /// The GPU when wgpu finds an adapter, else the CPU (the summary says which).
+    Auto,
+    /// The software rasterizer: the reference, the same bytes on every machine.
+    Cpu,
+    /// wgpu (Vulkan: a GPU, or Mesa's lavapipe); an error when there is no adapter.
+    Gpu,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum GraphFormat {
     /// Graphviz DOT.
     Dot,
@@ -204,16 +214,43 @@ struct Search {
     /// the touches that never validated, each face's left-out points named.
     #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u32).range(1..=1000))]
     rounds: u32,
+    /// Which backend computes the accessibility cones. The GPU's cones err on the blocked
+    /// side by f32 rounding, so its plans can differ from the CPU's; `cpu` gives the
+    /// same bytes on every machine.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    backend: BackendArg,
 }
 
 impl Search {
-    fn options(&self, allow_unmeasured: bool) -> inspc::plan::PlanOptions {
-        inspc::plan::PlanOptions {
+    /// The planner's options; None, after saying why, when `--backend gpu` finds no
+    /// adapter.
+    fn options(&self, allow_unmeasured: bool) -> Option<inspc::plan::PlanOptions> {
+        use inspc::access::BackendKind;
+        let found = (self.backend != BackendArg::Cpu).then(inspc::access::gpu);
+        let backend = match (self.backend, found) {
+            (BackendArg::Cpu, _) | (_, None) => BackendKind::Cpu,
+            (BackendArg::Auto | BackendArg::Gpu, Some(Ok(g))) => {
+                eprintln!("inspc: cones on the GPU: {}", g.adapter());
+                BackendKind::Gpu
+            }
+            (BackendArg::Auto, Some(Err(why))) => {
+                eprintln!("inspc: no GPU adapter ({why}); cones on the CPU");
+                BackendKind::Cpu
+            }
+            (BackendArg::Gpu, Some(Err(why))) => {
+                eprintln!(
+                    "inspc: --backend gpu: wgpu found no adapter ({why}); install a Vulkan driver (Debian: mesa-vulkan-drivers) or use --backend cpu"
+                );
+                return None;
+            }
+        };
+        Some(inspc::plan::PlanOptions {
             n: self.resolution,
             max_iterations: self.rounds as usize,
             allow_unmeasured,
+            backend,
             ..Default::default()
-        }
+        })
     }
 }
 
@@ -252,14 +289,20 @@ fn main() -> ExitCode {
             format,
             search,
             explain_setups,
-        } => plan(&file, format, &search.options(false), explain_setups),
+        } => match search.options(false) {
+            Some(opts) => plan(&file, format, &opts, explain_setups),
+            None => ExitCode::from(2),
+        },
         Command::Build {
             file,
             output,
             plan_json,
             search,
             allow_unmeasured,
-        } => build(&file, output, plan_json, &search.options(allow_unmeasured)),
+        } => match search.options(allow_unmeasured) {
+            Some(opts) => build(&file, output, plan_json, &opts),
+            None => ExitCode::from(2),
+        },
         Command::Dmis { file } => read_dmis(&file),
         Command::Import { file, output } => import(&file, output),
         Command::Simulate {

@@ -212,6 +212,8 @@ pub struct ConeOptions {
     /// Refine the grown components' cones with exact parry tests at their boundaries
     /// ([`refine`]): slower, and exact at the pixel centres it reaches.
     pub exact_boundary: bool,
+    /// Which backend rasterizes the shadows.
+    pub backend: BackendKind,
 }
 
 impl Default for ConeOptions {
@@ -222,6 +224,7 @@ impl Default for ConeOptions {
             retract: 2.0,
             d2_samples: 16,
             exact_boundary: false,
+            backend: BackendKind::Cpu,
         }
     }
 }
@@ -319,17 +322,27 @@ pub fn d2(
     samples: usize,
 ) -> CubeMap {
     let mut out = d1.empty_like();
-    let cells: Vec<Cell> = d1.cells().collect();
-    if cells.is_empty() || samples == 0 {
-        return out;
-    }
-    let step = cells.len().div_ceil(samples).max(1);
     let prefs: Vec<V3> = (0..d1.preferred_len()).map(|k| d1.preferred(k)).collect();
-    for cell in cells.iter().skip(step / 2).step_by(step) {
-        let x = c + d1.direction(*cell) * probe.reach();
+    for x in d2_points(c, probe, d1, samples) {
         out.or_assign(&gac(backend, scene, &x, &probe.second, d1.n(), &prefs));
     }
     out
+}
+
+/// The articulation points [`d2`] samples: c + d·u for up to `samples` directions u
+/// spread evenly over D1's cells.
+fn d2_points(c: &P3, probe: &ProbeShape, d1: &CubeMap, samples: usize) -> Vec<P3> {
+    let cells: Vec<Cell> = d1.cells().collect();
+    if cells.is_empty() || samples == 0 {
+        return Vec::new();
+    }
+    let step = cells.len().div_ceil(samples).max(1);
+    cells
+        .iter()
+        .skip(step / 2)
+        .step_by(step)
+        .map(|cell| c + d1.direction(*cell) * probe.reach())
+        .collect()
 }
 
 /// D1′ (ch. 2.5.3): the directions of D1 whose articulation point c + d·u lets the second
@@ -400,6 +413,161 @@ pub fn cones(
     fpoints
         .par_iter()
         .map(|f| point_cones(backend, scene, f, probe, opts))
+        .collect()
+}
+
+/// [`gac_halfline`] at many points (as tip centres), in their order: on a batching
+/// backend in one pass, otherwise in parallel.
+pub fn gac_halfline_many(
+    backend: &dyn Backend,
+    scene: &Scene,
+    points: &[P3],
+    n: u32,
+    preferred: &[V3],
+) -> Vec<CubeMap> {
+    let half = Component::half_line();
+    if backend.batches() {
+        let queries: Vec<Query> = points
+            .iter()
+            .map(|p| Query {
+                from: *p,
+                comp: &half,
+            })
+            .collect();
+        return backend
+            .blocked_many(scene, &queries, n, preferred)
+            .into_iter()
+            .map(|b| b.not())
+            .collect();
+    }
+    points
+        .par_iter()
+        .map(|p| backend.blocked(scene, p, &half, n, preferred).not())
+        .collect()
+}
+
+/// [`point_cones`] for many (fpoint, probe) pairs, in their order and the same for any
+/// thread count. A batching backend gets every approach query in one call and every D2
+/// sample in a second; the cones are those [`point_cones`] gives with that backend.
+pub fn point_cones_many(
+    backend: &dyn Backend,
+    scene: &Scene,
+    items: &[(&Fpoint, &ProbeShape)],
+    opts: &ConeOptions,
+) -> Vec<PointCones> {
+    if !backend.batches() || opts.exact_boundary {
+        return items
+            .par_iter()
+            .map(|(f, probe)| point_cones(backend, scene, f, probe, opts))
+            .collect();
+    }
+    let (n, pref) = (opts.n, &opts.preferred[..]);
+    // Where each pair's probe stands: None when the tip does not fit; else the tip
+    // centre and, when the retract point is tested too, the retract point.
+    let stands: Vec<Option<(P3, Option<P3>)>> = items
+        .par_iter()
+        .map(|(f, probe)| {
+            let r = probe.tip_radius;
+            let c = f.tip_centre(r);
+            if !tip_fits(scene, &c, r)
+                || !pose::room_to_touch(scene, &f.position, &f.normal, r, opts.retract)
+            {
+                return None;
+            }
+            let travel = pose::backoff(scene, &f.position, &f.normal, r, opts.retract);
+            let retract =
+                (opts.retract > 0.0 && travel >= opts.retract).then(|| c + f.normal * opts.retract);
+            Some((c, retract))
+        })
+        .collect();
+    let leading: Vec<Vec<Component>> = items.iter().map(|(_, p)| p.leading()).collect();
+    // The approach: every leading component at the contact and at the retract point.
+    let mut queries: Vec<Query> = Vec::new();
+    let mut owner: Vec<(usize, bool)> = Vec::new();
+    for (k, stand) in stands.iter().enumerate() {
+        let Some((c, retract)) = stand else { continue };
+        for (at, second) in std::iter::once((c, false)).chain(retract.iter().map(|r| (r, true))) {
+            for comp in &leading[k] {
+                queries.push(Query { from: *at, comp });
+                owner.push((k, second));
+            }
+        }
+    }
+    let blocked = backend.blocked_many(scene, &queries, n, pref);
+    let mut at_contact: Vec<CubeMap> = vec![CubeMap::empty(n, pref); items.len()];
+    let mut at_retract: Vec<Option<CubeMap>> = vec![None; items.len()];
+    for (&(k, second), b) in owner.iter().zip(&blocked) {
+        if second {
+            at_retract[k]
+                .get_or_insert_with(|| CubeMap::empty(n, pref))
+                .or_assign(b);
+        } else {
+            at_contact[k].or_assign(b);
+        }
+    }
+    let approach: Vec<CubeMap> = at_contact
+        .into_iter()
+        .zip(at_retract)
+        .map(|(c, r)| {
+            let mut a = c.not();
+            if let Some(r) = r {
+                if !a.is_empty() {
+                    a.and_assign(&r.not());
+                }
+            }
+            a
+        })
+        .collect();
+    // D2: the second components at the sampled articulation points of each D1.
+    let mut queries: Vec<Query> = Vec::new();
+    let mut owner: Vec<(usize, usize)> = Vec::new();
+    let mut samples = 0;
+    for (k, (_, probe)) in items.iter().enumerate() {
+        let Some((c, _)) = stands[k] else { continue };
+        if !probe.head.indexable() {
+            continue;
+        }
+        for x in d2_points(&c, probe, &approach[k], opts.d2_samples) {
+            for comp in &probe.second {
+                queries.push(Query { from: x, comp });
+                owner.push((k, samples));
+            }
+            samples += 1;
+        }
+    }
+    let blocked = backend.blocked_many(scene, &queries, n, pref);
+    let mut sample_blocked: Vec<Option<(usize, CubeMap)>> = vec![None; samples];
+    for (&(k, s), b) in owner.iter().zip(&blocked) {
+        sample_blocked[s]
+            .get_or_insert_with(|| (k, CubeMap::empty(n, pref)))
+            .1
+            .or_assign(b);
+    }
+    let mut d2s: Vec<Option<CubeMap>> = items
+        .iter()
+        .map(|(_, p)| p.head.indexable().then(|| CubeMap::empty(n, pref)))
+        .collect();
+    for (k, b) in sample_blocked.into_iter().flatten() {
+        if let Some(d) = &mut d2s[k] {
+            d.or_assign(&b.not());
+        }
+    }
+    stands
+        .iter()
+        .zip(approach)
+        .zip(d2s)
+        .map(|((stand, approach), d2)| match stand {
+            None => PointCones {
+                tip_fits: false,
+                approach: CubeMap::empty(n, pref),
+                d2,
+            },
+            Some(_) => PointCones {
+                tip_fits: true,
+                approach,
+                d2,
+            },
+        })
         .collect()
 }
 

@@ -359,15 +359,52 @@ impl<'a> Knowledge<'a> {
                             .position(|q| q.tip_radius == probe.tip_radius)
                     })
                     .collect();
-                let dom: Vec<Vec<Dom>> = fpoints
+                // The pairs whose knowledge is computed: each point with the first
+                // probe of each tip size. Their half-line cones go to the backend in
+                // one call.
+                let own: Vec<(usize, usize)> = (0..fpoints.len())
+                    .flat_map(|f| {
+                        (0..machine.probes.len())
+                            .filter(|&p| same_tip[p].is_none())
+                            .map(move |p| (f, p))
+                    })
+                    .collect();
+                let fits: Vec<bool> = own
                     .par_iter()
-                    .map(|f| {
+                    .map(|&(f, p)| tip_ok(&scene, &fpoints[f], &machine.probes[p], &opts))
+                    .collect();
+                let centres: Vec<P3> = own
+                    .iter()
+                    .zip(&fits)
+                    .filter(|(_, &ok)| ok)
+                    .map(|(&(f, p), _)| fpoints[f].tip_centre(machine.probes[p].tip_radius))
+                    .collect();
+                let mut halves = access::gac_halfline_many(
+                    opts.backend.get(),
+                    &scene,
+                    &centres,
+                    opts.n,
+                    &opts.preferred,
+                )
+                .into_iter();
+                let halves: Vec<Option<CubeMap>> = fits
+                    .iter()
+                    .map(|&ok| if ok { halves.next() } else { None })
+                    .collect();
+                let mut own_dom = halves
+                    .into_par_iter()
+                    .map(|half| initial(half, machine, &opts))
+                    .collect::<Vec<Dom>>()
+                    .into_iter();
+                let dom: Vec<Vec<Dom>> = (0..fpoints.len())
+                    .map(|_| {
                         let mut out: Vec<Dom> = Vec::with_capacity(machine.probes.len());
-                        for (p, probe) in machine.probes.iter().enumerate() {
-                            out.push(match same_tip[p] {
-                                Some(q) => out[q].clone(),
-                                None => initial(&scene, f, probe, machine, &opts),
-                            });
+                        for q in same_tip.iter() {
+                            let d = match q {
+                                Some(q) => out[*q].clone(),
+                                None => own_dom.next().expect("one dom per own pair"),
+                            };
+                            out.push(d);
                         }
                         out
                     })
@@ -705,18 +742,23 @@ impl<'a> Knowledge<'a> {
             d2_samples: D2_SAMPLES,
             ..self.opts.clone()
         };
+        let fresh: Vec<(usize, usize)> = todo
+            .iter()
+            .copied()
+            .filter(|pair| !self.memo.cones.contains_key(pair))
+            .collect();
+        let items: Vec<(&Fpoint, &ProbeShape)> = fresh
+            .iter()
+            .map(|&(f, p)| (&self.points[f], &machine.probes[p]))
+            .collect();
+        let mut fresh_cones =
+            access::point_cones_many(opts.backend.get(), &self.scene, &items, &opts).into_iter();
         let memo = &self.memo.cones;
         let computed: Vec<access::PointCones> = todo
-            .par_iter()
-            .map(|&(f, p)| match memo.get(&(f, p)) {
+            .iter()
+            .map(|pair| match memo.get(pair) {
                 Some(cones) => cones.clone(),
-                None => access::point_cones(
-                    &access::Cpu,
-                    &self.scene,
-                    &self.points[f],
-                    &machine.probes[p],
-                    &opts,
-                ),
+                None => fresh_cones.next().expect("one cone per fresh pair"),
             })
             .collect();
         for (&pair, cones) in todo.iter().zip(&computed) {
@@ -785,36 +827,33 @@ const MAX_FACE_DIRECTIONS: usize = 48;
 /// How far around a forbidden setup direction the setups are forbidden (degrees).
 pub(crate) const FORBID_ANGLE: f64 = 10.0;
 
-/// The first knowledge of (fpoint, probe): tip fit at contact and retract point, the
-/// half-line cone; for a bent probe D1 = that cone and D2 every setup within the head's
-/// A range of it.
-fn initial(
-    scene: &Scene,
-    f: &Fpoint,
-    probe: &ProbeShape,
-    machine: &Machine,
-    opts: &ConeOptions,
-) -> Dom {
-    let (n, pref) = (opts.n, &opts.preferred[..]);
+/// Whether the tip of `probe` fits at `f`: at the contact and at the retract point, with
+/// room to touch.
+fn tip_ok(scene: &Scene, f: &Fpoint, probe: &ProbeShape, opts: &ConeOptions) -> bool {
     let c = f.tip_centre(probe.tip_radius);
     let r = probe.tip_radius;
     let travel = access::pose::backoff(scene, &f.position, &f.normal, r, opts.retract);
-    let tip = tip_fits(scene, &c, r)
+    tip_fits(scene, &c, r)
         && access::pose::room_to_touch(scene, &f.position, &f.normal, r, opts.retract)
-        && tip_fits(scene, &(c + f.normal * travel), r);
-    if !tip {
-        let e = CubeMap::empty(n, pref);
+        && tip_fits(scene, &(c + f.normal * travel), r)
+}
+
+/// The first knowledge of (fpoint, probe) from its tip fit and, where the tip fits, its
+/// half-line cone: for a bent probe D1 = that cone and D2 every setup within the head's
+/// A range of it.
+fn initial(half: Option<CubeMap>, machine: &Machine, opts: &ConeOptions) -> Dom {
+    let Some(half) = half else {
+        let e = CubeMap::empty(opts.n, &opts.preferred);
         return Dom {
-            tip,
+            tip: false,
             setup: e.clone(),
             d1: machine.head.indexable().then_some(e),
             full: true,
         };
-    }
-    let half = access::gac_halfline(scene, &c, n, pref);
+    };
     if !machine.head.indexable() {
         return Dom {
-            tip,
+            tip: true,
             setup: half,
             d1: None,
             full: false,
@@ -822,7 +861,7 @@ fn initial(
     }
     let d2 = d2_cap(&half, machine.a_max);
     Dom {
-        tip,
+        tip: true,
         setup: d2,
         d1: Some(half),
         full: false,

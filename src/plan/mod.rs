@@ -61,6 +61,8 @@ pub struct PlanOptions {
     pub allow_unmeasured: bool,
     /// Configurations the path stage found no move to: validation fails them.
     pub bans: Vec<Ban>,
+    /// Which backend computes the cones.
+    pub backend: crate::access::BackendKind,
 }
 
 /// A touch configuration the path stage could not reach: the point (index into
@@ -98,6 +100,7 @@ impl Default for PlanOptions {
             exact_budget: 200_000,
             allow_unmeasured: false,
             bans: Vec::new(),
+            backend: crate::access::BackendKind::Cpu,
         }
     }
 }
@@ -357,6 +360,7 @@ pub fn plan_with(
         n: opts.n,
         // The approach validated is the longer of the pre-hit and retract moves.
         retract: input.plan.motion.prehit.max(input.plan.motion.retract),
+        backend: opts.backend,
         ..Default::default()
     };
     let mut k = Knowledge::new(

@@ -141,3 +141,114 @@ fn gpu_cones_match_the_cpu_on_the_nist_parts() {
         compare(spec, 2, 64);
     }
 }
+
+/// The CPU, claiming to batch: drives the batched code paths with exact CPU maps.
+struct BatchingCpu;
+
+impl Backend for BatchingCpu {
+    fn blocked(&self, scene: &Scene, from: &P3, comp: &Component, n: u32, pref: &[V3]) -> CubeMap {
+        Cpu.blocked(scene, from, comp, n, pref)
+    }
+
+    fn batches(&self) -> bool {
+        true
+    }
+}
+
+/// The batched cones (all approach queries in one call, all D2 samples in another) are
+/// the per-point cones, on a fixed and an indexable head; on the GPU they are those
+/// cones or more pessimistic, pixel for pixel.
+#[test]
+fn batched_point_cones_are_the_per_point_cones() {
+    use inspc::access::{gac_halfline, gac_halfline_many, point_cones, point_cones_many};
+    for spec in ["examples/f3_fixed.insp", "examples/f3_indexed.insp"] {
+        let (checked, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[PathBuf::from(spec)]);
+        let gr = &graphs[0];
+        let scene = Scene::of_part(&parts[gr.part].as_ref().unwrap().geometry);
+        let model = &checked.model;
+        let probes = ProbeShape::of_cmm(model, &model.cmms[model.plans[0].cmm.0]);
+        let opts = inspc::access::ConeOptions {
+            n: 32,
+            d2_samples: 4,
+            ..Default::default()
+        };
+        let items: Vec<_> = gr
+            .graph
+            .fpoints
+            .iter()
+            .step_by(3)
+            .flat_map(|f| probes.iter().map(move |p| (f, p)))
+            .collect();
+        let batched = point_cones_many(&BatchingCpu, &scene, &items, &opts);
+        for ((f, p), b) in items.iter().zip(&batched) {
+            assert_eq!(*b, point_cones(&Cpu, &scene, f, p, &opts), "{spec}");
+        }
+        assert!(batched.iter().any(|c| !c.approach.is_empty()));
+        let centres: Vec<P3> = items
+            .iter()
+            .map(|(f, p)| f.tip_centre(p.tip_radius))
+            .collect();
+        let halves = gac_halfline_many(&BatchingCpu, &scene, &centres, 32, &opts.preferred);
+        for (c, h) in centres.iter().zip(&halves) {
+            assert_eq!(*h, gac_halfline(&scene, c, 32, &opts.preferred));
+        }
+        let Some(gpu) = device() else { continue };
+        for (g, c) in point_cones_many(gpu, &scene, &items, &opts)
+            .iter()
+            .zip(&batched)
+        {
+            assert_eq!(g.tip_fits, c.tip_fits);
+            // The GPU's approach cone lies inside the CPU's.
+            assert_eq!(g.approach.and(&c.approach), g.approach, "{spec}");
+        }
+    }
+}
+
+/// `inspc build --backend gpu` writes a program that measures what the CPU's does, and
+/// says which adapter it used; `--backend auto` builds wherever it runs.
+#[test]
+fn build_on_the_gpu_backend() {
+    let dir = std::env::temp_dir().join(format!("inspc-gpu-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |backend: &str| {
+        let out = dir.join(format!("f3_indexed_{backend}.dmi"));
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_inspc"))
+            .args([
+                "build",
+                "examples/f3_indexed.insp",
+                "--backend",
+                backend,
+                "-o",
+            ])
+            .arg(&out)
+            .output()
+            .expect("inspc runs");
+        let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+        let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+        (o.status.code(), stdout, stderr, out)
+    };
+    let (code, cpu, _, _) = run("cpu");
+    assert_eq!(code, Some(0));
+    let (code, _, stderr, _) = run("auto");
+    assert_eq!(code, Some(0), "{stderr}");
+    let (code, stdout, stderr, out) = run("gpu");
+    if device().is_none() {
+        assert_eq!(code, Some(2), "{stderr}");
+        assert!(
+            stderr.contains("--backend gpu: wgpu found no adapter"),
+            "{stderr}"
+        );
+        assert!(!out.exists(), "nothing written");
+        return;
+    }
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stderr.contains("cones on the GPU: "), "{stderr}");
+    assert!(std::fs::read_to_string(&out).unwrap().contains("PTMEAS"));
+    let first = |s: &str| s.lines().next().unwrap_or("").to_string();
+    // f3_indexed: both tolerances measured in one setup on either backend.
+    assert!(
+        first(&stdout).contains("tolerances measured 2 of 2, 1 setup"),
+        "{stdout}"
+    );
+    assert_eq!(first(&stdout), first(&cpu));
+}
