@@ -6,6 +6,8 @@
 //! fpoints spread over the part; divide by 16 for one cone. `grown_exact_boundary` adds
 //! the exact refinement of the grown cone's boundary.
 //!
+//! `batch_cpu` and `batch_gpu` compare the two backends on the same batch of queries.
+//!
 //! Run with `cargo bench --bench access`.
 
 use inspc::access::{Backend, Cell, Component, Cpu, CubeMap, End, ProbeShape, Scene};
@@ -120,4 +122,54 @@ fn parry_ray_per_pixel(bencher: divan::Bencher, (spec, n): (&str, u32)) {
             })
             .sum::<usize>()
     });
+}
+
+/// The CPU backend and the GPU backend on the same queries, in the same run: the three
+/// components (half-line, grown half-line, ram) at the 16 fpoints, 48 cones per
+/// iteration, as the planner hands them over — one `blocked_many` call. The CPU answers
+/// them one by one on all cores (rayon); the GPU (`access::Gpu`: lavapipe on a machine
+/// without one) rasterizes the polygons of 32 at a time. Divide by 16 for one fpoint's
+/// three cones. Without a Vulkan adapter `batch_gpu` says so and measures nothing.
+fn batch(bencher: divan::Bencher, (spec, n): (&str, u32), backend: &dyn Backend) {
+    use rayon::prelude::*;
+    let (scene, pts, probe) = scene(spec);
+    let comps: Vec<Component> = ["halfline", "grown", "ram"]
+        .iter()
+        .map(|k| component(k, &probe))
+        .collect();
+    let queries: Vec<inspc::access::Query> = pts
+        .iter()
+        .flat_map(|p| {
+            comps
+                .iter()
+                .map(|comp| inspc::access::Query { from: *p, comp })
+        })
+        .collect();
+    bencher.bench(|| {
+        let maps: Vec<CubeMap> = if backend.batches() {
+            backend.blocked_many(&scene, divan::black_box(&queries), n, &[])
+        } else {
+            queries
+                .par_iter()
+                .map(|q| backend.blocked(&scene, &q.from, q.comp, n, &[]))
+                .collect()
+        };
+        maps.iter().map(CubeMap::count).sum::<usize>()
+    });
+}
+
+#[divan::bench(args = CASES)]
+fn batch_cpu(bencher: divan::Bencher, case: (&str, u32)) {
+    batch(bencher, case, &Cpu);
+}
+
+#[divan::bench(args = CASES)]
+fn batch_gpu(bencher: divan::Bencher, case: (&str, u32)) {
+    match inspc::access::gpu() {
+        Ok(g) => batch(bencher, case, g),
+        Err(why) => {
+            eprintln!("batch_gpu: no adapter ({why})");
+            bencher.bench(|| 0);
+        }
+    }
 }

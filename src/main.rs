@@ -46,11 +46,11 @@ enum TableFormat {
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum BackendArg {
-    /// The GPU when wgpu finds an adapter, else the CPU (the summary says which).
+    /// The GPU when wgpu finds a hardware adapter, else the CPU (the command says which).
     Auto,
     /// The software rasterizer: the reference, the same bytes on every machine.
     Cpu,
-    /// wgpu (Vulkan: a GPU, or Mesa's lavapipe); an error when there is no adapter.
+    /// wgpu on any adapter (Vulkan: a GPU, or Mesa's lavapipe); an error without one.
     Gpu,
 }
 
@@ -226,23 +226,25 @@ impl Search {
     /// adapter.
     fn options(&self, allow_unmeasured: bool) -> Option<inspc::plan::PlanOptions> {
         use inspc::access::BackendKind;
-        let found = (self.backend != BackendArg::Cpu).then(inspc::access::gpu);
-        let backend = match (self.backend, found) {
-            (BackendArg::Cpu, _) | (_, None) => BackendKind::Cpu,
-            (BackendArg::Auto | BackendArg::Gpu, Some(Ok(g))) => {
-                eprintln!("inspc: cones on the GPU: {}", g.adapter());
-                BackendKind::Gpu
+        let backend = match self.backend {
+            BackendArg::Cpu => BackendKind::Cpu,
+            BackendArg::Auto => {
+                let (kind, why) = inspc::access::auto_backend();
+                eprintln!("inspc: {why}");
+                kind
             }
-            (BackendArg::Auto, Some(Err(why))) => {
-                eprintln!("inspc: no GPU adapter ({why}); cones on the CPU");
-                BackendKind::Cpu
-            }
-            (BackendArg::Gpu, Some(Err(why))) => {
-                eprintln!(
-                    "inspc: --backend gpu: wgpu found no adapter ({why}); install a Vulkan driver (Debian: mesa-vulkan-drivers) or use --backend cpu"
-                );
-                return None;
-            }
+            BackendArg::Gpu => match inspc::access::gpu() {
+                Ok(g) => {
+                    eprintln!("inspc: cones on the GPU: {}", g.adapter());
+                    BackendKind::Gpu
+                }
+                Err(why) => {
+                    eprintln!(
+                        "inspc: --backend gpu: wgpu found no adapter ({why}); install a Vulkan driver (Debian: mesa-vulkan-drivers) or use --backend cpu"
+                    );
+                    return None;
+                }
+            },
         };
         Some(inspc::plan::PlanOptions {
             n: self.resolution,

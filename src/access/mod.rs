@@ -124,6 +124,29 @@ pub fn gpu() -> Result<&'static Gpu, String> {
     GPU.get_or_init(Gpu::new).as_ref().map_err(Clone::clone)
 }
 
+/// The backend `--backend auto` picks: the GPU when wgpu finds a hardware adapter; a
+/// software one (lavapipe) is slower than the CPU backend it would replace, so there the
+/// CPU. Also says why, for the summary.
+pub fn auto_backend() -> (BackendKind, String) {
+    match gpu() {
+        Ok(g) if !g.is_software() => (
+            BackendKind::Gpu,
+            format!("cones on the GPU: {}", g.adapter()),
+        ),
+        Ok(g) => (
+            BackendKind::Cpu,
+            format!(
+                "cones on the CPU: the only adapter is a software one ({})",
+                g.adapter()
+            ),
+        ),
+        Err(why) => (
+            BackendKind::Cpu,
+            format!("cones on the CPU: no GPU adapter ({why})"),
+        ),
+    }
+}
+
 impl BackendKind {
     /// The backend itself; the GPU's when one was found, else the CPU's.
     pub fn get(self) -> &'static dyn Backend {

@@ -28,6 +28,7 @@ const CHUNK: usize = 32;
 
 /// A wgpu device with the shadow pipeline.
 pub struct Gpu {
+    software: bool,
     device: wgpu::Device,
     queue: wgpu::Queue,
     pipeline: wgpu::ComputePipeline,
@@ -58,6 +59,7 @@ impl Gpu {
         .map_err(|e| e.to_string())?;
         let info = adapter.get_info();
         let name = format!("{} ({:?})", info.name, info.device_type);
+        let software = info.device_type == wgpu::DeviceType::Cpu;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("inspc"),
             required_features: wgpu::Features::empty(),
@@ -78,11 +80,17 @@ impl Gpu {
             cache: None,
         });
         Ok(Gpu {
+            software,
             device,
             queue,
             pipeline,
             adapter: name,
         })
+    }
+
+    /// Whether the adapter runs on the CPU (Mesa's lavapipe, say).
+    pub fn is_software(&self) -> bool {
+        self.software
     }
 
     /// The adapter's name and kind, for the summary.
