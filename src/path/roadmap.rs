@@ -19,6 +19,10 @@ use std::collections::BinaryHeap;
 /// Neighbours each new node is connected to.
 const K: usize = 8;
 
+/// How many of the closest node pairs [`Roadmap::bridge`] tries between a component
+/// left out and the main one.
+const BRIDGES: usize = 16;
+
 /// How a local path between two nodes runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Route {
@@ -197,7 +201,14 @@ impl<'a> Roadmap<'a> {
         }
         pairs.sort_unstable();
         pairs.dedup();
+        self.join(pairs);
+    }
+
+    /// Adds the edges between the `pairs` of nodes the local planner connects; returns
+    /// how many.
+    fn join(&mut self, mut pairs: Vec<(usize, usize)>) -> usize {
         pairs.retain(|&(i, j)| !self.adj[i].iter().any(|e| e.to == j));
+        let mut joined = 0;
         let results: Vec<_> = pairs
             .par_iter()
             .map(|&(i, j)| self.connect(&self.nodes[i], &self.nodes[j]))
@@ -205,6 +216,7 @@ impl<'a> Roadmap<'a> {
         for (&(i, j), (r, c)) in pairs.iter().zip(results) {
             self.checks += c;
             if let Ok((route, length)) = r {
+                joined += 1;
                 self.adj[i].push(Edge {
                     to: j,
                     length,
@@ -218,6 +230,44 @@ impl<'a> Roadmap<'a> {
                 });
             }
         }
+        joined
+    }
+
+    /// Tries to join each component holding stray goals to the main one through its
+    /// `BRIDGES` closest pairs of nodes. K-nearest linking can leave a dense cluster
+    /// linked only to itself: the stand-offs of a bore sampled densely all sit near its
+    /// axis, and their lifted copies are one another's nearest neighbours.
+    fn bridge(&mut self) -> usize {
+        let comp = self.components();
+        let stray = self.stray_goals();
+        let Some(first) = (0..self.goals).find(|g| !stray.contains(g)) else {
+            return 0;
+        };
+        let main = comp[first];
+        let mut islands: Vec<usize> = stray.iter().map(|&g| comp[g]).collect();
+        islands.sort_unstable();
+        islands.dedup();
+        let mut pairs = Vec::new();
+        for island in islands {
+            let mut near: Vec<(f64, usize, usize)> = (0..self.nodes.len())
+                .filter(|&i| comp[i] == island)
+                .flat_map(|i| {
+                    (0..self.nodes.len())
+                        .filter(|&j| comp[j] == main)
+                        .map(move |j| (i, j))
+                })
+                .map(|(i, j)| ((self.nodes[i] - self.nodes[j]).norm(), i, j))
+                .collect();
+            near.sort_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+            pairs.extend(
+                near.iter()
+                    .take(BRIDGES)
+                    .map(|&(_, i, j)| (i.min(j), i.max(j))),
+            );
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        self.join(pairs)
     }
 
     /// Adds the nodes that are clear; returns how many.
@@ -329,6 +379,9 @@ impl<'a> Roadmap<'a> {
                 }
             }
             added += self.insert(cands);
+        }
+        if !self.stray_goals().is_empty() {
+            self.bridge();
         }
         let stray = self.stray_goals();
         match stray.first() {

@@ -785,3 +785,26 @@ fn import_writes_a_spec_that_checks_and_reports_a_broken_file() {
     assert!(!out_spec.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A bore sampled densely puts every stand-off near its axis; their lifted copies were
+/// one another's nearest roadmap neighbours and formed an island the path stage could
+/// not leave (swiss_block at 10 points per hole failed with `insp::path::no_path`).
+/// `Roadmap::bridge` joins such islands; the program runs in tolerance at nominal.
+#[test]
+fn densely_sampled_bores_get_a_path() {
+    let text = std::fs::read_to_string("examples/swiss_block.insp")
+        .unwrap()
+        .replace("hammersley(points 6)", "hammersley(points 10)");
+    assert!(text.contains("points 10"));
+    let spec = temp_spec("swiss_block_dense.insp", &text);
+    let program = spec.replace(".insp", ".dmi");
+    let (code, stdout, stderr) = inspc(&["build", &spec, "-o", &program]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.contains("tolerances measured 1 of 1, 1 setup, 1 probe, 1 orientation"),
+        "{stdout}"
+    );
+    let (code, stdout, stderr) = inspc(&["simulate", &program, &spec]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("100 in, 0 out"), "{stdout}");
+}
