@@ -14,7 +14,8 @@ use inspc::geometry::{P3, V3};
 use inspc::source::FsWorld;
 use std::path::PathBuf;
 
-const EXAMPLES: [&str; 7] = [
+/// Every example (the GPU tests use them too).
+pub(crate) const EXAMPLES: [&str; 7] = [
     "examples/f2.insp",
     "examples/f3_fixed.insp",
     "examples/f3_indexed.insp",

@@ -116,15 +116,7 @@ fn compare(spec: &str, count: usize, n: u32) -> (usize, usize, usize) {
 
 #[test]
 fn gpu_cones_match_the_cpu_on_the_examples() {
-    for spec in [
-        "examples/f2.insp",
-        "examples/f3_fixed.insp",
-        "examples/f3_indexed.insp",
-        "examples/f4.insp",
-        "examples/swiss_block.insp",
-        "examples/swiss_sphere_fixed.insp",
-        "examples/swiss_sphere_indexed.insp",
-    ] {
+    for spec in crate::access::EXAMPLES {
         compare(spec, 4, 32);
     }
 }
