@@ -25,10 +25,16 @@ const DRAW_WORDS: usize = 40;
 const MAX_DRAWS: usize = 40_000;
 /// Queries drawn on the CPU before their polygons are submitted together.
 const CHUNK: usize = 32;
+/// The most bytes of maps one submission writes (far under wgpu's least binding limit,
+/// 128 MiB); a query whose maps alone exceed it is computed on the CPU.
+const MAP_BUDGET: usize = 32 << 20;
 
 /// A wgpu device with the shadow pipeline.
 pub struct Gpu {
     software: bool,
+    /// Set by wgpu's error handler (out of memory, a lost device): the maps of the
+    /// submission in flight are not trusted, and the CPU computes them instead.
+    failed: std::sync::Arc<std::sync::atomic::AtomicBool>,
     device: wgpu::Device,
     queue: wgpu::Queue,
     pipeline: wgpu::ComputePipeline,
@@ -67,6 +73,11 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| e.to_string())?;
+        let failed = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let flag = failed.clone();
+        device.on_uncaptured_error(std::sync::Arc::new(move |_e: wgpu::Error| {
+            flag.store(true, std::sync::atomic::Ordering::SeqCst);
+        }));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shadow"),
             source: wgpu::ShaderSource::Wgsl(include_str!("shadow.wgsl").into()),
@@ -79,8 +90,12 @@ impl Gpu {
             compilation_options: Default::default(),
             cache: None,
         });
+        if failed.load(std::sync::atomic::Ordering::SeqCst) {
+            return Err("the shadow shader did not compile on this adapter".into());
+        }
         Ok(Gpu {
             software,
+            failed,
             device,
             queue,
             pipeline,
@@ -177,6 +192,9 @@ impl Gpu {
         let words = bytemuck::cast_slice::<u8, u32>(&view).to_vec();
         drop(view);
         staging.unmap();
+        if self.failed.load(std::sync::atomic::Ordering::SeqCst) {
+            return Vec::new();
+        }
         words
     }
 }
@@ -222,7 +240,6 @@ impl Backend for Gpu {
         n: u32,
         preferred: &[V3],
     ) -> Vec<CubeMap> {
-        let like = CubeMap::empty(n, preferred);
         let pixels = 6 * (n as usize) * (n as usize);
         let words_per_map = pixels.div_ceil(32);
         let mut out = Vec::with_capacity(queries.len());
@@ -238,54 +255,98 @@ impl Backend for Gpu {
                     (rec, drawn)
                 })
                 .collect();
-            // Map indices: each query's targets, one after another.
-            let mut first = Vec::with_capacity(chunk.len());
-            let mut maps = 0usize;
-            let mut draws = Vec::new();
-            for (rec, drawn) in &recorded {
-                first.push(maps);
+            // Submissions: queries in order, as many as the map budget takes.
+            let bytes = |(rec, drawn): &(Record, Drawn)| {
                 if drawn.full {
+                    0
+                } else {
+                    (rec.targets as usize + 1) * words_per_map * 4
+                }
+            };
+            let mut start = 0;
+            while start < chunk.len() {
+                let mut end = start;
+                let mut total = 0;
+                while end < chunk.len() && total + bytes(&recorded[end]) <= MAP_BUDGET {
+                    total += bytes(&recorded[end]);
+                    end += 1;
+                }
+                if end == start {
+                    // Too large for one submission: the CPU draws it.
+                    let q = &chunk[start];
+                    out.push(cpu::blocked(scene, &q.from, q.comp, n, preferred));
+                    start += 1;
                     continue;
                 }
-                for d in rec.draws.chunks(DRAW_WORDS) {
-                    draws.push(d[0] + maps as u32);
-                    draws.extend_from_slice(&d[1..]);
-                }
-                maps += rec.targets as usize + 1;
+                out.extend(self.submit(
+                    scene,
+                    &chunk[start..end],
+                    &recorded[start..end],
+                    (n, preferred, words_per_map),
+                ));
+                start = end;
             }
-            let words = if draws.is_empty() {
-                vec![0; maps * words_per_map]
-            } else {
-                self.raster(&draws, maps, n, words_per_map)
-            };
-            let lost = words.len() < maps * words_per_map;
-            let finished: Vec<CubeMap> = chunk
-                .par_iter()
-                .zip(&recorded)
-                .zip(&first)
-                .map(|((q, (rec, drawn)), &m)| {
-                    if lost {
-                        return cpu::blocked(scene, &q.from, q.comp, n, preferred);
-                    }
-                    let map = |t: usize| {
-                        let at = (m + t) * words_per_map;
-                        like.with_pixel_words(&words[at..at + words_per_map])
-                    };
-                    let (base, bands) = if drawn.full {
-                        (like.clone(), Vec::new())
-                    } else {
-                        let bands = (1..=rec.targets as usize).map(|t| Some(map(t))).collect();
-                        (map(0), bands)
-                    };
-                    cpu::finish(scene, &q.from, q.comp, base, bands, drawn)
-                })
-                .collect();
-            out.extend(finished);
         }
         out
     }
 
     fn batches(&self) -> bool {
         true
+    }
+}
+
+impl Gpu {
+    /// Rasterizes the recorded polygons of `queries` in one submission and finishes their
+    /// maps; the CPU computes them when the GPU fails.
+    fn submit(
+        &self,
+        scene: &Scene,
+        queries: &[Query],
+        recorded: &[(Record, Drawn)],
+        (n, preferred, words_per_map): (u32, &[V3], usize),
+    ) -> Vec<CubeMap> {
+        let like = CubeMap::empty(n, preferred);
+        // Map indices: each query's targets, one after another.
+        let mut first = Vec::with_capacity(queries.len());
+        let mut maps = 0usize;
+        let mut draws = Vec::new();
+        for (rec, drawn) in recorded {
+            first.push(maps);
+            if drawn.full {
+                continue;
+            }
+            for d in rec.draws.chunks(DRAW_WORDS) {
+                draws.push(d[0] + maps as u32);
+                draws.extend_from_slice(&d[1..]);
+            }
+            maps += rec.targets as usize + 1;
+        }
+        let words = if draws.is_empty() {
+            vec![0; maps * words_per_map]
+        } else {
+            self.raster(&draws, maps, n, words_per_map)
+        };
+        let lost = words.len() < maps * words_per_map;
+        queries
+            .par_iter()
+            .zip(recorded)
+            .zip(&first)
+            .map(|((q, (rec, drawn)), &m)| {
+                if lost {
+                    return cpu::blocked(scene, &q.from, q.comp, n, preferred);
+                }
+                let map = |t: usize| {
+                    let at = (m + t) * words_per_map;
+                    like.with_pixel_words(&words[at..at + words_per_map])
+                };
+                let (base, bands) = if drawn.full {
+                    (like.clone(), Vec::new())
+                } else {
+                    let bands = (1..=rec.targets as usize).map(|t| Some(map(t))).collect();
+                    (map(0), bands)
+                };
+                cpu::finish(scene, &q.from, q.comp, base, bands, drawn)
+            })
+            .collect()
     }
 }
