@@ -226,6 +226,12 @@ impl Search {
     /// adapter.
     fn options(&self, allow_unmeasured: bool) -> Option<inspc::plan::PlanOptions> {
         use inspc::access::BackendKind;
+        if self.backend != BackendArg::Cpu && std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+            // Mesa's Vulkan loader prints "error: XDG_RUNTIME_DIR is invalid" once per
+            // device query without it, which reads as inspc's error. Nothing has started a
+            // thread yet (planning starts after the options are read).
+            std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir());
+        }
         let backend = match self.backend {
             BackendArg::Cpu => BackendKind::Cpu,
             BackendArg::Auto => {
