@@ -8,6 +8,7 @@
 pub mod access;
 pub mod diag;
 pub mod dmis;
+pub mod fmt;
 pub mod geometry;
 pub mod graph;
 pub mod import;

@@ -171,6 +171,16 @@ enum Command {
         #[arg(long)]
         report: Option<PathBuf>,
     },
+    /// Formats specs in place in the one canonical layout (indentation, spacing, blank
+    /// lines; comments and line breaks kept). A file that does not parse is left alone.
+    Fmt {
+        /// The `.insp` files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Write nothing; exit 1 and name the files that are not formatted.
+        #[arg(long)]
+        check: bool,
+    },
     /// Reads a DMIS program and checks it as a controller would: line lengths, labels,
     /// names defined before use, MEAS blocks.
     Dmis {
@@ -312,6 +322,7 @@ fn main() -> ExitCode {
             None => ExitCode::from(2),
         },
         Command::Dmis { file } => read_dmis(&file),
+        Command::Fmt { files, check } => fmt(&files, check),
         Command::Import { file, output } => import(&file, output),
         Command::Simulate {
             program,
@@ -674,6 +685,81 @@ fn simulate(
     } else {
         ExitCode::SUCCESS
     }
+}
+
+/// `inspc fmt`: formats every file that parses; with `--check`, only says which are not
+/// formatted. Nothing is written when a file does not parse.
+fn fmt(files: &[PathBuf], check: bool) -> ExitCode {
+    use inspc::source::World;
+    let mut sources = inspc::source::SourceMap::new();
+    let mut diags = inspc::diag::Diagnostics::new();
+    let mut writes: Vec<cli::outputs::Output> = Vec::new();
+    let mut unformatted: Vec<&PathBuf> = Vec::new();
+    for file in files {
+        let shown = file.display().to_string();
+        let text = match FsWorld.read(file, inspc::source::FileKind::Spec) {
+            Ok(b) => String::from_utf8_lossy(&b).into_owned(),
+            Err(e) => {
+                let id = sources.add(shown.clone(), Some(file.clone()), String::new());
+                diags.push(inspc::source::io::IoError::Unreadable {
+                    file: id,
+                    path: shown,
+                    reason: e.0,
+                });
+                continue;
+            }
+        };
+        let id = sources.add(shown, Some(file.clone()), text.clone());
+        if let Err(e) = inspc::syntax::parse(id, &text) {
+            diags.push(e);
+            continue;
+        }
+        let formatted = inspc::fmt::format(&text);
+        if formatted != text && inspc::syntax::outline(&formatted) != inspc::syntax::outline(&text)
+        {
+            // The formatter must never change what a spec says; refuse rather than write.
+            eprintln!(
+                "inspc: internal error: formatting {} would change its meaning; it is left as it is (please report)",
+                file.display()
+            );
+            return ExitCode::from(101);
+        }
+        if formatted != text {
+            unformatted.push(file);
+            writes.push(cli::outputs::Output {
+                path: file.clone(),
+                bytes: formatted.into_bytes(),
+                what: "the formatted spec",
+            });
+        }
+    }
+    let failed = diags.has_errors();
+    print_diagnostics(&sources, &diags.sorted());
+    if failed {
+        eprintln!("inspc: nothing formatted");
+        return ExitCode::from(1);
+    }
+    if check {
+        for f in &unformatted {
+            println!(
+                "{}: not formatted (run `inspc fmt {}`)",
+                f.display(),
+                f.display()
+            );
+        }
+        if !unformatted.is_empty() {
+            return ExitCode::from(1);
+        }
+        eprintln!("inspc: {} files formatted", files.len());
+        return ExitCode::SUCCESS;
+    }
+    if let Err(code) = commit(&writes, &[]) {
+        return code;
+    }
+    for w in &writes {
+        println!("formatted {}", w.path.display());
+    }
+    ExitCode::SUCCESS
 }
 
 fn read_dmis(file: &std::path::Path) -> ExitCode {

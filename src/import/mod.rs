@@ -509,7 +509,8 @@ fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
         &dim_lines,
     );
     Imported {
-        text,
+        // In the layout `inspc fmt` gives, so a formatted repository stays formatted.
+        text: crate::fmt::format(&text),
         faces: part.solid_faces(),
         datums: (seen_letters.len(), frames.datum_feature.len()),
         tolerances: (p.tolerances.len(), written_tols),

@@ -87,6 +87,29 @@ crate::located!(SyntaxError {
     InvalidEscape,
 });
 
+/// The parse tree of `text` as a list — each rule's name, and each leaf's text — or None
+/// when it does not parse. Two spellings of one spec (other spaces, comments, layout)
+/// have the same outline; `inspc fmt` checks this before it writes.
+pub fn outline(text: &str) -> Option<Vec<String>> {
+    use pest::Parser;
+    fn walk(pair: pest::iterators::Pair<Rule>, out: &mut Vec<String>) {
+        out.push(format!("{:?}", pair.as_rule()));
+        let mut inner = pair.clone().into_inner().peekable();
+        if inner.peek().is_none() {
+            out.push(pair.as_str().to_string());
+        }
+        for p in inner {
+            walk(p, out);
+        }
+    }
+    let pairs = InspParser::parse(Rule::file, text).ok()?;
+    let mut out = Vec::new();
+    for p in pairs {
+        walk(p, &mut out);
+    }
+    Some(out)
+}
+
 /// Parses one file. The entry point of the syntax stage.
 pub fn parse(file: FileId, text: &str) -> Result<ast::File, SyntaxError> {
     use pest::Parser;

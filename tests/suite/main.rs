@@ -11,6 +11,7 @@ mod cli;
 mod cluster_props;
 mod diagnostics;
 mod examples;
+mod fmt;
 mod fpoints;
 mod geometry_props;
 mod gpu;
