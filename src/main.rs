@@ -687,36 +687,58 @@ fn simulate(
     }
 }
 
+/// Reads a file the command line names into `sources`; an unreadable one is a diagnostic
+/// in `diags`, filed under its path.
+fn read_source(
+    sources: &mut inspc::source::SourceMap,
+    diags: &mut inspc::diag::Diagnostics,
+    file: &std::path::Path,
+    kind: inspc::source::FileKind,
+) -> Option<inspc::source::FileId> {
+    use inspc::source::World;
+    let shown = file.display().to_string();
+    match FsWorld.read(file, kind) {
+        Ok(b) => {
+            let text = String::from_utf8_lossy(&b).into_owned();
+            Some(sources.add(shown, Some(file.to_path_buf()), text))
+        }
+        Err(e) => {
+            let id = sources.add(shown.clone(), Some(file.to_path_buf()), String::new());
+            diags.push(inspc::source::io::IoError::Unreadable {
+                file: id,
+                path: shown,
+                reason: e.0,
+            });
+            None
+        }
+    }
+}
+
 /// `inspc fmt`: formats every file that parses; with `--check`, only says which are not
 /// formatted. Nothing is written when a file does not parse.
 fn fmt(files: &[PathBuf], check: bool) -> ExitCode {
-    use inspc::source::World;
     let mut sources = inspc::source::SourceMap::new();
     let mut diags = inspc::diag::Diagnostics::new();
     let mut writes: Vec<cli::outputs::Output> = Vec::new();
-    let mut unformatted: Vec<&PathBuf> = Vec::new();
     for file in files {
-        let shown = file.display().to_string();
-        let text = match FsWorld.read(file, inspc::source::FileKind::Spec) {
-            Ok(b) => String::from_utf8_lossy(&b).into_owned(),
-            Err(e) => {
-                let id = sources.add(shown.clone(), Some(file.clone()), String::new());
-                diags.push(inspc::source::io::IoError::Unreadable {
-                    file: id,
-                    path: shown,
-                    reason: e.0,
-                });
-                continue;
-            }
+        let Some(id) = read_source(
+            &mut sources,
+            &mut diags,
+            file,
+            inspc::source::FileKind::Spec,
+        ) else {
+            continue;
         };
-        let id = sources.add(shown, Some(file.clone()), text.clone());
-        if let Err(e) = inspc::syntax::parse(id, &text) {
+        let text = &sources.get(id).text;
+        if let Err(e) = inspc::syntax::parse(id, text) {
             diags.push(e);
             continue;
         }
-        let formatted = inspc::fmt::format(&text);
-        if formatted != text && inspc::syntax::outline(&formatted) != inspc::syntax::outline(&text)
-        {
+        let formatted = inspc::fmt::format(text);
+        if formatted == *text {
+            continue;
+        }
+        if inspc::syntax::outline(&formatted) != inspc::syntax::outline(text) {
             // The formatter must never change what a spec says; refuse rather than write.
             eprintln!(
                 "inspc: internal error: formatting {} would change its meaning; it is left as it is (please report)",
@@ -724,14 +746,11 @@ fn fmt(files: &[PathBuf], check: bool) -> ExitCode {
             );
             return ExitCode::from(101);
         }
-        if formatted != text {
-            unformatted.push(file);
-            writes.push(cli::outputs::Output {
-                path: file.clone(),
-                bytes: formatted.into_bytes(),
-                what: "the formatted spec",
-            });
-        }
+        writes.push(cli::outputs::Output {
+            path: file.clone(),
+            bytes: formatted.into_bytes(),
+            what: "the formatted spec",
+        });
     }
     let failed = diags.has_errors();
     print_diagnostics(&sources, &diags.sorted());
@@ -740,14 +759,11 @@ fn fmt(files: &[PathBuf], check: bool) -> ExitCode {
         return ExitCode::from(1);
     }
     if check {
-        for f in &unformatted {
-            println!(
-                "{}: not formatted (run `inspc fmt {}`)",
-                f.display(),
-                f.display()
-            );
+        for w in &writes {
+            let f = w.path.display();
+            println!("{f}: not formatted (run `inspc fmt {f}`)");
         }
-        if !unformatted.is_empty() {
+        if !writes.is_empty() {
             return ExitCode::from(1);
         }
         eprintln!("inspc: {} files formatted", files.len());
@@ -763,24 +779,17 @@ fn fmt(files: &[PathBuf], check: bool) -> ExitCode {
 }
 
 fn read_dmis(file: &std::path::Path) -> ExitCode {
-    use inspc::source::World;
     let mut sources = inspc::source::SourceMap::new();
-    let text = match FsWorld.read(file, inspc::source::FileKind::Dmis) {
-        Ok(b) => String::from_utf8_lossy(&b).into_owned(),
-        Err(e) => {
-            let shown = file.display().to_string();
-            let id = sources.add(shown.clone(), Some(file.to_path_buf()), String::new());
-            let mut diags = inspc::diag::Diagnostics::new();
-            diags.push(inspc::source::io::IoError::Unreadable {
-                file: id,
-                path: shown,
-                reason: e.0,
-            });
-            print_diagnostics(&sources, &diags.sorted());
-            return ExitCode::from(1);
-        }
+    let mut diags = inspc::diag::Diagnostics::new();
+    let Some(id) = read_source(
+        &mut sources,
+        &mut diags,
+        file,
+        inspc::source::FileKind::Dmis,
+    ) else {
+        print_diagnostics(&sources, &diags.sorted());
+        return ExitCode::from(1);
     };
-    let id = sources.add(file.display().to_string(), Some(file.to_path_buf()), text);
     match inspc::dmis::read(id, &sources.get(id).text) {
         Ok(p) => {
             let count = |m: &str| p.commands(m).count();

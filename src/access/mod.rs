@@ -270,6 +270,40 @@ pub struct PointCones {
     pub d2: Option<CubeMap>,
 }
 
+/// Where the probe stands to touch `f`: the tip centre, and the retract point when the
+/// approach is tested there too; None when the tip does not fit or has no room to touch.
+/// In a narrow feature the retract point moves in (see `pose::backoff`); there the
+/// contact's cone alone stands, and validation sweeps the real approach.
+fn stand(
+    scene: &Scene,
+    f: &Fpoint,
+    probe: &ProbeShape,
+    opts: &ConeOptions,
+) -> Option<(P3, Option<P3>)> {
+    let r = probe.tip_radius;
+    let c = f.tip_centre(r);
+    if !tip_fits(scene, &c, r)
+        || !pose::room_to_touch(scene, &f.position, &f.normal, r, opts.retract)
+    {
+        return None;
+    }
+    let travel = pose::backoff(scene, &f.position, &f.normal, r, opts.retract);
+    let retract =
+        (opts.retract > 0.0 && travel >= opts.retract).then(|| c + f.normal * opts.retract);
+    Some((c, retract))
+}
+
+impl PointCones {
+    /// The cones of a point whose tip does not fit: all empty.
+    fn unreachable(probe: &ProbeShape, n: u32, pref: &[V3]) -> PointCones {
+        PointCones {
+            tip_fits: false,
+            approach: CubeMap::empty(n, pref),
+            d2: probe.head.indexable().then(|| CubeMap::empty(n, pref)),
+        }
+    }
+}
+
 /// The cones of one fpoint under one probe. A tip that does not fit gives empty cones.
 pub fn point_cones(
     backend: &dyn Backend,
@@ -279,36 +313,13 @@ pub fn point_cones(
     opts: &ConeOptions,
 ) -> PointCones {
     let (n, pref) = (opts.n, &opts.preferred[..]);
-    let c = f.tip_centre(probe.tip_radius);
-    if !tip_fits(scene, &c, probe.tip_radius)
-        || !pose::room_to_touch(
-            scene,
-            &f.position,
-            &f.normal,
-            probe.tip_radius,
-            opts.retract,
-        )
-    {
-        return PointCones {
-            tip_fits: false,
-            approach: CubeMap::empty(n, pref),
-            d2: probe.head.indexable().then(|| CubeMap::empty(n, pref)),
-        };
-    }
-    // In a narrow feature the retract point moves in (see `pose::backoff`); there the
-    // contact's cone alone stands, and validation sweeps the real approach.
-    let travel = pose::backoff(
-        scene,
-        &f.position,
-        &f.normal,
-        probe.tip_radius,
-        opts.retract,
-    );
-    let retract = c + f.normal * opts.retract;
+    let Some((c, retract)) = stand(scene, f, probe, opts) else {
+        return PointCones::unreachable(probe, n, pref);
+    };
     let comps = probe.leading();
     let exact = opts.exact_boundary;
     let mut approach = gac_with(backend, scene, &c, &comps, n, pref, exact);
-    if !approach.is_empty() && opts.retract > 0.0 && travel >= opts.retract {
+    if let Some(retract) = retract.filter(|_| !approach.is_empty()) {
         approach.and_assign(&gac_with(backend, scene, &retract, &comps, n, pref, exact));
     }
     let d2 = probe
@@ -489,19 +500,7 @@ pub fn point_cones_many(
     // centre and, when the retract point is tested too, the retract point.
     let stands: Vec<Option<(P3, Option<P3>)>> = items
         .par_iter()
-        .map(|(f, probe)| {
-            let r = probe.tip_radius;
-            let c = f.tip_centre(r);
-            if !tip_fits(scene, &c, r)
-                || !pose::room_to_touch(scene, &f.position, &f.normal, r, opts.retract)
-            {
-                return None;
-            }
-            let travel = pose::backoff(scene, &f.position, &f.normal, r, opts.retract);
-            let retract =
-                (opts.retract > 0.0 && travel >= opts.retract).then(|| c + f.normal * opts.retract);
-            Some((c, retract))
-        })
+        .map(|(f, probe)| stand(scene, f, probe, opts))
         .collect();
     let leading: Vec<Vec<Component>> = items.iter().map(|(_, p)| p.leading()).collect();
     // The approach: every leading component at the contact and at the retract point.
@@ -575,16 +574,12 @@ pub fn point_cones_many(
             d.or_assign(&b.not());
         }
     }
-    stands
+    items
         .iter()
-        .zip(approach)
-        .zip(d2s)
-        .map(|((stand, approach), d2)| match stand {
-            None => PointCones {
-                tip_fits: false,
-                approach: CubeMap::empty(n, pref),
-                d2,
-            },
+        .zip(&stands)
+        .zip(approach.into_iter().zip(d2s))
+        .map(|((&(_, probe), stand), (approach, d2))| match stand {
+            None => PointCones::unreachable(probe, n, pref),
             Some(_) => PointCones {
                 tip_fits: true,
                 approach,

@@ -34,9 +34,7 @@ enum Tok<'a> {
 }
 
 /// A source line as tokens, each with whether whitespace preceded it.
-struct Line<'a> {
-    toks: Vec<(Tok<'a>, bool)>,
-}
+type Line<'a> = Vec<(Tok<'a>, bool)>;
 
 fn is_punct(c: char) -> bool {
     matches!(c, '{' | '}' | '(' | ')' | '[' | ']' | ',' | ';' | '=' | ':')
@@ -49,7 +47,7 @@ fn colon_pair(rest: &str, k: usize) -> bool {
 
 /// Splits the source into lines of tokens.
 fn lex(src: &str) -> Vec<Line<'_>> {
-    let mut lines = vec![Line { toks: Vec::new() }];
+    let mut lines = vec![Vec::new()];
     let bytes = src.as_bytes();
     let mut i = 0;
     let mut space = false;
@@ -58,7 +56,7 @@ fn lex(src: &str) -> Vec<Line<'_>> {
         let c = rest.chars().next().unwrap_or(' ');
         let cur = lines.len() - 1;
         if c == '\n' {
-            lines.push(Line { toks: Vec::new() });
+            lines.push(Vec::new());
             space = false;
             i += 1;
         } else if c == ' ' || c == '\t' || c == '\r' || c == '\u{FEFF}' {
@@ -66,15 +64,13 @@ fn lex(src: &str) -> Vec<Line<'_>> {
             i += c.len_utf8();
         } else if rest.starts_with("//") {
             let end = rest.find('\n').unwrap_or(rest.len());
-            lines[cur]
-                .toks
-                .push((Tok::Comment(rest[..end].trim_end()), space));
+            lines[cur].push((Tok::Comment(rest[..end].trim_end()), space));
             i += end;
         } else if rest.starts_with("/*") {
             // Kept as written, newlines and all: they are inside the comment, so the
             // tokens after it stay on its line.
             let end = rest.find("*/").map_or(rest.len(), |e| e + 2);
-            lines[cur].toks.push((Tok::Comment(&rest[..end]), space));
+            lines[cur].push((Tok::Comment(&rest[..end]), space));
             i += end;
             space = false;
         } else if c == '"' {
@@ -84,11 +80,11 @@ fn lex(src: &str) -> Vec<Line<'_>> {
                 j += if b[j] == b'\\' { 2 } else { 1 };
             }
             let end = (j + 1).min(rest.len());
-            lines[cur].toks.push((Tok::Str(&rest[..end]), space));
+            lines[cur].push((Tok::Str(&rest[..end]), space));
             i += end;
             space = false;
         } else if is_punct(c) && !rest.starts_with("::") {
-            lines[cur].toks.push((Tok::Punct(c), space));
+            lines[cur].push((Tok::Punct(c), space));
             i += 1;
             space = false;
         } else {
@@ -109,7 +105,7 @@ fn lex(src: &str) -> Vec<Line<'_>> {
                 j = k + ch.len_utf8();
             }
             let j = j.max(c.len_utf8());
-            lines[cur].toks.push((Tok::Word(&rest[..j]), space));
+            lines[cur].push((Tok::Word(&rest[..j]), space));
             i += j;
             space = false;
         }
@@ -137,19 +133,18 @@ pub fn format(src: &str) -> String {
     // Whether each open bracket is an import selection (`use a::{…}`), written tight.
     let mut tight: Vec<bool> = Vec::new();
     for line in &lex(src) {
-        if line.toks.is_empty() {
+        if line.is_empty() {
             if matches!(outs.last(), Some(Some(_))) {
                 outs.push(None);
             }
             continue;
         }
         let closing = line
-            .toks
             .iter()
             .take_while(|(t, _)| matches!(t, Tok::Punct('}' | ')' | ']')))
             .count() as i64;
         let indent = 4 * (depth - closing).max(0) as usize;
-        let mut toks: &[(Tok, bool)] = &line.toks;
+        let mut toks: &[(Tok, bool)] = line;
         let mut comment = None;
         if let [before @ .., (Tok::Comment(c), _)] = toks {
             if !before.is_empty() && c.starts_with("//") {

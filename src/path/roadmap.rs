@@ -239,12 +239,11 @@ impl<'a> Roadmap<'a> {
     /// axis, and their lifted copies are one another's nearest neighbours.
     fn bridge(&mut self) -> usize {
         let comp = self.components();
-        let stray = self.stray_goals();
-        let Some(first) = (0..self.goals).find(|g| !stray.contains(g)) else {
-            return 0;
-        };
-        let main = comp[first];
-        let mut islands: Vec<usize> = stray.iter().map(|&g| comp[g]).collect();
+        let main = self.main_component(&comp);
+        let mut islands: Vec<usize> = (0..self.goals)
+            .map(|g| comp[g])
+            .filter(|&c| c != main)
+            .collect();
         islands.sort_unstable();
         islands.dedup();
         let mut pairs = Vec::new();
@@ -316,6 +315,12 @@ impl<'a> Roadmap<'a> {
     /// Goals outside the component holding the most goals (ties: the lower index).
     fn stray_goals(&self) -> Vec<usize> {
         let comp = self.components();
+        let main = self.main_component(&comp);
+        (0..self.goals).filter(|&g| comp[g] != main).collect()
+    }
+
+    /// The component holding the most goals (ties: the lower index), given each node's.
+    fn main_component(&self, comp: &[usize]) -> usize {
         let mut count = vec![0usize; self.nodes.len()];
         for g in 0..self.goals {
             count[comp[g]] += 1;
@@ -326,7 +331,7 @@ impl<'a> Roadmap<'a> {
                 main = c;
             }
         }
-        (0..self.goals).filter(|&g| comp[g] != main).collect()
+        main
     }
 
     /// Builds the roadmap: initialisation, then enhancement until the goals are
@@ -380,9 +385,7 @@ impl<'a> Roadmap<'a> {
             }
             added += self.insert(cands);
         }
-        if !self.stray_goals().is_empty() {
-            self.bridge();
-        }
+        self.bridge();
         let stray = self.stray_goals();
         match stray.first() {
             None => Ok(added),

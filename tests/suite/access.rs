@@ -33,22 +33,27 @@ struct Case {
     probes: Vec<ProbeShape>,
 }
 
-/// The scene, `count` pseudo-random tip centres (for the first probe's tip, 1 mm
-/// without a plan) and the plan's probes.
-fn case(spec: &str, count: usize, seed: u64) -> Case {
+/// A spec's part as obstacle, its first plan's probes (none without a plan) and its
+/// fpoints.
+pub(crate) fn loaded(spec: &str) -> (Scene, Vec<ProbeShape>, Vec<inspc::sample::Fpoint>) {
     let (checked, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[PathBuf::from(spec)]);
     assert!(!checked.has_errors(), "{spec}");
     let gr = &graphs[0];
     let g = &parts[gr.part].as_ref().unwrap().geometry;
-    let scene = Scene::of_part(g);
     let model = &checked.model;
     let probes = model
         .plans
         .first()
         .map(|p| ProbeShape::of_cmm(model, &model.cmms[p.cmm.0]))
         .unwrap_or_default();
+    (Scene::of_part(g), probes, gr.graph.fpoints.clone())
+}
+
+/// The scene, `count` pseudo-random tip centres (for the first probe's tip, 1 mm
+/// without a plan) and the plan's probes.
+fn case(spec: &str, count: usize, seed: u64) -> Case {
+    let (scene, probes, fp) = loaded(spec);
     let r = probes.first().map_or(1.0, |p| p.tip_radius);
-    let fp = &gr.graph.fpoints;
     let mut state = seed;
     let points = (0..count)
         .map(|_| {

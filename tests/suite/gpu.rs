@@ -9,8 +9,6 @@
 
 use inspc::access::{axes, gpu, Backend, Component, Cpu, CubeMap, ProbeShape, Query, Scene};
 use inspc::geometry::{P3, V3};
-use inspc::source::FsWorld;
-use std::path::PathBuf;
 
 fn device() -> Option<&'static inspc::access::Gpu> {
     match gpu() {
@@ -26,19 +24,9 @@ fn device() -> Option<&'static inspc::access::Gpu> {
     }
 }
 
-/// The scene, `count` fpoints' tip centres per probe, and the plan's probes.
+/// The scene, the plan's probes, and `count` fpoints' tip centres per probe.
 fn case(spec: &str, count: usize) -> (Scene, Vec<ProbeShape>, Vec<(usize, P3)>) {
-    let (checked, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[PathBuf::from(spec)]);
-    assert!(!checked.has_errors(), "{spec}");
-    let gr = &graphs[0];
-    let g = &parts[gr.part].as_ref().unwrap().geometry;
-    let model = &checked.model;
-    let probes = model
-        .plans
-        .first()
-        .map(|p| ProbeShape::of_cmm(model, &model.cmms[p.cmm.0]))
-        .unwrap_or_default();
-    let fp = &gr.graph.fpoints;
+    let (scene, probes, fp) = crate::access::loaded(spec);
     let mut state = 41u64;
     let mut points = Vec::new();
     for (k, probe) in probes.iter().enumerate() {
@@ -52,7 +40,7 @@ fn case(spec: &str, count: usize) -> (Scene, Vec<ProbeShape>, Vec<(usize, P3)>) 
             ));
         }
     }
-    (Scene::of_part(g), probes, points)
+    (scene, probes, points)
 }
 
 /// (cells, agreeing cells, GPU-only blocked cells) over every query; panics where the
@@ -154,19 +142,13 @@ impl Backend for BatchingCpu {
 fn batched_point_cones_are_the_per_point_cones() {
     use inspc::access::{gac_halfline, gac_halfline_many, point_cones, point_cones_many};
     for spec in ["examples/f3_fixed.insp", "examples/f3_indexed.insp"] {
-        let (checked, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[PathBuf::from(spec)]);
-        let gr = &graphs[0];
-        let scene = Scene::of_part(&parts[gr.part].as_ref().unwrap().geometry);
-        let model = &checked.model;
-        let probes = ProbeShape::of_cmm(model, &model.cmms[model.plans[0].cmm.0]);
+        let (scene, probes, fpoints) = crate::access::loaded(spec);
         let opts = inspc::access::ConeOptions {
             n: 32,
             d2_samples: 4,
             ..Default::default()
         };
-        let items: Vec<_> = gr
-            .graph
-            .fpoints
+        let items: Vec<_> = fpoints
             .iter()
             .step_by(3)
             .flat_map(|f| probes.iter().map(move |p| (f, p)))

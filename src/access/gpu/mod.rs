@@ -197,6 +197,60 @@ impl Gpu {
         }
         words
     }
+
+    /// Rasterizes the recorded polygons of `queries` in one submission and finishes their
+    /// maps; the CPU computes them when the GPU fails.
+    fn submit(
+        &self,
+        scene: &Scene,
+        queries: &[Query],
+        recorded: &[(Record, Drawn)],
+        (n, preferred, words_per_map): (u32, &[V3], usize),
+    ) -> Vec<CubeMap> {
+        let like = CubeMap::empty(n, preferred);
+        // Map indices: each query's targets, one after another.
+        let mut first = Vec::with_capacity(queries.len());
+        let mut maps = 0usize;
+        let mut draws = Vec::new();
+        for (rec, drawn) in recorded {
+            first.push(maps);
+            if drawn.full {
+                continue;
+            }
+            for d in rec.draws.chunks(DRAW_WORDS) {
+                draws.push(d[0] + maps as u32);
+                draws.extend_from_slice(&d[1..]);
+            }
+            maps += rec.targets as usize + 1;
+        }
+        let words = if draws.is_empty() {
+            vec![0; maps * words_per_map]
+        } else {
+            self.raster(&draws, maps, n, words_per_map)
+        };
+        let lost = words.len() < maps * words_per_map;
+        queries
+            .par_iter()
+            .zip(recorded)
+            .zip(&first)
+            .map(|((q, (rec, drawn)), &m)| {
+                if lost {
+                    return cpu::blocked(scene, &q.from, q.comp, n, preferred);
+                }
+                let map = |t: usize| {
+                    let at = (m + t) * words_per_map;
+                    like.with_pixel_words(&words[at..at + words_per_map])
+                };
+                let (base, bands) = if drawn.full {
+                    (like.clone(), Vec::new())
+                } else {
+                    let bands = (1..=rec.targets as usize).map(|t| Some(map(t))).collect();
+                    (map(0), bands)
+                };
+                cpu::finish(scene, &q.from, q.comp, base, bands, drawn)
+            })
+            .collect()
+    }
 }
 
 /// A query's polygons, recorded for the GPU.
@@ -212,7 +266,7 @@ impl Canvas for Record {
         self.draws
             .extend_from_slice(&[target, u32::from(cov == Coverage::Cells), len as u32, 0]);
         for k in 0..12 {
-            let p = q.get(k).filter(|_| k < len).copied().unwrap_or_default();
+            let p = q.get(k).copied().unwrap_or_default();
             self.draws.extend(p.iter().map(|&c| (c as f32).to_bits()));
         }
         self.targets = self.targets.max(target);
@@ -292,61 +346,5 @@ impl Backend for Gpu {
 
     fn batches(&self) -> bool {
         true
-    }
-}
-
-impl Gpu {
-    /// Rasterizes the recorded polygons of `queries` in one submission and finishes their
-    /// maps; the CPU computes them when the GPU fails.
-    fn submit(
-        &self,
-        scene: &Scene,
-        queries: &[Query],
-        recorded: &[(Record, Drawn)],
-        (n, preferred, words_per_map): (u32, &[V3], usize),
-    ) -> Vec<CubeMap> {
-        let like = CubeMap::empty(n, preferred);
-        // Map indices: each query's targets, one after another.
-        let mut first = Vec::with_capacity(queries.len());
-        let mut maps = 0usize;
-        let mut draws = Vec::new();
-        for (rec, drawn) in recorded {
-            first.push(maps);
-            if drawn.full {
-                continue;
-            }
-            for d in rec.draws.chunks(DRAW_WORDS) {
-                draws.push(d[0] + maps as u32);
-                draws.extend_from_slice(&d[1..]);
-            }
-            maps += rec.targets as usize + 1;
-        }
-        let words = if draws.is_empty() {
-            vec![0; maps * words_per_map]
-        } else {
-            self.raster(&draws, maps, n, words_per_map)
-        };
-        let lost = words.len() < maps * words_per_map;
-        queries
-            .par_iter()
-            .zip(recorded)
-            .zip(&first)
-            .map(|((q, (rec, drawn)), &m)| {
-                if lost {
-                    return cpu::blocked(scene, &q.from, q.comp, n, preferred);
-                }
-                let map = |t: usize| {
-                    let at = (m + t) * words_per_map;
-                    like.with_pixel_words(&words[at..at + words_per_map])
-                };
-                let (base, bands) = if drawn.full {
-                    (like.clone(), Vec::new())
-                } else {
-                    let bands = (1..=rec.targets as usize).map(|t| Some(map(t))).collect();
-                    (map(0), bands)
-                };
-                cpu::finish(scene, &q.from, q.comp, base, bands, drawn)
-            })
-            .collect()
     }
 }
