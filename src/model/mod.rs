@@ -12,7 +12,7 @@
 mod part;
 mod summary;
 
-pub use summary::fmt_num;
+pub use summary::{fmt_num, ItemRef};
 
 pub use part::*;
 
@@ -89,6 +89,18 @@ pub struct Model {
     /// `std::sampling::fan_leu`, the sampling of a plan that names none and of a part
     /// sampled without a plan.
     pub default_sampling: Option<SamplingId>,
+    /// Every use of a name the resolver bound, with the declaration it names: the
+    /// editor's go-to-definition and references (`inspc lsp`). Sorted, no duplicates.
+    pub names: Vec<NameUse>,
+}
+
+/// A name as used (`used`) and the name it binds to where it is declared (`decl`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub struct NameUse {
+    /// The name (or path) where it is used.
+    pub used: Span,
+    /// The declared name.
+    pub decl: Span,
 }
 
 /// A coordinate measuring machine.

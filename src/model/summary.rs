@@ -19,6 +19,33 @@ fn v3(v: &Vec3) -> String {
     format!("({}, {}, {})", fmt_num(v[0]), fmt_num(v[1]), fmt_num(v[2]))
 }
 
+/// A top-level item of the model by kind and index: what [`Model::describe`] describes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ItemRef {
+    /// `heads[i]`
+    Head(usize),
+    /// `styli[i]`
+    Stylus(usize),
+    /// `bodies[i]`
+    Body(usize),
+    /// `extensions[i]`
+    Extension(usize),
+    /// `probes[i]`
+    Probe(usize),
+    /// `cmms[i]`, with its fixtures
+    Cmm(usize),
+    /// `fixtures[i]`
+    Fixture(usize),
+    /// `hierarchies[i]`
+    Hierarchy(usize),
+    /// `samplings[i]`
+    Sampling(usize),
+    /// `parts[i]`, with its operations, features, datums and tolerances
+    Part(usize),
+    /// `plans[i]`, with its preferences
+    Plan(usize),
+}
+
 impl Model {
     /// The model as indented text, in declaration order: every part, CMM and plan, and
     /// the catalogue items they use or that a file for which `shown` holds declares.
@@ -27,133 +54,167 @@ impl Model {
         let keep = |span: &crate::source::Span, kind: u8, index: usize| {
             shown(span.file) || used.contains(&(kind, index))
         };
+        let mut items: Vec<ItemRef> = Vec::new();
+        let mut add =
+            |n: usize, kind: u8, span: &dyn Fn(usize) -> Span, item: fn(usize) -> ItemRef| {
+                items.extend((0..n).filter(|&i| keep(&span(i), kind, i)).map(item));
+            };
+        add(self.heads.len(), 0, &|i| self.heads[i].span, ItemRef::Head);
+        add(
+            self.styli.len(),
+            1,
+            &|i| self.styli[i].span,
+            ItemRef::Stylus,
+        );
+        add(
+            self.bodies.len(),
+            2,
+            &|i| self.bodies[i].span,
+            ItemRef::Body,
+        );
+        add(
+            self.extensions.len(),
+            3,
+            &|i| self.extensions[i].span,
+            ItemRef::Extension,
+        );
+        add(
+            self.probes.len(),
+            4,
+            &|i| self.probes[i].span,
+            ItemRef::Probe,
+        );
+        // CMMs and parts only when shown (kind 7 is never used).
+        add(self.cmms.len(), 7, &|i| self.cmms[i].span, ItemRef::Cmm);
+        add(
+            self.hierarchies.len(),
+            5,
+            &|i| self.hierarchies[i].span,
+            ItemRef::Hierarchy,
+        );
+        add(
+            self.samplings.len(),
+            6,
+            &|i| self.samplings[i].span,
+            ItemRef::Sampling,
+        );
+        add(self.parts.len(), 7, &|i| self.parts[i].span, ItemRef::Part);
+        items.extend((0..self.plans.len()).map(ItemRef::Plan));
+        items.iter().map(|&item| self.describe(item)).collect()
+    }
+
+    /// One item as the summary prints it: a line `kind name: …`, then its members
+    /// indented (a CMM's fixtures, a part's operations and features, a plan's preferences).
+    pub fn describe(&self, item: ItemRef) -> String {
         let mut o = String::new();
-        for h in self
-            .heads
-            .iter()
-            .enumerate()
-            .filter(|(i, x)| keep(&x.span, 0, *i))
-            .map(|(_, x)| x)
-        {
-            let kind = match &h.kind {
-                HeadKind::Fixed => "fixed".to_string(),
-                HeadKind::Indexable { a, b, step } => format!(
-                    "indexable A {}..{} B {}..{} step {} ({} orientations)",
-                    fmt_num(a[0]),
-                    fmt_num(a[1]),
-                    fmt_num(b[0]),
-                    fmt_num(b[1]),
-                    fmt_num(*step),
-                    h.orientations().len()
-                ),
-            };
-            let _ = writeln!(
-                o,
-                "head {}: {kind}, envelope Ø{} × {}",
-                h.name,
-                fmt_num(h.diameter),
-                fmt_num(h.length)
-            );
-        }
-        for s in self
-            .styli
-            .iter()
-            .enumerate()
-            .filter(|(i, x)| keep(&x.span, 1, *i))
-            .map(|(_, x)| x)
-        {
-            let _ = writeln!(
-                o,
-                "stylus {}: tip Ø{}, length {}, stem Ø{}",
-                s.name,
-                fmt_num(s.tip),
-                fmt_num(s.length),
-                fmt_num(s.stem)
-            );
-        }
-        for b in self
-            .bodies
-            .iter()
-            .enumerate()
-            .filter(|(i, x)| keep(&x.span, 2, *i))
-            .map(|(_, x)| x)
-        {
-            let _ = writeln!(
-                o,
-                "body {}: Ø{} × {}",
-                b.name,
-                fmt_num(b.diameter),
-                fmt_num(b.length)
-            );
-        }
-        for e in self
-            .extensions
-            .iter()
-            .enumerate()
-            .filter(|(i, x)| keep(&x.span, 3, *i))
-            .map(|(_, x)| x)
-        {
-            let _ = writeln!(
-                o,
-                "extension {}: Ø{} × {}",
-                e.name,
-                fmt_num(e.diameter),
-                fmt_num(e.length)
-            );
-        }
-        for p in self
-            .probes
-            .iter()
-            .enumerate()
-            .filter(|(i, x)| keep(&x.span, 4, *i))
-            .map(|(_, x)| x)
-        {
-            let ext: Vec<&str> = p
-                .extensions
-                .iter()
-                .map(|e| self.extensions[e.0].name.as_str())
-                .collect();
-            let _ = writeln!(
-                o,
-                "probe {}: body {}, extensions [{}], stylus {}, cost {}",
-                p.name,
-                self.bodies[p.body.0].name,
-                ext.join(", "),
-                self.styli[p.stylus.0].name,
-                fmt_num(p.cost)
-            );
-        }
-        for c in self.cmms.iter().filter(|c| shown(c.span.file)) {
-            let probes: Vec<String> = c
-                .probes
-                .iter()
-                .map(|(l, p)| format!("{l}: {}", self.probes[p.0].name))
-                .collect();
-            let size = c.table_size.map_or(String::new(), |s| {
-                format!(" size {} × {}", fmt_num(s[0]), fmt_num(s[1]))
-            });
-            let fixtures: Vec<String> = c
-                .fixtures
-                .iter()
-                .map(|(l, f)| format!("{l}: {}", self.fixtures[f.0].name))
-                .collect();
-            let fixtures = if fixtures.is_empty() {
-                String::new()
-            } else {
-                format!(", fixtures [{}]", fixtures.join(", "))
-            };
-            let _ = writeln!(
-                o,
-                "cmm {}: table z {}{size}, ram r {} l {}, head {}, probes [{}]{fixtures}",
-                c.name,
-                fmt_num(c.table_z),
-                fmt_num(c.ram_radius),
-                fmt_num(c.ram_length),
-                self.heads[c.head.0].name,
-                probes.join(", ")
-            );
-            for (_, f) in &c.fixtures {
-                let f = &self.fixtures[f.0];
+        match item {
+            ItemRef::Head(i) => {
+                let h = &self.heads[i];
+                let kind = match &h.kind {
+                    HeadKind::Fixed => "fixed".to_string(),
+                    HeadKind::Indexable { a, b, step } => format!(
+                        "indexable A {}..{} B {}..{} step {} ({} orientations)",
+                        fmt_num(a[0]),
+                        fmt_num(a[1]),
+                        fmt_num(b[0]),
+                        fmt_num(b[1]),
+                        fmt_num(*step),
+                        h.orientations().len()
+                    ),
+                };
+                let _ = writeln!(
+                    o,
+                    "head {}: {kind}, envelope Ø{} × {}",
+                    h.name,
+                    fmt_num(h.diameter),
+                    fmt_num(h.length)
+                );
+            }
+            ItemRef::Stylus(i) => {
+                let s = &self.styli[i];
+                let _ = writeln!(
+                    o,
+                    "stylus {}: tip Ø{}, length {}, stem Ø{}",
+                    s.name,
+                    fmt_num(s.tip),
+                    fmt_num(s.length),
+                    fmt_num(s.stem)
+                );
+            }
+            ItemRef::Body(i) => {
+                let b = &self.bodies[i];
+                let _ = writeln!(
+                    o,
+                    "body {}: Ø{} × {}",
+                    b.name,
+                    fmt_num(b.diameter),
+                    fmt_num(b.length)
+                );
+            }
+            ItemRef::Extension(i) => {
+                let e = &self.extensions[i];
+                let _ = writeln!(
+                    o,
+                    "extension {}: Ø{} × {}",
+                    e.name,
+                    fmt_num(e.diameter),
+                    fmt_num(e.length)
+                );
+            }
+            ItemRef::Probe(i) => {
+                let p = &self.probes[i];
+                let ext: Vec<&str> = p
+                    .extensions
+                    .iter()
+                    .map(|e| self.extensions[e.0].name.as_str())
+                    .collect();
+                let _ = writeln!(
+                    o,
+                    "probe {}: body {}, extensions [{}], stylus {}, cost {}",
+                    p.name,
+                    self.bodies[p.body.0].name,
+                    ext.join(", "),
+                    self.styli[p.stylus.0].name,
+                    fmt_num(p.cost)
+                );
+            }
+            ItemRef::Cmm(i) => {
+                let c = &self.cmms[i];
+                let probes: Vec<String> = c
+                    .probes
+                    .iter()
+                    .map(|(l, p)| format!("{l}: {}", self.probes[p.0].name))
+                    .collect();
+                let size = c.table_size.map_or(String::new(), |s| {
+                    format!(" size {} × {}", fmt_num(s[0]), fmt_num(s[1]))
+                });
+                let fixtures: Vec<String> = c
+                    .fixtures
+                    .iter()
+                    .map(|(l, f)| format!("{l}: {}", self.fixtures[f.0].name))
+                    .collect();
+                let fixtures = if fixtures.is_empty() {
+                    String::new()
+                } else {
+                    format!(", fixtures [{}]", fixtures.join(", "))
+                };
+                let _ = writeln!(
+                    o,
+                    "cmm {}: table z {}{size}, ram r {} l {}, head {}, probes [{}]{fixtures}",
+                    c.name,
+                    fmt_num(c.table_z),
+                    fmt_num(c.ram_radius),
+                    fmt_num(c.ram_length),
+                    self.heads[c.head.0].name,
+                    probes.join(", ")
+                );
+                for (_, f) in &c.fixtures {
+                    o.push_str("  ");
+                    o.push_str(&self.describe(ItemRef::Fixture(f.0)));
+                }
+            }
+            ItemRef::Fixture(i) => {
+                let f = &self.fixtures[i];
                 let r = |x: &[f64; 2], unit: &str| {
                     format!("{} {unit} .. {} {unit}", fmt_num(x[0]), fmt_num(x[1]))
                 };
@@ -190,96 +251,86 @@ impl Model {
                     FixtureKind::Mesh { .. } => String::new(),
                     _ => format!(", height {} mm", fmt_num(f.height)),
                 };
-                let _ = writeln!(o, "  fixture {}: {} {what}{height}", f.name, f.kind.word());
+                let _ = writeln!(o, "fixture {}: {} {what}{height}", f.name, f.kind.word());
             }
-        }
-        for h in self
-            .hierarchies
-            .iter()
-            .enumerate()
-            .filter(|(i, x)| keep(&x.span, 5, *i))
-            .map(|(_, x)| x)
-        {
-            let levels: Vec<String> = h.levels.iter().map(|l| l.text()).collect();
-            let _ = writeln!(
-                o,
-                "hierarchy {}: required approachability > {}",
-                h.name,
-                levels.join(" > ")
-            );
-        }
-        for s in self
-            .samplings
-            .iter()
-            .enumerate()
-            .filter(|(i, x)| keep(&x.span, 6, *i))
-            .map(|(_, x)| x)
-        {
-            let per: Vec<String> = s
-                .per_surface
-                .iter()
-                .map(|(k, st)| format!("{} {}", k.keyword(), strategy_text(st)))
-                .collect();
-            let _ = writeln!(o, "sampling {}: {}", s.name, per.join(", "));
-        }
-        for p in self.parts.iter().filter(|p| shown(p.span.file)) {
-            part_summary(&mut o, p);
-        }
-        for p in &self.plans {
-            let _ = writeln!(
-                o,
-                "plan {}: part {}, cmm {}, hierarchy {}, sampling {}",
-                p.name,
-                self.parts[p.part.0].name,
-                self.cmms[p.cmm.0].name,
-                self.hierarchies[p.hierarchy.0].name,
-                self.samplings[p.sampling.0].name
-            );
-            let verb = |s: &super::Stance<f64>| match s {
-                super::Stance::Forbid => "forbid".to_string(),
-                super::Stance::Prefer(w) => format!("prefer (weight {})", fmt_num(*w)),
-            };
-            if !p.fixtures.is_empty() {
-                let cmm = &self.cmms[p.cmm.0];
-                let labels: Vec<&str> = p
-                    .fixtures
+            ItemRef::Hierarchy(i) => {
+                let h = &self.hierarchies[i];
+                let levels: Vec<String> = h.levels.iter().map(|l| l.text()).collect();
+                let _ = writeln!(
+                    o,
+                    "hierarchy {}: required approachability > {}",
+                    h.name,
+                    levels.join(" > ")
+                );
+            }
+            ItemRef::Sampling(i) => {
+                let s = &self.samplings[i];
+                let per: Vec<String> = s
+                    .per_surface
                     .iter()
-                    .filter_map(|&k| cmm.fixtures.get(k).map(|(l, _)| l.as_str()))
+                    .map(|(k, st)| format!("{} {}", k.keyword(), strategy_text(st)))
                     .collect();
-                let _ = writeln!(o, "  fixtures [{}]", labels.join(", "));
+                let _ = writeln!(o, "sampling {}: {}", s.name, per.join(", "));
             }
-            for s in &p.setups {
-                let verb = verb(&s.stance);
-                let _ = writeln!(o, "  {verb} setup {}", v3(&s.direction));
-            }
-            for s in &p.orientations {
-                let verb = verb(&s.stance);
-                let _ = writeln!(
-                    o,
-                    "  {verb} orientation A {} B {}",
-                    fmt_num(s.a),
-                    fmt_num(s.b)
-                );
-            }
-            for s in &p.probes {
-                let what = match s.stance {
-                    super::Stance::Forbid => "forbid".to_string(),
-                    super::Stance::Prefer(cost) => {
-                        format!("cost {}", cost.map_or("-".into(), fmt_num))
-                    }
-                };
-                let _ = writeln!(o, "  probe {}: {what}", s.label);
-            }
-            for (f, st) in &p.overrides {
-                let _ = writeln!(
-                    o,
-                    "  sample {} with {}",
-                    self.parts[p.part.0].features[f.0].name,
-                    strategy_text(st)
-                );
-            }
+            ItemRef::Part(i) => part_summary(&mut o, &self.parts[i]),
+            ItemRef::Plan(i) => self.plan_summary(&mut o, &self.plans[i]),
         }
         o
+    }
+
+    fn plan_summary(&self, o: &mut String, p: &Plan) {
+        let _ = writeln!(
+            o,
+            "plan {}: part {}, cmm {}, hierarchy {}, sampling {}",
+            p.name,
+            self.parts[p.part.0].name,
+            self.cmms[p.cmm.0].name,
+            self.hierarchies[p.hierarchy.0].name,
+            self.samplings[p.sampling.0].name
+        );
+        let verb = |s: &super::Stance<f64>| match s {
+            super::Stance::Forbid => "forbid".to_string(),
+            super::Stance::Prefer(w) => format!("prefer (weight {})", fmt_num(*w)),
+        };
+        if !p.fixtures.is_empty() {
+            let cmm = &self.cmms[p.cmm.0];
+            let labels: Vec<&str> = p
+                .fixtures
+                .iter()
+                .filter_map(|&k| cmm.fixtures.get(k).map(|(l, _)| l.as_str()))
+                .collect();
+            let _ = writeln!(o, "  fixtures [{}]", labels.join(", "));
+        }
+        for s in &p.setups {
+            let verb = verb(&s.stance);
+            let _ = writeln!(o, "  {verb} setup {}", v3(&s.direction));
+        }
+        for s in &p.orientations {
+            let verb = verb(&s.stance);
+            let _ = writeln!(
+                o,
+                "  {verb} orientation A {} B {}",
+                fmt_num(s.a),
+                fmt_num(s.b)
+            );
+        }
+        for s in &p.probes {
+            let what = match s.stance {
+                super::Stance::Forbid => "forbid".to_string(),
+                super::Stance::Prefer(cost) => {
+                    format!("cost {}", cost.map_or("-".into(), fmt_num))
+                }
+            };
+            let _ = writeln!(o, "  probe {}: {what}", s.label);
+        }
+        for (f, st) in &p.overrides {
+            let _ = writeln!(
+                o,
+                "  sample {} with {}",
+                self.parts[p.part.0].features[f.0].name,
+                strategy_text(st)
+            );
+        }
     }
 }
 

@@ -43,7 +43,10 @@ pub(super) fn datum(
     // A single name of a feature is that feature; anything else becomes a feature of its own.
     let single = match expr.terms.as_slice() {
         [ast::FaceTerm::Path(p)] if p.segs.len() == 1 => match pc.names.get(&p.head().name) {
-            Some((Local::Feature(i), _)) if *i < pc.lowered_features => Some(FeatureId(*i)),
+            Some(&(Local::Feature(i), decl)) if i < pc.lowered_features => {
+                cx.bind(p.head().span, decl);
+                Some(FeatureId(i))
+            }
             _ => None,
         },
         _ => None,
@@ -91,20 +94,20 @@ pub(super) fn datum_ref(cx: &mut Cx, pc: &PartCx, v: &ast::Value) -> Option<(Dat
         }
     };
     let head = path.head();
-    match pc.names.get(&head.name) {
-        Some((Local::Datum(i), _)) if path.segs.len() == 1 => {
-            if *i >= pc.part.datums.len() {
+    match pc.local(cx, head) {
+        Some(Local::Datum(i)) if path.segs.len() == 1 => {
+            if i >= pc.part.datums.len() {
                 return None; // the datum itself failed to resolve and was reported
             }
             Some((
                 DatumRef {
-                    datum: DatumId(*i),
+                    datum: DatumId(i),
                     modifier,
                 },
                 path.span,
             ))
         }
-        Some((other, _)) => {
+        Some(other) => {
             cx.err(E::WrongKind {
                 span: path.span,
                 name: path_text(path),

@@ -108,7 +108,7 @@ fn face_term(cx: &mut Cx, pc: &PartCx, t: &ast::FaceTerm, is_mesh: bool) -> Vec<
 
 fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
     let head = path.head();
-    let Some(&(local, _)) = pc.names.get(&head.name) else {
+    let Some(local) = pc.local(cx, head) else {
         let candidates: Vec<&str> = pc
             .names
             .iter()

@@ -27,7 +27,7 @@ pub use tolerance::{accepts, Accepts, Datums};
 
 use crate::diag::{suggest, Diagnostics};
 use crate::load::{ModuleId, Program};
-use crate::model::Model;
+use crate::model::{Model, NameUse};
 use crate::source::{FileId, SourceMap, World};
 use crate::syntax::ast;
 use errors::ResolveError as E;
@@ -96,6 +96,8 @@ pub(crate) struct Resolver<'a> {
     decls: Vec<Decl<'a>>,
     /// Per module: name → declaration index.
     scopes: Vec<BTreeMap<String, usize>>,
+    /// The names `use` statements bound (see [`Model::names`]).
+    imported: Vec<NameUse>,
 }
 
 /// Resolves a loaded program. The entry point of the resolve stage.
@@ -111,10 +113,15 @@ pub fn resolve(
         world,
         decls: Vec::new(),
         scopes: Vec::new(),
+        imported: Vec::new(),
     };
     r.declare(diags);
     r.import(diags);
-    let mut model = r.lower(diags);
+    let mut names = std::mem::take(&mut r.imported);
+    let mut model = r.lower(diags, &mut names);
+    names.sort();
+    names.dedup();
+    model.names = names;
     model.default_sampling = r
         .std_item("std::sampling", "fan_leu", Kind::Sampling)
         .map(crate::model::SamplingId);
@@ -244,6 +251,10 @@ impl<'a> Resolver<'a> {
                         }
                         _ => {
                             self.scopes[mi].insert(ident.name.clone(), d);
+                            self.imported.push(NameUse {
+                                used: ident.span,
+                                decl: self.decls[d].name.span,
+                            });
                         }
                     }
                 }
@@ -324,6 +335,7 @@ impl<'a> Resolver<'a> {
             return None;
         };
         let decl = &self.decls[d];
+        cx.bind(path.span, decl.name.span);
         if decl.kind != kind {
             cx.err(E::WrongKind {
                 span: path.span,
@@ -347,11 +359,12 @@ impl<'a> Resolver<'a> {
     }
 
     /// Lowers every declaration, in declaration order per kind.
-    fn lower(&self, diags: &mut Diagnostics) -> Model {
+    fn lower(&self, diags: &mut Diagnostics, names: &mut Vec<NameUse>) -> Model {
         let mut model = Model::default();
         for d in &self.decls {
             let mut cx = Cx {
                 diags,
+                names,
                 file: d.file,
                 unit_mm: None,
             };
@@ -372,6 +385,7 @@ impl<'a> Resolver<'a> {
             let ast::Item::Plan(p) = d.item else { continue };
             let mut cx = Cx {
                 diags,
+                names,
                 file: d.file,
                 unit_mm: None,
             };

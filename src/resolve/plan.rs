@@ -137,6 +137,7 @@ pub(super) fn lower(
                 let name = path_text(feature);
                 match the_part.features.iter().position(|f| f.name == name) {
                     Some(i) => {
+                        cx.bind(feature.span, the_part.features[i].span);
                         if let Some(st) = strategy(cx, sv, None) {
                             plan.overrides.push((FeatureId(i), st));
                         }

@@ -79,6 +79,8 @@ pub(crate) fn path_text(p: &ast::Path) -> String {
 /// The context values are converted in: where errors go and what a bare length means.
 pub(crate) struct Cx<'d> {
     pub diags: &'d mut Diagnostics,
+    /// The names bound so far (see [`crate::model::Model::names`]).
+    pub names: &'d mut Vec<crate::model::NameUse>,
     pub file: FileId,
     /// mm per bare number in a length position (inside a part), if any.
     pub unit_mm: Option<f64>,
@@ -87,6 +89,11 @@ pub(crate) struct Cx<'d> {
 impl Cx<'_> {
     pub fn err(&mut self, e: E) {
         self.diags.push(e);
+    }
+
+    /// Records that the name at `used` binds to the one declared at `decl`.
+    pub fn bind(&mut self, used: Span, decl: Span) {
+        self.names.push(crate::model::NameUse { used, decl });
     }
 
     pub fn mismatch(&mut self, v: &Value, expected: &str, help: &str) {

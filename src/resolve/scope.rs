@@ -4,7 +4,7 @@
 
 use crate::model::{Declared, Part};
 use crate::source::Span;
-use crate::syntax::ast::PartStmt;
+use crate::syntax::ast::{Ident, PartStmt};
 use std::collections::BTreeMap;
 
 /// What a name inside a part stands for.
@@ -41,4 +41,14 @@ pub(super) struct PartCx<'p> {
     /// Features lowered so far (features may only use those above them).
     pub lowered_features: usize,
     pub stmts: &'p [PartStmt],
+}
+
+impl PartCx<'_> {
+    /// What a name inside the part stands for, recording the binding (see
+    /// [`crate::model::Model::names`]).
+    pub(super) fn local(&self, cx: &mut super::props::Cx, name: &Ident) -> Option<Local> {
+        let &(local, decl) = self.names.get(&name.name)?;
+        cx.bind(name.span, decl);
+        Some(local)
+    }
 }

@@ -241,10 +241,10 @@ pub(super) fn lower(
                     if p.segs.len() == 1
                         && matches!(pc.names.get(&p.head().name), Some((Local::Frame(_), _))) =>
                 {
-                    let Some((Local::Frame(i), _)) = pc.names.get(&p.head().name) else {
+                    let Some(Local::Frame(i)) = pc.local(cx, p.head()) else {
                         unreachable!()
                     };
-                    match pc.part.frames.get(*i) {
+                    match pc.part.frames.get(i) {
                         Some(f) => datums.extend(f.refs.iter().map(|r| (r.clone(), p.span))),
                         None => ok = false,
                     }
@@ -381,14 +381,12 @@ fn target(cx: &mut Cx, pc: &PartCx, p: &ast::Path) -> Option<FeatureId> {
         });
         return None;
     }
-    match pc.names.get(&head.name) {
-        Some((Local::Feature(i), _)) if p.segs.len() == 1 => {
-            (*i < pc.part.features.len()).then_some(FeatureId(*i))
+    match pc.local(cx, head) {
+        Some(Local::Feature(i)) if p.segs.len() == 1 => {
+            (i < pc.part.features.len()).then_some(FeatureId(i))
         }
-        Some((Local::Datum(i), _)) if p.segs.len() == 1 => {
-            pc.part.datums.get(*i).map(|d| d.feature)
-        }
-        Some((other, _)) => {
+        Some(Local::Datum(i)) if p.segs.len() == 1 => pc.part.datums.get(i).map(|d| d.feature),
+        Some(other) => {
             cx.err(E::WrongKind {
                 span: p.span,
                 name: path_text(p),
