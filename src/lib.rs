@@ -13,6 +13,7 @@ pub mod geometry;
 pub mod graph;
 pub mod import;
 pub mod load;
+pub mod lsp;
 pub mod model;
 pub mod path;
 pub mod plan;
@@ -35,6 +36,8 @@ pub struct Checked {
     pub sources: source::SourceMap,
     /// The files named as roots (that loaded).
     pub roots: Vec<source::FileId>,
+    /// Every module read, with its syntax tree (the language server's symbols).
+    pub program: load::Program,
 }
 
 impl Checked {
@@ -614,6 +617,7 @@ pub fn check(world: &dyn source::World, roots: &[PathBuf]) -> Checked {
         diagnostics: diags.sorted(),
         sources,
         roots,
+        program,
     }
 }
 

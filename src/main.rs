@@ -181,6 +181,14 @@ enum Command {
         #[arg(long)]
         check: bool,
     },
+    /// The language server, over standard input and output: diagnostics as you type,
+    /// hover, go to definition, references, symbols, completion, rename, formatting.
+    Lsp {
+        /// Plan FILE and print the result for the server (what the server runs on save,
+        /// in a child process it can stop).
+        #[arg(long, hide = true)]
+        plan: Option<PathBuf>,
+    },
     /// Reads a DMIS program and checks it as a controller would: line lengths, labels,
     /// names defined before use, MEAS blocks.
     Dmis {
@@ -323,6 +331,17 @@ fn main() -> ExitCode {
         },
         Command::Dmis { file } => read_dmis(&file),
         Command::Fmt { files, check } => fmt(&files, check),
+        Command::Lsp { plan: Some(file) } => {
+            println!("{}", inspc::lsp::plan_file(&file));
+            ExitCode::SUCCESS
+        }
+        Command::Lsp { plan: None } => match inspc::lsp::stdio() {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("inspc lsp: {e}");
+                ExitCode::from(1)
+            }
+        },
         Command::Import { file, output } => import(&file, output),
         Command::Simulate {
             program,

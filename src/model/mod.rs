@@ -89,9 +89,30 @@ pub struct Model {
     /// `std::sampling::fan_leu`, the sampling of a plan that names none and of a part
     /// sampled without a plan.
     pub default_sampling: Option<SamplingId>,
+    /// What the resolver learnt about the source text, for the editor (`inspc lsp`).
+    pub index: SourceIndex,
+}
+
+/// The resolver's knowledge of the source text: which declaration each name binds to and
+/// which keys each block accepts.
+#[derive(Debug, Clone, Default)]
+pub struct SourceIndex {
     /// Every use of a name the resolver bound, with the declaration it names: the
-    /// editor's go-to-definition and references (`inspc lsp`). Sorted, no duplicates.
+    /// editor's go-to-definition and references. Sorted, no duplicates.
     pub names: Vec<NameUse>,
+    /// Every block of properties the resolver read, with the keys it accepts: the
+    /// editor's completion of properties.
+    pub keys: Vec<KeySet>,
+}
+
+/// The keys a block of properties accepts.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct KeySet {
+    /// What the block's diagnostics point at: the item's name, a nested block's value,
+    /// a mesh statement's path or a preference statement.
+    pub owner: Span,
+    /// The keys, in the order the resolver asks for them.
+    pub keys: Vec<&'static str>,
 }
 
 /// A name as used (`used`) and the name it binds to where it is declared (`decl`).

@@ -524,12 +524,7 @@ fn part_summary(o: &mut String, p: &Part) {
         let _ = writeln!(o, "  {verb} {}: {shape}{pattern}", op.name);
     }
     for f in &p.features {
-        let faces: Vec<String> = f.faces.iter().map(|r| face_text(p, r)).collect();
-        let what = match f.declared {
-            super::Declared::Face => "face",
-            super::Declared::Feature => "feature",
-        };
-        let _ = writeln!(o, "  {what} {} = {}", f.name, faces.join(" + "));
+        let _ = writeln!(o, "  {}", f.text(p));
     }
     for d in &p.datums {
         let _ = writeln!(o, "  datum {} on {}", d.name, p.features[d.feature.0].name);
@@ -538,33 +533,51 @@ fn part_summary(o: &mut String, p: &Part) {
         let _ = writeln!(o, "  frame {} = [{}]", f.name, datum_refs(p, &f.refs));
     }
     for t in &p.tolerances {
-        let targets: Vec<&str> = t
+        let _ = writeln!(o, "  {}", t.text(p));
+    }
+}
+
+impl Feature {
+    /// The feature as the summary prints it: `feature name = faces`.
+    pub fn text(&self, p: &Part) -> String {
+        let faces: Vec<String> = self.faces.iter().map(|r| face_text(p, r)).collect();
+        let what = match self.declared {
+            super::Declared::Face => "face",
+            super::Declared::Feature => "feature",
+        };
+        format!("{what} {} = {}", self.name, faces.join(" + "))
+    }
+}
+
+impl Tolerance {
+    /// The tolerance as the summary prints it: `tolerance name: kind(features) value | datums`.
+    pub fn text(&self, p: &Part) -> String {
+        let targets: Vec<&str> = self
             .targets
             .iter()
             .map(|f| p.features[f.0].name.as_str())
             .collect();
-        let value = t.value.text();
-        let m = match t.modifier {
+        let value = self.value.text();
+        let m = match self.modifier {
             Some(Material::Mmc) => " MMC",
             Some(Material::Lmc) => " LMC",
             Some(Material::Rfs) => " RFS",
             None => "",
         };
-        let datums = if t.datums.is_empty() {
+        let datums = if self.datums.is_empty() {
             String::new()
         } else {
-            format!(" | {}", datum_refs(p, &t.datums))
+            format!(" | {}", datum_refs(p, &self.datums))
         };
-        let basic = t
+        let basic = self
             .basic_angle
             .map_or(String::new(), |a| format!(" basic {}°", fmt_num(a)));
-        let kind = t.kind.keyword();
-        let _ = writeln!(
-            o,
-            "  tolerance {}: {kind}({}) {value}{m}{datums}{basic}",
-            t.name,
+        let kind = self.kind.keyword();
+        format!(
+            "tolerance {}: {kind}({}) {value}{m}{datums}{basic}",
+            self.name,
             targets.join(", ")
-        );
+        )
     }
 }
 

@@ -22,12 +22,12 @@ mod scope;
 mod tolerance;
 
 pub use errors::ResolveError;
-pub use props::length_unit_mm;
-pub use tolerance::{accepts, Accepts, Datums};
+pub use props::{length_unit_mm, units};
+pub use tolerance::{accepts, keywords as tolerance_keywords, Accepts, Datums};
 
 use crate::diag::{suggest, Diagnostics};
 use crate::load::{ModuleId, Program};
-use crate::model::{Model, NameUse};
+use crate::model::{Model, NameUse, SourceIndex};
 use crate::source::{FileId, SourceMap, World};
 use crate::syntax::ast;
 use errors::ResolveError as E;
@@ -96,7 +96,7 @@ pub(crate) struct Resolver<'a> {
     decls: Vec<Decl<'a>>,
     /// Per module: name → declaration index.
     scopes: Vec<BTreeMap<String, usize>>,
-    /// The names `use` statements bound (see [`Model::names`]).
+    /// The names `use` statements bound (see [`SourceIndex::names`]).
     imported: Vec<NameUse>,
 }
 
@@ -117,11 +117,14 @@ pub fn resolve(
     };
     r.declare(diags);
     r.import(diags);
-    let mut names = std::mem::take(&mut r.imported);
-    let mut model = r.lower(diags, &mut names);
-    names.sort();
-    names.dedup();
-    model.names = names;
+    let mut index = SourceIndex {
+        names: std::mem::take(&mut r.imported),
+        keys: Vec::new(),
+    };
+    let mut model = r.lower(diags, &mut index);
+    index.names.sort();
+    index.names.dedup();
+    model.index = index;
     model.default_sampling = r
         .std_item("std::sampling", "fan_leu", Kind::Sampling)
         .map(crate::model::SamplingId);
@@ -335,7 +338,7 @@ impl<'a> Resolver<'a> {
             return None;
         };
         let decl = &self.decls[d];
-        cx.bind(path.span, decl.name.span);
+        cx.bind(names[names.len() - 1].span, decl.name.span);
         if decl.kind != kind {
             cx.err(E::WrongKind {
                 span: path.span,
@@ -359,12 +362,12 @@ impl<'a> Resolver<'a> {
     }
 
     /// Lowers every declaration, in declaration order per kind.
-    fn lower(&self, diags: &mut Diagnostics, names: &mut Vec<NameUse>) -> Model {
+    fn lower(&self, diags: &mut Diagnostics, index: &mut SourceIndex) -> Model {
         let mut model = Model::default();
         for d in &self.decls {
             let mut cx = Cx {
                 diags,
-                names,
+                index,
                 file: d.file,
                 unit_mm: None,
             };
@@ -385,7 +388,7 @@ impl<'a> Resolver<'a> {
             let ast::Item::Plan(p) = d.item else { continue };
             let mut cx = Cx {
                 diags,
-                names,
+                index,
                 file: d.file,
                 unit_mm: None,
             };

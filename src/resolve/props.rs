@@ -41,6 +41,12 @@ pub(crate) const UNITS: &[(&str, Dim, f64)] = &[
 
 pub(crate) use crate::model::fmt_num as num;
 
+/// Every unit a quantity may carry, with what it measures (`a length`, `an angle`,
+/// `a ratio`): the editor's completion of units.
+pub fn units() -> impl Iterator<Item = (&'static str, &'static str)> {
+    UNITS.iter().map(|(n, d, _)| (*n, d.word()))
+}
+
 /// Millimetres per unit for a length unit name (`mm`, `in`, …).
 pub fn length_unit_mm(name: &str) -> Option<f64> {
     UNITS
@@ -79,8 +85,8 @@ pub(crate) fn path_text(p: &ast::Path) -> String {
 /// The context values are converted in: where errors go and what a bare length means.
 pub(crate) struct Cx<'d> {
     pub diags: &'d mut Diagnostics,
-    /// The names bound so far (see [`crate::model::Model::names`]).
-    pub names: &'d mut Vec<crate::model::NameUse>,
+    /// The names bound and blocks read so far (see [`crate::model::SourceIndex`]).
+    pub index: &'d mut crate::model::SourceIndex,
     pub file: FileId,
     /// mm per bare number in a length position (inside a part), if any.
     pub unit_mm: Option<f64>,
@@ -93,7 +99,7 @@ impl Cx<'_> {
 
     /// Records that the name at `used` binds to the one declared at `decl`.
     pub fn bind(&mut self, used: Span, decl: Span) {
-        self.names.push(crate::model::NameUse { used, decl });
+        self.index.names.push(crate::model::NameUse { used, decl });
     }
 
     pub fn mismatch(&mut self, v: &Value, expected: &str, help: &str) {
@@ -427,6 +433,10 @@ impl<'a> Props<'a> {
 
     /// Reports every property nobody asked for.
     pub fn finish(self, cx: &mut Cx) {
+        cx.index.keys.push(crate::model::KeySet {
+            owner: self.owner,
+            keys: self.asked.clone(),
+        });
         for p in &self.props {
             if !self.asked.contains(&p.key.name.as_str()) {
                 let help =

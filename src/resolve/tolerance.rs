@@ -44,6 +44,11 @@ pub fn accepts(kind: TolKind) -> Option<Accepts> {
     })
 }
 
+/// Every tolerance type's keyword, in the rules' order (the editor's completion).
+pub fn keywords() -> impl Iterator<Item = &'static str> {
+    RULES.iter().map(|r| r.name)
+}
+
 /// The rules of one tolerance type.
 struct Rule {
     name: &'static str,

@@ -163,7 +163,15 @@ impl SourceMap {
         self.files.iter().filter_map(|f| f.path.as_deref())
     }
 
-    /// The id of the file with this display name, if loaded.
+    /// The id of the file read from `path` (canonical), if read.
+    pub fn find_path(&self, path: &Path) -> Option<FileId> {
+        self.files
+            .iter()
+            .position(|f| f.path.as_deref() == Some(path))
+            .map(|i| FileId(i as u32))
+    }
+
+    /// The file shown under `name`, if read.
     pub fn find_name(&self, name: &str) -> Option<FileId> {
         self.files
             .iter()

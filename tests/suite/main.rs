@@ -17,6 +17,7 @@ mod geometry_props;
 mod gpu;
 mod grammar;
 mod import;
+mod lsp;
 mod mesh_fuzz;
 mod no_panic;
 mod qif;

@@ -1,0 +1,269 @@
+//! What hovering a name shows: the item as the model summary prints it, and for the names
+//! inside a part what the geometry, the measurement graph and the last plan know of them.
+
+use super::symbols::{decls, target, Decl, DeclKind};
+use super::Analysis;
+use crate::model::{ItemRef, Model};
+use crate::resolve::{accepts, Datums};
+use crate::source::{FileId, Span};
+use crate::syntax::ast;
+use serde_json::Value;
+use std::fmt::Write;
+
+/// The hover of the name at `offset` of `file`: the span hovered and markdown.
+pub fn hover(a: &Analysis, file: FileId, offset: usize) -> Option<(Span, String)> {
+    let checked = &a.front;
+    let (at, decl) = target(checked, file, offset)?;
+    let all = decls(checked);
+    let d = all.iter().find(|d| d.name.span == decl)?;
+    let model = &checked.model;
+    let mut o = String::new();
+    match d.kind {
+        DeclKind::Block(_) | DeclKind::Part | DeclKind::Hierarchy | DeclKind::Plan => {
+            let item = item_of(model, d)?;
+            let _ = write!(o, "```\n{}", model.describe(item));
+            if let ItemRef::Probe(i) = item {
+                let p = &model.probes[i];
+                o.push_str(&model.describe(ItemRef::Body(p.body.0)));
+                for e in &p.extensions {
+                    o.push_str(&model.describe(ItemRef::Extension(e.0)));
+                }
+                o.push_str(&model.describe(ItemRef::Stylus(p.stylus.0)));
+            }
+            o.push_str("```\n");
+        }
+        _ => local(a, d, &mut o)?,
+    }
+    Some((at, o))
+}
+
+/// The model item a top-level declaration made.
+fn item_of(model: &Model, d: &Decl) -> Option<ItemRef> {
+    let name = d.name.name.as_str();
+    let file = d.name.span.file;
+    macro_rules! find {
+        ($v:expr, $make:expr) => {
+            $v.iter()
+                .position(|x| x.name == name && x.span.file == file)
+                .map($make)
+        };
+    }
+    match d.kind {
+        DeclKind::Block(k) => match k {
+            ast::BlockKind::Cmm => find!(model.cmms, ItemRef::Cmm),
+            ast::BlockKind::Head => find!(model.heads, ItemRef::Head),
+            ast::BlockKind::Probe => find!(model.probes, ItemRef::Probe),
+            ast::BlockKind::Stylus => find!(model.styli, ItemRef::Stylus),
+            ast::BlockKind::Body => find!(model.bodies, ItemRef::Body),
+            ast::BlockKind::Extension => find!(model.extensions, ItemRef::Extension),
+            ast::BlockKind::Sampling => find!(model.samplings, ItemRef::Sampling),
+            ast::BlockKind::Fixture => find!(model.fixtures, ItemRef::Fixture),
+        },
+        DeclKind::Part => find!(model.parts, ItemRef::Part),
+        DeclKind::Hierarchy => find!(model.hierarchies, ItemRef::Hierarchy),
+        DeclKind::Plan => find!(model.plans, ItemRef::Plan),
+        _ => None,
+    }
+}
+
+/// The hover of a name declared inside a part.
+fn local(a: &Analysis, d: &Decl, o: &mut String) -> Option<()> {
+    let model = &a.front.model;
+    let ast_part = d.part?;
+    let k = model
+        .parts
+        .iter()
+        .position(|p| p.name == ast_part.name.name && p.span.file == ast_part.name.span.file)?;
+    let part = &model.parts[k];
+    let name = d.name.name.as_str();
+    match d.kind {
+        DeclKind::Face | DeclKind::Feature => {
+            let f = part.features.iter().position(|f| f.name == name)?;
+            let _ = writeln!(o, "```\n{}\n```", part.features[f].text(part));
+            feature_faces(a, k, f, o);
+        }
+        DeclKind::Datum => {
+            let datum = part.datums.iter().find(|x| x.name == name)?;
+            let f = datum.feature.0;
+            let _ = writeln!(o, "```\ndatum {name} on {}\n```", part.features[f].name);
+            feature_faces(a, k, f, o);
+        }
+        DeclKind::Tolerance => {
+            let t = part.tolerances.iter().find(|x| x.name == name)?;
+            let _ = writeln!(o, "```\n{}\n```", t.text(part));
+            if let Some(rule) = accepts(t.kind) {
+                let datums = match rule.datums {
+                    Datums::Forbidden => "takes no datums",
+                    Datums::Optional => "datums optional",
+                    Datums::Required => "datums required",
+                };
+                let material = if rule.material {
+                    "MMC/LMC allowed on the feature"
+                } else {
+                    "no material modifier"
+                };
+                let dia = if rule.dia { ", Ø zone allowed" } else { "" };
+                let _ = writeln!(o, "\n`{}`: {datums}, {material}{dia}.", rule.keyword);
+            }
+            tolerance_state(a, &part.name, name, o);
+        }
+        DeclKind::Frame => {
+            let fr = part.frames.iter().find(|x| x.name == name)?;
+            let letters: Vec<&str> = fr
+                .refs
+                .iter()
+                .map(|r| part.datums[r.datum.0].name.as_str())
+                .collect();
+            let _ = writeln!(o, "```\nframe {name} = [{}]\n```", letters.join(", "));
+        }
+        DeclKind::Op => {
+            let op = part.ops.iter().find(|x| x.name == name)?;
+            let _ = writeln!(
+                o,
+                "```\n{} {}: {}\n```",
+                op.kind.word(),
+                op.name,
+                op_faces(a, k, name)
+            );
+        }
+        _ => return None,
+    }
+    Some(())
+}
+
+/// The faces an operation made, by name, once the geometry is built.
+fn op_faces(a: &Analysis, part: usize, op: &str) -> String {
+    let Some(data) = a.deep.as_ref().and_then(|d| d.parts.get(part)?.as_ref()) else {
+        return "faces known once the geometry is built".into();
+    };
+    let prefix = format!("{op}.");
+    let names: Vec<&str> = data
+        .geometry
+        .faces
+        .iter()
+        .filter(|f| f.name.starts_with(&prefix) && f.area > 0.0)
+        .map(|f| f.name.as_str())
+        .collect();
+    format!("faces {}", names.join(", "))
+}
+
+/// A feature's faces: surface, area, points sampled, and how the last plan reached them.
+fn feature_faces(a: &Analysis, part: usize, feature: usize, o: &mut String) {
+    let Some(deep) = &a.deep else {
+        let _ = writeln!(o, "\n_The geometry is being built._");
+        return;
+    };
+    let Some(data) = deep.parts.get(part).and_then(Option::as_ref) else {
+        let _ = writeln!(o, "\n_No geometry: see the diagnostics._");
+        return;
+    };
+    let graph = deep.graphs.iter().find(|g| g.part == part);
+    let part_name = &a.front.model.parts[part].name;
+    let _ = writeln!(o);
+    for id in data.feature_faces.get(feature).into_iter().flatten() {
+        let f = &data.geometry.faces[id.0];
+        let points = graph.map_or(0, |g| {
+            g.graph.fpoints.iter().filter(|p| p.face == *id).count()
+        });
+        let surface = crate::geometry::describe(&f.surface);
+        let _ = writeln!(
+            o,
+            "- **{}**: {} {}, {} mm², {points} points",
+            f.name,
+            f.surface.kind().keyword(),
+            surface,
+            crate::model::fmt_num((f.area * 10.0).round() / 10.0)
+        );
+        if let Some(state) = face_state(a, part_name, &f.name) {
+            let _ = writeln!(o, "  - {state}");
+        }
+    }
+}
+
+/// The plans of the last run that plan `part`.
+fn plans_of<'a>(a: &'a Analysis, part: &str) -> Vec<&'a Value> {
+    a.plan.as_ref().map_or(Vec::new(), |p| {
+        p.plans
+            .iter()
+            .filter(|v| v["part"].as_str() == Some(part))
+            .collect()
+    })
+}
+
+/// How the last plan reached a face: per setup, the probe and orientation.
+fn face_state(a: &Analysis, part: &str, face: &str) -> Option<String> {
+    let plans = plans_of(a, part);
+    if plans.is_empty() {
+        return None;
+    }
+    let mut seen = Vec::new();
+    for plan in &plans {
+        for (s, setup) in plan["setups"].as_array().into_iter().flatten().enumerate() {
+            for probe in setup["probes"].as_array().into_iter().flatten() {
+                for orient in probe["orientations"].as_array().into_iter().flatten() {
+                    let points: usize = orient["inspect"]
+                        .as_array()
+                        .into_iter()
+                        .flatten()
+                        .flat_map(|i| i["faces"].as_array().into_iter().flatten())
+                        .filter(|f| f["face"].as_str() == Some(face))
+                        .map(|f| f["points"].as_array().map_or(0, Vec::len))
+                        .sum();
+                    if points > 0 {
+                        let at = if plan["indexable"].as_bool() == Some(true) {
+                            format!(" at A {} B {}", num(&orient["a"]), num(&orient["b"]))
+                        } else {
+                            String::new()
+                        };
+                        seen.push(format!(
+                            "setup {} ({}): probe {}{at}, {points} points",
+                            s + 1,
+                            setup["held_by"].as_str().unwrap_or("?"),
+                            probe["probe"].as_str().unwrap_or("?"),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    Some(if seen.is_empty() {
+        "not reached in the last plan".into()
+    } else {
+        format!("last plan: {}", seen.join("; "))
+    })
+}
+
+/// A tolerance's state in the last plan: the setups that record it.
+fn tolerance_state(a: &Analysis, part: &str, name: &str, o: &mut String) {
+    let plans = plans_of(a, part);
+    if plans.is_empty() {
+        let _ = writeln!(o, "\n_Not planned yet: save to plan._");
+        return;
+    }
+    let mut setups = Vec::new();
+    for plan in &plans {
+        for (s, setup) in plan["setups"].as_array().into_iter().flatten().enumerate() {
+            let records = setup["probes"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .flat_map(|p| p["orientations"].as_array().into_iter().flatten())
+                .flat_map(|or| or["inspect"].as_array().into_iter().flatten())
+                .flat_map(|i| i["record"].as_array().into_iter().flatten())
+                .any(|r| r.as_str() == Some(name));
+            if records && !setups.contains(&(s + 1)) {
+                setups.push(s + 1);
+            }
+        }
+    }
+    let _ = if setups.is_empty() {
+        writeln!(o, "\nLast plan: **not measured**.")
+    } else {
+        let list: Vec<String> = setups.iter().map(usize::to_string).collect();
+        writeln!(o, "\nLast plan: measured in setup {}.", list.join(", "))
+    };
+}
+
+fn num(v: &Value) -> String {
+    v.as_f64().map_or("?".into(), crate::model::fmt_num)
+}
