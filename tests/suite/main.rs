@@ -26,3 +26,4 @@ mod sampling;
 mod simulate;
 mod step;
 mod tours;
+mod vscode;
