@@ -22,6 +22,7 @@ pub mod sample;
 pub mod simulate;
 pub mod source;
 pub mod syntax;
+pub mod view;
 
 use std::path::{Path, PathBuf};
 

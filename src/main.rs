@@ -181,6 +181,21 @@ enum Command {
         #[arg(long)]
         check: bool,
     },
+    /// Builds a spec and draws the plan as one self-contained HTML page: the part in 3D
+    /// with faces coloured by feature, each setup's pose on the table with its fixture,
+    /// points, paths, the probe at a touch and that touch's accessibility cone.
+    View {
+        /// The `.insp` spec.
+        file: PathBuf,
+        /// Where to write the page (default: `<spec>.html` beside the spec).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Also write a still image of each setup into this folder (`<spec>_setup<k>.png`).
+        #[arg(long, value_name = "DIR")]
+        png: Option<PathBuf>,
+        #[command(flatten)]
+        search: Search,
+    },
     /// The language server, over standard input and output: diagnostics as you type,
     /// hover, go to definition, references, symbols, completion, rename, formatting.
     Lsp {
@@ -331,6 +346,15 @@ fn main() -> ExitCode {
         },
         Command::Dmis { file } => read_dmis(&file),
         Command::Fmt { files, check } => fmt(&files, check),
+        Command::View {
+            file,
+            output,
+            png,
+            search,
+        } => match search.options(false) {
+            Some(opts) => view(&file, output, png, &opts),
+            None => ExitCode::from(2),
+        },
         Command::Lsp { plan: Some(file) } => {
             println!("{}", inspc::lsp::plan_file(&file));
             ExitCode::SUCCESS
@@ -663,6 +687,92 @@ fn build(
 }
 
 /// `inspc dmis`: reads a program and reports what a controller would reject.
+/// `inspc view`: the pipeline, then the page (and images) of every plan, written
+/// atomically.
+fn view(
+    file: &std::path::Path,
+    output: Option<PathBuf>,
+    png: Option<PathBuf>,
+    opts: &inspc::plan::PlanOptions,
+) -> ExitCode {
+    let run = inspc::run(
+        &FsWorld,
+        &[file.to_path_buf()],
+        opts,
+        inspc::Until::Build,
+        &|_, _, _| {},
+    );
+    let checked = &run.checked;
+    print_diagnostics(&checked.sources, &checked.diagnostics);
+    if checked.has_errors() {
+        eprintln!("inspc: nothing written");
+        return ExitCode::from(1);
+    }
+    if run.built.is_empty() {
+        eprintln!("inspc: {} has no plan to view", file.display());
+        return ExitCode::from(1);
+    }
+    if run.built.len() > 1 && output.is_some() {
+        eprintln!(
+            "inspc: {} holds {} plans; -o names one file, so leave it out and each plan writes its own",
+            file.display(),
+            run.built.len()
+        );
+        return ExitCode::from(2);
+    }
+    let dir = file.parent().unwrap_or(std::path::Path::new(""));
+    let stem = file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "plan".into());
+    let mut writes: Vec<cli::outputs::Output> = Vec::new();
+    for b in &run.built {
+        let model = &checked.model;
+        let plan = &model.plans[b.plan];
+        let Some(Some(data)) = run.parts.get(plan.part.0) else {
+            continue;
+        };
+        let scene = inspc::view::scene(model, data, b);
+        let name = if run.built.len() == 1 {
+            stem.clone()
+        } else {
+            format!("{stem}_{}", plan.name)
+        };
+        let html = output
+            .clone()
+            .unwrap_or_else(|| dir.join(format!("{name}.html")));
+        writes.push(cli::outputs::Output {
+            path: html,
+            bytes: inspc::view::page(&scene).into_bytes(),
+            what: "the plan's page",
+        });
+        if let Some(png_dir) = &png {
+            for k in 0..scene.setups.len() {
+                if let Some(bytes) = inspc::view::png(&scene, k, 960, 720) {
+                    writes.push(cli::outputs::Output {
+                        path: png_dir.join(format!("{name}_setup{}.png", k + 1)),
+                        bytes,
+                        what: "a setup's image",
+                    });
+                }
+            }
+        }
+    }
+    if let Some(d) = &png {
+        if let Err(e) = std::fs::create_dir_all(d) {
+            eprintln!("inspc: cannot create {}: {e}", d.display());
+            return ExitCode::from(1);
+        }
+    }
+    if let Err(code) = commit(&writes, &checked.inputs()) {
+        return code;
+    }
+    for w in &writes {
+        println!("wrote {} ({} bytes)", w.path.display(), w.bytes.len());
+    }
+    ExitCode::SUCCESS
+}
+
 fn simulate(
     program: &std::path::Path,
     spec: &std::path::Path,

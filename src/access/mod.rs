@@ -270,6 +270,37 @@ pub struct PointCones {
     pub d2: Option<CubeMap>,
 }
 
+/// The approach cone of [`point_cones`] alone (no D2): the tip centre and the probe
+/// directions that clear the leading components at the contact and the retract point;
+/// `None` when the tip does not fit or has no room to touch.
+pub fn approach_cone(
+    backend: &dyn Backend,
+    scene: &Scene,
+    f: &Fpoint,
+    probe: &ProbeShape,
+    opts: &ConeOptions,
+) -> Option<CubeMap> {
+    approach_at(backend, scene, f, probe, opts).map(|(_, cone)| cone)
+}
+
+fn approach_at(
+    backend: &dyn Backend,
+    scene: &Scene,
+    f: &Fpoint,
+    probe: &ProbeShape,
+    opts: &ConeOptions,
+) -> Option<(P3, CubeMap)> {
+    let (n, pref) = (opts.n, &opts.preferred[..]);
+    let (c, retract) = stand(scene, f, probe, opts)?;
+    let comps = probe.leading();
+    let exact = opts.exact_boundary;
+    let mut approach = gac_with(backend, scene, &c, &comps, n, pref, exact);
+    if let Some(retract) = retract.filter(|_| !approach.is_empty()) {
+        approach.and_assign(&gac_with(backend, scene, &retract, &comps, n, pref, exact));
+    }
+    Some((c, approach))
+}
+
 /// Where the probe stands to touch `f`: the tip centre, and the retract point when the
 /// approach is tested there too; None when the tip does not fit or has no room to touch.
 /// In a narrow feature the retract point moves in (see `pose::backoff`); there the
@@ -313,15 +344,9 @@ pub fn point_cones(
     opts: &ConeOptions,
 ) -> PointCones {
     let (n, pref) = (opts.n, &opts.preferred[..]);
-    let Some((c, retract)) = stand(scene, f, probe, opts) else {
+    let Some((c, approach)) = approach_at(backend, scene, f, probe, opts) else {
         return PointCones::unreachable(probe, n, pref);
     };
-    let comps = probe.leading();
-    let exact = opts.exact_boundary;
-    let mut approach = gac_with(backend, scene, &c, &comps, n, pref, exact);
-    if let Some(retract) = retract.filter(|_| !approach.is_empty()) {
-        approach.and_assign(&gac_with(backend, scene, &retract, &comps, n, pref, exact));
-    }
     let d2 = probe
         .head
         .indexable()

@@ -249,6 +249,61 @@ impl Solid {
         })
     }
 
+    /// The solid as triangles in the part frame, for drawing (`inspc view`): a box's
+    /// twelve, a cylinder as a 24-sided prism, a mesh's own.
+    pub fn triangles(&self) -> (Vec<P3>, Vec<[u32; 3]>) {
+        let (local, tris): (Vec<P3>, Vec<[u32; 3]>) = match &self.shape {
+            SolidShape::Box(h) => {
+                let corner = |k: u32| {
+                    let s = |bit: u32| if k & bit == 0 { -1.0 } else { 1.0 };
+                    P3::new(s(1) * h.x, s(2) * h.y, s(4) * h.z)
+                };
+                let quads = [
+                    [0, 2, 3, 1],
+                    [4, 5, 7, 6],
+                    [0, 1, 5, 4],
+                    [2, 6, 7, 3],
+                    [0, 4, 6, 2],
+                    [1, 3, 7, 5],
+                ];
+                let tris = quads
+                    .iter()
+                    .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+                    .collect();
+                ((0..8).map(corner).collect(), tris)
+            }
+            SolidShape::Cylinder {
+                half_height,
+                radius,
+            } => {
+                const SIDES: u32 = 24;
+                let mut vs = Vec::new();
+                for k in 0..SIDES {
+                    let t = std::f64::consts::TAU * k as f64 / SIDES as f64;
+                    let (x, z) = (radius * t.cos(), radius * t.sin());
+                    vs.push(P3::new(x, -half_height, z));
+                    vs.push(P3::new(x, *half_height, z));
+                }
+                let (bottom, top) = (2 * SIDES, 2 * SIDES + 1);
+                vs.push(P3::new(0.0, -half_height, 0.0));
+                vs.push(P3::new(0.0, *half_height, 0.0));
+                let mut tris = Vec::new();
+                for k in 0..SIDES {
+                    let (a, b) = (2 * k, 2 * ((k + 1) % SIDES));
+                    tris.extend([
+                        [a, b, b + 1],
+                        [a, b + 1, a + 1],
+                        [bottom, b, a],
+                        [top, a + 1, b + 1],
+                    ]);
+                }
+                (vs, tris)
+            }
+            SolidShape::Mesh(m) => (m.vertices().to_vec(), m.indices().to_vec()),
+        };
+        (local.iter().map(|p| self.at * p).collect(), tris)
+    }
+
     /// Whether a shape given in the part frame meets this solid.
     pub fn hits(&self, shape: &dyn Shape) -> bool {
         let id = Isometry::identity();

@@ -181,13 +181,7 @@ fn example(name: &str) -> PathBuf {
 #[test]
 fn ctc_01_hover_definition_completion_and_a_typo() {
     let path = real("nist_ctc_01.insp");
-    if !Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/parts/nist_ctc_01_asme1_ap242-e1.stp")
-        .exists()
-    {
-        eprintln!("skipped: ../shared/parts is not beside the repository");
-        return;
-    }
+    crate::common::require_shared_parts();
     let mut c = Client::start();
     let (uri, text) = open(&mut c, &path);
     let first = c.wait_for(diagnostics_of(&uri));
@@ -478,13 +472,7 @@ fn diagnostics_follow_the_text_and_clear() {
 #[test]
 fn typing_during_a_plan_is_answered_and_a_new_save_stops_the_old_plan() {
     let path = real("nist_ctc_01.insp");
-    if !Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/parts/nist_ctc_01_asme1_ap242-e1.stp")
-        .exists()
-    {
-        eprintln!("skipped: ../shared/parts is not beside the repository");
-        return;
-    }
+    crate::common::require_shared_parts();
     let mut c = Client::start();
     let (uri, text) = open(&mut c, &path);
     c.wait_for(diagnostics_of(&uri));

@@ -26,4 +26,5 @@ mod sampling;
 mod simulate;
 mod step;
 mod tours;
+mod view;
 mod vscode;

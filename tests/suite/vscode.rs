@@ -26,7 +26,10 @@ fn npm(dir: &Path, args: &[&str]) {
 
 #[test]
 fn the_extension_builds_and_its_tests_pass() {
-    let has_npm = Command::new("npm").arg("--version").output().is_ok_and(|o| o.status.success());
+    let has_npm = Command::new("npm")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
     if !has_npm {
         assert!(
             std::env::var_os("INSPC_REQUIRE_NPM").is_none(),

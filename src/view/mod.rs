@@ -1,0 +1,338 @@
+//! `inspc view`: a built plan as one self-contained HTML page (the part in 3D, faces
+//! coloured by feature, the points and paths of each setup, the probe at a touch, the
+//! touch's accessibility cone, the setup's pose on the table with its fixture) and as
+//! still images, one per setup. Entry points: [`scene`] (the data), [`page`], [`png`].
+//!
+//! The page is `viewer.html` with the scene inlined as JSON: no network at view time,
+//! and a Canvas 2D renderer (painter's order) that needs no GPU, so a headless browser
+//! renders it as a desktop one does. [`png`] draws the same scene with the same camera
+//! in software.
+
+mod raster;
+
+pub use raster::png;
+
+use crate::access::{self, Cpu, ProbeShape};
+use crate::geometry::PartGeometry;
+use crate::plan::Hlip;
+use crate::{Built, PartData};
+use serde::Serialize;
+
+/// What the page and the images show.
+#[derive(Debug, Clone, Serialize)]
+pub struct Scene {
+    /// `plan NAME: part NAME`.
+    pub title: String,
+    /// The part's mesh, part frame (mm).
+    pub vertices: Vec<[f32; 3]>,
+    /// Its triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// Each triangle's face.
+    pub tri_face: Vec<u32>,
+    /// The faces: name and the feature they belong to.
+    pub faces: Vec<FaceInfo>,
+    /// The features, in the part's order, with their colours.
+    pub features: Vec<Named>,
+    /// The probes of the machine's rack, with their colours and shapes.
+    pub probes: Vec<ProbeInfo>,
+    /// Every point of the plan: position, normal, face.
+    pub points: Vec<PointInfo>,
+    /// The setups in order.
+    pub setups: Vec<SetupInfo>,
+    /// The directions the cones are sampled at (unit vectors, part frame).
+    pub sphere: Vec<[f32; 3]>,
+}
+
+/// A name and a colour (`#rrggbb`).
+#[derive(Debug, Clone, Serialize)]
+pub struct Named {
+    /// The name.
+    pub name: String,
+    /// Its colour.
+    pub color: String,
+}
+
+/// One face.
+#[derive(Debug, Clone, Serialize)]
+pub struct FaceInfo {
+    /// Its name.
+    pub name: String,
+    /// The feature it belongs to, by index into [`Scene::features`].
+    pub feature: Option<usize>,
+}
+
+/// One probe: its colour and its components from the tip centre along its axis.
+#[derive(Debug, Clone, Serialize)]
+pub struct ProbeInfo {
+    /// Its label in the rack.
+    pub name: String,
+    /// Its colour.
+    pub color: String,
+    /// The tip ball's radius (mm).
+    pub tip: f32,
+    /// Stylus, extensions, body: `[from, to, radius]` along the axis (mm).
+    pub components: Vec<[f32; 3]>,
+}
+
+/// One point of the plan.
+#[derive(Debug, Clone, Serialize)]
+pub struct PointInfo {
+    /// Contact position.
+    pub p: [f32; 3],
+    /// Surface normal.
+    pub n: [f32; 3],
+    /// Its face, by index into [`Scene::faces`].
+    pub face: u32,
+}
+
+/// One setup.
+#[derive(Debug, Clone, Serialize)]
+pub struct SetupInfo {
+    /// What holds the part.
+    pub held_by: String,
+    /// Part frame → machine frame (rows).
+    pub rotation: [[f32; 3]; 3],
+    /// The table's height along the setup's up direction (part frame, mm).
+    pub table: f32,
+    /// The fixture's solids as one mesh, part frame.
+    pub fixture: Mesh,
+    /// Its (probe, orientation) groups in order.
+    pub groups: Vec<GroupInfo>,
+}
+
+/// A triangle mesh.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Mesh {
+    /// Vertices.
+    pub vertices: Vec<[f32; 3]>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// One group of touches under one probe and orientation.
+#[derive(Debug, Clone, Serialize)]
+pub struct GroupInfo {
+    /// The probe, by index into [`Scene::probes`].
+    pub probe: usize,
+    /// Head angles (degrees).
+    pub a: f32,
+    /// Head angle B.
+    pub b: f32,
+    /// The probe direction, tip to head, part frame.
+    pub direction: [f32; 3],
+    /// The tip centre's path: entry, each touch's way in and out, exit.
+    pub path: Vec<[f32; 3]>,
+    /// The touches: point index and its cone over [`Scene::sphere`] (`1` free, `0`
+    /// blocked), of the probe at that point.
+    pub touches: Vec<(usize, String)>,
+}
+
+/// Feature colours: distinct, readable on white and grey (Tableau 10 and a second row).
+const PALETTE: &[&str] = &[
+    "#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7",
+    "#9c755f", "#17becf", "#8c564b", "#bcbd22", "#1f77b4", "#d62728", "#2ca02c", "#9467bd",
+];
+
+/// Probe colours (darker, so paths stand out on the faces).
+const PROBE_COLORS: &[&str] = &[
+    "#d62728", "#1f3a93", "#2e7d32", "#6a1b9a", "#e65100", "#00695c",
+];
+
+/// How many directions a cone is sampled at.
+const SPHERE: usize = 600;
+
+/// Cube-map resolution of the cones shown.
+const CONE_N: u32 = 32;
+
+fn f3(v: &[f64; 3]) -> [f32; 3] {
+    // Rounded to a micrometre: the same text on every machine.
+    let r = |x: f64| ((x * 1e3).round() / 1e3) as f32;
+    [r(v[0]), r(v[1]), r(v[2])]
+}
+
+/// The scene of one built plan.
+pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Scene {
+    let hlip: &Hlip = &built.hlip;
+    let plan = &model.plans[built.plan];
+    let part = &model.parts[plan.part.0];
+    let g: &PartGeometry = &data.geometry;
+    let mut face_feature: Vec<Option<usize>> = vec![None; g.faces.len()];
+    for (k, faces) in data.feature_faces.iter().enumerate() {
+        for f in faces {
+            face_feature[f.0].get_or_insert(k);
+        }
+    }
+    let features = part
+        .features
+        .iter()
+        .enumerate()
+        .map(|(k, f)| Named {
+            name: f.name.clone(),
+            color: PALETTE[k % PALETTE.len()].to_string(),
+        })
+        .collect();
+    let cmm = &model.cmms[plan.cmm.0];
+    let shapes = ProbeShape::of_cmm(model, cmm);
+    let probes = shapes
+        .iter()
+        .enumerate()
+        .map(|(k, s)| ProbeInfo {
+            name: s.name.clone(),
+            color: PROBE_COLORS[k % PROBE_COLORS.len()].to_string(),
+            tip: s.tip_radius as f32,
+            components: s
+                .first
+                .iter()
+                .map(|c| [c.a as f32, c.b as f32, c.radius as f32])
+                .collect(),
+        })
+        .collect();
+    let points: Vec<PointInfo> = hlip
+        .points
+        .iter()
+        .map(|p| PointInfo {
+            p: f3(&p.position.coords.into()),
+            n: f3(&p.normal.into()),
+            face: p.face.0 as u32,
+        })
+        .collect();
+    let sphere = fibonacci_sphere(SPHERE);
+    let scene3 = access::Scene::of_part(g);
+    let opts = access::ConeOptions {
+        n: CONE_N,
+        preferred: access::axes(),
+        ..access::ConeOptions::default()
+    };
+    let names = crate::plan::Names::new(model, g, crate::model::PlanId(built.plan));
+    let mut setups = Vec::new();
+    for sp in &built.llip.setups {
+        let s = &hlip.setups[sp.setup];
+        let mut groups = Vec::new();
+        for gp in &sp.groups {
+            let mut path: Vec<[f32; 3]> = gp.entry.iter().map(f3).collect();
+            let mut touches = Vec::new();
+            let shape = &shapes[gp.probe.0];
+            for b in &gp.blocks {
+                for t in &b.touches {
+                    path.extend(t.via.iter().map(f3));
+                    path.push(f3(&t.standoff));
+                    let p = &hlip.points[t.point];
+                    let c = p.position + p.normal * shape.tip_radius;
+                    path.push(f3(&c.coords.into()));
+                    path.push(f3(&t.standoff));
+                    touches.push(t.point);
+                }
+            }
+            path.extend(gp.exit.iter().map(f3));
+            let cones: Vec<(usize, String)> = {
+                use rayon::prelude::*;
+                touches
+                    .par_iter()
+                    .map(|&k| {
+                        let p = &hlip.points[k];
+                        let f = crate::sample::Fpoint {
+                            face: p.face,
+                            position: p.position,
+                            normal: p.normal,
+                        };
+                        let cone = access::approach_cone(&Cpu, &scene3, &f, shape, &opts);
+                        let bits: String = sphere
+                            .iter()
+                            .map(|d| {
+                                let v =
+                                    crate::geometry::V3::new(d[0] as f64, d[1] as f64, d[2] as f64);
+                                match &cone {
+                                    Some(c) if c.contains(&v) => '1',
+                                    _ => '0',
+                                }
+                            })
+                            .collect();
+                        (k, bits)
+                    })
+                    .collect()
+            };
+            groups.push(GroupInfo {
+                probe: gp.probe.0,
+                a: gp.a as f32,
+                b: gp.b as f32,
+                direction: f3(&gp.direction),
+                path,
+                touches: cones,
+            });
+        }
+        setups.push(SetupInfo {
+            held_by: names.holder(&s.holder, &s.up),
+            rotation: s
+                .rotation
+                .map(|r| r.map(|x| ((x * 1e6).round() / 1e6) as f32)),
+            table: ((s.table * 1e3).round() / 1e3) as f32,
+            fixture: fixture_mesh(s),
+            groups,
+        });
+    }
+    Scene {
+        title: format!("plan {}: part {}", plan.name, part.name),
+        vertices: g.vertices.iter().map(|v| f3(&v.coords.into())).collect(),
+        triangles: g.triangles.clone(),
+        tri_face: g.tri_face.clone(),
+        faces: g
+            .faces
+            .iter()
+            .enumerate()
+            .map(|(k, f)| FaceInfo {
+                name: f.name.clone(),
+                feature: face_feature[k],
+            })
+            .collect(),
+        features,
+        probes,
+        points,
+        setups,
+        sphere,
+    }
+}
+
+/// `n` directions spread evenly over the sphere (a Fibonacci lattice).
+fn fibonacci_sphere(n: usize) -> Vec<[f32; 3]> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let t = golden * i as f64;
+            f3(&[r * t.cos(), r * t.sin(), z])
+        })
+        .collect()
+}
+
+/// A setup's fixture solids as one triangle mesh, part frame.
+fn fixture_mesh(s: &crate::plan::SetupNode) -> Mesh {
+    let mut m = Mesh::default();
+    for solid in &s.fixture {
+        let (vs, ts) = solid.triangles();
+        let base = m.vertices.len() as u32;
+        m.vertices.extend(vs.iter().map(|v| f3(&v.coords.into())));
+        m.triangles
+            .extend(ts.iter().map(|t| [t[0] + base, t[1] + base, t[2] + base]));
+    }
+    m
+}
+
+/// The page: `viewer.html` with the scene inlined.
+pub fn page(scene: &Scene) -> String {
+    let data = serde_json::to_string(scene).unwrap_or_else(|_| "null".into());
+    // `</` would end the script element early.
+    let data = data.replace("</", "<\\/");
+    TEMPLATE
+        .replace("{{TITLE}}", &html_escape(&scene.title))
+        .replace("/*{{SCENE}}*/null", &data)
+}
+
+const TEMPLATE: &str = include_str!("viewer.html");
+
+fn html_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
