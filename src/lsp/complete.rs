@@ -97,13 +97,7 @@ pub fn complete(checked: &Checked, file: FileId, text: &str, offset: usize) -> V
             visible(checked, &all, file)
                 .into_iter()
                 .filter(|d| kind.is_none_or(|k| d.kind == k))
-                .map(|d| {
-                    item(
-                        &d.name.name,
-                        CompletionItemKind::REFERENCE,
-                        d.kind.keyword(),
-                    )
-                })
+                .map(|d| name_item(&d))
                 .collect()
         }
     }
@@ -116,6 +110,15 @@ fn item(label: &str, kind: CompletionItemKind, detail: &str) -> CompletionItem {
         detail: Some(detail.to_string()),
         ..CompletionItem::default()
     }
+}
+
+/// A declared item's name, its kind as the detail.
+fn name_item(d: &Decl) -> CompletionItem {
+    item(
+        &d.name.name,
+        CompletionItemKind::REFERENCE,
+        d.kind.keyword(),
+    )
 }
 
 fn keywords(words: &[&str]) -> Vec<CompletionItem> {
@@ -228,13 +231,7 @@ fn use_items(checked: &Checked, path: &str) -> Vec<CompletionItem> {
     decls(checked)
         .into_iter()
         .filter(|d| d.name.span.file == m.file && d.part.is_none())
-        .map(|d| {
-            item(
-                &d.name.name,
-                CompletionItemKind::REFERENCE,
-                d.kind.keyword(),
-            )
-        })
+        .map(|d| name_item(&d))
         .collect()
 }
 

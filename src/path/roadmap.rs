@@ -532,24 +532,17 @@ mod tests {
 
     /// The 12 triangles of a box, outward.
     fn cuboid(lo: P3, hi: P3) -> Vec<[P3; 3]> {
-        let c = |i: usize| {
-            P3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            )
+        let solid = crate::access::pose::Solid {
+            at: nalgebra::Isometry3::translation(
+                (lo.x + hi.x) / 2.0,
+                (lo.y + hi.y) / 2.0,
+                (lo.z + hi.z) / 2.0,
+            ),
+            shape: crate::access::pose::SolidShape::Box((hi - lo) / 2.0),
         };
-        let quads = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        quads
-            .iter()
-            .flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]])
+        let (vs, ts) = solid.triangles();
+        ts.iter()
+            .map(|t| [vs[t[0] as usize], vs[t[1] as usize], vs[t[2] as usize]])
             .collect()
     }
 
