@@ -350,7 +350,7 @@ pub fn point_cones(
     let d2 = probe
         .head
         .indexable()
-        .then(|| d2(backend, scene, &c, probe, &approach, opts.d2_samples));
+        .then(|| d2(backend, scene, &c, probe, &approach, pref, opts.d2_samples));
     PointCones {
         tip_fits: true,
         approach,
@@ -378,12 +378,14 @@ pub fn d2(
     c: &P3,
     probe: &ProbeShape,
     d1: &CubeMap,
+    preferred: &[V3],
     samples: usize,
 ) -> CubeMap {
+    // `preferred` is the list D1 was built with: rebuilt from D1's unit vectors, a
+    // direction that normalizing does not leave fixed would key differently.
     let mut out = d1.empty_like();
-    let prefs: Vec<V3> = (0..d1.preferred_len()).map(|k| d1.preferred(k)).collect();
     for x in d2_points(c, probe, d1, samples) {
-        out.or_assign(&gac(backend, scene, &x, &probe.second, d1.n(), &prefs));
+        out.or_assign(&gac(backend, scene, &x, &probe.second, d1.n(), preferred));
     }
     out
 }

@@ -42,9 +42,20 @@ pub struct RestPose {
     /// Whether the contact is a polygon of flat contact and corners (not a line or point
     /// of a curved face).
     pub flat: bool,
+    /// The direction of the support polygon's longest edge (perpendicular to `up`): what
+    /// an operator lines up against a plate's rail or stop.
+    pub edge: V3,
 }
 
 impl RestPose {
+    /// The four directions, square to `up`, a plate clamping this face may tilt it
+    /// towards: along its longest edge or square to it, either way.
+    pub fn azimuths(&self) -> [V3; 8] {
+        let w = self.up.cross(&self.edge).normalize();
+        let (a, b) = ((self.edge + w).normalize(), (self.edge - w).normalize());
+        [self.edge, -self.edge, w, -w, a, -a, b, -b]
+    }
+
     /// Whether the part stays in this pose on its own.
     pub fn stable(&self) -> bool {
         self.flat && self.tip_deg >= MIN_TIP_DEG
@@ -81,6 +92,9 @@ pub enum Holder {
         slot: usize,
         /// The faces the fixture grips or the part rests on in it.
         faces: Vec<FaceId>,
+        /// How the part lies on a tilted plate, for the operator: where the clamped
+        /// face's longest edge goes against the plate's hinge.
+        placement: Option<&'static str>,
     },
 }
 
@@ -96,6 +110,13 @@ const VBLOCK_LENGTH_MM: f64 = 50.0;
 
 /// How far a sine plate reaches past the part on every side (mm).
 const PLATE_MARGIN_MM: f64 = 30.0;
+
+/// A sine plate's tilts tried between its limits (degrees), and how many of the part's
+/// flat faces (largest first) it is tried under.
+const PLATE_STEP_DEG: f64 = 5.0;
+const PLATE_RESTS: usize = 8;
+/// The least support a face clamped on a plate has, as a share of the largest face's.
+const PLATE_MIN_SHARE: f64 = 0.25;
 
 /// The setups a plan may use and what holds the part in each: the stable rest poses
 /// first, then the plan's fixtures in the order it names them.
@@ -195,10 +216,66 @@ impl<'a> Setups<'a> {
                     }
                 }
                 FixtureKind::Mesh { up, .. } => out.push(V3::from(up).normalize()),
+                FixtureKind::SinePlate { tilt } => {
+                    for r in self.plate_rests() {
+                        for deg in plate_tilts(tilt) {
+                            let t = deg.to_radians();
+                            for z in r.azimuths() {
+                                out.push((r.up * t.cos() + z * t.sin()).normalize());
+                            }
+                        }
+                    }
+                }
                 _ => {}
             }
         }
         out
+    }
+
+    /// The face a sine plate tilted within `tilt` (degrees) clamps with `up` pointing
+    /// up, and how the part lies on it: the part clamped with its face's longest edge
+    /// against the plate's rail, square to it or at 45°, the plate tilting it towards
+    /// one of the face's [`RestPose::azimuths`].
+    fn on_plate(&self, tilt: [f64; 2], up: &V3) -> Option<(&RestPose, Option<&'static str>)> {
+        let (lo, hi) = (tilt[0].to_radians(), tilt[1].to_radians());
+        self.plate_rests().find_map(|r| {
+            let a = r.up.dot(up).clamp(-1.0, 1.0).acos();
+            if a < lo - 1e-9 || a > hi + 1e-9 {
+                return None;
+            }
+            if a < 1e-9 {
+                return Some((r, None));
+            }
+            // Within 1e-5 on the sphere (0.0006°): a program's ROTATEs give the
+            // simulator the setup to about that.
+            let (c, s) = (a.cos(), a.sin());
+            let k = r
+                .azimuths()
+                .iter()
+                .position(|z| (r.up * c + z * s - up).norm() < 1e-5)?;
+            let placement = match k {
+                0 | 1 => "its longest edge square to the hinge",
+                2 | 3 => "its longest edge along the hinge",
+                _ => "its longest edge at 45° to the hinge",
+            };
+            Some((r, Some(placement)))
+        })
+    }
+
+    /// The flat faces a sine plate may clamp: the largest [`PLATE_RESTS`] of those with
+    /// at least [`PLATE_MIN_SHARE`] of the largest one's support — a plate holds a part
+    /// by a broad face, not cantilevered from an end or a chamfer.
+    fn plate_rests(&self) -> impl Iterator<Item = &RestPose> {
+        let largest = self
+            .rests
+            .iter()
+            .filter(|r| r.flat)
+            .map(|r| r.area)
+            .fold(0.0, f64::max);
+        self.rests
+            .iter()
+            .filter(move |r| r.flat && r.area >= PLATE_MIN_SHARE * largest)
+            .take(PLATE_RESTS)
     }
 
     /// The placed mesh of the fixture in `slot` and its solid, if it is a mesh fixture.
@@ -248,7 +325,15 @@ impl<'a> Setups<'a> {
         }
         for &(slot, f) in &self.fixtures {
             if let Some(faces) = self.holds(slot, f, up) {
-                return Some(Holder::Fixture { slot, faces });
+                let placement = match f.kind {
+                    FixtureKind::SinePlate { tilt } => self.on_plate(tilt, up).and_then(|(_, p)| p),
+                    _ => None,
+                };
+                return Some(Holder::Fixture {
+                    slot,
+                    faces,
+                    placement,
+                });
             }
         }
         None
@@ -265,14 +350,9 @@ impl<'a> Setups<'a> {
                 same(&V3::from(its_up).normalize()).then(|| m.locating.clone())
             }
             FixtureKind::SinePlate { tilt } => {
-                let (lo, hi) = (tilt[0].to_radians(), tilt[1].to_radians());
-                self.rests
-                    .iter()
-                    .find(|r| {
-                        let a = r.up.dot(up).clamp(-1.0, 1.0).acos();
-                        r.flat && a >= lo - 1e-9 && a <= hi + 1e-9
-                    })
-                    .map(|r| r.faces.clone())
+                // The part clamped with an edge against the plate's rail: the plate tilts
+                // it towards one of the face's azimuths, by an angle in its range.
+                self.on_plate(tilt, up).map(|(r, _)| r.faces.clone())
             }
             FixtureKind::Vise { opening, .. } => {
                 let base = self.rests.iter().find(|r| r.flat && same(&r.up))?;
@@ -370,7 +450,7 @@ impl<'a> Setups<'a> {
     /// The fixture's solids in the part frame with `up` pointing up: obstacles to the
     /// probe like the part itself. None for the table.
     pub fn solids(&self, holder: &Holder, up: &V3) -> Vec<Solid> {
-        let Holder::Fixture { slot, faces } = holder else {
+        let Holder::Fixture { slot, faces, .. } = holder else {
             return vec![];
         };
         let g = self.geometry;
@@ -491,7 +571,9 @@ impl<'a> Setups<'a> {
                     .map(|v| v.coords.dot(&n))
                     .fold(f64::NEG_INFINITY, f64::max);
                 let com = self.com;
-                let (e1, e2) = perpendicular_basis(&n);
+                // Square to the face's longest edge, which lies along the rail.
+                let e1 = r.edge;
+                let e2 = n.cross(&e1);
                 let rot = nalgebra::Rotation3::from_basis_unchecked(&[e1, e2, n]);
                 let half = size / 2.0 + PLATE_MARGIN_MM;
                 let c = com.coords + n * (plane - com.coords.dot(&n) + JAW_MM / 2.0 + 1e-3);
@@ -610,9 +692,9 @@ impl<'a> Setups<'a> {
                     format!("holds one of {n} outer cylinders of Ø{}..{} mm with its axis horizontal, turned in {VBLOCK_STEP_DEG}° steps", diameter[0], diameter[1])
                 }
                 FixtureKind::SinePlate { tilt } => {
-                    let n = self.rests.iter().filter(|r| r.flat).count();
+                    let n = self.plate_rests().count();
                     format!(
-                        "clamps the part on one of its {n} flat faces, tilted {}°..{}°",
+                        "clamps the part on one of its {n} largest flat faces, the face's longest edge along the plate's rail or square to it, tilted {}°..{}° in {PLATE_STEP_DEG}° steps",
                         tilt[0], tilt[1]
                     )
                 }
@@ -760,7 +842,8 @@ fn rest_poses(g: &PartGeometry, hv: &[P3], hi_tris: &[[u32; 3]]) -> Vec<RestPose
         let flat2 = |x: &P3| (x.coords.dot(&e1), x.coords.dot(&e2));
         let h = p.d - p.n.dot(&com.coords);
         let c = flat2(&com);
-        let hull_tip = tip(&convex_hull(p.verts.iter().map(flat2).collect()), c, h);
+        let hull_poly = convex_hull(p.verts.iter().map(flat2).collect());
+        let hull_tip = tip(&hull_poly, c, h);
         // Planar faces of the part in the facet's plane.
         let mut faces: Vec<FaceId> = g
             .faces
@@ -785,6 +868,7 @@ fn rest_poses(g: &PartGeometry, hv: &[P3], hi_tris: &[[u32; 3]]) -> Vec<RestPose
                     area,
                     tip_deg: hull_tip,
                     flat: true,
+                    edge: longest_edge(&hull_poly, &e1, &e2),
                 });
             }
             continue;
@@ -823,6 +907,7 @@ fn rest_poses(g: &PartGeometry, hv: &[P3], hi_tris: &[[u32; 3]]) -> Vec<RestPose
             area: if flat { polygon_area(&poly) } else { 0.0 },
             tip_deg: if flat { tip(&poly, c, h) } else { 0.0 },
             flat,
+            edge: longest_edge(if flat { &poly } else { &hull_poly }, &e1, &e2),
         });
     }
     out.sort_by(|a, b| {
@@ -833,6 +918,36 @@ fn rest_poses(g: &PartGeometry, hv: &[P3], hi_tris: &[[u32; 3]]) -> Vec<RestPose
             .then(a.up.x.total_cmp(&b.up.x))
     });
     out
+}
+
+/// A sine plate's tilts (degrees): its limits and the multiples of [`PLATE_STEP_DEG`]
+/// between them.
+fn plate_tilts(tilt: [f64; 2]) -> Vec<f64> {
+    let mut out = vec![tilt[0]];
+    let mut k = (tilt[0] / PLATE_STEP_DEG).floor() + 1.0;
+    while k * PLATE_STEP_DEG < tilt[1] - 1e-9 {
+        out.push(k * PLATE_STEP_DEG);
+        k += 1.0;
+    }
+    if tilt[1] > tilt[0] + 1e-9 {
+        out.push(tilt[1]);
+    }
+    out
+}
+
+/// The direction of a polygon's longest edge (in the plane of `e1`, `e2`); `e1` when it
+/// has none. The first of equal edges, so the choice is the same on every machine.
+fn longest_edge(poly: &[(f64, f64)], e1: &V3, e2: &V3) -> V3 {
+    let mut best = (0.0, *e1);
+    for k in 0..poly.len() {
+        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+        let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+        let len = (dx * dx + dy * dy).sqrt();
+        if len > best.0 * (1.0 + 1e-9) {
+            best = (len, (e1 * dx + e2 * dy) / len);
+        }
+    }
+    best.1
 }
 
 /// The tipping angle (degrees) of a convex counter-clockwise polygon about its nearest

@@ -79,7 +79,11 @@ impl<'a> Names<'a> {
         };
         match h {
             super::poses::Holder::Table { faces: fs } => format!("the table on {}", faces(fs)),
-            super::poses::Holder::Fixture { slot, faces: fs } => {
+            super::poses::Holder::Fixture {
+                slot,
+                faces: fs,
+                placement,
+            } => {
                 let (label, id) = &self.model.cmms[self.plan.cmm.0].fixtures[*slot];
                 let kind = &self.model.fixtures[id.0].kind;
                 let name = format!("fixture {label} ({})", kind.word());
@@ -105,9 +109,10 @@ impl<'a> Names<'a> {
                             })
                             .unwrap_or(0.0);
                         format!(
-                            "{name} under {}, tilted {}°",
+                            "{name} under {}, tilted {}°{}",
                             faces(fs),
-                            fmt_num((tilt * 10.0).round() / 10.0)
+                            fmt_num((tilt * 10.0).round() / 10.0),
+                            placement.map_or(String::new(), |p| format!(", {p}"))
                         )
                     }
                     FixtureKind::Mesh { .. } => format!("{name} located on {}", faces(fs)),

@@ -166,10 +166,13 @@ fn deviations_on_real_parts_fail_exactly_their_tolerances() {
     let cases: [(&str, &str, &[&str]); 15] = [
         ("ctc_01", "feature top bow 1.2", &["FLAT_A"]),
         ("ctc_02", "feature f441 grow 0.12", &["SIZE_F441"]),
+        // H is J's secondary datum: tilted, it moves the frame J is located in. The plan
+        // measures H's first circle with J in the table setup, so J's position reads the
+        // shift at that circle's height, as a CMM building the frame from it would.
         (
             "ctc_02",
             "feature datum_h tilt 0.5 about (1, 0, 0)",
-            &["PERP_DATUM_H"],
+            &["PERP_DATUM_H", "POS_DATUM_J"],
         ),
         (
             "ctc_02",
