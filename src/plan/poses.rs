@@ -575,13 +575,52 @@ impl<'a> Setups<'a> {
                 let e1 = r.edge;
                 let e2 = n.cross(&e1);
                 let rot = nalgebra::Rotation3::from_basis_unchecked(&[e1, e2, n]);
-                let half = size / 2.0 + PLATE_MARGIN_MM;
                 let c = com.coords + n * (plane - com.coords.dot(&n) + JAW_MM / 2.0 + 1e-3);
-                vec![Solid::cuboid(
-                    P3::from(c),
-                    rot,
-                    V3::new(half, half, JAW_MM / 2.0),
-                )]
+                let rise = up - n * up.dot(&n);
+                if rise.norm() < 1e-9 {
+                    // Flat under the part: a square a little larger than the part.
+                    let half = size / 2.0 + PLATE_MARGIN_MM;
+                    return vec![Solid::cuboid(
+                        P3::from(c),
+                        rot,
+                        V3::new(half, half, JAW_MM / 2.0),
+                    )];
+                }
+                // Tilted: the plate runs up its own plane (`rise`) from the table, where
+                // its hinge stands `height` under the part, to a margin past the part's
+                // top; across, a margin past the part's sides.
+                let rise = rise.normalize();
+                // Right-handed: (across, rise, n).
+                let across = rise.cross(&n);
+                let span = |d: &V3| {
+                    self.hull
+                        .iter()
+                        .map(|v| v.coords.dot(d))
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                            (a.min(x), b.max(x))
+                        })
+                };
+                let (q0, q1) = span(&across);
+                let (r0, r1) = span(&rise);
+                let basis = nalgebra::Rotation3::from_basis_unchecked(&[across, rise, n]);
+                let plate = |lo: f64, hi: f64| {
+                    let mid = c - across * c.dot(&across) - rise * c.dot(&rise)
+                        + across * ((q0 + q1) / 2.0)
+                        + rise * ((lo + hi) / 2.0);
+                    Solid::cuboid(
+                        P3::from(mid),
+                        basis,
+                        V3::new(
+                            (q1 - q0) / 2.0 + PLATE_MARGIN_MM,
+                            ((hi - lo) / 2.0).max(1.0),
+                            JAW_MM / 2.0,
+                        ),
+                    )
+                };
+                let (mut lo, hi) = (r0 - PLATE_MARGIN_MM, r1 + PLATE_MARGIN_MM);
+                let floor = low - f.height;
+                lo += (floor - plate(lo, hi).lowest(up)) / rise.dot(up);
+                vec![plate(lo.min(hi - 2.0), hi)]
             }
         }
     }

@@ -98,6 +98,8 @@ pub struct SetupInfo {
     pub fixture: Mesh,
     /// Its (probe, orientation) groups in order.
     pub groups: Vec<GroupInfo>,
+    /// The camera's turn about the vertical that shows most of the part (degrees).
+    pub yaw: f32,
 }
 
 /// A triangle mesh.
@@ -268,9 +270,10 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
             table: ((s.table * 1e3).round() / 1e3) as f32,
             fixture: fixture_mesh(s),
             groups,
+            yaw: 0.0,
         });
     }
-    Scene {
+    let mut scene = Scene {
         title: format!("plan {}: part {}", plan.name, part.name),
         vertices: g.vertices.iter().map(|v| f3(&v.coords.into())).collect(),
         triangles: g.triangles.clone(),
@@ -289,7 +292,11 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
         points,
         setups,
         sphere,
+    };
+    for k in 0..scene.setups.len() {
+        scene.setups[k].yaw = raster::best_yaw(&scene, k);
     }
+    scene
 }
 
 /// `n` directions spread evenly over the sphere (a Fibonacci lattice).

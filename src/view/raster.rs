@@ -4,10 +4,12 @@
 
 use super::Scene;
 
-/// The camera the page opens with: turned 35° about the vertical, looking 30° down.
-pub const YAW_DEG: f32 = -35.0;
-/// See [`YAW_DEG`].
+/// The camera: turned about the vertical by the setup's yaw ([`best_yaw`]), looking
+/// 30° down.
 pub const PITCH_DEG: f32 = 30.0;
+
+/// The yaws tried for each setup (degrees): from the front-left, and round the part.
+const YAWS: [f32; 4] = [-35.0, 55.0, 145.0, -125.0];
 
 type V = [f32; 3];
 
@@ -43,8 +45,8 @@ fn hex(c: &str) -> [f32; 3] {
 /// Machine frame → view: turned by the yaw about z, then seen from the front and above
 /// at the pitch; x right and y up on the screen, z towards the viewer. The page's
 /// `view` is the same.
-fn view(p: &V) -> V {
-    let (sy, cy) = YAW_DEG.to_radians().sin_cos();
+fn view(p: &V, yaw: f32) -> V {
+    let (sy, cy) = yaw.to_radians().sin_cos();
     let (sp, cp) = PITCH_DEG.to_radians().sin_cos();
     let x = cy * p[0] - sy * p[1];
     let y = sy * p[0] + cy * p[1];
@@ -56,6 +58,10 @@ struct Canvas {
     h: usize,
     rgb: Vec<u8>,
     z: Vec<f32>,
+    /// Per pixel, whether the part's surface is what shows there.
+    part: Vec<bool>,
+    /// Whether what is drawn now is the part.
+    drawing_part: bool,
 }
 
 impl Canvas {
@@ -66,6 +72,7 @@ impl Canvas {
         let k = y as usize * self.w + x as usize;
         if depth >= self.z[k] {
             self.z[k] = depth;
+            self.part[k] = self.drawing_part;
             self.rgb[3 * k..3 * k + 3].copy_from_slice(&c.map(|v| v.clamp(0.0, 255.0) as u8));
         }
     }
@@ -110,11 +117,40 @@ impl Canvas {
     }
 }
 
-/// The PNG of setup `setup` (from 0) at `width` × `height` pixels; `None` when the scene
-/// has no such setup.
+/// The PNG of setup `setup` (from 0) at `width` × `height` pixels, from the setup's
+/// yaw; `None` when the scene has no such setup.
 pub fn png(scene: &Scene, setup: usize, width: u32, height: u32) -> Option<Vec<u8>> {
+    let yaw = scene.setups.get(setup)?.yaw;
+    let c = draw(scene, setup, width as usize, height as usize, yaw)?;
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, width, height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut writer = enc.write_header().ok()?;
+        writer.write_image_data(&c.rgb).ok()?;
+    }
+    Some(out)
+}
+
+/// The yaw (degrees) from which most of the part shows in setup `setup`: a fixture
+/// beside the part (an angle plate) hides it from one side.
+pub fn best_yaw(scene: &Scene, setup: usize) -> f32 {
+    let mut best = (0, YAWS[0]);
+    for yaw in YAWS {
+        let shown =
+            draw(scene, setup, 160, 120, yaw).map_or(0, |c| c.part.iter().filter(|p| **p).count());
+        if shown > best.0 {
+            best = (shown, yaw);
+        }
+    }
+    best.1
+}
+
+/// Draws setup `setup` from `yaw`.
+fn draw(scene: &Scene, setup: usize, w: usize, h: usize, yaw: f32) -> Option<Canvas> {
     let s = scene.setups.get(setup)?;
-    let (w, h) = (width as usize, height as usize);
+    let view = |p: &V| view(p, yaw);
     let r = &s.rotation;
     let part: Vec<V> = scene.vertices.iter().map(|p| view(&mul(r, p))).collect();
     let fixture: Vec<V> = s
@@ -157,6 +193,8 @@ pub fn png(scene: &Scene, setup: usize, width: u32, height: u32) -> Option<Vec<u
         h,
         rgb: vec![248; w * h * 3],
         z: vec![f32::NEG_INFINITY; w * h],
+        part: vec![false; w * h],
+        drawing_part: false,
     };
     let shade = |n: V, base: [f32; 3]| {
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-12);
@@ -175,6 +213,7 @@ pub fn png(scene: &Scene, setup: usize, width: u32, height: u32) -> Option<Vec<u
         tri(&mut c, &fixture, t, [150.0, 140.0, 125.0]);
     }
     let grey = [175.0, 178.0, 182.0];
+    c.drawing_part = true;
     for (k, t) in scene.triangles.iter().enumerate() {
         let face = scene.tri_face[k] as usize;
         let color = scene.faces[face]
@@ -182,6 +221,7 @@ pub fn png(scene: &Scene, setup: usize, width: u32, height: u32) -> Option<Vec<u
             .map_or(grey, |f| hex(&scene.features[f].color));
         tri(&mut c, &part, t, color);
     }
+    c.drawing_part = false;
     // Paths and points over the surfaces they run along.
     let lift = 2.0 * scale;
     for g in &s.groups {
@@ -204,13 +244,5 @@ pub fn png(scene: &Scene, setup: usize, width: u32, height: u32) -> Option<Vec<u
             }
         }
     }
-    let mut out = Vec::new();
-    {
-        let mut enc = png::Encoder::new(&mut out, width, height);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut writer = enc.write_header().ok()?;
-        writer.write_image_data(&c.rgb).ok()?;
-    }
-    Some(out)
+    Some(c)
 }
