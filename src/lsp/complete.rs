@@ -277,7 +277,7 @@ fn block_keys(checked: &Checked, all: &[Decl], file: FileId, offset: usize) -> V
 
 /// The top-level names visible in `file`: its own and those its `use` statements import.
 fn visible<'a>(checked: &'a Checked, all: &[Decl<'a>], file: FileId) -> Vec<Decl<'a>> {
-    let top = |d: &&Decl| d.part.is_none();
+    let top = |d: &&Decl| d.part.is_none() && d.kind != DeclKind::Label;
     let mut out: Vec<Decl> = all
         .iter()
         .filter(top)

@@ -15,9 +15,18 @@ pub fn hover(a: &Analysis, file: FileId, offset: usize) -> Option<(Span, String)
     let checked = &a.front;
     let (at, decl) = target(checked, file, offset)?;
     let all = decls(checked);
-    let d = all.iter().find(|d| d.name.span == decl)?;
+    let mut d = all.iter().find(|d| d.name.span == decl)?;
     let model = &checked.model;
     let mut o = String::new();
+    if d.kind == DeclKind::Label {
+        // A rack label stands for the item its entry names.
+        let named =
+            checked.model.index.names.iter().find(|u| {
+                u.used != decl && d.full.start <= u.used.start && u.used.end <= d.full.end
+            })?;
+        let _ = writeln!(o, "`{}` in the rack:\n", d.name.name);
+        d = all.iter().find(|x| x.name.span == named.decl)?;
+    }
     match d.kind {
         DeclKind::Block(_) | DeclKind::Part | DeclKind::Hierarchy | DeclKind::Plan => {
             let item = item_of(model, d)?;

@@ -851,6 +851,7 @@ fn document_symbols(a: &Analysis, file: crate::source::FileId) -> Vec<lt::Docume
         symbols::DeclKind::Block(_) => lt::SymbolKind::STRUCT,
         symbols::DeclKind::Tolerance => lt::SymbolKind::PROPERTY,
         symbols::DeclKind::Datum | symbols::DeclKind::Frame => lt::SymbolKind::CONSTANT,
+        symbols::DeclKind::Label => lt::SymbolKind::KEY,
         _ => lt::SymbolKind::FIELD,
     };
     let symbol =
@@ -864,15 +865,27 @@ fn document_symbols(a: &Analysis, file: crate::source::FileId) -> Vec<lt::Docume
             selection_range: text::range(text, d.name.span.range()),
             children,
         };
+    let label = |d: &&symbols::Decl| d.kind == symbols::DeclKind::Label;
     all.iter()
-        .filter(|d| d.name.span.file == file && d.part.is_none())
+        .filter(|d| d.name.span.file == file && d.part.is_none() && !label(d))
         .map(|d| {
-            let children = (d.kind == symbols::DeclKind::Part).then(|| {
-                all.iter()
-                    .filter(|c| c.part.is_some_and(|p| p.name.span == d.name.span))
-                    .map(|c| symbol(c, None))
-                    .collect()
-            });
+            let children = match d.kind {
+                symbols::DeclKind::Part => Some(
+                    all.iter()
+                        .filter(|c| c.part.is_some_and(|p| p.name.span == d.name.span))
+                        .map(|c| symbol(c, None))
+                        .collect(),
+                ),
+                symbols::DeclKind::Block(crate::syntax::ast::BlockKind::Cmm) => Some(
+                    all.iter()
+                        .filter(label)
+                        .filter(|c| c.full.file == d.full.file)
+                        .filter(|c| d.full.start <= c.full.start && c.full.end <= d.full.end)
+                        .map(|c| symbol(c, None))
+                        .collect(),
+                ),
+                _ => None,
+            };
             symbol(d, children)
         })
         .collect()

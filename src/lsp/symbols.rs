@@ -28,6 +28,8 @@ pub enum DeclKind {
     Tolerance,
     /// `cut hole h { … }` or `add boss b { … }` inside a part.
     Op,
+    /// A label in a cmm's rack: `probes [p1: TP20_D2_L20]`, `fixtures [vise: VISE_150]`.
+    Label,
 }
 
 impl DeclKind {
@@ -44,6 +46,7 @@ impl DeclKind {
             DeclKind::Frame => "frame",
             DeclKind::Tolerance => "tolerance",
             DeclKind::Op => "operation",
+            DeclKind::Label => "label",
         }
     }
 }
@@ -68,12 +71,34 @@ pub fn decls(checked: &Checked) -> Vec<Decl<'_>> {
         for item in &m.ast.items {
             match item {
                 ast::Item::Use(_) => {}
-                ast::Item::Block(b) => out.push(Decl {
-                    name: &b.name,
-                    kind: DeclKind::Block(b.kind),
-                    full: b.span,
-                    part: None,
-                }),
+                ast::Item::Block(b) => {
+                    out.push(Decl {
+                        name: &b.name,
+                        kind: DeclKind::Block(b.kind),
+                        full: b.span,
+                        part: None,
+                    });
+                    // A cmm's rack and fixtures: each label and the item it names.
+                    let lists = b
+                        .props
+                        .iter()
+                        .filter(|p| matches!(p.key.name.as_str(), "probes" | "fixtures"));
+                    for p in lists {
+                        let ast::ValueKind::List(entries) = &p.value.kind else {
+                            continue;
+                        };
+                        for e in entries {
+                            if let Some(label) = &e.label {
+                                out.push(Decl {
+                                    name: label,
+                                    kind: DeclKind::Label,
+                                    full: label.span.join(e.value.span),
+                                    part: None,
+                                });
+                            }
+                        }
+                    }
+                }
                 ast::Item::Hierarchy(h) => out.push(Decl {
                     name: &h.name,
                     kind: DeclKind::Hierarchy,

@@ -143,6 +143,10 @@ pub struct Cmm {
     pub probes: Vec<(String, ProbeId)>,
     /// The fixtures beside it, by label.
     pub fixtures: Vec<(String, FixtureId)>,
+    /// Where each probe's label is written (a plan's `prefer probe p1` binds to it).
+    pub probe_labels: Vec<Span>,
+    /// Where each fixture's label is written.
+    pub fixture_labels: Vec<Span>,
     /// Where it was declared.
     pub span: Span,
 }

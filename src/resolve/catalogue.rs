@@ -319,13 +319,16 @@ fn cmm(
         .and_then(|v| r.lookup_value(cx, module, v, Kind::Head))
         .unwrap_or(0);
     let mut probes: Vec<(String, ProbeId)> = Vec::new();
+    let mut probe_labels: Vec<crate::source::Span> = Vec::new();
     if let Some(v) = p.req(cx, "probes", "[p1: TP20_D2_L20]") {
         match &v.kind {
             ValueKind::List(entries) if !entries.is_empty() => {
-                probes = labelled(r, cx, module, entries, Kind::Probe, "probe in the rack")
-                    .into_iter()
-                    .map(|(l, id)| (l, ProbeId(id)))
-                    .collect();
+                for (l, id, at) in
+                    labelled(r, cx, module, entries, Kind::Probe, "probe in the rack")
+                {
+                    probes.push((l, ProbeId(id)));
+                    probe_labels.push(at);
+                }
             }
             ValueKind::List(_) => cx.err(E::MissingProperty {
                 span: v.span,
@@ -337,20 +340,21 @@ fn cmm(
         }
     }
     let mut fixtures: Vec<(String, FixtureId)> = Vec::new();
+    let mut fixture_labels: Vec<crate::source::Span> = Vec::new();
     if let Some(v) = p.get("fixtures") {
         match &v.kind {
             ValueKind::List(entries) => {
-                fixtures = labelled(
+                for (l, id, at) in labelled(
                     r,
                     cx,
                     module,
                     entries,
                     Kind::Fixture,
                     "fixture beside the CMM",
-                )
-                .into_iter()
-                .map(|(l, id)| (l, FixtureId(id)))
-                .collect();
+                ) {
+                    fixtures.push((l, FixtureId(id)));
+                    fixture_labels.push(at);
+                }
             }
             _ => cx.mismatch(v, "a list of fixtures", "write `fixtures [vise: VISE_150]`"),
         }
@@ -364,6 +368,8 @@ fn cmm(
         head: HeadId(head),
         probes,
         fixtures,
+        probe_labels,
+        fixture_labels,
         span,
     }
 }
@@ -377,8 +383,8 @@ fn labelled(
     entries: &[ast::ListEntry],
     kind: Kind,
     what: &str,
-) -> Vec<(String, usize)> {
-    let mut out: Vec<(String, usize)> = Vec::new();
+) -> Vec<(String, usize, crate::source::Span)> {
+    let mut out: Vec<(String, usize, crate::source::Span)> = Vec::new();
     for e in entries {
         let Some(id) = r.lookup_value(cx, module, &e.value, kind) else {
             continue;
@@ -393,7 +399,7 @@ fn labelled(
                 e.value.span,
             ),
         };
-        if out.iter().any(|(l, _)| *l == label) {
+        if out.iter().any(|(l, _, _)| *l == label) {
             cx.err(E::DuplicateName {
                 span: lspan,
                 first: None,
@@ -402,7 +408,7 @@ fn labelled(
             });
             continue;
         }
-        out.push((label, id));
+        out.push((label, id, lspan));
     }
     out
 }

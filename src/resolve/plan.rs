@@ -215,7 +215,12 @@ pub(super) fn lower(
                             o.get("cost").and_then(|v| cx.non_negative(v, "cost"))
                         };
                         if let Some(label) = cx.name(value) {
-                            if the_cmm.probes.iter().any(|(l, _)| *l == label.name) {
+                            if let Some(k) =
+                                the_cmm.probes.iter().position(|(l, _)| *l == label.name)
+                            {
+                                if let Some(&at) = the_cmm.probe_labels.get(k) {
+                                    cx.bind(label.span, at);
+                                }
                                 plan.probes.push(ProbePref {
                                     label: label.name.clone(),
                                     stance: stance(*forbid, cost),
@@ -362,7 +367,11 @@ fn plan_fixtures(cx: &mut Cx, v: &ast::Value, cmm: &Cmm) -> Vec<usize> {
         let Some(id) = cx.name(&e.value) else {
             continue;
         };
-        match cmm.fixtures.iter().position(|(l, _)| *l == id.name) {
+        let found = cmm.fixtures.iter().position(|(l, _)| *l == id.name);
+        if let Some(&at) = found.and_then(|k| cmm.fixture_labels.get(k)) {
+            cx.bind(id.span, at);
+        }
+        match found {
             Some(k) if !out.contains(&k) => out.push(k),
             Some(_) => {}
             None => {

@@ -233,6 +233,21 @@ fn ctc_01_hover_definition_completion_and_a_typo() {
     let std_text = std::fs::read_to_string(&std_path).unwrap();
     assert_eq!(std_text, include_str!("../../stdlib/heads.insp"));
 
+    // A rack label: the plan's `fixtures [angle]` goes to the cmm's `angle:` and shows
+    // the fixture it names.
+    let plan_angle = pos(&text, "fixtures [angle]", 0, "fixtures [".len() + 1);
+    let def = c.request("textDocument/definition", at(&uri, plan_angle.clone()));
+    assert_eq!(
+        def["range"]["start"],
+        pos(&text, "angle: ANGLE_PLATE", 0, 0),
+        "{def}"
+    );
+    let angle = hover_text(&mut c, &uri, plan_angle);
+    assert!(
+        angle.contains("`angle` in the rack") && angle.contains("fixture ANGLE_PLATE: sine_plate"),
+        "{angle}"
+    );
+
     // Completion: the properties of a cmm (as the resolver asks for them), units after
     // a number, a stdlib module's items after `use std::probes::`.
     let labels = |v: &Value| -> Vec<String> {
@@ -367,6 +382,13 @@ fn references_symbols_rename_and_formatting() {
             "T2"
         ]
     );
+    let rack: Vec<&str> = symbols[1]["children"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(rack, ["p1", "p2"]);
 
     // Renaming a feature edits its declaration and every use; a keyword is refused.
     let edit = c.request(
