@@ -574,29 +574,13 @@ fn build(
     };
     let (checked, built, timings) = inspc::build(&FsWorld, &[file.to_path_buf()], opts, &report);
     bar.finish_and_clear();
-    print_diagnostics(&checked.sources, &checked.diagnostics);
-    if checked.has_errors() {
-        eprintln!("inspc: nothing written");
-        return ExitCode::from(1);
-    }
-    if built.is_empty() {
-        eprintln!("inspc: {} has no plan to build", file.display());
-        return ExitCode::from(1);
-    }
-    if built.len() > 1 && (output.is_some() || plan_json.is_some()) {
-        eprintln!(
-            "inspc: {} holds {} plans; -o and --plan-json name one file, so leave them out and each plan writes its own",
-            file.display(),
-            built.len()
-        );
-        return ExitCode::from(2);
+    let named = (output.is_some() || plan_json.is_some())
+        .then_some("-o and --plan-json name one file, so leave them out");
+    if let Err(code) = writable(file, &checked, built.len(), "build", named) {
+        return code;
     }
     // Every file is decided before any is written.
-    let dir = file.parent().unwrap_or(std::path::Path::new(""));
-    let stem = file
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "program".into());
+    let (dir, stem) = beside(file);
     let mut writes: Vec<cli::outputs::Output> = Vec::new();
     let mut push = |path: PathBuf, bytes: Vec<u8>, what: &'static str| {
         writes.push(cli::outputs::Output { path, bytes, what });
@@ -687,6 +671,45 @@ fn build(
 }
 
 /// `inspc dmis`: reads a program and reports what a controller would reject.
+/// After a run that writes a file per plan: its diagnostics printed, and the exit code
+/// when nothing may be written — an error, no plan to `verb`, or one output file
+/// `named` on the command line for several plans.
+fn writable(
+    file: &std::path::Path,
+    checked: &inspc::Checked,
+    plans: usize,
+    verb: &str,
+    named: Option<&str>,
+) -> Result<(), ExitCode> {
+    print_diagnostics(&checked.sources, &checked.diagnostics);
+    if checked.has_errors() {
+        eprintln!("inspc: nothing written");
+        return Err(ExitCode::from(1));
+    }
+    if plans == 0 {
+        eprintln!("inspc: {} has no plan to {verb}", file.display());
+        return Err(ExitCode::from(1));
+    }
+    if let Some(named) = named.filter(|_| plans > 1) {
+        eprintln!(
+            "inspc: {} holds {plans} plans; {named} and each plan writes its own",
+            file.display()
+        );
+        return Err(ExitCode::from(2));
+    }
+    Ok(())
+}
+
+/// Where a spec's outputs go by default: its folder, and its file stem.
+fn beside(file: &std::path::Path) -> (&std::path::Path, String) {
+    let dir = file.parent().unwrap_or(std::path::Path::new(""));
+    let stem = file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "spec".into());
+    (dir, stem)
+}
+
 /// `inspc view`: the pipeline, then the page (and images) of every plan, written
 /// atomically.
 fn view(
@@ -703,28 +726,13 @@ fn view(
         &|_, _, _| {},
     );
     let checked = &run.checked;
-    print_diagnostics(&checked.sources, &checked.diagnostics);
-    if checked.has_errors() {
-        eprintln!("inspc: nothing written");
-        return ExitCode::from(1);
+    let named = output
+        .is_some()
+        .then_some("-o names one file, so leave it out");
+    if let Err(code) = writable(file, checked, run.built.len(), "view", named) {
+        return code;
     }
-    if run.built.is_empty() {
-        eprintln!("inspc: {} has no plan to view", file.display());
-        return ExitCode::from(1);
-    }
-    if run.built.len() > 1 && output.is_some() {
-        eprintln!(
-            "inspc: {} holds {} plans; -o names one file, so leave it out and each plan writes its own",
-            file.display(),
-            run.built.len()
-        );
-        return ExitCode::from(2);
-    }
-    let dir = file.parent().unwrap_or(std::path::Path::new(""));
-    let stem = file
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "plan".into());
+    let (dir, stem) = beside(file);
     let mut writes: Vec<cli::outputs::Output> = Vec::new();
     for b in &run.built {
         let model = &checked.model;
@@ -863,17 +871,16 @@ fn fmt(files: &[PathBuf], check: bool) -> ExitCode {
             diags.push(e);
             continue;
         }
-        let formatted = inspc::fmt::format(text);
-        if formatted == *text {
-            continue;
-        }
-        if inspc::syntax::outline(&formatted) != inspc::syntax::outline(text) {
-            // The formatter must never change what a spec says; refuse rather than write.
+        // It parses, so `None` means the layout would change what the spec says.
+        let Some(formatted) = inspc::fmt::format_checked(text) else {
             eprintln!(
                 "inspc: internal error: formatting {} would change its meaning; it is left as it is (please report)",
                 file.display()
             );
             return ExitCode::from(101);
+        };
+        if formatted == *text {
+            continue;
         }
         writes.push(cli::outputs::Output {
             path: file.clone(),

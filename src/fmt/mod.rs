@@ -126,6 +126,15 @@ struct Out {
     cont: bool,
 }
 
+/// The canonical layout of `src`, checked: `None` when `src` does not parse or when the
+/// layout would change its parse tree ([`crate::syntax::outline`]) — a formatter bug, and
+/// then nothing may be written.
+pub fn format_checked(src: &str) -> Option<String> {
+    let before = crate::syntax::outline(src)?;
+    let formatted = format(src);
+    (crate::syntax::outline(&formatted).as_ref() == Some(&before)).then_some(formatted)
+}
+
 /// The canonical layout of `src`, which should parse.
 pub fn format(src: &str) -> String {
     let mut outs: Vec<Option<Out>> = Vec::new();

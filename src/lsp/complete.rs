@@ -230,7 +230,7 @@ fn use_items(checked: &Checked, path: &str) -> Vec<CompletionItem> {
     };
     decls(checked)
         .into_iter()
-        .filter(|d| d.name.span.file == m.file && d.part.is_none())
+        .filter(|d| d.name.span.file == m.file && d.is_item())
         .map(|d| name_item(&d))
         .collect()
 }
@@ -277,10 +277,9 @@ fn block_keys(checked: &Checked, all: &[Decl], file: FileId, offset: usize) -> V
 
 /// The top-level names visible in `file`: its own and those its `use` statements import.
 fn visible<'a>(checked: &'a Checked, all: &[Decl<'a>], file: FileId) -> Vec<Decl<'a>> {
-    let top = |d: &&Decl| d.part.is_none() && d.kind != DeclKind::Label;
     let mut out: Vec<Decl> = all
         .iter()
-        .filter(top)
+        .filter(|d| d.is_item())
         .filter(|d| d.name.span.file == file)
         .cloned()
         .collect();
@@ -294,7 +293,7 @@ fn visible<'a>(checked: &'a Checked, all: &[Decl<'a>], file: FileId) -> Vec<Decl
         let target_file = checked.program.modules[target.0].file;
         let from_target = all
             .iter()
-            .filter(top)
+            .filter(|d| d.is_item())
             .filter(|d| d.name.span.file == target_file);
         let wanted: Vec<&str> = match (&u.select, &u.source) {
             (ast::UseSelect::Names(names), _) => names.iter().map(|n| n.name.as_str()).collect(),

@@ -1,7 +1,7 @@
 //! What hovering a name shows: the item as the model summary prints it, and for the names
 //! inside a part what the geometry, the measurement graph and the last plan know of them.
 
-use super::symbols::{decls, target, Decl, DeclKind};
+use super::symbols::{decls, target, within, Decl, DeclKind};
 use super::Analysis;
 use crate::model::{ItemRef, Model};
 use crate::resolve::{accepts, Datums};
@@ -20,10 +20,10 @@ pub fn hover(a: &Analysis, file: FileId, offset: usize) -> Option<(Span, String)
     let mut o = String::new();
     if d.kind == DeclKind::Label {
         // A rack label stands for the item its entry names.
-        let named =
-            checked.model.index.names.iter().find(|u| {
-                u.used != decl && d.full.start <= u.used.start && u.used.end <= d.full.end
-            })?;
+        let names = &checked.model.index.names;
+        let named = names
+            .iter()
+            .find(|u| u.used != decl && within(u.used, d.full))?;
         let _ = writeln!(o, "`{}` in the rack:\n", d.name.name);
         d = all.iter().find(|x| x.name.span == named.decl)?;
     }

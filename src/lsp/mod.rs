@@ -158,7 +158,6 @@ struct PlanRun {
 enum Event {
     Graphed {
         root: PathBuf,
-        version: i32,
         deep: Box<Deep>,
     },
     Planned {
@@ -229,11 +228,7 @@ fn spawn_graph_worker(events: Sender<Event>) -> Sender<GraphJob> {
                     parts,
                     graphs,
                 });
-                let ev = Event::Graphed {
-                    root,
-                    version: job.version,
-                    deep,
-                };
+                let ev = Event::Graphed { root, deep };
                 if events.send(ev).is_err() {
                     return;
                 }
@@ -422,15 +417,11 @@ impl Server {
 
     fn event(&mut self, ev: Event) {
         match ev {
-            Event::Graphed {
-                root,
-                version,
-                deep,
-            } => {
+            Event::Graphed { root, deep } => {
                 let Some(a) = self.analyses.get_mut(&root) else {
                     return;
                 };
-                if a.deep.as_ref().is_some_and(|d| d.version > version) {
+                if a.deep.as_ref().is_some_and(|d| d.version > deep.version) {
                     return;
                 }
                 a.deep = Some(*deep);
@@ -495,6 +486,25 @@ impl Server {
     /// Publishes every open spec's diagnostics, per file, where they changed.
     fn publish(&mut self) {
         let mut all: BTreeMap<String, (lt::Uri, Vec<lt::Diagnostic>)> = BTreeMap::new();
+        let docs = &self.docs;
+        let mut merge = |path: &Path, diags: &[lt::Diagnostic]| {
+            // An open document under the address the client gave it.
+            let Some(uri) = docs
+                .get(path)
+                .map(|d| d.uri.clone())
+                .or_else(|| text::uri_of(path))
+            else {
+                return;
+            };
+            let entry = all
+                .entry(uri.as_str().to_string())
+                .or_insert_with(|| (uri, Vec::new()));
+            for d in diags {
+                if !entry.1.contains(d) {
+                    entry.1.push(d.clone());
+                }
+            }
+        };
         for (root, a) in &self.analyses {
             let Some(doc) = self.docs.get(root) else {
                 continue;
@@ -504,34 +514,14 @@ impl Server {
                 Some(d) if d.version == doc.version => &d.checked,
                 _ => &a.front,
             };
+            // An open document is published even without diagnostics (clearing it).
+            merge(root, &[]);
             for (path, diags) in lsp_diagnostics(checked) {
-                let Some(uri) = text::uri_of(&path) else {
-                    continue;
-                };
-                let entry = all
-                    .entry(uri.as_str().to_string())
-                    .or_insert_with(|| (uri, Vec::new()));
-                for d in diags {
-                    if !entry.1.contains(&d) {
-                        entry.1.push(d);
-                    }
-                }
+                merge(&path, &diags);
             }
-            all.entry(doc.uri.as_str().to_string())
-                .or_insert_with(|| (doc.uri.clone(), Vec::new()));
             if let Some(plan) = a.plan.as_ref().filter(|p| p.text == doc.text) {
                 for (path, diags) in &plan.diagnostics {
-                    let Some(uri) = text::uri_of(path) else {
-                        continue;
-                    };
-                    let entry = all
-                        .entry(uri.as_str().to_string())
-                        .or_insert_with(|| (uri, Vec::new()));
-                    for d in diags {
-                        if !entry.1.contains(d) {
-                            entry.1.push(d.clone());
-                        }
-                    }
+                    merge(path, diags);
                 }
             }
         }
@@ -705,17 +695,13 @@ impl Server {
                 else {
                     return Ok(serde_json::Value::Null);
                 };
-                let formatted = crate::fmt::format(&doc.text);
                 // Only a layout change that keeps the parse tree (as `inspc fmt`).
-                let same = crate::syntax::outline(&doc.text).is_some()
-                    && crate::syntax::outline(&doc.text) == crate::syntax::outline(&formatted);
-                let edits = if !same || formatted == doc.text {
-                    Vec::new()
-                } else {
-                    vec![lt::TextEdit {
+                let edits = match crate::fmt::format_checked(&doc.text) {
+                    Some(formatted) if formatted != doc.text => vec![lt::TextEdit {
                         range: text::range(&doc.text, 0..doc.text.len()),
                         new_text: formatted,
-                    }]
+                    }],
+                    _ => Vec::new(),
                 };
                 json(serde_json::to_value(edits))
             }
@@ -865,9 +851,8 @@ fn document_symbols(a: &Analysis, file: crate::source::FileId) -> Vec<lt::Docume
             selection_range: text::range(text, d.name.span.range()),
             children,
         };
-    let label = |d: &&symbols::Decl| d.kind == symbols::DeclKind::Label;
     all.iter()
-        .filter(|d| d.name.span.file == file && d.part.is_none() && !label(d))
+        .filter(|d| d.name.span.file == file && d.is_item())
         .map(|d| {
             let children = match d.kind {
                 symbols::DeclKind::Part => Some(
@@ -878,9 +863,8 @@ fn document_symbols(a: &Analysis, file: crate::source::FileId) -> Vec<lt::Docume
                 ),
                 symbols::DeclKind::Block(crate::syntax::ast::BlockKind::Cmm) => Some(
                     all.iter()
-                        .filter(label)
-                        .filter(|c| c.full.file == d.full.file)
-                        .filter(|c| d.full.start <= c.full.start && c.full.end <= d.full.end)
+                        .filter(|c| c.kind == symbols::DeclKind::Label)
+                        .filter(|c| symbols::within(c.full, d.full))
                         .map(|c| symbol(c, None))
                         .collect(),
                 ),

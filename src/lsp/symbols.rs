@@ -64,6 +64,13 @@ pub struct Decl<'a> {
     pub part: Option<&'a ast::Part>,
 }
 
+impl Decl<'_> {
+    /// Whether it is a top-level item (not a name inside a part, not a rack label).
+    pub fn is_item(&self) -> bool {
+        self.part.is_none() && self.kind != DeclKind::Label
+    }
+}
+
 /// Every declaration of every module the run read (stdlib included), in source order.
 pub fn decls(checked: &Checked) -> Vec<Decl<'_>> {
     let mut out = Vec::new();
@@ -79,10 +86,10 @@ pub fn decls(checked: &Checked) -> Vec<Decl<'_>> {
                         part: None,
                     });
                     // A cmm's rack and fixtures: each label and the item it names.
-                    let lists = b
-                        .props
-                        .iter()
-                        .filter(|p| matches!(p.key.name.as_str(), "probes" | "fixtures"));
+                    let lists = b.props.iter().filter(|p| {
+                        b.kind == ast::BlockKind::Cmm
+                            && matches!(p.key.name.as_str(), "probes" | "fixtures")
+                    });
                     for p in lists {
                         let ast::ValueKind::List(entries) = &p.value.kind else {
                             continue;
@@ -158,6 +165,11 @@ pub fn decls(checked: &Checked) -> Vec<Decl<'_>> {
 /// a name is on it).
 pub fn contains(span: Span, file: FileId, offset: usize) -> bool {
     span.file == file && span.start as usize <= offset && offset <= span.end as usize
+}
+
+/// Whether span `inner` lies within span `outer` (in the same file).
+pub fn within(inner: Span, outer: Span) -> bool {
+    inner.file == outer.file && outer.start <= inner.start && inner.end <= outer.end
 }
 
 /// The name at `offset` of `file`: where it is written and the declared name it stands

@@ -324,11 +324,7 @@ impl<'a> Setups<'a> {
             });
         }
         for &(slot, f) in &self.fixtures {
-            if let Some(faces) = self.holds(slot, f, up) {
-                let placement = match f.kind {
-                    FixtureKind::SinePlate { tilt } => self.on_plate(tilt, up).and_then(|(_, p)| p),
-                    _ => None,
-                };
+            if let Some((faces, placement)) = self.holds(slot, f, up) {
                 return Some(Holder::Fixture {
                     slot,
                     faces,
@@ -340,8 +336,25 @@ impl<'a> Setups<'a> {
     }
 
     /// The faces fixture `f` (in `slot`) holds with `up` pointing up, if it can hold the
-    /// part so.
-    fn holds(&self, slot: usize, f: &Fixture, up: &V3) -> Option<Vec<FaceId>> {
+    /// part so, and on a plate how the part lies (see [`Holder::Fixture`]).
+    fn holds(
+        &self,
+        slot: usize,
+        f: &Fixture,
+        up: &V3,
+    ) -> Option<(Vec<FaceId>, Option<&'static str>)> {
+        if let FixtureKind::SinePlate { tilt } = f.kind {
+            // The part clamped with an edge against the plate's rail: the plate tilts it
+            // towards one of the face's azimuths, by an angle in its range.
+            return self
+                .on_plate(tilt, up)
+                .map(|(r, placement)| (r.faces.clone(), placement));
+        }
+        self.grips(slot, f, up).map(|faces| (faces, None))
+    }
+
+    /// [`Setups::holds`] for the fixtures other than plates: the faces they hold.
+    fn grips(&self, slot: usize, f: &Fixture, up: &V3) -> Option<Vec<FaceId>> {
         let g = self.geometry;
         let same = |a: &V3| (a - up).norm() < 1e-6;
         match f.kind {
@@ -349,11 +362,7 @@ impl<'a> Setups<'a> {
                 let (m, _) = self.mesh_of(slot)?;
                 same(&V3::from(its_up).normalize()).then(|| m.locating.clone())
             }
-            FixtureKind::SinePlate { tilt } => {
-                // The part clamped with an edge against the plate's rail: the plate tilts
-                // it towards one of the face's azimuths, by an angle in its range.
-                self.on_plate(tilt, up).map(|(r, _)| r.faces.clone())
-            }
+            FixtureKind::SinePlate { .. } => None, // `holds` answers for plates
             FixtureKind::Vise { opening, .. } => {
                 let base = self.rests.iter().find(|r| r.flat && same(&r.up))?;
                 self.clamps
