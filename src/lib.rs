@@ -324,6 +324,16 @@ fn plan_each(
         if !plan::check_machine(model, &model.plans[k], &data.geometry, &mut diags) {
             continue;
         }
+        let cmm = &model.cmms[model.plans[k].cmm.0];
+        if let (Some((label, _)), Some(&span)) = (cmm.scanners.first(), cmm.scanner_labels.first())
+        {
+            diags.push(plan::PlanError::ScannerNotPlanned {
+                span,
+                plan: name.clone(),
+                scanner: label.clone(),
+                cmm: cmm.name.clone(),
+            });
+        }
         let input = plan::Input {
             model,
             plan: &model.plans[k],

@@ -13,7 +13,9 @@
 //!   per submission;
 //! - the seed's family: the half-line GAC, grown and truncated half-lines (any
 //!   component), D1, D2 (weak GAC over dD1), D1′ for a chosen second-component
-//!   direction, feature cones as intersections, approach/retract cones.
+//!   direction, feature cones as intersections, approach/retract cones;
+//! - [`scan`]: a laser line scanner's visibility (laser and camera rays, incidence,
+//!   housing at the stand-off) on the same maps and backends.
 //!
 //! **Architecture Invariant:** for components of non-zero radius a direction the
 //! obstacle blocks is never reported accessible; the bare half-line is exact at pixel
@@ -29,6 +31,7 @@ pub mod pose;
 mod probe;
 mod raster;
 mod report;
+pub mod scan;
 mod scene;
 mod swept;
 
@@ -41,6 +44,7 @@ pub use pose::{Blocker, Contact, Head, Pose};
 pub use probe::{Component, End, ProbeShape};
 pub use raster::{shadow_polygon, Coverage};
 pub use report::{cone_report, pgm, ConeInput, ConeReport, ConeRequest};
+pub use scan::{scan_cones, ScanCones, ScannerShape};
 pub use scene::{point_triangle_distance, Scene, Tri};
 
 use crate::geometry::{PartGeometry, P3, V3};

@@ -79,6 +79,14 @@ pub fn cone_report(
         return None;
     };
     let plan = input.plan;
+    if let (Some(plan), Some(label)) = (plan, &req.probe) {
+        let cmm = &model.cmms[plan.cmm.0];
+        if let Some(k) = cmm.scanners.iter().position(|(l, _)| l == label) {
+            let (l, id) = &cmm.scanners[k];
+            let shape = ScannerShape::new(model, cmm, l, &model.scanners[id.0]);
+            return Some(scanner_report(input, req, f, chosen.len(), &shape));
+        }
+    }
     let probe = match plan {
         Some(plan) => {
             let cmm = &model.cmms[plan.cmm.0];
@@ -96,6 +104,7 @@ pub fn cone_report(
                         .probes
                         .iter()
                         .map(|(l, _)| l.as_str())
+                        .chain(cmm.scanners.iter().map(|(l, _)| l.as_str()))
                         .collect::<Vec<_>>()
                         .join(", "),
                 });
@@ -225,6 +234,86 @@ pub fn cone_report(
         text,
         pgm: pgm(&drawn),
     })
+}
+
+/// The report of a scanner's cones at one point: the share of directions each condition
+/// leaves, the head orientations that see it, and the visible cone drawn.
+fn scanner_report(
+    input: &ConeInput,
+    req: &ConeRequest,
+    f: &Fpoint,
+    of: usize,
+    shape: &ScannerShape,
+) -> ConeReport {
+    let g = input.geometry;
+    let scene = Scene::of_part(g);
+    let n = req.n;
+    let prefs = axes();
+    let total = 6 * (n as usize) * (n as usize) + prefs.len();
+    let pct = |c: &CubeMap| format!("{:5.1} %", 100.0 * c.count() as f64 / total as f64);
+    let v = |x: &V3| format!("({}, {}, {})", fmt_num(x.x), fmt_num(x.y), fmt_num(x.z));
+    let face = &g.faces[f.face.0];
+    let o = &shape.optics;
+    let mut text = String::new();
+    let _ = writeln!(
+        text,
+        "fpoint {} of {of} on face {} ({}): at {}, normal {}",
+        req.point,
+        face.name,
+        face.surface.kind().keyword(),
+        v(&f.position.coords),
+        v(&f.normal)
+    );
+    let _ = writeln!(
+        text,
+        "scanner {}: stripe {} mm at stand-off {} ± {} mm, triangulation {}°, incidence ≤ {}°",
+        shape.probe.name,
+        fmt_num(o.stripe),
+        fmt_num(o.standoff),
+        fmt_num(o.depth / 2.0),
+        fmt_num(o.triangulation.to_degrees()),
+        fmt_num(o.max_incidence.to_degrees())
+    );
+    let _ = writeln!(
+        text,
+        "cube map N = {n}: {total} cells (pixels and 6 axes); free share:"
+    );
+    let opts = ConeOptions {
+        n,
+        preferred: prefs.clone(),
+        ..ConeOptions::default()
+    };
+    let cones = scan_cones(&Cpu, &scene, &f.position, &f.normal, shape, &opts);
+    let within = cones.rays.cap(&f.normal, o.max_incidence.cos());
+    let _ = writeln!(text, "  within the incidence limit       {}", pct(&within));
+    let _ = writeln!(
+        text,
+        "  laser and camera reach the point {}",
+        pct(&cones.rays)
+    );
+    let what = match shape.probe.head {
+        Head::Indexable => "housing clear (D1)",
+        Head::Fixed => "housing, head and ram clear",
+    };
+    let _ = writeln!(text, "  {what:<32} {}", pct(&cones.visible));
+    if let Some(d2) = &cones.d2 {
+        let _ = writeln!(text, "  D2 (setup directions)           {}", pct(d2));
+        if let Some(plan) = input.plan {
+            let cmm = &input.model.cmms[plan.cmm.0];
+            let grid = input.model.heads[cmm.head.0].orientations();
+            let inside = orientations_in(&cones.visible, &grid);
+            let _ = writeln!(
+                text,
+                "  head orientations that see it: {} of {}",
+                inside.len(),
+                grid.len()
+            );
+        }
+    }
+    ConeReport {
+        text,
+        pgm: pgm(&cones.visible),
+    }
 }
 
 /// The cone as a binary PGM: free white, blocked black, the unused corners of the cross

@@ -12,6 +12,7 @@ pub const STD_MODULES: &[(&str, &str)] = &[
     ),
     ("std::sampling", include_str!("../../stdlib/sampling.insp")),
     ("std::fixtures", include_str!("../../stdlib/fixtures.insp")),
+    ("std::scanners", include_str!("../../stdlib/scanners.insp")),
 ];
 
 /// The names of the standard modules.

@@ -19,6 +19,7 @@ const ITEM_KEYWORDS: &[&str] = &[
     "extension",
     "sampling",
     "fixture",
+    "scanner",
     "hierarchy",
     "plan",
 ];
@@ -138,6 +139,7 @@ fn kind_of_key(key: &str) -> Option<DeclKind> {
         "extensions" => DeclKind::Block(ast::BlockKind::Extension),
         "sampling" => DeclKind::Block(ast::BlockKind::Sampling),
         "fixtures" => DeclKind::Block(ast::BlockKind::Fixture),
+        "scanners" => DeclKind::Block(ast::BlockKind::Scanner),
         "cmm" => DeclKind::Block(ast::BlockKind::Cmm),
         "part" => DeclKind::Part,
         "hierarchy" => DeclKind::Hierarchy,

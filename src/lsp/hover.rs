@@ -67,6 +67,7 @@ fn item_of(model: &Model, d: &Decl) -> Option<ItemRef> {
             ast::BlockKind::Extension => find!(model.extensions, ItemRef::Extension),
             ast::BlockKind::Sampling => find!(model.samplings, ItemRef::Sampling),
             ast::BlockKind::Fixture => find!(model.fixtures, ItemRef::Fixture),
+            ast::BlockKind::Scanner => find!(model.scanners, ItemRef::Scanner),
         },
         DeclKind::Part => find!(model.parts, ItemRef::Part),
         DeclKind::Hierarchy => find!(model.hierarchies, ItemRef::Hierarchy),

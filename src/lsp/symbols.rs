@@ -88,7 +88,7 @@ pub fn decls(checked: &Checked) -> Vec<Decl<'_>> {
                     // A cmm's rack and fixtures: each label and the item it names.
                     let lists = b.props.iter().filter(|p| {
                         b.kind == ast::BlockKind::Cmm
-                            && matches!(p.key.name.as_str(), "probes" | "fixtures")
+                            && matches!(p.key.name.as_str(), "probes" | "fixtures" | "scanners")
                     });
                     for p in lists {
                         let ast::ValueKind::List(entries) = &p.value.kind else {
@@ -246,6 +246,7 @@ pub const RESERVED: &[&str] = &[
     "extension",
     "sampling",
     "fixture",
+    "scanner",
 ];
 
 #[cfg(test)]

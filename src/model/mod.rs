@@ -57,6 +57,8 @@ ids! {
     PlanId,
     /// Index into [`Model::fixtures`].
     FixtureId,
+    /// Index into [`Model::scanners`].
+    ScannerId,
     /// Index into a machine's rack, [`Cmm::probes`]: a probe as mounted, with its label.
     SlotId,
 }
@@ -84,6 +86,8 @@ pub struct Model {
     pub samplings: Vec<Sampling>,
     /// Fixtures.
     pub fixtures: Vec<Fixture>,
+    /// Laser line scanners.
+    pub scanners: Vec<Scanner>,
     /// Plans declared in the root files (imported files' plans are not run).
     pub plans: Vec<Plan>,
     /// `std::sampling::fan_leu`, the sampling of a plan that names none and of a part
@@ -143,10 +147,45 @@ pub struct Cmm {
     pub probes: Vec<(String, ProbeId)>,
     /// The fixtures beside it, by label.
     pub fixtures: Vec<(String, FixtureId)>,
+    /// The laser line scanners in its rack beside the probes, by label; they mount on
+    /// the same head.
+    pub scanners: Vec<(String, ScannerId)>,
     /// Where each probe's label is written (a plan's `prefer probe p1` binds to it).
     pub probe_labels: Vec<Span>,
     /// Where each fixture's label is written.
     pub fixture_labels: Vec<Span>,
+    /// Where each scanner's label is written.
+    pub scanner_labels: Vec<Span>,
+    /// Where it was declared.
+    pub span: Span,
+}
+
+/// A laser line scanner (Álvarez et al., Zhao et al.): a laser plane and a camera at the
+/// triangulation angle to it, seeing a stripe `stripe_width` wide across the middle of a
+/// depth of field `depth_of_field` deep, `standoff` in front of its window.
+#[derive(Debug, Clone)]
+pub struct Scanner {
+    /// Its name.
+    pub name: String,
+    /// The stripe's length at the stand-off, across the scan direction (mm).
+    pub stripe_width: f64,
+    /// From the scanner's window to the middle of the depth of field (mm).
+    pub standoff: f64,
+    /// How deep the measuring range is along the laser, centred on the stand-off (mm).
+    pub depth_of_field: f64,
+    /// The angle between the laser plane's axis and the camera's line of sight (degrees).
+    pub triangulation: f64,
+    /// The largest angle between the laser and a surface's normal it still measures
+    /// (degrees): Zhao et al.'s view angle limit θs.
+    pub max_incidence: f64,
+    /// Point spacing along the stripe and between stripes (mm).
+    pub spacing: [f64; 2],
+    /// Its accuracy (mm), compared with a tolerance to choose the sensor.
+    pub accuracy: f64,
+    /// The housing, as a cylinder along the laser: diameter and length (mm).
+    pub body: [f64; 2],
+    /// Relative cost of a change to it (1 = an ordinary probe change).
+    pub cost: f64,
     /// Where it was declared.
     pub span: Span,
 }

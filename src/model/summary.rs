@@ -36,6 +36,8 @@ pub enum ItemRef {
     Cmm(usize),
     /// `fixtures[i]`
     Fixture(usize),
+    /// `scanners[i]`
+    Scanner(usize),
     /// `hierarchies[i]`
     Hierarchy(usize),
     /// `samplings[i]`
@@ -83,6 +85,12 @@ impl Model {
             4,
             &|i| self.probes[i].span,
             ItemRef::Probe,
+        );
+        add(
+            self.scanners.len(),
+            8,
+            &|i| self.scanners[i].span,
+            ItemRef::Scanner,
         );
         // CMMs and parts only when shown (kind 7 is never used).
         add(self.cmms.len(), 7, &|i| self.cmms[i].span, ItemRef::Cmm);
@@ -198,6 +206,16 @@ impl Model {
                 } else {
                     format!(", fixtures [{}]", fixtures.join(", "))
                 };
+                let scanners: Vec<String> = c
+                    .scanners
+                    .iter()
+                    .map(|(l, s)| format!("{l}: {}", self.scanners[s.0].name))
+                    .collect();
+                let fixtures = if scanners.is_empty() {
+                    fixtures
+                } else {
+                    format!("{fixtures}, scanners [{}]", scanners.join(", "))
+                };
                 let _ = writeln!(
                     o,
                     "cmm {}: table z {}{size}, ram r {} l {}, head {}, probes [{}]{fixtures}",
@@ -212,6 +230,26 @@ impl Model {
                     o.push_str("  ");
                     o.push_str(&self.describe(ItemRef::Fixture(f.0)));
                 }
+            }
+            ItemRef::Scanner(i) => {
+                let s = &self.scanners[i];
+                let _ = writeln!(
+                    o,
+                    "scanner {}: stripe {} at stand-off {} ± {}, triangulation {}°, incidence ≤ {}°, \
+                     spacing {} × {}, accuracy {}, body Ø{} × {}, cost {}",
+                    s.name,
+                    fmt_num(s.stripe_width),
+                    fmt_num(s.standoff),
+                    fmt_num(s.depth_of_field / 2.0),
+                    fmt_num(s.triangulation),
+                    fmt_num(s.max_incidence),
+                    fmt_num(s.spacing[0]),
+                    fmt_num(s.spacing[1]),
+                    fmt_num(s.accuracy),
+                    fmt_num(s.body[0]),
+                    fmt_num(s.body[1]),
+                    fmt_num(s.cost)
+                );
             }
             ItemRef::Fixture(i) => {
                 let f = &self.fixtures[i];
@@ -362,6 +400,7 @@ impl Model {
             .collect();
         for c in cmms {
             used.insert((0, self.cmms[c].head.0));
+            used.extend(self.cmms[c].scanners.iter().map(|(_, s)| (8, s.0)));
             probes.extend(self.cmms[c].probes.iter().map(|(_, p)| p.0));
         }
         for p in probes {

@@ -129,6 +129,10 @@ pub(super) fn lower(
             let f = fixture(r, cx, &mut p, name, span);
             model.fixtures.push(f);
         }
+        Kind::Scanner => {
+            let s = scanner(cx, &mut p, name, span);
+            model.scanners.push(s);
+        }
         Kind::Cmm => {
             let cmm = cmm(r, cx, module, &mut p, name, span);
             model.cmms.push(cmm);
@@ -359,6 +363,30 @@ fn cmm(
             _ => cx.mismatch(v, "a list of fixtures", "write `fixtures [vise: VISE_150]`"),
         }
     }
+    let mut scanners: Vec<(String, ScannerId)> = Vec::new();
+    let mut scanner_labels: Vec<crate::source::Span> = Vec::new();
+    if let Some(v) = p.get("scanners") {
+        match &v.kind {
+            ValueKind::List(entries) => {
+                for (l, id, at) in
+                    labelled(r, cx, module, entries, Kind::Scanner, "scanner in the rack")
+                {
+                    if probes.iter().any(|(pl, _)| *pl == l) {
+                        cx.err(E::DuplicateName {
+                            span: at,
+                            first: None,
+                            name: l,
+                            help: "a scanner and a probe of one rack need their own labels".into(),
+                        });
+                        continue;
+                    }
+                    scanners.push((l, ScannerId(id)));
+                    scanner_labels.push(at);
+                }
+            }
+            _ => cx.mismatch(v, "a list of scanners", "write `scanners [l1: LC15Dx]`"),
+        }
+    }
     Cmm {
         name,
         table_z,
@@ -368,8 +396,92 @@ fn cmm(
         head: HeadId(head),
         probes,
         fixtures,
+        scanners,
         probe_labels,
         fixture_labels,
+        scanner_labels,
+        span,
+    }
+}
+
+/// A laser line scanner: its optics (stripe, stand-off, depth of field, triangulation
+/// and incidence angles, point spacing), accuracy and housing.
+fn scanner(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Scanner {
+    let len = |cx: &mut Cx, p: &mut Props, key: &'static str, example: &str| {
+        p.req(cx, key, example)
+            .and_then(|v| cx.positive(v, Dim::Length, key))
+            .unwrap_or(1.0)
+    };
+    let stripe_width = len(cx, p, "stripe_width", "18 mm");
+    let standoff = len(cx, p, "standoff", "60 mm");
+    let depth_of_field = len(cx, p, "depth_of_field", "15 mm");
+    let angle = |cx: &mut Cx, p: &mut Props, key: &'static str, example: &str, hi: f64| {
+        let v = p.req(cx, key, example)?;
+        let a = cx.positive(v, Dim::Angle, key)?;
+        if a >= hi {
+            cx.err(E::OutOfRange {
+                span: v.span,
+                what: key.replace('_', " "),
+                value: format!("{}°", num(a)),
+                range: format!("0° < {key} < {}°", num(hi)),
+                help: "give the angle in degrees from the scanner's data sheet".into(),
+            });
+            return None;
+        }
+        Some(a)
+    };
+    let triangulation = angle(cx, p, "triangulation", "30 deg", 90.0).unwrap_or(30.0);
+    let max_incidence = angle(cx, p, "max_incidence", "75 deg", 90.0).unwrap_or(75.0);
+    let mut spacing = [stripe_width / 500.0; 2];
+    if let Some(v) = p.req(cx, "spacing", "(0.022 mm, 0.022 mm)") {
+        if let Some(s) = cx.lengths::<2>(v) {
+            if s.iter().any(|x| *x <= 0.0) {
+                cx.err(E::NonPositive {
+                    span: v.span,
+                    what: "the point spacing".into(),
+                    value: describe(v),
+                    help: "give the spacing along the stripe and between stripes".into(),
+                });
+            } else {
+                spacing = s;
+            }
+        }
+    }
+    let accuracy = len(cx, p, "accuracy", "0.0019 mm");
+    let mut body = [50.0, 100.0];
+    if let Some(v) = p.req(cx, "body", "{ diameter 60 mm, length 110 mm }") {
+        match &v.kind {
+            ValueKind::Block(props) => {
+                let mut t = Props::new(cx, "the scanner's body", v.span, props);
+                for (k, key, example) in [(0, "diameter", "60 mm"), (1, "length", "110 mm")] {
+                    if let Some(x) = t
+                        .req(cx, key, example)
+                        .and_then(|x| cx.positive(x, Dim::Length, key))
+                    {
+                        body[k] = x;
+                    }
+                }
+                t.finish(cx);
+            }
+            _ => cx.mismatch(v, "a block `{ diameter …, length … }`", ""),
+        }
+    }
+    let cost = p
+        .get("cost")
+        .and_then(|v| cx.non_negative(v, "cost"))
+        .unwrap_or(1.0);
+    describe_only(cx, p);
+    Scanner {
+        name,
+        stripe_width,
+        standoff,
+        depth_of_field,
+        triangulation,
+        max_incidence,
+        spacing,
+        accuracy,
+        body,
+        cost,
         span,
     }
 }

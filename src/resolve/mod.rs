@@ -47,6 +47,7 @@ pub(crate) enum Kind {
     Hierarchy,
     Sampling,
     Fixture,
+    Scanner,
     Plan,
 }
 
@@ -63,6 +64,7 @@ impl Kind {
             Kind::Hierarchy => "a hierarchy",
             Kind::Sampling => "a sampling",
             Kind::Fixture => "a fixture",
+            Kind::Scanner => "a scanner",
             Kind::Plan => "a plan",
         }
     }
@@ -158,6 +160,7 @@ impl<'a> Resolver<'a> {
                             ast::BlockKind::Extension => Kind::Extension,
                             ast::BlockKind::Sampling => Kind::Sampling,
                             ast::BlockKind::Fixture => Kind::Fixture,
+                            ast::BlockKind::Scanner => Kind::Scanner,
                         },
                         &b.name,
                     ),

@@ -92,6 +92,8 @@ pub enum BlockKind {
     Sampling,
     /// A fixture that holds a part on the table.
     Fixture,
+    /// A laser line scanner.
+    Scanner,
 }
 
 impl BlockKind {
@@ -106,6 +108,7 @@ impl BlockKind {
             BlockKind::Extension => "extension",
             BlockKind::Sampling => "sampling",
             BlockKind::Fixture => "fixture",
+            BlockKind::Scanner => "scanner",
         }
     }
 }

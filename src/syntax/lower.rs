@@ -251,6 +251,7 @@ impl L {
                     "body" => BlockKind::Body,
                     "extension" => BlockKind::Extension,
                     "fixture" => BlockKind::Fixture,
+                    "scanner" => BlockKind::Scanner,
                     _ => BlockKind::Sampling,
                 };
                 let name = self.ident(it.next().expect("name"));

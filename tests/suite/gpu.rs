@@ -226,3 +226,45 @@ fn build_on_the_gpu_backend() {
     );
     assert_eq!(first(&stdout), first(&cpu));
 }
+
+#[test]
+fn gpu_scanner_cones_match_the_cpu() {
+    let Some(gpu) = device() else {
+        return;
+    };
+    let opts = inspc::access::ConeOptions {
+        n: 32,
+        ..Default::default()
+    };
+    let (mut total, mut agree) = (0, 0);
+    for spec in ["examples/f4.insp", "examples/swiss_block.insp"] {
+        let (scene, _, fp) = crate::access::loaded(spec);
+        for head in [inspc::access::Head::Fixed, inspc::access::Head::Indexable] {
+            let s = crate::scan::scanner(head);
+            for f in fp.iter().step_by((fp.len() / 5).max(1)).take(5) {
+                let on_gpu =
+                    inspc::access::scan_cones(gpu, &scene, &f.position, &f.normal, &s, &opts);
+                let on_cpu =
+                    inspc::access::scan_cones(&Cpu, &scene, &f.position, &f.normal, &s, &opts);
+                for (g, c) in [
+                    (&on_gpu.rays, &on_cpu.rays),
+                    (&on_gpu.visible, &on_cpu.visible),
+                ] {
+                    let all = c.empty_like().not();
+                    for cell in all.cells() {
+                        assert!(
+                            !g.get(cell) || c.get(cell),
+                            "{spec}: the GPU sees {cell:?} at {:?}, the CPU does not",
+                            f.position
+                        );
+                        total += 1;
+                        agree += (g.get(cell) == c.get(cell)) as usize;
+                    }
+                }
+            }
+        }
+    }
+    let share = agree as f64 / total as f64;
+    println!("scanner cones, GPU against CPU: {agree} of {total} cells agree");
+    assert!(share > 0.995, "{share}");
+}

@@ -23,6 +23,7 @@ mod no_panic;
 mod qif;
 mod replan;
 mod sampling;
+mod scan;
 mod simulate;
 mod step;
 mod tours;

@@ -1,0 +1,240 @@
+//! Laser line scanners: the catalogue item and the rack, and the scanner's visibility
+//! cones against exact ray casts on every example and the NIST parts.
+
+use crate::common::{self, check_src};
+use inspc::access::scan::{sees, Optics, LIFT};
+use inspc::access::{
+    component_hits, scan_cones, Cell, Component, ConeOptions, Cpu, End, Head, ProbeShape,
+    ScannerShape,
+};
+use inspc::geometry::V3;
+
+/// An LC15Dx-like scanner (stdlib figures) on a fixed or an indexable head with a
+/// PH10MQ-sized head and a 35 mm ram.
+pub(crate) fn scanner(head: Head) -> ScannerShape {
+    let (standoff, length) = (60.0, 120.0);
+    let base = match head {
+        Head::Fixed => standoff + length,
+        Head::Indexable => 0.0,
+    };
+    let flat = |name: &str, a: f64, b: f64, radius: f64| Component {
+        name: name.into(),
+        a,
+        b,
+        radius,
+        end: End::Flat,
+    };
+    ScannerShape {
+        optics: Optics {
+            standoff,
+            depth: 15.0,
+            stripe: 18.0,
+            triangulation: 30f64.to_radians(),
+            max_incidence: 75f64.to_radians(),
+            spacing: [0.022, 0.022],
+        },
+        probe: ProbeShape {
+            name: "l1".into(),
+            tip_radius: 0.0,
+            first: vec![flat("housing", standoff, standoff + length, 30.0)],
+            second: vec![
+                flat("head", base, base + 73.0, 31.0),
+                flat("ram", base + 73.0, f64::INFINITY, 35.0),
+            ],
+            head,
+        },
+    }
+}
+
+/// At `count` fpoints of a spec spread over its faces: every direction the cone calls
+/// seen must be seen by exact ray casts, and the housing (with head and ram on a fixed
+/// head) must clear the part there. Returns (cells seen by the cone, cells seen exactly).
+fn verify(spec: &str, count: usize, n: u32) -> (usize, usize) {
+    let (scene, _, fp) = crate::access::loaded(spec);
+    let opts = ConeOptions {
+        n,
+        ..ConeOptions::default()
+    };
+    let (mut cone_seen, mut exact_seen) = (0, 0);
+    let step = (fp.len() / count).max(1);
+    for head in [Head::Fixed, Head::Indexable] {
+        let s = scanner(head);
+        for f in fp.iter().step_by(step).take(count) {
+            let cones = scan_cones(&Cpu, &scene, &f.position, &f.normal, &s, &opts);
+            let from = f.position + f.normal * LIFT;
+            let all = cones.rays.empty_like().not();
+            for cell in all.cells() {
+                let d = all.direction(cell);
+                let exact = sees(&scene, &f.position, &f.normal, &d, &s.optics);
+                let cone = cones.rays.get(cell);
+                assert!(
+                    exact || !cone,
+                    "{spec}: the cone sees {d:?} at {:?} (normal {:?}), exact rays do not",
+                    f.position,
+                    f.normal
+                );
+                exact_seen += exact as usize;
+                cone_seen += cone as usize;
+                if cones.visible.get(cell) {
+                    assert!(cone, "{spec}: visible outside the rays at {cell:?}");
+                    for c in &s.probe.leading() {
+                        assert!(
+                            !component_hits(&scene, &from, &d, c),
+                            "{spec}: the {} hits the part at {:?} from {d:?}",
+                            c.name,
+                            f.position
+                        );
+                    }
+                }
+            }
+            assert_eq!(cones.d2.is_some(), head == Head::Indexable);
+        }
+    }
+    (cone_seen, exact_seen)
+}
+
+#[test]
+fn scanner_cones_never_see_what_exact_rays_block() {
+    let mut seen = (0, 0);
+    for spec in crate::access::EXAMPLES {
+        let (c, e) = verify(spec, 4, 32);
+        seen = (seen.0 + c, seen.1 + e);
+    }
+    common::require_shared_parts();
+    for spec in [
+        "tests/real/nist_ctc_01.insp",
+        "tests/real/nist_ctc_02.insp",
+        "tests/real/nist_ftc_06.insp",
+        "tests/real/nist_ftc_08.insp",
+    ] {
+        let (c, e) = verify(spec, 6, 32);
+        seen = (seen.0 + c, seen.1 + e);
+    }
+    let share = seen.0 as f64 / seen.1 as f64;
+    println!(
+        "scanner rays: the cone sees {} of the {} cells exact rays see ({:.1} %)",
+        seen.0,
+        seen.1,
+        100.0 * share
+    );
+    // Conservative cells and one pixel of growth cost a little at the cone's rim.
+    assert!(share > 0.9, "{share}");
+}
+
+#[test]
+fn the_laser_needs_the_camera_too() {
+    // A point on a floor under a plate that overhangs to +x: the laser straight up passes
+    // the plate's edge, the camera 30° towards +x meets the plate. Leaning the scanner
+    // towards -x brings the camera's line of sight past the edge too.
+    let p = |x: f64, y: f64, z: f64| inspc::geometry::P3::new(x, y, z);
+    let scene = inspc::access::Scene::of_triangles(&[
+        [
+            p(10.0, -10.0, 20.0),
+            p(30.0, -10.0, 20.0),
+            p(30.0, 10.0, 20.0),
+        ],
+        [
+            p(10.0, -10.0, 20.0),
+            p(30.0, 10.0, 20.0),
+            p(10.0, 10.0, 20.0),
+        ],
+    ]);
+    let s = scanner(Head::Indexable);
+    let opts = ConeOptions {
+        n: 32,
+        ..ConeOptions::default()
+    };
+    let (at, n) = (p(0.0, 0.0, 0.0), V3::z());
+    let cones = scan_cones(&Cpu, &scene, &at, &n, &s, &opts);
+    assert!(scene
+        .cast_ray(&(at + n * LIFT), &n, f64::INFINITY)
+        .is_none());
+    assert!(!sees(&scene, &at, &n, &n, &s.optics));
+    assert!(!cones.rays.get(Cell::Preferred(4)), "+z seen");
+    let lean = V3::new(-(20f64.to_radians().sin()), 0.0, 20f64.to_radians().cos());
+    assert!(sees(&scene, &at, &n, &lean, &s.optics));
+    assert!(cones.rays.contains(&lean));
+    // Past the incidence limit nothing is seen, however free the rays.
+    let grazing = V3::new(-(80f64.to_radians().sin()), 0.0, 80f64.to_radians().cos());
+    assert!(!sees(&scene, &at, &n, &grazing, &s.optics));
+    assert!(!cones.rays.contains(&grazing));
+}
+
+const RACK: &str = r#"
+use std::heads::PH10MQ
+use std::probes::TP20_D2_L20
+use std::scanners::{LC15Dx, LC60Dx}
+part p { units mm, stock box(50, 50, 20), feature top = stock.top }
+cmm lab {
+    table { z 0 mm, size (1000 mm, 700 mm) }
+    ram { radius 35 mm, length 600 mm }
+    head PH10MQ
+    probes [p1: TP20_D2_L20]
+    scanners [l1: LC15Dx, l2: LC60Dx]
+}
+plan q { part p, cmm lab }
+"#;
+
+#[test]
+fn a_cmm_carries_scanners_beside_its_probes() {
+    let d = check_src(RACK);
+    assert!(d.unexpected().is_empty());
+    let d = common::plan_files(&[("main.insp", RACK.as_bytes())]);
+    let w = d.only();
+    assert_eq!(w.code, "insp::plan::scanner_not_planned");
+    assert!(w.warning && w.span_text == "l1", "{}", w.message);
+    // A scanner's label may not repeat a probe's.
+    let src = RACK.replace("l2: LC60Dx", "p1: LC60Dx");
+    let d = check_src(&src);
+    assert_eq!(d.only().code, "insp::resolve::duplicate_name");
+    // A missing optical property is named with an example.
+    let src = "scanner s { stripe_width 18 mm, standoff 60 mm, depth_of_field 15 mm, \
+               triangulation 30 deg, max_incidence 75 deg, accuracy 0.002 mm, \
+               body { diameter 60 mm, length 120 mm } }";
+    let d = check_src(src);
+    let e = d.only();
+    assert_eq!(e.code, "insp::resolve::missing_property");
+    assert!(e.message.contains("spacing"), "{}", e.message);
+}
+
+#[test]
+fn the_summary_and_cone_report_describe_a_scanner() {
+    let dir = std::env::temp_dir().join(format!("inspc-scan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = dir.join("rack.insp");
+    std::fs::write(&spec, RACK).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_inspc"))
+        .args(["check", "--emit", "model"])
+        .arg(&spec)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    for needle in [
+        "scanner LC15Dx: stripe 18 at stand-off 60 ± 7.5, triangulation 30°, incidence ≤ 75°",
+        "scanners [l1: LC15Dx, l2: LC60Dx]",
+    ] {
+        assert!(text.contains(needle), "no `{needle}` in:\n{text}");
+    }
+    let pgm = dir.join("cone.pgm");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_inspc"))
+        .args(["cones", "--probe", "l1", "-n", "32", "-o"])
+        .arg(&pgm)
+        .arg(&spec)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    for needle in [
+        "scanner l1: stripe 18 mm at stand-off 60 ± 7.5 mm",
+        "laser and camera reach the point",
+        "housing clear (D1)",
+        "head orientations that see it:",
+    ] {
+        assert!(text.contains(needle), "no `{needle}` in:\n{text}");
+    }
+    assert!(std::fs::read(&pgm)
+        .unwrap()
+        .starts_with(b"P5\n128 96\n255\n"));
+    std::fs::remove_dir_all(&dir).ok();
+}
