@@ -310,6 +310,50 @@ fn scanner_report(
             );
         }
     }
+    if req.face.is_some() {
+        let grid = match input.plan {
+            Some(plan) => input.model.heads[input.model.cmms[plan.cmm.0].head.0].orientations(),
+            None => Vec::new(),
+        };
+        let grid = if grid.is_empty() {
+            vec![(0.0, 0.0)]
+        } else {
+            grid
+        };
+        let overlap = 0.2;
+        let views = scan::Views {
+            grid: &grid,
+            overlap,
+        };
+        let fc = scan::face_coverage(&Cpu, &scene, g, f.face.0, shape, &views, &opts);
+        let _ = writeln!(
+            text,
+            "face {}: {} mm², judged on {} samples, the part in its own frame (+z up): \
+             {:.1} % of its area seen from {} head orientation{}",
+            face.name,
+            fmt_num((fc.area * 10.0).round() / 10.0),
+            fc.samples,
+            100.0 * fc.covered,
+            fc.views.len(),
+            if fc.views.len() == 1 { "" } else { "s" }
+        );
+        for v in &fc.views {
+            let _ = writeln!(
+                text,
+                "  A {} B {}: {:5.1} % of the area, {} pass{} of {} mm at {} elevation{} \
+                 ({} % overlap)",
+                fmt_num(v.a),
+                fmt_num(v.b),
+                100.0 * v.share,
+                v.passes,
+                if v.passes == 1 { "" } else { "es" },
+                fmt_num(v.length.round()),
+                v.elevations,
+                if v.elevations == 1 { "" } else { "s" },
+                fmt_num(100.0 * overlap)
+            );
+        }
+    }
     ConeReport {
         text,
         pgm: pgm(&cones.visible),

@@ -223,6 +223,234 @@ pub fn scan_cones(
     ScanCones { rays, visible, d2 }
 }
 
+/// How many samples a face's coverage is judged on, at most.
+const FACE_SAMPLES: usize = 300;
+
+/// One head orientation a face is scanned from, with what it covers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct View {
+    /// Head angles (degrees); (0, 0) on a fixed head.
+    pub a: f64,
+    /// B angle (degrees).
+    pub b: f64,
+    /// The share of the face's area this view adds.
+    pub share: f64,
+    /// Parallel passes of the stripe (Zhao et al. eq. 15).
+    pub passes: usize,
+    /// How long each pass is (mm).
+    pub length: f64,
+    /// Heights of the scanner along the view for the depth of field (Zhao et al. 5.2).
+    pub elevations: usize,
+}
+
+/// Where a face may be scanned from and how passes lie.
+#[derive(Debug, Clone, Copy)]
+pub struct Views<'a> {
+    /// The head's orientations (degrees); one (0, 0) for a fixed head.
+    pub grid: &'a [(f64, f64)],
+    /// The share of a stripe's width neighbouring passes overlap.
+    pub overlap: f64,
+}
+
+/// How a scanner covers one face from a head's orientations (Zhao et al. 5.1–5.3),
+/// judged on area-weighted samples of the face.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FaceCoverage {
+    /// The face's area (mm²).
+    pub area: f64,
+    /// How many samples judged it.
+    pub samples: usize,
+    /// The orientations chosen, most area first (greedy cover).
+    pub views: Vec<View>,
+    /// The share of the area some view sees.
+    pub covered: f64,
+}
+
+/// Area-weighted samples of a face: each triangle cut into k² similar pieces, the
+/// pieces' centroids with their areas and the surface's outward normal there.
+fn face_samples(g: &crate::geometry::PartGeometry, face: usize) -> Vec<(P3, V3, f64)> {
+    let f = &g.faces[face];
+    let h = (2.0 * f.area / FACE_SAMPLES as f64).sqrt().max(1e-3);
+    let mut out = Vec::new();
+    for &t in &f.triangles {
+        let v = g.triangles[t as usize].map(|i| g.vertices[i as usize]);
+        let tn = (v[1] - v[0]).cross(&(v[2] - v[0]));
+        let area = tn.norm() / 2.0;
+        if area < 1e-12 {
+            continue;
+        }
+        // k² pieces of about h²/2 each: the face's area decides the count, not how long
+        // and thin its triangles are.
+        let k = (((2.0 * area).sqrt() / h).ceil() as usize).clamp(1, 16);
+        let piece = area / (k * k) as f64;
+        let at =
+            |i: f64, j: f64| v[0] + (v[1] - v[0]) * (i / k as f64) + (v[2] - v[0]) * (j / k as f64);
+        for i in 0..k {
+            for j in 0..k - i {
+                let (fi, fj) = (i as f64, j as f64);
+                let mut pieces = vec![[at(fi, fj), at(fi + 1.0, fj), at(fi, fj + 1.0)]];
+                if i + j + 1 < k {
+                    pieces.push([at(fi + 1.0, fj), at(fi + 1.0, fj + 1.0), at(fi, fj + 1.0)]);
+                }
+                for q in pieces {
+                    let c = P3::from((q[0].coords + q[1].coords + q[2].coords) / 3.0);
+                    let n = f.surface.normal_at(&c).unwrap_or_else(|| tn.normalize());
+                    out.push((c, n, piece));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The coverage of `face` by a scanner from the head orientations of `views` (one (0, 0)
+/// for a fixed head), the part standing in its own frame with +z up. Per sample, the
+/// orientations whose direction the scanner's cone sees it from and whose head and ram
+/// clear the part; then a greedy cover by area until a view would add less than 1 % of
+/// it, taking among the views within 1 % of the best gain the one nearest the mean
+/// normal of what it sees. Per chosen orientation its passes: the stripe square to the
+/// motion, which runs along whichever of 12 directions (15° apart) in the view's plane
+/// makes the passes shortest, the views' overlap between neighbouring passes, and one
+/// elevation per depth of field.
+pub fn face_coverage(
+    backend: &dyn Backend,
+    scene: &super::Scene,
+    g: &crate::geometry::PartGeometry,
+    face: usize,
+    scanner: &ScannerShape,
+    views: &Views,
+    opts: &ConeOptions,
+) -> FaceCoverage {
+    let (grid, overlap) = (views.grid, views.overlap);
+    let samples = face_samples(g, face);
+    let area: f64 = samples.iter().map(|s| s.2).sum();
+    let dirs: Vec<V3> = grid
+        .iter()
+        .map(|&(a, b)| super::head_direction(a, b))
+        .collect();
+    let reach = scanner.probe.reach();
+    // The head and ram hang straight down from the articulation point: one depth map
+    // along +z answers for every sample and orientation.
+    let second = scanner.probe.head.indexable().then(|| {
+        let radius = scanner
+            .probe
+            .second
+            .iter()
+            .map(|c| c.radius)
+            .fold(0.0, f64::max);
+        super::SecondMap::new(scene, &V3::z(), radius, reach)
+    });
+    let sees_from: Vec<Vec<bool>> = samples
+        .iter()
+        .map(|(p, n, _)| {
+            let cones = scan_cones(backend, scene, p, n, scanner, opts);
+            let from = p + n * LIFT;
+            dirs.iter()
+                .map(|d| {
+                    cones.visible.contains(d)
+                        && second.as_ref().is_none_or(|m| m.clear(&(from + d * reach)))
+                })
+                .collect()
+        })
+        .collect();
+    let mut left: Vec<bool> = vec![true; samples.len()];
+    let mut views = Vec::new();
+    let mut covered = 0.0;
+    loop {
+        let gain = |j: usize| -> f64 {
+            (0..samples.len())
+                .filter(|&i| left[i] && sees_from[i][j])
+                .map(|i| samples[i].2)
+                .sum()
+        };
+        let gains: Vec<f64> = (0..dirs.len()).map(gain).collect();
+        let top = gains.iter().copied().fold(0.0, f64::max);
+        // A view that adds less than 1 % of the area is not worth a head move.
+        if top < 0.01 * area {
+            break;
+        }
+        // Among the views within 1 % of the best's gain, the one nearest the mean normal
+        // of what the first of them sees (Zhao et al.'s step 4).
+        let first = (0..dirs.len()).find(|&j| gains[j] == top).unwrap_or(0);
+        let mean: V3 = (0..samples.len())
+            .filter(|&i| left[i] && sees_from[i][first])
+            .map(|i| samples[i].1 * samples[i].2)
+            .sum();
+        let mean = mean.try_normalize(1e-12).unwrap_or(dirs[first]);
+        let mut j = first;
+        for k in 0..dirs.len() {
+            if gains[k] >= 0.99 * top && dirs[k].dot(&mean) > dirs[j].dot(&mean) + 1e-12 {
+                j = k;
+            }
+        }
+        let best = (gains[j], j);
+        let mine: Vec<usize> = (0..samples.len())
+            .filter(|&i| left[i] && sees_from[i][j])
+            .collect();
+        for &i in &mine {
+            left[i] = false;
+        }
+        covered += best.0;
+        let pts: Vec<P3> = mine.iter().map(|&i| samples[i].0).collect();
+        let (passes, length, elevations) = passes(&pts, &dirs[j], &scanner.optics, overlap);
+        views.push(View {
+            a: grid[j].0,
+            b: grid[j].1,
+            share: best.0 / area,
+            passes,
+            length,
+            elevations,
+        });
+    }
+    FaceCoverage {
+        area,
+        samples: samples.len(),
+        views,
+        covered: if area > 0.0 { covered / area } else { 0.0 },
+    }
+}
+
+/// The passes over points seen along `d`: (passes, length of each, elevations).
+fn passes(pts: &[P3], d: &V3, optics: &Optics, overlap: f64) -> (usize, f64, usize) {
+    let e1 = if d.x.abs() < 0.9 { V3::x() } else { V3::y() };
+    let e1 = (e1 - d * d.dot(&e1)).normalize();
+    let e2 = d.cross(&e1);
+    let width = optics.stripe * (1.0 - overlap);
+    let mut best = (usize::MAX, 0.0, f64::INFINITY);
+    for k in 0..12 {
+        let t = (k as f64 * 15.0).to_radians();
+        let m = e1 * t.cos() + e2 * t.sin();
+        let across = d.cross(&m);
+        let extent = |v: &V3| {
+            let (lo, hi) = pts
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                    let x = p.coords.dot(v);
+                    (lo.min(x), hi.max(x))
+                });
+            (hi - lo).max(0.0)
+        };
+        let (length, w) = (extent(&m), extent(&across));
+        let n = ((w / width).ceil() as usize).max(1);
+        let total = n as f64 * length;
+        if total < best.2 - 1e-9 {
+            best = (n, length, total);
+        }
+    }
+    // Elevations: from the highest point down, a new one wherever the depth of field ends.
+    let mut depth: Vec<f64> = pts.iter().map(|p| p.coords.dot(d)).collect();
+    depth.sort_by(|a, b| b.total_cmp(a));
+    let mut elevations = 0;
+    let mut top = f64::INFINITY;
+    for x in depth {
+        if elevations == 0 || top - x > optics.depth {
+            elevations += 1;
+            top = x;
+        }
+    }
+    (best.0, best.1, elevations)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

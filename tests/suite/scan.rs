@@ -218,7 +218,16 @@ fn the_summary_and_cone_report_describe_a_scanner() {
     }
     let pgm = dir.join("cone.pgm");
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_inspc"))
-        .args(["cones", "--probe", "l1", "-n", "32", "-o"])
+        .args([
+            "cones",
+            "--probe",
+            "l1",
+            "--face",
+            "stock.top",
+            "-n",
+            "32",
+            "-o",
+        ])
         .arg(&pgm)
         .arg(&spec)
         .output()
@@ -230,6 +239,9 @@ fn the_summary_and_cone_report_describe_a_scanner() {
         "laser and camera reach the point",
         "housing clear (D1)",
         "head orientations that see it:",
+        "face stock.top: 2500 mm²",
+        "100.0 % of its area seen from 1 head orientation",
+        "passes of",
     ] {
         assert!(text.contains(needle), "no `{needle}` in:\n{text}");
     }
@@ -237,4 +249,44 @@ fn the_summary_and_cone_report_describe_a_scanner() {
         .unwrap()
         .starts_with(b"P5\n128 96\n255\n"));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_face_is_covered_by_few_views_of_parallel_passes() {
+    use inspc::access::scan::{face_coverage, Views};
+    let (checked, parts, graphs) = inspc::measurement_graphs(
+        &inspc::source::FsWorld,
+        &[std::path::PathBuf::from("examples/swiss_block.insp")],
+    );
+    assert!(!checked.has_errors());
+    let g = &parts[graphs[0].part].as_ref().unwrap().geometry;
+    let scene = inspc::access::Scene::of_part(g);
+    let opts = ConeOptions {
+        n: 32,
+        ..ConeOptions::default()
+    };
+    let face = |name: &str| g.faces.iter().position(|f| f.name == name).unwrap();
+    let fixed = scanner(Head::Fixed);
+    let down = Views {
+        grid: &[(0.0, 0.0)],
+        overlap: 0.2,
+    };
+    // The 120 × 120 mm top around its 100 holes: one view straight down, passes 18 mm
+    // wide less 20 % overlap across it, one elevation.
+    let top = face_coverage(&Cpu, &scene, g, face("stock.top"), &fixed, &down, &opts);
+    assert!(top.covered > 0.99, "{top:?}");
+    assert_eq!(top.views.len(), 1, "{top:?}");
+    let v = &top.views[0];
+    assert!((8..=9).contains(&v.passes) && v.elevations == 1, "{v:?}");
+    assert!(v.length > 110.0 && v.length <= 120.0, "{v:?}");
+    let shares: f64 = top.views.iter().map(|v| v.share).sum();
+    assert!((shares - top.covered).abs() < 1e-9);
+    // A hole's wall seen only from above meets the laser at 90°: nothing is covered.
+    let wall = g
+        .faces
+        .iter()
+        .position(|f| f.name.ends_with(".wall"))
+        .unwrap();
+    let w = face_coverage(&Cpu, &scene, g, wall, &fixed, &down, &opts);
+    assert!(w.views.is_empty() && w.covered == 0.0, "{w:?}");
 }
