@@ -69,6 +69,38 @@ impl Component {
     }
 }
 
+/// The head a machine's probes hang from, and its second components — head and ram —
+/// for a first component reaching `reach` from the tip: from the articulation point of
+/// an indexable head (a bent probe), or continuing the first on a fixed head.
+pub fn second_components(model: &Model, cmm: &Cmm, reach: f64) -> (Head, Vec<Component>) {
+    let head = &model.heads[cmm.head.0];
+    let kind = match head.kind {
+        HeadKind::Fixed => Head::Fixed,
+        HeadKind::Indexable { .. } => Head::Indexable,
+    };
+    let base = match kind {
+        Head::Indexable => 0.0,
+        Head::Fixed => reach,
+    };
+    let second = vec![
+        Component {
+            name: "head".into(),
+            a: base,
+            b: base + head.length,
+            radius: head.diameter / 2.0,
+            end: End::Flat,
+        },
+        Component {
+            name: "ram".into(),
+            a: base + head.length,
+            b: f64::INFINITY,
+            radius: cmm.ram_radius,
+            end: End::Flat,
+        },
+    ];
+    (kind, second)
+}
+
 /// A probe on a machine: its tip and its components, from the tip up.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProbeShape {
@@ -119,32 +151,7 @@ impl ProbeShape {
             end: End::Flat,
         });
         at += body.length;
-        let head = &model.heads[cmm.head.0];
-        let kind = match head.kind {
-            HeadKind::Fixed => Head::Fixed,
-            HeadKind::Indexable { .. } => Head::Indexable,
-        };
-        // A bent probe's second component starts at the articulation point.
-        let base = match kind {
-            Head::Indexable => 0.0,
-            Head::Fixed => at,
-        };
-        let second = vec![
-            Component {
-                name: "head".into(),
-                a: base,
-                b: base + head.length,
-                radius: head.diameter / 2.0,
-                end: End::Flat,
-            },
-            Component {
-                name: "ram".into(),
-                a: base + head.length,
-                b: f64::INFINITY,
-                radius: cmm.ram_radius,
-                end: End::Flat,
-            },
-        ];
+        let (kind, second) = second_components(model, cmm, at);
         ProbeShape {
             name: name.into(),
             tip_radius: model.styli[probe.stylus.0].tip / 2.0,

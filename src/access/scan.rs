@@ -16,11 +16,10 @@
 //! squarely: a scanner indexed to d can put its camera on either side of the stripe by
 //! the direction it scans in, which the scan planner chooses per pass.
 
-use super::pose::Head;
-use super::probe::{Component, End, ProbeShape};
+use super::probe::{second_components, Component, End, ProbeShape};
 use super::{d2, gac, Backend, ConeOptions, CubeMap};
 use crate::geometry::{P3, V3};
-use crate::model::{Cmm, HeadKind, Model, Scanner};
+use crate::model::{Cmm, Model, Scanner};
 
 /// How far above the surface a scanned point's rays start (mm): past the mesh's chordal
 /// error (0.05 mm), so a concave face's own facets do not block its points.
@@ -63,11 +62,6 @@ pub struct ScannerShape {
 impl ScannerShape {
     /// A scanner as mounted on a machine's head, labelled `name`.
     pub fn new(model: &Model, cmm: &Cmm, name: &str, s: &Scanner) -> ScannerShape {
-        let head = &model.heads[cmm.head.0];
-        let kind = match head.kind {
-            HeadKind::Fixed => Head::Fixed,
-            HeadKind::Indexable { .. } => Head::Indexable,
-        };
         let body_end = s.standoff + s.body[1];
         let first = vec![Component {
             name: "housing".into(),
@@ -76,26 +70,7 @@ impl ScannerShape {
             radius: s.body[0] / 2.0,
             end: End::Flat,
         }];
-        let base = match kind {
-            Head::Indexable => 0.0,
-            Head::Fixed => body_end,
-        };
-        let second = vec![
-            Component {
-                name: "head".into(),
-                a: base,
-                b: base + head.length,
-                radius: head.diameter / 2.0,
-                end: End::Flat,
-            },
-            Component {
-                name: "ram".into(),
-                a: base + head.length,
-                b: f64::INFINITY,
-                radius: cmm.ram_radius,
-                end: End::Flat,
-            },
-        ];
+        let (kind, second) = second_components(model, cmm, body_end);
         ScannerShape {
             optics: Optics {
                 standoff: s.standoff,

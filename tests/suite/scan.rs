@@ -203,48 +203,46 @@ fn the_summary_and_cone_report_describe_a_scanner() {
     std::fs::create_dir_all(&dir).unwrap();
     let spec = dir.join("rack.insp");
     std::fs::write(&spec, RACK).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_inspc"))
-        .args(["check", "--emit", "model"])
-        .arg(&spec)
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{text}");
-    for needle in [
-        "scanner LC15Dx: stripe 18 at stand-off 60 ± 7.5, triangulation 30°, incidence ≤ 75°",
-        "scanners [l1: LC15Dx, l2: LC60Dx]",
-    ] {
-        assert!(text.contains(needle), "no `{needle}` in:\n{text}");
-    }
-    let pgm = dir.join("cone.pgm");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_inspc"))
-        .args([
-            "cones",
-            "--probe",
-            "l1",
-            "--face",
-            "stock.top",
-            "-n",
-            "32",
-            "-o",
-        ])
-        .arg(&pgm)
-        .arg(&spec)
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{text}");
-    for needle in [
-        "scanner l1: stripe 18 mm at stand-off 60 ± 7.5 mm",
-        "laser and camera reach the point",
-        "housing clear (D1)",
-        "head orientations that see it:",
-        "face stock.top: 2500 mm²",
-        "100.0 % of its area seen from 1 head orientation",
-        "passes of",
-    ] {
-        assert!(text.contains(needle), "no `{needle}` in:\n{text}");
-    }
+    // Runs inspc and checks that it succeeds and prints every needle.
+    let expect = |args: &[&str], needles: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_inspc"))
+            .args(args)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{text}");
+        for needle in needles {
+            assert!(text.contains(needle), "no `{needle}` in:\n{text}");
+        }
+    };
+    let (spec, pgm) = (spec.to_str().unwrap(), dir.join("cone.pgm"));
+    expect(
+        &["check", "--emit", "model", spec],
+        &[
+            "scanner LC15Dx: stripe 18 at stand-off 60 ± 7.5, triangulation 30°, incidence ≤ 75°",
+            "scanners [l1: LC15Dx, l2: LC60Dx]",
+        ],
+    );
+    let face = [
+        "--face",
+        "stock.top",
+        "-n",
+        "32",
+        "-o",
+        pgm.to_str().unwrap(),
+    ];
+    expect(
+        &[&["cones", "--probe", "l1"][..], &face, &[spec]].concat(),
+        &[
+            "scanner l1: stripe 18 mm at stand-off 60 ± 7.5 mm",
+            "laser and camera reach the point",
+            "housing clear (D1)",
+            "head orientations that see it:",
+            "face stock.top: 2500 mm²",
+            "100.0 % of its area seen from 1 head orientation",
+            "passes of",
+        ],
+    );
     assert!(std::fs::read(&pgm)
         .unwrap()
         .starts_with(b"P5\n128 96\n255\n"));
