@@ -494,6 +494,44 @@ impl CubeMap {
         }
     }
 
+    /// This map at resolution `n`, a multiple of its own: each fine pixel takes the bit
+    /// of the coarse pixel holding it, each preferred direction its own bit. A cone whose
+    /// free pixels are free in every direction they hold (cells, not centres) stays so.
+    pub fn refined(&self, n: u32) -> CubeMap {
+        debug_assert!(n >= self.n && n.is_multiple_of(self.n));
+        if n == self.n {
+            return self.clone();
+        }
+        let mut out = CubeMap {
+            n,
+            extra: self.extra.clone(),
+            bits: vec![0; (6 * (n as usize) * (n as usize) + self.extra.len()).div_ceil(64)],
+        };
+        let k = n / self.n;
+        for face in 0..6u8 {
+            for j in 0..n {
+                let mut i = 0;
+                while i < n {
+                    let coarse = Cell::Pixel(Pixel {
+                        face,
+                        i: i / k,
+                        j: j / k,
+                    });
+                    if self.get(coarse) {
+                        out.set_span(face, j, i, i + k - 1);
+                    }
+                    i += k;
+                }
+            }
+        }
+        for p in 0..self.extra.len() {
+            if self.get(Cell::Preferred(p)) {
+                out.set(Cell::Preferred(p), true);
+            }
+        }
+        out
+    }
+
     /// Adds every preferred direction.
     pub fn fill_preferred(&mut self) {
         for k in 0..self.extra.len() {
@@ -620,6 +658,30 @@ fn pixel_directions(like: &CubeMap) -> Arc<[V3]> {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn a_refined_map_gives_each_fine_pixel_its_coarse_pixels_bit() {
+        let pref = [V3::z()];
+        let mut coarse = CubeMap::empty(4, &pref);
+        coarse.set(
+            Cell::Pixel(Pixel {
+                face: 2,
+                i: 1,
+                j: 3,
+            }),
+            true,
+        );
+        coarse.set(Cell::Preferred(0), true);
+        let fine = coarse.refined(8);
+        assert_eq!(fine.n(), 8);
+        assert_eq!(fine.count(), 4 + 1);
+        for (i, j) in [(2, 6), (3, 6), (2, 7), (3, 7)] {
+            assert!(fine.get(Cell::Pixel(Pixel { face: 2, i, j })));
+        }
+        assert!(fine.get(Cell::Preferred(0)));
+        assert_eq!(coarse.refined(4), coarse);
+    }
+
     use super::*;
 
     #[test]

@@ -387,11 +387,25 @@ pub fn d2(
 ) -> CubeMap {
     // `preferred` is the list D1 was built with: rebuilt from D1's unit vectors, a
     // direction that normalizing does not leave fixed would key differently.
-    let mut out = d1.empty_like();
+    let coarse = d2_resolution(d1.n());
+    let mut out = CubeMap::empty(coarse, preferred);
     for x in d2_points(c, probe, d1, samples) {
-        out.or_assign(&gac(backend, scene, &x, &probe.second, d1.n(), preferred));
+        out.or_assign(&gac(backend, scene, &x, &probe.second, coarse, preferred));
     }
-    out
+    out.refined(d1.n())
+}
+
+/// The resolution D2 is rasterized at for cones of resolution `n`: half of it from 32
+/// up. The head and ram are wide (a pixel at N = 32 is under 4°), and a cone of grown
+/// components is free only where every direction of a pixel is, so a coarse free pixel
+/// frees its four fine ones soundly; a quarter of the pixels to draw, where D2 was over
+/// half of a real part's planning.
+fn d2_resolution(n: u32) -> u32 {
+    if n >= 32 && n.is_multiple_of(2) {
+        n / 2
+    } else {
+        n
+    }
 }
 
 /// The articulation points [`d2`] samples: c + d·u for up to `samples` directions u
@@ -588,23 +602,25 @@ pub fn point_cones_many(
             samples += 1;
         }
     }
-    let blocked = backend.blocked_many(scene, &queries, n, pref);
+    let coarse = d2_resolution(n);
+    let blocked = backend.blocked_many(scene, &queries, coarse, pref);
     let mut sample_blocked: Vec<Option<(usize, CubeMap)>> = vec![None; samples];
     for (&(k, s), b) in owner.iter().zip(&blocked) {
         sample_blocked[s]
-            .get_or_insert_with(|| (k, CubeMap::empty(n, pref)))
+            .get_or_insert_with(|| (k, CubeMap::empty(coarse, pref)))
             .1
             .or_assign(b);
     }
     let mut d2s: Vec<Option<CubeMap>> = items
         .iter()
-        .map(|(_, p)| p.head.indexable().then(|| CubeMap::empty(n, pref)))
+        .map(|(_, p)| p.head.indexable().then(|| CubeMap::empty(coarse, pref)))
         .collect();
     for (k, b) in sample_blocked.into_iter().flatten() {
         if let Some(d) = &mut d2s[k] {
             d.or_assign(&b.not());
         }
     }
+    let d2s: Vec<Option<CubeMap>> = d2s.into_iter().map(|d| d.map(|d| d.refined(n))).collect();
     items
         .iter()
         .zip(&stands)
