@@ -91,6 +91,29 @@ pub fn complete(checked: &Checked, file: FileId, text: &str, offset: usize) -> V
             }
             out
         }
+        Some("plan") if rack_value(trimmed).is_some() => {
+            // `prefer probe …`, `forbid probe …`, `fixtures [ …`: the labels of the plan's
+            // machine's rack, not the catalogue's items.
+            let model = &checked.model;
+            let plan = model
+                .plans
+                .iter()
+                .filter(|p| p.span.file == file && p.span.start as usize <= offset)
+                .max_by_key(|p| p.span.start);
+            let Some(cmm) = plan.map(|p| &model.cmms[p.cmm.0]) else {
+                return Vec::new();
+            };
+            let labels: Vec<&str> = if rack_value(trimmed) == Some(true) {
+                cmm.probes.iter().map(|(l, _)| l.as_str()).collect()
+            } else {
+                cmm.fixtures.iter().map(|(l, _)| l.as_str()).collect()
+            };
+            let what = format!("in cmm {}'s rack", cmm.name);
+            labels
+                .into_iter()
+                .map(|l| item(l, CompletionItemKind::REFERENCE, &what))
+                .collect()
+        }
         _ => {
             // A value: the names of the kind the key asks for, else every visible name.
             let key = trimmed.split_whitespace().next().unwrap_or("");
@@ -127,6 +150,17 @@ fn keywords(words: &[&str]) -> Vec<CompletionItem> {
         .iter()
         .map(|w| item(w, CompletionItemKind::KEYWORD, "keyword"))
         .collect()
+}
+
+/// Whether a plan statement's value is a rack label: Some(true) for a probe's
+/// (`prefer probe `, `forbid probe `), Some(false) for a fixture's (`fixtures [`).
+fn rack_value(statement: &str) -> Option<bool> {
+    let words: Vec<&str> = statement.split_whitespace().collect();
+    match words.as_slice() {
+        ["prefer" | "forbid", "probe"] => Some(true),
+        [w, ..] if w.starts_with("fixtures") => Some(false),
+        _ => None,
+    }
 }
 
 /// The kind of name a property key takes (`head PH6`, `probes [p1: TP20]`, `part f2`).

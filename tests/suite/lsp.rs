@@ -278,6 +278,16 @@ fn ctc_01_hover_definition_completion_and_a_typo() {
         ),
     ));
     assert!(probes.contains(&"TP20_D4_L50".to_string()), "{probes:?}");
+    // A plan's `fixtures [` takes the labels of its machine's rack, not catalogue items.
+    let rack = labels(&c.request(
+        "textDocument/completion",
+        at(
+            &uri,
+            pos(&text, "    fixtures [angle]", 0, "    fixtures [".len()),
+        ),
+    ));
+    assert!(rack.contains(&"angle".to_string()), "{rack:?}");
+    assert!(!rack.contains(&"ANGLE_PLATE".to_string()), "{rack:?}");
 
     // A typo: the unknown name's diagnostic, measured from sending the change.
     let typo = text.replacen("position(slot_a,", "position(slot_q,", 1);
