@@ -238,9 +238,14 @@ fn graphs_of(checked: &mut Checked, parts: &[Option<PartData>]) -> Vec<Graphed> 
             margin: sampling_margin(model, plan),
             span: plan.map_or(model.parts[k].span, |p| p.span),
         };
+        let mut built = graph::build(&input, &mut diags);
+        if let Some(plan) = plan {
+            built.sensors =
+                graph::sensors::select(model, plan, &data.geometry, &data.feature_faces);
+        }
         out.push(Graphed {
             part: k,
-            graph: graph::build(&input, &mut diags),
+            graph: built,
         });
     }
     checked.absorb(diags);
@@ -327,11 +332,25 @@ fn plan_each(
         let cmm = &model.cmms[model.plans[k].cmm.0];
         if let (Some((label, _)), Some(&span)) = (cmm.scanners.first(), cmm.scanner_labels.first())
         {
+            let part = &model.parts[g.part];
+            let chosen: Vec<String> = g
+                .graph
+                .sensors
+                .iter()
+                .filter(|s| matches!(s.sensor, graph::sensors::Sensor::Laser(_)))
+                .map(|s| format!("`{}` ({})", part.features[s.feature.0].name, s.why))
+                .collect();
+            let chosen = if chosen.is_empty() {
+                "no feature chose it".to_string()
+            } else {
+                format!("chosen for {}", chosen.join(", "))
+            };
             diags.push(plan::PlanError::ScannerNotPlanned {
                 span,
                 plan: name.clone(),
                 scanner: label.clone(),
                 cmm: cmm.name.clone(),
+                chosen,
             });
         }
         let input = plan::Input {

@@ -14,6 +14,7 @@
 
 mod errors;
 mod render;
+pub mod sensors;
 
 pub use errors::GraphError;
 pub use render::{dot, json, mermaid};
@@ -80,6 +81,9 @@ pub struct MeasurementGraph {
     pub fpoints: Vec<Fpoint>,
     /// The distance points keep from face boundaries (mm).
     pub margin: f64,
+    /// Per feature, its sensor and why, when the plan's machine carries a scanner
+    /// ([`sensors::select`]); empty otherwise.
+    pub sensors: Vec<sensors::SensorPick>,
 }
 
 /// The most measuring points one graph may hold. The path stage keeps a shortest-path
@@ -277,6 +281,7 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
         root,
         fpoints,
         margin: input.margin,
+        sensors: Vec::new(),
     }
 }
 

@@ -44,6 +44,9 @@ fn label(part: &Part, g: &PartGeometry, mg: &MeasurementGraph, n: NodeIndex) -> 
             if !datums.is_empty() {
                 l.push(format!("datum {}", datums.join(", ")));
             }
+            if let Some(s) = mg.sensors.iter().find(|s| s.feature == *feature) {
+                l.push(sensor_word(s).into());
+            }
             l
         }
         Node::Face { face, on_table } => {
@@ -183,7 +186,12 @@ pub fn json(part: &Part, g: &PartGeometry, mg: &MeasurementGraph) -> serde_json:
                     .graph
                     .neighbors_directed(n, petgraph::Direction::Incoming)
                     .any(|p| p != mg.root);
-                features.push(json!({ "name": part.features[feature.0].name, "datums": datums, "toleranced": toleranced, "faces": named(Edge::Face) }));
+                let mut f = json!({ "name": part.features[feature.0].name, "datums": datums, "toleranced": toleranced, "faces": named(Edge::Face) });
+                if let Some(s) = mg.sensors.iter().find(|s| s.feature == *feature) {
+                    f["sensor"] = json!(sensor_word(s));
+                    f["sensor_why"] = json!(s.why);
+                }
+                features.push(f);
             }
             Node::Face { face, on_table } => {
                 let f = &g.faces[face.0];
@@ -210,4 +218,12 @@ pub fn json(part: &Part, g: &PartGeometry, mg: &MeasurementGraph) -> serde_json:
         "features": features,
         "faces": faces,
     })
+}
+
+/// A feature's sensor as the graph shows it.
+fn sensor_word(s: &super::sensors::SensorPick) -> &'static str {
+    match s.sensor {
+        super::sensors::Sensor::Touch => "touch",
+        super::sensors::Sensor::Laser(_) => "laser",
+    }
 }

@@ -576,6 +576,28 @@ pub struct ProbePref {
     pub span: Span,
 }
 
+/// Which sensor a plan asks for a feature.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SensorChoice {
+    /// The rack's touch probes.
+    Touch,
+    /// A laser line scanner.
+    Laser,
+    /// The selection rule decides (tolerance to accuracy, the feature's shape).
+    Auto,
+}
+
+impl SensorChoice {
+    /// The keyword.
+    pub fn keyword(self) -> &'static str {
+        match self {
+            SensorChoice::Touch => "touch",
+            SensorChoice::Laser => "laser",
+            SensorChoice::Auto => "auto",
+        }
+    }
+}
+
 /// What a plan writes.
 #[derive(Debug, Clone, Default)]
 pub struct Outputs {
@@ -646,6 +668,12 @@ pub struct Plan {
     /// The fixtures of the plan's CMM it may use (indices into [`Cmm::fixtures`]); none:
     /// the table alone.
     pub fixtures: Vec<usize>,
+    /// The sensor asked for per feature (`sensors { top laser }`); a feature left out is
+    /// [`SensorChoice::Auto`].
+    pub sensors: Vec<(FeatureId, SensorChoice, Span)>,
+    /// A feature goes to a scanner only when its tightest tolerance is at least this many
+    /// times the scanner's accuracy (`sensor_ratio 10`; Zhao et al.'s 1:5 or 1:10).
+    pub sensor_ratio: f64,
     /// Where it was declared.
     pub span: Span,
 }

@@ -30,7 +30,7 @@ pub enum PlanError {
         why: String,
         help: String,
     },
-    #[error("plan `{plan}` measures every feature by touch: scanner `{scanner}` of `{cmm}` is not planned yet")]
+    #[error("plan `{plan}` measures every feature by touch: scanner `{scanner}` of `{cmm}` is not planned yet ({chosen})")]
     #[diagnostic(
         code(insp::plan::scanner_not_planned),
         severity(Warning),
@@ -42,6 +42,7 @@ pub enum PlanError {
         plan: String,
         scanner: String,
         cmm: String,
+        chosen: String,
     },
     #[error("planning `{plan}` did not settle after {iterations} rounds of generate-and-test")]
     #[diagnostic(

@@ -117,6 +117,17 @@ pub enum ResolveError {
         #[help]
         help: String,
     },
+    #[error("feature `{feature}` asks for a laser scanner, and cmm `{cmm}` has none")]
+    #[diagnostic(
+        code(insp::resolve::no_scanner),
+        help("add one to the machine's rack, `scanners [l1: std::scanners::LC15Dx]`, or measure `{feature}` by `touch`")
+    )]
+    NoScanner {
+        #[label("no scanner on the machine")]
+        span: Span,
+        feature: String,
+        cmm: String,
+    },
     #[error("{what} {value} is out of range: {range}")]
     #[diagnostic(code(insp::resolve::out_of_range))]
     OutOfRange {
@@ -438,6 +449,7 @@ crate::located!(ResolveError {
     MissingUnit,
     NonPositive,
     OutOfRange,
+    NoScanner,
     StepNotDividing,
     AngleOutOfRange,
     OffGrid,

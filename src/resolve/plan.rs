@@ -102,6 +102,23 @@ pub(super) fn lower(
         }
     }
     let fixtures_v = pp.get("fixtures");
+    let sensors_v = pp.get("sensors");
+    let mut sensor_ratio = 10.0;
+    if let Some(v) = pp.get("sensor_ratio") {
+        if let Some(x) = cx.number(v) {
+            if x <= 0.0 {
+                cx.err(E::OutOfRange {
+                    span: v.span,
+                    what: "`sensor_ratio`".into(),
+                    value: num(x),
+                    range: "it must be more than 0".into(),
+                    help: "tolerance over accuracy: 10 for the usual 1:10 rule, 5 for 1:5".into(),
+                });
+            } else {
+                sensor_ratio = x;
+            }
+        }
+    }
     pp.finish(cx);
     let (part, cmm, hierarchy, sampling) = (part?, cmm?, hierarchy?, sampling?);
     let the_part = &model.parts[part];
@@ -121,10 +138,15 @@ pub(super) fn lower(
         outputs,
         motion,
         fixtures: vec![],
+        sensors: vec![],
+        sensor_ratio,
         span: p.name.span,
     };
     if let Some(v) = fixtures_v {
         plan.fixtures = plan_fixtures(cx, v, the_cmm);
+    }
+    if let Some(v) = sensors_v {
+        plan.sensors = plan_sensors(cx, v, the_part, the_cmm);
     }
     for s in &p.stmts {
         match s {
@@ -393,6 +415,78 @@ fn plan_fixtures(cx: &mut Cx, v: &ast::Value, cmm: &Cmm) -> Vec<usize> {
                 });
             }
         }
+    }
+    out
+}
+
+/// `sensors { top laser, bore touch }`: per feature of the plan's part, `laser`, `touch`
+/// or `auto`; `laser` needs a scanner in the machine's rack.
+fn plan_sensors(
+    cx: &mut Cx,
+    v: &ast::Value,
+    part: &crate::model::Part,
+    cmm: &crate::model::Cmm,
+) -> Vec<(FeatureId, SensorChoice, crate::source::Span)> {
+    let ValueKind::Block(props) = &v.kind else {
+        cx.mismatch(v, "a block `{ top laser, bore touch }`", "");
+        return vec![];
+    };
+    let mut out: Vec<(FeatureId, SensorChoice, crate::source::Span)> = Vec::new();
+    for prop in props {
+        let name = &prop.key.name;
+        let Some(f) = part.features.iter().position(|f| &f.name == name) else {
+            let help = format!(
+                "part `{}` has no feature `{name}`; {}",
+                part.name,
+                suggest::help_for_unknown(
+                    "feature",
+                    name,
+                    part.features.iter().map(|f| f.name.as_str())
+                )
+            );
+            cx.err(E::UnknownName {
+                span: prop.key.span,
+                what: "feature".into(),
+                name: name.clone(),
+                help,
+            });
+            continue;
+        };
+        cx.bind(prop.key.span, part.features[f].span);
+        let words = ["laser", "touch", "auto"];
+        let choice = match cx.name(&prop.value).map(|i| i.name.as_str()) {
+            Some("laser") => SensorChoice::Laser,
+            Some("touch") => SensorChoice::Touch,
+            Some("auto") => SensorChoice::Auto,
+            Some(other) => {
+                cx.err(E::UnknownName {
+                    span: prop.value.span,
+                    what: "sensor".into(),
+                    name: other.to_string(),
+                    help: suggest::help_for_unknown("sensor", other, words),
+                });
+                continue;
+            }
+            None => continue,
+        };
+        if choice == SensorChoice::Laser && cmm.scanners.is_empty() {
+            cx.err(E::NoScanner {
+                span: prop.value.span,
+                feature: name.clone(),
+                cmm: cmm.name.clone(),
+            });
+            continue;
+        }
+        if out.iter().any(|(g, _, _)| g.0 == f) {
+            cx.err(E::DuplicateName {
+                span: prop.key.span,
+                first: None,
+                name: name.clone(),
+                help: "say each feature's sensor once".into(),
+            });
+            continue;
+        }
+        out.push((FeatureId(f), choice, prop.span));
     }
     out
 }

@@ -288,3 +288,136 @@ fn a_face_is_covered_by_few_views_of_parallel_passes() {
     let w = face_coverage(&Cpu, &scene, g, wall, &fixed, &down, &opts);
     assert!(w.views.is_empty() && w.covered == 0.0, "{w:?}");
 }
+
+/// A block with a flat top, a deep hole and a side face, on a machine with an LC60Dx
+/// (accuracy 9 µm); `plan` is the plan's body after its part and cmm.
+fn mixed(plan: &str) -> String {
+    format!(
+        r#"
+use std::heads::PH10MQ
+use std::probes::TP20_D2_L20
+use std::scanners::LC60Dx
+part p {{
+    units mm
+    stock box(100, 80, 40)
+    cut hole h {{ at (50, 40, 40), axis -z, diameter 8, depth 20 }}
+    feature top = stock.top
+    feature side = stock.front
+    feature bore = h.wall
+    datum A = top
+    tolerance flat = flatness(top, 0.2 mm)
+    tolerance side_flat = flatness(side, 0.05 mm)
+    tolerance pos = position(bore, dia 0.5 mm, A)
+}}
+cmm lab {{
+    table {{ z 0 mm, size (1000 mm, 700 mm) }}
+    ram {{ radius 35 mm, length 600 mm }}
+    head PH10MQ
+    probes [p1: TP20_D2_L20]
+    scanners [l1: LC60Dx]
+}}
+plan q {{
+    part p
+    cmm lab
+    {plan}
+}}
+"#
+    )
+}
+
+/// The sensor each feature of `mixed(plan)` gets, as (feature, sensor, why).
+fn picks(plan: &str) -> Vec<(String, String, String)> {
+    let mut world = inspc::source::MemoryWorld::new();
+    world.insert("main.insp", mixed(plan).into_bytes());
+    let (checked, parts, graphs) =
+        inspc::measurement_graphs(&world, &[std::path::PathBuf::from("main.insp")]);
+    assert!(!checked.has_errors(), "{:?}", checked.summary());
+    let g = &parts[graphs[0].part].as_ref().unwrap().geometry;
+    let json = inspc::graph::json(&checked.model.parts[0], g, &graphs[0].graph);
+    let features = json["features"].as_array().unwrap().clone();
+    features
+        .iter()
+        .map(|f| {
+            (
+                f["name"].as_str().unwrap().to_string(),
+                f["sensor"].as_str().unwrap_or("").to_string(),
+                f["sensor_why"].as_str().unwrap_or("").to_string(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn sensors_are_chosen_by_tolerance_over_accuracy_and_by_shape() {
+    let p = picks("");
+    let get = |name: &str| p.iter().find(|f| f.0 == name).unwrap().clone();
+    // 0.2 mm / 0.009 mm = 22 ≥ 10: the scanner.
+    assert_eq!(get("top").1, "laser", "{p:?}");
+    assert!(
+        get("top").2.contains("flat 0.2 mm / 0.009 mm = 22.2 ≥ 10"),
+        "{p:?}"
+    );
+    // 0.05 / 0.009 = 5.6 < 10: touch.
+    assert_eq!(get("side").1, "touch", "{p:?}");
+    assert!(
+        get("side")
+            .2
+            .contains("side_flat 0.05 mm / 0.009 mm = 5.6 < 10"),
+        "{p:?}"
+    );
+    // A Ø8 hole 20 deep: touch whatever its tolerance.
+    assert_eq!(get("bore").1, "touch", "{p:?}");
+    assert!(get("bore").2.contains("a bore Ø8 mm, 20 mm deep"), "{p:?}");
+    // The 1:5 rule sends the side to the scanner; the plan's word beats the rule.
+    let p = picks("sensor_ratio 5\n    sensors { top touch }");
+    let get = |name: &str| p.iter().find(|f| f.0 == name).unwrap().clone();
+    assert_eq!(get("side").1, "laser", "{p:?}");
+    assert_eq!(
+        get("top"),
+        (
+            "top".into(),
+            "touch".into(),
+            "the plan asks for touch".into()
+        )
+    );
+}
+
+#[test]
+fn bad_sensor_statements_are_diagnostics() {
+    for (plan, code, span) in [
+        (
+            "sensors { top lazer }",
+            "insp::resolve::unknown_name",
+            "lazer",
+        ),
+        (
+            "sensors { tpo laser }",
+            "insp::resolve::unknown_name",
+            "tpo",
+        ),
+        (
+            "sensors { top laser, top touch }",
+            "insp::resolve::duplicate_name",
+            "top",
+        ),
+        ("sensor_ratio 0", "insp::resolve::out_of_range", "0"),
+    ] {
+        let d = check_src(&mixed(plan));
+        let e = d.only();
+        assert_eq!(
+            (e.code.as_str(), e.span_text.as_str()),
+            (code, span),
+            "{plan}"
+        );
+    }
+    let d = check_src(&mixed("sensors { top lazer }"));
+    assert!(d.only().help.contains("laser"), "{}", d.only().help);
+    // Laser on a machine without a scanner.
+    let src = mixed("sensors { top laser }").replace("    scanners [l1: LC60Dx]\n", "");
+    let d = check_src(&src);
+    let e = d.only();
+    assert_eq!(
+        (e.code.as_str(), e.span_text.as_str()),
+        ("insp::resolve::no_scanner", "laser")
+    );
+}
