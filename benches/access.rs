@@ -8,6 +8,12 @@
 //!
 //! `batch_cpu` and `batch_gpu` compare the two backends on the same batch of queries.
 //!
+//! `scanner` computes a laser line scanner's cones (LC15Dx optics on a fixed head: laser,
+//! camera, incidence, housing, head and ram) at 16 surface points; `scanner_exact_rays`
+//! is its plain baseline for the rays alone: `access::scan::sees` (two parry ray casts)
+//! at every pixel centre within the incidence limit; `scanner_rays` is the cone's share
+//! of that same work (a scanner without solid parts).
+//!
 //! Run with `cargo bench --bench access`.
 
 use inspc::access::{Backend, Cell, Component, Cpu, CubeMap, End, ProbeShape, Scene};
@@ -172,4 +178,116 @@ fn batch_gpu(bencher: divan::Bencher, case: (&str, u32)) {
             bencher.bench(|| 0);
         }
     }
+}
+
+/// 16 surface points (position, normal) spread over the fpoints, and an LC15Dx-like
+/// scanner on a fixed head.
+fn scan_case(
+    spec: &str,
+) -> (
+    Scene,
+    Vec<(P3, inspc::geometry::V3)>,
+    inspc::access::ScannerShape,
+) {
+    use inspc::access::scan::Optics;
+    let (checked, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[PathBuf::from(spec)]);
+    let g = &parts[graphs[0].part].as_ref().unwrap().geometry;
+    let fp = &graphs[0].graph.fpoints;
+    let pts = (0..POINTS)
+        .map(|k| {
+            let f = &fp[k * fp.len() / POINTS];
+            (f.position, f.normal)
+        })
+        .collect();
+    let _ = checked;
+    let flat = |name: &str, a: f64, b: f64, radius: f64| Component {
+        name: name.into(),
+        a,
+        b,
+        radius,
+        end: End::Flat,
+    };
+    let shape = inspc::access::ScannerShape {
+        optics: Optics {
+            standoff: 60.0,
+            depth: 15.0,
+            stripe: 18.0,
+            triangulation: 30f64.to_radians(),
+            max_incidence: 75f64.to_radians(),
+            spacing: [0.022, 0.022],
+        },
+        probe: ProbeShape {
+            name: "l1".into(),
+            tip_radius: 0.0,
+            first: vec![flat("housing", 60.0, 180.0, 30.0)],
+            second: vec![
+                flat("head", 180.0, 253.0, 31.0),
+                flat("ram", 253.0, f64::INFINITY, 35.0),
+            ],
+            head: inspc::access::Head::Fixed,
+        },
+    };
+    (Scene::of_part(g), pts, shape)
+}
+
+#[divan::bench(args = CASES)]
+fn scanner(bencher: divan::Bencher, (spec, n): (&str, u32)) {
+    let (scene, pts, shape) = scan_case(spec);
+    let opts = inspc::access::ConeOptions {
+        n,
+        ..Default::default()
+    };
+    bencher.bench(|| {
+        pts.iter()
+            .map(|(p, nrm)| {
+                inspc::access::scan_cones(&Cpu, &scene, divan::black_box(p), nrm, &shape, &opts)
+                    .visible
+                    .count()
+            })
+            .sum::<usize>()
+    });
+}
+
+#[divan::bench(args = CASES, sample_count = 3, sample_size = 1)]
+fn scanner_exact_rays(bencher: divan::Bencher, (spec, n): (&str, u32)) {
+    let (scene, pts, shape) = scan_case(spec);
+    let all = CubeMap::full(n, &[]);
+    let dirs: Vec<_> = all.cells().map(|c| all.direction(c)).collect();
+    bencher.bench(|| {
+        pts.iter()
+            .map(|(p, nrm)| {
+                dirs.iter()
+                    .filter(|d| {
+                        inspc::access::scan::sees(
+                            &scene,
+                            divan::black_box(p),
+                            nrm,
+                            d,
+                            &shape.optics,
+                        )
+                    })
+                    .count()
+            })
+            .sum::<usize>()
+    });
+}
+
+#[divan::bench(args = CASES)]
+fn scanner_rays(bencher: divan::Bencher, (spec, n): (&str, u32)) {
+    let (scene, pts, mut shape) = scan_case(spec);
+    shape.probe.first.clear();
+    shape.probe.second.clear();
+    let opts = inspc::access::ConeOptions {
+        n,
+        ..Default::default()
+    };
+    bencher.bench(|| {
+        pts.iter()
+            .map(|(p, nrm)| {
+                inspc::access::scan_cones(&Cpu, &scene, divan::black_box(p), nrm, &shape, &opts)
+                    .rays
+                    .count()
+            })
+            .sum::<usize>()
+    });
 }
