@@ -170,6 +170,21 @@ fn feature_faces(a: &Analysis, part: usize, feature: usize, o: &mut String) {
     let graph = deep.graphs.iter().find(|g| g.part == part);
     let part_name = &a.front.model.parts[part].name;
     let _ = writeln!(o);
+    // On a machine with a scanner: the sensor chosen and why.
+    let sensors = deep
+        .graphs
+        .iter()
+        .filter(|g| g.part == part)
+        .flat_map(|g| g.graph.sensors.iter().map(move |s| (g, s)))
+        .filter(|(_, s)| s.feature.0 == feature);
+    for (g, s) in sensors {
+        let word = match s.sensor {
+            crate::graph::sensors::Sensor::Touch => "touch",
+            crate::graph::sensors::Sensor::Laser(_) => "laser",
+        };
+        let plan = g.graph.plan.as_deref().unwrap_or("");
+        let _ = writeln!(o, "sensor in plan `{plan}`: **{word}** ({})\n", s.why);
+    }
     for id in data.feature_faces.get(feature).into_iter().flatten() {
         let f = &data.geometry.faces[id.0];
         let points = graph.map_or(0, |g| {

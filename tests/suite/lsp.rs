@@ -558,3 +558,31 @@ fn typing_during_a_plan_is_answered_and_a_new_save_stops_the_old_plan() {
     c.notify("exit", Value::Null);
     assert!(c.child.wait().unwrap().success());
 }
+
+#[test]
+fn a_features_hover_says_which_sensor_it_got_and_why() {
+    let dir = std::env::temp_dir().join(format!("inspc-lsp-sensor-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("mixed.insp");
+    std::fs::write(&path, crate::scan::mixed("")).unwrap();
+    let mut c = Client::start();
+    let (uri, text) = open(&mut c, &path);
+    let mut top = String::new();
+    for _ in 0..600 {
+        top = hover_text(&mut c, &uri, pos(&text, "feature top", 0, 9));
+        if top.contains("sensor in plan") {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(
+        top.contains("sensor in plan `q`: **laser** (flat 0.2 mm / 0.009 mm = 22.2 ≥ 10)"),
+        "{top}"
+    );
+    let bore = hover_text(&mut c, &uri, pos(&text, "feature bore", 0, 9));
+    assert!(
+        bore.contains("**touch** (a bore Ø8 mm, 20 mm deep"),
+        "{bore}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

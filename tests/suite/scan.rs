@@ -291,7 +291,7 @@ fn a_face_is_covered_by_few_views_of_parallel_passes() {
 
 /// A block with a flat top, a deep hole and a side face, on a machine with an LC60Dx
 /// (accuracy 9 µm); `plan` is the plan's body after its part and cmm.
-fn mixed(plan: &str) -> String {
+pub(crate) fn mixed(plan: &str) -> String {
     format!(
         r#"
 use std::heads::PH10MQ
