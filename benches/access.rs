@@ -190,7 +190,7 @@ fn scan_case(
     inspc::access::ScannerShape,
 ) {
     use inspc::access::scan::Optics;
-    let (checked, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[PathBuf::from(spec)]);
+    let (_, parts, graphs) = inspc::measurement_graphs(&FsWorld, &[PathBuf::from(spec)]);
     let g = &parts[graphs[0].part].as_ref().unwrap().geometry;
     let fp = &graphs[0].graph.fpoints;
     let pts = (0..POINTS)
@@ -199,7 +199,6 @@ fn scan_case(
             (f.position, f.normal)
         })
         .collect();
-    let _ = checked;
     let flat = |name: &str, a: f64, b: f64, radius: f64| Component {
         name: name.into(),
         a,
@@ -230,9 +229,14 @@ fn scan_case(
     (Scene::of_part(g), pts, shape)
 }
 
-#[divan::bench(args = CASES)]
-fn scanner(bencher: divan::Bencher, (spec, n): (&str, u32)) {
-    let (scene, pts, shape) = scan_case(spec);
+/// The scanner's cones at the case's points: the visible cones, or the rays alone (a
+/// scanner without solid parts).
+fn scan_run(bencher: divan::Bencher, (spec, n): (&str, u32), rays_only: bool) {
+    let (scene, pts, mut shape) = scan_case(spec);
+    if rays_only {
+        shape.probe.first.clear();
+        shape.probe.second.clear();
+    }
     let opts = inspc::access::ConeOptions {
         n,
         ..Default::default()
@@ -246,6 +250,11 @@ fn scanner(bencher: divan::Bencher, (spec, n): (&str, u32)) {
             })
             .sum::<usize>()
     });
+}
+
+#[divan::bench(args = CASES)]
+fn scanner(bencher: divan::Bencher, case: (&str, u32)) {
+    scan_run(bencher, case, false);
 }
 
 #[divan::bench(args = CASES, sample_count = 3, sample_size = 1)]
@@ -273,21 +282,6 @@ fn scanner_exact_rays(bencher: divan::Bencher, (spec, n): (&str, u32)) {
 }
 
 #[divan::bench(args = CASES)]
-fn scanner_rays(bencher: divan::Bencher, (spec, n): (&str, u32)) {
-    let (scene, pts, mut shape) = scan_case(spec);
-    shape.probe.first.clear();
-    shape.probe.second.clear();
-    let opts = inspc::access::ConeOptions {
-        n,
-        ..Default::default()
-    };
-    bencher.bench(|| {
-        pts.iter()
-            .map(|(p, nrm)| {
-                inspc::access::scan_cones(&Cpu, &scene, divan::black_box(p), nrm, &shape, &opts)
-                    .rays
-                    .count()
-            })
-            .sum::<usize>()
-    });
+fn scanner_rays(bencher: divan::Bencher, case: (&str, u32)) {
+    scan_run(bencher, case, true);
 }

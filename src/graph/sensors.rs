@@ -100,8 +100,8 @@ pub fn select(
     out
 }
 
-/// Why a feature is a bore the scanner cannot see into: a hole's wall (inner cylinder or
-/// cone) at least as deep as its radius.
+/// Why a feature is a bore the scanner cannot see into: a hole's wall (an inner
+/// cylinder) at least as deep as its radius.
 fn deep_bore(g: &PartGeometry, faces: &[FaceId]) -> Option<String> {
     for face in faces {
         let f = &g.faces[face.0];
