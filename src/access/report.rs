@@ -81,8 +81,7 @@ pub fn cone_report(
     let plan = input.plan;
     if let (Some(plan), Some(label)) = (plan, &req.probe) {
         let cmm = &model.cmms[plan.cmm.0];
-        if let Some(k) = cmm.scanners.iter().position(|(l, _)| l == label) {
-            let (l, id) = &cmm.scanners[k];
+        if let Some((l, id)) = cmm.scanners.iter().find(|(l, _)| l == label) {
             let shape = ScannerShape::new(model, cmm, l, &model.scanners[id.0]);
             return Some(scanner_report(input, req, f, chosen.len(), &shape));
         }
@@ -124,22 +123,7 @@ pub fn cone_report(
     let scene = Scene::of_part(g);
     let n = req.n;
     let prefs = axes();
-    let total = 6 * (n as usize) * (n as usize) + prefs.len();
-    let pct = |c: &CubeMap| format!("{:5.1} %", 100.0 * c.count() as f64 / total as f64);
-    let v = |x: &V3| format!("({}, {}, {})", fmt_num(x.x), fmt_num(x.y), fmt_num(x.z));
-    let p3 = |x: &P3| v(&x.coords);
-    let mut text = String::new();
-    let face = &g.faces[f.face.0];
-    let _ = writeln!(
-        text,
-        "fpoint {} of {} on face {} ({}): at {}, normal {}",
-        req.point,
-        chosen.len(),
-        face.name,
-        face.surface.kind().keyword(),
-        p3(&f.position),
-        v(&f.normal)
-    );
+    let mut text = fpoint_line(g, req, f, chosen.len());
     let _ = writeln!(
         text,
         "part {}: {} triangles, {}",
@@ -151,14 +135,11 @@ pub fn cone_report(
             "open (no back-face culling)"
         }
     );
-    let _ = writeln!(
-        text,
-        "cube map N = {n}: {total} cells (pixels and 6 axes); free share:"
-    );
+    text.push_str(&cells_line(n, &prefs));
     let r = probe.as_ref().map_or(1.0, |p| p.tip_radius);
     let c = f.tip_centre(r);
     let half = gac_halfline(&scene, &c, n, &prefs);
-    let _ = writeln!(text, "  half-line at the tip centre      {}", pct(&half));
+    let _ = writeln!(text, "  half-line at the tip centre      {}", share(&half));
     let drawn = match &probe {
         None => half,
         Some(probe) => {
@@ -186,7 +167,7 @@ pub fn cone_report(
                     text,
                     "  {:<32} {}",
                     format!("{} (r {} mm)", comp.name, fmt_num(comp.radius)),
-                    pct(&cone)
+                    share(&cone)
                 );
             }
             let opts = ConeOptions {
@@ -199,7 +180,7 @@ pub fn cone_report(
                 Head::Indexable => "D1, approach and retract",
                 Head::Fixed => "probe, approach and retract",
             };
-            let _ = writeln!(text, "  {what:<32} {}", pct(&cones.approach));
+            let _ = writeln!(text, "  {what:<32} {}", share(&cones.approach));
             let axes_free: Vec<&str> = ["+x", "-x", "+y", "-y", "+z", "-z"]
                 .into_iter()
                 .enumerate()
@@ -216,7 +197,7 @@ pub fn cone_report(
                 }
             );
             if let Some(d2) = &cones.d2 {
-                let _ = writeln!(text, "  D2 (setup directions)           {}", pct(d2));
+                let _ = writeln!(text, "  D2 (setup directions)           {}", share(d2));
                 let cmm = &model.cmms[plan.map(|p| p.cmm.0).unwrap_or(0)];
                 let grid = model.heads[cmm.head.0].orientations();
                 let inside = orientations_in(&cones.approach, &grid);
@@ -249,21 +230,9 @@ fn scanner_report(
     let scene = Scene::of_part(g);
     let n = req.n;
     let prefs = axes();
-    let total = 6 * (n as usize) * (n as usize) + prefs.len();
-    let pct = |c: &CubeMap| format!("{:5.1} %", 100.0 * c.count() as f64 / total as f64);
-    let v = |x: &V3| format!("({}, {}, {})", fmt_num(x.x), fmt_num(x.y), fmt_num(x.z));
     let face = &g.faces[f.face.0];
     let o = &shape.optics;
-    let mut text = String::new();
-    let _ = writeln!(
-        text,
-        "fpoint {} of {of} on face {} ({}): at {}, normal {}",
-        req.point,
-        face.name,
-        face.surface.kind().keyword(),
-        v(&f.position.coords),
-        v(&f.normal)
-    );
+    let mut text = fpoint_line(g, req, f, of);
     let _ = writeln!(
         text,
         "scanner {}: stripe {} mm at stand-off {} ± {} mm, triangulation {}°, incidence ≤ {}°",
@@ -274,10 +243,7 @@ fn scanner_report(
         fmt_num(o.triangulation.to_degrees()),
         fmt_num(o.max_incidence.to_degrees())
     );
-    let _ = writeln!(
-        text,
-        "cube map N = {n}: {total} cells (pixels and 6 axes); free share:"
-    );
+    text.push_str(&cells_line(n, &prefs));
     let opts = ConeOptions {
         n,
         preferred: prefs.clone(),
@@ -285,22 +251,28 @@ fn scanner_report(
     };
     let cones = scan_cones(&Cpu, &scene, &f.position, &f.normal, shape, &opts);
     let within = cones.rays.cap(&f.normal, o.max_incidence.cos());
-    let _ = writeln!(text, "  within the incidence limit       {}", pct(&within));
+    let _ = writeln!(
+        text,
+        "  within the incidence limit       {}",
+        share(&within)
+    );
     let _ = writeln!(
         text,
         "  laser and camera reach the point {}",
-        pct(&cones.rays)
+        share(&cones.rays)
     );
     let what = match shape.probe.head {
         Head::Indexable => "housing clear (D1)",
         Head::Fixed => "housing, head and ram clear",
     };
-    let _ = writeln!(text, "  {what:<32} {}", pct(&cones.visible));
+    let _ = writeln!(text, "  {what:<32} {}", share(&cones.visible));
+    // The head's orientations; none for a fixed head or without a plan.
+    let grid = input.plan.map_or(Vec::new(), |plan| {
+        input.model.heads[input.model.cmms[plan.cmm.0].head.0].orientations()
+    });
     if let Some(d2) = &cones.d2 {
-        let _ = writeln!(text, "  D2 (setup directions)           {}", pct(d2));
-        if let Some(plan) = input.plan {
-            let cmm = &input.model.cmms[plan.cmm.0];
-            let grid = input.model.heads[cmm.head.0].orientations();
+        let _ = writeln!(text, "  D2 (setup directions)           {}", share(d2));
+        if !grid.is_empty() {
             let inside = orientations_in(&cones.visible, &grid);
             let _ = writeln!(
                 text,
@@ -311,10 +283,6 @@ fn scanner_report(
         }
     }
     if req.face.is_some() {
-        let grid = match input.plan {
-            Some(plan) => input.model.heads[input.model.cmms[plan.cmm.0].head.0].orientations(),
-            None => Vec::new(),
-        };
         let grid = if grid.is_empty() {
             vec![(0.0, 0.0)]
         } else {
@@ -358,6 +326,32 @@ fn scanner_report(
         text,
         pgm: pgm(&cones.visible),
     }
+}
+
+/// A report's first line: which fpoint, where, its normal.
+fn fpoint_line(g: &PartGeometry, req: &ConeRequest, f: &Fpoint, of: usize) -> String {
+    let v = |x: &V3| format!("({}, {}, {})", fmt_num(x.x), fmt_num(x.y), fmt_num(x.z));
+    let face = &g.faces[f.face.0];
+    format!(
+        "fpoint {} of {of} on face {} ({}): at {}, normal {}\n",
+        req.point,
+        face.name,
+        face.surface.kind().keyword(),
+        v(&f.position.coords),
+        v(&f.normal)
+    )
+}
+
+/// The line that introduces the shares: the resolution and the cells counted.
+fn cells_line(n: u32, preferred: &[V3]) -> String {
+    let total = 6 * (n as usize) * (n as usize) + preferred.len();
+    format!("cube map N = {n}: {total} cells (pixels and 6 axes); free share:\n")
+}
+
+/// The share of a cone's cells that are free, as the reports print it.
+fn share(c: &CubeMap) -> String {
+    let total = 6 * (c.n() as usize) * (c.n() as usize) + c.preferred_len();
+    format!("{:5.1} %", 100.0 * c.count() as f64 / total as f64)
 }
 
 /// The cone as a binary PGM: free white, blocked black, the unused corners of the cross

@@ -45,7 +45,7 @@ fn label(part: &Part, g: &PartGeometry, mg: &MeasurementGraph, n: NodeIndex) -> 
                 l.push(format!("datum {}", datums.join(", ")));
             }
             if let Some(s) = mg.sensors.iter().find(|s| s.feature == *feature) {
-                l.push(sensor_word(s).into());
+                l.push(s.sensor.word().into());
             }
             l
         }
@@ -188,7 +188,7 @@ pub fn json(part: &Part, g: &PartGeometry, mg: &MeasurementGraph) -> serde_json:
                     .any(|p| p != mg.root);
                 let mut f = json!({ "name": part.features[feature.0].name, "datums": datums, "toleranced": toleranced, "faces": named(Edge::Face) });
                 if let Some(s) = mg.sensors.iter().find(|s| s.feature == *feature) {
-                    f["sensor"] = json!(sensor_word(s));
+                    f["sensor"] = json!(s.sensor.word());
                     f["sensor_why"] = json!(s.why);
                 }
                 features.push(f);
@@ -218,12 +218,4 @@ pub fn json(part: &Part, g: &PartGeometry, mg: &MeasurementGraph) -> serde_json:
         "features": features,
         "faces": faces,
     })
-}
-
-/// A feature's sensor as the graph shows it.
-fn sensor_word(s: &super::sensors::SensorPick) -> &'static str {
-    match s.sensor {
-        super::sensors::Sensor::Touch => "touch",
-        super::sensors::Sensor::Laser(_) => "laser",
-    }
 }

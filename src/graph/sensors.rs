@@ -17,6 +17,16 @@ pub enum Sensor {
     Laser(usize),
 }
 
+impl Sensor {
+    /// The sensor's word, as the plan's `sensors { … }` spells it.
+    pub fn word(self) -> &'static str {
+        match self {
+            Sensor::Touch => "touch",
+            Sensor::Laser(_) => "laser",
+        }
+    }
+}
+
 /// One feature's sensor and the reason, in words for the plan's reader.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SensorPick {

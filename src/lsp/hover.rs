@@ -178,11 +178,8 @@ fn feature_faces(a: &Analysis, part: usize, feature: usize, o: &mut String) {
         .flat_map(|g| g.graph.sensors.iter().map(move |s| (g, s)))
         .filter(|(_, s)| s.feature.0 == feature);
     for (g, s) in sensors {
-        let word = match s.sensor {
-            crate::graph::sensors::Sensor::Touch => "touch",
-            crate::graph::sensors::Sensor::Laser(_) => "laser",
-        };
         let plan = g.graph.plan.as_deref().unwrap_or("");
+        let word = s.sensor.word();
         let _ = writeln!(o, "sensor in plan `{plan}`: **{word}** ({})\n", s.why);
     }
     for id in data.feature_faces.get(feature).into_iter().flatten() {
