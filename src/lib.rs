@@ -329,30 +329,6 @@ fn plan_each(
         if !plan::check_machine(model, &model.plans[k], &data.geometry, &mut diags) {
             continue;
         }
-        let cmm = &model.cmms[model.plans[k].cmm.0];
-        if let (Some((label, _)), Some(&span)) = (cmm.scanners.first(), cmm.scanner_labels.first())
-        {
-            let part = &model.parts[g.part];
-            let chosen: Vec<String> = g
-                .graph
-                .sensors
-                .iter()
-                .filter(|s| matches!(s.sensor, graph::sensors::Sensor::Laser(_)))
-                .map(|s| format!("`{}` ({})", part.features[s.feature.0].name, s.why))
-                .collect();
-            let chosen = if chosen.is_empty() {
-                "no feature chose it".to_string()
-            } else {
-                format!("chosen for {}", chosen.join(", "))
-            };
-            diags.push(plan::PlanError::ScannerNotPlanned {
-                span,
-                plan: name.clone(),
-                scanner: label.clone(),
-                cmm: cmm.name.clone(),
-                chosen,
-            });
-        }
         let input = plan::Input {
             model,
             plan: &model.plans[k],

@@ -508,6 +508,12 @@ impl<'a> Pose<'a> {
         self.sweep_fixture(c, &(c + n * travel), 0.0)
     }
 
+    /// Whether the probe standing with its tip centre at `p`, grown by the margin there,
+    /// clears the fixture (the part and the table not asked).
+    pub fn clear_of_fixture(&self, p: &P3) -> bool {
+        self.sweep_fixture(p, p, self.margin_at(p)).is_ok()
+    }
+
     /// Whether the probe, grown by `grow`, meets the fixture anywhere on the move from
     /// tip centre `p` to `q`.
     fn sweep_fixture(&self, p: &P3, q: &P3, grow: f64) -> Result<(), Blocker> {
@@ -542,8 +548,9 @@ impl<'a> Pose<'a> {
     /// Every shape is grown by `margin`, and the table kept at least that far.
     pub fn segment_with(&self, p: &P3, q: &P3, margin: f64) -> Result<(), Blocker> {
         let table = self.table + TABLE_MARGIN.max(margin);
+        // A scanner has no tip: the point it moves by is the focus of its optics.
         let lo = p.coords.dot(&self.up).min(q.coords.dot(&self.up)) - self.tip_radius;
-        if lo < table {
+        if self.tip_radius > 0.0 && lo < table {
             return Err(Blocker::TipOnTable);
         }
         for part in &self.parts {
@@ -572,7 +579,7 @@ impl<'a> Pose<'a> {
     ) -> Result<(), Blocker> {
         let v = q - p;
         let moving = v.norm() > 1e-9;
-        if hits(&Capsule::new(*p, *q, self.tip_radius + grow)) {
+        if self.tip_radius > 0.0 && hits(&Capsule::new(*p, *q, self.tip_radius + grow)) {
             return Err(Blocker::Tip);
         }
         let far = 4.0 * self.scene.size + 10.0;

@@ -290,6 +290,9 @@ fn scanner_report(
         };
         let overlap = 0.2;
         let views = scan::Views {
+            up: crate::geometry::V3::z(),
+            table: (f64::NEG_INFINITY, 0.0),
+            fixture: &[],
             grid: &grid,
             overlap,
         };

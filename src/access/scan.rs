@@ -20,6 +20,7 @@ use super::probe::{second_components, Component, End, ProbeShape};
 use super::{d2, gac, Backend, ConeOptions, CubeMap};
 use crate::geometry::{P3, V3};
 use crate::model::{Cmm, Model, Scanner};
+use rayon::prelude::*;
 
 /// How far above the surface a scanned point's rays start (mm): past the mesh's chordal
 /// error (0.05 mm), so a concave face's own facets do not block its points.
@@ -208,14 +209,28 @@ pub struct View {
     pub a: f64,
     /// B angle (degrees).
     pub b: f64,
+    /// The scanner's direction in the part frame: from the surface towards the scanner.
+    pub dir: V3,
     /// The share of the face's area this view adds.
     pub share: f64,
-    /// Parallel passes of the stripe (Zhao et al. eq. 15).
+    /// Parallel passes of the stripe (Zhao et al. eq. 15), one per strip and elevation.
     pub passes: usize,
-    /// How long each pass is (mm).
+    /// How long the longest pass is (mm).
     pub length: f64,
     /// Heights of the scanner along the view for the depth of field (Zhao et al. 5.2).
     pub elevations: usize,
+    /// The passes: the line the middle of the depth of field runs along, part frame.
+    pub lines: Vec<Pass>,
+}
+
+/// One pass of the stripe: the middle of the depth of field runs from `start` to `end`
+/// (part frame), the stripe square to the motion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pass {
+    /// Where the pass starts.
+    pub start: P3,
+    /// Where it ends.
+    pub end: P3,
 }
 
 /// Where a face may be scanned from and how passes lie.
@@ -225,6 +240,14 @@ pub struct Views<'a> {
     pub grid: &'a [(f64, f64)],
     /// The share of a stripe's width neighbouring passes overlap.
     pub overlap: f64,
+    /// The setup: the part direction facing the ram (`+z` for the part in its own
+    /// frame).
+    pub up: V3,
+    /// The table's height along `up` and the margin the housing keeps above it and
+    /// from the fixture (`f64::NEG_INFINITY` for no table).
+    pub table: (f64, f64),
+    /// The fixture holding the part in this setup (part frame).
+    pub fixture: &'a [super::pose::Solid],
 }
 
 /// How a scanner covers one face from a head's orientations (Zhao et al. 5.1–5.3),
@@ -279,7 +302,7 @@ fn face_samples(g: &crate::geometry::PartGeometry, face: usize) -> Vec<(P3, V3, 
 }
 
 /// The coverage of `face` by a scanner from the head orientations of `views` (one (0, 0)
-/// for a fixed head), the part standing in its own frame with +z up. Per sample, the
+/// for a fixed head), the part standing with `views.up` facing the ram. Per sample, the
 /// orientations whose direction the scanner's cone sees it from and whose head and ram
 /// clear the part; then a greedy cover by area until a view would add less than 1 % of
 /// it, taking among the views within 1 % of the best gain the one nearest the mean
@@ -299,13 +322,19 @@ pub fn face_coverage(
     let (grid, overlap) = (views.grid, views.overlap);
     let samples = face_samples(g, face);
     let area: f64 = samples.iter().map(|s| s.2).sum();
-    let dirs: Vec<V3> = grid
-        .iter()
-        .map(|&(a, b)| super::head_direction(a, b))
-        .collect();
+    // How far apart the samples lie.
+    let spacing = (2.0 * area / FACE_SAMPLES as f64).sqrt();
+    let up = views.up;
+    let dirs: Vec<V3> = match scanner.probe.head {
+        super::pose::Head::Indexable => grid
+            .iter()
+            .map(|&(a, b)| super::pose::orientation_dir(&up, a, b))
+            .collect(),
+        super::pose::Head::Fixed => vec![up; grid.len()],
+    };
     let reach = scanner.probe.reach();
     // The head and ram hang straight down from the articulation point: one depth map
-    // along +z answers for every sample and orientation.
+    // along `up` answers for every sample and orientation.
     let second = scanner.probe.head.indexable().then(|| {
         let radius = scanner
             .probe
@@ -313,17 +342,47 @@ pub fn face_coverage(
             .iter()
             .map(|c| c.radius)
             .fold(0.0, f64::max);
-        super::SecondMap::new(scene, &V3::z(), radius, reach)
+        super::SecondMap::new(scene, &up, radius, reach)
     });
-    let sees_from: Vec<Vec<bool>> = samples
+    // D2 is not asked: the depth map above decides the head and ram per orientation.
+    let opts = ConeOptions {
+        d2_samples: 0,
+        ..opts.clone()
+    };
+    // The housing keeps off the table wherever in the depth of field a pass puts the
+    // focus: checked with the focus half the depth nearer the table.
+    let (table, margin) = views.table;
+    let off_table = |p: &P3, d: &V3| {
+        let c = p - d * (scanner.optics.depth / 2.0);
+        scanner
+            .probe
+            .first
+            .iter()
+            .all(|comp| super::pose::lowest(comp, &c, d, &up) >= table + margin)
+    };
+    // The fixture, per direction: the scanner posed with its focus at the sample.
+    let held: Vec<Option<super::pose::Pose>> = dirs
         .iter()
+        .map(|d| {
+            (!views.fixture.is_empty()).then(|| {
+                super::pose::Pose::new(scene, &scanner.probe, *d, up, table)
+                    .with_fixture(views.fixture)
+                    .with_margin(margin)
+            })
+        })
+        .collect();
+    let sees_from: Vec<Vec<bool>> = samples
+        .par_iter()
         .map(|(p, n, _)| {
-            let cones = scan_cones(backend, scene, p, n, scanner, opts);
+            let cones = scan_cones(backend, scene, p, n, scanner, &opts);
             let from = p + n * LIFT;
             dirs.iter()
-                .map(|d| {
+                .zip(&held)
+                .map(|(d, pose)| {
                     cones.visible.contains(d)
+                        && off_table(p, d)
                         && second.as_ref().is_none_or(|m| m.clear(&(from + d * reach)))
+                        && pose.as_ref().is_none_or(|x| x.clear_of_fixture(p))
                 })
                 .collect()
         })
@@ -358,23 +417,27 @@ pub fn face_coverage(
                 j = k;
             }
         }
-        let best = (gains[j], j);
         let mine: Vec<usize> = (0..samples.len())
             .filter(|&i| left[i] && sees_from[i][j])
             .collect();
         for &i in &mine {
             left[i] = false;
         }
-        covered += best.0;
+        covered += gains[j];
         let pts: Vec<P3> = mine.iter().map(|&i| samples[i].0).collect();
-        let (passes, length, elevations) = passes(&pts, &dirs[j], &scanner.optics, overlap);
+        let (lines, elevations) = passes(&pts, &dirs[j], &scanner.optics, overlap, spacing / 2.0);
         views.push(View {
             a: grid[j].0,
             b: grid[j].1,
-            share: best.0 / area,
-            passes,
-            length,
+            dir: dirs[j],
+            share: gains[j] / area,
+            passes: lines.len(),
+            length: lines
+                .iter()
+                .map(|l| (l.end - l.start).norm())
+                .fold(0.0, f64::max),
             elevations,
+            lines,
         });
     }
     FaceCoverage {
@@ -385,45 +448,87 @@ pub fn face_coverage(
     }
 }
 
-/// The passes over points seen along `d`: (passes, length of each, elevations).
-fn passes(pts: &[P3], d: &V3, optics: &Optics, overlap: f64) -> (usize, f64, usize) {
+/// The passes over points seen along `d`, and how many elevations they take. The
+/// motion runs along whichever of 12 directions (15° apart) square to `d` makes the
+/// strips' total length least, each strip charged a stand-off more for its way in and
+/// out; the strips are the stripe's width less the overlap apart; the depth of field
+/// cuts the points into elevations from the highest down. Each (elevation, strip)
+/// holding points is one pass, from its first point to its last along the motion
+/// lengthened by `pad` at both ends (the samples' spacing: a sample stands for the area
+/// around it), its focus midway between its nearest and farthest points along `d`.
+fn passes(pts: &[P3], d: &V3, optics: &Optics, overlap: f64, pad: f64) -> (Vec<Pass>, usize) {
     let e1 = if d.x.abs() < 0.9 { V3::x() } else { V3::y() };
     let e1 = (e1 - d * d.dot(&e1)).normalize();
     let e2 = d.cross(&e1);
     let width = optics.stripe * (1.0 - overlap);
-    let mut best = (usize::MAX, 0.0, f64::INFINITY);
+    let range = |v: &V3| {
+        pts.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                let x = p.coords.dot(v);
+                (lo.min(x), hi.max(x))
+            })
+    };
+    let mut best = (V3::x(), f64::INFINITY);
     for k in 0..12 {
         let t = (k as f64 * 15.0).to_radians();
         let m = e1 * t.cos() + e2 * t.sin();
         let across = d.cross(&m);
-        let extent = |v: &V3| {
-            let (lo, hi) = pts
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                    let x = p.coords.dot(v);
-                    (lo.min(x), hi.max(x))
-                });
-            (hi - lo).max(0.0)
-        };
-        let (length, w) = (extent(&m), extent(&across));
-        let n = ((w / width).ceil() as usize).max(1);
-        let total = n as f64 * length;
-        if total < best.2 - 1e-9 {
-            best = (n, length, total);
+        let ((lo, hi), (alo, ahi)) = (range(&m), range(&across));
+        let n = (((ahi - alo).max(0.0) / width).ceil()).max(1.0);
+        // Each pass also costs its way in and out: about a stand-off.
+        let total = n * ((hi - lo).max(0.0) + optics.standoff);
+        if total < best.1 - 1e-9 {
+            best = (m, total);
         }
     }
-    // Elevations: from the highest point down, a new one wherever the depth of field ends.
+    let m = best.0;
+    let across = d.cross(&m);
+    // Elevations: from the highest point down, a new one wherever the depth of field
+    // ends; each keeps the height of its first (highest) point.
     let mut depth: Vec<f64> = pts.iter().map(|p| p.coords.dot(d)).collect();
     depth.sort_by(|a, b| b.total_cmp(a));
-    let mut elevations = 0;
-    let mut top = f64::INFINITY;
+    let mut tops: Vec<f64> = Vec::new();
     for x in depth {
-        if elevations == 0 || top - x > optics.depth {
-            elevations += 1;
-            top = x;
+        if tops.last().is_none_or(|t| t - x > optics.depth) {
+            tops.push(x);
         }
     }
-    (best.0, best.1, elevations)
+    let (alo, ahi) = range(&across);
+    let strips = (((ahi - alo).max(0.0) / width).ceil() as usize).max(1);
+    // A strip centred on the points it holds: the first strip's edge on the first point.
+    let spare = strips as f64 * width - (ahi - alo).max(0.0);
+    let a0 = alo - spare / 2.0;
+    let mut lines = Vec::new();
+    for &top in &tops {
+        for s in 0..strips {
+            let (lo, hi) = (a0 + s as f64 * width, a0 + (s + 1) as f64 * width);
+            let mine: Vec<&P3> = pts
+                .iter()
+                .filter(|p| {
+                    let (x, h) = (p.coords.dot(&across), p.coords.dot(d));
+                    x >= lo - 1e-9 && x <= hi + 1e-9 && h <= top + 1e-9 && h > top - optics.depth
+                })
+                .collect();
+            if mine.is_empty() {
+                continue;
+            }
+            let span = |v: &V3| {
+                mine.iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                        let x = p.coords.dot(v);
+                        (a.min(x), b.max(x))
+                    })
+            };
+            let (along, height) = (span(&m), span(d));
+            let mid = (height.0 + height.1) / 2.0;
+            let at = |t: f64| P3::from(m * t + across * ((lo + hi) / 2.0) + d * mid);
+            lines.push(Pass {
+                start: at(along.0 - pad),
+                end: at(along.1 + pad),
+            });
+        }
+    }
+    (lines, tops.len())
 }
 
 #[cfg(test)]

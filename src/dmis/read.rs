@@ -159,7 +159,7 @@ crate::located!(DmisError {
 });
 
 /// Statements that may appear between `MEAS` and `ENDMES`.
-const IN_MEAS: &[&str] = &["GOTO", "PTMEAS"];
+const IN_MEAS: &[&str] = &["GOTO", "PTMEAS", "PAMEAS"];
 
 /// Parses and checks a program (the text of `file`); every problem found, in text order.
 pub fn read(file: FileId, text: &str) -> Result<Program, Vec<DmisError>> {
@@ -392,9 +392,17 @@ fn check(statements: &[Statement], text: &str, file: FileId, errors: &mut Vec<Dm
                 "MEAS inside a MEAS block",
                 "close the block with ENDMES first",
             )),
-            ("PTMEAS", Some(m)) => m.2 += 1,
+            ("PTMEAS", Some(m)) => m.2 = m.2.saturating_add(1),
+            // A block that scans announces the cloud's size, which DMIS leaves to the
+            // machine: its count is not checked.
+            ("PAMEAS", Some(m)) => m.2 = usize::MAX,
+            ("PAMEAS", None) => errors.push(structure(
+                *at,
+                "PAMEAS outside a MEAS block",
+                "put scan passes between MEAS and ENDMES",
+            )),
             ("ENDMES", Some((start, n, got))) => {
-                if n != got {
+                if *got != usize::MAX && n != got {
                     errors.push(structure(
                         *start,
                         &format!("MEAS announces {n} points but takes {got}"),
@@ -411,7 +419,7 @@ fn check(statements: &[Statement], text: &str, file: FileId, errors: &mut Vec<Dm
             (m, Some(_)) if !IN_MEAS.contains(&m) => errors.push(structure(
                 *at,
                 &format!("{m} inside a MEAS block"),
-                "only GOTO and PTMEAS belong between MEAS and ENDMES",
+                "only GOTO, PTMEAS and PAMEAS belong between MEAS and ENDMES",
             )),
             ("PTMEAS", None) => errors.push(structure(
                 *at,

@@ -360,19 +360,26 @@ impl Writer<'_> {
     }
 
     /// One sensor per probe (per probe and A/B on an indexable head), in order of first
-    /// use.
+    /// use. A laser scanner is `SNSDEF/LASER` in the form of a probe's, its stand-off in
+    /// the length's place and its stripe's width in the diameter's (see ARCHITECTURE,
+    /// "Scans in DMIS").
     fn sensor_definitions(&mut self) {
         let input = self.input;
         let cmm = &input.model.cmms[input.plan.cmm.0];
         let probes = crate::access::ProbeShape::of_cmm(input.model, cmm);
+        let scanners = crate::access::scan::ScannerShape::of_cmm(input.model, cmm);
         self.o.comment("sensors");
         for g in input.llip.setups.iter().flat_map(|s| &s.groups) {
             let key = sensor_key(g);
             if self.sensors.contains_key(&key) {
                 continue;
             }
-            let Some(probe) = probes.get(g.probe.0) else {
-                continue;
+            let (kind, len, diam) = match probes.get(g.probe.0) {
+                Some(p) => ("PROBE", num(p.reach()), num(2.0 * p.tip_radius)),
+                None => match scanners.get(g.probe.0 - probes.len()) {
+                    Some(s) => ("LASER", num(s.optics.standoff), num(s.optics.stripe)),
+                    None => continue,
+                },
             };
             let label_text = self.names.probe(g.probe);
             let name = if self.indexable() {
@@ -383,19 +390,17 @@ impl Writer<'_> {
                 label_text.to_string()
             };
             let label = self.labels.fresh("S", &name);
-            let diam = num(2.0 * probe.tip_radius);
-            let len = num(probe.reach());
             if self.indexable() {
                 let d = crate::access::head_direction(g.a, g.b);
                 self.o.stmt(&format!(
-                    "S({label})=SNSDEF/PROBE,INDEX,POL,{},{},VEC,{},{len},{diam}",
+                    "S({label})=SNSDEF/{kind},INDEX,POL,{},{},VEC,{},{len},{diam}",
                     num(g.a),
                     num(g.b),
                     ijk(&d)
                 ));
             } else {
                 self.o.stmt(&format!(
-                    "S({label})=SNSDEF/PROBE,FIXED,CART,0,0,-{len},0,0,1,{diam}"
+                    "S({label})=SNSDEF/{kind},FIXED,CART,0,0,-{len},0,0,1,{diam}"
                 ));
             }
             self.sensors.insert(key, label);
@@ -499,6 +504,17 @@ impl Writer<'_> {
                 for k in keys {
                     self.feats.insert(*k, (full.clone(), id, r));
                     if keys.len() == 1 {
+                        continue;
+                    }
+                    // A scanned block of a surface scanned from several views measures
+                    // the surface itself: the best fit joins the views' clouds.
+                    if !block(k).passes.is_empty() {
+                        n += 1;
+                        let label = self.labels.fresh("F", &format!("{name}_S{n}"));
+                        self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
+                        self.nominals.insert(label.clone(), nominal.clone());
+                        self.points.insert((*k, usize::MAX), label.clone());
+                        partials.push(label);
                         continue;
                     }
                     for (ti, t) in block(k).touches.iter().enumerate() {
@@ -830,38 +846,47 @@ impl Writer<'_> {
             let meas = self.nominals.get(&label).map_or("PLANE", Nominal::meas);
             // A narrow block approaches and retracts by its own, shorter stand-off.
             let narrow = b.standoff < motion.prehit.max(motion.retract) - 1e-9;
-            let o = &mut self.o;
-            if narrow {
-                o.stmt(&format!("SNSET/APPRCH,{}", num(b.standoff)));
-                o.stmt(&format!("SNSET/RETRCT,{}", num(b.standoff)));
-            }
             let joined = !self.surfs[surf].rounds[round].partials.is_empty();
-            if !joined {
-                o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
-            }
-            for (ti, t) in b.touches.iter().enumerate() {
-                if joined {
-                    let point = &self.points[&((si, gi, bi), ti)];
-                    o.stmt(&format!("MEAS/POINT,F({point}),1"));
+            if !b.passes.is_empty() {
+                let target = if joined {
+                    self.points[&((si, gi, bi), usize::MAX)].clone()
+                } else {
+                    label.clone()
+                };
+                self.scan(g, b, &target, meas);
+            } else {
+                let o = &mut self.o;
+                if narrow {
+                    o.stmt(&format!("SNSET/APPRCH,{}", num(b.standoff)));
+                    o.stmt(&format!("SNSET/RETRCT,{}", num(b.standoff)));
                 }
-                for v in &t.via {
-                    o.goto(v);
+                if !joined {
+                    o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
                 }
-                o.goto(&t.standoff);
-                ptmeas(o, hlip, t.point);
-                if !narrow && motion.retract < motion.prehit {
+                for (ti, t) in b.touches.iter().enumerate() {
+                    if joined {
+                        let point = &self.points[&((si, gi, bi), ti)];
+                        o.stmt(&format!("MEAS/POINT,F({point}),1"));
+                    }
+                    for v in &t.via {
+                        o.goto(v);
+                    }
                     o.goto(&t.standoff);
+                    ptmeas(o, hlip, t.point);
+                    if !narrow && motion.retract < motion.prehit {
+                        o.goto(&t.standoff);
+                    }
+                    if joined {
+                        o.stmt("ENDMES");
+                    }
                 }
-                if joined {
+                if !joined {
                     o.stmt("ENDMES");
                 }
-            }
-            if !joined {
-                o.stmt("ENDMES");
-            }
-            if narrow {
-                o.stmt(&format!("SNSET/APPRCH,{}", num(motion.prehit)));
-                o.stmt(&format!("SNSET/RETRCT,{}", num(motion.retract)));
+                if narrow {
+                    o.stmt(&format!("SNSET/APPRCH,{}", num(motion.prehit)));
+                    o.stmt(&format!("SNSET/RETRCT,{}", num(motion.retract)));
+                }
             }
             // The last block of a round in points joins them into the whole.
             let s = &self.surfs[surf];
@@ -1041,6 +1066,48 @@ impl Writer<'_> {
         }
     }
 
+    /// A scanned block: one `PATH/LINE` per pass (start, end, and the scanner's direction
+    /// from the surface), then the `MEAS` of feature `target` running each pass with
+    /// `PAMEAS` after the moves to its start. The point count is the cloud's at the
+    /// scanner's spacing.
+    fn scan(&mut self, g: &GroupPath, b: &BlockPath, target: &str, meas: &str) {
+        let input = self.input;
+        let cmm = &input.model.cmms[input.plan.cmm.0];
+        let probes = cmm.probes.len();
+        let optics = crate::access::scan::ScannerShape::of_cmm(input.model, cmm)
+            .get(g.probe.0 - probes)
+            .map(|s| s.optics);
+        let dir = V3::from(g.direction);
+        let mut paths = Vec::new();
+        let mut count = 0.0;
+        for (k, p) in b.passes.iter().enumerate() {
+            let label = self.labels.fresh("P", &format!("{target}_{}", k + 1));
+            let (s, e) = (P3::from(p.start), P3::from(p.end));
+            self.o.stmt(&format!(
+                "P({label})=PATH/LINE,CART,{},{},{}",
+                xyz(&s),
+                xyz(&e),
+                ijk(&dir)
+            ));
+            if let Some(o) = optics {
+                count +=
+                    ((e - s).norm() / o.spacing[1]).floor() * (o.stripe / o.spacing[0]).floor();
+            }
+            paths.push(label);
+        }
+        let o = &mut self.o;
+        o.stmt(&format!("MEAS/{meas},F({target}),{}", count as u64));
+        for (p, label) in b.passes.iter().zip(&paths) {
+            for v in &p.via {
+                o.goto(v);
+            }
+            o.goto(&p.start);
+            o.stmt(&format!("PAMEAS/P({label})"));
+            o.at = Some(p.end);
+        }
+        o.stmt("ENDMES");
+    }
+
     /// `SNSLCT` when the group's sensor is not the current one.
     fn select(&mut self, g: &GroupPath) {
         if let Some(s) = self.sensors.get(&sensor_key(g)) {
@@ -1094,10 +1161,12 @@ fn direction_words(v: &V3) -> String {
 /// The nominal of a block: the face's analytic surface near its points, or the table.
 fn nominal_of(input: &Input, b: &BlockPath) -> Option<Nominal> {
     let hlip = input.hlip;
-    let first = b.touches.first()?;
     if b.contact == Contact::Table {
-        let p = &hlip.points[first.point];
+        let p = &hlip.points[b.touches.first()?.point];
         return Some(Nominal::Table(p.position, p.normal));
+    }
+    if b.touches.is_empty() && b.passes.is_empty() {
+        return None;
     }
     let face = input.geometry.faces.get(b.face.0)?;
     Some(Nominal::Surface(face.surface.clone(), face.centroid))

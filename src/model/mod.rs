@@ -674,6 +674,8 @@ pub struct Plan {
     /// A feature goes to a scanner only when its tightest tolerance is at least this many
     /// times the scanner's accuracy (`sensor_ratio 10`; Zhao et al.'s 1:5 or 1:10).
     pub sensor_ratio: f64,
+    /// The share of a scanned face's area its passes must see (`scan_coverage 95 %`).
+    pub scan_coverage: f64,
     /// Where it was declared.
     pub span: Span,
 }

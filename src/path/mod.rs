@@ -99,6 +99,20 @@ pub struct BlockPath {
     pub standoff: f64,
     /// The touches in order.
     pub touches: Vec<Touch>,
+    /// A scanner's passes in order (none for a touch probe).
+    pub passes: Vec<PassPath>,
+}
+
+/// One pass of a laser scanner: the middle of its depth of field moves from `start` to
+/// `end` in a straight line, the stripe square to the motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PassPath {
+    /// Positions passed on the way from where the scanner was, before `start`.
+    pub via: Vec<[f64; 3]>,
+    /// Where the pass starts.
+    pub start: [f64; 3],
+    /// Where it ends.
+    pub end: [f64; 3],
 }
 
 /// One touch.
@@ -170,7 +184,7 @@ pub fn plan(
     bans: &mut Vec<Ban>,
 ) -> Option<Llip> {
     let motion = input.plan.motion;
-    let probes = ProbeShape::of_cmm(input.model, &input.model.cmms[input.plan.cmm.0]);
+    let probes = sensor_shapes(input);
     let scene = Scene::of_part(input.geometry);
     let groups = linearise(input, hlip, &probes, &scene);
     let standoff = motion.prehit.max(motion.retract);
@@ -179,7 +193,11 @@ pub fn plan(
     let results: Vec<Result<GroupOut, Unreached>> = groups
         .par_iter()
         .map(|g| {
-            let r = plan_group(input, hlip, &scene, g, standoff);
+            let r = if g.blocks.iter().any(|b| !b.passes.is_empty()) {
+                plan_scan_group(input, &scene, g)
+            } else {
+                plan_group(input, hlip, &scene, g, standoff)
+            };
             progress(
                 done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
                 total,
@@ -213,6 +231,19 @@ pub fn plan(
             None
         }
     }
+}
+
+/// The machine's sensors as solids, by slot: the rack's probes, then its scanners
+/// (housing, head and ram with no tip).
+pub fn sensor_shapes(input: &Input) -> Vec<ProbeShape> {
+    let cmm = &input.model.cmms[input.plan.cmm.0];
+    let mut shapes = ProbeShape::of_cmm(input.model, cmm);
+    shapes.extend(
+        crate::access::scan::ScannerShape::of_cmm(input.model, cmm)
+            .into_iter()
+            .map(|s| s.probe),
+    );
+    shapes
 }
 
 /// Linearises the HLIP into groups — one per (setup, probe, orientation) — with their
@@ -260,7 +291,9 @@ fn linearise<'a>(
                         // The faces of a feature that lie on one surface (a bore in two
                         // halves) are one block: one feature, one `MEAS`.
                         let one = blocks.iter_mut().find(|b: &&mut BlockPath| {
-                            b.feature == i.feature
+                            f.passes.is_empty()
+                                && b.passes.is_empty()
+                                && b.feature == i.feature
                                 && b.contact == Contact::Part
                                 && f.contact == Contact::Part
                                 && input.geometry.same_surface(b.face, f.face)
@@ -281,6 +314,15 @@ fn linearise<'a>(
                             continue;
                         }
                         blocks.push(BlockPath {
+                            passes: f
+                                .passes
+                                .iter()
+                                .map(|x| PassPath {
+                                    via: vec![],
+                                    start: x.start.coords.into(),
+                                    end: x.end.coords.into(),
+                                })
+                                .collect(),
                             feature: i.feature,
                             face: f.face,
                             contact: f.contact,
@@ -401,6 +443,14 @@ fn join(
                 glen += 2.0 * b.standoff;
                 at = s;
                 touches += 1;
+            }
+            for p in &b.passes {
+                let mut pts = vec![at];
+                pts.extend(p.via.iter().map(|&v| P3::from(v)));
+                pts.push(P3::from(p.start));
+                pts.push(P3::from(p.end));
+                glen += polyline(&pts);
+                at = P3::from(p.end);
             }
         }
         length += glen;
@@ -727,6 +777,114 @@ fn plan_group(
         added,
         checks,
     })
+}
+
+/// Plans one scanner group: its blocks' passes in order, each pass run the way that
+/// starts nearer the scanner, joined by straight moves where they are clear, else over
+/// the passes lifted along the scanner's direction, else by the clearance plane; entry
+/// from and exit to the clearance plane as a touch group's. The housing keeps the plan's
+/// margin along every pass and move.
+fn plan_scan_group(input: &Input, scene: &Scene, g: &GroupIn) -> Result<GroupOut, Unreached> {
+    let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table)
+        .with_fixture(g.fixture)
+        .with_margin(input.plan.motion.margin);
+    let mut checks = 0;
+    let mut at: Option<P3> = None;
+    let mut entry: Vec<P3> = Vec::new();
+    let mut blocks = Vec::new();
+    for b in &g.blocks {
+        let mut out = b.clone();
+        for pass in &mut out.passes {
+            let (mut s, mut e) = (P3::from(pass.start), P3::from(pass.end));
+            if at.is_some_and(|x| (x - e).norm() < (x - s).norm()) {
+                std::mem::swap(&mut s, &mut e);
+            }
+            checks += 1;
+            if let Err(blocker) = pose.segment(&s, &e) {
+                let why = format!("{blocker} hits the part along a pass");
+                return Err(no_path(input, b, g, &why, vec![]));
+            }
+            let via = match at {
+                None => {
+                    let (up, n) = lift(&pose, &s, g);
+                    checks += n;
+                    let Some(up) = up else {
+                        return Err(no_path(input, b, g, "the way down to a pass", vec![]));
+                    };
+                    entry = up.into_iter().rev().collect();
+                    vec![]
+                }
+                Some(x) => match scan_move(&pose, &x, &s, g) {
+                    (Some(w), n) => {
+                        checks += n;
+                        w
+                    }
+                    (None, _) => {
+                        return Err(no_path(input, b, g, "the move between passes", vec![]));
+                    }
+                },
+            };
+            pass.via = via.iter().map(|p| p.coords.into()).collect();
+            pass.start = s.coords.into();
+            pass.end = e.coords.into();
+            at = Some(e);
+        }
+        blocks.push(out);
+    }
+    let last = at.unwrap_or_else(P3::origin);
+    let (exit, n) = lift(&pose, &last, g);
+    checks += n;
+    let Some(exit) = exit else {
+        let b = &g.blocks[g.blocks.len() - 1];
+        return Err(no_path(
+            input,
+            b,
+            g,
+            "the way up from the last pass",
+            vec![],
+        ));
+    };
+    if entry.is_empty() {
+        entry.push(last);
+    }
+    Ok(GroupOut {
+        entry,
+        blocks,
+        exit,
+        added: 0,
+        checks,
+    })
+}
+
+/// The waypoints from `x` to `y` (the end of one pass and the start of the next) for a
+/// scanner: straight across, or up along the scanner's direction by 10, 30 or 60 mm,
+/// across and down, or up to the clearance plane and down. Also how many segments it
+/// checked; `None` when every way is blocked.
+fn scan_move(pose: &Pose, x: &P3, y: &P3, g: &GroupIn) -> (Option<Vec<P3>>, usize) {
+    let mut tries: Vec<Vec<P3>> = vec![vec![*y]];
+    for h in [10.0, 30.0, 60.0] {
+        tries.push(vec![x + g.dir * h, y + g.dir * h, *y]);
+    }
+    let raise = |p: &P3| p + g.up * (g.height - p.coords.dot(&g.up)).max(0.0);
+    tries.push(vec![raise(x), raise(y), *y]);
+    let mut checks = 0;
+    let found = tries.into_iter().find(|w| {
+        let mut from = *x;
+        w.iter().all(|p| {
+            checks += 1;
+            let ok = pose.segment(&from, p).is_ok();
+            from = *p;
+            ok
+        })
+    });
+    // The pass's start is the block's own position, not a waypoint.
+    (
+        found.map(|mut w| {
+            w.pop();
+            w
+        }),
+        checks,
+    )
 }
 
 /// A block's stand-off: `standoff`, or half the free space in front of its points when

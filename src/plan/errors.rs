@@ -30,20 +30,6 @@ pub enum PlanError {
         why: String,
         help: String,
     },
-    #[error("plan `{plan}` measures every feature by touch: scanner `{scanner}` of `{cmm}` is not planned yet ({chosen})")]
-    #[diagnostic(
-        code(insp::plan::scanner_not_planned),
-        severity(Warning),
-        help("`inspc cones --probe {scanner}` shows where it sees a point from; this version generates no scan passes, so the program touches every face with the rack's probes")
-    )]
-    ScannerNotPlanned {
-        #[label("not used by the plan")]
-        span: Span,
-        plan: String,
-        scanner: String,
-        cmm: String,
-        chosen: String,
-    },
     #[error("planning `{plan}` did not settle after {iterations} rounds of generate-and-test")]
     #[diagnostic(
         code(insp::plan::no_convergence),
@@ -146,5 +132,4 @@ crate::located!(PlanError {
     NoPlan,
     PartOffTable,
     ProbeTooLong,
-    ScannerNotPlanned,
 });

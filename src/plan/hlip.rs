@@ -30,8 +30,34 @@ pub struct Hlip {
     pub setups: Vec<SetupNode>,
     /// Every point the plan may touch (graph fpoints, then table points).
     pub points: Vec<PlanPoint>,
+    /// The faces a laser scanner measures, in feature order ([`super::scan`]).
+    pub scans: Vec<ScannedFace>,
+    /// Features the selection gave the scanner that went back to the touch probes: a
+    /// face of theirs and the most of its area any setup let the scanner see.
+    pub to_touch: Vec<(FeatureId, FaceId, f64)>,
     /// Counts.
     pub summary: Summary,
+}
+
+/// A face the plan gives a laser scanner: where, how much of it, and why the scanner.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScannedFace {
+    /// The feature.
+    pub feature: FeatureId,
+    /// The face.
+    pub face: FaceId,
+    /// The scanner's slot (after the rack's probes, see [`ProbeNode::probe`]).
+    pub scanner: SlotId,
+    /// The setup, by index into [`Hlip::setups`].
+    pub setup: usize,
+    /// The share of its area the passes see.
+    pub coverage: f64,
+    /// Head orientations it is scanned from.
+    pub views: usize,
+    /// Passes over it.
+    pub passes: usize,
+    /// Why the scanner measures it (the sensor selection's reason).
+    pub why: String,
 }
 
 /// Which point of the knowledge base a plan point is.
@@ -85,10 +111,11 @@ pub struct SetupNode {
     pub probes: Vec<ProbeNode>,
 }
 
-/// One probe in a setup.
+/// One sensor in a setup: a touch probe, or a laser scanner.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProbeNode {
-    /// The probe's slot in the machine's rack.
+    /// The sensor's slot: a probe by its index in the machine's rack, a scanner by the
+    /// rack's probe count plus its index among the machine's scanners.
     pub probe: SlotId,
     /// The orientations used, in order.
     pub orients: Vec<OrientNode>,
@@ -127,6 +154,18 @@ pub struct FaceVisit {
     pub contact: Contact,
     /// Indices into [`Hlip::points`].
     pub points: Vec<usize>,
+    /// A scanner's passes over the face (none for a touch probe).
+    pub passes: Vec<ScanPass>,
+}
+
+/// One pass of a laser scanner: the middle of its depth of field runs from `start` to
+/// `end` (part frame, quantised), the stripe square to the motion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScanPass {
+    /// Where the pass starts.
+    pub start: P3,
+    /// Where it ends.
+    pub end: P3,
 }
 
 /// The plan in numbers.
@@ -146,6 +185,8 @@ pub struct Summary {
     pub features: usize,
     /// Points touched.
     pub points: usize,
+    /// Faces scanned, and the scanner's passes over them.
+    pub scanned: (usize, usize),
     /// Generate-and-test rounds.
     pub iterations: usize,
     /// Violated binary same-constraints, per level of the plan's hierarchy.
@@ -240,6 +281,7 @@ pub(crate) fn assemble(input: &Input, k: &mut Knowledge, m: &Machine, run: &Roun
                                 face,
                                 contact,
                                 points: pts.to_vec(),
+                                passes: vec![],
                             }),
                         }
                         if let Some(t) = tol {
@@ -311,6 +353,7 @@ pub(crate) fn assemble(input: &Input, k: &mut Knowledge, m: &Machine, run: &Roun
             orientation_changes,
             features: features.len(),
             points: used_points.len(),
+            scanned: (0, 0),
             iterations: run.iterations,
             violations,
             dropped_points: run.dropped,
@@ -320,6 +363,8 @@ pub(crate) fn assemble(input: &Input, k: &mut Knowledge, m: &Machine, run: &Roun
         },
         setups: out_setups,
         points,
+        scans: vec![],
+        to_touch: vec![],
     }
 }
 
@@ -431,7 +476,7 @@ fn collect(i: &Inst, tol: Option<ToleranceId>, feat: Option<FeatureId>, f: &mut 
 }
 
 /// A number at the plan's resolution, without `-0`.
-fn round(x: f64) -> f64 {
+pub(crate) fn round(x: f64) -> f64 {
     let r = (x * STEPS_PER_MM).round() / STEPS_PER_MM;
     if r == 0.0 {
         0.0
@@ -441,6 +486,6 @@ fn round(x: f64) -> f64 {
 }
 
 /// A vector at the plan's resolution.
-fn quantise(v: &V3) -> V3 {
+pub(crate) fn quantise(v: &V3) -> V3 {
     V3::new(round(v.x), round(v.y), round(v.z))
 }

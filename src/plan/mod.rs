@@ -22,6 +22,7 @@ mod hlip;
 mod machine;
 pub mod poses;
 mod render;
+mod scan;
 mod solve;
 mod validate;
 
@@ -144,9 +145,16 @@ pub(crate) fn min_points(kind: SurfaceKind) -> usize {
 }
 
 /// Counts the tolerances the plan measures — every face of their features and datum
-/// features touched — and reports each one it does not (an error unless
-/// `allow_unmeasured`), naming the first face it misses and why.
-fn account(input: &Input, mut hlip: Hlip, opts: &PlanOptions, diags: &mut Diagnostics) -> Hlip {
+/// features touched or scanned — and reports each one it does not (an error unless
+/// `allow_unmeasured`), naming the first face it misses and why; `uncovered` are the
+/// faces the plan asked the scanner for that it cannot cover enough.
+fn account(
+    input: &Input,
+    mut hlip: Hlip,
+    opts: &PlanOptions,
+    uncovered: &[scan::Uncovered],
+    diags: &mut Diagnostics,
+) -> Hlip {
     let part = &input.model.parts[input.plan.part.0];
     let g = input.graph;
     // Per face the distinct points the plan touches on it (or on the table under it).
@@ -182,7 +190,7 @@ fn account(input: &Input, mut hlip: Hlip, opts: &PlanOptions, diags: &mut Diagno
     }
     // A face is measured with as many points as its surface's fit needs (fewer only
     // where sampling gave it fewer).
-    let touched: BTreeSet<FaceId> = touches
+    let mut touched: BTreeSet<FaceId> = touches
         .iter()
         .filter(|(face, pts)| {
             let sampled = face_points(g, **face).len();
@@ -191,6 +199,9 @@ fn account(input: &Input, mut hlip: Hlip, opts: &PlanOptions, diags: &mut Diagno
         })
         .map(|(face, _)| *face)
         .collect();
+    // A scanned face is measured: the scan stage placed it only where its passes reach
+    // the plan's coverage.
+    touched.extend(hlip.scans.iter().map(|s| s.face));
     let mut measured = 0;
     for t in &part.tolerances {
         let features = t
@@ -211,7 +222,22 @@ fn account(input: &Input, mut hlip: Hlip, opts: &PlanOptions, diags: &mut Diagno
             continue;
         };
         let few = touches.get(&face).map_or(0, |p| p.len());
-        let (why, help) = if few > 0 {
+        let short = uncovered.iter().find(|u| u.feature == f);
+        let (why, help) = if let Some(u) = short {
+            (
+                format!(
+                    "is asked of the laser scanner, which sees {} % of {} at best (the plan asks {} %)",
+                    crate::model::fmt_num((u.best * 1000.0).round() / 10.0),
+                    if u.face == face {
+                        "it".to_string()
+                    } else {
+                        format!("face {}", input.geometry.faces[u.face.0].name)
+                    },
+                    crate::model::fmt_num((input.plan.scan_coverage * 1000.0).round() / 10.0)
+                ),
+                "touch it instead (`sensors { … touch }`), hold the part so the scanner sees more of it (a fixture), or lower `scan_coverage`".to_string(),
+            )
+        } else if few > 0 {
             (
                 format!(
                     "gets {few} {} in the plan, fewer than its surface's fit needs",
@@ -326,10 +352,48 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
 /// [`plan`], keeping in `memo` the cones and depth maps it computes and reusing those a
 /// previous planning of the same `input` left there (the re-plans after the path stage's
 /// bans). The plan is the one [`plan`] gives.
+///
+/// The features the sensor selection gave a laser scanner are left out of the touch plan
+/// and scanned in its setups ([`scan`]); those the selection chose by its rule and no
+/// setup lets the scanner cover go back to the touch probes, and the plan is made again
+/// once with them.
 pub fn plan_with(
     input: &Input,
     opts: &PlanOptions,
     memo: &mut Memo,
+    diags: &mut Diagnostics,
+) -> Option<Hlip> {
+    let mut lasers = scan::lasers(input);
+    let mut back: Vec<scan::Uncovered> = Vec::new();
+    let mut scan_memo = scan::Memo::default();
+    loop {
+        let skip: BTreeSet<FaceId> = lasers.iter().flat_map(|l| l.faces.clone()).collect();
+        let mut own = Diagnostics::new();
+        let Some(mut hlip) = plan_touch(input, opts, memo, &skip, &mut own) else {
+            diags.extend(own);
+            return None;
+        };
+        let uncovered = scan::plan_scans(input, &mut hlip, &lasers, opts, &mut scan_memo);
+        let asked = |f: crate::model::FeatureId| lasers.iter().any(|l| l.feature == f && l.asked);
+        let to_touch: Vec<&scan::Uncovered> =
+            uncovered.iter().filter(|u| !asked(u.feature)).collect();
+        if !to_touch.is_empty() && back.is_empty() {
+            back = to_touch.into_iter().cloned().collect();
+            lasers.retain(|l| !back.iter().any(|u| u.feature == l.feature));
+            continue;
+        }
+        diags.extend(own);
+        hlip.to_touch = back.iter().map(|u| (u.feature, u.face, u.best)).collect();
+        return Some(account(input, hlip, opts, &uncovered, diags));
+    }
+}
+
+/// The touch plan of every face but `skip` (those a scanner measures).
+fn plan_touch(
+    input: &Input,
+    opts: &PlanOptions,
+    memo: &mut Memo,
+    skip: &BTreeSet<FaceId>,
     diags: &mut Diagnostics,
 ) -> Option<Hlip> {
     let (model, plan, g) = (input.model, input.plan, input.graph);
@@ -378,8 +442,9 @@ pub fn plan_with(
     // The round whose plan had the fewest touches that failed validation: what the plan
     // falls back on, less those touches, if no round settles.
     let mut fallback: Option<Fallback> = None;
-    // Faces no probe inspects, left out under `allow_unmeasured`.
-    let mut skipped: BTreeSet<FaceId> = BTreeSet::new();
+    // Faces no probe inspects, left out under `allow_unmeasured`, and those a scanner
+    // measures.
+    let mut skipped: BTreeSet<FaceId> = skip.clone();
     for iteration in 1..=opts.max_iterations {
         let (dropped, bad) = filter(g, input.geometry, &k, &machine, &skipped);
         if !bad.is_empty() {
@@ -416,12 +481,7 @@ pub fn plan_with(
                 strategy: None,
                 exact_budget: opts.exact_budget,
             };
-            return Some(account(
-                input,
-                assemble(input, &mut k, &machine, &round),
-                opts,
-                diags,
-            ));
+            return Some(assemble(input, &mut k, &machine, &round));
         };
         let mut results: Vec<(Strategy, Vec<Branch>)> = Vec::new();
         let mut failures = Vec::new();
@@ -533,7 +593,7 @@ pub fn plan_with(
                     "no clustering found fewer; the minimum may need setups the hierarchy's order does not reach".into()
                 }));
             }
-            return Some(account(input, hlip, opts, diags));
+            return Some(hlip);
         }
         if !failed.is_empty() {
             let faces: Vec<String> = failed
@@ -565,7 +625,7 @@ pub fn plan_with(
     }
     if let Some(f) = fallback {
         if let Some(hlip) = f.settle(input, &mut k, &machine, opts, diags) {
-            return Some(account(input, hlip, opts, diags));
+            return Some(hlip);
         }
     }
     diags.push(PlanError::NoConvergence {

@@ -47,7 +47,19 @@ impl<'a> Names<'a> {
 
     /// A probe's label in the rack.
     pub fn probe(&self, p: SlotId) -> &'a str {
-        &self.model.cmms[self.plan.cmm.0].probes[p.0].0
+        let cmm = &self.model.cmms[self.plan.cmm.0];
+        match cmm.probes.get(p.0) {
+            Some(x) => &x.0,
+            None => cmm
+                .scanners
+                .get(p.0 - cmm.probes.len())
+                .map_or("?", |x| &x.0),
+        }
+    }
+
+    /// Whether a sensor slot is a laser scanner (after the rack's probes).
+    pub fn is_scanner(&self, p: SlotId) -> bool {
+        p.0 >= self.model.cmms[self.plan.cmm.0].probes.len()
     }
 
     /// A tolerance's name.
@@ -176,7 +188,12 @@ pub fn text(h: &Hlip, names: &Names) -> String {
             let _ = writeln!(out, "  rest {} on the table", names.face(*t));
         }
         for p in &s.probes {
-            let _ = writeln!(out, "  change-probe {}", names.probe(p.probe));
+            let kind = if names.is_scanner(p.probe) {
+                "scanner"
+            } else {
+                "probe"
+            };
+            let _ = writeln!(out, "  change-{kind} {}", names.probe(p.probe));
             for o in &p.orients {
                 o_count += 1;
                 if h.head == Head::Indexable {
@@ -198,6 +215,11 @@ pub fn text(h: &Hlip, names: &Names) -> String {
                             let n = f.points.len();
                             let s = if n == 1 { "" } else { "s" };
                             let face = names.face(f.face);
+                            if !f.passes.is_empty() {
+                                let k = f.passes.len();
+                                let es = if k == 1 { "" } else { "es" };
+                                return format!("{face} ({k} pass{es})");
+                            }
                             match f.contact {
                                 Contact::Table => format!("table under {face} ({n} point{s})"),
                                 Contact::Part => format!("{face} ({n} point{s})"),
@@ -212,6 +234,35 @@ pub fn text(h: &Hlip, names: &Names) -> String {
                 }
             }
         }
+    }
+    if !h.scans.is_empty() || !h.to_touch.is_empty() {
+        out += "sensors\n";
+    }
+    for sc in &h.scans {
+        let feature = names.feature(Some(sc.feature));
+        let _ = writeln!(
+            out,
+            "  scan {feature} ({}) in s{} with {}: {} % of its area, {} view{}, {} pass{}; {}",
+            names.face(sc.face),
+            sc.setup + 1,
+            names.probe(sc.scanner),
+            fmt_num((sc.coverage * 1000.0).floor() / 10.0),
+            sc.views,
+            if sc.views == 1 { "" } else { "s" },
+            sc.passes,
+            if sc.passes == 1 { "" } else { "es" },
+            sc.why
+        );
+    }
+    for (f, face, best) in &h.to_touch {
+        let _ = writeln!(
+            out,
+            "  touch {} instead of scanning it: the scanner sees {} % of {} at best, the plan asks {} %",
+            names.feature(Some(*f)),
+            fmt_num((best * 1000.0).floor() / 10.0),
+            names.face(*face),
+            fmt_num((plan.scan_coverage * 1000.0).round() / 10.0)
+        );
     }
     out += &summary_text(&h.summary, names);
     out
@@ -267,6 +318,13 @@ fn summary_text(s: &Summary, names: &Names) -> String {
         "  features {}, points {} ({} dropped)",
         s.features, s.points, s.dropped_points
     );
+    if s.scanned.0 > 0 {
+        let _ = writeln!(
+            out,
+            "  faces scanned {}, passes {}",
+            s.scanned.0, s.scanned.1
+        );
+    }
     let _ = writeln!(
         out,
         "  iterations {}, whole-probe cones {}, clustering {}",
@@ -300,11 +358,20 @@ pub fn json(h: &Hlip, names: &Names) -> Value {
                         "direction": arr(&o.direction),
                         "inspect": o.inspections.iter().map(|i| j!({
                             "feature": names.feature(i.feature),
-                            "faces": i.faces.iter().map(|f| j!({
-                                "face": names.face(f.face),
-                                "table": f.contact == Contact::Table,
-                                "points": f.points,
-                            })).collect::<Vec<_>>(),
+                            "faces": i.faces.iter().map(|f| {
+                                let mut v = j!({
+                                    "face": names.face(f.face),
+                                    "table": f.contact == Contact::Table,
+                                    "points": f.points,
+                                });
+                                if !f.passes.is_empty() {
+                                    v["passes"] = f.passes.iter().map(|x| j!([
+                                        arr(&x.start.coords),
+                                        arr(&x.end.coords),
+                                    ])).collect();
+                                }
+                                v
+                            }).collect::<Vec<_>>(),
                             "record": i.records.iter().map(|t| names.tolerance(*t)).collect::<Vec<_>>(),
                         })).collect::<Vec<_>>(),
                     })).collect::<Vec<_>>(),
@@ -315,7 +382,7 @@ pub fn json(h: &Hlip, names: &Names) -> Value {
     let s = &h.summary;
     let violations: serde_json::Map<String, Value> =
         violations(s, names).map(|(l, v)| (l, j!(v))).collect();
-    j!({
+    let mut out = j!({
         "plan": plan.name,
         "part": names.part().name,
         "cmm": model.cmms[plan.cmm.0].name,
@@ -348,5 +415,25 @@ pub fn json(h: &Hlip, names: &Names) -> Value {
             "unsettled": s.unsettled.map(|(moved, left)| serde_json::json!({"moved": moved, "left_out": left})),
             "strategy": strategy(s),
         },
-    })
+    });
+    if !h.scans.is_empty() {
+        out["scans"] = h
+            .scans
+            .iter()
+            .map(|sc| {
+                j!({
+                    "feature": names.feature(Some(sc.feature)),
+                    "face": names.face(sc.face),
+                    "setup": sc.setup + 1,
+                    "scanner": names.probe(sc.scanner),
+                    "coverage": sc.coverage,
+                    "views": sc.views,
+                    "passes": sc.passes,
+                    "why": sc.why,
+                })
+            })
+            .collect::<Vec<_>>()
+            .into();
+    }
+    out
 }

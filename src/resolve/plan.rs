@@ -119,6 +119,23 @@ pub(super) fn lower(
             }
         }
     }
+    let mut scan_coverage = 0.95;
+    if let Some(v) = pp.get("scan_coverage") {
+        if let Some(x) = cx.dim(v, Dim::Ratio) {
+            if x <= 0.0 || x > 1.0 {
+                cx.err(E::OutOfRange {
+                    span: v.span,
+                    what: "`scan_coverage`".into(),
+                    value: format!("{} %", num(x * 100.0)),
+                    range: "a share of the area above 0 % and at most 100 %".into(),
+                    help: "the share of a scanned face's area its passes must see; 95 % is usual"
+                        .into(),
+                });
+            } else {
+                scan_coverage = x;
+            }
+        }
+    }
     pp.finish(cx);
     let (part, cmm, hierarchy, sampling) = (part?, cmm?, hierarchy?, sampling?);
     let the_part = &model.parts[part];
@@ -140,6 +157,7 @@ pub(super) fn lower(
         fixtures: vec![],
         sensors: vec![],
         sensor_ratio,
+        scan_coverage,
         span: p.name.span,
     };
     if let Some(v) = fixtures_v {

@@ -82,6 +82,38 @@ impl Shape {
         })
     }
 
+    /// Whether two shapes are one surface, to `tol` (mm; and `tol` per mm for
+    /// directions): a plane's normal and offset, a cylinder's axis line and radius, a
+    /// cone's apex, axis and angle, a sphere's centre and radius. A feature's nominal
+    /// as a program writes it (four decimals) is its face's surface by this test.
+    pub fn same_surface(&self, o: &Shape, tol: f64) -> bool {
+        let parallel = |a: &V3, b: &V3| a.dot(b).abs() > 1.0 - tol * tol;
+        let off_line = |p: &P3, a: &V3, q: &P3| {
+            let d = q - p;
+            (d - a * d.dot(a)).norm()
+        };
+        match (self, o) {
+            (Shape::Plane { p, n }, Shape::Plane { p: q, n: m }) => {
+                parallel(n, m) && (q - p).dot(n).abs() < tol
+            }
+            (Shape::Cylinder { p, a, r }, Shape::Cylinder { p: q, a: b, r: s }) => {
+                parallel(a, b) && off_line(p, a, q) < tol && (r - s).abs() < tol
+            }
+            (
+                Shape::Cone { apex, a, half },
+                Shape::Cone {
+                    apex: q,
+                    a: b,
+                    half: h,
+                },
+            ) => a.dot(b) > 1.0 - tol * tol && (apex - q).norm() < tol && (half - h).abs() < tol,
+            (Shape::Sphere { c, r }, Shape::Sphere { c: d, r: s }) => {
+                (c - d).norm() < tol && (r - s).abs() < tol
+            }
+            _ => false,
+        }
+    }
+
     /// The shape moved by a rigid motion.
     pub fn moved(&self, m: &nalgebra::Isometry3<f64>) -> Shape {
         match self {
@@ -156,6 +188,25 @@ impl Shape {
             Shape::Sphere { c, r } => (q - c).norm() - r,
             Shape::Parpln { p, n, width } => (q - p).dot(n).abs() - width / 2.0,
             Shape::Surface => 0.0,
+        }
+    }
+
+    /// The direction the signed distance grows in at `q` (up to sign, the surface's
+    /// normal there); `None` for a free-form surface or on an axis.
+    pub fn normal_at(&self, q: &P3) -> Option<V3> {
+        match self {
+            Shape::Plane { n, .. } | Shape::Point { n, .. } | Shape::Parpln { n, .. } => Some(*n),
+            Shape::Cylinder { p, a, .. } => {
+                let d = q - p;
+                (d - a * d.dot(a)).try_normalize(1e-9)
+            }
+            Shape::Cone { apex, a, half } => {
+                let d = q - apex;
+                let radial = (d - a * d.dot(a)).try_normalize(1e-9)?;
+                Some(radial * half.cos() - a * half.sin())
+            }
+            Shape::Sphere { c, .. } => (q - c).try_normalize(1e-9),
+            Shape::Surface => None,
         }
     }
 

@@ -7,6 +7,7 @@ use super::fit::{self, Shape};
 use super::report::{Report, Row};
 use super::{Input, Options};
 use crate::access::pose::{Blocker, Contact, Pose, Solid};
+use crate::access::scan::{Optics, ScannerShape};
 use crate::access::{ProbeShape, Scene};
 use crate::dmis::{Program, Statement};
 use crate::geometry::{FaceId, P3, V3};
@@ -19,7 +20,16 @@ use parry3d_f64::shape::Ball;
 use std::collections::BTreeMap;
 
 /// What the virtual CMM runs.
-const SUPPORTED: &str = "DMISMN, UNITS/MM, MODE, SNSET, SNSDEF, SNSLCT, FEAT, TOL, TEXT, PAUSE, RECALL, ROTATE, DATSET, TRANS, GOTO, MEAS, PTMEAS, ENDMES, CONST, DATDEF, OUTPUT, ENDFIL";
+const SUPPORTED: &str = "DMISMN, UNITS/MM, MODE, SNSET, SNSDEF, SNSLCT, FEAT, TOL, TEXT, PAUSE, RECALL, ROTATE, DATSET, TRANS, GOTO, MEAS, PTMEAS, PATH/LINE, PAMEAS, ENDMES, CONST, DATDEF, OUTPUT, ENDFIL";
+
+/// How far the surface of the face a scanned point lies on may be from the block's
+/// nominal (mm, and per mm for directions) for the point to be the feature's: the
+/// clipping of the cloud to the feature, as scanning software does per feature.
+const CLIP: f64 = 2e-3;
+
+/// The most stripes and points per stripe one simulated pass keeps: the cloud thinned
+/// from the scanner's spacing evenly, which a fit at nominal does not notice.
+const CLOUD: (usize, usize) = (40, 10);
 
 /// The step of the contact search along a touch's vector (mm); the contact is then
 /// bisected to a nanometre.
@@ -106,6 +116,8 @@ struct Block {
     /// machine frame —, tip radius).
     touches: Vec<(P3, V3, P3, V3, f64)>,
     at: usize,
+    /// Whether a scan pass ran in it.
+    scanned: bool,
 }
 
 /// A nominal from `FEAT`: its shape (program frame) and whether it is convex.
@@ -148,7 +160,12 @@ struct Machine<'a> {
     plan: &'a Plan,
     scene: Scene,
     setups: Setups<'a>,
+    /// The sensors by slot: the rack's probes, then its scanners (no tip).
     probes: Vec<ProbeShape>,
+    /// Per slot, a scanner's optics and accuracy (`None` for a probe).
+    optics: Vec<Option<(Optics, f64)>>,
+    /// `PATH/LINE`s by label: start, end (program frame).
+    paths: BTreeMap<String, (P3, P3)>,
     exact: Vec<V3>,
     centre: P3,
     apprch: f64,
@@ -181,6 +198,8 @@ struct Machine<'a> {
     rows: Vec<Row>,
     sizes: BTreeMap<String, (f64, f64, f64)>,
     touches: usize,
+    /// Points the scan passes kept.
+    scanned: usize,
     moves: usize,
 }
 
@@ -199,7 +218,26 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         plan,
         scene: Scene::of_part(input.geometry),
         setups,
-        probes: ProbeShape::of_cmm(input.model, cmm),
+        probes: ProbeShape::of_cmm(input.model, cmm)
+            .into_iter()
+            .chain(
+                ScannerShape::of_cmm(input.model, cmm)
+                    .into_iter()
+                    .map(|s| s.probe),
+            )
+            .collect(),
+        optics: cmm
+            .probes
+            .iter()
+            .map(|_| None)
+            .chain(
+                ScannerShape::of_cmm(input.model, cmm)
+                    .into_iter()
+                    .zip(&cmm.scanners)
+                    .map(|(s, (_, id))| Some((s.optics, input.model.scanners[id.0].accuracy))),
+            )
+            .collect(),
+        paths: BTreeMap::new(),
         exact,
         centre: P3::from((lo.coords + hi.coords) / 2.0),
         apprch: 2.0,
@@ -224,6 +262,7 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         rows: Vec::new(),
         sizes: BTreeMap::new(),
         touches: 0,
+        scanned: 0,
         moves: 0,
     };
     for s in &input.program.statements {
@@ -251,6 +290,7 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         part: input.model.parts[plan.part.0].name.clone(),
         setups: m.aligns.len(),
         touches: m.touches,
+        scanned: m.scanned,
         moves: m.moves,
         noise: opts.noise,
         seed: opts.seed,
@@ -459,9 +499,19 @@ impl Machine<'_> {
                     word: word(0).to_string(),
                     touches: Vec::new(),
                     at,
+                    scanned: false,
                 });
             }
             "PTMEAS" => self.ptmeas(params, at)?,
+            "PATH" => {
+                let v = nums(params);
+                let (Some((_, l)), "LINE", 9) = (label, word(0), v.len()) else {
+                    return Err(self.unsupported(at, &format!("PATH/{}", params.join(","))));
+                };
+                let (a, b) = (P3::new(v[0], v[1], v[2]), P3::new(v[3], v[4], v[5]));
+                self.paths.insert(l.clone(), (a, b));
+            }
+            "PAMEAS" => self.pameas(params, at)?,
             "ENDMES" => self.endmes(at)?,
             "CONST" => self.construct(params, at)?,
             "DATDEF" => {
@@ -524,7 +574,8 @@ impl Machine<'_> {
 
     /// `SNSDEF/PROBE,FIXED,CART,0,0,-len,0,0,1,diam` or `…,INDEX,POL,a,b,VEC,i,j,k,len,diam`:
     /// the probe of the plan's machine with that tip and length (the label names it when
-    /// several match).
+    /// several match); `SNSDEF/LASER,…` in the same form, the scanner with that stand-off
+    /// (the length) and stripe (the diameter).
     fn sensor_def(&self, label: &str, params: &[String], at: usize) -> Result<Sensor, SimError> {
         let v = nums(params);
         let (a, b) = if params.get(1).map(String::as_str) == Some("INDEX") {
@@ -542,18 +593,30 @@ impl Machine<'_> {
             v.get(2).map(|x| -x).unwrap_or(0.0)
         };
         let cmm = &self.input.model.cmms[self.plan.cmm.0];
+        let laser = params.first().map(String::as_str) == Some("LASER");
         let matching: Vec<usize> = self
             .probes
             .iter()
+            .zip(&self.optics)
             .enumerate()
-            .filter(|(_, p)| {
-                (2.0 * p.tip_radius - diam).abs() < 2e-4 && (p.reach() - len).abs() < 2e-4
+            .filter(|(_, (p, o))| match (laser, o) {
+                (false, None) => {
+                    (2.0 * p.tip_radius - diam).abs() < 2e-4 && (p.reach() - len).abs() < 2e-4
+                }
+                (true, Some((o, _))) => {
+                    (o.stripe - diam).abs() < 2e-4 && (o.standoff - len).abs() < 2e-4
+                }
+                _ => false,
             })
             .map(|(k, _)| k)
             .collect();
+        let name_of = |k: usize| match cmm.probes.get(k) {
+            Some(p) => &p.0,
+            None => &cmm.scanners[k - cmm.probes.len()].0,
+        };
         let by_name = matching.iter().copied().find(|&k| {
             let mut l = crate::dmis::text::Labels::default();
-            let base = l.fresh("S", &cmm.probes[k].0);
+            let base = l.fresh("S", name_of(k));
             label == base || label.starts_with(&format!("{base}_"))
         });
         match by_name.or(matching.first().copied()) {
@@ -562,16 +625,21 @@ impl Machine<'_> {
                 span: self.span(at),
                 label: label.to_string(),
                 cmm: cmm.name.clone(),
-                probes: cmm
-                    .probes
-                    .iter()
-                    .zip(&self.probes)
-                    .map(|((n, _), p)| {
-                        format!(
-                            "`{n}` (tip Ø{} mm, {} mm long)",
-                            crate::dmis::text::num(2.0 * p.tip_radius),
-                            crate::dmis::text::num(p.reach())
-                        )
+                probes: (0..self.probes.len())
+                    .map(|k| {
+                        let (n, p) = (name_of(k), &self.probes[k]);
+                        match &self.optics[k] {
+                            None => format!(
+                                "`{n}` (tip Ø{} mm, {} mm long)",
+                                crate::dmis::text::num(2.0 * p.tip_radius),
+                                crate::dmis::text::num(p.reach())
+                            ),
+                            Some((o, _)) => format!(
+                                "`{n}` (scanner, stand-off {} mm, stripe {} mm)",
+                                crate::dmis::text::num(o.standoff),
+                                crate::dmis::text::num(o.stripe)
+                            ),
+                        }
                     })
                     .collect::<Vec<_>>()
                     .join(", "),
@@ -646,13 +714,19 @@ impl Machine<'_> {
     /// The probe posed in the current setup (part frame).
     fn pose<'p>(&'p self, ctx: &'p SetupCtx, s: Sensor) -> Pose<'p> {
         let probe = &self.probes[s.slot];
-        let dir = match probe.head {
+        let dir = self.sensor_dir(ctx, s);
+        Pose::new(&self.scene, probe, dir, ctx.up, ctx.table).with_fixture(&ctx.solids)
+    }
+
+    /// The sensor's direction (tip to head, or a scanner's from the surface towards
+    /// it) in the part frame of the current setup.
+    fn sensor_dir(&self, ctx: &SetupCtx, s: Sensor) -> V3 {
+        match self.probes[s.slot].head {
             crate::access::pose::Head::Fixed => ctx.up,
             crate::access::pose::Head::Indexable => {
                 (ctx.place.rotation.inverse() * crate::access::head_direction(s.a, s.b)).normalize()
             }
-        };
-        Pose::new(&self.scene, probe, dir, ctx.up, ctx.table).with_fixture(&ctx.solids)
+        }
     }
 
     fn collision(&self, at: usize, b: Blocker, during: &str) -> SimError {
@@ -814,6 +888,123 @@ impl Machine<'_> {
         Ok(())
     }
 
+    /// `PAMEAS/P(path)`: a scanner's pass along a `PATH/LINE` of the open `MEAS` block.
+    /// The housing sweeps from the path's start to its end (checked like any move);
+    /// the laser's stripe, square to the motion, samples the actual part along the
+    /// scanner's direction at its spacing (thinned to [`CLOUD`]); a point is kept when
+    /// it lies in the depth of field, the laser and the camera both reach it within the
+    /// incidence limit (exact ray casts on the nominal part), and the face it lies on is
+    /// the block's nominal surface ([`CLIP`]). Each point carries the scanner's noise when the run
+    /// has noise: the larger of the run's and half the scanner's accuracy.
+    fn pameas(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
+        let Some(&(s, e)) = self.paths.get(l) else {
+            return Err(self.bad(
+                at,
+                &format!("path `{l}` is not defined"),
+                "define it with `P(label)=PATH/LINE,CART,x1,y1,z1,x2,y2,z2,i,j,k` first",
+            ));
+        };
+        if self.block.is_none() {
+            return Err(self.bad(
+                at,
+                "PAMEAS outside a MEAS block",
+                "put scan passes between MEAS and ENDMES",
+            ));
+        }
+        let sensor = self.sensor(at)?;
+        let Some((optics, accuracy)) = self.optics[sensor.slot] else {
+            return Err(self.bad(
+                at,
+                "PAMEAS with a touch probe selected",
+                "select a scanner (`SNSDEF/LASER`) with SNSLCT before its passes",
+            ));
+        };
+        let ctx = self.ctx(at)?;
+        let inv = ctx.place.inverse() * self.frame;
+        let (sp, ep) = (inv * s, inv * e);
+        let place = ctx.place;
+        self.move_to(place * sp, at, "on the way to the pass")?;
+        self.move_to(place * ep, at, "along the scan pass")?;
+        let ctx = self.ctx(at)?;
+        let dir = self.sensor_dir(ctx, sensor);
+        let run = ep - sp;
+        let motion = run
+            .try_normalize(1e-9)
+            .unwrap_or_else(|| fit::across(&dir).0);
+        let across = dir.cross(&motion).normalize();
+        let along_n = ((run.norm() / optics.spacing[1]).floor() as usize).clamp(1, CLOUD.0);
+        let across_n = ((optics.stripe / optics.spacing[0]).floor() as usize).clamp(1, CLOUD.1);
+        // The block's nominal in the part frame (the program's frame is the part's).
+        let nominal = self
+            .block
+            .as_ref()
+            .and_then(|b| self.nominals.get(&b.label))
+            .map(|n| n.shape.clone());
+        let g = self.input.geometry;
+        let near = optics.standoff - optics.depth / 2.0;
+        let sigma = if self.opts.noise > 0.0 {
+            self.opts.noise.max(accuracy / 2.0)
+        } else {
+            0.0
+        };
+        let mut cloud = Vec::new();
+        for i in 0..=along_n {
+            for j in 0..=across_n {
+                let f = sp
+                    + run * (i as f64 / along_n as f64)
+                    + across * (optics.stripe * (j as f64 / across_n as f64 - 0.5));
+                let c0 = f + dir * optics.standoff;
+                let travel = optics.standoff + optics.depth / 2.0;
+                let Found::Contact(c, Contact::Part, Some(face)) =
+                    self.search_surface(ctx, &c0, &dir, 0.0, travel)
+                else {
+                    continue;
+                };
+                if (c0 - c).dot(&dir) < near {
+                    continue;
+                }
+                let n = g.faces[face.0]
+                    .surface
+                    .normal_at(&c)
+                    .unwrap_or(dir)
+                    .normalize();
+                if !crate::access::scan::sees(&self.scene, &c, &n, &dir, &optics) {
+                    continue;
+                }
+                // A point on a face of another surface (a fillet, the next wall) is
+                // not the feature's; a free-form nominal keeps every point.
+                let own = match (&nominal, Shape::of_surface(&g.faces[face.0].surface)) {
+                    (Some(Shape::Surface) | None, _) => true,
+                    (Some(shape), Some((surface, _))) => shape.same_surface(&surface, CLIP),
+                    (Some(_), None) => false,
+                };
+                if !own {
+                    continue;
+                }
+                cloud.push((place * c, place.rotation * n));
+            }
+        }
+        let prog = self.frame.inverse();
+        for (cw, nw) in cloud {
+            let noise = if sigma > 0.0 {
+                sigma * self.rng.gauss()
+            } else {
+                0.0
+            };
+            let q = cw + nw * noise;
+            if let Some(b) = self.block.as_mut() {
+                b.touches.push((prog * cw, prog * nw, q, nw, 0.0));
+                b.scanned = true;
+            }
+            self.scanned += 1;
+        }
+        if let Some(b) = self.block.as_mut() {
+            b.scanned = true;
+        }
+        Ok(())
+    }
+
     /// The part's face nearest `x` (part frame) on the nominal mesh, and its distance.
     fn nearest_face(&self, x: &P3) -> Option<(FaceId, f64)> {
         let mesh = self.scene.mesh()?;
@@ -964,6 +1155,17 @@ impl Machine<'_> {
             "GSURF" => Some(Shape::Surface),
             other => return Err(self.unsupported(b.at, &format!("MEAS/{other}"))),
         };
+        if b.scanned && b.touches.len() < 3 {
+            return Err(self.bad(
+                b.at,
+                &format!(
+                    "the scan passes saw {} points of feature `{}`",
+                    b.touches.len(),
+                    b.label
+                ),
+                "the passes must run over the feature within the scanner's depth of field, its laser and camera seeing it",
+            ));
+        }
         let Some(shape) = fitted else {
             return Err(self.bad(
                 b.at,

@@ -46,6 +46,8 @@ pub struct Report {
     pub setups: usize,
     /// Touches and moves made.
     pub touches: usize,
+    /// Points the scan passes kept.
+    pub scanned: usize,
     /// Moves checked.
     pub moves: usize,
     /// The noise (mm) and its seed.
@@ -82,12 +84,17 @@ impl Report {
     /// The report for people.
     pub fn text(&self) -> String {
         let mut out = format!(
-            "simulated program {} (plan {}, part {}): {} setups, {} touches, {} moves checked{}\n",
+            "simulated program {} (plan {}, part {}): {} setups, {} touches{}, {} moves checked{}\n",
             self.program,
             self.plan,
             self.part,
             self.setups,
             self.touches,
+            if self.scanned > 0 {
+                format!(", {} points scanned", self.scanned)
+            } else {
+                String::new()
+            },
             self.moves,
             if self.noise > 0.0 {
                 format!(", noise {} mm (seed {})", num(self.noise), self.seed)
@@ -183,6 +190,7 @@ impl Report {
             "part": self.part,
             "setups": self.setups,
             "touches": self.touches,
+            "scanned": self.scanned,
             "moves": self.moves,
             "noise": self.noise,
             "seed": self.seed,

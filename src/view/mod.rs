@@ -174,7 +174,13 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
         })
         .collect();
     let cmm = &model.cmms[plan.cmm.0];
-    let shapes = ProbeShape::of_cmm(model, cmm);
+    // The sensors by slot: the probes, then the scanners (housing, no tip).
+    let mut shapes = ProbeShape::of_cmm(model, cmm);
+    shapes.extend(
+        access::scan::ScannerShape::of_cmm(model, cmm)
+            .into_iter()
+            .map(|s| s.probe),
+    );
     let probes = shapes
         .iter()
         .enumerate()
@@ -223,6 +229,12 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
                     path.push(f3(&c.coords.into()));
                     path.push(f3(&t.standoff));
                     touches.push(t.point);
+                }
+                // A scanner's passes: the focus moves along each.
+                for p in &b.passes {
+                    path.extend(p.via.iter().map(f3));
+                    path.push(f3(&p.start));
+                    path.push(f3(&p.end));
                 }
             }
             path.extend(gp.exit.iter().map(f3));

@@ -404,7 +404,14 @@ fn every_move_is_collision_free() {
         let plan = &model.plans[b.plan];
         let geometry = &run.parts[plan.part.0].as_ref().unwrap().geometry;
         let scene = inspc::access::Scene::of_part(geometry);
-        let probes = inspc::access::ProbeShape::of_cmm(model, &model.cmms[plan.cmm.0]);
+        // The sensors by slot: the probes, then the scanners (no tip).
+        let cmm = &model.cmms[plan.cmm.0];
+        let mut probes = inspc::access::ProbeShape::of_cmm(model, cmm);
+        probes.extend(
+            inspc::access::scan::ScannerShape::of_cmm(model, cmm)
+                .into_iter()
+                .map(|s| s.probe),
+        );
         let mut segments = 0;
         for s in &b.llip.setups {
             let setup = &b.hlip.setups[s.setup];
@@ -441,6 +448,12 @@ fn every_move_is_collision_free() {
                     for t in &bl.touches {
                         pts.extend(t.via.iter().copied());
                         pts.push(t.standoff);
+                    }
+                    // A scanner's passes: the moves to each, and the pass itself.
+                    for p in &bl.passes {
+                        pts.extend(p.via.iter().copied());
+                        pts.push(p.start);
+                        pts.push(p.end);
                     }
                 }
                 pts.extend(g.exit.iter().copied());
@@ -689,4 +702,115 @@ fn plans_cover_the_graph_and_find_the_minimum_setups() {
             c.name
         );
     }
+}
+
+/// Every face a golden plan scans is covered to the plan's `scan_coverage`, judged here
+/// without the planner's cones: 2,000 area-weighted points of the face (a fixed
+/// sequence), each covered when some pass of its group runs over it — within the
+/// pass's length, the stripe's half-width across and half the depth of field along the
+/// scanner's direction — and exact ray casts see it from that direction
+/// (`access::scan::sees`: incidence, laser and camera).
+#[test]
+fn every_scanned_face_reaches_the_plans_coverage_by_exact_rays() {
+    let mut faces = 0;
+    for (c, run, b) in built() {
+        let model = &run.checked.model;
+        let plan = &model.plans[b.plan];
+        let cmm = &model.cmms[plan.cmm.0];
+        let geometry = &run.parts[plan.part.0].as_ref().unwrap().geometry;
+        let scene = inspc::access::Scene::of_part(geometry);
+        let scanners = inspc::access::scan::ScannerShape::of_cmm(model, cmm);
+        for sc in &b.hlip.scans {
+            let optics = scanners[sc.scanner.0 - cmm.probes.len()].optics;
+            // The passes over this face, with their scanner direction.
+            let mut passes = Vec::new();
+            for s in b.llip.setups.iter().filter(|s| s.setup == sc.setup) {
+                for g in &s.groups {
+                    let d = nalgebra::Vector3::from(g.direction);
+                    for bl in g.blocks.iter().filter(|bl| bl.face == sc.face) {
+                        for p in &bl.passes {
+                            passes.push((
+                                nalgebra::Point3::from(p.start),
+                                nalgebra::Point3::from(p.end),
+                                d,
+                            ));
+                        }
+                    }
+                }
+            }
+            let points = face_points(geometry, sc.face.0, 2000);
+            let covered = points
+                .iter()
+                .filter(|(q, n)| {
+                    passes.iter().any(|(s, e, d)| {
+                        let run = e - s;
+                        let len = run.norm().max(1e-9);
+                        let m = run / len;
+                        let across = d.cross(&m);
+                        let v = q - s;
+                        (-1e-6..=len + 1e-6).contains(&v.dot(&m))
+                            && v.dot(&across).abs() <= optics.stripe / 2.0
+                            && v.dot(d).abs() <= optics.depth / 2.0
+                            && inspc::access::scan::sees(&scene, q, n, d, &optics)
+                    })
+                })
+                .count();
+            let share = covered as f64 / points.len() as f64;
+            assert!(
+                share >= plan.scan_coverage - 0.02,
+                "{}: face {} covered {:.3} by exact rays, the plan says {:.3}",
+                c.name,
+                geometry.faces[sc.face.0].name,
+                share,
+                sc.coverage
+            );
+            faces += 1;
+        }
+    }
+    assert!(faces >= 2, "only {faces} scanned faces");
+}
+
+/// `count` points of a face spread by area (a fixed low-discrepancy sequence over its
+/// triangles), with the surface's outward normal at each.
+fn face_points(
+    g: &inspc::geometry::PartGeometry,
+    face: usize,
+    count: usize,
+) -> Vec<(nalgebra::Point3<f64>, nalgebra::Vector3<f64>)> {
+    let f = &g.faces[face];
+    let tris: Vec<[nalgebra::Point3<f64>; 3]> = f
+        .triangles
+        .iter()
+        .map(|&t| g.triangles[t as usize].map(|i| g.vertices[i as usize]))
+        .collect();
+    let areas: Vec<f64> = tris
+        .iter()
+        .map(|v| (v[1] - v[0]).cross(&(v[2] - v[0])).norm() / 2.0)
+        .collect();
+    let total: f64 = areas.iter().sum();
+    let mut out = Vec::new();
+    let mut acc = 0.0;
+    let mut k = 0;
+    for (v, a) in tris.iter().zip(&areas) {
+        acc += a;
+        // The points whose cumulative share falls in this triangle.
+        while k < count && (k as f64 + 0.5) / count as f64 * total <= acc {
+            // A golden-ratio sequence folded into the triangle.
+            let (u, w) = (
+                (k as f64 * 0.618_033_988_7).fract(),
+                (k as f64 * 0.754_877_666_2).fract(),
+            );
+            let (u, w) = if u + w > 1.0 {
+                (1.0 - u, 1.0 - w)
+            } else {
+                (u, w)
+            };
+            let q = v[0] + (v[1] - v[0]) * u + (v[2] - v[0]) * w;
+            let tn = (v[1] - v[0]).cross(&(v[2] - v[0]));
+            let n = f.surface.normal_at(&q).unwrap_or_else(|| tn.normalize());
+            out.push((q, n));
+            k += 1;
+        }
+    }
+    out
 }

@@ -153,6 +153,43 @@ fn a_deviation_fails_exactly_the_tolerance_it_targets() {
     assert_eq!(failing(&r), vec!["T1".to_string()], "{}", r.text());
 }
 
+/// Scanned features are judged from their clouds: on the mixed example a bowed front
+/// face (its scanned flatness) and a tilted pad (its scanned parallelism to the touched
+/// datum) fail exactly their tolerances; with noise, a scanned flatness reads the
+/// scanner's noise (its accuracy), not zero.
+#[test]
+fn scanned_features_are_judged_from_their_clouds() {
+    let (spec, program) = (
+        "examples/mixed_sensors.insp",
+        "tests/cases/example_mixed_sensors/program.dmi",
+    );
+    for (dev, target) in [
+        ("feature front bow 0.3", "FRONT_FLAT"),
+        ("feature pad tilt 0.2 deg about (1, 0, 0)", "PAD_PAR"),
+    ] {
+        let r = run(spec, program, Some(dev), Options::default())
+            .unwrap_or_else(|e| panic!("{dev}: {e:?}"));
+        assert!(r.scanned > 100, "{}", r.text());
+        assert_eq!(failing(&r), vec![target.to_string()], "{dev}\n{}", r.text());
+    }
+    let noisy = Options {
+        noise: 0.001,
+        ..Options::default()
+    };
+    let r = run(spec, program, None, noisy).expect("runs");
+    let flat = r
+        .rows
+        .iter()
+        .find(|x| x.tolerance == "FRONT_FLAT")
+        .expect("the front's flatness is output");
+    assert!(failing(&r).is_empty(), "{}", r.text());
+    assert!(r.text().contains("points scanned"), "{}", r.text());
+    // σ = 4.5 µm (half the LC60Dx's 9 µm) over some hundred points: a range of about
+    // six σ.
+    let a = flat.outcome.actual;
+    assert!((0.01..0.05).contains(&a), "{a}\n{}", r.text());
+}
+
 /// The same on the other real parts, one deviation per kind of tolerance: size, form
 /// (a bowed face, which four corner points cannot see), orientation, location, profile.
 /// A tolerance whose nominal lies on one of its limits (`35 +0 -0.2`) reads in or out

@@ -1,0 +1,443 @@
+//! Scan planning (Zhao et al. sec. 5, Álvarez et al. sec. V): the faces of the features
+//! the sensor selection ([`crate::graph::sensors`]) gave a laser scanner are left out of
+//! the touch plan and covered here, each in one setup, by the scanner's passes from few
+//! head orientations ([`crate::access::scan::face_coverage`]).
+//!
+//! A face is scanned in the setup of the plan whose `up` its mean normal faces most that
+//! reaches the plan's coverage (`scan_coverage`, 95 % of the area by default); where no
+//! setup of the touch plan does and the plan asked the laser for the feature, in the
+//! best of the part's other setups, which joins the plan (a feature the selection rule
+//! chose goes back to the touch probe instead: the hierarchy puts fewer setups first). In a setup the scanner comes after the touch probes, one sensor change in: the
+//! sensor is clustered under the setup as probes are, and a sensor change counts as a
+//! probe change. A face no setup covers enough is returned: a feature the selection gave
+//! the scanner by its rule goes back to the touch probe ([`super::plan_with`]); one the
+//! plan asked the laser for is reported unmeasured.
+//!
+//! **Decision:** coverage is judged at a cube-map resolution of at most 32 (cones of
+//! 6 × 32² directions, 2.8° pixels): the scanner's incidence limit and stripe are far
+//! coarser than that, and each face costs a few hundred cones.
+
+use super::hlip::{quantise, ScanPass, ScannedFace};
+use super::poses::Setups;
+use super::{FaceVisit, Hlip, Input, Inspection, OrientNode, ProbeNode, SetupNode};
+use crate::access::pose::{frame, Contact, Head, Pose};
+use crate::access::scan::{face_coverage, FaceCoverage, ScannerShape, Views};
+use crate::access::{ConeOptions, Scene};
+use crate::geometry::{FaceId, P3, V3};
+use crate::graph::sensors::Sensor;
+use crate::graph::Node;
+use crate::model::{FeatureId, SensorChoice, SlotId, ToleranceId};
+
+/// The overlap of neighbouring passes, as a share of the stripe's width.
+pub const OVERLAP: f64 = 0.2;
+
+/// A feature the sensor selection gave a scanner.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Laser {
+    /// The feature.
+    pub feature: FeatureId,
+    /// The scanner, by index among the machine's scanners.
+    pub scanner: usize,
+    /// Its faces.
+    pub faces: Vec<FaceId>,
+    /// Whether the plan asked for the laser (else the selection rule chose it).
+    pub asked: bool,
+    /// Why the scanner.
+    pub why: String,
+}
+
+/// The features of the plan's graph that go to a scanner, in feature order.
+pub(crate) fn lasers(input: &Input) -> Vec<Laser> {
+    let g = input.graph;
+    let mut faces_of: std::collections::BTreeMap<FeatureId, Vec<FaceId>> = Default::default();
+    for (n, node) in g.nodes() {
+        if let Node::Feature { feature, .. } = node {
+            for (c, _) in g.children(n) {
+                if let Node::Face { face, .. } = g.graph[c] {
+                    faces_of.entry(*feature).or_default().push(face);
+                }
+            }
+        }
+    }
+    g.sensors
+        .iter()
+        .filter_map(|s| match s.sensor {
+            Sensor::Laser(k) => Some(Laser {
+                feature: s.feature,
+                scanner: k,
+                faces: faces_of.get(&s.feature).cloned().unwrap_or_default(),
+                asked: input
+                    .plan
+                    .sensors
+                    .iter()
+                    .any(|(f, c, _)| *f == s.feature && *c == SensorChoice::Laser),
+                why: s.why.clone(),
+            }),
+            Sensor::Touch => None,
+        })
+        .filter(|l| !l.faces.is_empty())
+        .collect()
+}
+
+impl Memo {
+    /// The coverage of `face` in setup `up`, computed by `cover` the first time.
+    fn get(&mut self, face: FaceId, up: &V3, cover: &dyn Fn(&V3) -> FaceCoverage) -> FaceCoverage {
+        let key = (face.0, [up.x, up.y, up.z].map(|c| (c * 1e9).round() as i64));
+        self.0.entry(key).or_insert_with(|| cover(up)).clone()
+    }
+}
+
+/// A face no setup covers as the plan asks: the best share of its area any setup gave.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Uncovered {
+    /// The feature.
+    pub feature: FeatureId,
+    /// The face.
+    pub face: FaceId,
+    /// The best coverage found.
+    pub best: f64,
+}
+
+/// The coverages computed, by face and setup direction (to a nanometre), for the
+/// plan made again after features went back to touch: its setups are mostly the same.
+#[derive(Default)]
+pub(crate) struct Memo(std::collections::BTreeMap<(usize, [i64; 3]), FaceCoverage>);
+
+/// Where a face is scanned: the setup and the coverage there.
+struct Placed {
+    laser: usize,
+    face: FaceId,
+    setup: usize,
+    coverage: FaceCoverage,
+}
+
+/// Plans the scans of `lasers` into `hlip`: per face the setup, views and passes, in
+/// the setups' scanner nodes. Returns the faces no setup covers to the plan's
+/// `scan_coverage`; those are left out of the plan.
+pub(crate) fn plan_scans(
+    input: &Input,
+    hlip: &mut Hlip,
+    lasers: &[Laser],
+    opts: &super::PlanOptions,
+    memo: &mut Memo,
+) -> Vec<Uncovered> {
+    if lasers.is_empty() {
+        return Vec::new();
+    }
+    let (model, plan, g) = (input.model, input.plan, input.geometry);
+    let cmm = &model.cmms[plan.cmm.0];
+    let shapes = ScannerShape::of_cmm(model, cmm);
+    let scene = Scene::of_part(g);
+    let machine = super::domain::Machine::new(model, plan);
+    // The orientations the plan allows (one (0, 0) on a fixed head).
+    let grid: Vec<(f64, f64)> = machine
+        .grid_allowed
+        .ones()
+        .map(|k| machine.grid[k])
+        .collect();
+    let cone_opts = ConeOptions {
+        n: opts.n.min(32),
+        backend: opts.backend,
+        ..Default::default()
+    };
+    let backend = opts.backend.get();
+    let target = plan.scan_coverage;
+    let setups = Setups::new(model, plan, g, input.fixtures);
+    // The setups a face may go to: the plan's, then the part's others that can be held.
+    let mut ups: Vec<V3> = hlip.setups.iter().map(|s| s.up).collect();
+    let others: Vec<V3> = setups
+        .exact_dirs()
+        .into_iter()
+        .filter(|u| setups.holder(u).is_some())
+        .filter(|u| !ups.iter().any(|v| (u - v).norm() < 1e-6))
+        .collect();
+    // The table's height under the part in a setup and the fixture's solids, as the
+    // setup holds it.
+    let held_at = |up: &V3| match setups.holder(up) {
+        Some(h) => {
+            let solids = setups.solids(&h, up);
+            (setups.table(&h, up, &solids), solids)
+        }
+        None => (crate::access::pose::table_height(&scene, up), vec![]),
+    };
+    let margin = plan.motion.margin;
+    let mut placed: Vec<Placed> = Vec::new();
+    let mut uncovered = Vec::new();
+    for (li, l) in lasers.iter().enumerate() {
+        let shape = &shapes[l.scanner];
+        for &face in &l.faces {
+            let normal = mean_normal(g, face);
+            let cover = |up: &V3| {
+                let (table, solids) = held_at(up);
+                let views = Views {
+                    grid: &grid,
+                    overlap: OVERLAP,
+                    up: *up,
+                    table: (table, margin),
+                    fixture: &solids,
+                };
+                let mut c = face_coverage(backend, &scene, g, face.0, shape, &views, &cone_opts);
+                // The passes as the path stage will run them: a view whose housing does
+                // not clear the part, table and fixture by the margin along every pass
+                // is not the plan's.
+                c.views.retain(|v| {
+                    let pose = Pose::new(&scene, &shape.probe, v.dir, *up, table)
+                        .with_fixture(&solids)
+                        .with_margin(margin);
+                    let ok = v
+                        .lines
+                        .iter()
+                        .all(|l| pose.segment(&l.start, &l.end).is_ok());
+                    if !ok {
+                        c.covered -= v.share;
+                    }
+                    ok
+                });
+                c
+            };
+            // The plan's setups, the one the face looks up in most first.
+            let mut order: Vec<usize> = (0..ups.len()).collect();
+            order.sort_by(|&a, &b| {
+                normal
+                    .dot(&ups[b])
+                    .total_cmp(&normal.dot(&ups[a]))
+                    .then(a.cmp(&b))
+            });
+            let mut best: Option<(usize, FaceCoverage)> = None;
+            for s in order {
+                let c = memo.get(face, &ups[s], &cover);
+                let better = best
+                    .as_ref()
+                    .is_none_or(|b| c.covered > b.1.covered + 1e-12);
+                if better {
+                    best = Some((s, c));
+                }
+                if best.as_ref().is_some_and(|b| b.1.covered >= target) {
+                    break;
+                }
+            }
+            if l.asked && best.as_ref().is_none_or(|b| b.1.covered < target) {
+                // A setup the plan does not have yet, for a feature the plan asked the
+                // scanner for: the best of the others. (One the rule chose goes back to
+                // the touch probe instead: a setup costs more than touching it.)
+                let mut fresh: Option<(usize, FaceCoverage)> = None;
+                for (k, up) in others.iter().enumerate() {
+                    if ups.iter().any(|v| (up - v).norm() < 1e-6) {
+                        continue;
+                    }
+                    let c = memo.get(face, up, &cover);
+                    if fresh
+                        .as_ref()
+                        .is_none_or(|f| c.covered > f.1.covered + 1e-12)
+                    {
+                        fresh = Some((k, c));
+                    }
+                }
+                if let Some((k, c)) = fresh {
+                    let gain = best
+                        .as_ref()
+                        .is_none_or(|b| c.covered > b.1.covered + 1e-12);
+                    if c.covered >= target && gain {
+                        ups.push(others[k]);
+                        best = Some((ups.len() - 1, c));
+                    } else if gain && best.as_ref().is_none_or(|b| b.1.covered < c.covered) {
+                        best = Some((usize::MAX, c));
+                    }
+                }
+            }
+            match best {
+                Some((s, c)) if s != usize::MAX && c.covered >= target => placed.push(Placed {
+                    laser: li,
+                    face,
+                    setup: s,
+                    coverage: c,
+                }),
+                b => uncovered.push(Uncovered {
+                    feature: l.feature,
+                    face,
+                    best: b.map_or(0.0, |b| b.1.covered),
+                }),
+            }
+        }
+    }
+    // A feature is scanned whole or not at all: one face short sends it all back.
+    placed.retain(|p| {
+        !uncovered
+            .iter()
+            .any(|u| u.feature == lasers[p.laser].feature)
+    });
+    // New setups join the plan, held as the part's setups say.
+    for up in ups
+        .iter()
+        .skip(hlip.setups.len())
+        .copied()
+        .collect::<Vec<_>>()
+    {
+        if !placed.iter().any(|p| (ups[p.setup] - up).norm() < 1e-6) {
+            continue;
+        }
+        let Some(holder) = setups.holder(&up) else {
+            continue;
+        };
+        let solids = setups.solids(&holder, &up);
+        let table = super::hlip::round(setups.table(&holder, &up, &solids));
+        let r = frame(&up).into_inner();
+        hlip.setups.push(SetupNode {
+            up: quantise(&up),
+            rotation: [0, 1, 2].map(|i| [0, 1, 2].map(|j| super::hlip::round(r[(i, j)]))),
+            on_table: vec![],
+            holder,
+            table,
+            fixture: solids,
+            probes: vec![],
+        });
+    }
+    let setup_of = |p: &Placed| {
+        hlip.setups
+            .iter()
+            .position(|s| (s.up - ups[p.setup]).norm() < 1e-5)
+            .unwrap_or(0)
+    };
+    let placed: Vec<(usize, Placed)> = placed.into_iter().map(|p| (setup_of(&p), p)).collect();
+    let part = &model.parts[plan.part.0];
+    let probes = cmm.probes.len();
+    for (s, p) in &placed {
+        let l = &lasers[p.laser];
+        let slot = SlotId(probes + l.scanner);
+        let node = &mut hlip.setups[*s];
+        let pi = match node.probes.iter().position(|n| n.probe == slot) {
+            Some(k) => k,
+            None => {
+                node.probes.push(ProbeNode {
+                    probe: slot,
+                    orients: vec![],
+                });
+                node.probes.len() - 1
+            }
+        };
+        let last_view = p.coverage.views.len().saturating_sub(1);
+        for (vi, v) in p.coverage.views.iter().enumerate() {
+            let orients = &mut node.probes[pi].orients;
+            let oi = match orients
+                .iter()
+                .position(|o| o.a.to_bits() == v.a.to_bits() && o.b.to_bits() == v.b.to_bits())
+            {
+                Some(k) => k,
+                None => {
+                    orients.push(OrientNode {
+                        a: v.a,
+                        b: v.b,
+                        direction: quantise(&v.dir),
+                        inspections: vec![],
+                    });
+                    orients.len() - 1
+                }
+            };
+            let o = &mut orients[oi];
+            let passes: Vec<ScanPass> = v
+                .lines
+                .iter()
+                .map(|x| ScanPass {
+                    start: P3::from(quantise(&x.start.coords)),
+                    end: P3::from(quantise(&x.end.coords)),
+                })
+                .collect();
+            let visit = FaceVisit {
+                face: p.face,
+                contact: Contact::Part,
+                points: vec![],
+                passes,
+            };
+            // The tolerances reading the feature are recorded with its last view.
+            let records: Vec<ToleranceId> = if vi == last_view {
+                records_of(part, l.feature)
+            } else {
+                vec![]
+            };
+            match o
+                .inspections
+                .iter_mut()
+                .find(|i| i.feature == Some(l.feature))
+            {
+                Some(i) => {
+                    i.faces.push(visit);
+                    for r in records {
+                        if !i.records.contains(&r) {
+                            i.records.push(r);
+                        }
+                    }
+                }
+                None => o.inspections.push(Inspection {
+                    feature: Some(l.feature),
+                    faces: vec![visit],
+                    records,
+                }),
+            }
+        }
+        hlip.scans.push(ScannedFace {
+            feature: l.feature,
+            face: p.face,
+            scanner: slot,
+            setup: *s,
+            coverage: p.coverage.covered,
+            views: p.coverage.views.len(),
+            passes: p.coverage.views.iter().map(|v| v.passes).sum(),
+            why: l.why.clone(),
+        });
+    }
+    hlip.scans.sort_by_key(|s| (s.feature, s.face));
+    recount(hlip, machine.head);
+    uncovered
+}
+
+/// The tolerances that read a feature: as a target or through a datum it carries.
+fn records_of(part: &crate::model::Part, f: FeatureId) -> Vec<ToleranceId> {
+    part.tolerances
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| {
+            t.targets.contains(&f) || t.datums.iter().any(|d| part.datums[d.datum.0].feature == f)
+        })
+        .map(|(k, _)| ToleranceId(k))
+        .collect()
+}
+
+/// A face's area-weighted mean outward normal (zero for a closed cylinder).
+fn mean_normal(g: &crate::geometry::PartGeometry, face: FaceId) -> V3 {
+    let mut n = V3::zeros();
+    for &t in &g.faces[face.0].triangles {
+        let [a, b, c] = g.triangles[t as usize].map(|i| g.vertices[i as usize]);
+        n += (b - a).cross(&(c - a));
+    }
+    n.try_normalize(1e-12).unwrap_or_else(V3::zeros)
+}
+
+/// The plan's counts once scans joined it: setups, sensors used and sensor changes,
+/// orientations and their changes, scanned faces and passes.
+pub(crate) fn recount(hlip: &mut Hlip, head: Head) {
+    let mut seq: Vec<(SlotId, (u64, u64))> = Vec::new();
+    for s in &hlip.setups {
+        for p in &s.probes {
+            for o in &p.orients {
+                seq.push((p.probe, (o.a.to_bits(), o.b.to_bits())));
+            }
+        }
+    }
+    let s = &mut hlip.summary;
+    s.setups = hlip.setups.len();
+    s.probe_changes = seq.windows(2).filter(|w| w[0].0 != w[1].0).count();
+    s.probes_used = seq
+        .iter()
+        .map(|x| x.0)
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    if head == Head::Indexable {
+        s.orientation_changes = seq.windows(2).filter(|w| w[0].1 != w[1].1).count();
+        s.orientations = seq
+            .iter()
+            .map(|x| x.1)
+            .collect::<std::collections::BTreeSet<_>>()
+            .len();
+    }
+    s.scanned = (hlip.scans.len(), hlip.scans.iter().map(|x| x.passes).sum());
+}
