@@ -159,13 +159,22 @@ pub fn scan_cones(
         radius: RAY_RADIUS,
         end: End::Round,
     };
+    let optics = &scanner.optics;
+    // Only directions above the tangent plane through `from` are asked of the laser and
+    // camera maps (both lie within the incidence limit or the triangulation angle of
+    // `n`): a triangle wholly below that plane blocks none of them.
+    let height = |t: &super::Tri| {
+        t.v.iter()
+            .map(|v| (v - from).dot(n))
+            .fold(f64::MIN, f64::max)
+    };
+    let above = scene.culled(|t| height(t) <= 0.0);
     // The laser at pixel centres (exact there), the camera's lines of sight in whole
     // free pixels.
     let laser = backend
-        .blocked(scene, &from, &Component::half_line(), res, pref)
+        .blocked(&above, &from, &Component::half_line(), res, pref)
         .not();
-    let free = backend.blocked(scene, &from, &ray, res, pref).not();
-    let optics = &scanner.optics;
+    let free = backend.blocked(&above, &from, &ray, res, pref).not();
     let mut rays = laser.and(&laser.cap(n, optics.max_incidence.cos()));
     let cells: Vec<_> = rays.cells().collect();
     for cell in cells {
@@ -176,14 +185,21 @@ pub fn scan_cones(
     }
     let mut visible = rays.clone();
     if !visible.is_empty() {
-        visible.and_assign(&gac(
-            backend,
-            scene,
-            &from,
-            &scanner.probe.leading(),
-            res,
-            pref,
-        ));
+        // The housing is asked only in the pixels of `rays`, within the incidence limit
+        // α of `n`: each of their directions within α + δ, δ = 3/N rad a pixel's
+        // diameter (2√2/N at most), which also bounds the pixels a preferred direction
+        // of the cap is judged by. A component from a along d with radius r stays at
+        // least a·cos(α + δ) − r above the tangent plane; a triangle wholly below that
+        // cannot touch it. (Drawn at D2's coarser resolution it took a sixth less time
+        // and cost CTC 01's mixed plan two more head orientations: not taken.)
+        let leading = scanner.probe.leading();
+        let widest = (optics.max_incidence + 3.0 / res as f64).min(std::f64::consts::FRAC_PI_2);
+        let floor = leading
+            .iter()
+            .map(|c| c.a * widest.cos() - c.radius)
+            .fold(f64::INFINITY, f64::min);
+        let near = scene.culled(|t| height(t) < floor);
+        visible.and_assign(&gac(backend, &near, &from, &leading, res, pref));
     }
     let d2 = scanner.probe.head.indexable().then(|| {
         d2(
@@ -301,15 +317,133 @@ fn face_samples(g: &crate::geometry::PartGeometry, face: usize) -> Vec<(P3, V3, 
     out
 }
 
-/// The coverage of `face` by a scanner from the head orientations of `views` (one (0, 0)
-/// for a fixed head), the part standing with `views.up` facing the ram. Per sample, the
-/// orientations whose direction the scanner's cone sees it from and whose head and ram
-/// clear the part; then a greedy cover by area until a view would add less than 1 % of
-/// it, taking among the views within 1 % of the best gain the one nearest the mean
-/// normal of what it sees. Per chosen orientation its passes: the stripe square to the
-/// motion, which runs along whichever of 12 directions (15° apart) in the view's plane
-/// makes the passes shortest, the views' overlap between neighbouring passes, and one
-/// elevation per depth of field.
+/// A face's area-weighted samples and, per sample, the directions the scanner sees it
+/// from ([`ScanCones::visible`]): what a face's coverage needs that does not depend on
+/// the setup, so a planner trying the face in several setups draws its cones once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FaceCones {
+    /// Samples: point, outward normal, the area it stands for.
+    samples: Vec<(P3, V3, f64)>,
+    /// Per sample, where the laser, the camera and the housing clear the part.
+    visible: Vec<CubeMap>,
+}
+
+impl FaceCones {
+    /// The cones of `face`'s samples for `scanner`.
+    pub fn new(
+        backend: &dyn Backend,
+        scene: &super::Scene,
+        g: &crate::geometry::PartGeometry,
+        face: usize,
+        scanner: &ScannerShape,
+        opts: &ConeOptions,
+    ) -> FaceCones {
+        let samples = face_samples(g, face);
+        // D2 is not asked: the coverage decides the head and ram per orientation from
+        // one depth map along the setup's `up`.
+        let opts = ConeOptions {
+            d2_samples: 0,
+            ..opts.clone()
+        };
+        let visible = samples
+            .par_iter()
+            .map(|(p, n, _)| scan_cones(backend, scene, p, n, scanner, &opts).visible)
+            .collect();
+        FaceCones { samples, visible }
+    }
+
+    /// The coverage of the face by `scanner` from the head orientations of `views` (one
+    /// (0, 0) for a fixed head), the part standing with `views.up` facing the ram. Per
+    /// sample, the orientations whose direction the scanner's cone sees it from and
+    /// whose head and ram clear the part; then a greedy cover by area until a view would
+    /// add less than 1 % of it, taking among the views within 1 % of the best gain the
+    /// one nearest the mean normal of what it sees. Per chosen orientation its passes:
+    /// the stripe square to the motion, which runs along whichever of 12 directions (15°
+    /// apart) in the view's plane makes the passes shortest, the views' overlap between
+    /// neighbouring passes, and one elevation per depth of field.
+    pub fn coverage(
+        &self,
+        scene: &super::Scene,
+        scanner: &ScannerShape,
+        views: &Views,
+    ) -> FaceCoverage {
+        let samples = &self.samples;
+        let (grid, overlap) = (views.grid, views.overlap);
+        let area: f64 = samples.iter().map(|s| s.2).sum();
+        // How far apart the samples lie.
+        let spacing = (2.0 * area / FACE_SAMPLES as f64).sqrt();
+        let up = views.up;
+        let dirs: Vec<V3> = match scanner.probe.head {
+            super::pose::Head::Indexable => grid
+                .iter()
+                .map(|&(a, b)| super::pose::orientation_dir(&up, a, b))
+                .collect(),
+            super::pose::Head::Fixed => vec![up; grid.len()],
+        };
+        let reach = scanner.probe.reach();
+        // The head and ram hang straight down from the articulation point: one depth map
+        // along `up` answers for every sample and orientation.
+        let second = scanner.probe.head.indexable().then(|| {
+            let radius = scanner
+                .probe
+                .second
+                .iter()
+                .map(|c| c.radius)
+                .fold(0.0, f64::max);
+            super::SecondMap::new(scene, &up, radius, reach)
+        });
+        // The housing keeps off the table wherever in the depth of field a pass puts the
+        // focus: checked with the focus half the depth nearer the table.
+        let (table, margin) = views.table;
+        let off_table = |p: &P3, d: &V3| {
+            let c = p - d * (scanner.optics.depth / 2.0);
+            scanner
+                .probe
+                .first
+                .iter()
+                .all(|comp| super::pose::lowest(comp, &c, d, &up) >= table + margin)
+        };
+        // The fixture, per direction: the scanner posed with its focus at the sample.
+        let held: Vec<Option<super::pose::Pose>> = dirs
+            .iter()
+            .map(|d| {
+                (!views.fixture.is_empty()).then(|| {
+                    super::pose::Pose::new(scene, &scanner.probe, *d, up, table)
+                        .with_fixture(views.fixture)
+                        .with_margin(margin)
+                })
+            })
+            .collect();
+        let sees_from: Vec<Vec<bool>> = samples
+            .par_iter()
+            .zip(&self.visible)
+            .map(|((p, n, _), visible)| {
+                let from = p + n * LIFT;
+                dirs.iter()
+                    .zip(&held)
+                    .map(|(d, pose)| {
+                        visible.contains(d)
+                            && off_table(p, d)
+                            && second.as_ref().is_none_or(|m| m.clear(&(from + d * reach)))
+                            && pose.as_ref().is_none_or(|x| x.clear_of_fixture(p))
+                    })
+                    .collect()
+            })
+            .collect();
+        greedy_cover(
+            samples,
+            &sees_from,
+            &dirs,
+            grid,
+            &scanner.optics,
+            overlap,
+            spacing,
+        )
+    }
+}
+
+/// The coverage of `face` by a scanner from the head orientations of `views`:
+/// [`FaceCones::coverage`] of the face's cones.
 pub fn face_coverage(
     backend: &dyn Backend,
     scene: &super::Scene,
@@ -319,74 +453,21 @@ pub fn face_coverage(
     views: &Views,
     opts: &ConeOptions,
 ) -> FaceCoverage {
-    let (grid, overlap) = (views.grid, views.overlap);
-    let samples = face_samples(g, face);
+    FaceCones::new(backend, scene, g, face, scanner, opts).coverage(scene, scanner, views)
+}
+
+/// The greedy cover of [`FaceCones::coverage`]: `sees_from[i][j]` says whether sample
+/// `i` is seen from direction `dirs[j]` (head angles `grid[j]`).
+fn greedy_cover(
+    samples: &[(P3, V3, f64)],
+    sees_from: &[Vec<bool>],
+    dirs: &[V3],
+    grid: &[(f64, f64)],
+    optics: &Optics,
+    overlap: f64,
+    spacing: f64,
+) -> FaceCoverage {
     let area: f64 = samples.iter().map(|s| s.2).sum();
-    // How far apart the samples lie.
-    let spacing = (2.0 * area / FACE_SAMPLES as f64).sqrt();
-    let up = views.up;
-    let dirs: Vec<V3> = match scanner.probe.head {
-        super::pose::Head::Indexable => grid
-            .iter()
-            .map(|&(a, b)| super::pose::orientation_dir(&up, a, b))
-            .collect(),
-        super::pose::Head::Fixed => vec![up; grid.len()],
-    };
-    let reach = scanner.probe.reach();
-    // The head and ram hang straight down from the articulation point: one depth map
-    // along `up` answers for every sample and orientation.
-    let second = scanner.probe.head.indexable().then(|| {
-        let radius = scanner
-            .probe
-            .second
-            .iter()
-            .map(|c| c.radius)
-            .fold(0.0, f64::max);
-        super::SecondMap::new(scene, &up, radius, reach)
-    });
-    // D2 is not asked: the depth map above decides the head and ram per orientation.
-    let opts = ConeOptions {
-        d2_samples: 0,
-        ..opts.clone()
-    };
-    // The housing keeps off the table wherever in the depth of field a pass puts the
-    // focus: checked with the focus half the depth nearer the table.
-    let (table, margin) = views.table;
-    let off_table = |p: &P3, d: &V3| {
-        let c = p - d * (scanner.optics.depth / 2.0);
-        scanner
-            .probe
-            .first
-            .iter()
-            .all(|comp| super::pose::lowest(comp, &c, d, &up) >= table + margin)
-    };
-    // The fixture, per direction: the scanner posed with its focus at the sample.
-    let held: Vec<Option<super::pose::Pose>> = dirs
-        .iter()
-        .map(|d| {
-            (!views.fixture.is_empty()).then(|| {
-                super::pose::Pose::new(scene, &scanner.probe, *d, up, table)
-                    .with_fixture(views.fixture)
-                    .with_margin(margin)
-            })
-        })
-        .collect();
-    let sees_from: Vec<Vec<bool>> = samples
-        .par_iter()
-        .map(|(p, n, _)| {
-            let cones = scan_cones(backend, scene, p, n, scanner, &opts);
-            let from = p + n * LIFT;
-            dirs.iter()
-                .zip(&held)
-                .map(|(d, pose)| {
-                    cones.visible.contains(d)
-                        && off_table(p, d)
-                        && second.as_ref().is_none_or(|m| m.clear(&(from + d * reach)))
-                        && pose.as_ref().is_none_or(|x| x.clear_of_fixture(p))
-                })
-                .collect()
-        })
-        .collect();
     let mut left: Vec<bool> = vec![true; samples.len()];
     let mut views = Vec::new();
     let mut covered = 0.0;
@@ -425,7 +506,7 @@ pub fn face_coverage(
         }
         covered += gains[j];
         let pts: Vec<P3> = mine.iter().map(|&i| samples[i].0).collect();
-        let (lines, elevations) = passes(&pts, &dirs[j], &scanner.optics, overlap, spacing / 2.0);
+        let (lines, elevations) = passes(&pts, &dirs[j], optics, overlap, spacing / 2.0);
         views.push(View {
             a: grid[j].0,
             b: grid[j].1,

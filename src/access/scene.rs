@@ -29,7 +29,8 @@ pub struct Scene {
     pub closed: bool,
     /// The diagonal of its bounds (mm).
     pub size: f64,
-    mesh: Option<TriMesh>,
+    /// Shared with the scenes [`Scene::culled`] makes of it.
+    mesh: Option<std::sync::Arc<TriMesh>>,
 }
 
 impl Scene {
@@ -66,7 +67,9 @@ impl Scene {
         let mesh = if tris.is_empty() {
             None
         } else {
-            TriMesh::new(vertices, indices).ok()
+            TriMesh::new(vertices, indices)
+                .ok()
+                .map(std::sync::Arc::new)
         };
         Scene {
             tris,
@@ -90,6 +93,18 @@ impl Scene {
         Scene::new(tris, self.closed)
     }
 
+    /// The scene less the triangles `cull` says cannot touch what is asked of it: cones
+    /// drawn on it are the whole scene's only where that holds. Exact queries
+    /// ([`Scene::cast_ray`], [`Scene::distance`]) still answer for the whole scene.
+    pub fn culled(&self, cull: impl Fn(&Tri) -> bool) -> Scene {
+        Scene {
+            tris: self.tris.iter().filter(|t| !cull(t)).cloned().collect(),
+            closed: self.closed,
+            size: self.size,
+            mesh: self.mesh.clone(),
+        }
+    }
+
     /// The first hit of the ray `from + t·d` (t > 0, `d` unit), if within `max`.
     pub fn cast_ray(&self, from: &P3, d: &V3, max: f64) -> Option<f64> {
         let mesh = self.mesh.as_ref()?;
@@ -106,7 +121,7 @@ impl Scene {
 
     /// The parry mesh, for exact shape queries.
     pub fn mesh(&self) -> Option<&TriMesh> {
-        self.mesh.as_ref()
+        self.mesh.as_deref()
     }
 }
 

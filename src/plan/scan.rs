@@ -21,7 +21,7 @@ use super::hlip::{quantise, ScanPass, ScannedFace};
 use super::poses::Setups;
 use super::{FaceVisit, Hlip, Input, Inspection, OrientNode, ProbeNode, SetupNode};
 use crate::access::pose::{frame, Contact, Head, Pose};
-use crate::access::scan::{face_coverage, FaceCoverage, ScannerShape, Views};
+use crate::access::scan::{FaceCones, FaceCoverage, ScannerShape, Views};
 use crate::access::{ConeOptions, Scene};
 use crate::geometry::{FaceId, P3, V3};
 use crate::graph::sensors::Sensor;
@@ -80,10 +80,28 @@ pub(crate) fn lasers(input: &Input) -> Vec<Laser> {
 }
 
 impl Memo {
-    /// The coverage of `face` in setup `up`, computed by `cover` the first time.
-    fn get(&mut self, face: FaceId, up: &V3, cover: &dyn Fn(&V3) -> FaceCoverage) -> FaceCoverage {
-        let key = (face.0, [up.x, up.y, up.z].map(|c| (c * 1e9).round() as i64));
-        self.0.entry(key).or_insert_with(|| cover(up)).clone()
+    /// The coverage of `face` by scanner `scanner` in setup `up`, computed by `cover`
+    /// the first time, on the face's cones drawn by `cones` the first time it is asked
+    /// in any setup.
+    fn get(
+        &mut self,
+        (scanner, face): (usize, FaceId),
+        up: &V3,
+        cones: &dyn Fn() -> FaceCones,
+        cover: &dyn Fn(&FaceCones, &V3) -> FaceCoverage,
+    ) -> FaceCoverage {
+        let key = (
+            scanner,
+            face.0,
+            [up.x, up.y, up.z].map(|c| (c * 1e9).round() as i64),
+        );
+        if let Some(c) = self.coverages.get(&key) {
+            return c.clone();
+        }
+        let cones = self.cones.entry((scanner, face.0)).or_insert_with(cones);
+        let c = cover(cones, up);
+        self.coverages.insert(key, c.clone());
+        c
     }
 }
 
@@ -98,10 +116,14 @@ pub(crate) struct Uncovered {
     pub best: f64,
 }
 
-/// The coverages computed, by face and setup direction (to a nanometre), for the
-/// plan made again after features went back to touch: its setups are mostly the same.
+/// The coverages computed, by scanner, face and setup direction (to a nanometre), for
+/// the plan made again after features went back to touch (its setups are mostly the
+/// same), and the faces' cones, which every setup's coverage shares.
 #[derive(Default)]
-pub(crate) struct Memo(std::collections::BTreeMap<(usize, [i64; 3]), FaceCoverage>);
+pub(crate) struct Memo {
+    coverages: std::collections::BTreeMap<(usize, usize, [i64; 3]), FaceCoverage>,
+    cones: std::collections::BTreeMap<(usize, usize), FaceCones>,
+}
 
 /// Where a face is scanned: the setup and the coverage there.
 struct Placed {
@@ -167,7 +189,8 @@ pub(crate) fn plan_scans(
         let shape = &shapes[l.scanner];
         for &face in &l.faces {
             let normal = mean_normal(g, face);
-            let cover = |up: &V3| {
+            let cones = || FaceCones::new(backend, &scene, g, face.0, shape, &cone_opts);
+            let cover = |cones: &FaceCones, up: &V3| {
                 let (table, solids) = held_at(up);
                 let views = Views {
                     grid: &grid,
@@ -176,7 +199,7 @@ pub(crate) fn plan_scans(
                     table: (table, margin),
                     fixture: &solids,
                 };
-                let mut c = face_coverage(backend, &scene, g, face.0, shape, &views, &cone_opts);
+                let mut c = cones.coverage(&scene, shape, &views);
                 // The passes as the path stage will run them: a view whose housing does
                 // not clear the part, table and fixture by the margin along every pass
                 // is not the plan's.
@@ -205,7 +228,7 @@ pub(crate) fn plan_scans(
             });
             let mut best: Option<(usize, FaceCoverage)> = None;
             for s in order {
-                let c = memo.get(face, &ups[s], &cover);
+                let c = memo.get((l.scanner, face), &ups[s], &cones, &cover);
                 let better = best
                     .as_ref()
                     .is_none_or(|b| c.covered > b.1.covered + 1e-12);
@@ -225,7 +248,7 @@ pub(crate) fn plan_scans(
                     if ups.iter().any(|v| (up - v).norm() < 1e-6) {
                         continue;
                     }
-                    let c = memo.get(face, up, &cover);
+                    let c = memo.get((l.scanner, face), up, &cones, &cover);
                     if fresh
                         .as_ref()
                         .is_none_or(|f| c.covered > f.1.covered + 1e-12)
