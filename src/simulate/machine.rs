@@ -17,7 +17,7 @@ use crate::source::Span;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, Unit, UnitQuaternion};
 use parry3d_f64::query::{cast_shapes, PointQuery, Ray, RayCast, ShapeCastOptions};
 use parry3d_f64::shape::Ball;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// What the virtual CMM runs.
 const SUPPORTED: &str = "DMISMN, UNITS/MM, MODE, SNSET, SNSDEF, SNSLCT, FEAT, TOL, TEXT, PAUSE, RECALL, ROTATE, DATSET, TRANS, GOTO, MEAS, PTMEAS, PATH/LINE, PAMEAS, ENDMES, CONST, DATDEF, OUTPUT, ENDFIL";
@@ -933,8 +933,10 @@ impl Machine<'_> {
             .try_normalize(1e-9)
             .unwrap_or_else(|| fit::across(&dir).0);
         let across = dir.cross(&motion).normalize();
-        let along_n = ((run.norm() / optics.spacing[1]).floor() as usize).clamp(1, CLOUD.0);
-        let across_n = ((optics.stripe / optics.spacing[0]).floor() as usize).clamp(1, CLOUD.1);
+        let most = (
+            ((run.norm() / optics.spacing[1]).floor() as usize).max(1),
+            ((optics.stripe / optics.spacing[0]).floor() as usize).max(1),
+        );
         // The block's nominal in the part frame (the program's frame is the part's).
         let nominal = self
             .block
@@ -948,41 +950,63 @@ impl Machine<'_> {
         } else {
             0.0
         };
+        // The stripe sampled `along_n` + 1 times, `across_n` + 1 points each: the points
+        // kept, and on how many stripes and stripe positions they lie.
+        let sample = |along_n: usize, across_n: usize| {
+            let mut cloud = Vec::new();
+            let (mut rows, mut cols) = (BTreeSet::new(), BTreeSet::new());
+            for i in 0..=along_n {
+                for j in 0..=across_n {
+                    let f = sp
+                        + run * (i as f64 / along_n as f64)
+                        + across * (optics.stripe * (j as f64 / across_n as f64 - 0.5));
+                    let c0 = f + dir * optics.standoff;
+                    let travel = optics.standoff + optics.depth / 2.0;
+                    let Found::Contact(c, Contact::Part, Some(face)) =
+                        self.search_surface(ctx, &c0, &dir, 0.0, travel)
+                    else {
+                        continue;
+                    };
+                    if (c0 - c).dot(&dir) < near {
+                        continue;
+                    }
+                    let n = g.faces[face.0]
+                        .surface
+                        .normal_at(&c)
+                        .unwrap_or(dir)
+                        .normalize();
+                    if !crate::access::scan::sees(&self.scene, &c, &n, &dir, &optics) {
+                        continue;
+                    }
+                    // A point on a face of another surface (a fillet, the next wall) is
+                    // not the feature's; a free-form nominal keeps every point.
+                    let own = match (&nominal, Shape::of_surface(&g.faces[face.0].surface)) {
+                        (Some(Shape::Surface) | None, _) => true,
+                        (Some(shape), Some((surface, _))) => shape.same_surface(&surface, CLIP),
+                        (Some(_), None) => false,
+                    };
+                    if !own {
+                        continue;
+                    }
+                    rows.insert(i);
+                    cols.insert(j);
+                    cloud.push((place * c, place.rotation * n));
+                }
+            }
+            (cloud, rows.len().min(cols.len()))
+        };
+        // Thinned to CLOUD; on a feature narrower than the thinned stripe (a strip the
+        // pass runs along) or shorter than its spacing, sampled 4 and 16 times as
+        // densely across and along, up to the scanner's own spacing, until the points
+        // lie on three stripes and three positions along them.
         let mut cloud = Vec::new();
-        for i in 0..=along_n {
-            for j in 0..=across_n {
-                let f = sp
-                    + run * (i as f64 / along_n as f64)
-                    + across * (optics.stripe * (j as f64 / across_n as f64 - 0.5));
-                let c0 = f + dir * optics.standoff;
-                let travel = optics.standoff + optics.depth / 2.0;
-                let Found::Contact(c, Contact::Part, Some(face)) =
-                    self.search_surface(ctx, &c0, &dir, 0.0, travel)
-                else {
-                    continue;
-                };
-                if (c0 - c).dot(&dir) < near {
-                    continue;
-                }
-                let n = g.faces[face.0]
-                    .surface
-                    .normal_at(&c)
-                    .unwrap_or(dir)
-                    .normalize();
-                if !crate::access::scan::sees(&self.scene, &c, &n, &dir, &optics) {
-                    continue;
-                }
-                // A point on a face of another surface (a fillet, the next wall) is
-                // not the feature's; a free-form nominal keeps every point.
-                let own = match (&nominal, Shape::of_surface(&g.faces[face.0].surface)) {
-                    (Some(Shape::Surface) | None, _) => true,
-                    (Some(shape), Some((surface, _))) => shape.same_surface(&surface, CLIP),
-                    (Some(_), None) => false,
-                };
-                if !own {
-                    continue;
-                }
-                cloud.push((place * c, place.rotation * n));
+        for k in [1, 4, 16] {
+            let (along_n, across_n) = ((CLOUD.0 * k).min(most.0), (CLOUD.1 * k).min(most.1));
+            let (points, spread) = sample(along_n, across_n);
+            cloud = points;
+            let finest = along_n == most.0 && across_n == most.1;
+            if spread >= 3 || finest {
+                break;
             }
         }
         let prog = self.frame.inverse();
@@ -1555,20 +1579,18 @@ enum Found {
 }
 
 /// The first `t` in `[0, max]` where `gap` falls from positive to zero, by steps then
-/// bisection.
+/// bisection. The gaps are signed distances (less a bow of small slope), which change
+/// by at most twice the distance moved: a step of half the gap, or [`SEARCH_STEP`]
+/// where that is more, cannot cross a root, so a scanner's point 100 mm from where its
+/// search starts takes a few dozen steps, not ten thousand.
 fn first_root(gap: &dyn Fn(f64) -> f64, max: f64) -> Option<f64> {
-    let steps = (max / SEARCH_STEP).ceil().max(1.0) as usize;
     let mut lo = 0.0;
-    let mut armed = gap(0.0) > 0.0;
-    for k in 1..=steps {
-        let hi = (k as f64 * SEARCH_STEP).min(max);
-        let g = gap(hi);
-        if !armed {
-            armed = g > 0.0;
-            lo = hi;
-            continue;
-        }
-        if g <= 0.0 {
+    let mut g = gap(0.0);
+    let mut armed = g > 0.0;
+    while lo < max {
+        let hi = (lo + (g.abs() / 2.0).max(SEARCH_STEP)).min(max);
+        let gh = gap(hi);
+        if armed && gh <= 0.0 {
             let (mut a, mut b) = (lo, hi);
             for _ in 0..60 {
                 let m = 0.5 * (a + b);
@@ -1580,7 +1602,9 @@ fn first_root(gap: &dyn Fn(f64) -> f64, max: f64) -> Option<f64> {
             }
             return Some(0.5 * (a + b));
         }
+        armed |= gh > 0.0;
         lo = hi;
+        g = gh;
     }
     None
 }
