@@ -107,7 +107,10 @@ pub(super) fn draw<'s>(
     let from_tip = comp.a == 0.0;
     let mut candidates: Vec<&Tri> = Vec::new();
     let mut q = [V3::zeros(); 12];
-    for t in &scene.tris {
+    for t in scene.tris.iter() {
+        if scene.skips(t) {
+            continue;
+        }
         let dc = (t.centre - from).norm();
         if dc - t.radius > far || dc + t.radius < near {
             continue;

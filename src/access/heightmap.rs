@@ -36,7 +36,7 @@ impl HeightMap {
                 d.dot(&v),
             )
         };
-        for t in &scene.tris {
+        for t in scene.tris.iter() {
             let q = t.v.map(|p| to_uv(&p));
             let (umin, umax) = (
                 q[0].0.min(q[1].0).min(q[2].0),

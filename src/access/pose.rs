@@ -304,6 +304,24 @@ impl Solid {
         (local.iter().map(|p| self.at * p).collect(), tris)
     }
 
+    /// A sphere around it (part frame): centre and radius.
+    pub fn bounding_sphere(&self) -> (P3, f64) {
+        match &self.shape {
+            SolidShape::Box(h) => (P3::from(self.at.translation.vector), h.norm()),
+            SolidShape::Cylinder {
+                half_height,
+                radius,
+            } => (
+                P3::from(self.at.translation.vector),
+                half_height.hypot(*radius),
+            ),
+            SolidShape::Mesh(m) => {
+                let b = m.local_aabb();
+                (self.at * b.center(), b.half_extents().norm())
+            }
+        }
+    }
+
     /// Whether a shape given in the part frame meets this solid.
     pub fn hits(&self, shape: &dyn Shape) -> bool {
         let id = Isometry::identity();
@@ -520,11 +538,13 @@ impl<'a> Pose<'a> {
         if self.fixture.is_empty() {
             return Ok(());
         }
+        let spheres: Vec<(P3, f64)> = self.fixture.iter().map(Solid::bounding_sphere).collect();
         let hits = |s: &dyn Shape| self.fixture.iter().any(|f| f.hits(s));
-        self.sweep(p, q, &hits, grow).map_err(|b| match b {
-            Blocker::Component(c) => Blocker::Fixture(c),
-            _ => Blocker::Fixture("tip".into()),
-        })
+        self.sweep(p, q, &hits, grow, Some(&spheres))
+            .map_err(|b| match b {
+                Blocker::Component(c) => Blocker::Fixture(c),
+                _ => Blocker::Fixture("tip".into()),
+            })
     }
 
     /// Whether the probe standing with its tip centre at `p` is clear by the margin
@@ -561,7 +581,7 @@ impl<'a> Pose<'a> {
         if let Some(mesh) = self.scene.mesh() {
             let id = Isometry::identity();
             let hits = |shape: &dyn Shape| intersection_test(&id, shape, &id, mesh).unwrap_or(true);
-            self.sweep(p, q, &hits, margin)?;
+            self.sweep(p, q, &hits, margin, None)?;
         }
         self.sweep_fixture(p, q, margin)
     }
@@ -576,10 +596,20 @@ impl<'a> Pose<'a> {
         q: &P3,
         hits: &dyn Fn(&dyn Shape) -> bool,
         grow: f64,
+        spheres: Option<&[(P3, f64)]>,
     ) -> Result<(), Blocker> {
         let v = q - p;
         let moving = v.norm() > 1e-9;
-        if self.tip_radius > 0.0 && hits(&Capsule::new(*p, *q, self.tip_radius + grow)) {
+        // Whether a shape within `r` of `c` may meet the obstacle: with `spheres` (one
+        // around each of its solids), only when one of them is that near.
+        let near = |c: &P3, r: f64| {
+            spheres.is_none_or(|s| s.iter().any(|(x, rx)| (x - c).norm() <= r + rx))
+        };
+        let tip = self.tip_radius + grow;
+        if self.tip_radius > 0.0
+            && near(&(p + v / 2.0), v.norm() / 2.0 + tip)
+            && hits(&Capsule::new(*p, *q, tip))
+        {
             return Err(Blocker::Tip);
         }
         let far = 4.0 * self.scene.size + 10.0;
@@ -589,8 +619,14 @@ impl<'a> Pose<'a> {
             let b = c.b.min(c.a + far);
             let a0 = p + part.offset + part.dir * c.a;
             let b0 = p + part.offset + part.dir * b;
+            // A sphere around the swept component (its discs' circumscribed polygons
+            // included): the middle of the move, out to its farthest end.
+            let mid = P3::from((a0.coords + b0.coords + v) / 2.0);
+            let reach = ((b0 - a0).norm() + v.norm()) / 2.0
+                + radius / (std::f64::consts::PI / DISC_SIDES as f64).cos();
             let hit = match (c.end, moving) {
                 (_, _) if c.radius == 0.0 => false,
+                _ if !near(&mid, reach) => false,
                 (End::Round, false) => hits(&Capsule::new(a0, b0, radius)),
                 (End::Round, true) => {
                     let round = |t: Triangle| RoundShape {

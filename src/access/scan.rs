@@ -163,12 +163,7 @@ pub fn scan_cones(
     // Only directions above the tangent plane through `from` are asked of the laser and
     // camera maps (both lie within the incidence limit or the triangulation angle of
     // `n`): a triangle wholly below that plane blocks none of them.
-    let height = |t: &super::Tri| {
-        t.v.iter()
-            .map(|v| (v - from).dot(n))
-            .fold(f64::MIN, f64::max)
-    };
-    let above = scene.culled(|t| height(t) <= 0.0);
+    let above = scene.above(&from, n, f64::MIN_POSITIVE);
     // The laser at pixel centres (exact there), the camera's lines of sight in whole
     // free pixels.
     let laser = backend
@@ -198,7 +193,7 @@ pub fn scan_cones(
             .iter()
             .map(|c| c.a * widest.cos() - c.radius)
             .fold(f64::INFINITY, f64::min);
-        let near = scene.culled(|t| height(t) < floor);
+        let near = scene.above(&from, n, floor);
         visible.and_assign(&gac(backend, &near, &from, &leading, res, pref));
     }
     let d2 = scanner.probe.head.indexable().then(|| {

@@ -23,8 +23,11 @@ pub struct Tri {
 
 /// The obstacle.
 pub struct Scene {
-    /// Its triangles.
-    pub tris: Vec<Tri>,
+    /// Its triangles (shared with the scenes [`Scene::above`] makes of it).
+    pub tris: std::sync::Arc<Vec<Tri>>,
+    /// Where the backends' drawing skips what lies wholly under a plane: the plane's
+    /// point, unit normal and the height above it a triangle must reach to be drawn.
+    pub floor: Option<(P3, V3, f64)>,
     /// Whether the part's mesh is closed (every edge shared by exactly two triangles).
     pub closed: bool,
     /// The diagonal of its bounds (mm).
@@ -72,7 +75,8 @@ impl Scene {
                 .map(std::sync::Arc::new)
         };
         Scene {
-            tris,
+            tris: std::sync::Arc::new(tris),
+            floor: None,
             closed,
             size: (hi - lo).norm(),
             mesh,
@@ -87,22 +91,41 @@ impl Scene {
         let s = 4.0 * self.size.max(1.0);
         let c = |a: f64, b: f64| point + e1 * (a * s) + e2 * (b * s);
         let (p00, p10, p11, p01) = (c(-1.0, -1.0), c(1.0, -1.0), c(1.0, 1.0), c(-1.0, 1.0));
-        let mut tris = self.tris.clone();
+        let mut tris: Vec<Tri> = self.tris.as_ref().clone();
         tris.push(make_tri([p00, p10, p11], false));
         tris.push(make_tri([p00, p11, p01], false));
         Scene::new(tris, self.closed)
     }
 
-    /// The scene less the triangles `cull` says cannot touch what is asked of it: cones
-    /// drawn on it are the whole scene's only where that holds. Exact queries
-    /// ([`Scene::cast_ray`], [`Scene::distance`]) still answer for the whole scene.
-    pub fn culled(&self, cull: impl Fn(&Tri) -> bool) -> Scene {
+    /// The scene for cones asked only where nothing wholly under the plane through
+    /// `at` with unit normal `n`, offset by `height`, can reach: the backends' drawing
+    /// skips those triangles ([`Scene::skips`]), so cones drawn on it are the whole
+    /// scene's only there. Exact queries ([`Scene::cast_ray`], [`Scene::distance`])
+    /// still answer for the whole scene. Shares the triangles and the mesh.
+    pub fn above(&self, at: &P3, n: &V3, height: f64) -> Scene {
         Scene {
-            tris: self.tris.iter().filter(|t| !cull(t)).cloned().collect(),
+            tris: self.tris.clone(),
+            floor: Some((*at, *n, height)),
             closed: self.closed,
             size: self.size,
             mesh: self.mesh.clone(),
         }
+    }
+
+    /// Whether drawing leaves `t` out: wholly under the floor (see [`Scene::above`]).
+    #[inline]
+    pub fn skips(&self, t: &Tri) -> bool {
+        self.floor.as_ref().is_some_and(|(at, n, h)| {
+            // The bounding sphere first: most triangles are decided by it.
+            let c = (t.centre - at).dot(n);
+            if c - t.radius >= *h {
+                return false;
+            }
+            if c + t.radius < *h {
+                return true;
+            }
+            t.v.iter().all(|v| (v - at).dot(n) < *h)
+        })
     }
 
     /// The first hit of the ray `from + t·d` (t > 0, `d` unit), if within `max`.

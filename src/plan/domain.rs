@@ -186,6 +186,8 @@ pub struct Memo {
     cones: BTreeMap<(usize, usize), access::PointCones>,
     /// The second component's depth map per setup cell.
     second: BTreeMap<usize, SecondMap>,
+    /// The scanners' face cones and coverages.
+    pub(crate) scans: super::scan::Memo,
 }
 
 /// The cells within `angle` radians of `axis`, in the shape of `like`.

@@ -224,6 +224,45 @@ pub(crate) struct Round<'a> {
     pub exact_budget: usize,
 }
 
+impl Hlip {
+    /// Drops the touches of `faces`, which a scanner now measures: their visits, and the
+    /// inspections, orientations and probes left empty; the touched features and points
+    /// are counted again. Setups stay (a scan needs its setup), as do scanned visits.
+    pub(crate) fn drop_touches(&mut self, faces: &BTreeSet<FaceId>) {
+        for s in &mut self.setups {
+            for p in &mut s.probes {
+                for o in &mut p.orients {
+                    for i in &mut o.inspections {
+                        i.faces.retain(|v| {
+                            !(faces.contains(&v.face)
+                                && v.contact == Contact::Part
+                                && v.passes.is_empty())
+                        });
+                    }
+                    o.inspections.retain(|i| !i.faces.is_empty());
+                }
+                p.orients.retain(|o| !o.inspections.is_empty());
+            }
+            s.probes.retain(|p| !p.orients.is_empty());
+        }
+        let touches = || {
+            self.setups
+                .iter()
+                .flat_map(|s| &s.probes)
+                .flat_map(|p| &p.orients)
+                .flat_map(|o| &o.inspections)
+                .flat_map(|i| i.faces.iter().map(move |v| (i.feature, v)))
+                .filter(|(_, v)| v.passes.is_empty())
+        };
+        let features: BTreeSet<Option<FeatureId>> = touches().map(|(f, _)| f).collect();
+        let points: BTreeSet<usize> = touches()
+            .flat_map(|(_, v)| v.points.iter().copied())
+            .collect();
+        self.summary.features = features.len();
+        self.summary.points = points.len();
+    }
+}
+
 /// (probe, [(orientation, instance trees)]) of one setup.
 type Probes<'a> = Vec<(usize, Vec<(usize, Vec<&'a Inst>)>)>;
 

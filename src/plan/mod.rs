@@ -356,16 +356,17 @@ pub fn plan(input: &Input, opts: &PlanOptions, diags: &mut Diagnostics) -> Optio
 /// The features the sensor selection gave a laser scanner are left out of the touch plan
 /// and scanned in its setups ([`scan`]); those the selection chose by its rule and no
 /// setup lets the scanner cover go back to the touch probes, and the plan is made again
-/// once with them.
+/// with them until none is sent back. A feature sent back that the scanner covers in
+/// the final plan's setups is scanned after all, its touches dropped.
 pub fn plan_with(
     input: &Input,
     opts: &PlanOptions,
     memo: &mut Memo,
     diags: &mut Diagnostics,
 ) -> Option<Hlip> {
-    let mut lasers = scan::lasers(input);
+    let all = scan::lasers(input);
+    let mut lasers = all.clone();
     let mut back: Vec<scan::Uncovered> = Vec::new();
-    let mut scan_memo = scan::Memo::default();
     loop {
         let skip: BTreeSet<FaceId> = lasers.iter().flat_map(|l| l.faces.clone()).collect();
         let mut own = Diagnostics::new();
@@ -373,14 +374,50 @@ pub fn plan_with(
             diags.extend(own);
             return None;
         };
-        let uncovered = scan::plan_scans(input, &mut hlip, &lasers, opts, &mut scan_memo);
-        let asked = |f: crate::model::FeatureId| lasers.iter().any(|l| l.feature == f && l.asked);
-        let to_touch: Vec<&scan::Uncovered> =
-            uncovered.iter().filter(|u| !asked(u.feature)).collect();
-        if !to_touch.is_empty() && back.is_empty() {
-            back = to_touch.into_iter().cloned().collect();
+        // The features sent back are offered to the scanner again: this plan's setups are
+        // not the ones that left them short.
+        let offered: Vec<scan::Laser> = all
+            .iter()
+            .filter(|l| {
+                lasers.iter().any(|x| x.feature == l.feature)
+                    || back.iter().any(|u| u.feature == l.feature)
+            })
+            .cloned()
+            .collect();
+        let uncovered = scan::plan_scans(input, &mut hlip, &offered, opts, &mut memo.scans);
+        let asked = |f: crate::model::FeatureId| all.iter().any(|l| l.feature == f && l.asked);
+        let to_touch: Vec<&scan::Uncovered> = uncovered
+            .iter()
+            .filter(|u| !asked(u.feature) && !back.iter().any(|b| b.feature == u.feature))
+            .collect();
+        // Until none is left: the plan made again holds other setups, where other faces
+        // may fall short. Each round sends at least one feature back, so this ends.
+        if !to_touch.is_empty() {
+            back.extend(to_touch.into_iter().cloned());
             lasers.retain(|l| !back.iter().any(|u| u.feature == l.feature));
             continue;
+        }
+        // A feature sent back that the scanner covers in this plan's setups is scanned
+        // there: its touches leave the plan.
+        let rescanned: BTreeSet<FaceId> = hlip
+            .scans
+            .iter()
+            .filter(|x| back.iter().any(|u| u.feature == x.feature))
+            .map(|x| x.face)
+            .collect();
+        if !rescanned.is_empty() {
+            hlip.drop_touches(&rescanned);
+            let head = hlip.head;
+            scan::recount(&mut hlip, head);
+        }
+        back.retain(|u| {
+            !rescanned.contains(&u.face) && !hlip.scans.iter().any(|x| x.feature == u.feature)
+        });
+        // The best coverage any round's setups gave.
+        for u in back.iter_mut() {
+            if let Some(now) = uncovered.iter().find(|x| x.face == u.face) {
+                u.best = u.best.max(now.best);
+            }
         }
         diags.extend(own);
         hlip.to_touch = back.iter().map(|u| (u.feature, u.face, u.best)).collect();
