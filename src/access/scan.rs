@@ -409,6 +409,10 @@ impl FaceCones {
                 })
             })
             .collect();
+        // The incidence limit exactly: the cone's pixels are judged at their centres,
+        // and a head orientation at the limit lies in a pixel whose centre is inside it
+        // as often as not (a view of a boss along its axis saw nothing on the machine).
+        let grazing = scanner.optics.max_incidence.cos();
         let sees_from: Vec<Vec<bool>> = samples
             .par_iter()
             .zip(&self.visible)
@@ -417,7 +421,8 @@ impl FaceCones {
                 dirs.iter()
                     .zip(&held)
                     .map(|(d, pose)| {
-                        visible.contains(d)
+                        n.dot(d) >= grazing
+                            && visible.contains(d)
                             && off_table(p, d)
                             && second.as_ref().is_none_or(|m| m.clear(&(from + d * reach)))
                             && pose.as_ref().is_none_or(|x| x.clear_of_fixture(p))
