@@ -225,16 +225,18 @@ pub(crate) struct Round<'a> {
 }
 
 impl Hlip {
-    /// Drops the touches of `faces`, which a scanner now measures: their visits, and the
-    /// inspections, orientations and probes left empty; the touched features and points
-    /// are counted again. Setups stay (a scan needs its setup), as do scanned visits.
-    pub(crate) fn drop_touches(&mut self, faces: &BTreeSet<FaceId>) {
+    /// Drops the touches of the (feature, face) pairs `scanned`, which a scanner now
+    /// measures: their visits, and the inspections, orientations and probes left empty;
+    /// the touched features and points are counted again. Setups stay (a scan needs its
+    /// setup), as do scanned visits and another feature's touches of the same face.
+    pub(crate) fn drop_touches(&mut self, scanned: &BTreeSet<(FeatureId, FaceId)>) {
         for s in &mut self.setups {
             for p in &mut s.probes {
                 for o in &mut p.orients {
                     for i in &mut o.inspections {
+                        let Some(f) = i.feature else { continue };
                         i.faces.retain(|v| {
-                            !(faces.contains(&v.face)
+                            !(scanned.contains(&(f, v.face))
                                 && v.contact == Contact::Part
                                 && v.passes.is_empty())
                         });

@@ -399,20 +399,18 @@ pub fn plan_with(
         }
         // A feature sent back that the scanner covers in this plan's setups is scanned
         // there: its touches leave the plan.
-        let rescanned: BTreeSet<FaceId> = hlip
+        let rescanned: BTreeSet<(crate::model::FeatureId, FaceId)> = hlip
             .scans
             .iter()
             .filter(|x| back.iter().any(|u| u.feature == x.feature))
-            .map(|x| x.face)
+            .map(|x| (x.feature, x.face))
             .collect();
         if !rescanned.is_empty() {
             hlip.drop_touches(&rescanned);
             let head = hlip.head;
             scan::recount(&mut hlip, head);
         }
-        back.retain(|u| {
-            !rescanned.contains(&u.face) && !hlip.scans.iter().any(|x| x.feature == u.feature)
-        });
+        back.retain(|u| !hlip.scans.iter().any(|x| x.feature == u.feature));
         // The best coverage any round's setups gave.
         for u in back.iter_mut() {
             if let Some(now) = uncovered.iter().find(|x| x.face == u.face) {
