@@ -379,6 +379,8 @@ pub struct Pose<'a> {
     up: V3,
     table: f64,
     fixture: &'a [Solid],
+    /// A sphere around each solid of `fixture` ([`Solid::bounding_sphere`]).
+    spheres: Vec<(P3, f64)>,
     /// The margin moves keep ([`Pose::segment`]).
     margin: f64,
     /// Stand-offs where the margin is less (quantised position → margin).
@@ -424,6 +426,7 @@ impl<'a> Pose<'a> {
             up,
             table,
             fixture: &[],
+            spheres: Vec::new(),
             margin: 0.0,
             tight: Default::default(),
         }
@@ -452,6 +455,7 @@ impl<'a> Pose<'a> {
     /// The same pose with the fixture's solids as obstacles too.
     pub fn with_fixture(mut self, solids: &'a [Solid]) -> Pose<'a> {
         self.fixture = solids;
+        self.spheres = solids.iter().map(Solid::bounding_sphere).collect();
         self
     }
 
@@ -538,9 +542,8 @@ impl<'a> Pose<'a> {
         if self.fixture.is_empty() {
             return Ok(());
         }
-        let spheres: Vec<(P3, f64)> = self.fixture.iter().map(Solid::bounding_sphere).collect();
         let hits = |s: &dyn Shape| self.fixture.iter().any(|f| f.hits(s));
-        self.sweep(p, q, &hits, grow, Some(&spheres))
+        self.sweep(p, q, &hits, grow, Some(&self.spheres))
             .map_err(|b| match b {
                 Blocker::Component(c) => Blocker::Fixture(c),
                 _ => Blocker::Fixture("tip".into()),

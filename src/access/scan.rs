@@ -100,6 +100,18 @@ impl ScannerShape {
     }
 }
 
+/// Every sensor of a machine's rack by slot, as solids that move: the probes, then the
+/// scanners (housing, head and ram; no tip).
+pub fn sensor_shapes(model: &Model, cmm: &Cmm) -> Vec<ProbeShape> {
+    let mut shapes = ProbeShape::of_cmm(model, cmm);
+    shapes.extend(
+        ScannerShape::of_cmm(model, cmm)
+            .into_iter()
+            .map(|s| s.probe),
+    );
+    shapes
+}
+
 /// The camera's line of sight to a point seen along `d` (unit, towards the scanner) on a
 /// surface with outward normal `n`: `d` turned by `angle` towards `n` (see the module's
 /// decision).

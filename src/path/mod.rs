@@ -184,7 +184,8 @@ pub fn plan(
     bans: &mut Vec<Ban>,
 ) -> Option<Llip> {
     let motion = input.plan.motion;
-    let probes = sensor_shapes(input);
+    let probes =
+        crate::access::scan::sensor_shapes(input.model, &input.model.cmms[input.plan.cmm.0]);
     let scene = Scene::of_part(input.geometry);
     let groups = linearise(input, hlip, &probes, &scene);
     let standoff = motion.prehit.max(motion.retract);
@@ -231,19 +232,6 @@ pub fn plan(
             None
         }
     }
-}
-
-/// The machine's sensors as solids, by slot: the rack's probes, then its scanners
-/// (housing, head and ram with no tip).
-pub fn sensor_shapes(input: &Input) -> Vec<ProbeShape> {
-    let cmm = &input.model.cmms[input.plan.cmm.0];
-    let mut shapes = ProbeShape::of_cmm(input.model, cmm);
-    shapes.extend(
-        crate::access::scan::ScannerShape::of_cmm(input.model, cmm)
-            .into_iter()
-            .map(|s| s.probe),
-    );
-    shapes
 }
 
 /// Linearises the HLIP into groups — one per (setup, probe, orientation) — with their
@@ -867,6 +855,20 @@ fn scan_move(pose: &Pose, x: &P3, y: &P3, g: &GroupIn) -> (Option<Vec<P3>>, usiz
     }
     let raise = |p: &P3| p + g.up * (g.height - p.coords.dot(&g.up)).max(0.0);
     tries.push(vec![raise(x), raise(y), *y]);
+    let (found, checks) = first_clear(pose, x, tries);
+    // The pass's start is the block's own position, not a waypoint.
+    (
+        found.map(|mut w| {
+            w.pop();
+            w
+        }),
+        checks,
+    )
+}
+
+/// The first of `tries` (waypoints after `x`) along which `pose` moves clear, and how
+/// many segments were checked to find it.
+fn first_clear(pose: &Pose, x: &P3, tries: Vec<Vec<P3>>) -> (Option<Vec<P3>>, usize) {
     let mut checks = 0;
     let found = tries.into_iter().find(|w| {
         let mut from = *x;
@@ -877,14 +879,7 @@ fn scan_move(pose: &Pose, x: &P3, y: &P3, g: &GroupIn) -> (Option<Vec<P3>>, usiz
             ok
         })
     });
-    // The pass's start is the block's own position, not a waypoint.
-    (
-        found.map(|mut w| {
-            w.pop();
-            w
-        }),
-        checks,
-    )
+    (found, checks)
 }
 
 /// A block's stand-off: `standoff`, or half the free space in front of its points when
@@ -918,17 +913,7 @@ fn lift(pose: &Pose, x: &P3, g: &GroupIn) -> (Option<Vec<P3>>, usize) {
         let y = x + g.dir * h;
         tries.push(vec![y, raise(&y)]);
     }
-    let mut checks = 0;
-    let found = tries.into_iter().find(|w| {
-        let mut at = *x;
-        w.iter().all(|y| {
-            checks += 1;
-            let ok = pose.segment(&at, y).is_ok();
-            at = *y;
-            ok
-        })
-    });
-    (found, checks)
+    first_clear(pose, x, tries)
 }
 
 /// Warns of each tolerance read against a setup's frame that one of its own features

@@ -12,7 +12,7 @@ mod raster;
 
 pub use raster::png;
 
-use crate::access::{self, Cpu, ProbeShape};
+use crate::access::{self, Cpu};
 use crate::geometry::PartGeometry;
 use crate::plan::Hlip;
 use crate::{Built, PartData};
@@ -174,13 +174,7 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
         })
         .collect();
     let cmm = &model.cmms[plan.cmm.0];
-    // The sensors by slot: the probes, then the scanners (housing, no tip).
-    let mut shapes = ProbeShape::of_cmm(model, cmm);
-    shapes.extend(
-        access::scan::ScannerShape::of_cmm(model, cmm)
-            .into_iter()
-            .map(|s| s.probe),
-    );
+    let shapes = access::scan::sensor_shapes(model, cmm);
     let probes = shapes
         .iter()
         .enumerate()

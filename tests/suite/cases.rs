@@ -406,12 +406,7 @@ fn every_move_is_collision_free() {
         let scene = inspc::access::Scene::of_part(geometry);
         // The sensors by slot: the probes, then the scanners (no tip).
         let cmm = &model.cmms[plan.cmm.0];
-        let mut probes = inspc::access::ProbeShape::of_cmm(model, cmm);
-        probes.extend(
-            inspc::access::scan::ScannerShape::of_cmm(model, cmm)
-                .into_iter()
-                .map(|s| s.probe),
-        );
+        let probes = inspc::access::scan::sensor_shapes(model, cmm);
         let mut segments = 0;
         for s in &b.llip.setups {
             let setup = &b.hlip.setups[s.setup];
