@@ -32,7 +32,7 @@ pub struct Scene {
     pub closed: bool,
     /// The diagonal of its bounds (mm).
     pub size: f64,
-    /// Shared with the scenes [`Scene::culled`] makes of it.
+    /// Shared with the scenes [`Scene::above`] makes of it.
     mesh: Option<std::sync::Arc<TriMesh>>,
 }
 
