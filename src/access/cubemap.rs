@@ -494,6 +494,29 @@ impl CubeMap {
         }
     }
 
+    /// Whether pixels i0..=i1 of rows j0..=j1 of a face are all in the map (true for an
+    /// empty range).
+    pub fn spans_set(&self, face: u8, j0: u32, j1: u32, i0: u32, i1: u32) -> bool {
+        if i0 > i1 {
+            return true;
+        }
+        let n = self.n as usize;
+        (j0..=j1).all(|j| {
+            let start = (face as usize * n + j as usize) * n;
+            let (mut k, end) = (start + i0 as usize, start + i1 as usize + 1);
+            while k < end {
+                let (w, b) = (k / 64, k % 64);
+                let len = (64 - b).min(end - k);
+                let mask = row_mask(len) << b;
+                if self.bits[w] & mask != mask {
+                    return false;
+                }
+                k += len;
+            }
+            true
+        })
+    }
+
     /// This map at resolution `n`, a multiple of its own: each fine pixel takes the bit
     /// of the coarse pixel holding it, each preferred direction its own bit. A cone whose
     /// free pixels are free in every direction they hold (cells, not centres) stays so.

@@ -28,6 +28,10 @@ pub enum Coverage {
 /// Slack in cube-face coordinates: a pixel centre this close to a shadow counts as in it.
 const HAIR: f64 = 1e-9;
 
+/// How far past a polygon's corners a span's end may round: the bounding box a shadow
+/// is skipped by is widened so, and holds every pixel the shadow could mark.
+const SLACK: f64 = 1e-12;
+
 /// A small convex polygon in a cube face's frame (u, v, w).
 #[derive(Clone, Copy)]
 struct Poly {
@@ -159,11 +163,32 @@ fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage
     let n = out.n() as i64;
     let h = 2.0 / n as f64;
     let (mut vmin, mut vmax) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut umin, mut umax) = (f64::INFINITY, f64::NEG_INFINITY);
     for p in poly {
         vmin = vmin.min(p.1);
         vmax = vmax.max(p.1);
+        umin = umin.min(p.0);
+        umax = umax.max(p.0);
     }
     let clampi = |k: i64| k.clamp(0, n - 1);
+    // A shadow whose bounding box (widened past any rounding of the spans below) is
+    // already all marked adds nothing: on a fine mesh most shadows fall where others did.
+    let slack = match cov {
+        Coverage::Cells => SLACK,
+        Coverage::Centres => HAIR + SLACK,
+    };
+    let (j0, j1) = (
+        clampi(floor_i((vmin - slack + 1.0) / h)),
+        clampi(floor_i((vmax + slack + 1.0) / h)),
+    );
+    let (i0, i1) = (
+        clampi(floor_i((umin - slack + 1.0) / h)),
+        clampi(floor_i((umax + slack + 1.0) / h)),
+    );
+    let finite = [umin, umax, vmin, vmax].iter().all(|x| x.is_finite());
+    if finite && out.spans_set(face, j0 as u32, j1 as u32, i0 as u32, i1 as u32) {
+        return;
+    }
     match cov {
         Coverage::Cells => {
             let cell = |x: f64| clampi(floor_i((x + 1.0) / h));
