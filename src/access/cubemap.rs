@@ -555,6 +555,39 @@ impl CubeMap {
         out
     }
 
+    /// This map at resolution `n`, a divisor of its own: a coarse pixel is in it when
+    /// any fine pixel it holds is; each preferred direction keeps its bit.
+    pub fn coarsened(&self, n: u32) -> CubeMap {
+        debug_assert!(n <= self.n && self.n.is_multiple_of(n));
+        if n == self.n {
+            return self.clone();
+        }
+        let mut out = CubeMap {
+            n,
+            extra: self.extra.clone(),
+            bits: vec![0; (6 * (n as usize) * (n as usize) + self.extra.len()).div_ceil(64)],
+        };
+        let k = self.n / n;
+        for cell in self.cells() {
+            let c = match cell {
+                Cell::Pixel(p) => Cell::Pixel(Pixel {
+                    face: p.face,
+                    i: p.i / k,
+                    j: p.j / k,
+                }),
+                preferred => preferred,
+            };
+            out.set(c, true);
+        }
+        out
+    }
+
+    /// Whether every cell of `o` is in this map.
+    pub fn covers(&self, o: &CubeMap) -> bool {
+        debug_assert_eq!(self.n, o.n);
+        self.bits.iter().zip(&o.bits).all(|(a, b)| b & !a == 0)
+    }
+
     /// Adds every preferred direction.
     pub fn fill_preferred(&mut self) {
         for k in 0..self.extra.len() {

@@ -50,6 +50,7 @@ pub use scene::{point_triangle_distance, Scene, Tri};
 use crate::geometry::{PartGeometry, P3, V3};
 use crate::sample::Fpoint;
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// One component placed at one point: a question for [`Backend::blocked_many`].
 #[derive(Debug, Clone, Copy)]
@@ -241,6 +242,9 @@ pub struct ConeOptions {
     pub exact_boundary: bool,
     /// Which backend rasterizes the shadows.
     pub backend: BackendKind,
+    /// The setups D2 is asked about, when the caller masks it by them (the planner: the
+    /// realisable, unforbidden ones); D2 may then leave out other cells (see [`d2`]).
+    pub d2_wanted: Option<Arc<CubeMap>>,
 }
 
 impl Default for ConeOptions {
@@ -252,6 +256,7 @@ impl Default for ConeOptions {
             d2_samples: 16,
             exact_boundary: false,
             backend: BackendKind::Cpu,
+            d2_wanted: None,
         }
     }
 }
@@ -351,10 +356,19 @@ pub fn point_cones(
     let Some((c, approach)) = approach_at(backend, scene, f, probe, opts) else {
         return PointCones::unreachable(probe, n, pref);
     };
-    let d2 = probe
-        .head
-        .indexable()
-        .then(|| d2(backend, scene, &c, probe, &approach, pref, opts.d2_samples));
+    let d2 = probe.head.indexable().then(|| {
+        let wanted = opts.d2_wanted.as_deref();
+        d2(
+            backend,
+            scene,
+            &c,
+            probe,
+            &approach,
+            pref,
+            opts.d2_samples,
+            wanted,
+        )
+    });
     PointCones {
         tip_fits: true,
         approach,
@@ -376,6 +390,11 @@ pub fn d1(
 
 /// D2 (ch. 2.5.2): the weak GAC of dD1, the union of the second component's cones at up
 /// to `samples` points c + d·u, u spread evenly over D1's cells (a lower bound).
+///
+/// With `wanted` (the setups a plan can use: the caller masks D2 by them) sampling stops
+/// once D2 holds every wanted cell, and a sample whose components block every wanted
+/// cell D2 still lacks adds nothing (its later components are not drawn). D2 is then the
+/// same on the wanted cells and may hold fewer of the others; [`D2Sampler`] is the rule.
 pub fn d2(
     backend: &dyn Backend,
     scene: &Scene,
@@ -384,15 +403,60 @@ pub fn d2(
     d1: &CubeMap,
     preferred: &[V3],
     samples: usize,
+    wanted: Option<&CubeMap>,
 ) -> CubeMap {
     // `preferred` is the list D1 was built with: rebuilt from D1's unit vectors, a
     // direction that normalizing does not leave fixed would key differently.
     let coarse = d2_resolution(d1.n());
-    let mut out = CubeMap::empty(coarse, preferred);
+    let mut d2 = D2Sampler::new(coarse, preferred, wanted);
     for x in d2_points(c, probe, d1, samples) {
-        out.or_assign(&gac(backend, scene, &x, &probe.second, coarse, preferred));
+        let Some(need) = d2.need() else { break };
+        let mut blocked = CubeMap::empty(coarse, preferred);
+        for comp in &probe.second {
+            blocked.or_assign(&backend.blocked(scene, &x, comp, coarse, preferred));
+            if blocked.is_full() || need.as_ref().is_some_and(|nd| blocked.covers(nd)) {
+                break;
+            }
+        }
+        d2.add(&blocked, need.as_ref());
     }
-    out.refined(d1.n())
+    d2.out.refined(d1.n())
+}
+
+/// D2's union of samples, in sample order, under its `wanted` cells (see [`d2`]); the
+/// CPU path and the batched one share it so both give the same maps.
+struct D2Sampler {
+    out: CubeMap,
+    wanted: Option<CubeMap>,
+}
+
+impl D2Sampler {
+    fn new(coarse: u32, preferred: &[V3], wanted: Option<&CubeMap>) -> D2Sampler {
+        D2Sampler {
+            out: CubeMap::empty(coarse, preferred),
+            wanted: wanted.map(|w| w.coarsened(coarse)),
+        }
+    }
+
+    /// The wanted cells D2 lacks (`Some(None)` when every cell is wanted); None when it
+    /// has them all and no later sample matters.
+    fn need(&self) -> Option<Option<CubeMap>> {
+        match &self.wanted {
+            None => Some(None),
+            Some(w) => {
+                let mut need = w.clone();
+                need.and_not_assign(&self.out);
+                (!need.is_empty()).then_some(Some(need))
+            }
+        }
+    }
+
+    /// Adds one sample's free directions, unless it blocks every cell still needed.
+    fn add(&mut self, blocked: &CubeMap, need: Option<&CubeMap>) {
+        if need.is_none_or(|nd| !blocked.covers(nd)) {
+            self.out.or_assign(&blocked.not());
+        }
+    }
 }
 
 /// The resolution D2 is rasterized at for cones of resolution `n`: half of it from 32
@@ -611,15 +675,24 @@ pub fn point_cones_many(
             .1
             .or_assign(b);
     }
-    let mut d2s: Vec<Option<CubeMap>> = items
+    // Every sample was drawn; the samples are added as `d2` adds them, so the maps match.
+    let wanted = opts.d2_wanted.as_deref();
+    let mut d2s: Vec<Option<D2Sampler>> = items
         .iter()
-        .map(|(_, p)| p.head.indexable().then(|| CubeMap::empty(coarse, pref)))
+        .map(|(_, p)| {
+            p.head
+                .indexable()
+                .then(|| D2Sampler::new(coarse, pref, wanted))
+        })
         .collect();
     for (k, b) in sample_blocked.into_iter().flatten() {
         if let Some(d) = &mut d2s[k] {
-            d.or_assign(&b.not());
+            if let Some(need) = d.need() {
+                d.add(&b, need.as_ref());
+            }
         }
     }
+    let d2s: Vec<Option<CubeMap>> = d2s.into_iter().map(|d| d.map(|d| d.out)).collect();
     let d2s: Vec<Option<CubeMap>> = d2s.into_iter().map(|d| d.map(|d| d.refined(n))).collect();
     items
         .iter()

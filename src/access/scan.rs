@@ -217,6 +217,7 @@ pub fn scan_cones(
             &visible,
             pref,
             opts.d2_samples,
+            opts.d2_wanted.as_deref(),
         )
     });
     ScanCones { rays, visible, d2 }

@@ -326,6 +326,12 @@ impl<'a> Knowledge<'a> {
                 }
             }
         }
+        // Every use of D2 is masked by the setups a plan can take: the cones need be
+        // whole only there.
+        let opts = ConeOptions {
+            d2_wanted: Some(std::sync::Arc::new(real.and(&forbidden.not()))),
+            ..opts
+        };
         let mut points = fpoints.to_vec();
         let mut tables = Vec::new();
         for (face, up) in table_dirs {

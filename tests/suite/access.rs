@@ -232,6 +232,49 @@ fn cones_are_the_same_for_any_thread_count() {
     assert!(one.iter().any(|c| !c.approach.is_empty()));
 }
 
+/// D2 asked about some setups only (the planner's realisable ones) is the same there as
+/// the whole D2 and never holds more elsewhere, on the indexable example and a real part.
+#[test]
+fn d2_for_wanted_setups_is_the_whole_d2_there() {
+    use inspc::access::point_cones;
+    for spec in ["examples/f3_indexed.insp", "tests/real/nist_ctc_01.insp"] {
+        let (scene, probes, fp) = loaded(spec);
+        let probe = probes
+            .iter()
+            .find(|p| p.head.indexable())
+            .expect("an indexable head");
+        let whole = ConeOptions {
+            n: 32,
+            d2_samples: 6,
+            ..ConeOptions::default()
+        };
+        // A few setup directions, as a part's stable poses are: the axes and a tilt.
+        let mut wanted = CubeMap::empty(32, &whole.preferred);
+        for d in [
+            V3::z(),
+            -V3::z(),
+            V3::x(),
+            V3::new(0.0, 0.5, 0.8).normalize(),
+        ] {
+            let cell = wanted.cell_of(&d);
+            wanted.set(cell, true);
+        }
+        let some = ConeOptions {
+            d2_wanted: Some(std::sync::Arc::new(wanted.clone())),
+            ..whole.clone()
+        };
+        let mut stopped = 0;
+        for f in fp.iter().step_by(fp.len().div_ceil(40)) {
+            let a = point_cones(&Cpu, &scene, f, probe, &whole).d2.unwrap();
+            let b = point_cones(&Cpu, &scene, f, probe, &some).d2.unwrap();
+            assert_eq!(a.and(&wanted), b.and(&wanted), "{spec} at {:?}", f.position);
+            assert_eq!(a.and(&b), b, "{spec}: D2 for some setups holds no more");
+            stopped += usize::from(a != b);
+        }
+        assert!(stopped > 0, "{spec}: sampling stopped early somewhere");
+    }
+}
+
 /// D1′ for the vertical: every direction it keeps lets a cylinder of the head's and ram's
 /// largest radius stand on the articulation point and clear the part (parry), and it
 /// keeps most of the directions that do.
