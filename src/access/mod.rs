@@ -356,19 +356,10 @@ pub fn point_cones(
     let Some((c, approach)) = approach_at(backend, scene, f, probe, opts) else {
         return PointCones::unreachable(probe, n, pref);
     };
-    let d2 = probe.head.indexable().then(|| {
-        let wanted = opts.d2_wanted.as_deref();
-        d2(
-            backend,
-            scene,
-            &c,
-            probe,
-            &approach,
-            pref,
-            opts.d2_samples,
-            wanted,
-        )
-    });
+    let d2 = probe
+        .head
+        .indexable()
+        .then(|| d2(backend, scene, &c, probe, &approach, opts));
     PointCones {
         tip_fits: true,
         approach,
@@ -389,9 +380,9 @@ pub fn d1(
 }
 
 /// D2 (ch. 2.5.2): the weak GAC of dD1, the union of the second component's cones at up
-/// to `samples` points c + d·u, u spread evenly over D1's cells (a lower bound).
+/// to `opts.d2_samples` points c + d·u, u spread evenly over D1's cells (a lower bound).
 ///
-/// With `wanted` (the setups a plan can use: the caller masks D2 by them) sampling stops
+/// With `opts.d2_wanted` (the setups a plan can use: the caller masks D2 by them) sampling stops
 /// once D2 holds every wanted cell, and a sample whose components block every wanted
 /// cell D2 still lacks adds nothing (its later components are not drawn). D2 is then the
 /// same on the wanted cells and may hold fewer of the others; [`D2Sampler`] is the rule.
@@ -401,15 +392,14 @@ pub fn d2(
     c: &P3,
     probe: &ProbeShape,
     d1: &CubeMap,
-    preferred: &[V3],
-    samples: usize,
-    wanted: Option<&CubeMap>,
+    opts: &ConeOptions,
 ) -> CubeMap {
     // `preferred` is the list D1 was built with: rebuilt from D1's unit vectors, a
     // direction that normalizing does not leave fixed would key differently.
+    let preferred = &opts.preferred[..];
     let coarse = d2_resolution(d1.n());
-    let mut d2 = D2Sampler::new(coarse, preferred, wanted);
-    for x in d2_points(c, probe, d1, samples) {
+    let mut d2 = D2Sampler::new(coarse, preferred, opts.d2_wanted.as_deref());
+    for x in d2_points(c, probe, d1, opts.d2_samples) {
         let Some(need) = d2.need() else { break };
         let mut blocked = CubeMap::empty(coarse, preferred);
         for comp in &probe.second {

@@ -208,18 +208,11 @@ pub fn scan_cones(
         let near = scene.above(&from, n, floor);
         visible.and_assign(&gac(backend, &near, &from, &leading, res, pref));
     }
-    let d2 = scanner.probe.head.indexable().then(|| {
-        d2(
-            backend,
-            scene,
-            &from,
-            &scanner.probe,
-            &visible,
-            pref,
-            opts.d2_samples,
-            opts.d2_wanted.as_deref(),
-        )
-    });
+    let d2 = scanner
+        .probe
+        .head
+        .indexable()
+        .then(|| d2(backend, scene, &from, &scanner.probe, &visible, opts));
     ScanCones { rays, visible, d2 }
 }
 
