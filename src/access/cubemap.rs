@@ -21,6 +21,25 @@ pub struct CubeMap {
     bits: Vec<u64>,
 }
 
+/// The preferred directions of maps of one shape sorted by x, for
+/// [`CubeMap::cell_of_indexed`]: a plan has up to 48 and looks up millions of directions.
+#[derive(Debug, Clone)]
+pub struct PreferredIndex {
+    /// (x, preferred index), by x then index.
+    by_x: Vec<(f64, usize)>,
+}
+
+impl PreferredIndex {
+    /// The index of `like`'s preferred directions.
+    pub fn new(like: &CubeMap) -> PreferredIndex {
+        let mut by_x: Vec<(f64, usize)> = (0..like.preferred_len())
+            .map(|k| (like.preferred(k).x, k))
+            .collect();
+        by_x.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        PreferredIndex { by_x }
+    }
+}
+
 /// A pixel: cube face (0..6), column i and row j.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Pixel {
@@ -211,6 +230,30 @@ impl CubeMap {
         };
         match (0..self.extra.len()).find(|&k| near(k)) {
             Some(i) => Cell::Preferred(i),
+            None => Cell::Pixel(self.pixel_of(d)),
+        }
+    }
+
+    /// [`CubeMap::cell_of`] with the preferred directions looked up in `index` (built
+    /// from a map of this shape): the same cell, without testing every preferred
+    /// direction.
+    pub fn cell_of_indexed(&self, index: &PreferredIndex, d: &V3) -> Cell {
+        let u = d.normalize();
+        let from = index.by_x.partition_point(|&(x, _)| x < u.x - 3e-9);
+        let near = index.by_x[from..]
+            .iter()
+            .take_while(|&&(x, _)| x <= u.x + 3e-9)
+            .map(|&(_, k)| k)
+            .filter(|&k| {
+                let p = self.preferred(k);
+                (p.x - u.x).abs() < 2e-9
+                    && (p.y - u.y).abs() < 2e-9
+                    && (p.z - u.z).abs() < 2e-9
+                    && (p - u).norm() < 1e-9
+            })
+            .min();
+        match near {
+            Some(k) => Cell::Preferred(k),
             None => Cell::Pixel(self.pixel_of(d)),
         }
     }

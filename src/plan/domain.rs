@@ -166,11 +166,40 @@ pub(crate) struct Knowledge<'a> {
     /// Cones and depth maps computed before, and where new ones are kept.
     memo: &'a mut Memo,
     /// Per setup cell, the cube-map bit index of each grid orientation's direction in
-    /// that setup's part frame: one `cell_of` per (setup, orientation) instead of one
-    /// per (point, probe, setup, orientation).
-    grid_cells: BTreeMap<usize, std::sync::Arc<[u32]>>,
+    /// that setup's part frame: one `cell_of` per (setup, orientation) at most instead of
+    /// one per (point, probe, setup, orientation).
+    grid_cells: BTreeMap<usize, GridCells>,
+    /// The preferred directions of the knowledge's maps, for `grid_cells`' lookups.
+    pref_index: access::PreferredIndex,
     /// How many times the whole probe's cones were computed.
     pub acquired: usize,
+}
+
+/// The cube-map cells of the head's grid orientations in one setup, each computed when
+/// first asked for: a point reached at its first orientation asks for one.
+struct GridCells {
+    /// Machine frame → part frame of the setup.
+    to_part: nalgebra::Rotation3<f64>,
+    /// Per grid orientation, its direction's bit index; `u32::MAX` until asked for.
+    cells: Vec<u32>,
+}
+
+impl GridCells {
+    fn new(up: &V3, machine: &Machine) -> GridCells {
+        GridCells {
+            to_part: frame(up).inverse(),
+            cells: vec![u32::MAX; machine.grid_dirs.len()],
+        }
+    }
+
+    /// The bit index, in maps shaped `like`, of grid orientation `k` (direction `d` in
+    /// the machine frame).
+    fn index(&mut self, k: usize, d: &V3, like: &CubeMap, pref: &access::PreferredIndex) -> usize {
+        if self.cells[k] == u32::MAX {
+            self.cells[k] = like.index(like.cell_of_indexed(pref, &(self.to_part * d))) as u32;
+        }
+        self.cells[k] as usize
+    }
 }
 
 /// What one planning of an input computes that a later planning of the same input (a
@@ -437,25 +466,9 @@ impl<'a> Knowledge<'a> {
             d1p: BTreeMap::new(),
             memo,
             grid_cells: BTreeMap::new(),
+            pref_index: access::PreferredIndex::new(&empty),
             acquired: 0,
         }
-    }
-
-    /// The bit index, in the knowledge's cube maps, of each grid orientation's
-    /// direction in setup cell `s` (part direction `up`), computed once per setup.
-    fn grid_cells(&mut self, s: usize, up: &V3, machine: &Machine) -> std::sync::Arc<[u32]> {
-        if let Some(c) = self.grid_cells.get(&s) {
-            return c.clone();
-        }
-        let like = self.empty_cone();
-        let to_part = frame(up).inverse();
-        let cells: std::sync::Arc<[u32]> = machine
-            .grid_dirs
-            .iter()
-            .map(|d| like.index(like.cell_of(&(to_part * d))) as u32)
-            .collect();
-        self.grid_cells.insert(s, cells.clone());
-        cells
     }
 
     /// An empty cube map of the knowledge's shape.
@@ -601,9 +614,15 @@ impl<'a> Knowledge<'a> {
             return true;
         }
         // `candidates` without the list: the first orientation that passes will do.
-        let to_part = frame(up).inverse();
-        let cells = self.grid_cells(s, up, machine);
-        let Some(d1) = self.dom.get(f).and_then(|d| d[p].d1.as_ref()) else {
+        let Knowledge {
+            grid_cells,
+            dom,
+            forbidden: like,
+            pref_index,
+            ..
+        } = self;
+        let cells = grid_cells.entry(s).or_insert_with(|| GridCells::new(up, machine));
+        let Some(d1) = dom.get(f).and_then(|d| d[p].d1.as_ref()) else {
             return false;
         };
         // Every component's lowest point rises with cos A (the direction's component
@@ -614,11 +633,11 @@ impl<'a> Knowledge<'a> {
             let a = machine.grid[k].0;
             if a >= blocked_from
                 || !Set::has(&machine.grid_allowed, k)
-                || !d1.has_index(cells[k] as usize)
+                || !d1.has_index(cells.index(k, d, like, pref_index))
             {
                 return false;
             }
-            let ok = above_table(probe, &c, &(to_part * d), up, t0);
+            let ok = above_table(probe, &c, &(cells.to_part * d), up, t0);
             if !ok {
                 blocked_from = a;
             }
@@ -638,7 +657,14 @@ impl<'a> Knowledge<'a> {
         machine: &Machine,
     ) -> (P3, Vec<V3>, Vec<usize>) {
         let t0 = self.table_height(s);
-        let cells = self.grid_cells(s, up, machine);
+        let Knowledge {
+            grid_cells,
+            dom,
+            forbidden: like,
+            pref_index,
+            ..
+        } = self;
+        let cells = grid_cells.entry(s).or_insert_with(|| GridCells::new(up, machine));
         let probe = &machine.probes[p];
         let point = &self.points[f];
         let c = point.tip_centre(probe.tip_radius);
@@ -652,11 +678,14 @@ impl<'a> Knowledge<'a> {
         } else {
             0.0
         };
-        let d1 = self.dom.get(f).and_then(|d| d[p].d1.as_ref());
+        let d1 = dom.get(f).and_then(|d| d[p].d1.as_ref());
         let candidates: Vec<usize> = (0..dirs.len())
             .filter(|&k| {
                 Set::has(&machine.grid_allowed, k)
-                    && (table || d1.is_some_and(|d1| d1.has_index(cells[k] as usize)))
+                    && (table
+                        || d1.is_some_and(|d1| {
+                            d1.has_index(cells.index(k, &machine.grid_dirs[k], like, pref_index))
+                        }))
                     && above_table(probe, &c, &dirs[k], up, t0 - table_slack)
                     && (!table || dirs[k].dot(&point.normal) > 0.2)
             })
