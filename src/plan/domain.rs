@@ -21,6 +21,7 @@ use crate::sample::Fpoint;
 
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// The machine as the planner sees it.
 pub(crate) struct Machine {
@@ -180,25 +181,31 @@ pub(crate) struct Knowledge<'a> {
 struct GridCells {
     /// Machine frame → part frame of the setup.
     to_part: nalgebra::Rotation3<f64>,
-    /// Per grid orientation, its direction's bit index; `u32::MAX` until asked for.
-    cells: Vec<u32>,
+    /// Per grid orientation, its direction's bit index; `u32::MAX` until asked for. Two
+    /// threads asking at once both store the same value.
+    cells: Vec<AtomicU32>,
 }
 
 impl GridCells {
     fn new(up: &V3, machine: &Machine) -> GridCells {
         GridCells {
             to_part: frame(up).inverse(),
-            cells: vec![u32::MAX; machine.grid_dirs.len()],
+            cells: (0..machine.grid_dirs.len())
+                .map(|_| AtomicU32::new(u32::MAX))
+                .collect(),
         }
     }
 
     /// The bit index, in maps shaped `like`, of grid orientation `k` (direction `d` in
     /// the machine frame).
-    fn index(&mut self, k: usize, d: &V3, like: &CubeMap, pref: &access::PreferredIndex) -> usize {
-        if self.cells[k] == u32::MAX {
-            self.cells[k] = like.index(like.cell_of_indexed(pref, &(self.to_part * d))) as u32;
+    fn index(&self, k: usize, d: &V3, like: &CubeMap, pref: &access::PreferredIndex) -> usize {
+        let known = self.cells[k].load(Ordering::Relaxed);
+        if known != u32::MAX {
+            return known as usize;
         }
-        self.cells[k] as usize
+        let cell = like.index(like.cell_of_indexed(pref, &(self.to_part * d)));
+        self.cells[k].store(cell as u32, Ordering::Relaxed);
+        cell
     }
 }
 
@@ -486,26 +493,52 @@ impl<'a> Knowledge<'a> {
     /// height under it and the fixture's solids. A cell outside the realisable setups
     /// (which no plan uses) rests on its lowest point with no fixture.
     pub(crate) fn held(&mut self, s: usize) -> &Held {
+        if !self.held.contains_key(&s) {
+            let h = self.hold(s);
+            self.held.insert(s, h);
+        }
+        &self.held[&s]
+    }
+
+    /// [`Knowledge::held`], uncached.
+    fn hold(&self, s: usize) -> Held {
         let up = self.setup_dir(s);
         let setups = &self.setups;
-        let scene = &self.scene;
-        self.held
-            .entry(s)
-            .or_insert_with(|| match setups.holder(&up) {
-                Some(holder) => {
-                    let solids = setups.solids(&holder, &up);
-                    Held {
-                        table: setups.table(&holder, &up, &solids),
-                        solids,
-                        holder,
-                    }
+        match setups.holder(&up) {
+            Some(holder) => {
+                let solids = setups.solids(&holder, &up);
+                Held {
+                    table: setups.table(&holder, &up, &solids),
+                    solids,
+                    holder,
                 }
-                None => Held {
-                    holder: super::poses::Holder::Table { faces: vec![] },
-                    table: table_height(scene, &up),
-                    solids: vec![],
-                },
-            })
+            }
+            None => Held {
+                holder: super::poses::Holder::Table { faces: vec![] },
+                table: table_height(&self.scene, &up),
+                solids: vec![],
+            },
+        }
+    }
+
+    /// Computes, in parallel, how the part is held in each setup cell of `cells` and makes
+    /// room for their grid orientations' cells: what [`Knowledge::reaches_off_table`]
+    /// reads.
+    pub(crate) fn prepare(&mut self, cells: &BTreeSet<usize>, machine: &Machine) {
+        let new: Vec<usize> = cells
+            .iter()
+            .copied()
+            .filter(|s| !self.held.contains_key(s))
+            .collect();
+        let this = &*self;
+        let held: Vec<Held> = new.par_iter().map(|&s| this.hold(s)).collect();
+        self.held.extend(new.into_iter().zip(held));
+        for &s in cells {
+            if !self.grid_cells.contains_key(&s) {
+                let g = GridCells::new(&self.setup_dir(s), machine);
+                self.grid_cells.insert(s, g);
+            }
+        }
     }
 
     /// The table's height under the part in setup cell `s` (cached).
@@ -588,9 +621,10 @@ impl<'a> Knowledge<'a> {
     /// table when it touches graph fpoint `f` in setup `up` (cell `s`): the orientations
     /// before the second-order clearance test, cheap enough to ask of every realisable
     /// setup. It errs towards yes (a fixed head, a point higher above the table than the
-    /// probe is long), so a minimum counted with it stays a lower bound.
+    /// probe is long), so a minimum counted with it stays a lower bound. Cell `s` must
+    /// have been [`Knowledge::prepare`]d.
     pub(crate) fn reaches_off_table(
-        &mut self,
+        &self,
         f: usize,
         p: usize,
         s: usize,
@@ -607,22 +641,15 @@ impl<'a> Knowledge<'a> {
             .chain(&probe.second)
             .map(|c| c.radius)
             .fold(0.0, f64::max);
-        let t0 = self.table_height(s);
+        let t0 = self.held[&s].table;
         let c = self.points[f].tip_centre(probe.tip_radius);
         if c.coords.dot(up) - t0 >= probe.reach() + widest + access::pose::ORIENTATION_TABLE_MARGIN
         {
             return true;
         }
         // `candidates` without the list: the first orientation that passes will do.
-        let Knowledge {
-            grid_cells,
-            dom,
-            forbidden: like,
-            pref_index,
-            ..
-        } = self;
-        let cells = grid_cells.entry(s).or_insert_with(|| GridCells::new(up, machine));
-        let Some(d1) = dom.get(f).and_then(|d| d[p].d1.as_ref()) else {
+        let cells = &self.grid_cells[&s];
+        let Some(d1) = self.dom.get(f).and_then(|d| d[p].d1.as_ref()) else {
             return false;
         };
         // Every component's lowest point rises with cos A (the direction's component
@@ -633,7 +660,7 @@ impl<'a> Knowledge<'a> {
             let a = machine.grid[k].0;
             if a >= blocked_from
                 || !Set::has(&machine.grid_allowed, k)
-                || !d1.has_index(cells.index(k, d, like, pref_index))
+                || !d1.has_index(cells.index(k, d, &self.forbidden, &self.pref_index))
             {
                 return false;
             }
@@ -664,7 +691,9 @@ impl<'a> Knowledge<'a> {
             pref_index,
             ..
         } = self;
-        let cells = grid_cells.entry(s).or_insert_with(|| GridCells::new(up, machine));
+        let cells = grid_cells
+            .entry(s)
+            .or_insert_with(|| GridCells::new(up, machine));
         let probe = &machine.probes[p];
         let point = &self.points[f];
         let c = point.tip_centre(probe.tip_radius);

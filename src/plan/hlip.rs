@@ -13,6 +13,7 @@ use super::Input;
 use crate::access::pose::{frame, orientation_dir, Contact, Head, Solid};
 use crate::geometry::{FaceId, P3, V3};
 use crate::model::{FeatureId, PlanId, SlotId, ToleranceId};
+use rayon::prelude::*;
 use std::collections::BTreeSet;
 
 /// The resolution of the plan's coordinates and directions: steps per millimetre (or
@@ -458,29 +459,44 @@ fn min_setups(
     used_points: &BTreeSet<usize>,
     budget: usize,
 ) -> (usize, bool) {
-    let mut sets: Vec<crate::access::CubeMap> = Vec::new();
-    for i in 0..k.graph_points {
-        if !used_points.contains(&i) {
-            continue;
-        }
-        let face = k.points[i].face;
-        let mut s = k.setups(i, m);
-        let cells: Vec<usize> = s.cells().map(|c| s.index(c)).collect();
-        for cell in cells {
-            let up = k.setup_dir(cell);
-            let probes = k.probes(i, cell, m);
-            let reaches = probes
-                .ones()
-                .any(|p| k.reaches_off_table(i, p, cell, &up, m));
-            if !reaches {
-                let c = s.cell(cell);
-                s.set(c, false);
+    let points: Vec<usize> = (0..k.graph_points)
+        .filter(|i| used_points.contains(i))
+        .collect();
+    let candidates: Vec<crate::access::CubeMap> = points.iter().map(|&i| k.setups(i, m)).collect();
+    let cells: BTreeSet<usize> = candidates
+        .iter()
+        .flat_map(|s| s.cells().map(|c| s.index(c)))
+        .collect();
+    if m.head.indexable() {
+        k.prepare(&cells, m);
+    }
+    let k = &*k;
+    let reached: Vec<crate::access::CubeMap> = points
+        .par_iter()
+        .zip(candidates)
+        .map(|(&i, mut s)| {
+            let cells: Vec<usize> = s.cells().map(|c| s.index(c)).collect();
+            for cell in cells {
+                let up = k.setup_dir(cell);
+                let probes = k.probes(i, cell, m);
+                let reaches = probes
+                    .ones()
+                    .any(|p| k.reaches_off_table(i, p, cell, &up, m));
+                if !reaches {
+                    let c = s.cell(cell);
+                    s.set(c, false);
+                }
             }
-        }
-        if let Some(t) = k.tables.iter().find(|t| t.face == face && t.alive) {
-            let c = s.cell(t.cell);
-            s.set(c, true);
-        }
+            let face = k.points[i].face;
+            if let Some(t) = k.tables.iter().find(|t| t.face == face && t.alive) {
+                let c = s.cell(t.cell);
+                s.set(c, true);
+            }
+            s
+        })
+        .collect();
+    let mut sets: Vec<crate::access::CubeMap> = Vec::new();
+    for s in reached {
         if !s.is_empty() && !sets.contains(&s) {
             sets.push(s);
         }
