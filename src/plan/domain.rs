@@ -341,11 +341,12 @@ impl<'a> Knowledge<'a> {
         let mut forbidden = empty.clone();
         let mut real = empty.clone();
         let total = 6 * (empty.n() as usize).pow(2) + empty.preferred_len();
-        for k in 0..total {
-            let cell = empty.cell(k);
-            if setups.holder(&empty.direction(cell)).is_some() {
-                real.set(cell, true);
-            }
+        let holds: Vec<bool> = (0..total)
+            .into_par_iter()
+            .map(|k| setups.holder(&empty.direction(empty.cell(k))).is_some())
+            .collect();
+        for (k, _) in holds.iter().enumerate().filter(|(_, &h)| h) {
+            real.set(empty.cell(k), true);
         }
         let mut setup_weight = BTreeMap::new();
         let mut setup_prefs = Vec::new();
