@@ -129,6 +129,8 @@ pub struct Setups<'a> {
     clamps: Vec<(V3, FaceId, FaceId, f64)>,
     /// The convex hull's vertices: the part's extremes in any direction.
     hull: Vec<P3>,
+    /// The same vertices in clusters, for the extremes along one direction.
+    extremes: Extremes,
     /// The part's bounding-box diagonal (mm).
     size: f64,
     /// The solid's centre of mass.
@@ -180,6 +182,7 @@ impl<'a> Setups<'a> {
             rests,
             fixtures,
             clamps,
+            extremes: Extremes::new(&hull),
             hull,
             size: (hi - lo).norm(),
             com: centre_of_mass(geometry),
@@ -308,10 +311,7 @@ impl<'a> Setups<'a> {
 
     /// The lowest point of the part along `up`.
     fn low(&self, up: &V3) -> f64 {
-        self.hull
-            .iter()
-            .map(|v| v.coords.dot(up))
-            .fold(f64::INFINITY, f64::min)
+        self.extremes.lowest(up)
     }
 
     /// What holds the part with `up` pointing up, if anything can: resting on the table
@@ -465,11 +465,7 @@ impl<'a> Setups<'a> {
         let g = self.geometry;
         let f = self.fixture(*slot);
         let low = self.low(up);
-        let high = self
-            .hull
-            .iter()
-            .map(|v| v.coords.dot(up))
-            .fold(f64::NEG_INFINITY, f64::max);
+        let high = -self.extremes.lowest(&-up);
         let height = high - low;
         let size = self.size;
         match f.kind {
@@ -574,11 +570,7 @@ impl<'a> Setups<'a> {
                     return vec![];
                 };
                 let n = -r.up;
-                let plane = self
-                    .hull
-                    .iter()
-                    .map(|v| v.coords.dot(&n))
-                    .fold(f64::NEG_INFINITY, f64::max);
+                let plane = -self.extremes.lowest(&-n);
                 let com = self.com;
                 // Square to the face's longest edge, which lies along the rail.
                 let e1 = r.edge;
@@ -756,6 +748,81 @@ impl<'a> Setups<'a> {
 /// Pairs of planar faces with opposite normals that bound the part along their normal
 /// (nothing sticks out past either), for a vise's jaws: (normal of the first, first,
 /// second, distance between them). Largest faces first.
+/// Points in clusters of a few dozen with bounding spheres, split along their widest
+/// axis: the lowest point along a direction visits only the clusters whose sphere
+/// reaches below the lowest found so far, and is the same number a scan of every point
+/// gives (a hull of a tessellated sphere has thousands of vertices and a setup search
+/// asks tens of thousands of directions).
+#[derive(Debug, Clone)]
+struct Extremes {
+    /// The points, cluster by cluster.
+    pts: Vec<P3>,
+    /// (centre, radius plus a rounding margin, start, end) into `pts`.
+    clusters: Vec<(P3, f64, usize, usize)>,
+}
+
+impl Extremes {
+    /// Cluster size at most.
+    const LEAF: usize = 32;
+
+    fn new(pts: &[P3]) -> Extremes {
+        let mut pts = pts.to_vec();
+        let mut clusters = Vec::new();
+        Self::split(&mut pts, 0, &mut clusters);
+        Extremes { pts, clusters }
+    }
+
+    fn split(pts: &mut [P3], start: usize, out: &mut Vec<(P3, f64, usize, usize)>) {
+        if pts.is_empty() {
+            return;
+        }
+        let (mut lo, mut hi) = (pts[0], pts[0]);
+        for p in pts.iter() {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        if pts.len() <= Self::LEAF {
+            let centre = nalgebra::center(&lo, &hi);
+            let r = pts.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max);
+            // Dot products round: the bound keeps a margin far above their error.
+            let margin = 1e-9 * (1.0 + centre.coords.norm() + r);
+            out.push((centre, r + margin, start, start + pts.len()));
+            return;
+        }
+        let axis = (hi - lo).imax();
+        pts.sort_by(|a, b| a[axis].total_cmp(&b[axis]));
+        let mid = pts.len() / 2;
+        let (a, b) = pts.split_at_mut(mid);
+        Self::split(a, start, out);
+        Self::split(b, start + mid, out);
+    }
+
+    /// The least `p · d` over the points (+∞ for none).
+    fn lowest(&self, d: &V3) -> f64 {
+        let scan = |&(_, _, a, b): &(P3, f64, usize, usize)| {
+            self.pts[a..b]
+                .iter()
+                .map(|v| v.coords.dot(d))
+                .fold(f64::INFINITY, f64::min)
+        };
+        // The cluster whose centre is lowest first, then those that can go lower.
+        let Some(first) = self
+            .clusters
+            .iter()
+            .min_by(|x, y| x.0.coords.dot(d).total_cmp(&y.0.coords.dot(d)))
+        else {
+            return f64::INFINITY;
+        };
+        let mut best = scan(first);
+        for c in &self.clusters {
+            if c.0.coords.dot(d) - c.1 * d.norm() < best {
+                best = best.min(scan(c));
+            }
+        }
+        best
+    }
+}
+
 fn clamp_pairs(g: &PartGeometry, hull: &[P3]) -> Vec<(V3, FaceId, FaceId, f64)> {
     let (lo, hi) = g.bounds();
     let tol = 1e-4 * (hi - lo).norm().max(1.0);
@@ -1030,6 +1097,35 @@ fn polygon_area(poly: &[(f64, f64)]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn clustered_extremes_are_a_scan_of_every_point() {
+        // Points on a sphere, as a tessellated sphere's hull has them, and a few inside.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rand = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let pts: Vec<P3> = (0..3000)
+            .map(|k| {
+                let v = V3::new(rand(), rand(), rand()).normalize();
+                let r = if k % 10 == 0 { 20.0 } else { 25.0 };
+                P3::from(v * r + V3::new(3.0, -7.0, 40.0))
+            })
+            .collect();
+        let e = Extremes::new(&pts);
+        for _ in 0..500 {
+            let d = V3::new(rand(), rand(), rand()).normalize();
+            let scan = pts
+                .iter()
+                .map(|v| v.coords.dot(&d))
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(e.lowest(&d).to_bits(), scan.to_bits(), "{d:?}");
+        }
+        assert_eq!(Extremes::new(&[]).lowest(&V3::z()), f64::INFINITY);
+    }
 
     #[test]
     fn tipping_angle_of_a_square() {
