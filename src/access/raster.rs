@@ -189,6 +189,12 @@ fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage
     if finite && out.spans_set(face, j0 as u32, j1 as u32, i0 as u32, i1 as u32) {
         return;
     }
+    if finite && cov == Coverage::Cells && j0 == j1 && i0 == i1 {
+        // Within one pixel even with the slack (most far triangles of a fine mesh): the
+        // rows below would mark just it.
+        out.set_span(face, j0 as u32, i0 as u32, i0 as u32);
+        return;
+    }
     match cov {
         Coverage::Cells => {
             let cell = |x: f64| clampi(floor_i((x + 1.0) / h));
