@@ -363,10 +363,12 @@ impl<'a> Knowledge<'a> {
                 }
             }
         }
-        // Every use of D2 is masked by the setups a plan can take: the cones need be
-        // whole only there.
+        // Every use of D2 in planning is masked by the setups a plan can take: the cones
+        // need be whole only there. With none, D2 stays whole: the diagnostic then names
+        // the poses the probe would need.
+        let usable = real.and(&forbidden.not());
         let opts = ConeOptions {
-            d2_wanted: Some(std::sync::Arc::new(real.and(&forbidden.not()))),
+            d2_wanted: (!usable.is_empty()).then(|| std::sync::Arc::new(usable)),
             ..opts
         };
         let mut points = fpoints.to_vec();
