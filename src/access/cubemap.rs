@@ -219,19 +219,21 @@ impl CubeMap {
     /// 1e-9 rad, so a head's A = 90°, B = 0° is +x despite rounding), else its pixel.
     pub fn cell_of(&self, d: &V3) -> Cell {
         let u = d.normalize();
-        // A component more than 2e-9 off rules a preferred direction out before the norm
-        // (the norm is at least as large): the same answer, without a square root each.
-        let near = |k: usize| {
-            let p = self.preferred(k);
-            (p.x - u.x).abs() < 2e-9
-                && (p.y - u.y).abs() < 2e-9
-                && (p.z - u.z).abs() < 2e-9
-                && (p - u).norm() < 1e-9
-        };
-        match (0..self.extra.len()).find(|&k| near(k)) {
+        match (0..self.extra.len()).find(|&k| self.is_preferred(k, &u)) {
             Some(i) => Cell::Preferred(i),
             None => Cell::Pixel(self.pixel_of(d)),
         }
+    }
+
+    /// Whether unit `u` is preferred direction `k` (to within 1e-9 rad). A component more
+    /// than 2e-9 off rules it out before the norm (the norm is at least as large): the
+    /// same answer, without a square root each.
+    fn is_preferred(&self, k: usize, u: &V3) -> bool {
+        let p = self.preferred(k);
+        (p.x - u.x).abs() < 2e-9
+            && (p.y - u.y).abs() < 2e-9
+            && (p.z - u.z).abs() < 2e-9
+            && (p - u).norm() < 1e-9
     }
 
     /// [`CubeMap::cell_of`] with the preferred directions looked up in `index` (built
@@ -244,13 +246,7 @@ impl CubeMap {
             .iter()
             .take_while(|&&(x, _)| x <= u.x + 3e-9)
             .map(|&(_, k)| k)
-            .filter(|&k| {
-                let p = self.preferred(k);
-                (p.x - u.x).abs() < 2e-9
-                    && (p.y - u.y).abs() < 2e-9
-                    && (p.z - u.z).abs() < 2e-9
-                    && (p - u).norm() < 1e-9
-            })
+            .filter(|&k| self.is_preferred(k, &u))
             .min();
         match near {
             Some(k) => Cell::Preferred(k),
@@ -526,15 +522,24 @@ impl CubeMap {
         if i0 > i1 {
             return;
         }
+        for (w, mask) in self.span_words(face, j, i0, i1) {
+            self.bits[w] |= mask;
+        }
+    }
+
+    /// The words and masks of pixels i0..=i1 (i0 ≤ i1) of row j of a face.
+    fn span_words(&self, face: u8, j: u32, i0: u32, i1: u32) -> impl Iterator<Item = (usize, u64)> {
         let n = self.n as usize;
         let start = (face as usize * n + j as usize) * n;
         let (mut k, end) = (start + i0 as usize, start + i1 as usize + 1);
-        while k < end {
-            let (w, b) = (k / 64, k % 64);
-            let len = (64 - b).min(end - k);
-            self.bits[w] |= row_mask(len) << b;
-            k += len;
-        }
+        std::iter::from_fn(move || {
+            (k < end).then(|| {
+                let (w, b) = (k / 64, k % 64);
+                let len = (64 - b).min(end - k);
+                k += len;
+                (w, row_mask(len) << b)
+            })
+        })
     }
 
     /// Whether pixels i0..=i1 of rows j0..=j1 of a face are all in the map (true for an
@@ -543,20 +548,9 @@ impl CubeMap {
         if i0 > i1 {
             return true;
         }
-        let n = self.n as usize;
         (j0..=j1).all(|j| {
-            let start = (face as usize * n + j as usize) * n;
-            let (mut k, end) = (start + i0 as usize, start + i1 as usize + 1);
-            while k < end {
-                let (w, b) = (k / 64, k % 64);
-                let len = (64 - b).min(end - k);
-                let mask = row_mask(len) << b;
-                if self.bits[w] & mask != mask {
-                    return false;
-                }
-                k += len;
-            }
-            true
+            self.span_words(face, j, i0, i1)
+                .all(|(w, mask)| self.bits[w] & mask == mask)
         })
     }
 

@@ -682,8 +682,10 @@ pub fn point_cones_many(
             }
         }
     }
-    let d2s: Vec<Option<CubeMap>> = d2s.into_iter().map(|d| d.map(|d| d.out)).collect();
-    let d2s: Vec<Option<CubeMap>> = d2s.into_iter().map(|d| d.map(|d| d.refined(n))).collect();
+    let d2s: Vec<Option<CubeMap>> = d2s
+        .into_iter()
+        .map(|d| d.map(|d| d.out.refined(n)))
+        .collect();
     items
         .iter()
         .zip(&stands)

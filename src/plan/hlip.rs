@@ -463,11 +463,11 @@ fn min_setups(
         .filter(|i| used_points.contains(i))
         .collect();
     let candidates: Vec<crate::access::CubeMap> = points.iter().map(|&i| k.setups(i, m)).collect();
-    let cells: BTreeSet<usize> = candidates
-        .iter()
-        .flat_map(|s| s.cells().map(|c| s.index(c)))
-        .collect();
     if m.head.indexable() {
+        let cells: BTreeSet<usize> = candidates
+            .iter()
+            .flat_map(|s| s.cells().map(|c| s.index(c)))
+            .collect();
         k.prepare(&cells, m);
     }
     let k = &*k;

@@ -745,9 +745,6 @@ impl<'a> Setups<'a> {
     }
 }
 
-/// Pairs of planar faces with opposite normals that bound the part along their normal
-/// (nothing sticks out past either), for a vise's jaws: (normal of the first, first,
-/// second, distance between them). Largest faces first.
 /// Points in clusters of a few dozen with bounding spheres, split along their widest
 /// axis: the lowest point along a direction visits only the clusters whose sphere
 /// reaches below the lowest found so far, and is the same number a scan of every point
@@ -823,6 +820,9 @@ impl Extremes {
     }
 }
 
+/// Pairs of planar faces with opposite normals that bound the part along their normal
+/// (nothing sticks out past either), for a vise's jaws: (normal of the first, first,
+/// second, distance between them). Largest faces first.
 fn clamp_pairs(g: &PartGeometry, hull: &[P3]) -> Vec<(V3, FaceId, FaceId, f64)> {
     let (lo, hi) = g.bounds();
     let tol = 1e-4 * (hi - lo).norm().max(1.0);
