@@ -16,7 +16,7 @@
 
 use super::cubemap::CubeMap;
 use super::probe::Component;
-use super::raster::{shadow_polygon, Coverage};
+use super::raster::{footprint, shadow_polygon, Coverage};
 use super::scene::{point_triangle_distance, Scene, Tri};
 use crate::geometry::{P3, V3};
 
@@ -42,6 +42,14 @@ pub(super) trait Canvas {
     /// Marks the shadow of the convex polygon `q` (relative to the viewpoint, 3 to 12
     /// corners) in `target`.
     fn draw(&mut self, target: u32, q: &[V3], cov: Coverage);
+
+    /// Whether every pixel of rows j0..=j1, columns i0..=i1 of a face is marked in the
+    /// maps of targets `target` and up (for target 0, the base map alone). A canvas that
+    /// cannot tell says false.
+    fn covered(&self, target: u32, face: u8, j0: u32, j1: u32, i0: u32, i1: u32) -> bool {
+        let _ = (target, face, j0, j1, i0, i1);
+        false
+    }
 }
 
 /// The CPU's canvas: the maps themselves.
@@ -75,6 +83,15 @@ impl Canvas for Maps {
         };
         shadow_polygon(map, q, cov);
     }
+
+    fn covered(&self, target: u32, face: u8, j0: u32, j1: u32, i0: u32, i1: u32) -> bool {
+        if target == 0 {
+            self.base.spans_set(face, j0, j1, i0, i1)
+        } else {
+            let from = (target as usize - 1).min(self.bands.len());
+            CubeMap::spans_set_any(&self.bands[from..], face, j0, j1, i0, i1)
+        }
+    }
 }
 
 /// What drawing left for [`finish`]: whether the component meets the scene in every
@@ -93,8 +110,39 @@ pub fn blocked(scene: &Scene, from: &P3, comp: &Component, n: u32, preferred: &[
     finish(scene, from, comp, maps.base, maps.bands, &drawn)
 }
 
+/// [`blocked`] triangle by triangle in the scene's order, without the hierarchy: the
+/// plain baseline the hierarchy's maps must equal bit for bit (tests, benches).
+pub fn blocked_plain(
+    scene: &Scene,
+    from: &P3,
+    comp: &Component,
+    n: u32,
+    preferred: &[V3],
+) -> CubeMap {
+    let mut maps = Maps::new(n, preferred);
+    let (mut candidates, mut q) = (Vec::new(), [V3::zeros(); 12]);
+    let full = !scene
+        .tris
+        .iter()
+        .all(|t| draw_triangle(scene, from, comp, n, &mut maps, t, &mut candidates, &mut q));
+    finish(
+        scene,
+        from,
+        comp,
+        maps.base,
+        maps.bands,
+        &Drawn { full, candidates },
+    )
+}
+
 /// Draws the shadows of the scene's triangles for `comp` at `from` (cube maps of
-/// resolution `n`), cheapest test first (see the module's documentation).
+/// resolution `n`), cheapest test first (see the module's documentation). The scene's
+/// hierarchy is walked nearest child first, so the large shadows of near triangles are
+/// drawn before the far triangles they hide; a node is passed over whole when every
+/// triangle in it would be (too far, too near, under the floor) or when what its
+/// triangles could add is already marked ([`hidden`]). The maps are the same as
+/// triangle by triangle: a shadow adds nothing where its pixels are already marked in
+/// a band grown at least as far as its own.
 pub(super) fn draw<'s>(
     scene: &'s Scene,
     from: &P3,
@@ -102,63 +150,179 @@ pub(super) fn draw<'s>(
     n: u32,
     canvas: &mut impl Canvas,
 ) -> Drawn<'s> {
-    let r = comp.radius;
-    let (near, far) = (comp.near(), comp.far());
-    let from_tip = comp.a == 0.0;
     let mut candidates: Vec<&Tri> = Vec::new();
     let mut q = [V3::zeros(); 12];
-    for t in scene.tris.iter() {
-        if scene.skips(t) {
+    let (near, far) = (comp.near(), comp.far());
+    let bvh = &scene.bvh;
+    let full = |candidates| Drawn {
+        full: true,
+        candidates,
+    };
+    for &k in &bvh.large {
+        let t = &scene.tris[k as usize];
+        if !draw_triangle(scene, from, comp, n, canvas, t, &mut candidates, &mut q) {
+            return full(candidates);
+        }
+    }
+    let mut stack: Vec<u32> = if bvh.nodes.is_empty() {
+        Vec::new()
+    } else {
+        vec![0]
+    };
+    while let Some(k) = stack.pop() {
+        let node = &bvh.nodes[k as usize];
+        if scene.skips_ball(&node.centre, node.radius) {
             continue;
         }
-        let dc = (t.centre - from).norm();
-        if dc - t.radius > far || dc + t.radius < near {
+        let dc = (node.centre - from).norm();
+        let margin = 1e-9 * (1.0 + dc + node.radius);
+        if dc - node.radius > far + margin || dc + node.radius < near - margin {
             continue;
         }
-        let h = t.normal.dot(&(from - t.v[0]));
-        if from_tip && t.closed && h < 0.0 {
+        if hidden(
+            canvas,
+            from,
+            comp,
+            n,
+            node,
+            dc + node.radius + margin,
+            dc - node.radius - margin,
+        ) {
             continue;
         }
-        let exact = || point_triangle_distance(from, &t.v);
-        if r == 0.0 {
-            // Bare (possibly truncated) half-line: the shadow, sampled at pixel centres.
-            if dc - t.radius < near || dc + t.radius > far {
-                let d = exact();
-                if d > far {
-                    continue;
+        match node.kids {
+            Some((a, b)) => {
+                let d = |c: u32| (bvh.nodes[c as usize].centre - from).norm_squared();
+                let (first, second) = if d(b) < d(a) { (b, a) } else { (a, b) };
+                stack.push(second);
+                stack.push(first);
+            }
+            None => {
+                let leaf = &bvh.order[node.first as usize..(node.first + node.count) as usize];
+                for &t in leaf {
+                    let t = &scene.tris[t as usize];
+                    if !draw_triangle(scene, from, comp, n, canvas, t, &mut candidates, &mut q) {
+                        return full(candidates);
+                    }
                 }
             }
-            for (k, v) in t.v.iter().enumerate() {
-                q[k] = v - from;
-            }
-            canvas.draw(0, &q[..3], Coverage::Centres);
-            if near > 0.0 {
-                candidates.push(t);
-            }
-            continue;
-        }
-        let lower = dc - t.radius;
-        let dmin = if lower > 20.0 * r { lower } else { exact() };
-        if dmin > far {
-            continue;
-        }
-        if from_tip && dmin.max(near) > r {
-            let k = pixels_for((r / dmin.max(near)).asin(), n);
-            if k > PRISM_PIXELS && t.normal != V3::zeros() && prism_shadow(canvas, from, t, r, h) {
-                continue;
-            }
-        }
-        if !grown_shadow(canvas, n, from, comp, t.v, dmin, 0) {
-            return Drawn {
-                full: true,
-                candidates,
-            };
         }
     }
     Drawn {
         full: false,
         candidates,
     }
+}
+
+/// Whether the shadows `node`'s triangles could add (at distances `lo` to `hi` from
+/// `from`) are all marked already: its box's footprint is marked in the maps of every
+/// band at least as grown as any of its triangles' would be. Never for a truncated bare
+/// half-line (its triangles are kept as candidates for the preferred directions), nor
+/// when a triangle of the node could be drawn as a prism or meet the component in every
+/// direction.
+#[allow(clippy::too_many_arguments)]
+fn hidden(
+    canvas: &impl Canvas,
+    from: &P3,
+    comp: &Component,
+    n: u32,
+    node: &crate::access::scene::BvhNode,
+    hi: f64,
+    lo: f64,
+) -> bool {
+    let (r, near) = (comp.radius, comp.near());
+    let (target, cov) = if r == 0.0 {
+        if near > 0.0 {
+            return false;
+        }
+        (0, Coverage::Centres)
+    } else {
+        if comp.a == 0.0 {
+            let d = lo.max(near);
+            if d <= r || pixels_for((r / d).asin(), n) > PRISM_PIXELS {
+                return false;
+            }
+        }
+        let Some(alpha) = dilation(r, near, lo.max(0.0), hi) else {
+            return false;
+        };
+        let k = pixels_for(alpha * (1.0 + 1e-9), n);
+        if k as usize > 2 * n as usize {
+            return false;
+        }
+        (k, Coverage::Cells)
+    };
+    let (a, b) = (node.lo - from, node.hi - from);
+    let corners = [0, 1, 2, 3, 4, 5, 6, 7].map(|c: u8| {
+        V3::new(
+            if c & 1 == 0 { a.x } else { b.x },
+            if c & 2 == 0 { a.y } else { b.y },
+            if c & 4 == 0 { a.z } else { b.z },
+        )
+    });
+    match footprint(&corners[..], cov, n) {
+        Some((face, j0, j1, i0, i1)) => canvas.covered(target, face, j0, j1, i0, i1),
+        None => false,
+    }
+}
+
+/// One triangle's shadow for `comp` at `from`, cheapest test first; false when the
+/// component meets it in every direction.
+#[allow(clippy::too_many_arguments)]
+fn draw_triangle<'s>(
+    scene: &Scene,
+    from: &P3,
+    comp: &Component,
+    n: u32,
+    canvas: &mut impl Canvas,
+    t: &'s Tri,
+    candidates: &mut Vec<&'s Tri>,
+    q: &mut [V3; 12],
+) -> bool {
+    let r = comp.radius;
+    let (near, far) = (comp.near(), comp.far());
+    let from_tip = comp.a == 0.0;
+    if scene.skips(t) {
+        return true;
+    }
+    let dc = (t.centre - from).norm();
+    if dc - t.radius > far || dc + t.radius < near {
+        return true;
+    }
+    let h = t.normal.dot(&(from - t.v[0]));
+    if from_tip && t.closed && h < 0.0 {
+        return true;
+    }
+    let exact = || point_triangle_distance(from, &t.v);
+    if r == 0.0 {
+        // Bare (possibly truncated) half-line: the shadow, sampled at pixel centres.
+        if dc - t.radius < near || dc + t.radius > far {
+            let d = exact();
+            if d > far {
+                return true;
+            }
+        }
+        for (k, v) in t.v.iter().enumerate() {
+            q[k] = v - from;
+        }
+        canvas.draw(0, &q[..3], Coverage::Centres);
+        if near > 0.0 {
+            candidates.push(t);
+        }
+        return true;
+    }
+    let lower = dc - t.radius;
+    let dmin = if lower > 20.0 * r { lower } else { exact() };
+    if dmin > far {
+        return true;
+    }
+    if from_tip && dmin.max(near) > r {
+        let k = pixels_for((r / dmin.max(near)).asin(), n);
+        if k > PRISM_PIXELS && t.normal != V3::zeros() && prism_shadow(canvas, from, t, r, h) {
+            return true;
+        }
+    }
+    grown_shadow(canvas, n, from, comp, t.v, dmin, 0)
 }
 
 /// The blocked map from the drawn shadows: ∪ₖ growₖ(bandₖ) added to the base, then the
@@ -238,6 +402,18 @@ fn grown_shadow(
         .max((v[2] - v[1]).norm())
         .max((v[0] - v[2]).norm());
     if dmin < near && depth < MAX_SPLIT && size > 0.1 * near {
+        // Its pieces, each dilated at most as far as the whole triangle would be, add
+        // nothing where its shadow is already marked in a band grown as far or further.
+        if let Some(alpha) = dilation(r, near, dmin * (1.0 - 1e-9), reach * (1.0 + 1e-9)) {
+            let k = pixels_for(alpha * (1.0 + 1e-9), n);
+            let q = v.map(|p| p - from);
+            if k as usize <= 2 * n as usize
+                && footprint(&q, Coverage::Cells, n)
+                    .is_some_and(|(face, j0, j1, i0, i1)| canvas.covered(k, face, j0, j1, i0, i1))
+            {
+                return true;
+            }
+        }
         let m = [0, 1, 2].map(|k| P3::from((v[k].coords + v[(k + 1) % 3].coords) / 2.0));
         let parts = [
             [v[0], m[0], m[2]],

@@ -554,6 +554,26 @@ impl CubeMap {
         })
     }
 
+    /// Whether every pixel i0..=i1 of rows j0..=j1 of a face is in at least one of
+    /// `maps` (maps of one resolution; false when there is none).
+    pub fn spans_set_any(
+        maps: &[Option<CubeMap>],
+        face: u8,
+        j0: u32,
+        j1: u32,
+        i0: u32,
+        i1: u32,
+    ) -> bool {
+        let Some(first) = maps.iter().flatten().next() else {
+            return false;
+        };
+        (j0..=j1).all(|j| {
+            first.span_words(face, j, i0, i1).all(|(w, mask)| {
+                maps.iter().flatten().fold(0, |acc, m| acc | m.bits[w]) & mask == mask
+            })
+        })
+    }
+
     /// This map at resolution `n`, a multiple of its own: each fine pixel takes the bit
     /// of the coarse pixel holding it, each preferred direction its own bit. A cone whose
     /// free pixels are free in every direction they hold (cells, not centres) stays so.

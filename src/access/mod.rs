@@ -35,7 +35,7 @@ pub mod scan;
 mod scene;
 mod swept;
 
-pub use cpu::pixels_for;
+pub use cpu::{blocked_plain, pixels_for};
 pub use cubemap::{face_dir, face_uv, ones, Cell, CubeMap, Pixel, PreferredIndex};
 pub use errors::AccessError;
 pub use exact::{component_hits, refine};

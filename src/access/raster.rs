@@ -158,6 +158,45 @@ pub fn shadow_polygon(out: &mut CubeMap, q: &[V3], cov: Coverage) {
     }
 }
 
+/// The pixels that may be marked by the shadow of any polygon drawn with `cov` whose
+/// corners lie in the convex hull of `corners` (relative to the viewpoint; a box, a
+/// triangle): a face and the rows j0..=j1 and columns i0..=i1 of a rectangle on it, as
+/// (face, j0, j1, i0, i1). None unless the hull lies strictly inside one face's
+/// pyramid: then every such polygon takes [`shadow_polygon`]'s fast path on that face,
+/// and its projection lies in the hull's (central projection keeps it convex), so the
+/// rectangle holds every span [`raster_convex`] would set.
+pub fn footprint(corners: &[V3], cov: Coverage, n: u32) -> Option<(u8, u32, u32, u32, u32)> {
+    let face = face_of(&corners[0]);
+    let (mut umin, mut umax) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut vmin, mut vmax) = (f64::INFINITY, f64::NEG_INFINITY);
+    for c in corners {
+        let [u, v, w] = in_frame(face, c);
+        if !(w > 0.0 && u.abs() < w && v.abs() < w) {
+            return None;
+        }
+        let (u, v) = (u / w, v / w);
+        umin = umin.min(u);
+        umax = umax.max(u);
+        vmin = vmin.min(v);
+        vmax = vmax.max(v);
+    }
+    let n = n as i64;
+    let h = 2.0 / n as f64;
+    let slack = 1e-9
+        + match cov {
+            Coverage::Cells => SLACK,
+            Coverage::Centres => HAIR + SLACK,
+        };
+    let cell = |x: f64| floor_i((x + 1.0) / h).clamp(0, n - 1) as u32;
+    Some((
+        face,
+        cell(vmin - slack),
+        cell(vmax + slack),
+        cell(umin - slack),
+        cell(umax + slack),
+    ))
+}
+
 /// Marks the pixels of a cube face that a convex polygon in (u, v) ∈ [−1, 1]² covers.
 fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage) {
     let n = out.n() as i64;

@@ -34,6 +34,8 @@ pub struct Scene {
     pub size: f64,
     /// Shared with the scenes [`Scene::above`] makes of it.
     mesh: Option<std::sync::Arc<TriMesh>>,
+    /// The triangles' bounding-volume hierarchy, for the backends' drawing.
+    pub bvh: std::sync::Arc<Bvh>,
 }
 
 impl Scene {
@@ -74,11 +76,13 @@ impl Scene {
                 .ok()
                 .map(std::sync::Arc::new)
         };
+        let size = (hi - lo).norm();
         Scene {
+            bvh: std::sync::Arc::new(Bvh::new(&tris, size)),
             tris: std::sync::Arc::new(tris),
             floor: None,
             closed,
-            size: (hi - lo).norm(),
+            size,
             mesh,
         }
     }
@@ -109,7 +113,19 @@ impl Scene {
             closed: self.closed,
             size: self.size,
             mesh: self.mesh.clone(),
+            bvh: self.bvh.clone(),
         }
+    }
+
+    /// Whether drawing leaves out every triangle within `radius` of `centre`: the ball
+    /// lies wholly under the floor, with a margin for rounding, so that [`Scene::skips`]
+    /// leaves out each of them.
+    #[inline]
+    pub fn skips_ball(&self, centre: &P3, radius: f64) -> bool {
+        self.floor.as_ref().is_some_and(|(at, n, h)| {
+            let c = (centre - at).dot(n);
+            c + radius < h - 1e-9 * (1.0 + h.abs() + c.abs() + radius)
+        })
     }
 
     /// Whether drawing leaves `t` out: wholly under the floor (see [`Scene::above`]).
@@ -146,6 +162,120 @@ impl Scene {
     pub fn mesh(&self) -> Option<&TriMesh> {
         self.mesh.as_deref()
     }
+}
+
+/// A bounding-volume hierarchy over a scene's triangles, so that drawing decides whole
+/// groups of them at once: too far, under the floor, or hidden where the map is already
+/// marked (`access::cpu`). Each node holds a box around its triangles' corners and a
+/// ball around their bounding balls, so a test passed by the node's ball is passed by
+/// each triangle's.
+pub struct Bvh {
+    /// Triangles larger than a quarter of the scene (a table), outside every node; drawn
+    /// first, their large shadows hide the most.
+    pub large: Vec<u32>,
+    /// The nodes, the root first (none for a scene without other triangles).
+    pub nodes: Vec<BvhNode>,
+    /// Triangle indices; a leaf holds a range of them.
+    pub order: Vec<u32>,
+}
+
+/// One node of a [`Bvh`].
+pub struct BvhNode {
+    /// The box around its triangles' corners.
+    pub lo: P3,
+    /// Its upper corner.
+    pub hi: P3,
+    /// A ball holding every triangle's bounding ball.
+    pub centre: P3,
+    /// Its radius.
+    pub radius: f64,
+    /// Inner node: its two children; leaf: none.
+    pub kids: Option<(u32, u32)>,
+    /// A leaf's triangles: `order[first..first + count]`.
+    pub first: u32,
+    /// How many (0 for an inner node).
+    pub count: u32,
+}
+
+/// Most triangles in a leaf.
+const LEAF: usize = 4;
+
+impl Bvh {
+    fn new(tris: &[Tri], size: f64) -> Bvh {
+        let (large, mut order): (Vec<u32>, Vec<u32>) =
+            (0..tris.len() as u32).partition(|&k| tris[k as usize].radius > size / 4.0);
+        let mut nodes = Vec::new();
+        if !order.is_empty() {
+            let len = order.len();
+            build(tris, &mut order, 0, len, &mut nodes);
+        }
+        Bvh {
+            large,
+            nodes,
+            order,
+        }
+    }
+}
+
+/// Appends the node of `order[first..first + count]` (and its subtree), returning its
+/// index. Splits at the median of the longest axis of the centres' box, ties by index,
+/// so the tree is the same on every machine.
+fn build(
+    tris: &[Tri],
+    order: &mut [u32],
+    first: usize,
+    count: usize,
+    nodes: &mut Vec<BvhNode>,
+) -> u32 {
+    let ids = &mut order[first..first + count];
+    let (mut lo, mut hi) = (tris[ids[0] as usize].v[0], tris[ids[0] as usize].v[0]);
+    let (mut clo, mut chi) = (tris[ids[0] as usize].centre, tris[ids[0] as usize].centre);
+    for &k in ids.iter() {
+        let t = &tris[k as usize];
+        for v in &t.v {
+            lo = lo.inf(v);
+            hi = hi.sup(v);
+        }
+        clo = clo.inf(&t.centre);
+        chi = chi.sup(&t.centre);
+    }
+    let centre = P3::from((lo.coords + hi.coords) / 2.0);
+    let radius = ids
+        .iter()
+        .map(|&k| (tris[k as usize].centre - centre).norm() + tris[k as usize].radius)
+        .fold(0.0, f64::max)
+        * (1.0 + 1e-12);
+    let at = nodes.len();
+    nodes.push(BvhNode {
+        lo,
+        hi,
+        centre,
+        radius,
+        kids: None,
+        first: first as u32,
+        count: count as u32,
+    });
+    if count > LEAF {
+        let ext = chi - clo;
+        let axis = if ext.x >= ext.y && ext.x >= ext.z {
+            0
+        } else if ext.y >= ext.z {
+            1
+        } else {
+            2
+        };
+        let half = count / 2;
+        ids.select_nth_unstable_by(half, |&a, &b| {
+            let (ca, cb) = (tris[a as usize].centre[axis], tris[b as usize].centre[axis]);
+            ca.total_cmp(&cb).then(a.cmp(&b))
+        });
+        let left = build(tris, order, first, half, nodes);
+        let right = build(tris, order, first + half, count - half, nodes);
+        let node = &mut nodes[at];
+        node.kids = Some((left, right));
+        node.count = 0;
+    }
+    at as u32
 }
 
 fn make_tri(v: [P3; 3], closed: bool) -> Tri {

@@ -203,6 +203,59 @@ fn halfline_gac_is_the_complement_of_its_blocked_map() {
     assert!(!gac.is_empty() && gac.count() < 6 * 32 * 32);
 }
 
+/// Drawing walks the scene's bounding-volume hierarchy and passes over nodes whose
+/// shadows are already marked; the maps must be those of drawing every triangle in
+/// order, bit for bit: every component of every probe (second components too), bare,
+/// truncated and grown half-lines, with a table and with a floor, on the examples and
+/// two real parts.
+#[test]
+fn the_hierarchy_draws_the_same_maps_as_every_triangle() {
+    use inspc::access::blocked_plain;
+    let specs = EXAMPLES.iter().chain(NIST.iter());
+    for spec in specs {
+        let c = case(spec, if spec.contains("nist") { 3 } else { 4 }, 41);
+        let lo = c
+            .scene
+            .tris
+            .iter()
+            .flat_map(|t| t.v)
+            .reduce(|a, b| a.inf(&b));
+        let mut comps = vec![
+            Component::half_line(),
+            Component::half_line().shifted(5.0),
+            Component {
+                name: "grown half-line".into(),
+                a: 0.0,
+                b: f64::INFINITY,
+                radius: 0.8,
+                end: End::Round,
+            },
+        ];
+        for p in &c.probes {
+            comps.extend(p.first.iter().cloned());
+            comps.extend(p.second.iter().cloned());
+        }
+        let table = c.scene.with_table(&lo.unwrap(), &V3::z());
+        for (k, p) in c.points.iter().enumerate() {
+            let floor = c.scene.above(p, &V3::new(0.0, 0.6, 0.8), -3.0);
+            let scenes = [&c.scene, &table, &floor];
+            for comp in &comps {
+                let scene = scenes[k % 3];
+                for n in [32, 64] {
+                    let axes = inspc::access::axes();
+                    let fast = Cpu.blocked(scene, p, comp, n, &axes);
+                    let plain = blocked_plain(scene, p, comp, n, &axes);
+                    assert!(
+                        fast == plain,
+                        "{spec}: {} at {p:?}, n = {n}: the hierarchy's map differs",
+                        comp.name
+                    );
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn cones_are_the_same_for_any_thread_count() {
     let (checked, parts, graphs) =
