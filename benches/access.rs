@@ -6,6 +6,10 @@
 //! fpoints spread over the part; divide by 16 for one cone. `grown_exact_boundary` adds
 //! the exact refinement of the grown cone's boundary.
 //!
+//! `halfline_plain`, `grown_plain` and `ram_plain` draw the same cones triangle by
+//! triangle, without the scene's bounding-volume hierarchy (the maps are equal bit for
+//! bit): the hierarchy's gain.
+//!
 //! `batch_cpu` and `batch_gpu` compare the two backends on the same batch of queries.
 //!
 //! `scanner` computes a laser line scanner's cones (LC15Dx optics on a fixed head: laser,
@@ -62,14 +66,29 @@ fn component(kind: &str, probe: &ProbeShape) -> Component {
 }
 
 fn run(bencher: divan::Bencher, (spec, n): (&str, u32), kind: &str) {
+    run_with(bencher, (spec, n), kind, |s, p, c, n| {
+        Cpu.blocked(s, p, c, n, &[])
+    });
+}
+
+/// The same cones drawn triangle by triangle, without the scene's hierarchy.
+fn run_plain(bencher: divan::Bencher, (spec, n): (&str, u32), kind: &str) {
+    run_with(bencher, (spec, n), kind, |s, p, c, n| {
+        inspc::access::blocked_plain(s, p, c, n, &[])
+    });
+}
+
+fn run_with(
+    bencher: divan::Bencher,
+    (spec, n): (&str, u32),
+    kind: &str,
+    blocked: impl Fn(&Scene, &P3, &Component, u32) -> CubeMap + Sync,
+) {
     let (scene, pts, probe) = scene(spec);
     let comp = component(kind, &probe);
     bencher.bench(|| {
         pts.iter()
-            .map(|p| {
-                Cpu.blocked(&scene, divan::black_box(p), &comp, n, &[])
-                    .count()
-            })
+            .map(|p| blocked(&scene, divan::black_box(p), &comp, n).count())
             .sum::<usize>()
     });
 }
@@ -87,6 +106,21 @@ fn grown(bencher: divan::Bencher, case: (&str, u32)) {
 #[divan::bench(args = CASES)]
 fn ram(bencher: divan::Bencher, case: (&str, u32)) {
     run(bencher, case, "ram");
+}
+
+#[divan::bench(args = CASES)]
+fn halfline_plain(bencher: divan::Bencher, case: (&str, u32)) {
+    run_plain(bencher, case, "halfline");
+}
+
+#[divan::bench(args = CASES)]
+fn grown_plain(bencher: divan::Bencher, case: (&str, u32)) {
+    run_plain(bencher, case, "grown");
+}
+
+#[divan::bench(args = CASES)]
+fn ram_plain(bencher: divan::Bencher, case: (&str, u32)) {
+    run_plain(bencher, case, "ram");
 }
 
 /// The grown half-line with its boundary refined by exact parry capsule tests (opt-in and

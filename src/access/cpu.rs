@@ -14,7 +14,7 @@
 //!   near triangles, whose dilation would be many pixels, are grown in space instead: the
 //!   shadow of a prism that holds the triangle swept by a ball of radius ρ.
 
-use super::cubemap::CubeMap;
+use super::cubemap::{CubeMap, Disc};
 use super::probe::Component;
 use super::raster::{footprint, shadow_polygon, Coverage};
 use super::scene::{point_triangle_distance, Scene, Tri};
@@ -43,11 +43,21 @@ pub(super) trait Canvas {
     /// corners) in `target`.
     fn draw(&mut self, target: u32, q: &[V3], cov: Coverage);
 
-    /// Whether every pixel of rows j0..=j1, columns i0..=i1 of a face is marked in the
-    /// maps of targets `target` and up (for target 0, the base map alone). A canvas that
-    /// cannot tell says false.
-    fn covered(&self, target: u32, face: u8, j0: u32, j1: u32, i0: u32, i1: u32) -> bool {
-        let _ = (target, face, j0, j1, i0, i1);
+    /// Whether every pixel of the rectangle `area` gives (a face, rows j0..=j1, columns
+    /// i0..=i1, as (face, j0, j1, i0, i1); None for no rectangle) is marked in the maps
+    /// of targets `target` and up (for target 0, the base map alone). A canvas that
+    /// cannot tell says false; `area` is asked only when a map could hold it.
+    fn covered(
+        &self,
+        target: u32,
+        area: impl FnOnce() -> Option<(u8, u32, u32, u32, u32)>,
+    ) -> bool {
+        let _ = (target, area);
+        false
+    }
+
+    /// Whether drawing may stop: what the caller waits for is blocked already.
+    fn enough(&mut self) -> bool {
         false
     }
 }
@@ -58,20 +68,57 @@ pub(super) struct Maps {
     pub base: CubeMap,
     /// Target k at index k − 1.
     pub bands: Vec<Option<CubeMap>>,
+    /// Whether anything was drawn in the base.
+    base_marked: bool,
+    /// The pixels whose blocking ends the drawing early ([`blocked_until`]).
+    stop: Option<Stop>,
 }
+
+/// What [`blocked_until`] waits for: pixels not yet blocked, each with its discs
+/// ([`CubeMap::discs`]). A look reads each pending pixel's discs of the bands drawn;
+/// the next is taken once [`LOOK_EVERY`] polygons per word the last one read are drawn.
+struct Stop {
+    pending: Vec<(usize, std::sync::Arc<[Disc]>)>,
+    drawn: usize,
+    next: usize,
+}
+
+/// Polygons drawn per word a look reads (a polygon costs about as much as reading a
+/// hundred words).
+const LOOK_EVERY: usize = 1;
+
+/// Past this many pixels to wait for, [`blocked_until`] draws the whole map.
+const MOST_PENDING: usize = 64;
 
 impl Maps {
     pub fn new(n: u32, preferred: &[V3]) -> Maps {
         Maps {
             base: CubeMap::empty(n, preferred),
             bands: Vec::new(),
+            base_marked: false,
+            stop: None,
         }
+    }
+
+    /// Whether pixel `index` is blocked in the map [`finish`] would make of these (in
+    /// the base, or in a band k that meets its disc k), and how many words that read.
+    fn pixel_blocked(&self, index: usize, discs: &[Disc]) -> (bool, usize) {
+        let mut read = 0;
+        let blocked = self.base.has_index(index)
+            || self.bands.iter().zip(&discs[1..]).any(|(b, d)| {
+                b.as_ref().is_some_and(|b| {
+                    read += d.words();
+                    b.meets(d)
+                })
+            });
+        (blocked, read)
     }
 }
 
 impl Canvas for Maps {
     fn draw(&mut self, target: u32, q: &[V3], cov: Coverage) {
         let map = if target == 0 {
+            self.base_marked = true;
             &mut self.base
         } else {
             let k = target as usize;
@@ -82,14 +129,46 @@ impl Canvas for Maps {
             self.bands[k - 1].get_or_insert_with(|| base.empty_like())
         };
         shadow_polygon(map, q, cov);
+        if let Some(stop) = &mut self.stop {
+            stop.drawn += 1;
+        }
     }
 
-    fn covered(&self, target: u32, face: u8, j0: u32, j1: u32, i0: u32, i1: u32) -> bool {
+    fn enough(&mut self) -> bool {
+        let Some(mut stop) = self.stop.take() else {
+            return false;
+        };
+        if stop.drawn >= stop.next {
+            let mut read = 0;
+            stop.pending.retain(|(p, discs)| {
+                let (blocked, words) = self.pixel_blocked(*p, discs);
+                read += words;
+                !blocked
+            });
+            stop.drawn = 0;
+            stop.next = LOOK_EVERY * read;
+        }
+        let done = stop.pending.is_empty();
+        self.stop = Some(stop);
+        done
+    }
+
+    fn covered(
+        &self,
+        target: u32,
+        area: impl FnOnce() -> Option<(u8, u32, u32, u32, u32)>,
+    ) -> bool {
         if target == 0 {
-            self.base.spans_set(face, j0, j1, i0, i1)
+            self.base_marked
+                && area()
+                    .is_some_and(|(face, j0, j1, i0, i1)| self.base.spans_set(face, j0, j1, i0, i1))
         } else {
             let from = (target as usize - 1).min(self.bands.len());
-            CubeMap::spans_set_any(&self.bands[from..], face, j0, j1, i0, i1)
+            let bands = &self.bands[from..];
+            bands.iter().any(Option::is_some)
+                && area().is_some_and(|(face, j0, j1, i0, i1)| {
+                    CubeMap::spans_set_any(bands, face, j0, j1, i0, i1)
+                })
         }
     }
 }
@@ -106,6 +185,49 @@ pub(super) struct Drawn<'s> {
 /// scene.
 pub fn blocked(scene: &Scene, from: &P3, comp: &Component, n: u32, preferred: &[V3]) -> CubeMap {
     let mut maps = Maps::new(n, preferred);
+    let drawn = draw(scene, from, comp, n, &mut maps);
+    finish(scene, from, comp, maps.base, maps.bands, &drawn)
+}
+
+/// [`blocked`], stopping early once every cell of `stop` is blocked: then the map holds
+/// fewer blocked cells than [`blocked`]'s but all of `stop`'s; otherwise it is
+/// [`blocked`]'s. A preferred direction counts as blocked when every pixel holding it
+/// is, as [`finish`] decides for a grown component; a bare half-line is drawn whole.
+pub fn blocked_until(
+    scene: &Scene,
+    from: &P3,
+    comp: &Component,
+    n: u32,
+    preferred: &[V3],
+    stop: &CubeMap,
+) -> CubeMap {
+    let mut maps = Maps::new(n, preferred);
+    if comp.radius > 0.0 && stop.n() == n {
+        let mut pixels: Vec<usize> = Vec::new();
+        for cell in stop.cells() {
+            match cell {
+                super::Cell::Pixel(_) => pixels.push(stop.index(cell)),
+                super::Cell::Preferred(k) => pixels.extend(
+                    stop.pixels_holding(&stop.preferred(k))
+                        .into_iter()
+                        .map(|p| stop.index(super::Cell::Pixel(p))),
+                ),
+            }
+        }
+        pixels.sort_unstable();
+        pixels.dedup();
+        // Many pending pixels are seldom all blocked, and each look costs more.
+        if pixels.len() <= MOST_PENDING {
+            maps.stop = Some(Stop {
+                next: LOOK_EVERY * 16 * pixels.len(),
+                pending: pixels
+                    .into_iter()
+                    .map(|p| (p, CubeMap::discs(n, p)))
+                    .collect(),
+                drawn: 0,
+            });
+        }
+    }
     let drawn = draw(scene, from, comp, n, &mut maps);
     finish(scene, from, comp, maps.base, maps.bands, &drawn)
 }
@@ -153,6 +275,7 @@ pub(super) fn draw<'s>(
     let mut candidates: Vec<&Tri> = Vec::new();
     let mut q = [V3::zeros(); 12];
     let (near, far) = (comp.near(), comp.far());
+    let from_tip = comp.a == 0.0;
     let bvh = &scene.bvh;
     let full = |candidates| Drawn {
         full: true,
@@ -164,6 +287,10 @@ pub(super) fn draw<'s>(
             return full(candidates);
         }
     }
+    let partial = |candidates| Drawn {
+        full: false,
+        candidates,
+    };
     let mut stack: Vec<u32> = if bvh.nodes.is_empty() {
         Vec::new()
     } else {
@@ -174,9 +301,13 @@ pub(super) fn draw<'s>(
         if scene.skips_ball(&node.centre, node.radius) {
             continue;
         }
-        let dc = (node.centre - from).norm();
+        let w = from - node.centre;
+        let dc = w.norm();
         let margin = 1e-9 * (1.0 + dc + node.radius);
         if dc - node.radius > far + margin || dc + node.radius < near - margin {
+            continue;
+        }
+        if from_tip && faces_away(node, &w, dc, margin) {
             continue;
         }
         if hidden(
@@ -205,13 +336,32 @@ pub(super) fn draw<'s>(
                         return full(candidates);
                     }
                 }
+                if canvas.enough() {
+                    return partial(candidates);
+                }
             }
         }
     }
-    Drawn {
-        full: false,
-        candidates,
+    partial(candidates)
+}
+
+/// Whether every triangle of `node` faces away from the viewpoint at `w` from the
+/// node's centre (`dc` = |w|), as [`draw_triangle`] culls them for a component from the
+/// tip: each normal n is within θ of the node's axis a and each corner p within its
+/// ball, so n·(viewpoint − p) ≤ |w|·cos(φ − θ) + radius, with φ the angle from a to w.
+fn faces_away(node: &crate::access::scene::BvhNode, w: &V3, dc: f64, margin: f64) -> bool {
+    let Some((a, cos_t, sin_t)) = node.normals else {
+        return false;
+    };
+    if dc <= node.radius {
+        return false;
     }
+    let cos_p = a.dot(w) / dc;
+    if cos_p >= cos_t {
+        return false;
+    }
+    let sin_p = (1.0 - cos_p * cos_p).max(0.0).sqrt();
+    dc * (cos_p * cos_t + sin_p * sin_t) + node.radius < -margin
 }
 
 /// Whether the shadows `node`'s triangles could add (at distances `lo` to `hi` from
@@ -252,18 +402,17 @@ fn hidden(
         }
         (k, Coverage::Cells)
     };
-    let (a, b) = (node.lo - from, node.hi - from);
-    let corners = [0, 1, 2, 3, 4, 5, 6, 7].map(|c: u8| {
-        V3::new(
-            if c & 1 == 0 { a.x } else { b.x },
-            if c & 2 == 0 { a.y } else { b.y },
-            if c & 4 == 0 { a.z } else { b.z },
-        )
-    });
-    match footprint(&corners[..], cov, n) {
-        Some((face, j0, j1, i0, i1)) => canvas.covered(target, face, j0, j1, i0, i1),
-        None => false,
-    }
+    canvas.covered(target, || {
+        let (a, b) = (node.lo - from, node.hi - from);
+        let corners = [0, 1, 2, 3, 4, 5, 6, 7].map(|c: u8| {
+            V3::new(
+                if c & 1 == 0 { a.x } else { b.x },
+                if c & 2 == 0 { a.y } else { b.y },
+                if c & 4 == 0 { a.z } else { b.z },
+            )
+        });
+        footprint(&corners, cov, n)
+    })
 }
 
 /// One triangle's shadow for `comp` at `from`, cheapest test first; false when the
@@ -408,8 +557,7 @@ fn grown_shadow(
             let k = pixels_for(alpha * (1.0 + 1e-9), n);
             let q = v.map(|p| p - from);
             if k as usize <= 2 * n as usize
-                && footprint(&q, Coverage::Cells, n)
-                    .is_some_and(|(face, j0, j1, i0, i1)| canvas.covered(k, face, j0, j1, i0, i1))
+                && canvas.covered(k, || footprint(&q, Coverage::Cells, n))
             {
                 return true;
             }

@@ -574,6 +574,46 @@ impl CubeMap {
         })
     }
 
+    /// Whether the map's pixels meet those of `disc` (one of [`CubeMap::discs`]).
+    pub fn meets(&self, disc: &Disc) -> bool {
+        self.bits[disc.start..]
+            .iter()
+            .zip(&disc.words)
+            .any(|(a, b)| a & b != 0)
+    }
+
+    /// The pixels within k growth steps of pixel `index` at resolution `n`, for k = 0
+    /// up to 2n: pixel c is in `B` grown k times exactly when `B` meets c's disc k, the
+    /// neighbour relation being symmetric (tested). Computed once per process for each
+    /// pixel asked about.
+    pub fn discs(n: u32, index: usize) -> Arc<[Disc]> {
+        use std::collections::HashMap;
+        use std::sync::{Mutex, OnceLock};
+        type Discs = HashMap<(u32, usize), Arc<[Disc]>>;
+        static DISCS: OnceLock<Mutex<Discs>> = OnceLock::new();
+        let discs = DISCS.get_or_init(|| Mutex::new(HashMap::new()));
+        if let Some(d) = discs
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .get(&(n, index))
+        {
+            return d.clone();
+        }
+        let mut m = CubeMap::empty(n, &[]);
+        m.bits[index / 64] |= 1 << (index % 64);
+        let mut out = vec![Disc::of(&m.bits)];
+        for _ in 0..2 * n {
+            m = m.grow();
+            out.push(Disc::of(&m.bits));
+        }
+        let out: Arc<[Disc]> = out.into();
+        discs
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .insert((n, index), out.clone());
+        out
+    }
+
     /// This map at resolution `n`, a multiple of its own: each fine pixel takes the bit
     /// of the coarse pixel holding it, each preferred direction its own bit. A cone whose
     /// free pixels are free in every direction they hold (cells, not centres) stays so.
@@ -697,6 +737,30 @@ impl CubeMap {
     }
 }
 
+/// Pixels around one pixel ([`CubeMap::discs`]): the pixel words from the first that
+/// holds one to the last.
+#[derive(Debug)]
+pub struct Disc {
+    start: usize,
+    words: Vec<u64>,
+}
+
+impl Disc {
+    fn of(bits: &[u64]) -> Disc {
+        let start = bits.iter().position(|&w| w != 0).unwrap_or(0);
+        let end = bits.iter().rposition(|&w| w != 0).map_or(start, |e| e + 1);
+        Disc {
+            start,
+            words: bits[start..end].to_vec(),
+        }
+    }
+
+    /// How many words a look at it reads.
+    pub fn words(&self) -> usize {
+        self.words.len()
+    }
+}
+
 /// Per border pixel, its neighbours on other cube faces (bit indices), computed once per
 /// resolution.
 struct EdgeTable {
@@ -771,6 +835,48 @@ fn pixel_directions(like: &CubeMap) -> Arc<[V3]> {
 
 #[cfg(test)]
 mod tests {
+
+    /// [`CubeMap::discs`] relies on it: q is a neighbour of p exactly when p is one of q.
+    #[test]
+    fn growing_is_symmetric_and_discs_are_grown_pixels() {
+        for n in [4, 7, 16, 32] {
+            let empty = CubeMap::empty(n, &[]);
+            let grown: Vec<Vec<usize>> = (0..6 * (n as usize).pow(2))
+                .map(|p| {
+                    let mut m = empty.clone();
+                    m.bits[p / 64] |= 1 << (p % 64);
+                    let g = m.grow();
+                    (0..6 * (n as usize).pow(2))
+                        .filter(|&q| g.has_index(q))
+                        .collect()
+                })
+                .collect();
+            for (p, near) in grown.iter().enumerate() {
+                for &q in near {
+                    assert!(
+                        grown[q].contains(&p),
+                        "n = {n}: {q} grows from {p}, not back"
+                    );
+                }
+            }
+            let d = CubeMap::discs(n, 5);
+            assert_eq!(d.len(), 2 * n as usize + 1);
+            let mut m = empty.clone();
+            m.bits[0] |= 1 << 5;
+            let g = m.grown(3);
+            assert_eq!(
+                g.bits[d[3].start..d[3].start + d[3].words()],
+                d[3].words[..]
+            );
+            assert_eq!(
+                g.count(),
+                d[3].words
+                    .iter()
+                    .map(|w| w.count_ones() as usize)
+                    .sum::<usize>()
+            );
+        }
+    }
 
     #[test]
     fn a_refined_map_gives_each_fine_pixel_its_coarse_pixels_bit() {

@@ -36,7 +36,7 @@ mod scene;
 mod swept;
 
 pub use cpu::{blocked_plain, pixels_for};
-pub use cubemap::{face_dir, face_uv, ones, Cell, CubeMap, Pixel, PreferredIndex};
+pub use cubemap::{face_dir, face_uv, ones, Cell, CubeMap, Disc, Pixel, PreferredIndex};
 pub use errors::AccessError;
 pub use exact::{component_hits, refine};
 pub use gpu::Gpu;
@@ -74,6 +74,22 @@ pub trait Backend: Sync {
         preferred: &[V3],
     ) -> CubeMap;
 
+    /// [`Backend::blocked`], or, once every cell of `stop` is blocked, a map with fewer
+    /// blocked cells that still holds all of `stop`'s (the CPU stops drawing then;
+    /// others may draw the whole map).
+    fn blocked_until(
+        &self,
+        scene: &Scene,
+        from: &P3,
+        comp: &Component,
+        n: u32,
+        preferred: &[V3],
+        stop: &CubeMap,
+    ) -> CubeMap {
+        let _ = stop;
+        self.blocked(scene, from, comp, n, preferred)
+    }
+
     /// [`Backend::blocked`] for many queries, in their order.
     fn blocked_many(
         &self,
@@ -109,6 +125,18 @@ impl Backend for Cpu {
         preferred: &[V3],
     ) -> CubeMap {
         cpu::blocked(scene, from, comp, n, preferred)
+    }
+
+    fn blocked_until(
+        &self,
+        scene: &Scene,
+        from: &P3,
+        comp: &Component,
+        n: u32,
+        preferred: &[V3],
+        stop: &CubeMap,
+    ) -> CubeMap {
+        cpu::blocked_until(scene, from, comp, n, preferred, stop)
     }
 }
 
@@ -399,11 +427,24 @@ pub fn d2(
     let preferred = &opts.preferred[..];
     let coarse = d2_resolution(d1.n());
     let mut d2 = D2Sampler::new(coarse, preferred, opts.d2_wanted.as_deref());
+    // Drawing stops early only for a few wanted cells: each needs its own discs.
+    let few = d2.wanted.as_ref().is_some_and(|w| w.count() <= FEW_WANTED);
     for x in d2_points(c, probe, d1, opts.d2_samples) {
         let Some(need) = d2.need() else { break };
         let mut blocked = CubeMap::empty(coarse, preferred);
-        for comp in &probe.second {
-            blocked.or_assign(&backend.blocked(scene, &x, comp, coarse, preferred));
+        // The ram first: it blocks the most, so the head is drawn less often. A sample
+        // adds nothing once its components block every cell still needed, so drawing
+        // stops as soon as they do; either order gives the same D2.
+        for comp in probe.second.iter().rev() {
+            let b = match &need {
+                Some(nd) if few => {
+                    let mut rest = nd.clone();
+                    rest.and_not_assign(&blocked);
+                    backend.blocked_until(scene, &x, comp, coarse, preferred, &rest)
+                }
+                _ => backend.blocked(scene, &x, comp, coarse, preferred),
+            };
+            blocked.or_assign(&b);
             if blocked.is_full() || need.as_ref().is_some_and(|nd| blocked.covers(nd)) {
                 break;
             }
@@ -412,6 +453,10 @@ pub fn d2(
     }
     d2.out.refined(d1.n())
 }
+
+/// How many wanted cells [`d2`] may wait for (see [`Backend::blocked_until`]); more,
+/// and the discs it would keep per cell cost more than stopping early saves.
+const FEW_WANTED: usize = 256;
 
 /// D2's union of samples, in sample order, under its `wanted` cells (see [`d2`]); the
 /// CPU path and the batched one share it so both give the same maps.

@@ -189,6 +189,10 @@ pub struct BvhNode {
     pub centre: P3,
     /// Its radius.
     pub radius: f64,
+    /// Its triangles' normals when all bound a closed solid and lie within 90° of one
+    /// axis: the axis and the cosine and sine of the widest angle to it, so a viewpoint
+    /// all of them face away from passes the node over.
+    pub normals: Option<(V3, f64, f64)>,
     /// Inner node: its two children; leaf: none.
     pub kids: Option<(u32, u32)>,
     /// A leaf's triangles: `order[first..first + count]`.
@@ -245,12 +249,29 @@ fn build(
         .map(|&k| (tris[k as usize].centre - centre).norm() + tris[k as usize].radius)
         .fold(0.0, f64::max)
         * (1.0 + 1e-12);
+    let normals = if ids
+        .iter()
+        .all(|&k| tris[k as usize].closed && tris[k as usize].normal != V3::zeros())
+    {
+        let sum: V3 = ids.iter().map(|&k| tris[k as usize].normal).sum();
+        let axis = sum.try_normalize(1e-9);
+        axis.and_then(|a| {
+            let cos = ids
+                .iter()
+                .map(|&k| tris[k as usize].normal.dot(&a))
+                .fold(1.0, f64::min);
+            (cos > 1e-6).then(|| (a, cos, (1.0 - cos * cos).max(0.0).sqrt()))
+        })
+    } else {
+        None
+    };
     let at = nodes.len();
     nodes.push(BvhNode {
         lo,
         hi,
         centre,
         radius,
+        normals,
         kids: None,
         first: first as u32,
         count: count as u32,

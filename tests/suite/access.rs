@@ -256,6 +256,37 @@ fn the_hierarchy_draws_the_same_maps_as_every_triangle() {
     }
 }
 
+/// Drawing that stops once some cells are blocked (D2's samples) gives the whole map,
+/// or fewer blocked cells that still hold every one waited for; on a real part it does
+/// stop early.
+#[test]
+fn drawing_stops_once_the_cells_waited_for_are_blocked() {
+    let c = case("tests/real/nist_ctc_01.insp", 6, 53);
+    let axes = inspc::access::axes();
+    let n = 32;
+    let mut early = 0;
+    for (k, p) in c.points.iter().enumerate() {
+        for comp in c.probes.iter().flat_map(|p| p.second.iter()) {
+            let whole = Cpu.blocked(&c.scene, p, comp, n, &axes);
+            // A few cells around one direction, and a preferred direction.
+            let d = V3::new(1.0, 0.3 * k as f64 - 0.7, 0.5).normalize();
+            let mut stop = whole.cap(&d, 0.995);
+            stop.set(Cell::Preferred(k % axes.len()), true);
+            let got = Cpu.blocked_until(&c.scene, p, comp, n, &axes, &stop);
+            assert!(whole.covers(&got), "{}: more than the whole map", comp.name);
+            if got != whole {
+                assert!(
+                    got.covers(&stop),
+                    "{}: stopped before the cells were blocked",
+                    comp.name
+                );
+                early += 1;
+            }
+        }
+    }
+    assert!(early > 0, "never stopped early");
+}
+
 #[test]
 fn cones_are_the_same_for_any_thread_count() {
     let (checked, parts, graphs) =
