@@ -88,7 +88,7 @@ struct Stop {
 const LOOK_EVERY: usize = 1;
 
 /// Past this many pixels to wait for, [`blocked_until`] draws the whole map.
-const MOST_PENDING: usize = 64;
+const MOST_PENDING: usize = 512;
 
 impl Maps {
     pub fn new(n: u32, preferred: &[V3]) -> Maps {

@@ -222,6 +222,9 @@ pub struct Memo {
     cones: BTreeMap<(usize, usize), access::PointCones>,
     /// The second component's depth map per setup cell.
     second: BTreeMap<usize, SecondMap>,
+    /// [`Knowledge::orientations`] as first computed, per (point, probe, setup cell,
+    /// whether the whole probe's cones were acquired): D1 is a function of those.
+    orientations: BTreeMap<(usize, usize, usize, bool), Bits>,
     /// The scanners' face cones and coverages.
     pub(crate) scans: super::scan::Memo,
 }
@@ -589,6 +592,11 @@ impl<'a> Knowledge<'a> {
         if let Some(b) = self.d1p.get(&(f, p, s)) {
             return b.clone();
         }
+        let key = (f, p, s, self.dom.get(f).is_some_and(|d| d[p].full));
+        if let Some(b) = self.memo.orientations.get(&key) {
+            self.d1p.insert((f, p, s), b.clone());
+            return b.clone();
+        }
         let (c, dirs, candidates) = self.candidates(f, p, s, up, machine);
         let probe = &machine.probes[p];
         let clear: Vec<bool> = if candidates.is_empty() {
@@ -617,6 +625,7 @@ impl<'a> Knowledge<'a> {
                 .map(|(&k, _)| k),
         );
         self.d1p.insert((f, p, s), out.clone());
+        self.memo.orientations.insert(key, out.clone());
         out
     }
 
