@@ -242,11 +242,12 @@ pub fn blocked_plain(
     preferred: &[V3],
 ) -> CubeMap {
     let mut maps = Maps::new(n, preferred);
+    let at = Placed::new(from, comp, n);
     let (mut candidates, mut q) = (Vec::new(), [V3::zeros(); 12]);
     let full = !scene
         .tris
         .iter()
-        .all(|t| draw_triangle(scene, from, comp, n, &mut maps, t, &mut candidates, &mut q));
+        .all(|t| draw_triangle(scene, &at, &mut maps, t, &mut candidates, &mut q));
     finish(
         scene,
         from,
@@ -274,7 +275,8 @@ pub(super) fn draw<'s>(
 ) -> Drawn<'s> {
     let mut candidates: Vec<&Tri> = Vec::new();
     let mut q = [V3::zeros(); 12];
-    let (near, far) = (comp.near(), comp.far());
+    let at = Placed::new(from, comp, n);
+    let (near, far) = (at.near, at.far);
     let from_tip = comp.a == 0.0;
     let bvh = &scene.bvh;
     let full = |candidates| Drawn {
@@ -283,7 +285,7 @@ pub(super) fn draw<'s>(
     };
     for &k in &bvh.large {
         let t = &scene.tris[k as usize];
-        if !draw_triangle(scene, from, comp, n, canvas, t, &mut candidates, &mut q) {
+        if !draw_triangle(scene, &at, canvas, t, &mut candidates, &mut q) {
             return full(candidates);
         }
     }
@@ -332,7 +334,7 @@ pub(super) fn draw<'s>(
                 let leaf = &bvh.order[node.first as usize..(node.first + node.count) as usize];
                 for &t in leaf {
                     let t = &scene.tris[t as usize];
-                    if !draw_triangle(scene, from, comp, n, canvas, t, &mut candidates, &mut q) {
+                    if !draw_triangle(scene, &at, canvas, t, &mut candidates, &mut q) {
                         return full(candidates);
                     }
                 }
@@ -415,21 +417,48 @@ fn hidden(
     })
 }
 
+/// A component placed at `from` for maps of resolution `n`, with its nearest and
+/// farthest distances (computed once, not per triangle).
+struct Placed<'c> {
+    from: P3,
+    comp: &'c Component,
+    n: u32,
+    near: f64,
+    far: f64,
+}
+
+impl<'c> Placed<'c> {
+    fn new(from: &P3, comp: &'c Component, n: u32) -> Placed<'c> {
+        Placed {
+            from: *from,
+            comp,
+            n,
+            near: comp.near(),
+            far: comp.far(),
+        }
+    }
+}
+
 /// One triangle's shadow for `comp` at `from`, cheapest test first; false when the
 /// component meets it in every direction.
 #[allow(clippy::too_many_arguments)]
 fn draw_triangle<'s>(
     scene: &Scene,
-    from: &P3,
-    comp: &Component,
-    n: u32,
+    at: &Placed,
     canvas: &mut impl Canvas,
     t: &'s Tri,
     candidates: &mut Vec<&'s Tri>,
     q: &mut [V3; 12],
 ) -> bool {
+    let &Placed {
+        from,
+        comp,
+        n,
+        near,
+        far,
+    } = at;
+    let from = &from;
     let r = comp.radius;
-    let (near, far) = (comp.near(), comp.far());
     let from_tip = comp.a == 0.0;
     if scene.skips(t) {
         return true;
