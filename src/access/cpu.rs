@@ -13,11 +13,16 @@
 //!   asin(ρ / distance), rounded up to whole pixels, in bands so each band grows once;
 //!   near triangles, whose dilation would be many pixels, are grown in space instead: the
 //!   shadow of a prism that holds the triangle swept by a ball of radius ρ.
+//!
+//! The same tests decide whole nodes of the scene's bounding-volume hierarchy, plus one
+//! of its own: a node whose footprint is already marked in a band grown at least as far
+//! as any of its triangles' is hidden ([`draw`]). [`blocked_until`] stops once given
+//! cells are blocked, for callers that need only those.
 
 use super::cubemap::{CubeMap, Disc};
 use super::probe::Component;
 use super::raster::{footprint, shadow_polygon, Coverage};
-use super::scene::{point_triangle_distance, Scene, Tri};
+use super::scene::{point_triangle_distance, BvhNode, Scene, Tri};
 use crate::geometry::{P3, V3};
 
 /// Past this many pixels of dilation a triangle is grown in space, as a prism.
@@ -262,10 +267,10 @@ pub fn blocked_plain(
 /// resolution `n`), cheapest test first (see the module's documentation). The scene's
 /// hierarchy is walked nearest child first, so the large shadows of near triangles are
 /// drawn before the far triangles they hide; a node is passed over whole when every
-/// triangle in it would be (too far, too near, under the floor) or when what its
-/// triangles could add is already marked ([`hidden`]). The maps are the same as
-/// triangle by triangle: a shadow adds nothing where its pixels are already marked in
-/// a band grown at least as far as its own.
+/// triangle in it would be (too far, too near, under the floor, all facing away) or
+/// when what its triangles could add is already marked ([`hidden`]). The maps are the
+/// same as triangle by triangle: a shadow adds nothing where its pixels are already
+/// marked in a band grown at least as far as its own.
 pub(super) fn draw<'s>(
     scene: &'s Scene,
     from: &P3,
@@ -312,15 +317,8 @@ pub(super) fn draw<'s>(
         if from_tip && faces_away(node, &w, dc, margin) {
             continue;
         }
-        if hidden(
-            canvas,
-            from,
-            comp,
-            n,
-            node,
-            dc + node.radius + margin,
-            dc - node.radius - margin,
-        ) {
+        let (hi, lo) = (dc + node.radius + margin, dc - node.radius - margin);
+        if hidden(canvas, &at, node, hi, lo) {
             continue;
         }
         match node.kids {
@@ -351,7 +349,7 @@ pub(super) fn draw<'s>(
 /// node's centre (`dc` = |w|), as [`draw_triangle`] culls them for a component from the
 /// tip: each normal n is within θ of the node's axis a and each corner p within its
 /// ball, so n·(viewpoint − p) ≤ |w|·cos(φ − θ) + radius, with φ the angle from a to w.
-fn faces_away(node: &crate::access::scene::BvhNode, w: &V3, dc: f64, margin: f64) -> bool {
+fn faces_away(node: &BvhNode, w: &V3, dc: f64, margin: f64) -> bool {
     let Some((a, cos_t, sin_t)) = node.normals else {
         return false;
     };
@@ -372,17 +370,15 @@ fn faces_away(node: &crate::access::scene::BvhNode, w: &V3, dc: f64, margin: f64
 /// half-line (its triangles are kept as candidates for the preferred directions), nor
 /// when a triangle of the node could be drawn as a prism or meet the component in every
 /// direction.
-#[allow(clippy::too_many_arguments)]
-fn hidden(
-    canvas: &impl Canvas,
-    from: &P3,
-    comp: &Component,
-    n: u32,
-    node: &crate::access::scene::BvhNode,
-    hi: f64,
-    lo: f64,
-) -> bool {
-    let (r, near) = (comp.radius, comp.near());
+fn hidden(canvas: &impl Canvas, at: &Placed, node: &BvhNode, hi: f64, lo: f64) -> bool {
+    let &Placed {
+        ref from,
+        comp,
+        n,
+        near,
+        ..
+    } = at;
+    let r = comp.radius;
     let (target, cov) = if r == 0.0 {
         if near > 0.0 {
             return false;
