@@ -584,8 +584,8 @@ impl CubeMap {
 
     /// The pixels within k growth steps of pixel `index` at resolution `n`, for k = 0
     /// up to 2n: pixel c is in `B` grown k times exactly when `B` meets c's disc k, the
-    /// neighbour relation being symmetric (tested). Computed once per process for each
-    /// pixel asked about.
+    /// neighbour relation being symmetric (tested). Kept once computed, for up to 1,024
+    /// pixels (`DISCS_KEPT`).
     pub fn discs(n: u32, index: usize) -> Arc<[Disc]> {
         use std::collections::HashMap;
         use std::sync::{Mutex, OnceLock};
@@ -607,10 +607,13 @@ impl CubeMap {
             out.push(Disc::of(&m.bits));
         }
         let out: Arc<[Disc]> = out.into();
-        discs
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .insert((n, index), out.clone());
+        let mut kept = discs.lock().unwrap_or_else(|e| e.into_inner());
+        // A long-running process (the language server) plans many specs: the cache is
+        // emptied rather than let grow past a few tens of megabytes.
+        if kept.len() >= DISCS_KEPT {
+            kept.clear();
+        }
+        kept.insert((n, index), out.clone());
         out
     }
 
@@ -736,6 +739,9 @@ impl CubeMap {
         }
     }
 }
+
+/// How many pixels' discs [`CubeMap::discs`] keeps at most.
+const DISCS_KEPT: usize = 1024;
 
 /// Pixels around one pixel ([`CubeMap::discs`]): the pixel words from the first that
 /// holds one to the last.
