@@ -556,7 +556,7 @@ impl CubeMap {
 
     /// Whether every pixel i0..=i1 of rows j0..=j1 of a face is in at least one of
     /// `maps` (maps of one resolution; false when there is none).
-    pub fn spans_set_any(
+    pub(crate) fn spans_set_any(
         maps: &[Option<CubeMap>],
         face: u8,
         j0: u32,
@@ -575,7 +575,7 @@ impl CubeMap {
     }
 
     /// Whether the map's pixels meet those of `disc` (one of [`CubeMap::discs`]).
-    pub fn meets(&self, disc: &Disc) -> bool {
+    pub(crate) fn meets(&self, disc: &Disc) -> bool {
         self.bits[disc.start..]
             .iter()
             .zip(&disc.words)
@@ -586,7 +586,7 @@ impl CubeMap {
     /// up to 2n: pixel c is in `B` grown k times exactly when `B` meets c's disc k, the
     /// neighbour relation being symmetric (tested). Kept once computed, for up to 1,024
     /// pixels (`DISCS_KEPT`).
-    pub fn discs(n: u32, index: usize) -> Arc<[Disc]> {
+    pub(crate) fn discs(n: u32, index: usize) -> Arc<[Disc]> {
         use std::collections::HashMap;
         use std::sync::{Mutex, OnceLock};
         type Discs = HashMap<(u32, usize), Arc<[Disc]>>;
@@ -746,7 +746,7 @@ const DISCS_KEPT: usize = 1024;
 /// Pixels around one pixel ([`CubeMap::discs`]): the pixel words from the first that
 /// holds one to the last.
 #[derive(Debug)]
-pub struct Disc {
+pub(crate) struct Disc {
     start: usize,
     words: Vec<u64>,
 }
@@ -762,7 +762,7 @@ impl Disc {
     }
 
     /// How many words a look at it reads.
-    pub fn words(&self) -> usize {
+    pub(crate) fn words(&self) -> usize {
         self.words.len()
     }
 }

@@ -36,7 +36,7 @@ mod scene;
 mod swept;
 
 pub use cpu::{blocked_plain, pixels_for};
-pub use cubemap::{face_dir, face_uv, ones, Cell, CubeMap, Disc, Pixel, PreferredIndex};
+pub use cubemap::{face_dir, face_uv, ones, Cell, CubeMap, Pixel, PreferredIndex};
 pub use errors::AccessError;
 pub use exact::{component_hits, refine};
 pub use gpu::Gpu;
