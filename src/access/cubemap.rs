@@ -295,6 +295,30 @@ impl CubeMap {
         &self.bits
     }
 
+    /// A cap that holds every direction of the cone's cells, as (unit axis, angle in
+    /// radians), or `None` for an empty cone. The axis is the cells' centres' mean
+    /// direction; the angle the widest from it to a centre plus 2/N: a pixel's half
+    /// diagonal is √2/N on a face at distance 1 (or more), so it subtends less than 2/N
+    /// radians, and a preferred cell holds only directions within 1e-9 of its own.
+    pub fn bounding_cap(&self) -> Option<(V3, f64)> {
+        let pixels = pixel_directions(self);
+        let centre = |k: usize| match pixels.get(k) {
+            Some(d) => *d,
+            None => self.direction(self.cell(k)),
+        };
+        let first = centre(ones(&self.bits).next()?);
+        let sum: V3 = ones(&self.bits).map(centre).sum();
+        let axis = if sum.norm() > 1e-6 {
+            sum.normalize()
+        } else {
+            first
+        };
+        let least = ones(&self.bits)
+            .map(|k| centre(k).dot(&axis))
+            .fold(1.0, f64::min);
+        Some((axis, least.clamp(-1.0, 1.0).acos() + 2.0 / self.n as f64))
+    }
+
     /// Whether no direction is in the cone.
     pub fn is_empty(&self) -> bool {
         self.bits.iter().all(|&w| w == 0)
@@ -841,6 +865,44 @@ fn pixel_directions(like: &CubeMap) -> Arc<[V3]> {
 
 #[cfg(test)]
 mod tests {
+
+    /// Every direction of every cell, corners of pixels included, lies in the bounding
+    /// cap: the planner passes over grid directions outside it unlooked.
+    #[test]
+    fn the_bounding_cap_holds_every_direction_of_every_cell() {
+        use super::*;
+        let pref = [V3::new(0.0, 0.6, 0.8), V3::new(-1.0, 0.0, 0.0)];
+        for n in [4, 7, 32] {
+            let empty = CubeMap::empty(n, &pref);
+            assert!(empty.bounding_cap().is_none());
+            let mut scattered = empty.clone();
+            for k in (0..6 * (n as usize).pow(2)).filter(|k| k % 13 == 5) {
+                scattered.set(scattered.cell(k), true);
+            }
+            scattered.set(Cell::Preferred(1), true);
+            let cap = empty.cap(&V3::new(0.3, -0.2, 0.9).normalize(), 0.8);
+            let mut across = empty.cap(&V3::new(1.0, 1.0, 1.0).normalize(), 0.97);
+            across.set(Cell::Preferred(0), true);
+            for map in [scattered, cap, across, empty.not()] {
+                let (axis, angle) = map.bounding_cap().expect("not empty");
+                for cell in map.cells() {
+                    let corners: Vec<V3> = match cell {
+                        Cell::Pixel(p) => {
+                            let at = |k: u32| 2.0 * k as f64 / n as f64 - 1.0;
+                            [(0, 0), (0, 1), (1, 0), (1, 1)]
+                                .map(|(di, dj)| face_dir(p.face, at(p.i + di), at(p.j + dj)))
+                                .to_vec()
+                        }
+                        Cell::Preferred(k) => vec![map.preferred(k)],
+                    };
+                    for d in corners {
+                        let a = d.normalize().dot(&axis).clamp(-1.0, 1.0).acos();
+                        assert!(a <= angle, "n = {n}: {cell:?} at {a} outside {angle}");
+                    }
+                }
+            }
+        }
+    }
 
     /// [`CubeMap::discs`] relies on it: q is a neighbour of p exactly when p is one of q.
     #[test]

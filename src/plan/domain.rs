@@ -38,6 +38,9 @@ pub(crate) struct Machine {
     /// The grid's probe directions in the machine frame (`access::head_direction`),
     /// computed once: the planner asks for them per point, probe and setup.
     pub grid_dirs: Vec<V3>,
+    /// Each grid direction's angle (radians) from the head's axis, the machine's z (A up
+    /// to rounding), and whether they never decrease along the grid.
+    pub grid_polar: (Vec<f64>, bool),
     /// The grid orientations the plan allows.
     pub grid_allowed: Bits,
     /// Preference weights of grid orientations (0.5 when unspecified).
@@ -90,11 +93,17 @@ impl Machine {
                 }
             }
         }
-        let grid_dirs = grid
+        let grid_dirs: Vec<V3> = grid
             .iter()
             .map(|&(a, b)| access::head_direction(a, b))
             .collect();
+        let polar: Vec<f64> = grid_dirs
+            .iter()
+            .map(|d| d.z.clamp(-1.0, 1.0).acos())
+            .collect();
+        let sorted = polar.is_sorted();
         Machine {
+            grid_polar: (polar, sorted),
             probes,
             costs,
             allowed,
@@ -547,6 +556,11 @@ impl<'a> Knowledge<'a> {
         }
     }
 
+    /// How the part is held in setup cell `s`, computed by [`Knowledge::prepare`].
+    pub(crate) fn held_prepared(&self, s: usize) -> &Held {
+        &self.held[&s]
+    }
+
     /// The table's height under the part in setup cell `s` (cached).
     pub(crate) fn table_height(&mut self, s: usize) -> f64 {
         self.held(s).table
@@ -630,18 +644,20 @@ impl<'a> Knowledge<'a> {
     }
 
     /// Whether probe `p` may have a grid orientation in D1′ that keeps its stylus off the
-    /// table when it touches graph fpoint `f` in setup `up` (cell `s`): the orientations
-    /// before the second-order clearance test, cheap enough to ask of every realisable
-    /// setup. It errs towards yes (a fixed head, a point higher above the table than the
-    /// probe is long), so a minimum counted with it stays a lower bound. Cell `s` must
-    /// have been [`Knowledge::prepare`]d.
+    /// table when it touches graph fpoint `f` in setup `up` (cell `s`, the table at
+    /// height `t0`): the orientations before the second-order clearance test, cheap
+    /// enough to ask of every realisable setup. It errs towards yes (a fixed head, a point
+    /// higher above the table than the probe is long), so a minimum counted with it stays
+    /// a lower bound. `d1_cap` is the point's D1's [`CubeMap::bounding_cap`]. Cell `s`
+    /// must have been [`Knowledge::prepare`]d.
     pub(crate) fn reaches_off_table(
         &self,
         f: usize,
         p: usize,
         s: usize,
-        up: &V3,
+        (up, t0): (&V3, f64),
         machine: &Machine,
+        d1_cap: Option<(V3, f64)>,
     ) -> bool {
         if !machine.head.indexable() {
             return true;
@@ -653,30 +669,64 @@ impl<'a> Knowledge<'a> {
             .chain(&probe.second)
             .map(|c| c.radius)
             .fold(0.0, f64::max);
-        let t0 = self.held[&s].table;
-        let c = self.points[f].tip_centre(probe.tip_radius);
+        let point = &self.points[f];
+        let c = point.tip_centre(probe.tip_radius);
         if c.coords.dot(up) - t0 >= probe.reach() + widest + access::pose::ORIENTATION_TABLE_MARGIN
         {
             return true;
         }
         // `candidates` without the list: the first orientation that passes will do.
         let cells = &self.grid_cells[&s];
-        let Some(d1) = self.dom.get(f).and_then(|d| d[p].d1.as_ref()) else {
+        let (Some(d1), Some((centre, spread))) =
+            (self.dom.get(f).and_then(|d| d[p].d1.as_ref()), d1_cap)
+        else {
             return false;
+        };
+        // Every direction of D1 lies within `spread` of `centre` (its bounding cap), and a
+        // grid direction lies at its polar angle from the head's axis: by the triangle
+        // inequality on the sphere, one whose polar angle differs from the axis's angle to
+        // `centre` by more than `spread` cannot be in D1. Those are passed over unlooked
+        // (their cells uncomputed); the answer is the same.
+        let axis = cells.to_part * V3::z();
+        let phi = axis.dot(&centre).clamp(-1.0, 1.0).acos();
+        let reach = spread + 1e-9;
+        let (polar, sorted) = &machine.grid_polar;
+        let range = if *sorted {
+            polar.partition_point(|&a| a < phi - reach)
+                ..polar.partition_point(|&a| a <= phi + reach)
+        } else {
+            0..polar.len()
         };
         // Every component's lowest point rises with cos A (the direction's component
         // along `up`), so once an orientation at some A hits the table, every one at that
         // A or more does: a point low in this setup is ruled out after one test, not 720.
+        // Within a ring, the same cap passes over the directions farther from `centre`.
+        let least_cos = if reach < std::f64::consts::PI {
+            reach.cos() - 1e-12
+        } else {
+            -2.0
+        };
         let mut blocked_from = f64::INFINITY;
-        machine.grid_dirs.iter().enumerate().any(|(k, d)| {
+        range.into_iter().any(|k| {
             let a = machine.grid[k].0;
             if a >= blocked_from
+                || (polar[k] - phi).abs() > reach
                 || !Set::has(&machine.grid_allowed, k)
-                || !d1.has_index(cells.index(k, d, &self.forbidden, &self.pref_index))
             {
                 return false;
             }
-            let ok = above_table(probe, &c, &(cells.to_part * d), up, t0);
+            let dir = cells.to_part * machine.grid_dirs[k];
+            if dir.dot(&centre) < least_cos
+                || !d1.has_index(cells.index(
+                    k,
+                    &machine.grid_dirs[k],
+                    &self.forbidden,
+                    &self.pref_index,
+                ))
+            {
+                return false;
+            }
+            let ok = above_table(probe, &c, &dir, up, t0);
             if !ok {
                 blocked_from = a;
             }

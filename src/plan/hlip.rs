@@ -471,17 +471,39 @@ fn min_setups(
         k.prepare(&cells, m);
     }
     let k = &*k;
+    // Each candidate setup's direction and table height, by cell index: asked per point
+    // and probe, looked up in a slice rather than computed or searched for each.
+    let mut setup_at: Vec<Option<(V3, f64)>> = Vec::new();
+    if m.head.indexable() {
+        for s in &candidates {
+            for c in s.cells() {
+                let cell = s.index(c);
+                if setup_at.len() <= cell {
+                    setup_at.resize(cell + 1, None);
+                }
+                if setup_at[cell].is_none() {
+                    setup_at[cell] = Some((k.setup_dir(cell), k.held_prepared(cell).table));
+                }
+            }
+        }
+    }
     let reached: Vec<crate::access::CubeMap> = points
         .par_iter()
         .zip(candidates)
         .map(|(&i, mut s)| {
             let cells: Vec<usize> = s.cells().map(|c| s.index(c)).collect();
+            let caps: Vec<Option<(V3, f64)>> = k.dom[i]
+                .iter()
+                .map(|d| d.d1.as_ref().and_then(|d1| d1.bounding_cap()))
+                .collect();
             for cell in cells {
-                let up = k.setup_dir(cell);
                 let probes = k.probes(i, cell, m);
-                let reaches = probes
-                    .ones()
-                    .any(|p| k.reaches_off_table(i, p, cell, &up, m));
+                let reaches = match setup_at.get(cell).copied().flatten() {
+                    Some((up, t0)) => probes
+                        .ones()
+                        .any(|p| k.reaches_off_table(i, p, cell, (&up, t0), m, caps[p])),
+                    None => probes.ones().next().is_some(),
+                };
                 if !reaches {
                     let c = s.cell(cell);
                     s.set(c, false);
