@@ -99,8 +99,18 @@ fn path_stage(bencher: divan::Bencher, spec: &str) {
         graph: &g.graph,
     };
     let hlip = p.hlip.as_ref().unwrap();
+    // The scene is built once per part and shared by the path stage's attempts.
+    let scene = inspc::access::Scene::of_part(input.geometry);
     bencher.bench_local(|| {
         let mut diags = inspc::diag::Diagnostics::new();
-        inspc::path::plan(&input, hlip, &|_, _| {}, &mut diags, &mut Vec::new()).unwrap()
+        inspc::path::plan(
+            &input,
+            hlip,
+            &scene,
+            &|_, _| {},
+            &mut diags,
+            &mut Vec::new(),
+        )
+        .unwrap()
     });
 }

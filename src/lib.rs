@@ -513,7 +513,8 @@ fn paths_of(
         for attempt in 0..=REPLANS {
             let mut moves = diag::Diagnostics::new();
             let mut bans = Vec::new();
-            let llip = path::plan(&input, &hlip, &report, &mut moves, &mut bans);
+            let scene = memo.scene(input.geometry);
+            let llip = path::plan(&input, &hlip, &scene, &report, &mut moves, &mut bans);
             if llip.is_some() || bans.is_empty() || attempt == REPLANS {
                 diags.extend(own);
                 diags.extend(moves);

@@ -301,22 +301,28 @@ impl CubeMap {
     /// diagonal is √2/N on a face at distance 1 (or more), so it subtends less than 2/N
     /// radians, and a preferred cell holds only directions within 1e-9 of its own.
     pub fn bounding_cap(&self) -> Option<(V3, f64)> {
-        let pixels = pixel_directions(self);
-        let centre = |k: usize| match pixels.get(k) {
-            Some(d) => *d,
-            None => self.direction(self.cell(k)),
-        };
-        let first = centre(ones(&self.bits).next()?);
-        let sum: V3 = ones(&self.bits).map(centre).sum();
+        let dirs = self.centres();
+        let first = *dirs.first()?;
+        let sum: V3 = dirs.iter().sum();
         let axis = if sum.norm() > 1e-6 {
             sum.normalize()
         } else {
             first
         };
-        let least = ones(&self.bits)
-            .map(|k| centre(k).dot(&axis))
-            .fold(1.0, f64::min);
+        let least = dirs.iter().map(|d| d.dot(&axis)).fold(1.0, f64::min);
         Some((axis, least.clamp(-1.0, 1.0).acos() + 2.0 / self.n as f64))
+    }
+
+    /// The directions of the cone's cells in cell order, as [`CubeMap::direction`] gives
+    /// them (the pixels' from a table built once per resolution).
+    pub fn centres(&self) -> Vec<V3> {
+        let pixels = pixel_directions(self);
+        ones(&self.bits)
+            .map(|k| match pixels.get(k) {
+                Some(d) => *d,
+                None => self.direction(self.cell(k)),
+            })
+            .collect()
     }
 
     /// Whether no direction is in the cone.

@@ -21,7 +21,8 @@ pub struct Tri {
     pub closed: bool,
 }
 
-/// The obstacle.
+/// The obstacle. Cloning shares its triangles and hierarchy.
+#[derive(Clone)]
 pub struct Scene {
     /// Its triangles (shared with the scenes [`Scene::above`] makes of it).
     pub tris: std::sync::Arc<Vec<Tri>>,

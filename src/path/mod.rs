@@ -173,12 +173,14 @@ struct GroupOut {
     checks: usize,
 }
 
-/// Plans every move of `hlip`. `None` after pushing diagnostics when some move cannot
-/// be made collision-free; `bans` then gets the configurations of the touches no move
-/// reached, for the planner to fail in validation on another try.
+/// Plans every move of `hlip` around `scene` (the part, [`Scene::of_part`]). `None`
+/// after pushing diagnostics when some move cannot be made collision-free; `bans` then
+/// gets the configurations of the touches no move reached, for the planner to fail in
+/// validation on another try.
 pub fn plan(
     input: &Input,
     hlip: &Hlip,
+    scene: &Scene,
     progress: &(dyn Fn(usize, usize) + Sync),
     diags: &mut Diagnostics,
     bans: &mut Vec<Ban>,
@@ -186,8 +188,7 @@ pub fn plan(
     let motion = input.plan.motion;
     let probes =
         crate::access::scan::sensor_shapes(input.model, &input.model.cmms[input.plan.cmm.0]);
-    let scene = Scene::of_part(input.geometry);
-    let groups = linearise(input, hlip, &probes, &scene);
+    let groups = linearise(input, hlip, &probes, scene);
     let standoff = motion.prehit.max(motion.retract);
     let total = groups.len();
     let done = std::sync::atomic::AtomicUsize::new(0);

@@ -236,6 +236,19 @@ pub struct Memo {
     orientations: BTreeMap<(usize, usize, usize, bool), Bits>,
     /// The scanners' face cones and coverages.
     pub(crate) scans: super::scan::Memo,
+    /// The part as obstacle.
+    scene: Option<Scene>,
+}
+
+impl Memo {
+    /// The part as obstacle, built on first use (a memo belongs to one input, so to one
+    /// part): re-plans and the path stage share it instead of building its hierarchy
+    /// again.
+    pub fn scene(&mut self, geometry: &crate::geometry::PartGeometry) -> Scene {
+        self.scene
+            .get_or_insert_with(|| Scene::of_part(geometry))
+            .clone()
+    }
 }
 
 /// The cells within `angle` radians of `axis`, in the shape of `like`.
@@ -304,7 +317,7 @@ impl<'a> Knowledge<'a> {
         memo: &'a mut Memo,
     ) -> Knowledge<'a> {
         let realisable = setups.exact_dirs();
-        let scene = Scene::of_part(geometry);
+        let scene = memo.scene(geometry);
         // Preferred directions: the axes, the plan's setups, the table setups, then
         // feature axes and plane normals — a probe often fits a hole only along its
         // axis (at most MAX_FACE_DIRECTIONS of those).
@@ -1000,7 +1013,7 @@ fn initial(half: Option<CubeMap>, machine: &Machine, opts: &ConeOptions) -> Dom 
 /// degrees) of some direction of D1 — the cap around D1's mean axis, widened by D1's
 /// angular radius and a pixel.
 fn d2_cap(d1: &CubeMap, a_max: f64) -> CubeMap {
-    let dirs: Vec<V3> = d1.cells().map(|c| d1.direction(c)).collect();
+    let dirs = d1.centres();
     let sum: V3 = dirs.iter().sum();
     if dirs.is_empty() {
         return d1.empty_like();
