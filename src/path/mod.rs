@@ -196,9 +196,9 @@ pub fn plan(
         .par_iter()
         .map(|g| {
             let r = if g.blocks.iter().any(|b| !b.passes.is_empty()) {
-                plan_scan_group(input, &scene, g)
+                plan_scan_group(input, scene, g)
             } else {
-                plan_group(input, hlip, &scene, g, standoff)
+                plan_group(input, hlip, scene, g, standoff)
             };
             progress(
                 done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
@@ -220,7 +220,7 @@ pub fn plan(
     if outs.len() < total {
         return None;
     }
-    match join(input, hlip, &scene, &groups, outs) {
+    match join(input, hlip, scene, &groups, outs) {
         Ok(llip) => {
             for sp in &llip.setups {
                 self_aligned(input, sp, diags);
