@@ -236,6 +236,9 @@ pub struct Memo {
     orientations: BTreeMap<(usize, usize, usize, bool), Bits>,
     /// The scanners' face cones and coverages.
     pub(crate) scans: super::scan::Memo,
+    /// D2's cap over a bent probe's D1 once acquired, per (point, probe): D1 is then
+    /// the first D1 and the whole probe's approach cone, both kept here.
+    caps: BTreeMap<(usize, usize), CubeMap>,
     /// The part as obstacle.
     scene: Option<Scene>,
 }
@@ -938,7 +941,22 @@ impl<'a> Knowledge<'a> {
                     .collect()
             })
             .collect();
-        for ((&(f, p), mut cones), exact) in todo.iter().zip(computed).zip(exact) {
+        // D2's cap over the new D1 (the first D1 and the approach cone: a function of the
+        // pair, kept in the memo), for the pairs of a bent probe, in parallel.
+        let caps: Vec<Option<CubeMap>> = todo
+            .par_iter()
+            .zip(&computed)
+            .map(|(pair, cones)| {
+                let d1 = self.dom[pair.0][pair.1].d1.as_ref()?;
+                cones.d2.as_ref()?;
+                Some(match self.memo.caps.get(pair) {
+                    Some(cap) => cap.clone(),
+                    None => d2_cap(&d1.and(&cones.approach), machine.a_max),
+                })
+            })
+            .collect();
+        let mut done: BTreeSet<(usize, usize)> = BTreeSet::new();
+        for (((&(f, p), mut cones), exact), cap) in todo.iter().zip(computed).zip(exact).zip(caps) {
             if self.dom[f][p].full {
                 continue;
             }
@@ -948,17 +966,19 @@ impl<'a> Knowledge<'a> {
             let dom = &mut self.dom[f][p];
             dom.full = true;
             dom.tip &= cones.tip_fits;
-            match (&mut dom.d1, cones.d2) {
-                (Some(d1), Some(d2)) => {
+            match (&mut dom.d1, cones.d2, cap) {
+                (Some(d1), Some(d2), Some(cap)) => {
                     d1.and_assign(&cones.approach);
-                    dom.setup.and_assign(&d2_cap(d1, machine.a_max));
+                    dom.setup.and_assign(&cap);
                     dom.setup.and_assign(&d2);
+                    self.memo.caps.entry((f, p)).or_insert(cap);
                 }
                 _ => dom.setup.and_assign(&cones.approach),
             }
             self.acquired += 1;
-            self.d1p.retain(|&(ff, pp, _), _| !(ff == f && pp == p));
+            done.insert((f, p));
         }
+        self.d1p.retain(|&(f, p, _), _| !done.contains(&(f, p)));
     }
 }
 
