@@ -15,6 +15,7 @@
 use super::brep::{Bound, Brep, Edge, Face};
 use super::geom::{unwrap_near, Curve, Surf};
 use crate::geometry::{P3, V3};
+use rayon::prelude::*;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation};
 use std::f64::consts::TAU;
 
@@ -58,8 +59,15 @@ pub fn tessellate(b: &Brep, res: Resolution) -> (Soup, Vec<FaceFailure>) {
     let edges = edge_polylines(b, res);
     let mut soup = Soup::default();
     let mut failures = Vec::new();
-    for (index, face) in b.faces.iter().enumerate() {
-        match face_mesh(face, &edges, res) {
+    // Faces are meshed in parallel and gathered in their order: the soup is the same for
+    // any thread count.
+    let meshes: Vec<_> = b
+        .faces
+        .par_iter()
+        .map(|face| face_mesh(face, &edges, res))
+        .collect();
+    for ((index, face), mesh) in b.faces.iter().enumerate().zip(meshes) {
+        match mesh {
             Ok(tris) => {
                 for t in tris {
                     let base = soup.positions.len();
@@ -280,7 +288,7 @@ fn face_loops(face: &Face, edges: &[Vec<P3>]) -> Vec<Loop> {
 
 /// Edges cut into polylines as [`tessellate`] cuts them.
 pub fn edge_polylines(b: &Brep, res: Resolution) -> Vec<Vec<P3>> {
-    b.edges.iter().map(|e| edge_points(e, res)).collect()
+    b.edges.par_iter().map(|e| edge_points(e, res)).collect()
 }
 
 /// Whether a face lies along its surface's natural normal, told from its bounds alone
