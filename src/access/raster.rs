@@ -237,29 +237,40 @@ fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage
     match cov {
         Coverage::Cells => {
             let cell = |x: f64| clampi(floor_i((x + 1.0) / h));
-            for j in cell(vmin)..=cell(vmax) {
-                let (lo, hi) = (-1.0 + j as f64 * h, -1.0 + (j + 1) as f64 * h);
-                // The polygon's u extent over the strip lo ≤ v ≤ hi: at corners inside the
-                // strip and where edges cross its borders.
+            // Where the edges cross the line v = border: the extent of those crossings.
+            let crossings = |border: f64| {
                 let (mut umin, mut umax) = (f64::INFINITY, f64::NEG_INFINITY);
                 for k in 0..poly.len() {
                     let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+                    if (a.1 - border) * (b.1 - border) < 0.0 {
+                        let t = (border - a.1) / (b.1 - a.1);
+                        let u = a.0 + t * (b.0 - a.0);
+                        umin = umin.min(u);
+                        umax = umax.max(u);
+                    }
+                }
+                (umin, umax)
+            };
+            let (ja, jb) = (cell(vmin), cell(vmax));
+            let mut lo = -1.0 + ja as f64 * h;
+            let mut below = crossings(lo);
+            for j in ja..=jb {
+                // The polygon's u extent over the strip lo ≤ v ≤ hi: at corners inside the
+                // strip and where edges cross its borders (a row's upper border is the
+                // next one's lower, crossed once).
+                let hi = -1.0 + (j + 1) as f64 * h;
+                let above = crossings(hi);
+                let (mut umin, mut umax) = (below.0.min(above.0), below.1.max(above.1));
+                for a in poly {
                     if a.1 >= lo && a.1 <= hi {
                         umin = umin.min(a.0);
                         umax = umax.max(a.0);
-                    }
-                    for border in [lo, hi] {
-                        if (a.1 - border) * (b.1 - border) < 0.0 {
-                            let t = (border - a.1) / (b.1 - a.1);
-                            let u = a.0 + t * (b.0 - a.0);
-                            umin = umin.min(u);
-                            umax = umax.max(u);
-                        }
                     }
                 }
                 if umin <= umax {
                     out.set_span(face, j as u32, cell(umin) as u32, cell(umax) as u32);
                 }
+                (lo, below) = (hi, above);
             }
         }
         Coverage::Centres => {
