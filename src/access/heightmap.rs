@@ -95,6 +95,7 @@ impl HeightMap {
         // Dilate by the radius plus a texel diagonal, over a disc of texels.
         let k = ((radius / texel) + std::f64::consts::SQRT_2).ceil() as i64;
         let mut h = vec![f64::NEG_INFINITY; M * M];
+        let mut wide = [f64::NEG_INFINITY; M];
         for j in 0..M as i64 {
             for dj in -k..=k {
                 let jj = j + dj;
@@ -102,13 +103,9 @@ impl HeightMap {
                     continue;
                 }
                 let w = ((k * k - dj * dj) as f64).sqrt().floor() as i64;
-                for i in 0..M as i64 {
-                    let (lo, hi) = ((i - w).max(0), (i + w).min(M as i64 - 1));
-                    let row = &raw[jj as usize * M..jj as usize * M + M];
-                    let m = row[lo as usize..=hi as usize]
-                        .iter()
-                        .fold(f64::NEG_INFINITY, |m, &x| m.max(x));
-                    let cell = &mut h[j as usize * M + i as usize];
+                let row = &raw[jj as usize * M..jj as usize * M + M];
+                window_max(row, w as usize, &mut wide);
+                for (cell, &m) in h[j as usize * M..j as usize * M + M].iter_mut().zip(&wide) {
                     *cell = cell.max(m);
                 }
             }
@@ -138,6 +135,45 @@ impl HeightMap {
     }
 }
 
+/// Per index i, the largest of `row[i − w ..= i + w]` (clipped to the row; NaN counts
+/// for nothing, as in a fold of `f64::max` from −∞), in O(len) whatever `w`: the row is
+/// cut into blocks of 2w + 1, each with its running maxima from either end, and a window
+/// spans one block or the end of one and the start of the next (van Herk, Gil and
+/// Werman). `max` is exact, so the result is the fold's, to the bit.
+fn window_max(row: &[f64], w: usize, out: &mut [f64]) {
+    let len = row.len().min(M);
+    let size = 2 * w + 1;
+    let mut from_start = [f64::NEG_INFINITY; M];
+    let mut to_end = [f64::NEG_INFINITY; M];
+    for start in (0..len).step_by(size) {
+        let end = (start + size).min(len);
+        let mut m = f64::NEG_INFINITY;
+        for x in start..end {
+            m = m.max(row[x]);
+            from_start[x] = m;
+        }
+        let mut m = f64::NEG_INFINITY;
+        for x in (start..end).rev() {
+            m = m.max(row[x]);
+            to_end[x] = m;
+        }
+    }
+    for (i, o) in out.iter_mut().enumerate().take(len) {
+        let (a, b) = (i.saturating_sub(w), (i + w).min(len - 1));
+        *o = if a / size == b / size {
+            // One block: the window starts it or ends it (a full window lies in one
+            // block only when it starts it; a clipped one touches the row's end).
+            if a % size == 0 {
+                from_start[b]
+            } else {
+                to_end[a]
+            }
+        } else {
+            to_end[a].max(from_start[b])
+        };
+    }
+}
+
 /// Whether the triangle's projection (texel units) touches texel (i, j): separating axes
 /// of the texel square and the triangle's edges.
 fn touches(q: &[(f64, f64, f64); 3], i: f64, j: f64) -> bool {
@@ -155,4 +191,37 @@ fn touches(q: &[(f64, f64, f64); 3], i: f64, j: f64) -> bool {
         }
     }
     true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The dilation's windows give what folding each window gives, bit for bit.
+    #[test]
+    fn window_maxima_are_the_folds() {
+        let mut row = [f64::NEG_INFINITY; M];
+        let mut seed = 7u64;
+        for x in row.iter_mut() {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            *x = match seed >> 60 {
+                0 => f64::NEG_INFINITY,
+                1 => f64::NAN,
+                _ => (seed >> 11) as f64 / (1u64 << 53) as f64 * 200.0 - 100.0,
+            };
+        }
+        let mut out = [0.0; M];
+        for w in 0..=M + 3 {
+            window_max(&row, w, &mut out);
+            for (i, &got) in out.iter().enumerate() {
+                let (lo, hi) = (i.saturating_sub(w), (i + w).min(M - 1));
+                let want = row[lo..=hi]
+                    .iter()
+                    .fold(f64::NEG_INFINITY, |m, &x| m.max(x));
+                assert_eq!(got.to_bits(), want.to_bits(), "w = {w}, i = {i}");
+            }
+        }
+    }
 }
