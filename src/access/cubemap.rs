@@ -347,9 +347,31 @@ impl CubeMap {
 
     fn same_shape(&self, o: &CubeMap) {
         assert!(
-            self.n == o.n && self.extra == o.extra,
+            self.n == o.n && (Arc::ptr_eq(&self.extra, &o.extra) || self.extra == o.extra),
             "cube maps of different resolution or preferred directions"
         );
+    }
+
+    /// The union of `maps`, within `inside` and outside `outside`, shaped like `like`: in
+    /// one pass over the words.
+    pub fn union_within<'m>(
+        like: &CubeMap,
+        maps: impl Iterator<Item = &'m CubeMap>,
+        inside: &CubeMap,
+        outside: &CubeMap,
+    ) -> CubeMap {
+        like.same_shape(inside);
+        like.same_shape(outside);
+        let mut out = like.empty_like();
+        for m in maps {
+            like.same_shape(m);
+            out.bits.iter_mut().zip(&m.bits).for_each(|(a, b)| *a |= b);
+        }
+        out.bits
+            .iter_mut()
+            .zip(inside.bits.iter().zip(&outside.bits))
+            .for_each(|(a, (i, o))| *a &= i & !o);
+        out
     }
 
     /// In place: keep only directions also in `o`.

@@ -511,7 +511,8 @@ impl<'a> Knowledge<'a> {
 
     /// An empty cube map of the knowledge's shape.
     pub(crate) fn empty_cone(&self) -> CubeMap {
-        CubeMap::empty(self.opts.n, &self.opts.preferred)
+        // Shaped like every map of the knowledge, sharing their preferred directions.
+        self.forbidden.empty_like()
     }
 
     /// The up direction of setup cell `s`.
@@ -584,15 +585,12 @@ impl<'a> Knowledge<'a> {
 
     /// The setups from which some allowed probe reaches graph fpoint `f`.
     pub(crate) fn setups(&self, f: usize, machine: &Machine) -> CubeMap {
-        let mut out = self.empty_cone();
-        for (p, d) in self.dom[f].iter().enumerate() {
-            if machine.allowed[p] && d.tip {
-                out.or_assign(&d.setup);
-            }
-        }
-        out.and_not_assign(&self.forbidden);
-        out.and_assign(&self.realisable);
-        out
+        let reached = self.dom[f]
+            .iter()
+            .enumerate()
+            .filter(|&(p, d)| machine.allowed[p] && d.tip)
+            .map(|(_, d)| &d.setup);
+        CubeMap::union_within(&self.forbidden, reached, &self.realisable, &self.forbidden)
     }
 
     /// The allowed probes that reach graph fpoint `f` in setup cell `s`.
