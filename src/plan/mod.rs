@@ -306,9 +306,10 @@ fn forcing_levels(
     }
     let mut relaxed = h.clone();
     relaxed.levels.retain(|l| !grouped(&l));
+    let sets = solve::setup_sets(root, k, m);
     let fewest = Strategy::ALL
         .iter()
-        .filter_map(|&s| solve::solve(root, k, m, &relaxed, s).ok())
+        .filter_map(|&s| solve::solve(root, k, m, &relaxed, s, &sets).ok())
         .map(|b| count(&b))
         .min()?;
     (fewest < used).then(|| {
@@ -520,8 +521,9 @@ fn plan_touch(
         };
         let mut results: Vec<(Strategy, Vec<Branch>)> = Vec::new();
         let mut failures = Vec::new();
+        let sets = solve::setup_sets(&root, &k, &machine);
         for strategy in Strategy::ALL {
-            match solve::solve(&root, &mut k, &machine, hierarchy, strategy) {
+            match solve::solve(&root, &mut k, &machine, hierarchy, strategy, &sets) {
                 Ok(b) => results.push((strategy, b)),
                 Err(f) => failures.extend(f),
             }

@@ -419,18 +419,16 @@ fn pick_orient(mu: &Bits, m: &Machine) -> usize {
         .unwrap_or(0)
 }
 
-/// Runs the main algorithm (ch. 3.5.3) with one clustering strategy.
-pub(crate) fn solve(
-    root: &Inst,
-    k: &mut Knowledge,
-    m: &Machine,
-    h: &Hierarchy,
-    strategy: Strategy,
-) -> Result<Vec<Branch>, Vec<Failure>> {
-    // 1. Setups.
+/// The setups each leaf of a tree may take, by (point, table alternative): the point's
+/// setups, and the table's setup for a table point. Solving reads them and changes none
+/// of what they come from, so every strategy of a round shares one computation.
+pub(crate) type SetupSets = BTreeMap<(usize, Option<usize>), CubeMap>;
+
+/// [`SetupSets`] of the leaves of `root`.
+pub(crate) fn setup_sets(root: &Inst, k: &Knowledge, m: &Machine) -> SetupSets {
     let mut pts = Vec::new();
     leaf_kinds(root, &mut pts);
-    let mut setup_sets: BTreeMap<(usize, Option<usize>), CubeMap> = BTreeMap::new();
+    let mut setup_sets = SetupSets::new();
     for key in pts {
         setup_sets.entry(key).or_insert_with(|| {
             let mut s = k.setups(key.0, m);
@@ -441,6 +439,20 @@ pub(crate) fn solve(
             s
         });
     }
+    setup_sets
+}
+
+/// Runs the main algorithm (ch. 3.5.3) with one clustering strategy, the leaves' setups
+/// given ([`setup_sets`]).
+pub(crate) fn solve(
+    root: &Inst,
+    k: &mut Knowledge,
+    m: &Machine,
+    h: &Hierarchy,
+    strategy: Strategy,
+    setup_sets: &SetupSets,
+) -> Result<Vec<Branch>, Vec<Failure>> {
+    // 1. Setups.
     let sw = |e: usize| k.setup_weight.get(&e).copied().unwrap_or(0.5);
     let leaf_setup = |i: &Inst| match i.kind {
         Kind::Point { point, table } => setup_sets[&(point, table)].clone(),
