@@ -295,22 +295,35 @@ impl CubeMap {
         &self.bits
     }
 
-    /// A cap that holds every direction of the cone's cells, as (unit axis, angle in
-    /// radians), or `None` for an empty cone. The axis is the cells' centres' mean
-    /// direction; the angle the widest from it to a centre plus 2/N: a pixel's half
-    /// diagonal is √2/N on a face at distance 1 (or more), so it subtends less than 2/N
-    /// radians, and a preferred cell holds only directions within 1e-9 of its own.
-    pub fn bounding_cap(&self) -> Option<(V3, f64)> {
+    /// The cells' centres' mean direction and the widest angle (radians) from it to a
+    /// centre: `None` for an empty cone, `Some(None)` when the centres cancel out.
+    pub fn spread(&self) -> Option<Option<(V3, f64)>> {
         let dirs = self.centres();
-        let first = *dirs.first()?;
+        if dirs.is_empty() {
+            return None;
+        }
         let sum: V3 = dirs.iter().sum();
-        let axis = if sum.norm() > 1e-6 {
-            sum.normalize()
-        } else {
-            first
-        };
-        let least = dirs.iter().map(|d| d.dot(&axis)).fold(1.0, f64::min);
-        Some((axis, least.clamp(-1.0, 1.0).acos() + 2.0 / self.n as f64))
+        if sum.norm() < 1e-9 {
+            return Some(None);
+        }
+        let m = sum.normalize();
+        let rho = dirs
+            .iter()
+            .map(|d| d.dot(&m).clamp(-1.0, 1.0).acos())
+            .fold(0.0, f64::max);
+        Some(Some((m, rho)))
+    }
+
+    /// A cap that holds every direction of the cone's cells, as (unit axis, angle in
+    /// radians), or `None` for an empty cone: the [`CubeMap::spread`] plus 2/N (a
+    /// pixel's half diagonal is √2/N on a face at distance 1 or more, so it subtends
+    /// less than 2/N radians, and a preferred cell holds only directions within 1e-9 of
+    /// its own), or the whole sphere when the centres have no mean direction.
+    pub fn bounding_cap(&self) -> Option<(V3, f64)> {
+        Some(match self.spread()? {
+            Some((axis, rho)) => (axis, rho + 2.0 / self.n as f64),
+            None => (V3::z(), std::f64::consts::PI),
+        })
     }
 
     /// The directions of the cone's cells in cell order, as [`CubeMap::direction`] gives

@@ -1031,21 +1031,14 @@ fn initial(half: Option<CubeMap>, machine: &Machine, opts: &ConeOptions) -> Dom 
 /// degrees) of some direction of D1 — the cap around D1's mean axis, widened by D1's
 /// angular radius and a pixel.
 fn d2_cap(d1: &CubeMap, a_max: f64) -> CubeMap {
-    let dirs = d1.centres();
-    let sum: V3 = dirs.iter().sum();
-    if dirs.is_empty() {
-        return d1.empty_like();
+    match d1.spread() {
+        None => d1.empty_like(),
+        Some(None) => d1.not().or(d1),
+        Some(Some((m, rho))) => {
+            let pixel = 2.0 / d1.n() as f64;
+            cone_around(d1, &m, a_max.to_radians() + rho + pixel)
+        }
     }
-    if sum.norm() < 1e-9 {
-        return d1.not().or(d1);
-    }
-    let m = sum.normalize();
-    let rho = dirs
-        .iter()
-        .map(|d| d.dot(&m).clamp(-1.0, 1.0).acos())
-        .fold(0.0, f64::max);
-    let pixel = 2.0 / d1.n() as f64;
-    cone_around(d1, &m, a_max.to_radians() + rho + pixel)
 }
 
 /// How many articulation points the weak GAC D2 samples when a bent probe's knowledge
