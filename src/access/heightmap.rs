@@ -5,9 +5,13 @@
 
 use super::scene::Scene;
 use crate::geometry::{P3, V3};
+use rayon::prelude::*;
 
 /// Texels per side.
 const M: usize = 96;
+
+/// Triangles drawn per task: each task fills a map of its own (72 KiB).
+const TRIS_PER_CHUNK: usize = 2048;
 
 pub(crate) struct HeightMap {
     origin: P3,
@@ -27,7 +31,6 @@ impl HeightMap {
         let v = v.normalize();
         let (e1, e2) = crate::sample::perpendicular_basis(&v);
         let texel = 2.0 * half / M as f64;
-        let mut raw = vec![f64::NEG_INFINITY; M * M];
         let to_uv = |p: &P3| {
             let d = p - centre;
             (
@@ -36,80 +39,43 @@ impl HeightMap {
                 d.dot(&v),
             )
         };
-        for t in scene.tris.iter() {
-            let q = t.v.map(|p| to_uv(&p));
-            let (umin, umax) = (
-                q[0].0.min(q[1].0).min(q[2].0),
-                q[0].0.max(q[1].0).max(q[2].0),
-            );
-            let (vmin, vmax) = (
-                q[0].1.min(q[1].1).min(q[2].1),
-                q[0].1.max(q[1].1).max(q[2].1),
-            );
-            if umax < 0.0 || vmax < 0.0 || umin > M as f64 || vmin > M as f64 {
-                continue;
-            }
-            let hmax = q[0].2.max(q[1].2).max(q[2].2);
-            let hmin = q[0].2.min(q[1].2).min(q[2].2);
-            // Height over the plane as a function of (u, v), when the triangle is not
-            // seen edge-on; otherwise its highest corner.
-            let (a, b) = (
-                (q[1].0 - q[0].0, q[1].1 - q[0].1),
-                (q[2].0 - q[0].0, q[2].1 - q[0].1),
-            );
-            let det = a.0 * b.1 - a.1 * b.0;
-            let plane = (det.abs() > 1e-9).then(|| {
-                let (dh1, dh2) = (q[1].2 - q[0].2, q[2].2 - q[0].2);
-                let gu = (dh1 * b.1 - dh2 * a.1) / det;
-                let gv = (dh2 * a.0 - dh1 * b.0) / det;
-                (gu, gv)
-            });
-            let clampi = |x: f64| (x.floor().max(0.0) as usize).min(M - 1);
-            for j in clampi(vmin)..=clampi(vmax) {
-                for i in clampi(umin)..=clampi(umax) {
-                    if !touches(&q, i as f64, j as f64) {
-                        continue;
-                    }
-                    let top = match plane {
-                        Some((gu, gv)) => {
-                            let at =
-                                |x: f64, y: f64| q[0].2 + gu * (x - q[0].0) + gv * (y - q[0].1);
-                            let corners = [
-                                at(i as f64, j as f64),
-                                at(i as f64 + 1.0, j as f64),
-                                at(i as f64, j as f64 + 1.0),
-                                at(i as f64 + 1.0, j as f64 + 1.0),
-                            ];
-                            corners
-                                .iter()
-                                .fold(f64::NEG_INFINITY, |m, &x| m.max(x))
-                                .clamp(hmin, hmax)
-                        }
-                        None => hmax,
-                    };
-                    let cell = &mut raw[j * M + i];
-                    *cell = cell.max(top);
+        // Each texel takes the highest of the triangles over it: chunks of triangles are
+        // drawn in parallel and their maps joined by `max`, exact and in any order.
+        let raw = scene
+            .tris
+            .par_chunks(TRIS_PER_CHUNK)
+            .map(|tris| {
+                let mut raw = vec![f64::NEG_INFINITY; M * M];
+                for t in tris {
+                    draw(&mut raw, t.v.map(|p| to_uv(&p)));
                 }
-            }
-        }
+                raw
+            })
+            .reduce_with(|mut a, b| {
+                for (x, y) in a.iter_mut().zip(b) {
+                    *x = x.max(y);
+                }
+                a
+            })
+            .unwrap_or_else(|| vec![f64::NEG_INFINITY; M * M]);
         // Dilate by the radius plus a texel diagonal, over a disc of texels.
         let k = ((radius / texel) + std::f64::consts::SQRT_2).ceil() as i64;
         let mut h = vec![f64::NEG_INFINITY; M * M];
-        let mut wide = [f64::NEG_INFINITY; M];
-        for j in 0..M as i64 {
+        h.par_chunks_mut(M).enumerate().for_each(|(j, out)| {
+            let mut wide = [f64::NEG_INFINITY; M];
             for dj in -k..=k {
-                let jj = j + dj;
+                let jj = j as i64 + dj;
                 if jj < 0 || jj >= M as i64 {
                     continue;
                 }
                 let w = ((k * k - dj * dj) as f64).sqrt().floor() as i64;
                 let row = &raw[jj as usize * M..jj as usize * M + M];
                 window_max(row, w as usize, &mut wide);
-                for (cell, &m) in h[j as usize * M..j as usize * M + M].iter_mut().zip(&wide) {
+                for (cell, &m) in out.iter_mut().zip(&wide) {
                     *cell = cell.max(m);
                 }
             }
-        }
+        });
         HeightMap {
             origin: *centre,
             e1,
@@ -132,6 +98,63 @@ impl HeightMap {
             return false;
         }
         self.h[w as usize * M + u as usize] < d.dot(&self.v)
+    }
+}
+
+/// Raises the texels under the triangle `q` (texel units and height) to its highest
+/// point over each.
+fn draw(raw: &mut [f64], q: [(f64, f64, f64); 3]) {
+    let (umin, umax) = (
+        q[0].0.min(q[1].0).min(q[2].0),
+        q[0].0.max(q[1].0).max(q[2].0),
+    );
+    let (vmin, vmax) = (
+        q[0].1.min(q[1].1).min(q[2].1),
+        q[0].1.max(q[1].1).max(q[2].1),
+    );
+    if umax < 0.0 || vmax < 0.0 || umin > M as f64 || vmin > M as f64 {
+        return;
+    }
+    let hmax = q[0].2.max(q[1].2).max(q[2].2);
+    let hmin = q[0].2.min(q[1].2).min(q[2].2);
+    // Height over the plane as a function of (u, v), when the triangle is not
+    // seen edge-on; otherwise its highest corner.
+    let (a, b) = (
+        (q[1].0 - q[0].0, q[1].1 - q[0].1),
+        (q[2].0 - q[0].0, q[2].1 - q[0].1),
+    );
+    let det = a.0 * b.1 - a.1 * b.0;
+    let plane = (det.abs() > 1e-9).then(|| {
+        let (dh1, dh2) = (q[1].2 - q[0].2, q[2].2 - q[0].2);
+        let gu = (dh1 * b.1 - dh2 * a.1) / det;
+        let gv = (dh2 * a.0 - dh1 * b.0) / det;
+        (gu, gv)
+    });
+    let clampi = |x: f64| (x.floor().max(0.0) as usize).min(M - 1);
+    for j in clampi(vmin)..=clampi(vmax) {
+        for i in clampi(umin)..=clampi(umax) {
+            if !touches(&q, i as f64, j as f64) {
+                continue;
+            }
+            let top = match plane {
+                Some((gu, gv)) => {
+                    let at = |x: f64, y: f64| q[0].2 + gu * (x - q[0].0) + gv * (y - q[0].1);
+                    let corners = [
+                        at(i as f64, j as f64),
+                        at(i as f64 + 1.0, j as f64),
+                        at(i as f64, j as f64 + 1.0),
+                        at(i as f64 + 1.0, j as f64 + 1.0),
+                    ];
+                    corners
+                        .iter()
+                        .fold(f64::NEG_INFINITY, |m, &x| m.max(x))
+                        .clamp(hmin, hmax)
+                }
+                None => hmax,
+            };
+            let cell = &mut raw[j * M + i];
+            *cell = cell.max(top);
+        }
     }
 }
 
