@@ -664,14 +664,18 @@ impl CubeMap {
         {
             return d.clone();
         }
-        let mut m = CubeMap::empty(n, &[]);
-        m.bits[index / 64] |= 1 << (index % 64);
-        let mut out = vec![Disc::of(&m.bits)];
-        for _ in 0..2 * n {
-            m = m.grow();
-            out.push(Disc::of(&m.bits));
-        }
-        let out: Arc<[Disc]> = out.into();
+        let out: Arc<[Disc]> = if n <= 64 {
+            Self::discs_by_steps(n, index)
+        } else {
+            let mut m = CubeMap::empty(n, &[]);
+            m.bits[index / 64] |= 1 << (index % 64);
+            let mut out = vec![Disc::of(&m.bits)];
+            for _ in 0..2 * n {
+                m = m.grow();
+                out.push(Disc::of(&m.bits));
+            }
+            out.into()
+        };
         let mut kept = discs.lock().unwrap_or_else(|e| e.into_inner());
         // A long-running process (the language server) plans many specs: the cache is
         // emptied rather than let grow past a few tens of megabytes.
@@ -680,6 +684,50 @@ impl CubeMap {
         }
         kept.insert((n, index), out.clone());
         out
+    }
+
+    /// [`CubeMap::discs`] by a breadth-first walk from the pixel over the neighbours
+    /// [`CubeMap::grow`] adds (the eight around it on its face, and those across the
+    /// cube's edges): disc k holds the pixels at most k steps away. One walk instead of
+    /// 2n growths of the whole map.
+    fn discs_by_steps(n: u32, index: usize) -> Arc<[Disc]> {
+        let nu = n as usize;
+        let table = EdgeTable::of(n);
+        let mut steps = vec![u32::MAX; 6 * nu * nu];
+        let mut order = vec![index];
+        steps[index] = 0;
+        let mut next = 0;
+        while next < order.len() {
+            let p = order[next];
+            next += 1;
+            let s = steps[p] + 1;
+            if s > 2 * n {
+                continue;
+            }
+            let (face, j, i) = (p / (nu * nu), (p / nu) % nu, p % nu);
+            let inside = (j.saturating_sub(1)..=(j + 1).min(nu - 1)).flat_map(|jj| {
+                (i.saturating_sub(1)..=(i + 1).min(nu - 1))
+                    .map(move |ii| (face * nu + jj) * nu + ii)
+            });
+            let across = table.across(p).iter().map(|&q| q as usize);
+            for q in inside.chain(across) {
+                if steps[q] == u32::MAX {
+                    steps[q] = s;
+                    order.push(q);
+                }
+            }
+        }
+        let mut bits = vec![0u64; (6 * nu * nu).div_ceil(64)];
+        let mut out = Vec::with_capacity(2 * nu + 1);
+        let mut at = 0;
+        for k in 0..=2 * n {
+            while at < order.len() && steps[order[at]] <= k {
+                bits[order[at] / 64] |= 1 << (order[at] % 64);
+                at += 1;
+            }
+            out.push(Disc::of(&bits));
+        }
+        out.into()
     }
 
     /// This map at resolution `n`, a multiple of its own: each fine pixel takes the bit
@@ -970,6 +1018,23 @@ mod tests {
             }
             let d = CubeMap::discs(n, 5);
             assert_eq!(d.len(), 2 * n as usize + 1);
+            // The walk's discs are the growths', ring by ring, from a face's inside,
+            // edge and corner.
+            let last = 6 * (n as usize).pow(2) - 1;
+            for p in [0, 5, n as usize * (n as usize / 2) + 1, last] {
+                let walked = CubeMap::discs_by_steps(n, p);
+                let mut m = empty.clone();
+                m.bits[p / 64] |= 1 << (p % 64);
+                for (k, disc) in walked.iter().enumerate() {
+                    let grown = Disc::of(&m.bits);
+                    assert_eq!(
+                        (disc.start, &disc.words),
+                        (grown.start, &grown.words),
+                        "n = {n}, pixel {p}, ring {k}"
+                    );
+                    m = m.grow();
+                }
+            }
             let mut m = empty.clone();
             m.bits[0] |= 1 << 5;
             let g = m.grown(3);
