@@ -7,16 +7,15 @@ use super::scene::Scene;
 use crate::geometry::{P3, V3};
 use parry3d_f64::math::Isometry;
 use parry3d_f64::na::{Translation3, UnitQuaternion};
-use parry3d_f64::query::intersection_test;
 use parry3d_f64::shape::{Capsule, Cylinder};
 
 /// Whether `comp`, its axis from `from` along the unit direction `d`, meets the scene:
 /// an exact ray for the bare half-line, a capsule or cylinder test otherwise. The ram's
 /// infinite end is cut well past the scene.
 pub fn component_hits(scene: &Scene, from: &P3, d: &V3, comp: &Component) -> bool {
-    let Some(mesh) = scene.mesh() else {
+    if scene.mesh().is_none() {
         return false;
-    };
+    }
     let b = comp.b.min(comp.a + 4.0 * scene.size + 10.0);
     if comp.radius == 0.0 {
         return scene
@@ -24,10 +23,11 @@ pub fn component_hits(scene: &Scene, from: &P3, d: &V3, comp: &Component) -> boo
             .is_some_and(|t| t > 1e-9);
     }
     let id = Isometry::identity();
-    let hit = match comp.end {
+    let axis = [from + d * comp.a, from + d * b, from + d * b];
+    match comp.end {
         End::Round => {
-            let cap = Capsule::new(from + d * comp.a, from + d * b, comp.radius);
-            intersection_test(&id, &cap, &id, mesh)
+            let cap = Capsule::new(axis[0], axis[1], comp.radius);
+            scene.meets(&cap, &id, &[axis], comp.radius)
         }
         End::Flat => {
             let half = (b - comp.a) / 2.0;
@@ -37,11 +37,10 @@ pub fn component_hits(scene: &Scene, from: &P3, d: &V3, comp: &Component) -> boo
             });
             let centre = from + d * (comp.a + half);
             let pos = Isometry::from_parts(Translation3::from(centre.coords), rot);
-            intersection_test(&pos, &cyl, &id, mesh)
+            // The cylinder lies within its radius of its axis.
+            scene.meets(&cyl, &pos, &[axis], comp.radius)
         }
-    };
-    // Every shape pair used here is supported; an unsupported one counts as a hit.
-    hit.unwrap_or(true)
+    }
 }
 
 /// Refines a component's blocked map at its boundary: blocked pixels next to free ones

@@ -542,7 +542,7 @@ impl<'a> Pose<'a> {
         if self.fixture.is_empty() {
             return Ok(());
         }
-        let hits = |s: &dyn Shape| self.fixture.iter().any(|f| f.hits(s));
+        let hits = |s: &dyn Shape, _: &Core| self.fixture.iter().any(|f| f.hits(s));
         self.sweep(p, q, &hits, grow, Some(&self.spheres))
             .map_err(|b| match b {
                 Blocker::Component(c) => Blocker::Fixture(c),
@@ -581,9 +581,12 @@ impl<'a> Pose<'a> {
                 return Err(Blocker::ComponentOnTable(part.comp.name.clone()));
             }
         }
-        if let Some(mesh) = self.scene.mesh() {
-            let id = Isometry::identity();
-            let hits = |shape: &dyn Shape| intersection_test(&id, shape, &id, mesh).unwrap_or(true);
+        if self.scene.mesh().is_some() {
+            let hits = |shape: &dyn Shape, core: &Core| {
+                let id = Isometry::identity();
+                self.scene
+                    .meets(shape, &id, &core.tris[..core.len], core.radius)
+            };
             self.sweep(p, q, &hits, margin, None)?;
         }
         self.sweep_fixture(p, q, margin)
@@ -592,12 +595,13 @@ impl<'a> Pose<'a> {
     /// Sweeps every component from tip centre `p` to `q` against what `hits` tests:
     /// the tip as an exact capsule, a stylus or extension capsule as the exact union of
     /// two rounded triangles, a body, head or ram cylinder as the convex hull of its two
-    /// end positions (its discs as circumscribed 16-gons).
+    /// end positions (its discs as circumscribed 16-gons). `hits` gets each shape with a
+    /// [`Core`] it lies within.
     fn sweep(
         &self,
         p: &P3,
         q: &P3,
-        hits: &dyn Fn(&dyn Shape) -> bool,
+        hits: &dyn Fn(&dyn Shape, &Core) -> bool,
         grow: f64,
         spheres: Option<&[(P3, f64)]>,
     ) -> Result<(), Blocker> {
@@ -611,7 +615,7 @@ impl<'a> Pose<'a> {
         let tip = self.tip_radius + grow;
         if self.tip_radius > 0.0
             && near(&(p + v / 2.0), v.norm() / 2.0 + tip)
-            && hits(&Capsule::new(*p, *q, tip))
+            && hits(&Capsule::new(*p, *q, tip), &Core::segment(p, q, tip))
         {
             return Err(Blocker::Tip);
         }
@@ -630,14 +634,26 @@ impl<'a> Pose<'a> {
             let hit = match (c.end, moving) {
                 (_, _) if c.radius == 0.0 => false,
                 _ if !near(&mid, reach) => false,
-                (End::Round, false) => hits(&Capsule::new(a0, b0, radius)),
+                (End::Round, false) => hits(
+                    &Capsule::new(a0, b0, radius),
+                    &Core::segment(&a0, &b0, radius),
+                ),
                 (End::Round, true) => {
-                    let round = |t: Triangle| RoundShape {
-                        inner_shape: t,
-                        border_radius: radius,
+                    let round = |t: [P3; 3]| {
+                        let shape = RoundShape {
+                            inner_shape: Triangle::new(t[0], t[1], t[2]),
+                            border_radius: radius,
+                        };
+                        hits(
+                            &shape,
+                            &Core {
+                                tris: [t, t],
+                                len: 1,
+                                radius,
+                            },
+                        )
                     };
-                    hits(&round(Triangle::new(a0, b0, a0 + v)))
-                        || hits(&round(Triangle::new(b0, b0 + v, a0 + v)))
+                    round([a0, b0, a0 + v]) || round([b0, b0 + v, a0 + v])
                 }
                 (End::Flat, _) => {
                     let (e1, e2) = crate::sample::perpendicular_basis(&part.dir);
@@ -650,7 +666,13 @@ impl<'a> Pose<'a> {
                         points.push(b0 + e);
                     }
                     let v = if moving { v } else { V3::zeros() };
-                    hits(&super::swept::SweptHull { points, v })
+                    // Every corner lies r from the axis's ends, moved along v at most.
+                    let core = Core {
+                        tris: [[a0, b0, a0 + v], [b0, b0 + v, a0 + v]],
+                        len: 2,
+                        radius: r,
+                    };
+                    hits(&super::swept::SweptHull { points, v }, &core)
                 }
             };
             if hit {
@@ -658,6 +680,24 @@ impl<'a> Pose<'a> {
             }
         }
         Ok(())
+    }
+}
+
+/// Where a swept shape lies: within `radius` of its first `len` triangles (a segment
+/// is a triangle with two corners equal).
+struct Core {
+    tris: [[P3; 3]; 2],
+    len: usize,
+    radius: f64,
+}
+
+impl Core {
+    fn segment(a: &P3, b: &P3, radius: f64) -> Core {
+        Core {
+            tris: [[*a, *b, *b]; 2],
+            len: 1,
+            radius,
+        }
     }
 }
 

@@ -2,9 +2,10 @@
 //! setup places one), with what culling needs, and a parry mesh for exact queries.
 
 use crate::geometry::{PartGeometry, P3, V3};
+use parry3d_f64::bounding_volume::BoundingVolume;
 use parry3d_f64::math::Isometry;
-use parry3d_f64::query::{PointQuery, Ray, RayCast};
-use parry3d_f64::shape::TriMesh;
+use parry3d_f64::query::{DefaultQueryDispatcher, PointQuery, QueryDispatcher, Ray, RayCast};
+use parry3d_f64::shape::{Shape, TriMesh};
 
 /// One obstacle triangle.
 #[derive(Debug, Clone)]
@@ -162,6 +163,40 @@ impl Scene {
     /// The parry mesh, for exact shape queries.
     pub fn mesh(&self) -> Option<&TriMesh> {
         self.mesh.as_deref()
+    }
+
+    /// Whether `shape` at `pos`, which lies within `radius` of the triangles `core`,
+    /// meets the mesh: what `intersection_test(pos, shape, identity, mesh)` answers —
+    /// parry's traversal of the boxes that meet the shape's, and its test of each
+    /// triangle, posed as there — asked only of the triangles whose balls come within
+    /// `radius` of the core: most of those a long, slanted shape's box overlaps are far
+    /// from the shape. A segment is a triangle with two corners equal.
+    pub fn meets(
+        &self,
+        shape: &dyn Shape,
+        pos: &Isometry<f64>,
+        core: &[[P3; 3]],
+        radius: f64,
+    ) -> bool {
+        let Some(mesh) = self.mesh() else {
+            return false;
+        };
+        let margin = 1e-6 * (1.0 + self.size + radius);
+        let near = |c: &P3, r: f64| {
+            core.iter()
+                .any(|t| point_triangle_distance(c, t) <= radius + r + margin)
+        };
+        // The shape's pose relative to each triangle, as parry's composite test makes it.
+        let pose = pos.inv_mul(&Isometry::identity()).inverse();
+        let bounds = shape.compute_aabb(&pose);
+        mesh.bvh()
+            .leaves(|node| node.aabb().intersects(&bounds))
+            .any(|k| {
+                let t = &self.tris[k as usize];
+                near(&t.centre, t.radius)
+                    && DefaultQueryDispatcher.intersection_test(&pose, &mesh.triangle(k), shape)
+                        == Ok(true)
+            })
     }
 }
 
@@ -376,5 +411,68 @@ mod tests {
         assert!((d(-1.0, -1.0, 0.0) - 2f64.sqrt()).abs() < 1e-12);
         assert!((d(1.0, -2.0, 0.0) - 2.0).abs() < 1e-12);
         assert!((d(2.0, 2.0, 0.0) - 2f64.sqrt()).abs() < 1e-12);
+    }
+
+    /// `meets` answers what parry's test of the whole mesh answers, for capsules and
+    /// posed cylinders, hitting and missing: its filter by the core never drops a
+    /// triangle parry would find.
+    #[test]
+    fn meeting_the_mesh_is_parrys_answer() {
+        use parry3d_f64::na::{Translation3, UnitQuaternion};
+        use parry3d_f64::query::intersection_test;
+        use parry3d_f64::shape::{Capsule, Cylinder};
+        let mut seed = 11u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut tris = Vec::new();
+        for _ in 0..400 {
+            let c = P3::new(100.0 * next(), 100.0 * next(), 20.0 * next());
+            let corner = |c: &P3, r: &mut dyn FnMut() -> f64| {
+                c + V3::new(r() - 0.5, r() - 0.5, r() - 0.5) * 8.0
+            };
+            tris.push([c, corner(&c, &mut next), corner(&c, &mut next)]);
+        }
+        let scene = Scene::of_triangles(&tris);
+        let mesh = scene.mesh().expect("a mesh");
+        let id = Isometry::identity();
+        let (mut hits, mut misses) = (0, 0);
+        for k in 0..600 {
+            let a = P3::new(
+                120.0 * next() - 10.0,
+                120.0 * next() - 10.0,
+                60.0 * next() - 20.0,
+            );
+            let d = V3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+            let (len, r) = (80.0 * next(), 0.5 + 6.0 * next());
+            let b = a + d * len;
+            let core = [[a, b, b]];
+            let (got, want) = if k % 2 == 0 {
+                let cap = Capsule::new(a, b, r);
+                (
+                    scene.meets(&cap, &id, &core, r),
+                    intersection_test(&id, &cap, &id, mesh).unwrap_or(true),
+                )
+            } else {
+                let cyl = Cylinder::new(len / 2.0, r);
+                let rot = UnitQuaternion::rotation_between(&V3::y(), &d).expect("a turn");
+                let centre = a + d * (len / 2.0);
+                let pos = Isometry::from_parts(Translation3::from(centre.coords), rot);
+                (
+                    scene.meets(&cyl, &pos, &core, r),
+                    intersection_test(&pos, &cyl, &id, mesh).unwrap_or(true),
+                )
+            };
+            assert_eq!(got, want, "shape {k}");
+            if want {
+                hits += 1;
+            } else {
+                misses += 1;
+            }
+        }
+        assert!(hits > 50 && misses > 50, "{hits} hits, {misses} misses");
     }
 }
