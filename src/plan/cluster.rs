@@ -27,6 +27,22 @@ pub trait Set: Clone {
     fn count(&self) -> usize {
         self.words().iter().map(|w| w.count_ones() as usize).sum()
     }
+    /// Whether the two sets share no element (without making their intersection).
+    fn disjoint(&self, o: &Self) -> bool {
+        self.words().iter().zip(o.words()).all(|(a, b)| a & b == 0)
+    }
+    /// Whether every element of this set is in `o`.
+    fn within(&self, o: &Self) -> bool {
+        self.words().iter().zip(o.words()).all(|(a, b)| a & !b == 0)
+    }
+    /// The number of elements of the union (without making it).
+    fn count_or(&self, o: &Self) -> usize {
+        self.words()
+            .iter()
+            .zip(o.words())
+            .map(|(a, b)| (a | b).count_ones() as usize)
+            .sum()
+    }
 }
 
 impl Set for CubeMap {
@@ -282,7 +298,7 @@ pub fn min_hitting_set<S: Set>(w: &[&S], budget: usize) -> (usize, bool) {
     // Drop signatures contained in another.
     let mut keep: Vec<Bits> = Vec::new();
     for c in cands {
-        if !keep.iter().any(|k| c.and(k) == c) {
+        if !keep.iter().any(|k| c.within(k)) {
             keep.push(c);
         }
     }
@@ -295,7 +311,7 @@ pub fn min_hitting_set<S: Set>(w: &[&S], budget: usize) -> (usize, bool) {
     order.sort_by_key(|&i| (w[i].count(), i));
     let mut packed: Vec<usize> = Vec::new();
     for &i in &order {
-        if packed.iter().all(|&j| w[i].and(w[j]).is_empty()) {
+        if packed.iter().all(|&j| w[i].disjoint(w[j])) {
             packed.push(i);
         }
     }
@@ -306,7 +322,7 @@ pub fn min_hitting_set<S: Set>(w: &[&S], budget: usize) -> (usize, bool) {
     while covered.count() < n {
         let best = keep
             .iter()
-            .max_by_key(|c| c.or(&covered).count())
+            .max_by_key(|c| c.count_or(&covered))
             .expect("every set is non-empty");
         covered = covered.or(best);
         greedy += 1;
