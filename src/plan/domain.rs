@@ -829,12 +829,14 @@ impl<'a> Knowledge<'a> {
                 // Every other orientation against the fixture now, not one a round.
                 let up = self.setup_dir(s);
                 let held = self.held[&s].clone();
-                let keep: Vec<usize> = left
-                    .ones()
+                let ones: Vec<usize> = left.ones().collect();
+                let this = &*self;
+                let keep: Vec<usize> = ones
+                    .into_par_iter()
                     .filter(|&k| {
                         let (a, b) = machine.grid[k];
                         let dir = access::pose::orientation_dir(&up, a, b);
-                        self.pose_check(machine, f, p, dir, up, &held).is_ok()
+                        this.pose_check(machine, f, p, dir, up, &held).is_ok()
                     })
                     .collect();
                 left = Bits::of(machine.grid.len(), keep);
