@@ -283,16 +283,16 @@ pub fn min_hitting_set<S: Set>(w: &[&S], budget: usize) -> (usize, bool) {
     if w.is_empty() {
         return (0, true);
     }
-    // Each element's signature: the sets that hold it, as a bitset over `w`.
-    let mut sig: std::collections::BTreeMap<usize, Bits> = std::collections::BTreeMap::new();
+    // Each element's signature: the sets that hold it, as a bitset over `w`, in the
+    // elements' order.
+    let universe = w.iter().map(|s| s.words().len()).max().unwrap_or(0) * 64;
+    let mut sig: Vec<Option<Bits>> = vec![None; universe];
     for (i, s) in w.iter().enumerate() {
         for e in ones(s.words()) {
-            sig.entry(e)
-                .or_insert_with(|| Bits::empty(w.len()))
-                .insert(i);
+            sig[e].get_or_insert_with(|| Bits::empty(w.len())).insert(i);
         }
     }
-    let mut cands: Vec<Bits> = sig.into_values().collect();
+    let mut cands: Vec<Bits> = sig.into_iter().flatten().collect();
     cands.sort_by(|a, b| b.count().cmp(&a.count()).then(a.words.cmp(&b.words)));
     cands.dedup();
     // Drop signatures contained in another.

@@ -565,12 +565,17 @@ impl<'a> Knowledge<'a> {
         let this = &*self;
         let held: Vec<Held> = new.par_iter().map(|&s| this.hold(s)).collect();
         self.held.extend(new.into_iter().zip(held));
-        for &s in cells {
-            if !self.grid_cells.contains_key(&s) {
-                let g = GridCells::new(&self.setup_dir(s), machine);
-                self.grid_cells.insert(s, g);
-            }
-        }
+        let fresh: Vec<usize> = cells
+            .iter()
+            .copied()
+            .filter(|s| !self.grid_cells.contains_key(s))
+            .collect();
+        let this = &*self;
+        let grids: Vec<GridCells> = fresh
+            .par_iter()
+            .map(|&s| GridCells::new(&this.setup_dir(s), machine))
+            .collect();
+        self.grid_cells.extend(fresh.into_iter().zip(grids));
     }
 
     /// How the part is held in setup cell `s`, computed by [`Knowledge::prepare`].

@@ -463,29 +463,26 @@ fn min_setups(
         .filter(|i| used_points.contains(i))
         .collect();
     let candidates: Vec<crate::access::CubeMap> = points.iter().map(|&i| k.setups(i, m)).collect();
+    // Every candidate setup cell, once, ascending.
+    let cells: Vec<usize> = match candidates.split_first() {
+        Some((first, rest)) if m.head.indexable() => {
+            let mut all = first.clone();
+            for s in rest {
+                all.or_assign(s);
+            }
+            all.cells().map(|c| all.index(c)).collect()
+        }
+        _ => Vec::new(),
+    };
     if m.head.indexable() {
-        let cells: BTreeSet<usize> = candidates
-            .iter()
-            .flat_map(|s| s.cells().map(|c| s.index(c)))
-            .collect();
-        k.prepare(&cells, m);
+        k.prepare(&cells.iter().copied().collect(), m);
     }
     let k = &*k;
     // Each candidate setup's direction and table height, by cell index: asked per point
     // and probe, looked up in a slice rather than computed or searched for each.
-    let mut setup_at: Vec<Option<(V3, f64)>> = Vec::new();
-    if m.head.indexable() {
-        for s in &candidates {
-            for c in s.cells() {
-                let cell = s.index(c);
-                if setup_at.len() <= cell {
-                    setup_at.resize(cell + 1, None);
-                }
-                if setup_at[cell].is_none() {
-                    setup_at[cell] = Some((k.setup_dir(cell), k.held_prepared(cell).table));
-                }
-            }
-        }
+    let mut setup_at: Vec<Option<(V3, f64)>> = vec![None; cells.last().map_or(0, |&c| c + 1)];
+    for &cell in &cells {
+        setup_at[cell] = Some((k.setup_dir(cell), k.held_prepared(cell).table));
     }
     let reached: Vec<crate::access::CubeMap> = points
         .par_iter()
@@ -518,8 +515,9 @@ fn min_setups(
         })
         .collect();
     let mut sets: Vec<crate::access::CubeMap> = Vec::new();
+    let mut seen: BTreeSet<Vec<u64>> = BTreeSet::new();
     for s in reached {
-        if !s.is_empty() && !sets.contains(&s) {
+        if !s.is_empty() && seen.insert(s.words().to_vec()) {
             sets.push(s);
         }
     }
