@@ -182,9 +182,13 @@ impl Scene {
             return false;
         };
         let margin = 1e-6 * (1.0 + self.size + radius);
+        // A distance that is not a number (a core triangle degenerate in a way the
+        // distance does not handle) counts as near.
         let near = |c: &P3, r: f64| {
-            core.iter()
-                .any(|t| point_triangle_distance(c, t) <= radius + r + margin)
+            core.iter().any(|t| {
+                let d = point_triangle_distance(c, t);
+                d.is_nan() || d <= radius + r + margin
+            })
         };
         // The shape's pose relative to each triangle, as parry's composite test makes it.
         let pose = pos.inv_mul(&Isometry::identity()).inverse();
