@@ -184,19 +184,28 @@ impl<'a> Roadmap<'a> {
             .filter(|&j| j != i)
             .map(|j| ((self.nodes[j] - self.nodes[i]).norm(), j))
             .collect();
-        v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        v.truncate(K);
+        // A total order (ties by index): the K least are one set, selected in linear
+        // time and then sorted, as sorting everything would give them.
+        let order = |a: &(f64, usize), b: &(f64, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+        if v.len() > K {
+            v.select_nth_unstable_by(K - 1, order);
+            v.truncate(K);
+        }
+        v.sort_by(order);
         v.into_iter().map(|(_, j)| j).collect()
     }
 
     /// Connects nodes `from..` to their neighbours (in parallel, applied in order).
     fn link(&mut self, from: usize) {
         let n = self.nodes.len();
+        let near: Vec<Vec<usize>> = (from..n)
+            .into_par_iter()
+            .map(|i| self.nearest(i, n))
+            .collect();
         let mut pairs: Vec<(usize, usize)> = Vec::new();
-        for i in from..n {
-            for j in self.nearest(i, n) {
-                let e = (i.min(j), i.max(j));
-                pairs.push(e);
+        for (i, js) in (from..n).zip(near) {
+            for j in js {
+                pairs.push((i.min(j), i.max(j)));
             }
         }
         pairs.sort_unstable();
