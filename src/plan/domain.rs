@@ -556,7 +556,7 @@ impl<'a> Knowledge<'a> {
     /// Computes, in parallel, how the part is held in each setup cell of `cells` and makes
     /// room for their grid orientations' cells: what [`Knowledge::reaches_off_table`]
     /// reads.
-    pub(crate) fn prepare(&mut self, cells: &BTreeSet<usize>, machine: &Machine) {
+    pub(crate) fn prepare(&mut self, cells: &[usize], machine: &Machine) {
         let new: Vec<usize> = cells
             .iter()
             .copied()

@@ -463,7 +463,8 @@ fn min_setups(
         .filter(|i| used_points.contains(i))
         .collect();
     let candidates: Vec<crate::access::CubeMap> = points.iter().map(|&i| k.setups(i, m)).collect();
-    // Every candidate setup cell, once, ascending.
+    // Every candidate setup cell of a bent probe, once, ascending (a fixed head asks
+    // nothing per setup).
     let cells: Vec<usize> = match candidates.split_first() {
         Some((first, rest)) if m.head.indexable() => {
             let mut all = first.clone();
@@ -474,9 +475,7 @@ fn min_setups(
         }
         _ => Vec::new(),
     };
-    if m.head.indexable() {
-        k.prepare(&cells.iter().copied().collect(), m);
-    }
+    k.prepare(&cells, m);
     let k = &*k;
     // Each candidate setup's direction and table height, by cell index: asked per point
     // and probe, looked up in a slice rather than computed or searched for each.
