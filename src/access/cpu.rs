@@ -565,10 +565,40 @@ fn grown_shadow(
     dmin: f64,
     depth: u32,
 ) -> bool {
+    match grown_piece(canvas, n, from, comp, v, dmin, depth) {
+        Err(Everywhere) => false,
+        Ok(Some(k)) => {
+            canvas.draw(k, &v.map(|p| p - from), Coverage::Cells);
+            true
+        }
+        Ok(None) => true,
+    }
+}
+
+/// The component meets a triangle whatever its direction.
+struct Everywhere;
+
+/// [`grown_shadow`]'s rule for one piece, leaving its drawing to the caller where the
+/// whole piece falls in one band: `Some(k)` when the piece is to be drawn whole in band
+/// k, None when it is drawn (or adds nothing). A split piece's children that fall in the
+/// same band as its middle child are drawn as one convex polygon (the middle and the
+/// corners sharing its band; the midpoints kept as corners, so its outline is the
+/// children's own edges); all four in one band make the piece itself whole. The union
+/// of the children's shadows is the shadow of their union, so the maps are the same as
+/// drawing every child.
+fn grown_piece(
+    canvas: &mut impl Canvas,
+    n: u32,
+    from: &P3,
+    comp: &Component,
+    v: [P3; 3],
+    dmin: f64,
+    depth: u32,
+) -> Result<Option<u32>, Everywhere> {
     let (r, near) = (comp.radius, comp.near());
     let reach = v.iter().map(|p| (p - from).norm()).fold(0.0, f64::max);
     if reach < near {
-        return true;
+        return Ok(None);
     }
     // Splitting pays only for triangles large beside the distance they straddle.
     let size = (v[1] - v[0])
@@ -584,7 +614,7 @@ fn grown_shadow(
             if k as usize <= 2 * n as usize
                 && canvas.covered(k, || footprint(&q, Coverage::Cells, n))
             {
-                return true;
+                return Ok(None);
             }
         }
         let m = [0, 1, 2].map(|k| P3::from((v[k].coords + v[(k + 1) % 3].coords) / 2.0));
@@ -594,21 +624,48 @@ fn grown_shadow(
             [m[2], m[1], v[2]],
             [m[0], m[1], m[2]],
         ];
-        return parts.into_iter().all(|part| {
+        let mut bands = [None; 4];
+        for (band, part) in bands.iter_mut().zip(parts) {
             let d = point_triangle_distance(from, &part);
-            d > comp.far() || grown_shadow(canvas, n, from, comp, part, d, depth + 1)
-        });
+            if d <= comp.far() {
+                *band = grown_piece(canvas, n, from, comp, part, d, depth + 1)?;
+            }
+        }
+        let Some(middle) = bands[3] else {
+            for (band, part) in bands.iter().zip(&parts) {
+                if let Some(k) = *band {
+                    canvas.draw(k, &part.map(|p| p - from), Coverage::Cells);
+                }
+            }
+            return Ok(None);
+        };
+        if bands[..3].iter().all(|b| *b == Some(middle)) {
+            return Ok(Some(middle));
+        }
+        // v0, m0, v1, m1, v2, m2 around the piece; a corner's vertex where it joins.
+        let mut outline = [V3::zeros(); 6];
+        let mut len = 0;
+        for k in 0..3 {
+            if bands[k] == Some(middle) {
+                outline[len] = v[k] - from;
+                len += 1;
+            } else if let Some(b) = bands[k] {
+                canvas.draw(b, &parts[k].map(|p| p - from), Coverage::Cells);
+            }
+            outline[len] = m[k] - from;
+            len += 1;
+        }
+        canvas.draw(middle, &outline[..len], Coverage::Cells);
+        return Ok(None);
     }
     let Some(alpha) = dilation(r, near, dmin, reach) else {
-        return false;
+        return Err(Everywhere);
     };
     let k = pixels_for(alpha, n);
     if k as usize > 2 * n as usize {
-        return false;
+        return Err(Everywhere);
     }
-    let q = v.map(|p| p - from);
-    canvas.draw(k, &q, Coverage::Cells);
-    true
+    Ok(Some(k))
 }
 
 /// The largest angle between the axis of a component of radius `r` whose points all lie
