@@ -496,7 +496,7 @@ fn draw_triangle<'s>(
             return true;
         }
     }
-    grown_shadow(canvas, n, from, comp, t.v, dmin, 0)
+    grown_shadow(canvas, n, from, comp, t.v, dmin)
 }
 
 /// The blocked map from the drawn shadows: ∪ₖ growₖ(bandₖ) added to the base, then the
@@ -563,9 +563,9 @@ fn grown_shadow(
     comp: &Component,
     v: [P3; 3],
     dmin: f64,
-    depth: u32,
 ) -> bool {
-    match grown_piece(canvas, n, from, comp, v, dmin, depth) {
+    let dist = v.map(|p| (p - from).norm());
+    match grown_piece(canvas, n, from, comp, v, dist, dmin, 0) {
         Err(Everywhere) => false,
         Ok(Some(k)) => {
             canvas.draw(k, &v.map(|p| p - from), Coverage::Cells);
@@ -586,17 +586,23 @@ struct Everywhere;
 /// children's own edges); all four in one band make the piece itself whole. The union
 /// of the children's shadows is the shadow of their union, so the maps are the same as
 /// drawing every child.
+///
+/// `dist` holds the corners' distances from `from`. `dmin` is the piece's distance, or,
+/// for a piece with a corner nearer than the component's nearest distance, any distance
+/// under it: the rule then reads no more of it than that it is under (see [`dilation`]).
+#[allow(clippy::too_many_arguments)]
 fn grown_piece(
     canvas: &mut impl Canvas,
     n: u32,
     from: &P3,
     comp: &Component,
     v: [P3; 3],
+    dist: [f64; 3],
     dmin: f64,
     depth: u32,
 ) -> Result<Option<u32>, Everywhere> {
     let (r, near) = (comp.radius, comp.near());
-    let reach = v.iter().map(|p| (p - from).norm()).fold(0.0, f64::max);
+    let reach = dist.iter().copied().fold(0.0, f64::max);
     if reach < near {
         return Ok(None);
     }
@@ -618,17 +624,30 @@ fn grown_piece(
             }
         }
         let m = [0, 1, 2].map(|k| P3::from((v[k].coords + v[(k + 1) % 3].coords) / 2.0));
+        let dm = m.map(|p| (p - from).norm());
         let parts = [
             [v[0], m[0], m[2]],
             [m[0], v[1], m[1]],
             [m[2], m[1], v[2]],
             [m[0], m[1], m[2]],
         ];
+        let dists = [
+            [dist[0], dm[0], dm[2]],
+            [dm[0], dist[1], dm[1]],
+            [dm[2], dm[1], dist[2]],
+            dm,
+        ];
         let mut bands = [None; 4];
-        for (band, part) in bands.iter_mut().zip(parts) {
-            let d = point_triangle_distance(from, &part);
+        for ((band, part), dist) in bands.iter_mut().zip(parts).zip(dists) {
+            let corner = dist.iter().copied().fold(f64::INFINITY, f64::min);
+            // A corner under `near` tells all the rule needs (and it is within `far`).
+            let d = if corner < near {
+                corner
+            } else {
+                point_triangle_distance(from, &part)
+            };
             if d <= comp.far() {
-                *band = grown_piece(canvas, n, from, comp, part, d, depth + 1)?;
+                *band = grown_piece(canvas, n, from, comp, part, dist, d, depth + 1)?;
             }
         }
         let Some(middle) = bands[3] else {
