@@ -187,7 +187,7 @@ pub fn footprint(corners: &[V3], cov: Coverage, n: u32) -> Option<(u8, u32, u32,
             Coverage::Cells => SLACK,
             Coverage::Centres => HAIR + SLACK,
         };
-    let cell = |x: f64| floor_i((x + 1.0) / h).clamp(0, n - 1) as u32;
+    let cell = |x: f64| clamped_floor((x + 1.0) / h, n) as u32;
     Some((
         face,
         cell(vmin - slack),
@@ -210,6 +210,7 @@ fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage
         umax = umax.max(p.0);
     }
     let clampi = |k: i64| k.clamp(0, n - 1);
+    let floor = |y: f64| clamped_floor(y, n);
     // A shadow whose bounding box (widened past any rounding of the spans below) is
     // already all marked adds nothing: on a fine mesh most shadows fall where others did.
     let slack = match cov {
@@ -217,12 +218,12 @@ fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage
         Coverage::Centres => HAIR + SLACK,
     };
     let (j0, j1) = (
-        clampi(floor_i((vmin - slack + 1.0) / h)),
-        clampi(floor_i((vmax + slack + 1.0) / h)),
+        floor((vmin - slack + 1.0) / h),
+        floor((vmax + slack + 1.0) / h),
     );
     let (i0, i1) = (
-        clampi(floor_i((umin - slack + 1.0) / h)),
-        clampi(floor_i((umax + slack + 1.0) / h)),
+        floor((umin - slack + 1.0) / h),
+        floor((umax + slack + 1.0) / h),
     );
     let finite = [umin, umax, vmin, vmax].iter().all(|x| x.is_finite());
     if finite && out.spans_set(face, j0 as u32, j1 as u32, i0 as u32, i1 as u32) {
@@ -236,7 +237,7 @@ fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage
     }
     match cov {
         Coverage::Cells => {
-            let cell = |x: f64| clampi(floor_i((x + 1.0) / h));
+            let cell = |x: f64| floor((x + 1.0) / h);
             // Where the edges cross the line v = border: the extent of those crossings.
             let crossings = |border: f64| {
                 let (mut umin, mut umax) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -307,6 +308,14 @@ fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage
     }
 }
 
+/// `floor_i(y).clamp(0, n - 1)`, clamped before it is rounded: on [0, n − 1] the floor
+/// is the truncating cast, and below 0, past n − 1, at the infinities and at NaN (0) the
+/// two agree. Cheaper than the floor and the integer clamp, and called per span.
+#[inline]
+fn clamped_floor(y: f64, n: i64) -> i64 {
+    y.max(0.0).min((n - 1) as f64) as i64
+}
+
 /// `x.floor() as i64` without the libm call the baseline x86-64 target makes of
 /// `floor` (no SSE4.1 rounding): the same integer for every `x`, NaN and infinities
 /// saturating as the cast does. The rasterizer calls it for every span.
@@ -333,7 +342,7 @@ pub(super) fn ceil_i(x: f64) -> i64 {
 
 #[cfg(test)]
 mod rounding {
-    use super::{ceil_i, floor_i};
+    use super::{ceil_i, clamped_floor, floor_i};
 
     #[test]
     fn fast_floor_and_ceil_match_the_library() {
@@ -365,6 +374,13 @@ mod rounding {
             xs.push((s as f64 / u64::MAX as f64 - 0.5) * 300.0);
         }
         for x in xs {
+            for n in [1, 2, 16, 32, 48, 64, 128] {
+                assert_eq!(
+                    clamped_floor(x, n),
+                    (x.floor() as i64).clamp(0, n - 1),
+                    "clamped floor {x} {n}"
+                );
+            }
             assert_eq!(floor_i(x), x.floor() as i64, "floor {x}");
             assert_eq!(ceil_i(x), x.ceil() as i64, "ceil {x}");
         }
