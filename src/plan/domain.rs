@@ -193,6 +193,9 @@ struct GridCells {
     /// Per grid orientation, its direction's bit index; `u32::MAX` until asked for. Two
     /// threads asking at once both store the same value.
     cells: Vec<AtomicU32>,
+    /// The grid's directions in the part frame, made when first asked for (most setups
+    /// of the minimum never are).
+    dirs: std::sync::OnceLock<Vec<V3>>,
 }
 
 impl GridCells {
@@ -202,7 +205,14 @@ impl GridCells {
             cells: (0..machine.grid_dirs.len())
                 .map(|_| AtomicU32::new(u32::MAX))
                 .collect(),
+            dirs: std::sync::OnceLock::new(),
         }
+    }
+
+    /// The grid's directions in the part frame.
+    fn dirs(&self, machine: &Machine) -> &[V3] {
+        self.dirs
+            .get_or_init(|| machine.grid_dirs.iter().map(|d| self.to_part * d).collect())
     }
 
     /// The bit index, in maps shaped `like`, of grid orientation `k` (direction `d` in
@@ -630,20 +640,23 @@ impl<'a> Knowledge<'a> {
             self.d1p.insert((f, p, s), b.clone());
             return b.clone();
         }
-        let (c, dirs, candidates) = self.candidates(f, p, s, up, machine);
+        let (c, candidates) = self.candidates(f, p, s, up, machine);
         let probe = &machine.probes[p];
         let clear: Vec<bool> = if candidates.is_empty() {
             vec![]
         } else {
-            let map = self.memo.second.entry(s).or_insert_with(|| {
+            if !self.memo.second.contains_key(&s) {
                 let radius = machine
                     .probes
                     .iter()
                     .flat_map(|p| p.second.iter().map(|c| c.radius))
                     .fold(0.0, f64::max);
                 let reach = machine.probes.iter().map(|p| p.reach()).fold(0.0, f64::max);
-                SecondMap::new(&self.scene, up, radius, reach + 2.0 * self.opts.retract)
-            });
+                let map = SecondMap::new(&self.scene, up, radius, reach + 2.0 * self.opts.retract);
+                self.memo.second.insert(s, map);
+            }
+            let map = &self.memo.second[&s];
+            let dirs = self.grid_cells[&s].dirs(machine);
             candidates
                 .iter()
                 .map(|&k| map.clear(&(c + dirs[k] * probe.reach())))
@@ -753,9 +766,9 @@ impl<'a> Knowledge<'a> {
         })
     }
 
-    /// The tip centre of probe `p` on point `f`, the grid's directions in the part frame of
-    /// setup `up`, and the allowed grid orientations in D1′ that keep the stylus above the
-    /// table.
+    /// The tip centre of probe `p` on point `f` and the allowed grid orientations in D1′
+    /// that keep the stylus above the table in setup `up` (cell `s`, whose grid cells it
+    /// makes when first asked).
     fn candidates(
         &mut self,
         f: usize,
@@ -763,7 +776,7 @@ impl<'a> Knowledge<'a> {
         s: usize,
         up: &V3,
         machine: &Machine,
-    ) -> (P3, Vec<V3>, Vec<usize>) {
+    ) -> (P3, Vec<usize>) {
         let t0 = self.table_height(s);
         let Knowledge {
             grid_cells,
@@ -778,8 +791,7 @@ impl<'a> Knowledge<'a> {
         let probe = &machine.probes[p];
         let point = &self.points[f];
         let c = point.tip_centre(probe.tip_radius);
-        let to_part = frame(up).inverse();
-        let dirs: Vec<V3> = machine.grid_dirs.iter().map(|d| to_part * d).collect();
+        let dirs = cells.dirs(machine);
         let table = f >= self.graph_points;
         // A table point's tip touches the table: its stylus comes as near as the stem
         // leaves (the move's own margin still holds), not the orientation margin.
@@ -800,7 +812,7 @@ impl<'a> Knowledge<'a> {
                     && (!table || dirs[k].dot(&point.normal) > 0.2)
             })
             .collect();
-        (c, dirs, candidates)
+        (c, candidates)
     }
 
     /// Learns that probe `p` cannot reach point `f` from setup cell `s` (and, for a bent
