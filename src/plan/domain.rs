@@ -593,11 +593,6 @@ impl<'a> Knowledge<'a> {
         &self.held[&s]
     }
 
-    /// The table's height under the part in setup cell `s` (cached).
-    pub(crate) fn table_height(&mut self, s: usize) -> f64 {
-        self.held(s).table
-    }
-
     /// The setups from which some allowed probe reaches graph fpoint `f`.
     pub(crate) fn setups(&self, f: usize, machine: &Machine) -> CubeMap {
         let reached = self.dom[f]
@@ -635,26 +630,118 @@ impl<'a> Knowledge<'a> {
         if let Some(b) = self.d1p.get(&(f, p, s)) {
             return b.clone();
         }
-        let key = (f, p, s, self.dom.get(f).is_some_and(|d| d[p].full));
+        let key = self.orientations_key(f, p, s);
         if let Some(b) = self.memo.orientations.get(&key) {
             self.d1p.insert((f, p, s), b.clone());
             return b.clone();
         }
-        let (c, candidates) = self.candidates(f, p, s, up, machine);
+        self.grid(s, up, machine);
+        let (c, candidates) = self.candidates(f, p, s, machine);
+        if !candidates.is_empty() {
+            self.second_map(s, up, machine);
+        }
+        let out = self.clear_of(p, s, &c, &candidates, machine);
+        self.d1p.insert((f, p, s), out.clone());
+        self.memo.orientations.insert(key, out.clone());
+        out
+    }
+
+    /// [`Knowledge::orientations`] of many (point, probe) pairs in setup cell `s`, those
+    /// not known yet computed in parallel: the same sets, kept as asking one by one would
+    /// keep them, so the sequential queries that follow find them made.
+    pub(crate) fn prefetch_orientations(
+        &mut self,
+        pairs: &[(usize, usize)],
+        s: usize,
+        machine: &Machine,
+    ) {
+        if !machine.head.indexable() {
+            return;
+        }
+        let mut todo: Vec<(usize, usize)> = pairs
+            .iter()
+            .copied()
+            .filter(|&(f, p)| {
+                !self.d1p.contains_key(&(f, p, s))
+                    && !self
+                        .memo
+                        .orientations
+                        .contains_key(&self.orientations_key(f, p, s))
+            })
+            .collect();
+        todo.sort_unstable();
+        todo.dedup();
+        if todo.len() < 2 {
+            return;
+        }
+        let up = self.setup_dir(s);
+        self.grid(s, &up, machine);
+        let this = &*self;
+        let candidates: Vec<(P3, Vec<usize>)> = todo
+            .par_iter()
+            .map(|&(f, p)| this.candidates(f, p, s, machine))
+            .collect();
+        if candidates.iter().any(|(_, c)| !c.is_empty()) {
+            self.second_map(s, &up, machine);
+        }
+        let this = &*self;
+        let outs: Vec<Bits> = todo
+            .par_iter()
+            .zip(&candidates)
+            .map(|(&(_, p), (c, cands))| this.clear_of(p, s, c, cands, machine))
+            .collect();
+        for ((f, p), out) in todo.into_iter().zip(outs) {
+            let key = self.orientations_key(f, p, s);
+            self.d1p.insert((f, p, s), out.clone());
+            self.memo.orientations.insert(key, out);
+        }
+    }
+
+    /// The memo's key of (f, p, s)'s orientations: D1 is a function of the pair and of
+    /// whether its whole probe's cones are acquired.
+    fn orientations_key(&self, f: usize, p: usize, s: usize) -> (usize, usize, usize, bool) {
+        (f, p, s, self.dom.get(f).is_some_and(|d| d[p].full))
+    }
+
+    /// Makes how setup cell `s` holds the part and its grid cells (`up` its direction),
+    /// if not made yet.
+    fn grid(&mut self, s: usize, up: &V3, machine: &Machine) {
+        self.held(s);
+        self.grid_cells
+            .entry(s)
+            .or_insert_with(|| GridCells::new(up, machine));
+    }
+
+    /// Makes setup cell `s`'s depth map of the second component if not made yet.
+    fn second_map(&mut self, s: usize, up: &V3, machine: &Machine) {
+        if self.memo.second.contains_key(&s) {
+            return;
+        }
+        let radius = machine
+            .probes
+            .iter()
+            .flat_map(|p| p.second.iter().map(|c| c.radius))
+            .fold(0.0, f64::max);
+        let reach = machine.probes.iter().map(|p| p.reach()).fold(0.0, f64::max);
+        let map = SecondMap::new(&self.scene, up, radius, reach + 2.0 * self.opts.retract);
+        self.memo.second.insert(s, map);
+    }
+
+    /// The candidates (see [`Knowledge::candidates`]) whose articulation point the second
+    /// component clears in setup cell `s`, as grid orientations; `s`'s grid cells and,
+    /// for any candidate, its depth map must be made.
+    fn clear_of(
+        &self,
+        p: usize,
+        s: usize,
+        c: &P3,
+        candidates: &[usize],
+        machine: &Machine,
+    ) -> Bits {
         let probe = &machine.probes[p];
         let clear: Vec<bool> = if candidates.is_empty() {
             vec![]
         } else {
-            if !self.memo.second.contains_key(&s) {
-                let radius = machine
-                    .probes
-                    .iter()
-                    .flat_map(|p| p.second.iter().map(|c| c.radius))
-                    .fold(0.0, f64::max);
-                let reach = machine.probes.iter().map(|p| p.reach()).fold(0.0, f64::max);
-                let map = SecondMap::new(&self.scene, up, radius, reach + 2.0 * self.opts.retract);
-                self.memo.second.insert(s, map);
-            }
             let map = &self.memo.second[&s];
             let dirs = self.grid_cells[&s].dirs(machine);
             candidates
@@ -662,17 +749,14 @@ impl<'a> Knowledge<'a> {
                 .map(|&k| map.clear(&(c + dirs[k] * probe.reach())))
                 .collect()
         };
-        let out = Bits::of(
+        Bits::of(
             machine.grid.len(),
             candidates
                 .iter()
                 .zip(clear)
                 .filter(|(_, ok)| *ok)
                 .map(|(&k, _)| k),
-        );
-        self.d1p.insert((f, p, s), out.clone());
-        self.memo.orientations.insert(key, out.clone());
-        out
+        )
     }
 
     /// Whether probe `p` may have a grid orientation in D1′ that keeps its stylus off the
@@ -767,17 +851,11 @@ impl<'a> Knowledge<'a> {
     }
 
     /// The tip centre of probe `p` on point `f` and the allowed grid orientations in D1′
-    /// that keep the stylus above the table in setup `up` (cell `s`, whose grid cells it
-    /// makes when first asked).
-    fn candidates(
-        &mut self,
-        f: usize,
-        p: usize,
-        s: usize,
-        up: &V3,
-        machine: &Machine,
-    ) -> (P3, Vec<usize>) {
-        let t0 = self.table_height(s);
+    /// that keep the stylus above the table in setup cell `s` (whose holding and grid
+    /// cells must be made).
+    fn candidates(&self, f: usize, p: usize, s: usize, machine: &Machine) -> (P3, Vec<usize>) {
+        let t0 = self.held[&s].table;
+        let up = &self.setup_dir(s);
         let Knowledge {
             grid_cells,
             dom,
@@ -785,9 +863,7 @@ impl<'a> Knowledge<'a> {
             pref_index,
             ..
         } = self;
-        let cells = grid_cells
-            .entry(s)
-            .or_insert_with(|| GridCells::new(up, machine));
+        let cells = &grid_cells[&s];
         let probe = &machine.probes[p];
         let point = &self.points[f];
         let c = point.tip_centre(probe.tip_radius);

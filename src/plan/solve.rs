@@ -375,6 +375,12 @@ fn pick_bent_setup(mu: &CubeMap, sub: &Inst, k: &mut Knowledge, m: &Machine) -> 
     let mut best = (0usize, cands[0]);
     for &s in &cands {
         let up = k.setup_dir(s);
+        // Each point's first probe is asked first: those in parallel.
+        let first: Vec<(usize, usize)> = pts
+            .iter()
+            .filter_map(|&f| k.probes(f, s, m).ones().next().map(|p| (f, p)))
+            .collect();
+        k.prefetch_orientations(&first, s, m);
         let mut ok = 0;
         for &f in &pts {
             let probes = k.probes(f, s, m);
@@ -512,6 +518,8 @@ pub(crate) fn solve(
             let psub = extract(&sub, &ptree, &[j as u32]);
             let mut pts = Vec::new();
             leaves(&psub, &mut pts);
+            let pairs: Vec<(usize, usize)> = pts.iter().map(|&f| (f, p)).collect();
+            k.prefetch_orientations(&pairs, s, m);
             let mut orient_sets: BTreeMap<usize, Bits> = BTreeMap::new();
             for &f in &pts {
                 if orient_sets.contains_key(&f) {
