@@ -518,10 +518,11 @@ pub(super) fn finish(
     }
     let (r, near, far) = (comp.radius, comp.near(), comp.far());
     // ∪ₖ growₖ(bandₖ), growing each accumulated band once per step (Horner's scheme).
+    // Pixels only: the preferred directions are decided below.
     let mut acc: Option<CubeMap> = None;
     for band in bands.into_iter().rev() {
         let mut m = match acc.take() {
-            Some(a) => a.grow(),
+            Some(a) => a.grow_pixels(),
             None => base.empty_like(),
         };
         if let Some(b) = band {
@@ -530,7 +531,7 @@ pub(super) fn finish(
         acc = Some(m);
     }
     if let Some(a) = acc {
-        base.or_assign(&a.grow());
+        base.or_assign(&a.grow_pixels());
     }
     // Preferred directions.
     for k in 0..base.preferred_len() {

@@ -463,6 +463,15 @@ impl CubeMap {
     /// pessimistic step of ch. 4.3.4 when the cone is a set of blocked directions).
     /// Preferred directions join when their pixel is in the grown cone.
     pub fn grow(&self) -> CubeMap {
+        let mut out = self.grow_pixels();
+        out.settle_preferred();
+        out
+    }
+
+    /// [`CubeMap::grow`] of the pixels alone: the preferred bits are kept as they are, for
+    /// callers that decide them afterwards (each settling looks up every preferred
+    /// direction's pixel).
+    pub(crate) fn grow_pixels(&self) -> CubeMap {
         let n = self.n as usize;
         if n > 64 {
             return self.grow_slow();
@@ -470,9 +479,13 @@ impl CubeMap {
         let mut out = self.clone();
         let mask = row_mask(n);
         let table = EdgeTable::of(self.n);
+        let (mut rows, mut wide) = ([0u64; 64], [0u64; 64]);
         for face in 0..6u8 {
-            let rows: Vec<u64> = (0..n).map(|j| self.row(face, j)).collect();
-            let wide: Vec<u64> = rows.iter().map(|&r| (r | r << 1 | r >> 1) & mask).collect();
+            for j in 0..n {
+                let r = self.row(face, j);
+                rows[j] = r;
+                wide[j] = (r | r << 1 | r >> 1) & mask;
+            }
             for j in 0..n {
                 let mut g = wide[j];
                 if j > 0 {
@@ -484,7 +497,7 @@ impl CubeMap {
                 out.or_row(face, j, g);
             }
             // Pixels on the face's border reach across cube edges.
-            for (j, &r) in rows.iter().enumerate() {
+            for (j, &r) in rows[..n].iter().enumerate() {
                 let border = if j == 0 || j == n - 1 {
                     r
                 } else {
@@ -501,7 +514,6 @@ impl CubeMap {
                 }
             }
         }
-        out.settle_preferred();
         out
     }
 
@@ -523,7 +535,6 @@ impl CubeMap {
                 }
             }
         }
-        out.settle_preferred();
         out
     }
 
@@ -1148,7 +1159,7 @@ mod tests {
                     c.set(c.cell(idx), true);
                 }
             }
-            assert_eq!(c.grow(), c.grow_slow(), "n = {n}");
+            assert_eq!(c.grow_pixels(), c.grow_slow(), "n = {n}");
         }
     }
 
