@@ -61,6 +61,18 @@ pub(super) trait Canvas {
         false
     }
 
+    /// Whether a shadow in `target` within the rectangle `area` gives could mark a pixel
+    /// the caller needs right (see [`blocked_within`]). A canvas that needs every pixel,
+    /// or cannot tell, says true; `area` is asked only when it could say false.
+    fn relevant(
+        &mut self,
+        target: u32,
+        area: impl FnOnce() -> Option<(u8, u32, u32, u32, u32)>,
+    ) -> bool {
+        let _ = (target, area);
+        true
+    }
+
     /// Whether drawing may stop: what the caller waits for is blocked already.
     fn enough(&mut self) -> bool {
         false
@@ -77,6 +89,27 @@ pub(super) struct Maps {
     base_marked: bool,
     /// The pixels whose blocking ends the drawing early ([`blocked_until`]).
     stop: Option<Stop>,
+    /// The pixels the map must be right on ([`blocked_within`]).
+    focus: Option<Focus>,
+}
+
+/// What [`blocked_within`] must get right: pixels, and their growths. A shadow drawn
+/// in band k marks pixel p of the finished map only through growth k, so only if it
+/// meets p's disc k, which lies in growth k of the focus: a shadow whose rectangle
+/// meets no pixel of that growth cannot mark a focus pixel.
+struct Focus {
+    /// Growth k at index k, made when first asked for.
+    grown: Vec<CubeMap>,
+}
+
+impl Focus {
+    fn meets(&mut self, k: u32, (face, j0, j1, i0, i1): (u8, u32, u32, u32, u32)) -> bool {
+        while self.grown.len() <= k as usize {
+            let next = self.grown[self.grown.len() - 1].grow_pixels();
+            self.grown.push(next);
+        }
+        self.grown[k as usize].spans_meet(face, j0, j1, i0, i1)
+    }
 }
 
 /// What [`blocked_until`] waits for: pixels not yet blocked, each with its discs
@@ -102,6 +135,7 @@ impl Maps {
             bands: Vec::new(),
             base_marked: false,
             stop: None,
+            focus: None,
         }
     }
 
@@ -136,6 +170,17 @@ impl Canvas for Maps {
         shadow_polygon(map, q, cov);
         if let Some(stop) = &mut self.stop {
             stop.drawn += 1;
+        }
+    }
+
+    fn relevant(
+        &mut self,
+        target: u32,
+        area: impl FnOnce() -> Option<(u8, u32, u32, u32, u32)>,
+    ) -> bool {
+        match &mut self.focus {
+            None => true,
+            Some(focus) => area().is_none_or(|rect| focus.meets(target, rect)),
         }
     }
 
@@ -190,6 +235,29 @@ pub(super) struct Drawn<'s> {
 /// scene.
 pub fn blocked(scene: &Scene, from: &P3, comp: &Component, n: u32, preferred: &[V3]) -> CubeMap {
     let mut maps = Maps::new(n, preferred);
+    let drawn = draw(scene, from, comp, n, &mut maps);
+    finish(scene, from, comp, maps.base, maps.bands, &drawn)
+}
+
+/// [`blocked`], right on the cells of `within` (and the pixels holding its preferred
+/// directions); elsewhere it may hold fewer blocked cells. Shadows that cannot reach
+/// those pixels ([`Focus`]) are passed over, whole nodes of the hierarchy at once: a
+/// union of components needs each one only where the others leave it free. A bare
+/// half-line is drawn whole.
+pub fn blocked_within(
+    scene: &Scene,
+    from: &P3,
+    comp: &Component,
+    n: u32,
+    preferred: &[V3],
+    within: &CubeMap,
+) -> CubeMap {
+    let mut maps = Maps::new(n, preferred);
+    if comp.radius > 0.0 && within.n() == n {
+        maps.focus = Some(Focus {
+            grown: vec![within.pixels_of_cells()],
+        });
+    }
     let drawn = draw(scene, from, comp, n, &mut maps);
     finish(scene, from, comp, maps.base, maps.bands, &drawn)
 }
@@ -268,7 +336,7 @@ pub fn blocked_plain(
 /// hierarchy is walked nearest child first, so the large shadows of near triangles are
 /// drawn before the far triangles they hide; a node is passed over whole when every
 /// triangle in it would be (too far, too near, under the floor, all facing away) or
-/// when what its triangles could add is already marked ([`hidden`]). The maps are the
+/// when what its triangles could add is already marked ([`node_band`]). The maps are the
 /// same as triangle by triangle: a shadow adds nothing where its pixels are already
 /// marked in a band grown at least as far as its own.
 pub(super) fn draw<'s>(
@@ -320,8 +388,14 @@ pub(super) fn draw<'s>(
         let (hi, lo) = (dc + node.radius + margin, dc - node.radius - margin);
         // A leaf's few triangles are drawn untested: projecting its box's eight corners
         // costs about what their own shadows' already-marked checks do.
-        if node.kids.is_some() && hidden(canvas, &at, node, hi, lo) {
-            continue;
+        if node.kids.is_some() {
+            if let Some((target, cov)) = node_band(&at, lo, hi) {
+                let mut rect = None;
+                let mut area = || *rect.get_or_insert_with(|| node_footprint(&at, node, cov));
+                if canvas.covered(target, &mut area) || !canvas.relevant(target, &mut area) {
+                    continue;
+                }
+            }
         }
         match node.kids {
             Some((a, b)) => {
@@ -366,53 +440,42 @@ fn faces_away(node: &BvhNode, w: &V3, dc: f64, margin: f64) -> bool {
     dc * (cos_p * cos_t + sin_p * sin_t) + node.radius < -margin
 }
 
-/// Whether the shadows `node`'s triangles could add (at distances `lo` to `hi` from
-/// `from`) are all marked already: its box's footprint is marked in the maps of every
-/// band at least as grown as any of its triangles' would be. Never for a truncated bare
-/// half-line (its triangles are kept as candidates for the preferred directions), nor
-/// when a triangle of the node could be drawn as a prism or meet the component in every
-/// direction.
-fn hidden(canvas: &impl Canvas, at: &Placed, node: &BvhNode, hi: f64, lo: f64) -> bool {
-    let &Placed {
-        ref from,
-        comp,
-        n,
-        near,
-        ..
-    } = at;
+/// The band and coverage that bound every shadow `node`'s triangles (at distances `lo`
+/// to `hi` from the viewpoint) could be drawn with: a node whose box's footprint is
+/// marked in that band or a more grown one adds nothing (it is hidden), and one whose
+/// footprint cannot reach a pixel the caller needs is not drawn ([`Canvas::relevant`]).
+/// None for a truncated bare half-line (its triangles are kept as candidates for the
+/// preferred directions), and when a triangle of the node could be drawn as a prism or
+/// meet the component in every direction.
+fn node_band(at: &Placed, lo: f64, hi: f64) -> Option<(u32, Coverage)> {
+    let &Placed { comp, n, near, .. } = at;
     let r = comp.radius;
-    let (target, cov) = if r == 0.0 {
-        if near > 0.0 {
-            return false;
+    if r == 0.0 {
+        return (near <= 0.0).then_some((0, Coverage::Centres));
+    }
+    if comp.a == 0.0 {
+        let d = lo.max(near);
+        if d <= r || pixels_for((r / d).asin(), n) > PRISM_PIXELS {
+            return None;
         }
-        (0, Coverage::Centres)
-    } else {
-        if comp.a == 0.0 {
-            let d = lo.max(near);
-            if d <= r || pixels_for((r / d).asin(), n) > PRISM_PIXELS {
-                return false;
-            }
-        }
-        let Some(alpha) = dilation(r, near, lo.max(0.0), hi) else {
-            return false;
-        };
-        let k = pixels_for(alpha * (1.0 + 1e-9), n);
-        if k as usize > 2 * n as usize {
-            return false;
-        }
-        (k, Coverage::Cells)
-    };
-    canvas.covered(target, || {
-        let (a, b) = (node.lo - from, node.hi - from);
-        let corners = [0, 1, 2, 3, 4, 5, 6, 7].map(|c: u8| {
-            V3::new(
-                if c & 1 == 0 { a.x } else { b.x },
-                if c & 2 == 0 { a.y } else { b.y },
-                if c & 4 == 0 { a.z } else { b.z },
-            )
-        });
-        footprint(&corners, cov, n)
-    })
+    }
+    let alpha = dilation(r, near, lo.max(0.0), hi)?;
+    let k = pixels_for(alpha * (1.0 + 1e-9), n);
+    (k as usize <= 2 * n as usize).then_some((k, Coverage::Cells))
+}
+
+/// The rectangle that holds the shadow of every polygon inside `node`'s box (see
+/// [`footprint`]).
+fn node_footprint(at: &Placed, node: &BvhNode, cov: Coverage) -> Option<(u8, u32, u32, u32, u32)> {
+    let (a, b) = (node.lo - at.from, node.hi - at.from);
+    let corners = [0, 1, 2, 3, 4, 5, 6, 7].map(|c: u8| {
+        V3::new(
+            if c & 1 == 0 { a.x } else { b.x },
+            if c & 2 == 0 { a.y } else { b.y },
+            if c & 4 == 0 { a.z } else { b.z },
+        )
+    });
+    footprint(&corners, cov, at.n)
 }
 
 /// A component placed at `from` for maps of resolution `n`, with its nearest and
@@ -571,7 +634,7 @@ fn grown_shadow(
     match grown_piece(canvas, n, from, comp, v, dist, dmin, 0) {
         Err(Everywhere) => false,
         Ok(Some(k)) => {
-            canvas.draw(k, &v.map(|p| p - from), Coverage::Cells);
+            draw_grown(canvas, n, k, &v.map(|p| p - from));
             true
         }
         Ok(None) => true,
@@ -580,6 +643,14 @@ fn grown_shadow(
 
 /// The component meets a triangle whatever its direction.
 struct Everywhere;
+
+/// Marks a grown shadow (corners relative to the viewpoint) in band `k`, unless it
+/// cannot reach a pixel the canvas needs.
+fn draw_grown(canvas: &mut impl Canvas, n: u32, k: u32, q: &[V3]) {
+    if canvas.relevant(k, || footprint(q, Coverage::Cells, n)) {
+        canvas.draw(k, q, Coverage::Cells);
+    }
+}
 
 /// [`grown_shadow`]'s rule for one piece, leaving its drawing to the caller where the
 /// whole piece falls in one band: `Some(k)` when the piece is to be drawn whole in band
@@ -620,10 +691,12 @@ fn grown_piece(
         if let Some(alpha) = dilation(r, near, dmin * (1.0 - 1e-9), reach * (1.0 + 1e-9)) {
             let k = pixels_for(alpha * (1.0 + 1e-9), n);
             let q = v.map(|p| p - from);
-            if k as usize <= 2 * n as usize
-                && canvas.covered(k, || footprint(&q, Coverage::Cells, n))
-            {
-                return Ok(None);
+            if k as usize <= 2 * n as usize {
+                let mut rect = None;
+                let mut area = || *rect.get_or_insert_with(|| footprint(&q, Coverage::Cells, n));
+                if canvas.covered(k, &mut area) || !canvas.relevant(k, &mut area) {
+                    return Ok(None);
+                }
             }
         }
         let m = [0, 1, 2].map(|k| P3::from((v[k].coords + v[(k + 1) % 3].coords) / 2.0));
@@ -656,7 +729,7 @@ fn grown_piece(
         let Some(middle) = bands[3] else {
             for (band, part) in bands.iter().zip(&parts) {
                 if let Some(k) = *band {
-                    canvas.draw(k, &part.map(|p| p - from), Coverage::Cells);
+                    draw_grown(canvas, n, k, &part.map(|p| p - from));
                 }
             }
             return Ok(None);
@@ -672,12 +745,12 @@ fn grown_piece(
                 outline[len] = v[k] - from;
                 len += 1;
             } else if let Some(b) = bands[k] {
-                canvas.draw(b, &parts[k].map(|p| p - from), Coverage::Cells);
+                draw_grown(canvas, n, b, &parts[k].map(|p| p - from));
             }
             outline[len] = m[k] - from;
             len += 1;
         }
-        canvas.draw(middle, &outline[..len], Coverage::Cells);
+        draw_grown(canvas, n, middle, &outline[..len]);
         return Ok(None);
     }
     let Some(alpha) = dilation(r, near, dmin, reach) else {

@@ -630,6 +630,33 @@ impl CubeMap {
         })
     }
 
+    /// Whether some pixel i0..=i1 of rows j0..=j1 of a face is in the map (false for an
+    /// empty range).
+    pub(crate) fn spans_meet(&self, face: u8, j0: u32, j1: u32, i0: u32, i1: u32) -> bool {
+        if i0 > i1 {
+            return false;
+        }
+        (j0..=j1).any(|j| {
+            self.span_words(face, j, i0, i1)
+                .any(|(w, mask)| self.bits[w] & mask != 0)
+        })
+    }
+
+    /// The pixels of the map's cells: its pixels and those holding its preferred
+    /// directions (preferred bits clear).
+    pub(crate) fn pixels_of_cells(&self) -> CubeMap {
+        let mut out = self.clone();
+        for k in 0..self.extra.len() {
+            if self.get(Cell::Preferred(k)) {
+                out.set(Cell::Preferred(k), false);
+                for p in self.pixels_holding(&self.preferred(k)) {
+                    out.set(Cell::Pixel(p), true);
+                }
+            }
+        }
+        out
+    }
+
     /// Whether every pixel i0..=i1 of rows j0..=j1 of a face is in at least one of
     /// `maps` (maps of one resolution; false when there is none).
     pub(crate) fn spans_set_any(

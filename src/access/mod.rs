@@ -90,6 +90,22 @@ pub trait Backend: Sync {
         self.blocked(scene, from, comp, n, preferred)
     }
 
+    /// [`Backend::blocked`], right on the cells of `within` (and the pixels holding its
+    /// preferred directions); elsewhere it may hold fewer blocked cells (the CPU passes
+    /// over shadows that cannot reach them; others may draw the whole map).
+    fn blocked_within(
+        &self,
+        scene: &Scene,
+        from: &P3,
+        comp: &Component,
+        n: u32,
+        preferred: &[V3],
+        within: &CubeMap,
+    ) -> CubeMap {
+        let _ = within;
+        self.blocked(scene, from, comp, n, preferred)
+    }
+
     /// [`Backend::blocked`] for many queries, in their order.
     fn blocked_many(
         &self,
@@ -137,6 +153,18 @@ impl Backend for Cpu {
         stop: &CubeMap,
     ) -> CubeMap {
         cpu::blocked_until(scene, from, comp, n, preferred, stop)
+    }
+
+    fn blocked_within(
+        &self,
+        scene: &Scene,
+        from: &P3,
+        comp: &Component,
+        n: u32,
+        preferred: &[V3],
+        within: &CubeMap,
+    ) -> CubeMap {
+        cpu::blocked_within(scene, from, comp, n, preferred, within)
     }
 }
 
@@ -233,9 +261,33 @@ pub fn gac_with(
     preferred: &[V3],
     exact: bool,
 ) -> CubeMap {
-    let mut blocked = CubeMap::empty(n, preferred);
-    for c in comps {
-        let mut b = backend.blocked(scene, from, c, n, preferred);
+    gac_within(backend, scene, from, comps, (n, preferred), exact, None)
+}
+
+/// [`gac_with`], right on the cells of `within` (all cells when None); elsewhere it may
+/// hold more. Each component after the first is needed only where those before leave
+/// the probe free (and within `within`), so it is drawn for those cells alone
+/// ([`Backend::blocked_within`]); refined cones are drawn whole, their boundary being
+/// what refining reads.
+fn gac_within(
+    backend: &dyn Backend,
+    scene: &Scene,
+    from: &P3,
+    comps: &[Component],
+    (n, preferred): (u32, &[V3]),
+    exact: bool,
+    within: Option<&CubeMap>,
+) -> CubeMap {
+    let mut blocked = match within {
+        Some(w) if !exact => w.not(),
+        _ => CubeMap::empty(n, preferred),
+    };
+    for (k, c) in comps.iter().enumerate() {
+        let mut b = if exact || (k == 0 && within.is_none()) {
+            backend.blocked(scene, from, c, n, preferred)
+        } else {
+            backend.blocked_within(scene, from, c, n, preferred, &blocked.not())
+        };
         if exact && c.radius > 0.0 {
             refine(scene, from, c, &mut b);
         }
@@ -333,7 +385,17 @@ fn approach_at(
     let exact = opts.exact_boundary;
     let mut approach = gac_with(backend, scene, &c, &comps, n, pref, exact);
     if let Some(retract) = retract.filter(|_| !approach.is_empty()) {
-        approach.and_assign(&gac_with(backend, scene, &retract, &comps, n, pref, exact));
+        // Needed only where the contact leaves the probe free.
+        let at_retract = gac_within(
+            backend,
+            scene,
+            &retract,
+            &comps,
+            (n, pref),
+            exact,
+            Some(&approach),
+        );
+        approach.and_assign(&at_retract);
     }
     Some((c, approach))
 }
