@@ -307,9 +307,11 @@ fn forcing_levels(
     let mut relaxed = h.clone();
     relaxed.levels.retain(|l| !grouped(&l));
     let sets = solve::setup_sets(root, k, m);
+    let trees = solve::setup_trees(root, k, &relaxed, &sets);
     let fewest = Strategy::ALL
-        .iter()
-        .filter_map(|&s| solve::solve(root, k, m, &relaxed, s, &sets).ok())
+        .into_iter()
+        .zip(trees)
+        .filter_map(|(s, tree)| solve::solve(root, k, m, &relaxed, s, tree).ok())
         .map(|b| count(&b))
         .min()?;
     (fewest < used).then(|| {
@@ -522,8 +524,9 @@ fn plan_touch(
         let mut results: Vec<(Strategy, Vec<Branch>)> = Vec::new();
         let mut failures = Vec::new();
         let sets = solve::setup_sets(&root, &k, &machine);
-        for strategy in Strategy::ALL {
-            match solve::solve(&root, &mut k, &machine, hierarchy, strategy, &sets) {
+        let trees = solve::setup_trees(&root, &k, hierarchy, &sets);
+        for (strategy, tree) in Strategy::ALL.into_iter().zip(trees) {
+            match solve::solve(&root, &mut k, &machine, hierarchy, strategy, tree) {
                 Ok(b) => results.push((strategy, b)),
                 Err(f) => failures.extend(f),
             }

@@ -448,29 +448,49 @@ pub(crate) fn setup_sets(root: &Inst, k: &Knowledge, m: &Machine) -> SetupSets {
     setup_sets
 }
 
-/// Runs the main algorithm (ch. 3.5.3) with one clustering strategy, the leaves' setups
-/// given ([`setup_sets`]).
+/// The clustering of setups (step 1 of [`solve`]) under each strategy of
+/// [`Strategy::ALL`], in that order: pure functions of the knowledge, so the four are
+/// clustered in parallel before the rounds' sequential steps.
+pub(crate) fn setup_trees(
+    root: &Inst,
+    k: &Knowledge,
+    h: &Hierarchy,
+    setup_sets: &SetupSets,
+) -> Vec<SetupTree> {
+    use rayon::prelude::*;
+    Strategy::ALL
+        .par_iter()
+        .map(|&strategy| {
+            let sw = |e: usize| k.setup_weight.get(&e).copied().unwrap_or(0.5);
+            let leaf_setup = |i: &Inst| match i.kind {
+                Kind::Point { point, table } => setup_sets[&(point, table)].clone(),
+                _ => unreachable!("leaves are points"),
+            };
+            SetupTree(up(
+                root,
+                &leaf_setup,
+                &|kind| merges(h, SameVar::Setup, kind),
+                strategy,
+                &sw,
+            ))
+        })
+        .collect()
+}
+
+/// One strategy's clustering of setups ([`setup_trees`]).
+pub(crate) struct SetupTree(CNode<CubeMap>);
+
+/// Runs the main algorithm (ch. 3.5.3) with one clustering strategy, its setups
+/// clustered ([`setup_trees`]).
 pub(crate) fn solve(
     root: &Inst,
     k: &mut Knowledge,
     m: &Machine,
     h: &Hierarchy,
     strategy: Strategy,
-    setup_sets: &SetupSets,
+    SetupTree(tree): SetupTree,
 ) -> Result<Vec<Branch>, Vec<Failure>> {
-    // 1. Setups.
-    let sw = |e: usize| k.setup_weight.get(&e).copied().unwrap_or(0.5);
-    let leaf_setup = |i: &Inst| match i.kind {
-        Kind::Point { point, table } => setup_sets[&(point, table)].clone(),
-        _ => unreachable!("leaves are points"),
-    };
-    let tree = up(
-        root,
-        &leaf_setup,
-        &|kind| merges(h, SameVar::Setup, kind),
-        strategy,
-        &sw,
-    );
+    // 1. Setups (clustered), each cluster's setup picked.
     let mut by_setup: Vec<(usize, Inst)> = Vec::new();
     for (j, cl) in tree.clusters.iter().enumerate() {
         let sub = extract(root, &tree, &[j as u32]);
