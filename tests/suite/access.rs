@@ -287,6 +287,64 @@ fn drawing_stops_once_the_cells_waited_for_are_blocked() {
     assert!(early > 0, "never stopped early");
 }
 
+/// A map drawn for some cells alone (the later components of a probe, the retract
+/// point) is the whole map on those cells and on the pixels holding their preferred
+/// directions, never more blocked anywhere, and on a real part it does pass shadows
+/// over.
+#[test]
+fn drawing_for_some_cells_is_the_whole_map_there() {
+    for spec in [
+        "tests/real/nist_ctc_01.insp",
+        "examples/swiss_sphere_fixed.insp",
+    ] {
+        let c = case(spec, 6, 59);
+        let axes = inspc::access::axes();
+        let mut fewer = 0;
+        for (k, p) in c.points.iter().enumerate() {
+            let comps = c
+                .probes
+                .iter()
+                .flat_map(|p| p.first.iter().chain(&p.second));
+            for (j, comp) in comps.enumerate() {
+                for n in [32, 64] {
+                    let whole = Cpu.blocked(&c.scene, p, comp, n, &axes);
+                    // A cap around some direction, a preferred direction, and the
+                    // cells the stylus leaves free.
+                    let d = V3::new(0.4 * k as f64 - 1.0, 0.5, 0.3 * j as f64 - 0.6).normalize();
+                    let mut within = whole.cap(&d, 0.9);
+                    within.set(Cell::Preferred((k + j) % axes.len()), true);
+                    if j > 0 {
+                        let stylus = Cpu.blocked(&c.scene, p, &c.probes[0].first[0], n, &axes);
+                        within.or_assign(&stylus.not());
+                    }
+                    let got = Cpu.blocked_within(&c.scene, p, comp, n, &axes, &within);
+                    assert!(
+                        whole.covers(&got),
+                        "{spec}: {}: more than the whole map",
+                        comp.name
+                    );
+                    for cell in within.cells() {
+                        assert_eq!(
+                            got.get(cell),
+                            whole.get(cell),
+                            "{spec}: {} at {p:?}, n = {n}: {cell:?} differs",
+                            comp.name
+                        );
+                        if let Cell::Preferred(q) = cell {
+                            for px in whole.pixels_holding(&whole.preferred(q)) {
+                                let px = Cell::Pixel(px);
+                                assert_eq!(got.get(px), whole.get(px), "{spec}: {}", comp.name);
+                            }
+                        }
+                    }
+                    fewer += usize::from(got != whole);
+                }
+            }
+        }
+        assert!(fewer > 0, "{spec}: never passed a shadow over");
+    }
+}
+
 #[test]
 fn cones_are_the_same_for_any_thread_count() {
     let (checked, parts, graphs) =
