@@ -702,18 +702,7 @@ impl CubeMap {
         {
             return d.clone();
         }
-        let out: Arc<[Disc]> = if n <= 64 {
-            Self::discs_by_steps(n, index)
-        } else {
-            let mut m = CubeMap::empty(n, &[]);
-            m.bits[index / 64] |= 1 << (index % 64);
-            let mut out = vec![Disc::of(&m.bits)];
-            for _ in 0..2 * n {
-                m = m.grow();
-                out.push(Disc::of(&m.bits));
-            }
-            out.into()
-        };
+        let out = Self::discs_by_steps(n, index);
         let mut kept = discs.lock().unwrap_or_else(|e| e.into_inner());
         // A long-running process (the language server) plans many specs: the cache is
         // emptied rather than let grow past a few tens of megabytes.

@@ -635,15 +635,8 @@ impl<'a> Knowledge<'a> {
             self.d1p.insert((f, p, s), b.clone());
             return b.clone();
         }
-        self.grid(s, up, machine);
-        let (c, candidates) = self.candidates(f, p, s, machine);
-        if !candidates.is_empty() {
-            self.second_map(s, up, machine);
-        }
-        let out = self.clear_of(p, s, &c, &candidates, machine);
-        self.d1p.insert((f, p, s), out.clone());
-        self.memo.orientations.insert(key, out.clone());
-        out
+        self.make_orientations(&[(f, p)], s, up, machine);
+        self.d1p[&(f, p, s)].clone()
     }
 
     /// [`Knowledge::orientations`] of many (point, probe) pairs in setup cell `s`, those
@@ -671,18 +664,23 @@ impl<'a> Knowledge<'a> {
             .collect();
         todo.sort_unstable();
         todo.dedup();
-        if todo.len() < 2 {
-            return;
+        if todo.len() >= 2 {
+            let up = self.setup_dir(s);
+            self.make_orientations(&todo, s, &up, machine);
         }
-        let up = self.setup_dir(s);
-        self.grid(s, &up, machine);
+    }
+
+    /// Computes the orientations of (point, probe) pairs not known yet in setup cell `s`
+    /// (`up` its direction), in parallel, and keeps them in `d1p` and the memo.
+    fn make_orientations(&mut self, todo: &[(usize, usize)], s: usize, up: &V3, machine: &Machine) {
+        self.ready(s, up, machine);
         let this = &*self;
         let candidates: Vec<(P3, Vec<usize>)> = todo
             .par_iter()
             .map(|&(f, p)| this.candidates(f, p, s, machine))
             .collect();
         if candidates.iter().any(|(_, c)| !c.is_empty()) {
-            self.second_map(s, &up, machine);
+            self.second_map(s, up, machine);
         }
         let this = &*self;
         let outs: Vec<Bits> = todo
@@ -690,7 +688,7 @@ impl<'a> Knowledge<'a> {
             .zip(&candidates)
             .map(|(&(_, p), (c, cands))| this.clear_of(p, s, c, cands, machine))
             .collect();
-        for ((f, p), out) in todo.into_iter().zip(outs) {
+        for (&(f, p), out) in todo.iter().zip(outs) {
             let key = self.orientations_key(f, p, s);
             self.d1p.insert((f, p, s), out.clone());
             self.memo.orientations.insert(key, out);
@@ -705,7 +703,7 @@ impl<'a> Knowledge<'a> {
 
     /// Makes how setup cell `s` holds the part and its grid cells (`up` its direction),
     /// if not made yet.
-    fn grid(&mut self, s: usize, up: &V3, machine: &Machine) {
+    fn ready(&mut self, s: usize, up: &V3, machine: &Machine) {
         self.held(s);
         self.grid_cells
             .entry(s)
