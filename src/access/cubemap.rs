@@ -307,11 +307,10 @@ impl CubeMap {
             return Some(None);
         }
         let m = sum.normalize();
-        let rho = dirs
-            .iter()
-            .map(|d| d.dot(&m).clamp(-1.0, 1.0).acos())
-            .fold(0.0, f64::max);
-        Some(Some((m, rho)))
+        // The widest angle is the arccosine of the least cosine (one arccosine, not one
+        // per cell).
+        let least = dirs.iter().map(|d| d.dot(&m)).fold(1.0, f64::min);
+        Some(Some((m, least.clamp(-1.0, 1.0).acos())))
     }
 
     /// A cap that holds every direction of the cone's cells, as (unit axis, angle in

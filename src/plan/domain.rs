@@ -771,7 +771,7 @@ impl<'a> Knowledge<'a> {
         s: usize,
         (up, t0): (&V3, f64),
         machine: &Machine,
-        d1_cap: Option<(V3, f64)>,
+        d1_cap: impl FnOnce() -> Option<(V3, f64)>,
     ) -> bool {
         if !machine.head.indexable() {
             return true;
@@ -791,9 +791,10 @@ impl<'a> Knowledge<'a> {
         }
         // `candidates` without the list: the first orientation that passes will do.
         let cells = &self.grid_cells[&s];
-        let (Some(d1), Some((centre, spread))) =
-            (self.dom.get(f).and_then(|d| d[p].d1.as_ref()), d1_cap)
-        else {
+        let Some(d1) = self.dom.get(f).and_then(|d| d[p].d1.as_ref()) else {
+            return false;
+        };
+        let Some((centre, spread)) = d1_cap() else {
             return false;
         };
         // Every direction of D1 lies within `spread` of `centre` (its bounding cap), and a

@@ -365,7 +365,8 @@ pub(crate) fn assemble(input: &Input, k: &mut Knowledge, m: &Machine, run: &Roun
     let probes_used: BTreeSet<usize> = seq.iter().map(|s| s.0).collect();
     let hierarchy = &input.model.hierarchies[input.plan.hierarchy.0];
     let violations = solve::violations(run.branches, m, hierarchy);
-    let min_setups = min_setups(k, m, &used_points, run.exact_budget);
+    let plan_cells: Vec<usize> = setups.iter().map(|s| s.0).collect();
+    let min_setups = min_setups(k, m, &used_points, &plan_cells, run.exact_budget);
     let points = k
         .points
         .iter()
@@ -457,12 +458,16 @@ fn min_setups(
     k: &mut Knowledge,
     m: &Machine,
     used_points: &BTreeSet<usize>,
+    plan_cells: &[usize],
     budget: usize,
 ) -> (usize, bool) {
     let points: Vec<usize> = (0..k.graph_points)
         .filter(|i| used_points.contains(i))
         .collect();
     let candidates: Vec<crate::access::CubeMap> = points.iter().map(|&i| k.setups(i, m)).collect();
+    if let Some(found) = few_setups(k, m, &points, &candidates, plan_cells) {
+        return found;
+    }
     // Every candidate setup cell of a bent probe, once, ascending (a fixed head asks
     // nothing per setup).
     let cells: Vec<usize> = match candidates.split_first() {
@@ -488,19 +493,10 @@ fn min_setups(
         .zip(candidates)
         .map(|(&i, mut s)| {
             let cells: Vec<usize> = s.cells().map(|c| s.index(c)).collect();
-            let caps: Vec<Option<(V3, f64)>> = k.dom[i]
-                .iter()
-                .map(|d| d.d1.as_ref().and_then(|d1| d1.bounding_cap()))
-                .collect();
+            let caps = d1_caps(k, i);
             for cell in cells {
-                let probes = k.probes(i, cell, m);
-                let reaches = match setup_at.get(cell).copied().flatten() {
-                    Some((up, t0)) => probes
-                        .ones()
-                        .any(|p| k.reaches_off_table(i, p, cell, (&up, t0), m, caps[p])),
-                    None => probes.ones().next().is_some(),
-                };
-                if !reaches {
+                let at = setup_at.get(cell).copied().flatten();
+                if !reaches(k, m, i, cell, at, &caps) {
                     let c = s.cell(cell);
                     s.set(c, false);
                 }
@@ -522,6 +518,134 @@ fn min_setups(
     }
     let refs: Vec<&crate::access::CubeMap> = sets.iter().collect();
     min_hitting_set(&refs, budget)
+}
+
+/// D1's bounding cap per probe of a graph point, as [`Knowledge::reaches_off_table`]
+/// takes it: computed when first asked for (a point high above the table never is).
+type Caps = Vec<std::sync::OnceLock<Option<(V3, f64)>>>;
+
+fn d1_caps(k: &Knowledge, i: usize) -> Caps {
+    k.dom[i]
+        .iter()
+        .map(|_| std::sync::OnceLock::new())
+        .collect()
+}
+
+/// Whether some allowed probe reaches graph point `i` in candidate setup cell `cell`
+/// with its stylus off the table: `at` is the setup's direction and table height for a
+/// bent probe (None asks only for a probe).
+fn reaches(
+    k: &Knowledge,
+    m: &Machine,
+    i: usize,
+    cell: usize,
+    at: Option<(V3, f64)>,
+    caps: &Caps,
+) -> bool {
+    let probes = k.probes(i, cell, m);
+    match at {
+        Some((up, t0)) => probes.ones().any(|p| {
+            let cap = || {
+                *caps[p].get_or_init(|| k.dom[i][p].d1.as_ref().and_then(|d1| d1.bounding_cap()))
+            };
+            k.reaches_off_table(i, p, cell, (&up, t0), m, cap)
+        }),
+        None => probes.ones().next().is_some(),
+    }
+}
+
+/// [`min_setups`] without every point's whole setup set when the plan has one or two
+/// setups: the plan's setups reach every point (so every set is non-empty and the
+/// minimum is at most theirs), and the minimum is 1 exactly when a setup in every
+/// point's candidates reaches them all — each looked at until a point it misses. The
+/// same answer as the hitting set of the whole sets, proven; None when the plan has
+/// more setups or some point is reached in none of them (the whole sets decide then).
+fn few_setups(
+    k: &mut Knowledge,
+    m: &Machine,
+    points: &[usize],
+    candidates: &[crate::access::CubeMap],
+    plan_cells: &[usize],
+) -> Option<(usize, bool)> {
+    if points.is_empty() || plan_cells.is_empty() || plan_cells.len() > 2 {
+        return None;
+    }
+    // Each point's possible cells: its candidates, and its table face's cell (always
+    // in its set, as in `min_setups`).
+    let table: Vec<Option<usize>> = points
+        .iter()
+        .map(|&i| {
+            let face = k.points[i].face;
+            k.tables
+                .iter()
+                .find(|t| t.face == face && t.alive)
+                .map(|t| t.cell)
+        })
+        .collect();
+    let mut common = candidates[0].clone();
+    if let Some(t) = table[0] {
+        let c = common.cell(t);
+        common.set(c, true);
+    }
+    for (s, t) in candidates.iter().zip(&table).skip(1) {
+        let mut possible = s.clone();
+        if let Some(t) = *t {
+            let c = possible.cell(t);
+            possible.set(c, true);
+        }
+        common.and_assign(&possible);
+    }
+    let mut look: Vec<usize> = common.cells().map(|c| common.index(c)).collect();
+    look.extend_from_slice(plan_cells);
+    look.sort_unstable();
+    look.dedup();
+    // A cell is a setup the bent probe's test needs held when some point has it as a
+    // candidate (the cells `min_setups` prepares).
+    let bent = m.head.indexable();
+    let prepared: Vec<usize> = look
+        .iter()
+        .copied()
+        .filter(|&c| bent && candidates.iter().any(|s| s.has_index(c)))
+        .collect();
+    k.prepare(&prepared, m);
+    let k = &*k;
+    let at = |cell: usize| {
+        prepared
+            .binary_search(&cell)
+            .is_ok()
+            .then(|| (k.setup_dir(cell), k.held_prepared(cell).table))
+    };
+    let caps: Vec<Caps> = points.iter().map(|&i| d1_caps(k, i)).collect();
+    let reached = |j: usize, cell: usize| {
+        table[j] == Some(cell)
+            || (candidates[j].has_index(cell) && reaches(k, m, points[j], cell, at(cell), &caps[j]))
+    };
+    // Every point in some setup of the plan, or the whole sets decide.
+    let in_plan: Vec<bool> = (0..points.len())
+        .into_par_iter()
+        .map(|j| plan_cells.iter().any(|&c| reached(j, c)))
+        .collect();
+    if in_plan.contains(&false) {
+        return None;
+    }
+    if plan_cells.len() == 1 {
+        return Some((1, true));
+    }
+    // One setup for all: a cell that every point's set holds. Most cells are missed by
+    // a few points, so the point that missed the last cell is asked first.
+    let cells: Vec<usize> = common.cells().map(|c| common.index(c)).collect();
+    let one = cells.par_chunks(16).any(|chunk| {
+        let mut order: Vec<usize> = (0..points.len()).collect();
+        chunk.iter().any(|&cell| {
+            let Some(at) = order.iter().position(|&j| !reached(j, cell)) else {
+                return true;
+            };
+            let j = order.remove(at);
+            order.insert(0, j);
+            false
+        })
+    });
+    Some((if one { 1 } else { 2 }, true))
 }
 
 /// A face visit: (tolerance, feature, face, contact, points).
