@@ -806,26 +806,70 @@ fn prism_shadow(out: &mut impl Canvas, from: &P3, t: &Tri, r: f64, h: f64) -> bo
         return false;
     }
     // The viewpoint is the origin here: a side faces it when m·(0 − p) > 0.
-    let facing: Vec<bool> = (0..6)
-        .map(|k| {
-            let side = hex[(k + 1) % 6] - hex[k];
-            side.norm_squared() > 1e-24 && side.cross(&nn).dot(&-hex[k]) > 0.0
-        })
-        .collect();
+    let facing: [bool; 6] = std::array::from_fn(|k| {
+        let side = hex[(k + 1) % 6] - hex[k];
+        side.norm_squared() > 1e-24 && side.cross(&nn).dot(&-hex[k]) > 0.0
+    });
     let above = h.abs() > r;
     if !above && !facing.iter().any(|&f| f) {
         return false;
     }
     let up = nn * (r * if h >= 0.0 { 1.0 } else { -1.0 });
-    if above {
-        let near: Vec<V3> = hex.iter().map(|p| p + up).collect();
-        out.draw(0, &near, Coverage::Cells);
-    }
-    for k in 0..6 {
-        if facing[k] {
-            let (p, q) = (hex[k], hex[(k + 1) % 6]);
-            out.draw(0, &[p + up, q + up, q - up, p - up], Coverage::Cells);
+    // The prism is convex and the viewpoint outside it, so the faces that face the
+    // viewpoint project onto the projection of their outline (the edges between a face
+    // that faces it and one that does not): one polygon drawn for up to seven.
+    let mut outline = [V3::zeros(); 12];
+    let mut len = 0;
+    let mut push = |p: V3| {
+        if len == 0 || outline[len - 1] != p {
+            outline[len] = p;
+            len += 1;
         }
+    };
+    if above {
+        // The top faces the viewpoint: a side that does too shows its bottom edge, one
+        // that does not its top edge, and the vertical edges join them.
+        for k in 0..6 {
+            let (p, q) = (hex[k], hex[(k + 1) % 6]);
+            let off = if facing[k] { -up } else { up };
+            push(p + off);
+            push(q + off);
+        }
+    } else {
+        // Neither top nor bottom does: the sides that face the viewpoint (one run of
+        // them around the prism), their top edges out and their bottom edges back.
+        let first = (0..6).find(|&k| facing[k] && !facing[(k + 5) % 6]);
+        let run: Vec<usize> = first.map_or_else(Vec::new, |first| {
+            (0..6)
+                .map(|i| (first + i) % 6)
+                .take_while(|&k| facing[k])
+                .collect()
+        });
+        if run.is_empty() || run.len() != facing.iter().filter(|&&f| f).count() {
+            // Two runs, with a degenerate side between them: side by side instead.
+            for k in 0..6 {
+                if facing[k] {
+                    let (p, q) = (hex[k], hex[(k + 1) % 6]);
+                    out.draw(0, &[p + up, q + up, q - up, p - up], Coverage::Cells);
+                }
+            }
+            return true;
+        }
+        for &k in &run {
+            push(hex[k] + up);
+        }
+        let end = (run[run.len() - 1] + 1) % 6;
+        push(hex[end] + up);
+        push(hex[end] - up);
+        for &k in run.iter().rev() {
+            push(hex[k] - up);
+        }
+    }
+    if len > 1 && outline[len - 1] == outline[0] {
+        len -= 1;
+    }
+    if len >= 3 {
+        out.draw(0, &outline[..len], Coverage::Cells);
     }
     true
 }
