@@ -782,39 +782,76 @@ fn dilation(r: f64, near: f64, dmin: f64, dmax: f64) -> Option<f64> {
     })
 }
 
-/// Marks the shadow of a prism that holds the triangle swept by a ball of radius `r`:
-/// its cross-section is the triangle offset by `r` in its plane with bevelled corners
-/// (six sides), and it reaches `r` to either side of the plane. Only the faces that face
-/// the viewpoint are drawn; they hide the rest. False, drawing nothing, when the
+/// The prism that holds a triangle swept by a ball of radius `r`, relative to the
+/// viewpoint: its cross-section is the triangle offset by `r` in its plane with
+/// bevelled corners (six sides), and it reaches `r` to either side of the plane.
+struct Prism {
+    /// The cross-section's corners in the triangle's plane.
+    hex: [V3; 6],
+    /// Whether side k (corners k and k + 1) faces the viewpoint.
+    facing: [bool; 6],
+    /// Whether the top (`hex + up`) faces the viewpoint (the bottom never does).
+    above: bool,
+    up: V3,
+}
+
+impl Prism {
+    /// None when the viewpoint is inside the prism (or the triangle is degenerate).
+    fn of(from: &P3, t: &Tri, r: f64, h: f64) -> Option<Prism> {
+        let nn = t.normal;
+        let mut hex = [V3::zeros(); 6];
+        for i in 0..3 {
+            let (prev, v, next) = (t.v[(i + 2) % 3], t.v[i], t.v[(i + 1) % 3]);
+            let t_in = (v - prev).normalize();
+            let t_out = (next - v).normalize();
+            let m_in = t_in.cross(&nn);
+            let m_out = t_out.cross(&nn);
+            let b = (m_in + m_out).normalize();
+            let lam_in = r * (1.0 - b.dot(&m_in)) / b.dot(&t_in);
+            let lam_out = r * (1.0 - b.dot(&m_out)) / b.dot(&-t_out);
+            hex[2 * i] = (v - from) + m_in * r + t_in * lam_in;
+            hex[2 * i + 1] = (v - from) + m_out * r - t_out * lam_out;
+        }
+        if hex.iter().any(|p| !p.iter().all(|x| x.is_finite())) {
+            return None;
+        }
+        // The viewpoint is the origin here: a side faces it when m·(0 − p) > 0.
+        let facing: [bool; 6] = std::array::from_fn(|k| {
+            let side = hex[(k + 1) % 6] - hex[k];
+            side.norm_squared() > 1e-24 && side.cross(&nn).dot(&-hex[k]) > 0.0
+        });
+        let above = h.abs() > r;
+        if !above && !facing.iter().any(|&f| f) {
+            return None;
+        }
+        let up = nn * (r * if h >= 0.0 { 1.0 } else { -1.0 });
+        Some(Prism {
+            hex,
+            facing,
+            above,
+            up,
+        })
+    }
+
+    /// Side k as a quadrilateral.
+    fn side(&self, k: usize) -> [V3; 4] {
+        let (p, q, up) = (self.hex[k], self.hex[(k + 1) % 6], self.up);
+        [p + up, q + up, q - up, p - up]
+    }
+}
+
+/// Marks the shadow of the triangle's [`Prism`]; false, drawing nothing, when the
 /// viewpoint is inside the prism.
 fn prism_shadow(out: &mut impl Canvas, from: &P3, t: &Tri, r: f64, h: f64) -> bool {
-    let nn = t.normal;
-    let mut hex = [V3::zeros(); 6];
-    for i in 0..3 {
-        let (prev, v, next) = (t.v[(i + 2) % 3], t.v[i], t.v[(i + 1) % 3]);
-        let t_in = (v - prev).normalize();
-        let t_out = (next - v).normalize();
-        let m_in = t_in.cross(&nn);
-        let m_out = t_out.cross(&nn);
-        let b = (m_in + m_out).normalize();
-        let lam_in = r * (1.0 - b.dot(&m_in)) / b.dot(&t_in);
-        let lam_out = r * (1.0 - b.dot(&m_out)) / b.dot(&-t_out);
-        hex[2 * i] = (v - from) + m_in * r + t_in * lam_in;
-        hex[2 * i + 1] = (v - from) + m_out * r - t_out * lam_out;
-    }
-    if hex.iter().any(|p| !p.iter().all(|x| x.is_finite())) {
+    let Some(prism) = Prism::of(from, t, r, h) else {
         return false;
-    }
-    // The viewpoint is the origin here: a side faces it when m·(0 − p) > 0.
-    let facing: [bool; 6] = std::array::from_fn(|k| {
-        let side = hex[(k + 1) % 6] - hex[k];
-        side.norm_squared() > 1e-24 && side.cross(&nn).dot(&-hex[k]) > 0.0
-    });
-    let above = h.abs() > r;
-    if !above && !facing.iter().any(|&f| f) {
-        return false;
-    }
-    let up = nn * (r * if h >= 0.0 { 1.0 } else { -1.0 });
+    };
+    let Prism {
+        hex,
+        facing,
+        above,
+        up,
+    } = prism;
     // The prism is convex and the viewpoint outside it, so the faces that face the
     // viewpoint project onto the projection of their outline (the edges between a face
     // that faces it and one that does not): one polygon drawn for up to seven.
@@ -847,11 +884,8 @@ fn prism_shadow(out: &mut impl Canvas, from: &P3, t: &Tri, r: f64, h: f64) -> bo
         });
         if run.is_empty() || run.len() != facing.iter().filter(|&&f| f).count() {
             // Two runs, with a degenerate side between them: side by side instead.
-            for k in 0..6 {
-                if facing[k] {
-                    let (p, q) = (hex[k], hex[(k + 1) % 6]);
-                    out.draw(0, &[p + up, q + up, q - up, p - up], Coverage::Cells);
-                }
+            for k in (0..6).filter(|&k| facing[k]) {
+                out.draw(0, &prism.side(k), Coverage::Cells);
             }
             return true;
         }
@@ -872,4 +906,68 @@ fn prism_shadow(out: &mut impl Canvas, from: &P3, t: &Tri, r: f64, h: f64) -> bo
         out.draw(0, &outline[..len], Coverage::Cells);
     }
     true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A prism drawn as its outline marks the pixels its faces that face the viewpoint
+    /// mark drawn one by one (the top when above, and those sides): near and far,
+    /// above and beside, thin and fat triangles, at three resolutions.
+    #[test]
+    fn a_prism_drawn_as_its_outline_marks_what_its_faces_do() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let (mut drawn, mut beside, mut differ) = (0, 0, Vec::new());
+        for case in 0..3000 {
+            let v = [0, 1, 2].map(|_| P3::new(next() * 20.0, next() * 20.0, next() * 20.0));
+            let normal = (v[1] - v[0]).cross(&(v[2] - v[0]));
+            if normal.norm() < 1e-3 {
+                continue;
+            }
+            let t = Tri {
+                v,
+                normal: normal.normalize(),
+                centre: v[0],
+                radius: 0.0,
+                closed: true,
+            };
+            let r = 1.0 + 15.0 * next().abs();
+            let from = P3::new(next() * 60.0, next() * 60.0, next() * 60.0);
+            let h = t.normal.dot(&(from - t.v[0]));
+            let Some(prism) = Prism::of(&from, &t, r, h) else {
+                continue;
+            };
+            beside += usize::from(!prism.above);
+            for n in [16, 32, 64] {
+                let mut outline = Maps::new(n, &[]);
+                assert!(prism_shadow(&mut outline, &from, &t, r, h));
+                let mut faces = Maps::new(n, &[]);
+                if prism.above {
+                    let top = prism.hex.map(|p| p + prism.up);
+                    faces.draw(0, &top, Coverage::Cells);
+                }
+                for k in (0..6).filter(|&k| prism.facing[k]) {
+                    faces.draw(0, &prism.side(k), Coverage::Cells);
+                }
+                drawn += 1;
+                if outline.base != faces.base {
+                    differ.push((case, n));
+                }
+            }
+        }
+        assert!(drawn > 3000 && beside > 100, "{drawn} {beside}");
+        assert!(
+            differ.is_empty(),
+            "{} of {drawn} differ: {:?}",
+            differ.len(),
+            &differ[..differ.len().min(10)]
+        );
+    }
 }
