@@ -105,7 +105,9 @@ struct Focus {
 impl Focus {
     fn meets(&mut self, k: u32, (face, j0, j1, i0, i1): (u8, u32, u32, u32, u32)) -> bool {
         while self.grown.len() <= k as usize {
-            let next = self.grown[self.grown.len() - 1].grow_pixels();
+            let k = self.grown.len();
+            let before = k.checked_sub(2).map(|b| &self.grown[b]);
+            let next = self.grown[k - 1].grow_pixels_after(before);
             self.grown.push(next);
         }
         self.grown[k as usize].spans_meet(face, j0, j1, i0, i1)
@@ -582,10 +584,16 @@ pub(super) fn finish(
     let (r, near, far) = (comp.radius, comp.near(), comp.far());
     // ∪ₖ growₖ(bandₖ), growing each accumulated band once per step (Horner's scheme).
     // Pixels only: the preferred directions are decided below.
-    let mut acc: Option<CubeMap> = None;
+    // Each step holds the one before it grown, so grows only its own new pixels across
+    // cube edges.
+    let (mut acc, mut before): (Option<CubeMap>, Option<CubeMap>) = (None, None);
     for band in bands.into_iter().rev() {
         let mut m = match acc.take() {
-            Some(a) => a.grow_pixels(),
+            Some(a) => {
+                let g = a.grow_pixels_after(before.as_ref());
+                before = Some(a);
+                g
+            }
             None => base.empty_like(),
         };
         if let Some(b) = band {
@@ -594,7 +602,7 @@ pub(super) fn finish(
         acc = Some(m);
     }
     if let Some(a) = acc {
-        base.or_assign(&a.grow_pixels());
+        base.or_assign(&a.grow_pixels_after(before.as_ref()));
     }
     // Preferred directions.
     for k in 0..base.preferred_len() {
