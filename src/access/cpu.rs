@@ -21,7 +21,7 @@
 
 use super::cubemap::{CubeMap, Disc};
 use super::probe::Component;
-use super::raster::{footprint, shadow_polygon, Coverage};
+use super::raster::{footprint, shadow_polygon_where, Coverage};
 use super::scene::{point_triangle_distance, BvhNode, Scene, Tri};
 use crate::geometry::{P3, V3};
 
@@ -103,14 +103,20 @@ struct Focus {
 }
 
 impl Focus {
-    fn meets(&mut self, k: u32, (face, j0, j1, i0, i1): (u8, u32, u32, u32, u32)) -> bool {
+    /// Growth `k` of the focus pixels: the pixels a shadow drawn in band k must reach to
+    /// mark one of them.
+    fn growth(&mut self, k: u32) -> &CubeMap {
         while self.grown.len() <= k as usize {
             let k = self.grown.len();
             let before = k.checked_sub(2).map(|b| &self.grown[b]);
             let next = self.grown[k - 1].grow_pixels_after(before);
             self.grown.push(next);
         }
-        self.grown[k as usize].spans_meet(face, j0, j1, i0, i1)
+        &self.grown[k as usize]
+    }
+
+    fn meets(&mut self, k: u32, (face, j0, j1, i0, i1): (u8, u32, u32, u32, u32)) -> bool {
+        self.growth(k).spans_meet(face, j0, j1, i0, i1)
     }
 }
 
@@ -169,7 +175,8 @@ impl Canvas for Maps {
             let base = &self.base;
             self.bands[k - 1].get_or_insert_with(|| base.empty_like())
         };
-        shadow_polygon(map, q, cov);
+        let matter = self.focus.as_mut().map(|f| f.growth(target));
+        shadow_polygon_where(map, q, cov, matter);
         if let Some(stop) = &mut self.stop {
             stop.drawn += 1;
         }

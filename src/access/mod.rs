@@ -497,12 +497,20 @@ pub fn d2(
         // The ram first: it blocks the most, so the head is drawn less often. A sample
         // adds nothing once its components block every cell still needed, so drawing
         // stops as soon as they do; either order gives the same D2.
-        for comp in probe.second.iter().rev() {
+        for (ci, comp) in probe.second.iter().rev().enumerate() {
             let b = match &need {
                 Some(nd) if few => {
                     let mut rest = nd.clone();
                     rest.and_not_assign(&blocked);
                     backend.blocked_until(scene, &x, comp, coarse, preferred, &rest)
+                }
+                _ if ci > 0 => {
+                    // Needed only where the components before leave the probe free.
+                    let mut rest = blocked.not();
+                    if let Some(nd) = &need {
+                        rest.and_assign(nd);
+                    }
+                    backend.blocked_within(scene, &x, comp, coarse, preferred, &rest)
                 }
                 _ => backend.blocked(scene, &x, comp, coarse, preferred),
             };

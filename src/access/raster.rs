@@ -100,6 +100,12 @@ fn in_frame(face: u8, x: &V3) -> [f64; 3] {
 /// Marks in `out` the shadow, seen from the origin, of the convex planar polygon with
 /// corners `q` (relative to the viewpoint, at most 12).
 pub fn shadow_polygon(out: &mut CubeMap, q: &[V3], cov: Coverage) {
+    shadow_polygon_where(out, q, cov, None);
+}
+
+/// [`shadow_polygon`], drawn only if it could mark a pixel of `matter` (when given):
+/// a shadow whose rectangle on every face misses those pixels is passed over.
+pub fn shadow_polygon_where(out: &mut CubeMap, q: &[V3], cov: Coverage, matter: Option<&CubeMap>) {
     debug_assert!(q.len() >= 3 && q.len() <= 12);
     // Fast path: every corner strictly inside one face's pyramid.
     let f0 = face_of(&q[0]);
@@ -115,7 +121,7 @@ pub fn shadow_polygon(out: &mut CubeMap, q: &[V3], cov: Coverage) {
             flat[k] = (u / w, v / w);
         }
         if ok {
-            raster_convex(out, f0, &flat[..q.len()], cov);
+            raster_convex(out, f0, &flat[..q.len()], cov, matter);
             return;
         }
     }
@@ -154,7 +160,7 @@ pub fn shadow_polygon(out: &mut CubeMap, q: &[V3], cov: Coverage) {
         for (k, x) in pts.iter().enumerate() {
             flat[k] = (x[0] / x[2], x[1] / x[2]);
         }
-        raster_convex(out, face, &flat[..poly.len], cov);
+        raster_convex(out, face, &flat[..poly.len], cov, matter);
     }
 }
 
@@ -198,7 +204,13 @@ pub fn footprint(corners: &[V3], cov: Coverage, n: u32) -> Option<(u8, u32, u32,
 }
 
 /// Marks the pixels of a cube face that a convex polygon in (u, v) ∈ [−1, 1]² covers.
-fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage) {
+fn raster_convex(
+    out: &mut CubeMap,
+    face: u8,
+    poly: &[(f64, f64)],
+    cov: Coverage,
+    matter: Option<&CubeMap>,
+) {
     let n = out.n() as i64;
     let h = 2.0 / n as f64;
     let (mut vmin, mut vmax) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -226,8 +238,13 @@ fn raster_convex(out: &mut CubeMap, face: u8, poly: &[(f64, f64)], cov: Coverage
         floor((umax + slack + 1.0) / h),
     );
     let finite = [umin, umax, vmin, vmax].iter().all(|x| x.is_finite());
-    if finite && out.spans_set(face, j0 as u32, j1 as u32, i0 as u32, i1 as u32) {
-        return;
+    if finite {
+        let (j0, j1, i0, i1) = (j0 as u32, j1 as u32, i0 as u32, i1 as u32);
+        if out.spans_set(face, j0, j1, i0, i1)
+            || matter.is_some_and(|m| !m.spans_meet(face, j0, j1, i0, i1))
+        {
+            return;
+        }
     }
     if finite && cov == Coverage::Cells && j0 == j1 && i0 == i1 {
         // Within one pixel even with the slack (most far triangles of a fine mesh): the
