@@ -468,7 +468,7 @@ fn node_band(at: &Placed, lo: f64, hi: f64) -> Option<(u32, Coverage)> {
             return None;
         }
     }
-    let alpha = dilation(r, near, lo.max(0.0), hi)?;
+    let alpha = at.dilation(lo.max(0.0), hi)?;
     let k = pixels_for(alpha * (1.0 + 1e-9), n);
     (k as usize <= 2 * n as usize).then_some((k, Coverage::Cells))
 }
@@ -495,17 +495,42 @@ struct Placed<'c> {
     n: u32,
     near: f64,
     far: f64,
+    /// The distance where [`Placed::dilation`] peaks, and the peak (for `near` > 0).
+    turn: f64,
+    peak: f64,
 }
 
 impl<'c> Placed<'c> {
     fn new(from: &P3, comp: &'c Component, n: u32) -> Placed<'c> {
+        let (r, near) = (comp.radius, comp.near());
         Placed {
             from: *from,
             comp,
             n,
-            near: comp.near(),
+            near,
             far: comp.far(),
+            turn: near.hypot(r),
+            peak: (r / near).atan(),
         }
+    }
+
+    /// The largest angle between the component's axis and a direction to an obstacle
+    /// point it touches, for obstacle points between `dmin` and `dmax` away; None when it
+    /// touches whatever its direction. A point at distance D and angle θ is inside only
+    /// if D·sin θ ≤ r and D·cos θ ≥ near: θ ≤ min(asin(r/D), acos(near/D)), which peaks
+    /// at atan(r/near).
+    fn dilation(&self, dmin: f64, dmax: f64) -> Option<f64> {
+        let (r, near) = (self.comp.radius, self.near);
+        if near <= 0.0 {
+            return (dmin > r).then(|| (r / dmin).asin());
+        }
+        Some(if dmax <= self.turn {
+            (near / dmax).min(1.0).acos()
+        } else if dmin >= self.turn {
+            (r / dmin).asin()
+        } else {
+            self.peak
+        })
     }
 }
 
@@ -526,6 +551,7 @@ fn draw_triangle<'s>(
         n,
         near,
         far,
+        ..
     } = at;
     let from = &from;
     let r = comp.radius;
@@ -570,7 +596,7 @@ fn draw_triangle<'s>(
             return true;
         }
     }
-    grown_shadow(canvas, n, from, comp, t.v, dmin)
+    grown_shadow(canvas, at, t.v, dmin)
 }
 
 /// The blocked map from the drawn shadows: ∪ₖ growₖ(bandₖ) added to the base, then the
@@ -637,16 +663,10 @@ pub(super) fn finish(
 /// radius ρ, in the band of its dilation. A triangle that reaches inside the component's
 /// nearest distance is split, up to `MAX_SPLIT` times, and the pieces wholly inside are
 /// dropped. False when the component meets the triangle in every direction.
-fn grown_shadow(
-    canvas: &mut impl Canvas,
-    n: u32,
-    from: &P3,
-    comp: &Component,
-    v: [P3; 3],
-    dmin: f64,
-) -> bool {
+fn grown_shadow(canvas: &mut impl Canvas, at: &Placed, v: [P3; 3], dmin: f64) -> bool {
+    let (n, from) = (at.n, &at.from);
     let dist = v.map(|p| (p - from).norm());
-    match grown_piece(canvas, n, from, comp, v, dist, dmin, 0) {
+    match grown_piece(canvas, at, v, dist, dmin, 0) {
         Err(Everywhere) => false,
         Ok(Some(k)) => {
             draw_grown(canvas, n, k, &v.map(|p| p - from));
@@ -682,15 +702,13 @@ fn draw_grown(canvas: &mut impl Canvas, n: u32, k: u32, q: &[V3]) {
 #[allow(clippy::too_many_arguments)]
 fn grown_piece(
     canvas: &mut impl Canvas,
-    n: u32,
-    from: &P3,
-    comp: &Component,
+    at: &Placed,
     v: [P3; 3],
     dist: [f64; 3],
     dmin: f64,
     depth: u32,
 ) -> Result<Option<u32>, Everywhere> {
-    let (r, near) = (comp.radius, comp.near());
+    let (n, from, near, far) = (at.n, &at.from, at.near, at.far);
     let reach = dist.iter().copied().fold(0.0, f64::max);
     if reach < near {
         return Ok(None);
@@ -703,7 +721,7 @@ fn grown_piece(
     if dmin < near && depth < MAX_SPLIT && size > 0.1 * near {
         // Its pieces, each dilated at most as far as the whole triangle would be, add
         // nothing where its shadow is already marked in a band grown as far or further.
-        if let Some(alpha) = dilation(r, near, dmin * (1.0 - 1e-9), reach * (1.0 + 1e-9)) {
+        if let Some(alpha) = at.dilation(dmin * (1.0 - 1e-9), reach * (1.0 + 1e-9)) {
             let k = pixels_for(alpha * (1.0 + 1e-9), n);
             let q = v.map(|p| p - from);
             if k as usize <= 2 * n as usize {
@@ -737,8 +755,8 @@ fn grown_piece(
             } else {
                 point_triangle_distance(from, &part)
             };
-            if d <= comp.far() {
-                *band = grown_piece(canvas, n, from, comp, part, dist, d, depth + 1)?;
+            if d <= far {
+                *band = grown_piece(canvas, at, part, dist, d, depth + 1)?;
             }
         }
         let Some(middle) = bands[3] else {
@@ -768,7 +786,7 @@ fn grown_piece(
         draw_grown(canvas, n, middle, &outline[..len]);
         return Ok(None);
     }
-    let Some(alpha) = dilation(r, near, dmin, reach) else {
+    let Some(alpha) = at.dilation(dmin, reach) else {
         return Err(Everywhere);
     };
     let k = pixels_for(alpha, n);
@@ -776,25 +794,6 @@ fn grown_piece(
         return Err(Everywhere);
     }
     Ok(Some(k))
-}
-
-/// The largest angle between the axis of a component of radius `r` whose points all lie
-/// at least `near` along its axis and a direction to an obstacle point it touches, for
-/// obstacle points between `dmin` and `dmax` away; None when it touches whatever its
-/// direction. A point at distance D and angle θ is inside only if D·sin θ ≤ r and
-/// D·cos θ ≥ near: θ ≤ min(asin(r/D), acos(near/D)), which peaks at atan(r/near).
-fn dilation(r: f64, near: f64, dmin: f64, dmax: f64) -> Option<f64> {
-    if near <= 0.0 {
-        return (dmin > r).then(|| (r / dmin).asin());
-    }
-    let turn = near.hypot(r);
-    Some(if dmax <= turn {
-        (near / dmax).min(1.0).acos()
-    } else if dmin >= turn {
-        (r / dmin).asin()
-    } else {
-        (r / near).atan()
-    })
 }
 
 /// The prism that holds a triangle swept by a ball of radius `r`, relative to the
