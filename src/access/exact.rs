@@ -27,7 +27,7 @@ pub fn component_hits(scene: &Scene, from: &P3, d: &V3, comp: &Component) -> boo
     match comp.end {
         End::Round => {
             let cap = Capsule::new(axis[0], axis[1], comp.radius);
-            scene.meets(&cap, &id, &[axis], comp.radius)
+            scene.meets_axis((&cap, &id), &axis[0], &axis[1], comp.radius, false)
         }
         End::Flat => {
             let half = (b - comp.a) / 2.0;
@@ -37,8 +37,7 @@ pub fn component_hits(scene: &Scene, from: &P3, d: &V3, comp: &Component) -> boo
             });
             let centre = from + d * (comp.a + half);
             let pos = Isometry::from_parts(Translation3::from(centre.coords), rot);
-            // The cylinder lies within its radius of its axis.
-            scene.meets(&cyl, &pos, &[axis], comp.radius)
+            scene.meets_axis((&cyl, &pos), &axis[0], &axis[1], comp.radius, true)
         }
     }
 }
