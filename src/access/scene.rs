@@ -182,10 +182,11 @@ impl Scene {
     }
 
     /// [`Scene::meets`] for the capsule (`flat` false) or cylinder (`flat`) of radius `r`
-    /// whose axis runs from `a` to `b`, `shape` at `pos` being that solid: a triangle
-    /// wholly past the plane of either end (by the margin, and the radius for a capsule)
-    /// misses it and one with a corner inside it (by the margin) meets it, without
-    /// parry's test; the others are tested as [`Scene::meets`] tests them.
+    /// whose axis runs from `a` to `b`, `shape` at `pos` being that solid, deciding
+    /// triangles without parry's test where it can: a capsule by the exact distance from
+    /// its axis; a cylinder misses a triangle wholly past either end's plane and meets
+    /// one with a corner inside it (each by the margin). The others are tested as
+    /// [`Scene::meets`] tests them.
     pub fn meets_axis(
         &self,
         (shape, pos): (&dyn Shape, &Isometry<f64>),
@@ -200,7 +201,6 @@ impl Scene {
             return self.meets(shape, pos, &[[*a, *b, *b]], r);
         }
         let d = (b - a) / len;
-        let ends = if flat { 0.0 } else { r };
         let inner = (r - margin) * (r - margin);
         let decide = |t: &Tri| {
             if !flat {
@@ -215,19 +215,11 @@ impl Scene {
                 };
             }
             let s = t.v.map(|v| (v - a).dot(&d));
-            if s.iter().all(|&x| x < -ends - margin) || s.iter().all(|&x| x > len + ends + margin) {
+            if s.iter().all(|&x| x < -margin) || s.iter().all(|&x| x > len + margin) {
                 return Some(false);
             }
             let inside = t.v.iter().zip(s).any(|(v, x)| {
-                let along = if flat {
-                    if x <= margin || x >= len - margin {
-                        return false;
-                    }
-                    x
-                } else {
-                    x.clamp(0.0, len)
-                };
-                (v - a - d * along).norm_squared() < inner
+                x > margin && x < len - margin && (v - a - d * x).norm_squared() < inner
             });
             inside.then_some(true)
         };

@@ -525,8 +525,7 @@ fn min_setups(
 type Caps = Vec<std::sync::OnceLock<Option<(V3, f64)>>>;
 
 fn d1_caps(k: &Knowledge, i: usize) -> Caps {
-    k.dom[i]
-        .iter()
+    (0..k.dom[i].len())
         .map(|_| std::sync::OnceLock::new())
         .collect()
 }
@@ -595,7 +594,8 @@ fn few_setups(
         }
         common.and_assign(&possible);
     }
-    let mut look: Vec<usize> = common.cells().map(|c| common.index(c)).collect();
+    let shared: Vec<usize> = common.cells().map(|c| common.index(c)).collect();
+    let mut look = shared.clone();
     look.extend_from_slice(plan_cells);
     look.sort_unstable();
     look.dedup();
@@ -633,8 +633,7 @@ fn few_setups(
     }
     // One setup for all: a cell that every point's set holds. Most cells are missed by
     // a few points, so the point that missed the last cell is asked first.
-    let cells: Vec<usize> = common.cells().map(|c| common.index(c)).collect();
-    let one = cells.par_chunks(16).any(|chunk| {
+    let one = shared.par_chunks(16).any(|chunk| {
         let mut order: Vec<usize> = (0..points.len()).collect();
         chunk.iter().any(|&cell| {
             let Some(at) = order.iter().position(|&j| !reached(j, cell)) else {
