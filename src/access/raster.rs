@@ -54,9 +54,10 @@ impl Poly {
         }
     }
 
-    /// Sutherland–Hodgman: the part where `f ≥ 0`.
-    fn clip(&self, f: impl Fn(&[f64; 3]) -> f64) -> Poly {
-        let mut out = Poly::new();
+    /// Sutherland–Hodgman: the part where `f ≥ 0`, into `out` (whose corners it
+    /// replaces: the buffers are reused, not zeroed per clip).
+    fn clip_into(&self, out: &mut Poly, f: impl Fn(&[f64; 3]) -> f64) {
+        out.len = 0;
         for k in 0..self.len {
             let (a, b) = (&self.pts[k], &self.pts[(k + 1) % self.len]);
             let (fa, fb) = (f(a), f(b));
@@ -72,7 +73,6 @@ impl Poly {
                 ]);
             }
         }
-        out
     }
 }
 
@@ -126,8 +126,9 @@ pub fn shadow_polygon_where(out: &mut CubeMap, q: &[V3], cov: Coverage, matter: 
         }
     }
     let scale = q.iter().map(|x| x.norm()).fold(0.0, f64::max);
+    let (mut poly, mut other) = (Poly::new(), Poly::new());
     for face in 0..6u8 {
-        let mut poly = Poly::new();
+        poly.len = 0;
         for x in q {
             poly.push(in_frame(face, x));
         }
@@ -140,11 +141,10 @@ pub fn shadow_polygon_where(out: &mut CubeMap, q: &[V3], cov: Coverage, matter: 
         {
             continue;
         }
-        let poly = poly
-            .clip(|x| x[2] - x[0])
-            .clip(|x| x[2] + x[0])
-            .clip(|x| x[2] - x[1])
-            .clip(|x| x[2] + x[1]);
+        poly.clip_into(&mut other, |x| x[2] - x[0]);
+        other.clip_into(&mut poly, |x| x[2] + x[0]);
+        poly.clip_into(&mut other, |x| x[2] - x[1]);
+        other.clip_into(&mut poly, |x| x[2] + x[1]);
         if poly.len == 0 {
             continue;
         }
