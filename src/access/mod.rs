@@ -324,7 +324,35 @@ pub struct ConeOptions {
     pub backend: BackendKind,
     /// The setups D2 is asked about, when the caller masks it by them (the planner: the
     /// realisable, unforbidden ones); D2 may then leave out other cells (see [`d2`]).
-    pub d2_wanted: Option<Arc<CubeMap>>,
+    pub d2_wanted: Option<Arc<D2Wanted>>,
+}
+
+/// The cells D2 is asked about ([`ConeOptions::d2_wanted`]), with their map at D2's
+/// coarser resolution made once for every point that shares them (coarsening the
+/// 24,600 cells of a sphere in a chuck for each point was 1.6 % of its build).
+#[derive(Debug)]
+pub struct D2Wanted {
+    map: CubeMap,
+    coarse: std::sync::OnceLock<CubeMap>,
+}
+
+impl D2Wanted {
+    /// The cells of `map` (at the cones' resolution).
+    pub fn new(map: CubeMap) -> D2Wanted {
+        D2Wanted {
+            map,
+            coarse: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// The wanted cells at resolution `n`, a divisor of the map's.
+    fn at(&self, n: u32) -> CubeMap {
+        if n == d2_resolution(self.map.n()) {
+            self.coarse.get_or_init(|| self.map.coarsened(n)).clone()
+        } else {
+            self.map.coarsened(n)
+        }
+    }
 }
 
 impl Default for ConeOptions {
@@ -536,10 +564,10 @@ struct D2Sampler {
 }
 
 impl D2Sampler {
-    fn new(coarse: u32, preferred: &[V3], wanted: Option<&CubeMap>) -> D2Sampler {
+    fn new(coarse: u32, preferred: &[V3], wanted: Option<&D2Wanted>) -> D2Sampler {
         D2Sampler {
             out: CubeMap::empty(coarse, preferred),
-            wanted: wanted.map(|w| w.coarsened(coarse)),
+            wanted: wanted.map(|w| w.at(coarse)),
         }
     }
 

@@ -406,7 +406,8 @@ impl<'a> Knowledge<'a> {
         // the poses the probe would need.
         let usable = real.and(&forbidden.not());
         let opts = ConeOptions {
-            d2_wanted: (!usable.is_empty()).then(|| std::sync::Arc::new(usable)),
+            d2_wanted: (!usable.is_empty())
+                .then(|| std::sync::Arc::new(access::D2Wanted::new(usable))),
             ..opts
         };
         let mut points = fpoints.to_vec();

@@ -402,7 +402,9 @@ fn d2_for_wanted_setups_is_the_whole_d2_there() {
             wanted.set(cell, true);
         }
         let some = ConeOptions {
-            d2_wanted: Some(std::sync::Arc::new(wanted.clone())),
+            d2_wanted: Some(std::sync::Arc::new(inspc::access::D2Wanted::new(
+                wanted.clone(),
+            ))),
             ..whole.clone()
         };
         let mut stopped = 0;
