@@ -271,10 +271,12 @@ pub fn blocked_within(
     finish(scene, from, comp, maps.base, maps.bands, &drawn)
 }
 
-/// [`blocked`], stopping early once every cell of `stop` is blocked: then the map holds
-/// fewer blocked cells than [`blocked`]'s but all of `stop`'s; otherwise it is
-/// [`blocked`]'s. A preferred direction counts as blocked when every pixel holding it
-/// is, as [`finish`] decides for a grown component; a bare half-line is drawn whole.
+/// [`blocked`], right on the cells of `stop`, stopping early once all of them are
+/// blocked; elsewhere it may hold fewer blocked cells. A preferred direction counts as
+/// blocked when every pixel holding it is, as [`finish`] decides for a grown component;
+/// a bare half-line is drawn whole. With few enough pixels to wait for, those alone are
+/// decided at the end (each from its discs, as the early stop reads them) instead of
+/// growing every band of the whole map.
 pub fn blocked_until(
     scene: &Scene,
     from: &P3,
@@ -302,16 +304,49 @@ pub fn blocked_until(
         if pixels.len() <= MOST_PENDING {
             maps.stop = Some(Stop {
                 next: LOOK_EVERY * 16 * pixels.len(),
-                pending: pixels
-                    .into_iter()
-                    .map(|p| (p, CubeMap::discs(n, p)))
-                    .collect(),
+                pending: pixels.iter().map(|&p| (p, CubeMap::discs(n, p))).collect(),
                 drawn: 0,
             });
+            let drawn = draw(scene, from, comp, n, &mut maps);
+            return stop_cells(stop, &pixels, &maps, drawn.full);
         }
     }
     let drawn = draw(scene, from, comp, n, &mut maps);
     finish(scene, from, comp, maps.base, maps.bands, &drawn)
+}
+
+/// [`blocked_until`]'s map once drawn: `stop`'s cells decided, its `pixels` (sorted)
+/// those that are or hold them; every other cell free.
+fn stop_cells(stop: &CubeMap, pixels: &[usize], maps: &Maps, full: bool) -> CubeMap {
+    let mut out = stop.empty_like();
+    if full {
+        out.or_assign(stop);
+        return out;
+    }
+    // The pixels still pending at the last look may have been blocked since.
+    let open: Vec<usize> = maps
+        .stop
+        .as_ref()
+        .map(|s| {
+            s.pending
+                .iter()
+                .filter(|(p, discs)| !maps.pixel_blocked(*p, discs).0)
+                .map(|(p, _)| *p)
+                .collect()
+        })
+        .unwrap_or_default();
+    let blocked = |p: usize| pixels.binary_search(&p).is_ok() && !open.contains(&p);
+    for cell in stop.cells() {
+        let hit = match cell {
+            super::Cell::Pixel(_) => blocked(stop.index(cell)),
+            super::Cell::Preferred(k) => stop
+                .pixels_holding(&stop.preferred(k))
+                .into_iter()
+                .all(|p| blocked(stop.index(super::Cell::Pixel(p)))),
+        };
+        out.set(cell, hit);
+    }
+    out
 }
 
 /// [`blocked`] triangle by triangle in the scene's order, without the hierarchy: the

@@ -74,9 +74,9 @@ pub trait Backend: Sync {
         preferred: &[V3],
     ) -> CubeMap;
 
-    /// [`Backend::blocked`], or, once every cell of `stop` is blocked, a map with fewer
-    /// blocked cells that still holds all of `stop`'s (the CPU stops drawing then;
-    /// others may draw the whole map).
+    /// [`Backend::blocked`], right on the cells of `stop`; elsewhere it may hold fewer
+    /// blocked cells (the CPU stops drawing once every cell of `stop` is blocked, and
+    /// decides only those; others may draw the whole map).
     fn blocked_until(
         &self,
         scene: &Scene,
@@ -502,8 +502,9 @@ pub fn d1(
 ///
 /// With `opts.d2_wanted` (the setups a plan can use: the caller masks D2 by them) sampling stops
 /// once D2 holds every wanted cell, and a sample whose components block every wanted
-/// cell D2 still lacks adds nothing (its later components are not drawn). D2 is then the
-/// same on the wanted cells and may hold fewer of the others; [`D2Sampler`] is the rule.
+/// cell D2 still lacks adds nothing (its later components are not drawn). Each sample is
+/// decided only on the wanted cells D2 still lacks, so D2 is the same on the wanted
+/// cells and holds none of the others; [`D2Sampler`] is the rule.
 pub fn d2(
     backend: &dyn Backend,
     scene: &Scene,
@@ -584,11 +585,15 @@ impl D2Sampler {
         }
     }
 
-    /// Adds one sample's free directions, unless it blocks every cell still needed.
+    /// Adds one sample's free directions among the cells still needed (every cell
+    /// without wanted ones): a map drawn only for those may hold too few blocked cells
+    /// elsewhere.
     fn add(&mut self, blocked: &CubeMap, need: Option<&CubeMap>) {
-        if need.is_none_or(|nd| !blocked.covers(nd)) {
-            self.out.or_assign(&blocked.not());
+        let mut free = blocked.not();
+        if let Some(nd) = need {
+            free.and_assign(nd);
         }
+        self.out.or_assign(&free);
     }
 }
 
