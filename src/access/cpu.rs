@@ -512,6 +512,17 @@ fn node_band(at: &Placed, lo: f64, hi: f64) -> Option<(u32, Coverage)> {
 /// [`footprint`]).
 fn node_footprint(at: &Placed, node: &BvhNode, cov: Coverage) -> Option<(u8, u32, u32, u32, u32)> {
     let (a, b) = (node.lo - at.from, node.hi - at.from);
+    // A box whose corners are not all strictly inside one face's pyramid has none (what
+    // `footprint` finds corner by corner): told from its extents first, as about half
+    // the boxes asked straddle a cube edge. Inside the +m pyramid every corner has
+    // c_m > |c_j|, so a_m > b_j and a_m > −a_j for both other axes j (−b_m for −m).
+    let inside = |m: usize, near: f64| {
+        let (j, k) = ((m + 1) % 3, (m + 2) % 3);
+        near > 0.0 && near > b[j] && near > -a[j] && near > b[k] && near > -a[k]
+    };
+    if !(0..3).any(|m| inside(m, a[m]) || inside(m, -b[m])) {
+        return None;
+    }
     let corners = [0, 1, 2, 3, 4, 5, 6, 7].map(|c: u8| {
         V3::new(
             if c & 1 == 0 { a.x } else { b.x },
