@@ -304,20 +304,23 @@ pub fn blocked_until(
         if pixels.len() <= MOST_PENDING {
             maps.stop = Some(Stop {
                 next: LOOK_EVERY * 16 * pixels.len(),
-                pending: pixels.iter().map(|&p| (p, CubeMap::discs(n, p))).collect(),
+                pending: pixels
+                    .into_iter()
+                    .map(|p| (p, CubeMap::discs(n, p)))
+                    .collect(),
                 drawn: 0,
             });
             let drawn = draw(scene, from, comp, n, &mut maps);
-            return stop_cells(stop, &pixels, &maps, drawn.full);
+            return stop_cells(stop, &maps, drawn.full);
         }
     }
     let drawn = draw(scene, from, comp, n, &mut maps);
     finish(scene, from, comp, maps.base, maps.bands, &drawn)
 }
 
-/// [`blocked_until`]'s map once drawn: `stop`'s cells decided, its `pixels` (sorted)
-/// those that are or hold them; every other cell free.
-fn stop_cells(stop: &CubeMap, pixels: &[usize], maps: &Maps, full: bool) -> CubeMap {
+/// [`blocked_until`]'s map once drawn: `stop`'s cells decided from the pixels waited
+/// for (every pixel that is or holds one of them); every other cell free.
+fn stop_cells(stop: &CubeMap, maps: &Maps, full: bool) -> CubeMap {
     let mut out = stop.empty_like();
     if full {
         out.or_assign(stop);
@@ -335,7 +338,7 @@ fn stop_cells(stop: &CubeMap, pixels: &[usize], maps: &Maps, full: bool) -> Cube
                 .collect()
         })
         .unwrap_or_default();
-    let blocked = |p: usize| pixels.binary_search(&p).is_ok() && !open.contains(&p);
+    let blocked = |p: usize| !open.contains(&p);
     for cell in stop.cells() {
         let hit = match cell {
             super::Cell::Pixel(_) => blocked(stop.index(cell)),
@@ -745,7 +748,6 @@ fn draw_grown(canvas: &mut impl Canvas, n: u32, k: u32, q: &[V3]) {
 /// `dist` holds the corners' distances from `from`. `dmin` is the piece's distance, or,
 /// for a piece with a corner nearer than the component's nearest distance, any distance
 /// under it: the rule then reads no more of it than that it is under (see [`dilation`]).
-#[allow(clippy::too_many_arguments)]
 fn grown_piece(
     canvas: &mut impl Canvas,
     at: &Placed,

@@ -517,6 +517,16 @@ pub fn point_triangle_distance(p: &P3, t: &[P3; 3]) -> f64 {
 mod tests {
     use super::*;
 
+    /// Pseudo-random numbers in [0, 1) from `seed` (a 64-bit LCG): the same every run.
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     #[test]
     fn point_triangle_distances() {
         let t = [
@@ -540,13 +550,7 @@ mod tests {
         use parry3d_f64::na::{Translation3, UnitQuaternion};
         use parry3d_f64::query::intersection_test;
         use parry3d_f64::shape::{Capsule, Cylinder};
-        let mut seed = 11u64;
-        let mut next = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(11);
         let mut tris = Vec::new();
         for _ in 0..400 {
             let c = P3::new(100.0 * next(), 100.0 * next(), 20.0 * next());
@@ -618,22 +622,13 @@ mod tests {
         }
         assert!(hits > 50 && misses > 50, "{hits} hits, {misses} misses");
     }
-}
-#[cfg(test)]
-mod gjk {
-    use super::*;
 
     /// The segment–triangle distance is the least distance of points along the segment,
     /// sampled finely (never more than it, and within the sampling's step).
     #[test]
     fn segment_triangle_distance_is_the_sampled_least() {
-        let mut seed = 3u64;
-        let mut next = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut uniform = uniform(3);
+        let mut next = move || uniform() - 0.5;
         let mut pierced = 0;
         for _ in 0..2000 {
             let mut p = || P3::new(10.0 * next(), 10.0 * next(), 10.0 * next());
@@ -660,13 +655,7 @@ mod gjk {
     fn parrys_test_misses_triangles_with_a_corner_inside() {
         use parry3d_f64::query::intersection_test;
         use parry3d_f64::shape::{Capsule, Triangle};
-        let mut seed = 5u64;
-        let mut next = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(5);
         let id = Isometry::identity();
         let (mut sure, mut parry_missed, mut missed) = (0, 0, 0);
         for _ in 0..60000 {
