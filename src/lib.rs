@@ -687,7 +687,7 @@ pub fn simulate(
         }
     };
     let text = checked.sources.get(dmi).text.clone();
-    let prog = match dmis::read(dmi, &text) {
+    let mut prog = match dmis::read(dmi, &text) {
         Ok(p) => p,
         Err(errors) => {
             for e in errors {
@@ -696,6 +696,9 @@ pub fn simulate(
             return finish(checked, diags, None);
         }
     };
+    for w in std::mem::take(&mut prog.warnings) {
+        diags.push(w);
+    }
     let plan = match simulate::plan_of(&checked.model, &prog, dmi, &text) {
         Ok(k) => k,
         Err(e) => {

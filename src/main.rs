@@ -927,7 +927,12 @@ fn read_dmis(file: &std::path::Path) -> ExitCode {
         return ExitCode::from(1);
     };
     match inspc::dmis::read(id, &sources.get(id).text) {
-        Ok(p) => {
+        Ok(mut p) => {
+            let mut warnings = inspc::diag::Diagnostics::new();
+            for w in std::mem::take(&mut p.warnings) {
+                warnings.push(w);
+            }
+            print_diagnostics(&sources, &warnings.sorted());
             let count = |m: &str| p.commands(m).count();
             println!(
                 "{}: {} statements, {} sensors, {} features, {} tolerances, {} MEAS blocks, {} touches, {} moves",

@@ -23,6 +23,18 @@ pub fn num(x: f64) -> String {
     }
 }
 
+/// A real number as a DMIS parameter: [`num`] with its decimal point always written
+/// (`50.0`, `-40.0`, `0.0`), as NIST's programs write reals, so that no reader takes a
+/// real for an integer.
+pub fn real(x: f64) -> String {
+    let s = num(x);
+    if s.contains('.') {
+        s
+    } else {
+        s + ".0"
+    }
+}
+
 /// Whether `s` is a legal label: `[A-Z][A-Z0-9_]{0,15}`.
 pub fn is_label(s: &str) -> bool {
     let b = s.as_bytes();
@@ -34,16 +46,32 @@ pub fn is_label(s: &str) -> bool {
 }
 
 /// Text made safe for a quoted string or a comment: printable ASCII without the quote,
-/// upper case; anything else becomes `?`, and it is cut to `max` characters.
+/// upper case, cut to `max` characters. The signs a drawing uses become the words an
+/// operator reads (`30°` → `30 DEG`, `Ø8` → `DIA 8`, `±` → `+/-`, `µm` → `UM`); any
+/// other character outside ASCII becomes `?`.
 pub fn plain(s: &str, max: usize) -> String {
-    s.chars()
-        .map(|c| match c {
-            '\'' => '"',
-            c if (' '..='~').contains(&c) => c.to_ascii_uppercase(),
-            _ => '?',
-        })
-        .take(max)
-        .collect()
+    ascii(s, max).to_ascii_uppercase()
+}
+
+/// [`plain`] without the upper case: quoted text as a person wrote it (a results file's
+/// `FILNAM`, which NIST's `output.dms` keeps as its program wrote it).
+pub fn ascii(s: &str, max: usize) -> String {
+    let mut out = String::new();
+    for c in s.chars() {
+        match c {
+            '\'' => out.push('"'),
+            '°' => out.push_str(" DEG"),
+            'Ø' | 'ø' | '⌀' => out.push_str("DIA "),
+            '±' => out.push_str("+/-"),
+            'µ' | 'μ' => out.push('U'),
+            '×' => out.push('X'),
+            '–' | '—' => out.push('-'),
+            '→' => out.push_str("->"),
+            c if (' '..='~').contains(&c) => out.push(c),
+            _ => out.push('?'),
+        }
+    }
+    out.chars().take(max).collect()
 }
 
 /// Labels per namespace (`F`, `S`, `T`, `DAT`, `D`): derived from spec names, legal and
@@ -144,6 +172,9 @@ mod tests {
         assert_eq!(num(2.5), "2.5");
         assert_eq!(num(1.23456), "1.2346");
         assert_eq!(num(-40.0), "-40");
+        assert_eq!(real(-40.0), "-40.0");
+        assert_eq!(real(-0.00001), "0.0");
+        assert_eq!(real(2.5), "2.5");
     }
 
     #[test]
@@ -178,6 +209,7 @@ mod tests {
         }
         let joined: String = lines.iter().map(|l| l.trim_end_matches('$')).collect();
         assert_eq!(joined, s);
-        assert_eq!(plain("it's ø", 80), "IT\"S ?");
+        assert_eq!(plain("it's ø8, tilted 30°", 80), "IT\"S DIA 8, TILTED 30 DEG");
+        assert_eq!(plain("a ☃", 80), "A ?");
     }
 }

@@ -10,7 +10,7 @@
 //! `DATDEF`s it names) and `OUTPUT`; `ENDFIL` last. Coordinates are in the part frame: after each
 //! setup's `DATSET`, a `TRANS` puts the origin back at the part's.
 
-use super::text::{num, plain, wrap, Labels};
+use super::text::{num, plain, real, wrap, Labels};
 use super::Input;
 use crate::access::pose::{Contact, Head};
 use crate::geometry::{FaceId, Surface, P3, V3};
@@ -63,16 +63,16 @@ impl Out {
             return;
         }
         self.at = Some(*p);
-        self.stmt(&format!("GOTO/{},{},{}", num(p[0]), num(p[1]), num(p[2])));
+        self.stmt(&format!("GOTO/{},{},{}", real(p[0]), real(p[1]), real(p[2])));
     }
 }
 
 fn xyz(p: &P3) -> String {
-    format!("{},{},{}", num(p.x), num(p.y), num(p.z))
+    format!("{},{},{}", real(p.x), real(p.y), real(p.z))
 }
 
 fn ijk(v: &V3) -> String {
-    format!("{},{},{}", num(v.x), num(v.y), num(v.z))
+    format!("{},{},{}", real(v.x), real(v.y), real(v.z))
 }
 
 /// Where a block's nominal comes from.
@@ -119,7 +119,7 @@ impl Nominal {
                         side(*convex),
                         xyz(&p),
                         ijk(axis),
-                        num(2.0 * radius)
+                        real(2.0 * radius)
                     )
                 }
                 Surface::Cone {
@@ -132,7 +132,7 @@ impl Nominal {
                     side(*convex),
                     xyz(apex),
                     ijk(axis),
-                    num(2.0 * half_angle.to_degrees())
+                    real(2.0 * half_angle.to_degrees())
                 ),
                 Surface::Sphere {
                     center,
@@ -142,7 +142,7 @@ impl Nominal {
                     "SPHERE,{},CART,{},{}",
                     side(*convex),
                     xyz(center),
-                    num(2.0 * radius)
+                    real(2.0 * radius)
                 ),
                 Surface::Freeform => format!("GSURF,CART,{}", xyz(c)),
             },
@@ -175,6 +175,16 @@ fn tol_word(k: TolKind) -> &'static str {
         TolKind::Angle => "ANGLB",
     }
 }
+
+/// Tolerances whose `TOL` statement always carries a material-condition word (ANSI/DMIS
+/// 105.2's `TOL/POS,2D|3D,tolzon,MMC|LMC|RFS,…`, and the orientation tolerances that
+/// take the same word in the forms PTC Creo's "Supported DMIS Commands" lists).
+const MATERIAL_WORD: &[TolKind] = &[
+    TolKind::Position,
+    TolKind::Perpendicularity,
+    TolKind::Parallelism,
+    TolKind::Angularity,
+];
 
 fn material(m: Option<Material>) -> Option<&'static str> {
     match m {
@@ -351,12 +361,25 @@ impl Writer<'_> {
             num((llip.summary.length * 10.0).round() / 10.0)
         ));
         o.stmt(&format!("DMISMN/'{}',05.3", plain(&input.plan.name, 60)));
+        // The results file's name, as NIST's `simple_in.dms` names its output file:
+        // the controller writes every `OUTPUT` there.
+        o.stmt(&format!(
+            "FILNAM/'{} RESULTS'",
+            plain(&input.plan.name, 52)
+        ));
         o.stmt("UNITS/MM,ANGDEC");
         o.stmt("MODE/PROG,MAN");
-        o.stmt(&format!("SNSET/APPRCH,{}", num(motion.prehit)));
-        o.stmt(&format!("SNSET/RETRCT,{}", num(motion.retract)));
-        o.stmt(&format!("SNSET/SEARCH,{}", num(motion.search)));
-        o.stmt(&format!("SNSET/CLRSRF,{}", num(motion.clearance)));
+        // Speeds: positioning at NIST's figure in `simple_in.dms` (1.8 m/min, 30 mm/s),
+        // touches at 3 mm/s, slow enough for a touch-trigger probe's pre-travel to stay
+        // within its repeatability; probe radius compensation on, so that every
+        // actual is the surface, not the tip centre.
+        o.stmt("FEDRAT/POSVEL,MPM,1.8");
+        o.stmt("FEDRAT/MESVEL,MMPS,3.0");
+        o.stmt("PRCOMP/ON");
+        o.stmt(&format!("SNSET/APPRCH,{}", real(motion.prehit)));
+        o.stmt(&format!("SNSET/RETRCT,{}", real(motion.retract)));
+        o.stmt(&format!("SNSET/SEARCH,{}", real(motion.search)));
+        o.stmt(&format!("SNSET/CLRSRF,{}", real(motion.clearance)));
     }
 
     /// One sensor per probe (per probe and A/B on an indexable head), in order of first
@@ -375,9 +398,9 @@ impl Writer<'_> {
                 continue;
             }
             let (kind, len, diam) = match probes.get(g.probe.0) {
-                Some(p) => ("PROBE", num(p.reach()), num(2.0 * p.tip_radius)),
+                Some(p) => ("PROBE", real(p.reach()), real(2.0 * p.tip_radius)),
                 None => match scanners.get(g.probe.0 - probes.len()) {
-                    Some(s) => ("LASER", num(s.optics.standoff), num(s.optics.stripe)),
+                    Some(s) => ("LASER", real(s.optics.standoff), real(s.optics.stripe)),
                     None => continue,
                 },
             };
@@ -394,13 +417,13 @@ impl Writer<'_> {
                 let d = crate::access::head_direction(g.a, g.b);
                 self.o.stmt(&format!(
                     "S({label})=SNSDEF/{kind},INDEX,POL,{},{},VEC,{},{len},{diam}",
-                    num(g.a),
-                    num(g.b),
+                    real(g.a),
+                    real(g.b),
                     ijk(&d)
                 ));
             } else {
                 self.o.stmt(&format!(
-                    "S({label})=SNSDEF/{kind},FIXED,CART,0,0,-{len},0,0,1,{diam}"
+                    "S({label})=SNSDEF/{kind},FIXED,CART,0.0,0.0,-{len},0.0,0.0,1.0,{diam}"
                 ));
             }
             self.sensors.insert(key, label);
@@ -626,7 +649,7 @@ impl Writer<'_> {
                 if inner { "INNER" } else { "OUTER" },
                 xyz(&mid),
                 ijk(&na),
-                num(width)
+                real(width)
             ));
             self.pairs.insert(f, (label, [a, b]));
         }
@@ -649,10 +672,16 @@ impl Writer<'_> {
                         params.push(if *diameter { "2D" } else { "3D" }.into());
                     }
                     if t.kind == TolKind::Angularity {
-                        params.push(num(t.basic_angle.unwrap_or(0.0)));
+                        params.push(real(t.basic_angle.unwrap_or(0.0)));
                     }
-                    params.push(num(*width));
-                    params.extend(material(t.modifier).map(String::from));
+                    params.push(real(*width));
+                    // A location or orientation zone names its material condition; with
+                    // none on the drawing it is RFS (ASME Y14.5-2018 §5.8.1, rule #2:
+                    // regardless of feature size applies where no modifier is given).
+                    let word = material(t.modifier).or(MATERIAL_WORD
+                        .contains(&t.kind)
+                        .then_some("RFS"));
+                    params.extend(word.map(String::from));
                 }
                 TolValue::Size {
                     nominal,
@@ -663,10 +692,10 @@ impl Writer<'_> {
                         params.push("NOMINL".into());
                     }
                     if matches!(t.kind, TolKind::Distance | TolKind::Angle) {
-                        params.push(num(*nominal));
+                        params.push(real(*nominal));
                     }
-                    params.push(num(lower - nominal));
-                    params.push(num(upper - nominal));
+                    params.push(real(lower - nominal));
+                    params.push(real(upper - nominal));
                 }
             }
             for d in &t.datums {
@@ -693,7 +722,7 @@ impl Writer<'_> {
         }
         for (axis, angle) in zxz_rotations(&r) {
             let d = self.labels.fresh("D", &format!("NOM{}", si + 1));
-            self.o.stmt(&format!("D({d})=ROTATE/{axis},{}", num(angle)));
+            self.o.stmt(&format!("D({d})=ROTATE/{axis},{}", real(angle)));
         }
         self.o.oper(&format!(
             "SETUP {} OF {setups_n}: PLACE THE PART WITH ITS {} DIRECTION UP",
@@ -782,7 +811,7 @@ impl Writer<'_> {
         let shifts: Vec<String> = al
             .trans
             .iter()
-            .map(|(k, v)| format!("{k}ORIG,{}", num(-v)))
+            .map(|(k, v)| format!("{k}ORIG,{}", real(-v)))
             .collect();
         self.datset(&format!("SETUP{}", si + 1), &fa, &shifts);
         self.o.stmt("MODE/PROG,MAN");
@@ -857,8 +886,8 @@ impl Writer<'_> {
             } else {
                 let o = &mut self.o;
                 if narrow {
-                    o.stmt(&format!("SNSET/APPRCH,{}", num(b.standoff)));
-                    o.stmt(&format!("SNSET/RETRCT,{}", num(b.standoff)));
+                    o.stmt(&format!("SNSET/APPRCH,{}", real(b.standoff)));
+                    o.stmt(&format!("SNSET/RETRCT,{}", real(b.standoff)));
                 }
                 if !joined {
                     o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
@@ -884,8 +913,8 @@ impl Writer<'_> {
                     o.stmt("ENDMES");
                 }
                 if narrow {
-                    o.stmt(&format!("SNSET/APPRCH,{}", num(motion.prehit)));
-                    o.stmt(&format!("SNSET/RETRCT,{}", num(motion.retract)));
+                    o.stmt(&format!("SNSET/APPRCH,{}", real(motion.prehit)));
+                    o.stmt(&format!("SNSET/RETRCT,{}", real(motion.retract)));
                 }
             }
             // The last block of a round in points joins them into the whole.
@@ -966,7 +995,7 @@ impl Writer<'_> {
         // Datums measured here, then the tolerances this group completes.
         for (d, label) in datums_here {
             let dl = &self.datums[d.0];
-            self.o.stmt(&format!("DAT({dl})=DATDEF/FA({label})"));
+            self.o.stmt(&format!("DATDEF/FA({label}),DAT({dl})"));
         }
         // A tolerance is output once every surface of its features and datum features
         // is complete (a surface joined from points completes at its last block).

@@ -455,6 +455,44 @@ pub fn cylinder(points: &[P3], guess: &Shape) -> Option<Shape> {
     (rr.is_finite() && rr > 0.0).then_some(Shape::Cylinder { p: o, a: ax, r: rr })
 }
 
+/// The least-squares circle of points about `guess`'s axis (a cylinder whose point is
+/// the nominal centre): the axis kept, the centre and radius fitted in the plane square
+/// to it, at the points' mean height along it. Three points off a line determine it.
+pub fn circle(points: &[P3], guess: &Shape) -> Option<Shape> {
+    let Shape::Cylinder { a, .. } = guess else {
+        return None;
+    };
+    let (u, v) = across(a);
+    let flat: Vec<[f64; 2]> = points.iter().map(|q| [q.coords.dot(&u), q.coords.dot(&v)]).collect();
+    if points.len() < 3 || collinear(&flat) {
+        return None;
+    }
+    // The cylinder fit holds the axis when the points do not spread along it; flattened
+    // onto one plane, they never do.
+    let mean = points.iter().fold(V3::zeros(), |s, q| s + q.coords) / points.len() as f64;
+    let h = mean.dot(a);
+    let on_plane: Vec<P3> = points.iter().map(|q| q - a * (q.coords.dot(a) - h)).collect();
+    cylinder(&on_plane, guess)
+}
+
+/// Whether 2D points lie on one line (to a micrometre over their spread).
+fn collinear(pts: &[[f64; 2]]) -> bool {
+    let n = pts.len() as f64;
+    let (mx, my) = pts.iter().fold((0.0, 0.0), |s, p| (s.0 + p[0] / n, s.1 + p[1] / n));
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for p in pts {
+        let (dx, dy) = (p[0] - mx, p[1] - my);
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    // The smaller eigenvalue of the scatter: the spread across the best line.
+    let tr = sxx + syy;
+    let det = sxx * syy - sxy * sxy;
+    let small = tr / 2.0 - ((tr * tr / 4.0 - det).max(0.0)).sqrt();
+    small / n < 1e-12 || small <= 1e-12 * tr
+}
+
 /// The least-squares cone started from `guess`.
 pub fn cone(points: &[P3], guess: &Shape) -> Option<Shape> {
     let Shape::Cone { apex, a, half } = guess else {

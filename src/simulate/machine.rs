@@ -4,7 +4,7 @@ use super::deviation::Deviations;
 use super::errors::SimError;
 use super::evaluate::{self, Measured, TolDef};
 use super::fit::{self, Shape};
-use super::report::{Report, Row};
+use super::report::{FeatureRow, Report, Row};
 use super::{Input, Options};
 use crate::access::pose::{Blocker, Contact, Pose, Solid};
 use crate::access::scan::{Optics, ScannerShape};
@@ -36,7 +36,7 @@ const CLOUD: (usize, usize) = (40, 10);
 const SEARCH_STEP: f64 = 0.01;
 
 /// The plan (index into `model.plans`) that wrote `program`: the one whose name its
-/// `DMISMN` carries.
+/// `DMISMN` carries, or the spec's only plan.
 pub fn plan_of(
     model: &Model,
     program: &Program,
@@ -59,10 +59,13 @@ pub fn plan_of(
             _ => None,
         })
         .unwrap_or_default();
+    // A program written elsewhere names itself, not a plan of ours: with one plan in
+    // the spec, that plan's part, machine and setups are the ones it runs on.
     let found = model
         .plans
         .iter()
-        .position(|p| crate::dmis::text::plain(&p.name, 60) == name);
+        .position(|p| crate::dmis::text::plain(&p.name, 60) == name)
+        .or_else(|| (model.plans.len() == 1).then_some(0));
     found.ok_or_else(|| SimError::NoPlan {
         span: line_span(file, text, at),
         program: name,
@@ -125,6 +128,9 @@ struct Block {
 struct Nominal {
     shape: Shape,
     convex: bool,
+    /// The `FEAT` word (`CIRCLE`, `PLANE`, …) and its numbers after `CART`.
+    word: String,
+    numbers: Vec<f64>,
 }
 
 /// A sensor: its probe (slot) and head angles.
@@ -174,6 +180,11 @@ struct Machine<'a> {
     manual: bool,
     sensors: BTreeMap<String, Sensor>,
     sensor: Option<Sensor>,
+    /// The probe on the ram when the program starts: the one it selects first. A
+    /// program may move before its first `SNSLCT` (NIST's `simple_in.dms` does); the
+    /// machine moves whatever is mounted, and a program that selects a probe first
+    /// selects the one it expects to be there.
+    mounted: Option<Sensor>,
     nominals: BTreeMap<String, Nominal>,
     tols: BTreeMap<String, TolDef>,
     /// Program → machine: the current alignment.
@@ -196,6 +207,8 @@ struct Machine<'a> {
     at: Option<P3>,
     rng: Rng,
     rows: Vec<Row>,
+    /// The features output, each once, as it was when first output.
+    features: Vec<FeatureRow>,
     sizes: BTreeMap<String, (f64, f64, f64)>,
     touches: usize,
     /// Points the scan passes kept.
@@ -246,6 +259,7 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         manual: false,
         sensors: BTreeMap::new(),
         sensor: None,
+        mounted: None,
         nominals: BTreeMap::new(),
         tols: BTreeMap::new(),
         frame: Isometry3::identity(),
@@ -260,11 +274,13 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         at: None,
         rng: Rng(opts.seed ^ 0x5EED_1A5E_D00D_F00D),
         rows: Vec::new(),
+        features: Vec::new(),
         sizes: BTreeMap::new(),
         touches: 0,
         scanned: 0,
         moves: 0,
     };
+    m.mounted = m.first_selected();
     for s in &input.program.statements {
         let Statement::Command {
             label,
@@ -278,7 +294,22 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         m.statement(label.as_ref(), major, params, *at)
             .map_err(|e| vec![e])?;
     }
+    let program = input
+        .program
+        .commands("DMISMN")
+        .next()
+        .and_then(|p| p.first())
+        .map(|p| p.trim_matches('\'').to_string())
+        .unwrap_or_default();
+    let filnam = input
+        .program
+        .commands("FILNAM")
+        .next()
+        .and_then(|p| p.first())
+        .map(|p| p.trim_matches('\'').to_string())
+        .unwrap_or_else(|| program.clone());
     Ok(Report {
+        filnam,
         program: input
             .program
             .commands("DMISMN")
@@ -295,6 +326,7 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         noise: opts.noise,
         seed: opts.seed,
         rows: m.rows,
+        features: m.features,
     })
 }
 
@@ -331,8 +363,24 @@ impl Machine<'_> {
         at: usize,
     ) -> Result<(), SimError> {
         let word = |k: usize| params.get(k).map(String::as_str).unwrap_or("");
+        if crate::dmis::word(major) != crate::dmis::Word::Runs {
+            // The reader warned on it: DMIS the virtual CMM does not run, or not DMIS.
+            return Ok(());
+        }
         match major {
-            "DMISMN" | "TEXT" | "ENDFIL" => {}
+            // What a real controller needs and a virtual one has no use for: names, feed
+            // rates, probe compensation (always on here), the work plane, the results
+            // file (the report goes where `--report` says).
+            "DMISMN" | "DMISMD" | "FILNAM" | "TEXT" | "ENDFIL" | "FEDRAT" | "ACLRAT"
+            | "PRCOMP" | "WKPLAN" | "DECPL" | "DEVICE" | "OPEN" | "CLOSE" | "DISPLY"
+            | "PARTID" | "PARTRV" | "PARTSN" | "PLANID" => {}
+            "SAVE" => {
+                for p in params {
+                    if let Some(l) = label_of(p) {
+                        self.saved.insert(l.to_string(), self.frame);
+                    }
+                }
+            }
             "UNITS" => {
                 if word(0) != "MM" {
                     return Err(self.unsupported(at, &format!("UNITS/{}", params.join(","))));
@@ -404,7 +452,15 @@ impl Machine<'_> {
                         .first()
                         .and_then(|m| self.nominals.get(m))
                         .is_some_and(|n| n.convex);
-                    self.nominals.insert(l.clone(), Nominal { shape, convex });
+                    self.nominals.insert(
+                        l.clone(),
+                        Nominal {
+                            shape,
+                            convex,
+                            word: "PATERN".into(),
+                            numbers: Vec::new(),
+                        },
+                    );
                     self.patterns.insert(l.clone(), members);
                 } else {
                     let n = nominal(params)
@@ -450,6 +506,11 @@ impl Machine<'_> {
                 let q =
                     UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), angle.to_radians());
                 self.frame = Isometry3::from_parts(self.frame.translation, self.frame.rotation * q);
+                self.realigned(label);
+            }
+            // `DATSET/MCS`: the machine's own axes and origin (NIST's `simple_in.dms`).
+            "DATSET" if params.len() == 1 && params[0] == "MCS" => {
+                self.frame = Isometry3::identity();
                 self.realigned(label);
             }
             "DATSET" => {
@@ -514,12 +575,19 @@ impl Machine<'_> {
             "PAMEAS" => self.pameas(params, at)?,
             "ENDMES" => self.endmes(at)?,
             "CONST" => self.construct(params, at)?,
+            // `DATDEF/FA(f),DAT(x)` (ANSI/DMIS 105.2; NIST's and the QIF bindings' form):
+            // the datum is the last parameter.
             "DATDEF" => {
-                let Some((_, d)) = label else {
+                let Some(d) = params
+                    .last()
+                    .filter(|p| p.starts_with("DAT("))
+                    .and_then(|p| label_of(p))
+                    .map(str::to_string)
+                else {
                     return Err(self.bad(
                         at,
-                        "DATDEF without a label",
-                        "write `DAT(A)=DATDEF/FA(label)`",
+                        "DATDEF without the datum it defines",
+                        "write `DATDEF/FA(label),DAT(A)`",
                     ));
                 };
                 let l = params
@@ -542,7 +610,7 @@ impl Machine<'_> {
                     .filter_map(|m| Some((self.actuals.get(m).cloned()?, m.clone())))
                     .collect();
                 let all = std::iter::once((f, l)).chain(members).collect();
-                self.datums.insert(d.clone(), all);
+                self.datums.insert(d, all);
             }
             "OUTPUT" => self.output(params, at)?,
             other => return Err(self.unsupported(at, other)),
@@ -572,7 +640,8 @@ impl Machine<'_> {
         }
     }
 
-    /// `SNSDEF/PROBE,FIXED,CART,0,0,-len,0,0,1,diam` or `…,INDEX,POL,a,b,VEC,i,j,k,len,diam`:
+    /// `SNSDEF/PROBE,FIXED,CART,x,y,z,i,j,k,diam` (in either sign convention: see
+    /// [`fixed_length`]) or `…,INDEX,POL,a,b,VEC,i,j,k,len,diam`:
     /// the probe of the plan's machine with that tip and length (the label names it when
     /// several match); `SNSDEF/LASER,…` in the same form, the scanner with that stand-off
     /// (the length) and stripe (the diameter).
@@ -590,7 +659,13 @@ impl Machine<'_> {
         let len = if params.get(1).map(String::as_str) == Some("INDEX") {
             v.get(v.len().wrapping_sub(2)).copied().unwrap_or(0.0)
         } else {
-            v.get(2).map(|x| -x).unwrap_or(0.0)
+            fixed_length(&v).ok_or_else(|| {
+                self.bad(
+                    at,
+                    "SNSDEF/PROBE,FIXED,CART with a tip offset not along its direction",
+                    "write `SNSDEF/PROBE,FIXED,CART,x,y,z,i,j,k,diam`, the tip's offset x,y,z along the probe's direction i,j,k (docs/dmis.md)",
+                )
+            })?
         };
         let cmm = &self.input.model.cmms[self.plan.cmm.0];
         let laser = params.first().map(String::as_str) == Some("LASER");
@@ -691,6 +766,16 @@ impl Machine<'_> {
         Ok(())
     }
 
+    /// A program that moves before any `PAUSE` (one written elsewhere, as NIST's
+    /// `simple_in.dms`) runs on the part where it already stands: its first setup starts
+    /// at its first motion, the part placed where the program's alignment then says.
+    fn ensure_setup(&mut self, at: usize) -> Result<(), SimError> {
+        if self.setup.is_none() && self.aligns.is_empty() {
+            self.start_setup(at)?;
+        }
+        Ok(())
+    }
+
     fn ctx(&self, at: usize) -> Result<&SetupCtx, SimError> {
         self.setup.as_ref().ok_or_else(|| {
             self.bad(
@@ -701,8 +786,30 @@ impl Machine<'_> {
         })
     }
 
+    /// The sensor the program's first `SNSLCT` selects, from its `SNSDEF`.
+    fn first_selected(&self) -> Option<Sensor> {
+        let commands = || {
+            self.input.program.statements.iter().filter_map(|s| match s {
+                Statement::Command {
+                    label,
+                    major,
+                    params,
+                    at,
+                } => Some((label, major, params, *at)),
+                Statement::Comment(_) => None,
+            })
+        };
+        let l = commands()
+            .find(|c| c.1 == "SNSLCT")
+            .and_then(|c| c.2.first().and_then(|p| label_of(p)))?;
+        let (_, _, params, at) = commands().find(|c| {
+            c.1 == "SNSDEF" && c.0.as_ref().is_some_and(|(k, x)| k == "S" && x == l)
+        })?;
+        self.sensor_def(l, params, at).ok()
+    }
+
     fn sensor(&self, at: usize) -> Result<Sensor, SimError> {
-        self.sensor.ok_or_else(|| {
+        self.sensor.or(self.mounted).ok_or_else(|| {
             self.bad(
                 at,
                 "a touch or move with no sensor selected",
@@ -748,6 +855,7 @@ impl Machine<'_> {
 
     /// A move of the tip centre to `q` (machine frame).
     fn move_to(&mut self, q: P3, at: usize, during: &str) -> Result<(), SimError> {
+        self.ensure_setup(at)?;
         let ctx = self.ctx(at)?;
         let s = self.sensor(at)?;
         let qp = ctx.place.inverse() * q;
@@ -766,6 +874,7 @@ impl Machine<'_> {
 
     /// A touch: approach, search for the surface, record the tip centre.
     fn ptmeas(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        self.ensure_setup(at)?;
         let v = nums(params);
         if v.len() != 6 {
             return Err(self.bad(
@@ -897,6 +1006,7 @@ impl Machine<'_> {
     /// the block's nominal surface ([`CLIP`]). Each point carries the scanner's noise when the run
     /// has noise: the larger of the run's and half the scanner's accuracy.
     fn pameas(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        self.ensure_setup(at)?;
         let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
         let Some(&(s, e)) = self.paths.get(l) else {
             return Err(self.bad(
@@ -1167,6 +1277,11 @@ impl Machine<'_> {
                 }
             }
             "CYLNDR" => fit::cylinder(&centres, &guess.offset(r, nominal.convex))
+                .map(|s| s.offset(-r, nominal.convex)),
+            // A circle is a cylinder's section: its axis the nominal's, its centre at the
+            // touches' mean height along it (NIST's `output.dms` reports the circle of
+            // `simple_in.dms` at the touches' z).
+            "CIRCLE" => fit::circle(&centres, &guess.offset(r, nominal.convex))
                 .map(|s| s.offset(-r, nominal.convex)),
             "CONE" => fit::cone(&centres, &guess.offset(r, nominal.convex))
                 .map(|s| s.offset(-r, nominal.convex)),
@@ -1497,14 +1612,30 @@ impl Machine<'_> {
     /// `OUTPUT/FA(…)[,FA(…)],TA(t)`: the tolerance evaluated on its features as the
     /// program measured them, its datums as `DATDEF` defined them.
     fn output(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
-        let Some(tl) = params
+        for p in params.iter().filter(|p| p.starts_with("FA(")) {
+            let (l, f) = self.feature(p, at)?;
+            if self.features.iter().any(|r| r.label == l) {
+                continue;
+            }
+            let row = self.feature_row(&l, &self.in_program(f));
+            self.features.extend(row);
+        }
+        // Each tolerance the statement names is judged (a feature output alone reports
+        // its actual, nothing to judge).
+        let tols: Vec<String> = params
             .iter()
-            .find(|p| p.starts_with("TA("))
-            .and_then(|p| label_of(p))
-        else {
-            // A feature output alone reports nothing to judge.
-            return Ok(());
-        };
+            .filter(|p| p.starts_with("TA("))
+            .filter_map(|p| label_of(p))
+            .map(str::to_string)
+            .collect();
+        for tl in &tols {
+            self.judge(tl, params, at)?;
+        }
+        Ok(())
+    }
+
+    /// One tolerance of an `OUTPUT`, on the statement's features.
+    fn judge(&mut self, tl: &str, params: &[String], at: usize) -> Result<(), SimError> {
         let def = self.tols.get(tl).cloned().ok_or_else(|| {
             self.bad(
                 at,
@@ -1570,6 +1701,58 @@ impl Machine<'_> {
     }
 }
 
+impl Machine<'_> {
+    /// A feature's actual beside its nominal, in the `FEAT` statement's layout.
+    fn feature_row(&self, label: &str, m: &Measured) -> Option<FeatureRow> {
+        let n = self.nominals.get(label)?;
+        let ijk = |v: &V3| [v.x, v.y, v.z];
+        // A direction reported the way the nominal's points (a fit may turn it over).
+        let along = |v: &V3| match n.shape.direction() {
+            Some(d) if d.dot(v) < 0.0 => -v,
+            _ => *v,
+        };
+        let xyz = |p: &P3| vec![p.x, p.y, p.z];
+        let with = |mut v: Vec<f64>, more: &[f64]| {
+            v.extend_from_slice(more);
+            v
+        };
+        let actual: Vec<f64> = match &m.shape {
+            Shape::Plane { p, n: v } | Shape::Point { p, n: v } => with(xyz(p), &ijk(&along(v))),
+            Shape::Cylinder { p, a, r } => {
+                with(with(xyz(p), &ijk(&along(a))), &[2.0 * r])
+            }
+            Shape::Cone { apex, a, half } => {
+                with(with(xyz(apex), &ijk(&along(a))), &[2.0 * half.to_degrees()])
+            }
+            Shape::Sphere { c, r } => with(xyz(c), &[2.0 * r]),
+            Shape::Parpln { p, n: v, width } => with(with(xyz(p), &ijk(&along(v))), &[*width]),
+            Shape::Surface => Vec::new(),
+        };
+        let form = match &m.shape {
+            Shape::Point { .. } | Shape::Surface => None,
+            shape if !m.touches.is_empty() && n.word != "PATERN" => Some(
+                m.touches
+                    .iter()
+                    .map(|t| shape.signed(&t.2))
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| {
+                        (lo.min(d), hi.max(d))
+                    }),
+            )
+            .map(|(lo, hi)| hi - lo),
+            _ => None,
+        };
+        Some(FeatureRow {
+            label: label.to_string(),
+            kind: n.word.clone(),
+            inner: !n.convex,
+            nominal: n.numbers.clone(),
+            actual,
+            form,
+            points: m.touches.len(),
+        })
+    }
+}
+
 /// What a touch's search finds.
 enum Found {
     /// The tip centre at contact, what it touched, and the part's face it touched.
@@ -1609,6 +1792,21 @@ fn first_root(gap: &dyn Fn(f64) -> f64, max: f64) -> Option<f64> {
     None
 }
 
+/// The length of a fixed probe from `SNSDEF/PROBE,FIXED,CART,x,y,z,i,j,k,diam`'s numbers:
+/// the tip's offset `x,y,z` from the gauge point, along the probe's direction `i,j,k`.
+/// Writers differ in the signs: CMM Quarterly's "DMIS Probe Command Set" (and inspc)
+/// write the tip's offset in machine axes with the mounting direction, tip to head
+/// (`0,0,-50,0,0,1` for a probe hanging 50 mm below the ram); NIST's I++ simple-part
+/// program writes `0,0,30,0,0,-1` — the same probe the other way round. Both put the
+/// tip on the probe's axis at `|x,y,z|` from the gauge point; anything off that axis is
+/// no probe the rack can hold (`None`).
+fn fixed_length(v: &[f64]) -> Option<f64> {
+    let off = V3::new(*v.first()?, *v.get(1)?, *v.get(2)?);
+    let dir = V3::new(*v.get(3)?, *v.get(4)?, *v.get(5)?).try_normalize(1e-9)?;
+    let len = off.norm();
+    (off.cross(&dir).norm() <= 1e-6 * len.max(1.0)).then_some(len)
+}
+
 /// A nominal from `FEAT` parameters.
 fn nominal(params: &[String]) -> Option<Nominal> {
     let word = params.first()?.as_str();
@@ -1619,7 +1817,10 @@ fn nominal(params: &[String]) -> Option<Nominal> {
     let shape = match word {
         "PLANE" => Shape::Plane { p: p(0)?, n: d(3)? },
         "POINT" => Shape::Point { p: p(0)?, n: d(3)? },
-        "CYLNDR" => Shape::Cylinder {
+        // `FEAT/CYLNDR,INNER|OUTER,CART,x,y,z,i,j,k,diam[,len]`; a circle
+        // (`FEAT/CIRCLE,…,x,y,z,i,j,k,diam`) is held as the cylinder it is a section
+        // of, its point the circle's centre.
+        "CYLNDR" | "CIRCLE" => Shape::Cylinder {
             p: p(0)?,
             a: d(3)?,
             r: v.get(6)? / 2.0,
@@ -1641,7 +1842,12 @@ fn nominal(params: &[String]) -> Option<Nominal> {
         "GSURF" => Shape::Surface,
         _ => return None,
     };
-    Some(Nominal { shape, convex })
+    Some(Nominal {
+        shape,
+        convex,
+        word: word.to_string(),
+        numbers: v,
+    })
 }
 
 #[cfg(test)]

@@ -25,7 +25,7 @@ mod report;
 pub use deviation::Deviations;
 pub use errors::SimError;
 pub use machine::{plan_of, simulate};
-pub use report::{Report, Row};
+pub use report::{FeatureRow, Report, Row};
 
 use crate::geometry::{FaceId, FixtureMesh, PartGeometry};
 use crate::model::Model;

@@ -33,11 +33,37 @@ impl Row {
     }
 }
 
+/// One feature measured or constructed, as the program output it (`OUTPUT/FA(x)`) or
+/// as the run left it: the nominal the program declared (`FEAT/…`) beside the actual.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeatureRow {
+    /// The feature's DMIS label.
+    pub label: String,
+    /// Its DMIS feature word: `PLANE`, `CIRCLE`, `CYLNDR`, `CONE`, `SPHERE`, `POINT`,
+    /// `PARPLN`, `PATERN`, `GSURF`.
+    pub kind: String,
+    /// `INNER` (a hole, a slot) rather than `OUTER` (a boss, a block).
+    pub inner: bool,
+    /// The nominal's numbers in the `FEAT` statement's order after `CART`: a location
+    /// `x, y, z`, a direction `i, j, k`, then the size (diameter, width, half angle in
+    /// degrees for a cone) where the kind has one. Empty for `PATERN` and `GSURF`.
+    pub nominal: Vec<f64>,
+    /// The actual in the same layout, in the alignment current when it was output.
+    pub actual: Vec<f64>,
+    /// Form error of the fit (mm): the spread of the points about it, when the kind has
+    /// one; `None` for a point or a pattern.
+    pub form: Option<f64>,
+    /// Points it was fitted to (touches, or scanned points kept).
+    pub points: usize,
+}
+
 /// A run of the virtual CMM.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Report {
     /// The program's name.
     pub program: String,
+    /// The name of its results (the program's `FILNAM`, else its name).
+    pub filnam: String,
     /// The plan and part.
     pub plan: String,
     /// The part.
@@ -56,6 +82,8 @@ pub struct Report {
     pub seed: u64,
     /// Every tolerance output, in program order.
     pub rows: Vec<Row>,
+    /// Every feature measured or constructed, in the order it was first finished.
+    pub features: Vec<FeatureRow>,
 }
 
 /// Four decimals, like the program's numbers (a micrometre is 0.001).
@@ -160,6 +188,22 @@ impl Report {
         for r in &rows {
             out.push_str(&line(r));
         }
+        for f in &self.features {
+            let nums: Vec<String> = f.actual.iter().map(|x| val(*x)).collect();
+            out.push_str(&format!(
+                "feature {} ({}{}): {}; {} points{}\n",
+                f.label,
+                f.kind,
+                match f.kind.as_str() {
+                    "PLANE" | "POINT" => "",
+                    _ if f.inner => ", inner",
+                    _ => ", outer",
+                },
+                if nums.is_empty() { "-".to_string() } else { nums.join(", ") },
+                f.points,
+                f.form.map_or(String::new(), |e| format!(", form {}", val(e)))
+            ));
+        }
         let n = self.rows.len();
         out.push_str(&format!(
             "{} tolerance outputs: {} in, {} out{}\n",
@@ -216,41 +260,66 @@ impl Report {
         })
     }
 
-    /// The results as DMIS output statements, one `TA` per tolerance output.
+    /// The results as a DMIS output file, in the form of NIST's `output.dms`: the
+    /// program's `FILNAM` and units, then per feature output `OUTPUT/FA(x)` and its
+    /// actual `FA(x)=FEAT/…`, per tolerance output `OUTPUT/FA(…),TA(t)` and
+    /// `TA(t)=TOL/…,actual,deviation,INTOL|OUTOL`; tolerances not judged are comments.
     pub fn dmis(&self) -> String {
-        let mut out = format!(
-            "DMISMN/'{}',05.3\n",
-            crate::dmis::text::plain(&self.program, 60)
-        );
-        for r in &self.rows {
-            let o = &r.outcome;
-            let verdict = if r.unjudged() {
+        use crate::dmis::text::{ascii, real, wrap};
+        let mut out = String::new();
+        let mut stmt = |s: &str| {
+            if s.starts_with("$$") {
+                out.push_str(s);
+                out.push('\n');
+                return;
+            }
+            for line in wrap(s) {
+                out.push_str(&line);
+                out.push('\n');
+            }
+        };
+        stmt(&format!("FILNAM/'{}'", ascii(&self.filnam, 60)));
+        stmt("UNITS/MM,ANGDEC");
+        for f in &self.features {
+            if f.actual.is_empty() {
                 continue;
-            } else if r.pass() {
-                "INTOL"
-            } else {
-                "OUTOL"
+            }
+            let side = match f.kind.as_str() {
+                "PLANE" | "POINT" => String::new(),
+                _ => format!("{},", if f.inner { "INNER" } else { "OUTER" }),
             };
+            let nums: Vec<String> = f.actual.iter().map(|x| real(round4(*x))).collect();
+            stmt(&format!("OUTPUT/FA({})", f.label));
+            stmt(&format!(
+                "FA({})=FEAT/{},{side}CART,{}",
+                f.label,
+                f.kind,
+                nums.join(",")
+            ));
+        }
+        for r in &self.rows {
             let fa: Vec<String> = r.features.iter().map(|l| format!("FA({l})")).collect();
-            let stmt = format!(
+            let o = &r.outcome;
+            if r.unjudged() {
+                stmt(&format!("$$ TA({}) NOT JUDGED", r.tolerance));
+                continue;
+            }
+            let verdict = if r.pass() { "INTOL" } else { "OUTOL" };
+            stmt(&format!("OUTPUT/{},TA({})", fa.join(","), r.tolerance));
+            stmt(&format!(
                 "TA({})=TOL/{},{},{},{verdict}",
                 r.tolerance,
                 r.kind,
-                val(o.actual),
-                val(o.deviation()),
-            );
-            for line in
-                crate::dmis::text::wrap(&format!("OUTPUT/{},TA({})", fa.join(","), r.tolerance))
-            {
-                out.push_str(&line);
-                out.push('\n');
-            }
-            for line in crate::dmis::text::wrap(&stmt) {
-                out.push_str(&line);
-                out.push('\n');
-            }
+                real(round4(o.actual)),
+                real(round4(o.deviation())),
+            ));
         }
-        out.push_str("ENDFIL\n");
+        stmt("ENDFIL");
         out
     }
+}
+
+/// To the 0.1 µm the program's numbers carry.
+fn round4(x: f64) -> f64 {
+    (x * 1e4).round() / 1e4
 }

@@ -355,6 +355,12 @@ fn programs_read_back() {
                 )
             });
         assert!(
+            program.warnings.is_empty(),
+            "{}: the reader warns on the program: {:?}",
+            c.name,
+            program.warnings.iter().map(|e| e.to_string()).collect::<Vec<_>>()
+        );
+        assert!(
             program.to_text() == b.dmis,
             "{}: the program does not print back the same:\n{}",
             c.name,

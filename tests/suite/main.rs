@@ -10,6 +10,7 @@ mod catalogue;
 mod cli;
 mod cluster_props;
 mod diagnostics;
+mod dmis_foreign;
 mod examples;
 mod fmt;
 mod fpoints;
