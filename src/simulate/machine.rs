@@ -280,7 +280,7 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         scanned: 0,
         moves: 0,
     };
-    m.mounted = m.first_selected();
+    m.mounted = m.first_selected().map_err(|e| vec![e])?;
     for s in &input.program.statements {
         let Statement::Command {
             label,
@@ -786,8 +786,9 @@ impl Machine<'_> {
         })
     }
 
-    /// The sensor the program's first `SNSLCT` selects, from its `SNSDEF`.
-    fn first_selected(&self) -> Option<Sensor> {
+    /// The sensor the program's first `SNSLCT` selects, from its `SNSDEF`: none when
+    /// it selects none; an error when the rack holds no probe of that definition.
+    fn first_selected(&self) -> Result<Option<Sensor>, SimError> {
         let commands = || {
             self.input.program.statements.iter().filter_map(|s| match s {
                 Statement::Command {
@@ -799,13 +800,18 @@ impl Machine<'_> {
                 Statement::Comment(_) => None,
             })
         };
-        let l = commands()
+        let Some(l) = commands()
             .find(|c| c.1 == "SNSLCT")
-            .and_then(|c| c.2.first().and_then(|p| label_of(p)))?;
-        let (_, _, params, at) = commands().find(|c| {
+            .and_then(|c| c.2.first().and_then(|p| label_of(p)))
+        else {
+            return Ok(None);
+        };
+        let Some((_, _, params, at)) = commands().find(|c| {
             c.1 == "SNSDEF" && c.0.as_ref().is_some_and(|(k, x)| k == "S" && x == l)
-        })?;
-        self.sensor_def(l, params, at).ok()
+        }) else {
+            return Ok(None);
+        };
+        self.sensor_def(l, params, at).map(Some)
     }
 
     fn sensor(&self, at: usize) -> Result<Sensor, SimError> {

@@ -189,7 +189,7 @@ mod tests {
     fn quoted_text_keeps_its_case_blanks_and_dollars() {
         let c = canonical("TEXT/OPER, 'Place it $$ here, now'").unwrap();
         assert_eq!(c, "TEXT/OPER,'Place it $$ here, now'");
-        assert_eq!(comment_start("TEXT/OPER,'a $$ b' $$ c"), Some(18));
+        assert_eq!(comment_start("TEXT/OPER,'a $$ b' $$ c"), Some(19));
         assert_eq!(parse(&c).unwrap().2.len(), 2);
         assert!(canonical("TEXT/OPER,'open").is_none());
     }

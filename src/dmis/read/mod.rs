@@ -323,7 +323,7 @@ mod tests {
             ["insp::dmis::undefined"]
         );
         assert_eq!(
-            codes("DMISMN/'X',05.3\nF(a)=FEAT/POINT,CART,0,0,0,0,0,1\nENDFIL\n"),
+            codes("DMISMN/'X',05.3\nF(A-B)=FEAT/POINT,CART,0,0,0,0,0,1\nENDFIL\n"),
             ["insp::dmis::bad_label"]
         );
         assert_eq!(
