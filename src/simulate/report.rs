@@ -263,7 +263,7 @@ impl Report {
     /// The results as a DMIS output file, in the form of NIST's `output.dms`: the
     /// program's `FILNAM` and units, then per feature output `OUTPUT/FA(x)` and its
     /// actual `FA(x)=FEAT/…`, per tolerance output `OUTPUT/FA(…),TA(t)` and
-    /// `TA(t)=TOL/…,actual,deviation,INTOL|OUTOL`; tolerances not judged are comments.
+    /// `TA(t)=TOL/…,actual,INTOL|OUTOL`; tolerances not judged are comments.
     pub fn dmis(&self) -> String {
         use crate::dmis::text::{ascii, real, wrap};
         let mut out = String::new();
@@ -306,12 +306,13 @@ impl Report {
             }
             let verdict = if r.pass() { "INTOL" } else { "OUTOL" };
             stmt(&format!("OUTPUT/{},TA({})", fa.join(","), r.tolerance));
+            // The actual, then the verdict: the form the QIF community's DMIS bindings
+            // write (`TA(DIAM1)=TOL/DIAM,6.2,OUTOL`, `bindings/Python/demoQIFin.py`).
             stmt(&format!(
-                "TA({})=TOL/{},{},{},{verdict}",
+                "TA({})=TOL/{},{},{verdict}",
                 r.tolerance,
                 r.kind,
                 real(round4(o.actual)),
-                real(round4(o.deviation())),
             ));
         }
         stmt("ENDFIL");
