@@ -209,7 +209,10 @@ mod tests {
         }
         let joined: String = lines.iter().map(|l| l.trim_end_matches('$')).collect();
         assert_eq!(joined, s);
-        assert_eq!(plain("it's ø8, tilted 30°", 80), "IT\"S DIA 8, TILTED 30 DEG");
+        assert_eq!(
+            plain("it's ø8, tilted 30°", 80),
+            "IT\"S DIA 8, TILTED 30 DEG"
+        );
         assert_eq!(plain("a ☃", 80), "A ?");
     }
 }

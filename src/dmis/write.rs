@@ -41,6 +41,8 @@ impl Out {
 
     /// An operator message, split into `TEXT/OPER` statements that fit a line.
     fn oper(&mut self, s: &str) {
+        // In plain ASCII first: a sign spelt out (`°` as ` DEG`) takes more room.
+        let s = plain(s, usize::MAX);
         let words: Vec<&str> = s.split_whitespace().collect();
         let mut cur = String::new();
         for w in words {
@@ -63,7 +65,12 @@ impl Out {
             return;
         }
         self.at = Some(*p);
-        self.stmt(&format!("GOTO/{},{},{}", real(p[0]), real(p[1]), real(p[2])));
+        self.stmt(&format!(
+            "GOTO/{},{},{}",
+            real(p[0]),
+            real(p[1]),
+            real(p[2])
+        ));
     }
 }
 
@@ -363,10 +370,7 @@ impl Writer<'_> {
         o.stmt(&format!("DMISMN/'{}',05.3", plain(&input.plan.name, 60)));
         // The results file's name, as NIST's `simple_in.dms` names its output file:
         // the controller writes every `OUTPUT` there.
-        o.stmt(&format!(
-            "FILNAM/'{} RESULTS'",
-            plain(&input.plan.name, 52)
-        ));
+        o.stmt(&format!("FILNAM/'{} RESULTS'", plain(&input.plan.name, 52)));
         o.stmt("UNITS/MM,ANGDEC");
         o.stmt("MODE/PROG,MAN");
         // Speeds: positioning at NIST's figure in `simple_in.dms` (1.8 m/min, 30 mm/s),
@@ -678,9 +682,8 @@ impl Writer<'_> {
                     // A location or orientation zone names its material condition; with
                     // none on the drawing it is RFS (ASME Y14.5-2018 §5.8.1, rule #2:
                     // regardless of feature size applies where no modifier is given).
-                    let word = material(t.modifier).or(MATERIAL_WORD
-                        .contains(&t.kind)
-                        .then_some("RFS"));
+                    let word =
+                        material(t.modifier).or(MATERIAL_WORD.contains(&t.kind).then_some("RFS"));
                     params.extend(word.map(String::from));
                 }
                 TolValue::Size {
@@ -709,6 +712,28 @@ impl Writer<'_> {
         }
     }
 
+    /// A face as the operator knows it: the datum or feature the program measures on it,
+    /// with the face's name (the one the viewer and `inspc faces` show), else that name.
+    fn face_words(&self, f: FaceId) -> String {
+        let face = self.names.face(f);
+        let feature = self
+            .input
+            .llip
+            .setups
+            .iter()
+            .flat_map(|s| &s.groups)
+            .flat_map(|g| &g.blocks)
+            .find(|b| b.face == f)
+            .and_then(|b| b.feature);
+        let Some(ft) = feature else {
+            return face.to_string();
+        };
+        match self.names.part().datums.iter().find(|d| d.feature == ft) {
+            Some(d) => format!("datum {} ({face})", d.name),
+            None => format!("{} ({face})", self.names.feature(Some(ft))),
+        }
+    }
+
     /// A setup's operator prompt, its manual alignment and `DATSET`.
     fn setup(&mut self, si: usize, setups_n: usize, sp: &SetupPath) {
         let hlip = self.input.hlip;
@@ -722,17 +747,19 @@ impl Writer<'_> {
         }
         for (axis, angle) in zxz_rotations(&r) {
             let d = self.labels.fresh("D", &format!("NOM{}", si + 1));
-            self.o.stmt(&format!("D({d})=ROTATE/{axis},{}", real(angle)));
+            self.o
+                .stmt(&format!("D({d})=ROTATE/{axis},{}", real(angle)));
         }
         self.o.oper(&format!(
             "SETUP {} OF {setups_n}: PLACE THE PART WITH ITS {} DIRECTION UP",
             si + 1,
             direction_words(&setup.up)
         ));
-        self.o.oper(&format!(
-            "HOLD IT BY {}",
-            self.names.holder(&setup.holder, &setup.up).to_uppercase()
-        ));
+        let holder = self
+            .names
+            .holder_naming(&setup.holder, &setup.up, &|f| self.face_words(f));
+        self.o
+            .oper(&format!("HOLD IT BY {}", holder.to_uppercase()));
         // How it is turned about the vertical: where a part axis across `up` points.
         let across = if setup.up.x.abs() < 0.9 {
             V3::x()
@@ -746,8 +773,8 @@ impl Writer<'_> {
             direction_words(&V3::new(round3(m.x), round3(m.y), round3(m.z)))
         ));
         for f in &setup.on_table {
-            let face = self.names.face(*f);
-            self.o.oper(&format!("REST FACE {face} ON THE TABLE"));
+            let face = self.face_words(*f);
+            self.o.oper(&format!("REST {face} ON THE TABLE"));
         }
         let al = &sp.alignment;
         if !al.missing.is_empty() {
@@ -1208,5 +1235,38 @@ fn round3(x: f64) -> f64 {
         0.0
     } else {
         r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn operator_text_keeps_every_word_when_signs_are_spelt_out() {
+        let mut o = Out {
+            text: String::new(),
+            at: None,
+        };
+        let msg = "hold it by fixture sine (sine_plate) under datum G (face_22), face_27, \
+                   tilted 53.4°, its longest edge at 45° to the hinge, Ø8 ± 0.1";
+        o.oper(msg);
+        let said: Vec<String> = o
+            .text
+            .lines()
+            .map(|l| {
+                assert!(l.len() <= crate::dmis::text::LINE_MAX, "{l}");
+                l.trim_start_matches("TEXT/OPER,'")
+                    .trim_end_matches('\'')
+                    .to_string()
+            })
+            .collect();
+        assert_eq!(
+            said.join(" "),
+            plain(msg, usize::MAX)
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
     }
 }

@@ -82,13 +82,19 @@ impl<'a> Names<'a> {
     /// …`, `vise v (vise): jaws on … and …, resting on …`, `chuck c (chuck) gripping …`,
     /// `plate p (sine_plate) under …, tilted 30°`.
     pub fn holder(&self, h: &super::poses::Holder, up: &V3) -> String {
+        self.holder_naming(h, up, &|f| self.face(f).to_string())
+    }
+
+    /// [`Names::holder`] with the faces named by `face` (the DMIS writer names them by
+    /// the datum or feature measured on them, for the operator).
+    pub fn holder_naming(
+        &self,
+        h: &super::poses::Holder,
+        up: &V3,
+        face: &dyn Fn(FaceId) -> String,
+    ) -> String {
         use crate::model::FixtureKind;
-        let faces = |fs: &[FaceId]| {
-            fs.iter()
-                .map(|f| self.face(*f))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
+        let faces = |fs: &[FaceId]| fs.iter().map(|f| face(*f)).collect::<Vec<_>>().join(", ");
         match h {
             super::poses::Holder::Table { faces: fs } => format!("the table on {}", faces(fs)),
             super::poses::Holder::Fixture {
@@ -102,8 +108,8 @@ impl<'a> Names<'a> {
                 match kind {
                     FixtureKind::Vise { .. } if fs.len() >= 2 => format!(
                         "{name}: jaws on {} and {}, resting on {}",
-                        self.face(fs[0]),
-                        self.face(fs[1]),
+                        face(fs[0]),
+                        face(fs[1]),
                         faces(&fs[2..])
                     ),
                     FixtureKind::Chuck { .. } => format!("{name} gripping {}", faces(fs)),

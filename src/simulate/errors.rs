@@ -67,10 +67,10 @@ pub enum SimError {
         supported: String,
     },
 
-    #[error("no plan of the spec wrote program `{program}`")]
+    #[error("program `{program}` names no plan of the spec, which holds several")]
     #[diagnostic(
         code(insp::simulate::no_plan),
-        help("simulate a program with the spec it was built from; its plans are: {plans}")
+        help("the spec holds several plans: name one of them in the program's DMISMN (with one plan, any program runs on it); its plans are: {plans}")
     )]
     NoPlan {
         #[label("the program's name")]

@@ -463,7 +463,10 @@ pub fn circle(points: &[P3], guess: &Shape) -> Option<Shape> {
         return None;
     };
     let (u, v) = across(a);
-    let flat: Vec<[f64; 2]> = points.iter().map(|q| [q.coords.dot(&u), q.coords.dot(&v)]).collect();
+    let flat: Vec<[f64; 2]> = points
+        .iter()
+        .map(|q| [q.coords.dot(&u), q.coords.dot(&v)])
+        .collect();
     if points.len() < 3 || collinear(&flat) {
         return None;
     }
@@ -471,14 +474,19 @@ pub fn circle(points: &[P3], guess: &Shape) -> Option<Shape> {
     // onto one plane, they never do.
     let mean = points.iter().fold(V3::zeros(), |s, q| s + q.coords) / points.len() as f64;
     let h = mean.dot(a);
-    let on_plane: Vec<P3> = points.iter().map(|q| q - a * (q.coords.dot(a) - h)).collect();
+    let on_plane: Vec<P3> = points
+        .iter()
+        .map(|q| q - a * (q.coords.dot(a) - h))
+        .collect();
     cylinder(&on_plane, guess)
 }
 
 /// Whether 2D points lie on one line (to a micrometre over their spread).
 fn collinear(pts: &[[f64; 2]]) -> bool {
     let n = pts.len() as f64;
-    let (mx, my) = pts.iter().fold((0.0, 0.0), |s, p| (s.0 + p[0] / n, s.1 + p[1] / n));
+    let (mx, my) = pts
+        .iter()
+        .fold((0.0, 0.0), |s, p| (s.0 + p[0] / n, s.1 + p[1] / n));
     let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
     for p in pts {
         let (dx, dy) = (p[0] - mx, p[1] - my);

@@ -371,9 +371,9 @@ impl Machine<'_> {
             // What a real controller needs and a virtual one has no use for: names, feed
             // rates, probe compensation (always on here), the work plane, the results
             // file (the report goes where `--report` says).
-            "DMISMN" | "DMISMD" | "FILNAM" | "TEXT" | "ENDFIL" | "FEDRAT" | "ACLRAT"
-            | "PRCOMP" | "WKPLAN" | "DECPL" | "DEVICE" | "OPEN" | "CLOSE" | "DISPLY"
-            | "PARTID" | "PARTRV" | "PARTSN" | "PLANID" => {}
+            "DMISMN" | "DMISMD" | "FILNAM" | "TEXT" | "ENDFIL" | "FEDRAT" | "ACLRAT" | "PRCOMP"
+            | "WKPLAN" | "DECPL" | "DEVICE" | "OPEN" | "CLOSE" | "DISPLY" | "PARTID" | "PARTRV"
+            | "PARTSN" | "PLANID" => {}
             "SAVE" => {
                 for p in params {
                     if let Some(l) = label_of(p) {
@@ -790,15 +790,19 @@ impl Machine<'_> {
     /// it selects none; an error when the rack holds no probe of that definition.
     fn first_selected(&self) -> Result<Option<Sensor>, SimError> {
         let commands = || {
-            self.input.program.statements.iter().filter_map(|s| match s {
-                Statement::Command {
-                    label,
-                    major,
-                    params,
-                    at,
-                } => Some((label, major, params, *at)),
-                Statement::Comment(_) => None,
-            })
+            self.input
+                .program
+                .statements
+                .iter()
+                .filter_map(|s| match s {
+                    Statement::Command {
+                        label,
+                        major,
+                        params,
+                        at,
+                    } => Some((label, major, params, *at)),
+                    Statement::Comment(_) => None,
+                })
         };
         let Some(l) = commands()
             .find(|c| c.1 == "SNSLCT")
@@ -806,9 +810,9 @@ impl Machine<'_> {
         else {
             return Ok(None);
         };
-        let Some((_, _, params, at)) = commands().find(|c| {
-            c.1 == "SNSDEF" && c.0.as_ref().is_some_and(|(k, x)| k == "S" && x == l)
-        }) else {
+        let Some((_, _, params, at)) = commands()
+            .find(|c| c.1 == "SNSDEF" && c.0.as_ref().is_some_and(|(k, x)| k == "S" && x == l))
+        else {
             return Ok(None);
         };
         self.sensor_def(l, params, at).map(Some)
@@ -1724,9 +1728,7 @@ impl Machine<'_> {
         };
         let actual: Vec<f64> = match &m.shape {
             Shape::Plane { p, n: v } | Shape::Point { p, n: v } => with(xyz(p), &ijk(&along(v))),
-            Shape::Cylinder { p, a, r } => {
-                with(with(xyz(p), &ijk(&along(a))), &[2.0 * r])
-            }
+            Shape::Cylinder { p, a, r } => with(with(xyz(p), &ijk(&along(a))), &[2.0 * r]),
             Shape::Cone { apex, a, half } => {
                 with(with(xyz(apex), &ijk(&along(a))), &[2.0 * half.to_degrees()])
             }

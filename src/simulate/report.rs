@@ -199,9 +199,14 @@ impl Report {
                     _ if f.inner => ", inner",
                     _ => ", outer",
                 },
-                if nums.is_empty() { "-".to_string() } else { nums.join(", ") },
+                if nums.is_empty() {
+                    "-".to_string()
+                } else {
+                    nums.join(", ")
+                },
                 f.points,
-                f.form.map_or(String::new(), |e| format!(", form {}", val(e)))
+                f.form
+                    .map_or(String::new(), |e| format!(", form {}", val(e)))
             ));
         }
         let n = self.rows.len();

@@ -358,7 +358,11 @@ fn programs_read_back() {
             program.warnings.is_empty(),
             "{}: the reader warns on the program: {:?}",
             c.name,
-            program.warnings.iter().map(|e| e.to_string()).collect::<Vec<_>>()
+            program
+                .warnings
+                .iter()
+                .map(|e| e.to_string())
+                .collect::<Vec<_>>()
         );
         assert!(
             program.to_text() == b.dmis,

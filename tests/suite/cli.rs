@@ -535,7 +535,7 @@ fn a_failed_build_writes_nothing() {
 fn the_dmis_reader_reports_what_a_controller_rejects() {
     let bad = temp_spec(
         "bad.dmi",
-        "DMISMN/'X',05.3\nF(bad)=FEAT/POINT,CART,0,0,0,0,0,1\nMEAS/POINT,F(NONE),2\nPTMEAS/CART,1,2,3,0,0,1\nENDMES\nOUTPUT/FA(NONE),TA(T1)\n",
+        "DMISMN/'X',05.3\nF(B-AD)=FEAT/POINT,CART,0,0,0,0,0,1\nMEAS/POINT,F(NONE),2\nPTMEAS/CART,1,2,3,0,0,1\nENDMES\nOUTPUT/FA(NONE),TA(T1)\n",
     );
     let (code, _, stderr) = inspc(&["dmis", &bad]);
     assert_eq!(code, 1);

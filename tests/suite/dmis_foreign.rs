@@ -13,7 +13,11 @@ const NIST: &str = "../shared/parts/nist_ipp_simple";
 fn read(text: &str) -> Result<inspc::dmis::Program, Vec<String>> {
     inspc::dmis::read(FileId(0), text).map_err(|es| {
         es.iter()
-            .map(|e| miette::Diagnostic::code(e).map(|c| c.to_string()).unwrap_or_default())
+            .map(|e| {
+                miette::Diagnostic::code(e)
+                    .map(|c| c.to_string())
+                    .unwrap_or_default()
+            })
             .collect()
     })
 }
@@ -21,7 +25,11 @@ fn read(text: &str) -> Result<inspc::dmis::Program, Vec<String>> {
 fn warnings(p: &inspc::dmis::Program) -> Vec<String> {
     p.warnings
         .iter()
-        .map(|e| miette::Diagnostic::code(e).map(|c| c.to_string()).unwrap_or_default())
+        .map(|e| {
+            miette::Diagnostic::code(e)
+                .map(|c| c.to_string())
+                .unwrap_or_default()
+        })
         .collect()
 }
 
@@ -50,10 +58,15 @@ fn nists_program_runs_unchanged_and_reports_the_circle() {
         &inspc::simulate::Options::default(),
     );
     let codes: Vec<String> = r.checked.diagnostics.iter().map(|d| d.code()).collect();
-    let rep = r.report.unwrap_or_else(|| panic!("the run stopped: {codes:?}"));
+    let rep = r
+        .report
+        .unwrap_or_else(|| panic!("the run stopped: {codes:?}"));
     assert_eq!(rep.features.len(), 1, "{:?}", rep.features);
     let f = &rep.features[0];
-    assert_eq!((f.label.as_str(), f.kind.as_str(), f.inner), ("A_CIRCLE", "CIRCLE", true));
+    assert_eq!(
+        (f.label.as_str(), f.kind.as_str(), f.inner),
+        ("A_CIRCLE", "CIRCLE", true)
+    );
     // NIST's output.dms: 50, 50, 40, 0, 0, 1, 50.
     let want = [50.0, 50.0, 40.0, 0.0, 0.0, 1.0, 50.0];
     assert_eq!(f.actual.len(), 7);
@@ -62,7 +75,10 @@ fn nists_program_runs_unchanged_and_reports_the_circle() {
     }
     // The results file reads back, in the output file's form.
     let dmo = rep.dmis();
-    assert!(dmo.starts_with("FILNAM/'IPP SIMPLE DMIS output'\n"), "{dmo}");
+    assert!(
+        dmo.starts_with("FILNAM/'IPP SIMPLE DMIS output'\n"),
+        "{dmo}"
+    );
     assert!(dmo.contains("FA(A_CIRCLE)=FEAT/CIRCLE,INNER,CART,50.0,50.0,40.0,0.0,0.0,1.0,50.0\n"));
     let back = read(&dmo).unwrap_or_else(|e| panic!("{e:?}\n{dmo}"));
     assert!(warnings(&back).is_empty());
@@ -72,7 +88,10 @@ fn nists_program_runs_unchanged_and_reports_the_circle() {
 fn a_probe_not_in_the_rack_names_its_snsdef() {
     let text = std::fs::read_to_string(Path::new(NIST).join("simple_in.dms"))
         .unwrap()
-        .replace("0.0, 0.0, 30.0, 0.0, 0.0, -1.0, 4.0", "0.0, 0.0, 30.0, 0.0, 0.0, -1.0, 3.0");
+        .replace(
+            "0.0, 0.0, 30.0, 0.0, 0.0, -1.0, 4.0",
+            "0.0, 0.0, 30.0, 0.0, 0.0, -1.0, 3.0",
+        );
     let dir = std::env::temp_dir().join(format!("inspc-foreign-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let prog = dir.join("other_probe.dms");
@@ -86,7 +105,10 @@ fn a_probe_not_in_the_rack_names_its_snsdef() {
     );
     assert!(r.report.is_none());
     let codes: Vec<String> = r.checked.diagnostics.iter().map(|d| d.code()).collect();
-    assert!(codes.contains(&"insp::simulate::unknown_sensor".to_string()), "{codes:?}");
+    assert!(
+        codes.contains(&"insp::simulate::unknown_sensor".to_string()),
+        "{codes:?}"
+    );
 }
 
 #[test]
@@ -97,7 +119,9 @@ fn the_language_not_a_dialect() {
     assert_eq!(p.commands("FEAT").next().unwrap().len(), 8);
     // inspc's old datum form is not DMIS.
     let old = text.replace("DATDEF/FA(P),DAT(A)", "DAT(A)=DATDEF/FA(P)");
-    assert!(read(&old).unwrap_err().contains(&"insp::dmis::datdef_form".to_string()));
+    assert!(read(&old)
+        .unwrap_err()
+        .contains(&"insp::dmis::datdef_form".to_string()));
     // What inspc does not run, or does not know, is a warning on the statement.
     let more = text.replace(
         "endfil",
@@ -110,5 +134,7 @@ fn the_language_not_a_dialect() {
     }
     // A block left open is an error.
     let open = text.replace("endfil", "DO/V(I),1,3\nendfil");
-    assert!(read(&open).unwrap_err().contains(&"insp::dmis::structure".to_string()));
+    assert!(read(&open)
+        .unwrap_err()
+        .contains(&"insp::dmis::structure".to_string()));
 }

@@ -395,20 +395,51 @@ fn every_stop_is_a_diagnostic() {
         code(spec, program, Some("face stock.top grow 1")),
         vec!["insp::simulate::bad_deviation"]
     );
-    // A program of another plan, a probe the machine lacks, a statement it does not run,
-    // a setup nothing holds, a touch with no sensor.
+    // A program named after no plan runs against a spec with one plan, and stops on a
+    // spec with several; a probe the machine lacks; a statement in a form it does not
+    // run (DMIS it does not run at all is a reader's warning, passed over); a setup
+    // nothing holds; a touch with no sensor.
     let p = edited("other.dmi", "DMISMN/'F2_PLAN'", "DMISMN/'OTHER'");
-    assert_eq!(code(spec, &p, None), vec!["insp::simulate::no_plan"]);
-    let p = edited("sensor.dmi", "0,0,1,4\n", "0,0,1,7\n");
+    assert!(run(spec, &p, None, Options::default()).is_ok());
+    let two = dir.join("two_plans.insp");
+    let f2 = std::fs::read_to_string(spec).expect("spec");
+    std::fs::write(
+        &two,
+        format!(
+            "{f2}
+plan f2_again {{
+    part f2
+    cmm lab
+}}
+"
+        ),
+    )
+    .expect("write");
+    assert_eq!(
+        code(two.to_str().unwrap(), &p, None),
+        vec!["insp::simulate::no_plan"]
+    );
+    let p = edited("sensor.dmi", "0.0,0.0,1.0,4.0\n", "0.0,0.0,1.0,7.0\n");
     assert_eq!(code(spec, &p, None), vec!["insp::simulate::unknown_sensor"]);
     let p = edited(
         "call.dmi",
         "MODE/PROG,MAN\n",
         "MODE/PROG,MAN\nCALL/EXTERN,DME,'X'\n",
     );
+    assert!(run(spec, &p, None, Options::default()).is_ok());
+    let p = edited("inch.dmi", "UNITS/MM,ANGDEC\n", "UNITS/INCH,ANGDEC\n");
     assert_eq!(code(spec, &p, None), vec!["insp::simulate::unsupported"]);
     let p = edited("tilted.dmi", "PAUSE\n", "D(TILT)=ROTATE/XAXIS,45\nPAUSE\n");
     assert_eq!(code(spec, &p, None), vec!["insp::simulate::no_setup"]);
-    let p = edited("nosensor.dmi", "SNSLCT/S(P1)\n", "");
-    assert_eq!(code(spec, &p, None), vec!["insp::simulate::bad_statement"]);
+    let p = dir.join("nosensor.dmi");
+    std::fs::write(
+        &p,
+        text.replace("SNSLCT/S(P1)\n", "")
+            .replace("SNSLCT/S(P2)\n", ""),
+    )
+    .expect("write");
+    assert_eq!(
+        code(spec, &p.display().to_string(), None),
+        vec!["insp::simulate::bad_statement"]
+    );
 }

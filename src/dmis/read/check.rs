@@ -271,7 +271,9 @@ fn numbers_or_words(params: &[String]) -> bool {
     params.iter().enumerate().all(|(k, p)| {
         decimal(p).is_some()
             || (k == 0 && matches!(p.as_str(), "CART" | "POL" | "INCR"))
-            || refs(std::slice::from_ref(p)).first().is_some_and(|(k, _)| k == "V")
+            || refs(std::slice::from_ref(p))
+                .first()
+                .is_some_and(|(k, _)| k == "V")
     })
 }
 

@@ -122,9 +122,12 @@ pub(super) fn split(s: &str) -> Vec<String> {
     out
 }
 
+/// A statement's label (`KIND`, name), major word and parameters.
+pub(super) type Parsed = (Option<(String, String)>, String, Vec<String>);
+
 /// A statement in canonical form as its label, major word and parameters; `None` when
 /// it has no legal major word.
-pub(super) fn parse(s: &str) -> Option<(Option<(String, String)>, String, Vec<String>)> {
+pub(super) fn parse(s: &str) -> Option<Parsed> {
     let slash = s.find('/');
     let head = &s[..slash.unwrap_or(s.len())];
     let (label, major) = match head.split_once('=') {
@@ -175,7 +178,10 @@ mod tests {
         };
         let (label, major, params) = parse(&canonical(t).unwrap()).unwrap();
         assert_eq!(label, Some(("D".into(), "START".into())));
-        assert_eq!((major.as_str(), params), ("DATSET", vec!["MCS".to_string()]));
+        assert_eq!(
+            (major.as_str(), params),
+            ("DATSET", vec!["MCS".to_string()])
+        );
         assert_eq!(
             ls[2],
             Line::Comment {

@@ -161,7 +161,9 @@ pub enum DmisError {
         what: String,
         help: String,
     },
-    #[error("`DAT({datum})=DATDEF/…` is not DMIS: a datum is defined by the statement's last parameter")]
+    #[error(
+        "`DAT({datum})=DATDEF/…` is not DMIS: a datum is defined by the statement's last parameter"
+    )]
     #[diagnostic(
         code(insp::dmis::datdef_form),
         help("write `DATDEF/{feature},DAT({datum})`, the form of ANSI/DMIS 105.2 and of NIST's and the QIF bindings' programs; a controller stops on this one")
@@ -275,7 +277,11 @@ pub fn read(file: FileId, text: &str) -> Result<Program, Vec<DmisError>> {
         })
     } else {
         errors.extend(warnings);
-        errors.sort_by_key(|e| miette::Diagnostic::labels(e).and_then(|mut l| l.next()).map_or(0, |l| l.offset()));
+        errors.sort_by_key(|e| {
+            miette::Diagnostic::labels(e)
+                .and_then(|mut l| l.next())
+                .map_or(0, |l| l.offset())
+        });
         Err(errors)
     }
 }
