@@ -167,7 +167,8 @@ enum Command {
         /// Seed of the noise.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Also write the report: `.json` as JSON, `.dmo` as DMIS output, else text.
+        /// Also write the report: `.json` as JSON, `.dmo` as DMIS output, `.qif` as QIF 3
+        /// Results, else text.
         #[arg(long)]
         report: Option<PathBuf>,
     },
@@ -805,6 +806,16 @@ fn simulate(
         let bytes = match ext {
             "json" => serde_json::to_string_pretty(&r.json()).unwrap_or_default() + "\n",
             "dmo" => r.dmis(),
+            "qif" => {
+                let text = run
+                    .checked
+                    .sources
+                    .find_path(program)
+                    .map(|id| run.checked.sources.get(id).text.as_str())
+                    .unwrap_or_default();
+                let meta = inspc::simulate::QifMeta::new(spec, program, text);
+                inspc::simulate::qif_results(&r, &meta)
+            }
             _ => r.text(),
         };
         let out = cli::outputs::Output {

@@ -418,12 +418,14 @@ impl Writer<'_> {
             };
             let label = self.labels.fresh("S", &name);
             if self.indexable() {
-                let d = crate::access::head_direction(g.a, g.b);
+                // CMM Quarterly's form (`SNSDEF/PROBE,INDEX,POL,45,45,0,0,1,100,3`): the
+                // head's A and B, the mounting vector of the head (a vertical ram: +Z),
+                // the length from the head's centre of rotation to the tip centre, the
+                // tip's diameter (docs/dmis.md).
                 self.o.stmt(&format!(
-                    "S({label})=SNSDEF/{kind},INDEX,POL,{},{},VEC,{},{len},{diam}",
+                    "S({label})=SNSDEF/{kind},INDEX,POL,{},{},0.0,0.0,1.0,{len},{diam}",
                     real(g.a),
                     real(g.b),
-                    ijk(&d)
                 ));
             } else {
                 self.o.stmt(&format!(

@@ -20,11 +20,13 @@ mod errors;
 pub mod evaluate;
 pub mod fit;
 mod machine;
+pub mod qif;
 mod report;
 
 pub use deviation::Deviations;
 pub use errors::SimError;
 pub use machine::{plan_of, simulate};
+pub use qif::{qif_results, QifMeta};
 pub use report::{FeatureRow, Report, Row};
 
 use crate::geometry::{FaceId, FixtureMesh, PartGeometry};

@@ -45,8 +45,9 @@ pub struct FeatureRow {
     /// `INNER` (a hole, a slot) rather than `OUTER` (a boss, a block).
     pub inner: bool,
     /// The nominal's numbers in the `FEAT` statement's order after `CART`: a location
-    /// `x, y, z`, a direction `i, j, k`, then the size (diameter, width, half angle in
-    /// degrees for a cone) where the kind has one. Empty for `PATERN` and `GSURF`.
+    /// `x, y, z`, a direction `i, j, k`, then the size (diameter, width, or the full
+    /// included angle in degrees for a cone) where the kind has one. Empty for `PATERN`
+    /// and `GSURF`.
     pub nominal: Vec<f64>,
     /// The actual in the same layout, in the alignment current when it was output.
     pub actual: Vec<f64>,

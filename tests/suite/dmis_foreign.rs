@@ -82,6 +82,14 @@ fn nists_program_runs_unchanged_and_reports_the_circle() {
     assert!(dmo.contains("FA(A_CIRCLE)=FEAT/CIRCLE,INNER,CART,50.0,50.0,40.0,0.0,0.0,1.0,50.0\n"));
     let back = read(&dmo).unwrap_or_else(|e| panic!("{e:?}\n{dmo}"));
     assert!(warnings(&back).is_empty());
+    // And as QIF 3 Results, valid against the schemas.
+    let program = Path::new(NIST).join("simple_in.dms");
+    let text = std::fs::read_to_string(&program).unwrap();
+    let meta =
+        inspc::simulate::QifMeta::new(Path::new("tests/foreign/ipp_simple.insp"), &program, &text);
+    let doc = inspc::simulate::qif_results(&rep, &meta);
+    assert!(doc.contains("CircleFeatureMeasurement"), "{doc}");
+    super::qif_results::check("ipp_simple", &rep, &doc);
 }
 
 #[test]

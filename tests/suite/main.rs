@@ -22,6 +22,7 @@ mod lsp;
 mod mesh_fuzz;
 mod no_panic;
 mod qif;
+mod qif_results;
 mod replan;
 mod sampling;
 mod scan;

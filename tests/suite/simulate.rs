@@ -1,7 +1,8 @@
 //! The virtual CMM (`inspc simulate`) on the golden programs: at nominal every
 //! tolerance is in with deviations near zero; a deviation beyond one tolerance's zone
 //! makes exactly that tolerance fail; a part placed off on the table is found by the
-//! alignment and measures the same; every way a run stops is a diagnostic.
+//! alignment and measures the same; every way a run stops is a diagnostic. Every golden
+//! run's results are written as QIF 3 and validated against the schemas.
 
 use inspc::simulate::{Options, Report};
 use inspc::source::FsWorld;
@@ -117,6 +118,15 @@ fn every_golden_program_measures_its_part_in_tolerance() {
                 row.features
             );
         }
+        // Its results as QIF 3, valid against the schemas.
+        let text = std::fs::read_to_string(&program).expect("program");
+        let meta = inspc::simulate::QifMeta::new(Path::new(&spec), Path::new(&program), &text);
+        let name = dir.file_name().map(|n| n.to_string_lossy().into_owned());
+        super::qif_results::check(
+            &name.unwrap_or_default(),
+            &r,
+            &inspc::simulate::qif_results(&r, &meta),
+        );
         checked += 1;
     }
     assert!(checked >= 10, "only {checked} programs simulated");
