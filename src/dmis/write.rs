@@ -255,6 +255,8 @@ struct Writer<'a> {
     /// Sensor labels by probe and angles.
     sensors: BTreeMap<SensorKey, String>,
     current_sensor: Option<String>,
+    /// The probe on the head (its slot), once one is selected.
+    current_probe: Option<SlotId>,
     /// Per block, the feature label its `MEAS` names, the surface and the round.
     feats: BTreeMap<BlockKey, (String, usize, usize)>,
     /// The surfaces measured.
@@ -294,6 +296,8 @@ struct Writer<'a> {
 
 /// Writes the program.
 pub fn write(input: &Input) -> String {
+    let mut labels = Labels::default();
+    labels.fresh("D", "MACHINE");
     let mut w = Writer {
         input,
         names: Names::new(input.model, input.geometry, input.hlip.plan),
@@ -301,9 +305,10 @@ pub fn write(input: &Input) -> String {
             text: String::new(),
             at: None,
         },
-        labels: Labels::default(),
+        labels,
         sensors: BTreeMap::new(),
         current_sensor: None,
+        current_probe: None,
         feats: BTreeMap::new(),
         surfs: Vec::new(),
         points: BTreeMap::new(),
@@ -372,6 +377,9 @@ impl Writer<'_> {
         // the controller writes every `OUTPUT` there.
         o.stmt(&format!("FILNAM/'{} RESULTS'", plain(&input.plan.name, 52)));
         o.stmt("UNITS/MM,ANGDEC");
+        // The machine's own frame, under a label every later setup recalls: NIST's
+        // `D(START) = DATSET/MCS`, not a `D(MCS)` a strict controller never defined.
+        o.stmt("D(MACHINE)=DATSET/MCS");
         o.stmt("MODE/PROG,MAN");
         // Speeds: positioning at NIST's figure in `simple_in.dms` (1.8 m/min, 30 mm/s),
         // touches at 3 mm/s, slow enough for a touch-trigger probe's pre-travel to stay
@@ -680,7 +688,19 @@ impl Writer<'_> {
                     if t.kind == TolKind::Angularity {
                         params.push(real(t.basic_angle.unwrap_or(0.0)));
                     }
-                    params.push(real(*width));
+                    if matches!(t.kind, TolKind::ProfileLine | TolKind::ProfileSurface) {
+                        // A profile's zone as its lower and upper limits about the true
+                        // profile, equally disposed (ASME Y14.5-2018 §11.3.1: without
+                        // another indication the zone is equally disposed).
+                        params.push(real(-width / 2.0));
+                    }
+                    params.push(real(
+                        if matches!(t.kind, TolKind::ProfileLine | TolKind::ProfileSurface) {
+                            width / 2.0
+                        } else {
+                            *width
+                        },
+                    ));
                     // A location or orientation zone names its material condition; with
                     // none on the drawing it is RFS (ASME Y14.5-2018 §5.8.1, rule #2:
                     // regardless of feature size applies where no modifier is given).
@@ -745,7 +765,7 @@ impl Writer<'_> {
         // place in this setup (machine axes turned by the setup's rotation).
         let r = nalgebra::Matrix3::from_fn(|i, j| setup.rotation[i][j]);
         if si > 0 {
-            self.o.stmt("RECALL/D(MCS)");
+            self.o.stmt("RECALL/D(MACHINE)");
         }
         for (axis, angle) in zxz_rotations(&r) {
             let d = self.labels.fresh("D", &format!("NOM{}", si + 1));
@@ -790,8 +810,13 @@ impl Writer<'_> {
             return;
         }
         self.o.stmt("MODE/MAN");
-        self.o
-            .oper("TOUCH THE POINTS SHOWN BY HAND, THEN LEAVE THE PROBE ABOVE THE PART");
+        // The probe first (fitted if it is not on the head), then how to align.
+        if let Some(step) = al.steps.first() {
+            self.select(&sp.groups[step.group]);
+        }
+        self.o.oper(
+            "ALIGN BY HAND: TOUCH EACH POINT THE CONTROLLER SHOWS, FEATURE BY FEATURE, THEN LEAVE THE PROBE ABOVE THE PART",
+        );
         let mut fa = Vec::new();
         for step in &al.steps {
             let g = &sp.groups[step.group];
@@ -799,6 +824,14 @@ impl Writer<'_> {
                 continue;
             };
             self.select(g);
+            if let Some(b) = g.blocks.get(step.block) {
+                let n = step.points.len();
+                self.o.oper(&format!(
+                    "BY HAND: {n} TOUCH{} ON {}",
+                    if n == 1 { "" } else { "ES" },
+                    self.face_words(b.face)
+                ));
+            }
             let meas = self.nominals.get(&label).map_or("PLANE", Nominal::meas);
             self.o
                 .stmt(&format!("MEAS/{meas},F({label}),{}", step.points.len()));
@@ -1167,14 +1200,45 @@ impl Writer<'_> {
     }
 
     /// `SNSLCT` when the group's sensor is not the current one.
+    /// `SNSLCT` of the group's sensor; where it is another probe than the one on the
+    /// head (not only other angles), or the first, the operator is told to fit it and the
+    /// program waits (`PAUSE`): the machine has no changer the spec declares, and a
+    /// controller running with the wrong stylus would drive it into the part by the
+    /// difference in length.
     fn select(&mut self, g: &GroupPath) {
-        if let Some(s) = self.sensors.get(&sensor_key(g)) {
-            if self.current_sensor.as_ref() != Some(s) {
-                self.o.at = None;
-                self.o.stmt(&format!("SNSLCT/S({s})"));
-                self.current_sensor = Some(s.clone());
-            }
+        let Some(s) = self.sensors.get(&sensor_key(g)).cloned() else {
+            return;
+        };
+        if self.current_sensor.as_ref() == Some(&s) {
+            return;
         }
+        if self.current_probe != Some(g.probe) {
+            let cmm = &self.input.model.cmms[self.input.plan.cmm.0];
+            let what = cmm
+                .probes
+                .get(g.probe.0)
+                .map(|(_, id)| self.input.model.probes[id.0].name.clone());
+            let label = self.names.probe(g.probe);
+            let kind = if self.names.is_scanner(g.probe) {
+                "SCANNER"
+            } else {
+                "PROBE"
+            };
+            let verb = if self.current_probe.is_some() {
+                "CHANGE THE"
+            } else {
+                "THE FIRST"
+            };
+            self.o.oper(&format!(
+                "{verb} {kind}: FIT {label}{} ON THE HEAD, QUALIFIED, THEN CONTINUE",
+                what.map_or(String::new(), |w| format!(" ({w})"))
+            ));
+            self.o.stmt("PAUSE");
+        }
+        self.o.at = None;
+        self.o.stmt(&format!("SNSLCT/S({s})"));
+        self.current_sensor = Some(s);
+        self.current_probe = Some(g.probe);
     }
 }
 

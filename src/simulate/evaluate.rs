@@ -126,6 +126,20 @@ impl TolDef {
                 def.nominal = Some(num(rest.next()?)?);
             }
             def.zone = Some(num(rest.next()?)?);
+            // A profile's zone is written as its lower and upper limits about the true
+            // profile (`TOL/PROFS,-0.25,0.25,…`, as PC-DMIS's surface profile has a minus
+            // and a plus tolerance); one value is the whole width, centred. The virtual
+            // CMM judges a zone centred on the true profile: an unequal one is not run.
+            if matches!(word.as_str(), "PROFS" | "PROFL" | "PROFP") {
+                if let Some(hi) = rest.peek().and_then(|s| num(s)) {
+                    rest.next();
+                    let lo = def.zone.unwrap_or(0.0);
+                    if (lo + hi).abs() > 1e-9 || hi < lo {
+                        return None;
+                    }
+                    def.zone = Some(hi - lo);
+                }
+            }
         }
         for p in rest {
             if let Some(l) = p.strip_prefix("DAT(").and_then(|s| s.strip_suffix(')')) {

@@ -190,6 +190,9 @@ struct Machine<'a> {
     /// Program → machine: the current alignment.
     frame: Isometry3<f64>,
     saved: BTreeMap<String, Isometry3<f64>>,
+    /// Labels of the machine's own frame (`D(x)=DATSET/MCS`): recalling one leaves the
+    /// setups, as `RECALL/D(MCS)` does.
+    machine_frames: BTreeSet<String>,
     setup: Option<SetupCtx>,
     /// Per setup, its latest alignment.
     aligns: Vec<Isometry3<f64>>,
@@ -264,6 +267,7 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         tols: BTreeMap::new(),
         frame: Isometry3::identity(),
         saved: BTreeMap::new(),
+        machine_frames: BTreeSet::new(),
         setup: None,
         aligns: Vec::new(),
         between: false,
@@ -476,7 +480,11 @@ impl Machine<'_> {
                     .ok_or_else(|| self.unsupported(at, &format!("TOL/{}", params.join(","))))?;
                 self.tols.insert(l.clone(), def);
             }
-            "PAUSE" => self.start_setup(at)?,
+            // A `PAUSE` after the part was let go (`RECALL` of the machine's frame), or
+            // before any setup, is the next setup's placing; any other waits for the
+            // operator (a probe changed by hand), who may move the ram meanwhile.
+            "PAUSE" if self.setup.is_none() || self.between => self.start_setup(at)?,
+            "PAUSE" => self.at = None,
             "RECALL" => {
                 let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
                 self.frame = if l == "MCS" {
@@ -490,7 +498,7 @@ impl Machine<'_> {
                         )
                     })?
                 };
-                self.between = l == "MCS";
+                self.between = l == "MCS" || self.machine_frames.contains(l);
                 self.realigned(label);
             }
             "ROTATE" => {
@@ -511,6 +519,9 @@ impl Machine<'_> {
             // `DATSET/MCS`: the machine's own axes and origin (NIST's `simple_in.dms`).
             "DATSET" if params.len() == 1 && params[0] == "MCS" => {
                 self.frame = Isometry3::identity();
+                if let Some((_, l)) = label {
+                    self.machine_frames.insert(l.clone());
+                }
                 self.realigned(label);
             }
             "DATSET" => {

@@ -20,7 +20,7 @@ mod errors;
 pub mod evaluate;
 pub mod fit;
 mod machine;
-pub mod qif;
+mod qif;
 mod report;
 
 pub use deviation::Deviations;

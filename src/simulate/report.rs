@@ -185,7 +185,9 @@ impl Report {
             s.push_str(&c[6]);
             s.trim_end().to_string() + "\n"
         };
-        out.push_str(&line(&head.map(String::from)));
+        if !rows.is_empty() {
+            out.push_str(&line(&head.map(String::from)));
+        }
         for r in &rows {
             out.push_str(&line(r));
         }
