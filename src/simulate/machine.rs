@@ -187,6 +187,8 @@ struct Machine<'a> {
     mounted: Option<Sensor>,
     nominals: BTreeMap<String, Nominal>,
     tols: BTreeMap<String, TolDef>,
+    /// Per tolerance, its `2D`/`3D`, material words and datum references as written.
+    tol_words: BTreeMap<String, Vec<String>>,
     /// Program → machine: the current alignment.
     frame: Isometry3<f64>,
     saved: BTreeMap<String, Isometry3<f64>>,
@@ -265,6 +267,7 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         mounted: None,
         nominals: BTreeMap::new(),
         tols: BTreeMap::new(),
+        tol_words: BTreeMap::new(),
         frame: Isometry3::identity(),
         saved: BTreeMap::new(),
         machine_frames: BTreeSet::new(),
@@ -479,6 +482,15 @@ impl Machine<'_> {
                 let def = TolDef::parse(params)
                     .ok_or_else(|| self.unsupported(at, &format!("TOL/{}", params.join(","))))?;
                 self.tols.insert(l.clone(), def);
+                let words = params[1..]
+                    .iter()
+                    .filter(|p| {
+                        matches!(p.as_str(), "2D" | "3D" | "MMC" | "LMC" | "RFS")
+                            || p.starts_with("DAT(")
+                    })
+                    .cloned()
+                    .collect();
+                self.tol_words.insert(l.clone(), words);
             }
             // A `PAUSE` after the part was let go (`RECALL` of the machine's frame), or
             // before any setup, is the next setup's placing; any other waits for the
@@ -1716,6 +1728,7 @@ impl Machine<'_> {
             kind: def.word.clone(),
             features: labels,
             datums: def.datums.clone(),
+            words: self.tol_words.get(tl).cloned().unwrap_or_default(),
             outcome: out,
         });
         Ok(())

@@ -17,6 +17,10 @@ pub struct Row {
     pub features: Vec<String>,
     /// Its datums' labels.
     pub datums: Vec<String>,
+    /// Its zone's `2D`/`3D` (a position) and its material-condition words and datum
+    /// references, as its `TOL` statement wrote them (`MMC`, `DAT(A)`, `DAT(B)`, `MMC`):
+    /// what a results file repeats around the actual.
+    pub words: Vec<String>,
     /// What it measured.
     pub outcome: Outcome,
 }
@@ -314,14 +318,18 @@ impl Report {
             }
             let verdict = if r.pass() { "INTOL" } else { "OUTOL" };
             stmt(&format!("OUTPUT/{},TA({})", fa.join(","), r.tolerance));
-            // The actual, then the verdict: the form the QIF community's DMIS bindings
-            // write (`TA(DIAM1)=TOL/DIAM,6.2,OUTOL`, `bindings/Python/demoQIFin.py`).
-            stmt(&format!(
-                "TA({})=TOL/{},{},{verdict}",
-                r.tolerance,
-                r.kind,
-                real(round4(o.actual)),
-            ));
+            // The actual, then the verdict, then the zone's modifiers and datums: the
+            // form the QIF community's DMIS bindings write (`TA(DIAM1)=TOL/DIAM,6.2,OUTOL`,
+            // `TA(POSN2)=TOL/POS,3D,0.0618,INTOL,MMC,DAT(A),DAT(B),MMC,DAT(C),MMC`,
+            // `bindings/Python/demoQIFin.py`).
+            let (dims, rest): (Vec<&String>, Vec<&String>) =
+                r.words.iter().partition(|w| *w == "2D" || *w == "3D");
+            let mut params = vec![r.kind.clone()];
+            params.extend(dims.into_iter().cloned());
+            params.push(real(round4(o.actual)));
+            params.push(verdict.to_string());
+            params.extend(rest.into_iter().cloned());
+            stmt(&format!("TA({})=TOL/{}", r.tolerance, params.join(",")));
         }
         stmt("ENDFIL");
         out

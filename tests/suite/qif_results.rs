@@ -237,6 +237,7 @@ fn row(t: &str, kind: &str, features: &[&str], datums: &[&str], o: (f64, f64, f6
         kind: kind.into(),
         features: features.iter().map(|s| s.to_string()).collect(),
         datums: datums.iter().map(|s| s.to_string()).collect(),
+        words: datums.iter().map(|d| format!("DAT({d})")).collect(),
         outcome: Outcome {
             nominal: o.0,
             actual: o.1,

@@ -84,6 +84,7 @@ fn row(t: &str, kind: &str, features: &[&str], datums: &[&str], o: Outcome) -> R
         kind: kind.into(),
         features: features.iter().map(|s| s.to_string()).collect(),
         datums: datums.iter().map(|s| s.to_string()).collect(),
+        words: datums.iter().map(|d| format!("DAT({d})")).collect(),
         outcome: o,
     }
 }
