@@ -82,6 +82,14 @@ fn ijk(v: &V3) -> String {
     format!("{},{},{}", real(v.x), real(v.y), real(v.z))
 }
 
+/// The feature a manual alignment step measures: its label, `MEAS` word and, for a
+/// line, the `DATSET` direction keyword it gives in place of its wall's normal.
+struct Manual {
+    label: String,
+    meas: &'static str,
+    line_dir: Option<String>,
+}
+
 /// Where a block's nominal comes from.
 #[derive(Clone)]
 enum Nominal {
@@ -818,6 +826,9 @@ impl Writer<'_> {
             "ALIGN BY HAND: TOUCH EACH POINT THE CONTROLLER SHOWS, FEATURE BY FEATURE, THEN LEAVE THE PROBE ABOVE THE PART",
         );
         let mut fa = Vec::new();
+        let mut fa_manual = Vec::new();
+        // The part axis the primary's direction fixes, once measured.
+        let mut primary: Option<usize> = None;
         for step in &al.steps {
             let g = &sp.groups[step.group];
             let Some((label, ..)) = self.feats.get(&(si, step.group, step.block)).cloned() else {
@@ -832,13 +843,25 @@ impl Writer<'_> {
                     self.face_words(b.face)
                 ));
             }
-            let meas = self.nominals.get(&label).map_or("PLANE", Nominal::meas);
-            self.o
-                .stmt(&format!("MEAS/{meas},F({label}),{}", step.points.len()));
+            let manual = self.manual_feature(&label, step, primary);
+            self.o.stmt(&format!(
+                "MEAS/{},F({}),{}",
+                manual.meas,
+                manual.label,
+                step.points.len()
+            ));
             for &k in &step.points {
                 ptmeas(&mut self.o, hlip, k);
             }
             self.o.stmt("ENDMES");
+            if primary.is_none() {
+                primary = step
+                    .keywords
+                    .iter()
+                    .find(|k| k.ends_with("DIR"))
+                    .and_then(|k| k.trim_start_matches('-').chars().next())
+                    .and_then(|c| "XYZ".find(c));
+            }
             // A direction is the `FEAT`'s: where the feature's nominal axis (its first
             // face's) runs against the touched face's (the other half of a split bore),
             // the keyword's sign turns with it.
@@ -869,13 +892,25 @@ impl Writer<'_> {
                 )
                 .collect();
             fa.push(format!("FA({label}),{}", keywords.join(",")));
+            let manual_keywords: Vec<String> = keywords
+                .iter()
+                .map(|k| match (&manual.line_dir, k.ends_with("DIR")) {
+                    (Some(d), true) => d.clone(),
+                    _ => k.clone(),
+                })
+                .collect();
+            fa_manual.push(format!(
+                "FA({}),{}",
+                manual.label,
+                manual_keywords.join(",")
+            ));
         }
         let shifts: Vec<String> = al
             .trans
             .iter()
             .map(|(k, v)| format!("{k}ORIG,{}", real(-v)))
             .collect();
-        self.datset(&format!("SETUP{}", si + 1), &fa, &shifts);
+        self.datset(&format!("SETUP{}", si + 1), &fa_manual, &shifts);
         self.o.stmt("MODE/PROG,MAN");
         // Once the program has measured the alignment features itself, it aligns again
         // on those measurements: the hand-touched points only start it.
@@ -895,6 +930,111 @@ impl Writer<'_> {
             shifts,
             measured: std::collections::BTreeSet::new(),
         });
+    }
+
+    /// The feature a manual alignment step touches, in the DMIS kind its touches
+    /// determine: the block's own feature where they do (3 on a plane, circles on two
+    /// levels of a bore); else a feature of its own, defined here — a line for 2 touches
+    /// on a plane (the 3-2-1 secondary), a point for 1 (the tertiary), a circle for a
+    /// bore touched at one level. DMIS fits no plane to 2 points and no cylinder to one
+    /// circle (`MEAS/PLANE` needs 3, Hexagon's PC-DMIS help: "a plane is defined by 3
+    /// points"), so neither does a controller running this program.
+    fn manual_feature(
+        &mut self,
+        label: &str,
+        step: &crate::path::AlignStep,
+        primary: Option<usize>,
+    ) -> Manual {
+        let hlip = self.input.hlip;
+        let nominal = self.nominals.get(label).cloned();
+        let pts: Vec<&crate::plan::PlanPoint> =
+            step.points.iter().map(|&k| &hlip.points[k]).collect();
+        let own = |meas: &'static str| Manual {
+            label: label.to_string(),
+            meas,
+            line_dir: None,
+        };
+        let Some(nominal) = nominal else {
+            return own("PLANE");
+        };
+        let mean = P3::from(
+            pts.iter().fold(V3::zeros(), |s, p| s + p.position.coords) / pts.len().max(1) as f64,
+        );
+        match (nominal.clone(), pts.len()) {
+            (Nominal::Surface(Surface::Plane { .. }, _) | Nominal::Table(..), 1) => {
+                let l = self.labels.fresh("F", &format!("{label}_PT"));
+                let p = pts[0];
+                self.o.stmt(&format!(
+                    "F({l})=FEAT/POINT,CART,{},{}",
+                    xyz(&p.position),
+                    ijk(&p.normal)
+                ));
+                Manual {
+                    label: l,
+                    meas: "POINT",
+                    line_dir: None,
+                }
+            }
+            (Nominal::Surface(Surface::Plane { normal, .. }, _) | Nominal::Table(_, normal), 2) => {
+                let d = (pts[1].position - pts[0].position).normalize();
+                let plane = d.cross(&normal).normalize();
+                let l = self.labels.fresh("F", &format!("{label}_LN"));
+                self.o.stmt(&format!(
+                    "F({l})=FEAT/LINE,UNBND,CART,{},{},{}",
+                    xyz(&mean),
+                    ijk(&d),
+                    ijk(&plane)
+                ));
+                // The line's direction keyword: the part axis it runs along, across the
+                // wall's normal and the primary's direction.
+                let wall = (0..3).max_by(|&a, &b| normal[a].abs().total_cmp(&normal[b].abs()));
+                let axis = (0..3)
+                    .filter(|&k| Some(k) != wall && Some(k) != primary)
+                    .max_by(|&a, &b| d[a].abs().total_cmp(&d[b].abs()))
+                    .unwrap_or(0);
+                let word = format!(
+                    "{}{}DIR",
+                    if d[axis] < 0.0 { "-" } else { "" },
+                    ['X', 'Y', 'Z'][axis]
+                );
+                Manual {
+                    label: l,
+                    meas: "LINE",
+                    line_dir: Some(word),
+                }
+            }
+            (
+                Nominal::Surface(
+                    Surface::Cylinder {
+                        origin,
+                        axis,
+                        radius,
+                        convex,
+                    },
+                    _,
+                ),
+                _,
+            ) if pts
+                .iter()
+                .all(|p| ((p.position - mean).dot(&axis)).abs() < 1e-6) =>
+            {
+                let c = origin + axis * (mean - origin).dot(&axis);
+                let l = self.labels.fresh("F", &format!("{label}_CI"));
+                self.o.stmt(&format!(
+                    "F({l})=FEAT/CIRCLE,{},CART,{},{},{}",
+                    if convex { "OUTER" } else { "INNER" },
+                    xyz(&c),
+                    ijk(&axis),
+                    real(2.0 * radius)
+                ));
+                Manual {
+                    label: l,
+                    meas: "CIRCLE",
+                    line_dir: None,
+                }
+            }
+            _ => own(nominal.meas()),
+        }
     }
 
     /// `DATSET` on the alignment features (`FA(label),keywords`), then the `TRANS` that

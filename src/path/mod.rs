@@ -25,7 +25,7 @@ mod render;
 mod roadmap;
 pub mod tour;
 
-pub use align::Alignment;
+pub use align::{AlignStep, Alignment};
 pub use errors::PathError;
 pub use render::json;
 

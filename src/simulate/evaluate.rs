@@ -184,6 +184,8 @@ fn constraints(s: &Shape) -> (Option<V3>, Vec<V3>, Option<P3>) {
         Shape::Cone { apex, a, .. } => (Some(*a), vec![V3::x(), V3::y(), V3::z()], Some(*apex)),
         Shape::Sphere { c, .. } => (None, vec![V3::x(), V3::y(), V3::z()], Some(*c)),
         Shape::Point { p, .. } => (None, vec![V3::x(), V3::y(), V3::z()], Some(*p)),
+        // A line on a face: its run is a direction, the face's normal a location.
+        Shape::Line { p, d, n } => (Some(*d), vec![*n], Some(*p)),
         Shape::Surface => (None, vec![], None),
     }
 }
@@ -696,7 +698,7 @@ fn location(drf: &Drf, m: &Measured, nominal: &Shape, width: f64) -> Outcome {
                 None,
             )
         }
-        (Shape::Surface, _) => {
+        (Shape::Surface | Shape::Line { .. }, _) => {
             let t = &m.touches;
             let mut e: Vec<f64> = t.iter().map(|(p, n, q)| (q - p).dot(n)).collect();
             let n: Vec<V3> = t.iter().map(|x| x.1).collect();

@@ -22,6 +22,9 @@ pub enum Shape {
     Sphere { c: P3, r: f64 },
     /// One point and its vector.
     Point { p: P3, n: V3 },
+    /// A line on a face (the 3-2-1 secondary): a point, its unit direction, and the
+    /// face's normal across it (the side its touches came from).
+    Line { p: P3, d: V3, n: V3 },
     /// Two opposed planes: the centre plane's point and normal, and the width.
     Parpln { p: P3, n: V3, width: f64 },
     /// No analytic shape (a free-form surface): the points are the feature.
@@ -130,6 +133,11 @@ impl Shape {
             },
             Shape::Sphere { c, r } => Shape::Sphere { c: m * c, r: *r },
             Shape::Point { p, n } => Shape::Point { p: m * p, n: m * n },
+            Shape::Line { p, d, n } => Shape::Line {
+                p: m * p,
+                d: m * d,
+                n: m * n,
+            },
             Shape::Parpln { p, n, width } => Shape::Parpln {
                 p: m * p,
                 n: m * n,
@@ -139,9 +147,11 @@ impl Shape {
         }
     }
 
-    /// Its direction: a plane's normal, an axis; none for spheres and surfaces.
+    /// Its direction: a plane's normal, an axis, a line's run; none for spheres and
+    /// surfaces.
     pub fn direction(&self) -> Option<V3> {
         match self {
+            Shape::Line { d, .. } => Some(*d),
             Shape::Plane { n, .. } | Shape::Point { n, .. } | Shape::Parpln { n, .. } => Some(*n),
             Shape::Cylinder { a, .. } | Shape::Cone { a, .. } => Some(*a),
             _ => None,
@@ -153,6 +163,7 @@ impl Shape {
         match self {
             Shape::Plane { p, .. }
             | Shape::Point { p, .. }
+            | Shape::Line { p, .. }
             | Shape::Parpln { p, .. }
             | Shape::Cylinder { p, .. } => Some(*p),
             Shape::Cone { apex, .. } => Some(*apex),
@@ -174,7 +185,9 @@ impl Shape {
     /// radius points to (outside a cylinder, cone or sphere; above a plane).
     pub fn signed(&self, q: &P3) -> f64 {
         match self {
-            Shape::Plane { p, n } | Shape::Point { p, n } => (q - p).dot(n),
+            Shape::Plane { p, n } | Shape::Point { p, n } | Shape::Line { p, n, .. } => {
+                (q - p).dot(n)
+            }
             Shape::Cylinder { p, a, r } => {
                 let d = q - p;
                 (d - a * d.dot(a)).norm() - r
@@ -195,7 +208,10 @@ impl Shape {
     /// normal there); `None` for a free-form surface or on an axis.
     pub fn normal_at(&self, q: &P3) -> Option<V3> {
         match self {
-            Shape::Plane { n, .. } | Shape::Point { n, .. } | Shape::Parpln { n, .. } => Some(*n),
+            Shape::Plane { n, .. }
+            | Shape::Point { n, .. }
+            | Shape::Line { n, .. }
+            | Shape::Parpln { n, .. } => Some(*n),
             Shape::Cylinder { p, a, .. } => {
                 let d = q - p;
                 (d - a * d.dot(a)).try_normalize(1e-9)
@@ -453,6 +469,22 @@ pub fn cylinder(points: &[P3], guess: &Shape) -> Option<Shape> {
     });
     let (o, ax, rr) = shape(&x);
     (rr.is_finite() && rr > 0.0).then_some(Shape::Cylinder { p: o, a: ax, r: rr })
+}
+
+/// The line through surface points touched along `n` on a face: their mean and
+/// their principal direction, turned the way `guess` runs; at least two points apart.
+pub fn line(points: &[P3], n: &V3, guess: &V3) -> Option<Shape> {
+    let (first, last) = (points.first()?, points.last()?);
+    let d = (last - first).try_normalize(1e-6)?;
+    let d = if d.dot(guess) < 0.0 { -d } else { d };
+    let mean = points.iter().fold(V3::zeros(), |s, q| s + q.coords) / points.len() as f64;
+    // The face's normal square to the line.
+    let n = (n - d * n.dot(&d)).try_normalize(1e-9)?;
+    Some(Shape::Line {
+        p: P3::from(mean),
+        d,
+        n,
+    })
 }
 
 /// The least-squares circle of points about `guess`'s axis (a cylinder whose point is

@@ -20,7 +20,7 @@ use parry3d_f64::shape::Ball;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// What the virtual CMM runs.
-const SUPPORTED: &str = "DMISMN, UNITS/MM, MODE, SNSET, SNSDEF, SNSLCT, FEAT, TOL, TEXT, PAUSE, RECALL, ROTATE, DATSET, TRANS, GOTO, MEAS, PTMEAS, PATH/LINE, PAMEAS, ENDMES, CONST, DATDEF, OUTPUT, ENDFIL";
+const SUPPORTED: &str = "DMISMN, DMISMD, FILNAM, UNITS/MM, MODE, FEDRAT, PRCOMP, SNSET, SNSDEF, SNSLCT, FEAT (PLANE, LINE, POINT, CIRCLE, CYLNDR, CONE, SPHERE, PARPLN, PATERN, GSURF), TOL, TEXT, PAUSE, SAVE, RECALL, ROTATE, DATSET, TRANS, GOTO, MEAS, PTMEAS, PATH/LINE, PAMEAS, ENDMES, CONST, DATDEF, OUTPUT, ENDFIL";
 
 /// How far the surface of the face a scanned point lies on may be from the block's
 /// nominal (mm, and per mm for directions) for the point to be the feature's: the
@@ -1287,27 +1287,18 @@ impl Machine<'_> {
         let centres: Vec<P3> = b.touches.iter().map(|t| t.2).collect();
         let guess = nominal.shape.moved(&self.frame);
         let fitted = match b.word.as_str() {
+            // A plane takes 3 touches off a line: a controller fits none to fewer.
             "PLANE" => {
                 let near = guess.direction().unwrap_or(V3::z());
-                match centres.len() {
-                    // The manual alignment's secondary and tertiary: a plane through
-                    // two points square to the nominal normal, or one point with it.
-                    1 | 2 => {
-                        let c = P3::from(
-                            centres.iter().fold(V3::zeros(), |s, q| s + q.coords)
-                                / centres.len() as f64,
-                        );
-                        let n = match centres[..] {
-                            [a, b] => {
-                                let l = (b - a).normalize();
-                                (near - l * near.dot(&l)).try_normalize(1e-9)
-                            }
-                            _ => Some(near),
-                        };
-                        n.map(|n| Shape::Plane { p: c - n * r, n })
-                    }
-                    _ => fit::plane(&centres, &near).map(|s| s.offset(-r, true)),
-                }
+                fit::plane(&centres, &near).map(|s| s.offset(-r, true))
+            }
+            // A line on a face (the 3-2-1 secondary): the surface points the touches
+            // found, the face's normal from their vectors.
+            "LINE" => {
+                let surface: Vec<P3> = b.touches.iter().map(|t| t.2 - t.3 * t.4).collect();
+                let n = b.touches.iter().fold(V3::zeros(), |s, t| s + t.3);
+                let run = guess.direction().unwrap_or(V3::x());
+                fit::line(&surface, &n, &run)
             }
             "CYLNDR" => fit::cylinder(&centres, &guess.offset(r, nominal.convex))
                 .map(|s| s.offset(-r, nominal.convex)),
@@ -1752,6 +1743,7 @@ impl Machine<'_> {
         };
         let actual: Vec<f64> = match &m.shape {
             Shape::Plane { p, n: v } | Shape::Point { p, n: v } => with(xyz(p), &ijk(&along(v))),
+            Shape::Line { p, d, n: v } => with(with(xyz(p), &ijk(&along(d))), &ijk(v)),
             Shape::Cylinder { p, a, r } => with(with(xyz(p), &ijk(&along(a))), &[2.0 * r]),
             Shape::Cone { apex, a, half } => {
                 with(with(xyz(apex), &ijk(&along(a))), &[2.0 * half.to_degrees()])
@@ -1871,6 +1863,21 @@ fn nominal(params: &[String]) -> Option<Nominal> {
             n: d(3)?,
             width: *v.get(6)?,
         },
+        // `FEAT/LINE,UNBND,CART,x,y,z,i,j,k,pi,pj,pk`: a point, the line's direction and
+        // the normal of the plane it lies in (`BND`: its two ends, then that normal;
+        // Horsfall's DMIS notes, CAMCAD's writer);
+        // the face's normal across it is the one in that plane, square to the line.
+        "LINE" => {
+            let (p, d, plane) = if params.iter().any(|w| w == "BND") {
+                // Bounded: its two ends, then the plane's normal.
+                let (a, b) = (p(0)?, p(3)?);
+                (a, (b - a).try_normalize(1e-9)?, d(6)?)
+            } else {
+                (p(0)?, d(3)?, d(6)?)
+            };
+            let n = d.cross(&plane).try_normalize(1e-9)?;
+            Shape::Line { p, d, n }
+        }
         "GSURF" => Shape::Surface,
         _ => return None,
     };

@@ -1,9 +1,12 @@
-//! Stage 11, the virtual CMM (`inspc simulate`): runs a DMIS program — the subset inspc
-//! writes, as [`crate::dmis::read`] reads it — against the part of its spec, moved and
-//! deformed by a deviations file, and reports every tolerance the program outputs.
+//! Stage 11, the virtual CMM (`inspc simulate`): runs a DMIS program — one inspc wrote
+//! or one written elsewhere, as [`crate::dmis::read`] reads it, passing over what the
+//! reader warned it does not run — against the part of its spec, moved and deformed by a
+//! deviations file, and reports every feature and tolerance the program outputs (as
+//! text, JSON, a DMIS results file, or QIF 3 Results: [`qif_results`]).
 //!
-//! The machine: per setup, the frame the program's `RECALL/D(MCS)` and `ROTATE`s give
-//! before its `PAUSE` is the part's nominal place; the operator places the part there,
+//! The machine: per setup, the frame the program's `RECALL` of the machine's frame and
+//! `ROTATE`s give before its `PAUSE` is the part's nominal place; the operator places
+//! the part there,
 //! off by the deviations' placement. Manual touches land on the part where the program
 //! shows them; every move under `MODE/PROG` is swept with the real probe against part,
 //! table and fixture ([`crate::access::Pose`]); each `PTMEAS` searches along its vector
