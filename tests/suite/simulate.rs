@@ -441,6 +441,22 @@ plan f2_again {{
     assert_eq!(code(spec, &p, None), vec!["insp::simulate::unsupported"]);
     let p = edited("tilted.dmi", "PAUSE\n", "D(TILT)=ROTATE/XAXIS,45\nPAUSE\n");
     assert_eq!(code(spec, &p, None), vec!["insp::simulate::no_setup"]);
+    // A plane fitted to two touches: the manual secondary written as a plane, not the
+    // line it is.
+    let p = dir.join("two_point_plane.dmi");
+    std::fs::write(
+        &p,
+        text.replace(
+            "MEAS/LINE,F(LARGE_SLOT_1_LN),2",
+            "MEAS/PLANE,F(LARGE_SLOT_1),2",
+        )
+        .replace("FA(LARGE_SLOT_1_LN),YDIR", "FA(LARGE_SLOT_1),-XDIR"),
+    )
+    .expect("write");
+    assert_eq!(
+        code(spec, &p.display().to_string(), None),
+        vec!["insp::simulate::bad_statement"]
+    );
     let p = dir.join("nosensor.dmi");
     std::fs::write(
         &p,
