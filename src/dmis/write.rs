@@ -466,7 +466,7 @@ impl Writer<'_> {
                 for (bi, b) in g.blocks.iter().enumerate() {
                     let same = |f: FaceId| {
                         f == b.face
-                            || (b.contact == Contact::Part && geometry.same_surface(f, b.face))
+                            || (b.contact == Contact::Part && geometry.one_surface(f, b.face))
                     };
                     match surfs
                         .iter_mut()
@@ -1252,8 +1252,11 @@ impl Writer<'_> {
                     vec![pair.clone()]
                 };
             }
+            // Every surface of the feature, those of this group first: a tolerance is
+            // output once all of them are complete, and it applies to each (a size on a
+            // pattern of holes is every hole's size, not the last one measured).
             let f = Some(f);
-            let here: Vec<String> = self
+            let mut labels: Vec<String> = self
                 .faces_of
                 .get(&f)
                 .into_iter()
@@ -1261,11 +1264,12 @@ impl Writer<'_> {
                 .filter(|l| in_group.contains(l))
                 .cloned()
                 .collect();
-            if here.is_empty() {
-                self.measured.get(&f).cloned().unwrap_or_default()
-            } else {
-                here
+            for l in self.measured.get(&f).into_iter().flatten() {
+                if !labels.contains(l) {
+                    labels.push(l.clone());
+                }
             }
+            labels
         };
         let mut lines = Vec::new();
         if t.targets.len() > 1 {

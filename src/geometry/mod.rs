@@ -342,6 +342,39 @@ impl PartGeometry {
         a == b || self.faces[a.0].surface.same_as(&self.faces[b.0].surface)
     }
 
+    /// Whether two faces of one feature are pieces of one surface to measure: coplanar
+    /// planes (pads at one height are one plane), and a curved surface's pieces that
+    /// touch (a bore the B-rep splits in two halves along a seam) — not two holes that
+    /// are merely coaxial (blind holes facing each other across a sphere: each a hole of
+    /// its own, with its own size).
+    pub fn one_surface(&self, a: FaceId, b: FaceId) -> bool {
+        a == b
+            || (self.same_surface(a, b)
+                && (matches!(self.faces[a.0].surface, Surface::Plane { .. })
+                    || self.faces_touch(a, b)))
+    }
+
+    /// Whether two faces share a point of their boundaries (to 1 µm).
+    fn faces_touch(&self, a: FaceId, b: FaceId) -> bool {
+        let key = |p: &P3| {
+            (
+                (p.x * 1e3).round() as i64,
+                (p.y * 1e3).round() as i64,
+                (p.z * 1e3).round() as i64,
+            )
+        };
+        let corners = |f: FaceId| {
+            self.faces[f.0]
+                .triangles
+                .iter()
+                .flat_map(|&t| self.triangles[t as usize])
+                .map(|v| key(&self.vertices[v as usize]))
+                .collect::<std::collections::HashSet<_>>()
+        };
+        let (ca, cb) = (corners(a), corners(b));
+        ca.iter().any(|k| cb.contains(k))
+    }
+
     /// Assembles faces from per-triangle face indices, computing areas and centroids.
     pub(crate) fn new(
         vertices: Vec<P3>,

@@ -285,7 +285,7 @@ fn linearise<'a>(
                                 && b.feature == i.feature
                                 && b.contact == Contact::Part
                                 && f.contact == Contact::Part
-                                && input.geometry.same_surface(b.face, f.face)
+                                && input.geometry.one_surface(b.face, f.face)
                         });
                         if let Some(b) = one {
                             let own = block_standoff(scene, hlip, &f.points, standoff, probe);
