@@ -1039,9 +1039,28 @@ impl Writer<'_> {
 
     /// `DATSET` on the alignment features (`FA(label),keywords`), then the `TRANS` that
     /// puts the origin back at the part's.
+    ///
+    /// DATSET refers to features only through datum labels ("the DATSET statement … does
+    /// not allow you to refer to features directly", MBC's DMIS datum notes:
+    /// `D(DAT1)=DATSET/DAT(A),ZDIR,ZORIG,DAT(B),YDIR,YORIG,DAT(C),XORIG`): each
+    /// alignment feature is given a datum label of its own by `DATDEF` first.
     fn datset(&mut self, name: &str, fa: &[String], shifts: &[String]) {
+        let mut via_datums = Vec::new();
+        for (k, entry) in fa.iter().enumerate() {
+            let Some((feature, rest)) = entry.strip_prefix("FA(").and_then(|e| e.split_once(')'))
+            else {
+                via_datums.push(entry.clone());
+                continue;
+            };
+            let dl = self
+                .labels
+                .fresh("DAT", &format!("{}_{}", name.replace("SETUP", "AL"), k + 1));
+            self.o.stmt(&format!("DATDEF/FA({feature}),DAT({dl})"));
+            via_datums.push(format!("DAT({dl}){rest}"));
+        }
         let d = self.labels.fresh("D", name);
-        self.o.stmt(&format!("D({d})=DATSET/{}", fa.join(",")));
+        self.o
+            .stmt(&format!("D({d})=DATSET/{}", via_datums.join(",")));
         if !shifts.is_empty() {
             let dt = self.labels.fresh("D", &name.replace("SETUP", "PART"));
             self.o.stmt(&format!("D({dt})=TRANS/{}", shifts.join(",")));

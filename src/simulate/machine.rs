@@ -1502,6 +1502,25 @@ impl Machine<'_> {
     /// `DATSET/FA(f),[-]XDIR,XORIG,…`: the frame whose axes and origin the features
     /// give; what they leave free comes from the current frame.
     fn datset(&self, params: &[String], at: usize) -> Result<Isometry3<f64>, SimError> {
+        // `DAT(x)` stands for the feature its `DATDEF` named (DMIS's DATSET names
+        // features through datum labels); `FA(x)` directly is read too.
+        let params: Vec<String> = params
+            .iter()
+            .map(
+                |p| match p.strip_prefix("DAT(").and_then(|r| r.strip_suffix(')')) {
+                    Some(d) => match self.datums.get(d).and_then(|fs| fs.first()) {
+                        Some((_, l)) => Ok(format!("FA({l})")),
+                        None => Err(self.bad(
+                            at,
+                            &format!("datum `{d}` is not defined"),
+                            "define it with DATDEF/FA(feature),DAT(x) before DATSET",
+                        )),
+                    },
+                    None => Ok(p.clone()),
+                },
+            )
+            .collect::<Result<_, _>>()?;
+        let params = &params[..];
         let mut dirs: Vec<(usize, V3)> = Vec::new();
         let mut origins: Vec<(usize, Shape)> = Vec::new();
         let mut cur: Option<Measured> = None;

@@ -450,7 +450,8 @@ plan f2_again {{
             "MEAS/LINE,F(LARGE_SLOT_1_LN),2",
             "MEAS/PLANE,F(LARGE_SLOT_1),2",
         )
-        .replace("FA(LARGE_SLOT_1_LN),YDIR", "FA(LARGE_SLOT_1),-XDIR"),
+        .replace("DATDEF/FA(LARGE_SLOT_1_LN),", "DATDEF/FA(LARGE_SLOT_1),")
+        .replace("DAT(AL1_2),YDIR", "DAT(AL1_2),-XDIR"),
     )
     .expect("write");
     assert_eq!(
