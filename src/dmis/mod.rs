@@ -11,7 +11,7 @@ mod read;
 pub mod text;
 mod write;
 
-pub use read::{read, word, DmisError, Program, Statement, Word};
+pub use read::{read, word, Command, DmisError, Program, Statement, Word};
 
 use crate::geometry::PartGeometry;
 use crate::model::{Model, Plan};

@@ -817,15 +817,7 @@ impl Machine<'_> {
                 .program
                 .statements
                 .iter()
-                .filter_map(|s| match s {
-                    Statement::Command {
-                        label,
-                        major,
-                        params,
-                        at,
-                    } => Some((label, major, params, *at)),
-                    Statement::Comment(_) => None,
-                })
+                .filter_map(Statement::command)
         };
         let Some(l) = commands()
             .find(|c| c.1 == "SNSLCT")

@@ -9,7 +9,6 @@
 
 use inspc::simulate::evaluate::Outcome;
 use inspc::simulate::{qif_results, FeatureRow, Options, QifMeta, Report, Row};
-use inspc::source::FsWorld;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -107,26 +106,11 @@ pub(crate) fn check(name: &str, r: &Report, doc: &str) {
     validate(name, doc);
 }
 
-/// Runs `program` against `spec` with the deviations `dev` (file text).
+/// Runs `program` against `spec` with the deviations `dev` (file text), as
+/// `simulate.rs` runs it.
 fn run(spec: &str, program: &str, dev: Option<&str>) -> Report {
-    let dev_path = dev.map(|text| {
-        let dir = std::env::temp_dir().join(format!("inspc-qif-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).expect("temp dir");
-        let p = dir.join(format!("{}.dev", text.len()));
-        std::fs::write(&p, text).expect("write deviations");
-        p
-    });
-    let r = inspc::simulate(
-        &FsWorld,
-        Path::new(spec),
-        Path::new(program),
-        dev_path.as_deref(),
-        &Options::default(),
-    );
-    r.report.unwrap_or_else(|| {
-        let codes: Vec<String> = r.checked.diagnostics.iter().map(|d| d.code()).collect();
-        panic!("{program}: the run stopped: {codes:?}")
-    })
+    super::simulate::run(spec, program, dev, Options::default())
+        .unwrap_or_else(|codes| panic!("{program}: the run stopped: {codes:?}"))
 }
 
 fn meta(spec: &str, program: &str) -> QifMeta {

@@ -10,7 +10,12 @@ use std::path::{Path, PathBuf};
 
 /// Runs `program` against `spec` with the deviations `dev` (file text), or fails with
 /// the run's diagnostics.
-fn run(spec: &str, program: &str, dev: Option<&str>, opts: Options) -> Result<Report, Vec<String>> {
+pub(crate) fn run(
+    spec: &str,
+    program: &str,
+    dev: Option<&str>,
+    opts: Options,
+) -> Result<Report, Vec<String>> {
     let dev_path = dev.map(|text| {
         let dir = std::env::temp_dir().join(format!("inspc-sim-{}", std::process::id()));
         std::fs::create_dir_all(&dir).expect("temp dir");

@@ -34,7 +34,7 @@ const BLOCKS: &[(&str, &str)] = &[
 ];
 
 /// A command as the checks see it: label, major word, parameters, offset.
-type Cmd<'a> = (&'a Option<(String, String)>, &'a str, &'a [String], usize);
+type Cmd<'a> = super::Command<'a>;
 
 /// The `KIND(label)` references in a parameter list.
 pub(super) fn refs(params: &[String]) -> Vec<(String, String)> {
@@ -74,18 +74,7 @@ pub(super) fn check(
     errors: &mut Vec<DmisError>,
     warnings: &mut Vec<DmisError>,
 ) {
-    let commands: Vec<Cmd> = statements
-        .iter()
-        .filter_map(|s| match s {
-            Statement::Command {
-                label,
-                major,
-                params,
-                at,
-            } => Some((label, major.as_str(), &params[..], *at)),
-            _ => None,
-        })
-        .collect();
+    let commands: Vec<Cmd> = statements.iter().filter_map(Statement::command).collect();
     let structure = |at: usize, what: &str, help: &str| DmisError::Structure {
         span: span(at),
         what: what.into(),

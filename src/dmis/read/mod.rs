@@ -39,6 +39,24 @@ pub enum Statement {
     },
 }
 
+/// A command's label, major word, parameters and offset.
+pub type Command<'a> = (&'a Option<(String, String)>, &'a str, &'a [String], usize);
+
+impl Statement {
+    /// The command it is, if it is not a comment.
+    pub fn command(&self) -> Option<Command<'_>> {
+        match self {
+            Statement::Command {
+                label,
+                major,
+                params,
+                at,
+            } => Some((label, major.as_str(), &params[..], *at)),
+            Statement::Comment(_) => None,
+        }
+    }
+}
+
 /// A program read.
 #[derive(Debug)]
 pub struct Program {
