@@ -22,6 +22,7 @@ pub mod sample;
 pub mod simulate;
 pub mod source;
 pub mod syntax;
+pub mod verify;
 pub mod view;
 
 use std::path::{Path, PathBuf};
@@ -758,4 +759,109 @@ pub fn simulate(
         }
     };
     finish(checked, diags, report)
+}
+
+/// A spec's programs tried on the virtual CMM (see [`verify()`]).
+pub struct Verified {
+    /// The spec's front end and every diagnostic of the build and the runs.
+    pub checked: Checked,
+    /// Per program, the battery's results.
+    pub results: Vec<verify::Verification>,
+}
+
+/// Runs the battery of [`verify`] on the program `program` of spec `spec`, or on every
+/// plan of the spec built afresh when no program is given.
+pub fn verify(
+    world: &dyn source::World,
+    spec: &Path,
+    program: Option<&Path>,
+    plan_opts: &plan::PlanOptions,
+    opts: &verify::Options,
+) -> Verified {
+    let roots = [spec.to_path_buf()];
+    let (mut checked, parts, programs) = match program {
+        None => {
+            let mut r = run(world, &roots, plan_opts, Until::Build, &|_, _, _| {});
+            let programs: Vec<(source::FileId, String)> = r
+                .built
+                .iter()
+                .map(|b| {
+                    let name = format!("{}.dmi", r.checked.model.plans[b.plan].name);
+                    let id = r.checked.sources.add(name, None, b.dmis.clone());
+                    (id, b.dmis.clone())
+                })
+                .collect();
+            (r.checked, r.parts, programs)
+        }
+        Some(path) => {
+            let (mut checked, parts) = check_geometry(world, &roots);
+            let shown = path.display().to_string();
+            match world.read(path, source::FileKind::Dmis) {
+                Ok(b) => {
+                    let text = String::from_utf8_lossy(&b).into_owned();
+                    let id = checked
+                        .sources
+                        .add(shown, Some(path.to_path_buf()), text.clone());
+                    (checked, parts, vec![(id, text)])
+                }
+                Err(e) => {
+                    let file =
+                        checked
+                            .sources
+                            .add(shown.clone(), Some(path.to_path_buf()), String::new());
+                    let mut diags = diag::Diagnostics::new();
+                    diags.push(source::io::IoError::Unreadable {
+                        file,
+                        path: shown,
+                        reason: e.0,
+                    });
+                    checked.absorb(diags);
+                    return Verified {
+                        checked,
+                        results: Vec::new(),
+                    };
+                }
+            }
+        }
+    };
+    let mut diags = diag::Diagnostics::new();
+    let mut results = Vec::new();
+    for (file, text) in programs {
+        if checked.has_errors() {
+            break;
+        }
+        let prog = match dmis::read(file, &text) {
+            Ok(p) => p,
+            Err(errors) => {
+                for e in errors {
+                    diags.push(e);
+                }
+                continue;
+            }
+        };
+        let plan = match simulate::plan_of(&checked.model, &prog, file, &text) {
+            Ok(k) => k,
+            Err(e) => {
+                diags.push(e);
+                continue;
+            }
+        };
+        let part = checked.model.plans[plan].part.0;
+        let Some(data) = parts.get(part).and_then(|p| p.as_ref()) else {
+            continue;
+        };
+        let bench = verify::Bench {
+            model: &checked.model,
+            part,
+            geometry: &data.geometry,
+            feature_faces: &data.feature_faces,
+            fixtures: &data.fixtures,
+            program: &prog,
+            file,
+            text: &text,
+        };
+        results.push(verify::verify(&bench, opts));
+    }
+    checked.absorb(diags);
+    Verified { checked, results }
 }

@@ -172,6 +172,32 @@ enum Command {
         #[arg(long)]
         report: Option<PathBuf>,
     },
+    /// Shows whether a program sees what it claims to measure: builds the spec (or
+    /// takes `--program`) and runs it on the virtual CMM at nominal, at random placements
+    /// of the part, with each tolerance's forbidden deviation at 2x and 0.5x its zone,
+    /// and with each size at its limits. Exits 0 when every trial reads as it should, 2
+    /// when some do not, 1 when nothing could run.
+    Verify {
+        /// The `.insp` spec.
+        spec: PathBuf,
+        /// A program to try instead of the one the spec builds.
+        #[arg(long)]
+        program: Option<PathBuf>,
+        /// Random placements tried.
+        #[arg(long, default_value_t = 20)]
+        placements: usize,
+        /// Largest shift of a placement in machine x and y (mm).
+        #[arg(long, default_value_t = 5.0)]
+        shift: f64,
+        /// Largest turn of a placement about the vertical (degrees).
+        #[arg(long, default_value_t = 3.0)]
+        turn: f64,
+        /// Also write the results as JSON to this file.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        #[command(flatten)]
+        search: Search,
+    },
     /// Formats specs in place in the one canonical layout (indentation, spacing, blank
     /// lines; comments and line breaks kept). A file that does not parse is left alone.
     Fmt {
@@ -376,6 +402,25 @@ fn main() -> ExitCode {
             seed,
             report,
         } => simulate(&program, &spec, deviations.as_deref(), noise, seed, report),
+        Command::Verify {
+            spec,
+            program,
+            placements,
+            shift,
+            turn,
+            json,
+            search,
+        } => {
+            let Some(plan_opts) = search.options(false) else {
+                return ExitCode::from(1);
+            };
+            let opts = inspc::verify::Options {
+                placements,
+                shift,
+                turn,
+            };
+            verify(&spec, program.as_deref(), &plan_opts, &opts, json)
+        }
         Command::Check {
             files,
             message_format,
@@ -829,6 +874,46 @@ fn simulate(
     }
     print!("{}", r.text());
     if r.failed() > 0 {
+        ExitCode::from(2)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// `inspc verify`: the battery's report per program; exit 2 when it found problems.
+fn verify(
+    spec: &std::path::Path,
+    program: Option<&std::path::Path>,
+    plan_opts: &inspc::plan::PlanOptions,
+    opts: &inspc::verify::Options,
+    json: Option<PathBuf>,
+) -> ExitCode {
+    if !(opts.shift.is_finite() && opts.shift >= 0.0 && opts.turn.is_finite() && opts.turn >= 0.0) {
+        eprintln!("inspc: --shift and --turn take a distance and an angle, 0 or more");
+        return ExitCode::from(2);
+    }
+    let run = inspc::verify(&FsWorld, spec, program, plan_opts, opts);
+    print_diagnostics(&run.checked.sources, &run.checked.diagnostics);
+    if run.results.is_empty() {
+        eprintln!("inspc: no program to verify");
+        return ExitCode::from(1);
+    }
+    if let Some(path) = json {
+        let v: Vec<serde_json::Value> = run.results.iter().map(|r| r.json()).collect();
+        let text = serde_json::to_string_pretty(&v).unwrap_or_default() + "\n";
+        let out = cli::outputs::Output {
+            path,
+            bytes: text.into_bytes(),
+            what: "the results",
+        };
+        if let Err(code) = commit(&[out], &run.checked.inputs()) {
+            return code;
+        }
+    }
+    for r in &run.results {
+        print!("{}", r.text());
+    }
+    if run.results.iter().any(|r| r.problems() > 0) {
         ExitCode::from(2)
     } else {
         ExitCode::SUCCESS

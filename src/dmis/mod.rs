@@ -12,6 +12,7 @@ pub mod text;
 mod write;
 
 pub use read::{read, word, Command, DmisError, Program, Statement, Word};
+pub use write::tol_word;
 
 use crate::geometry::PartGeometry;
 use crate::model::{Model, Plan};

@@ -166,7 +166,7 @@ impl Nominal {
 }
 
 /// The DMIS word of a tolerance kind.
-fn tol_word(k: TolKind) -> &'static str {
+pub fn tol_word(k: TolKind) -> &'static str {
     match k {
         TolKind::Flatness => "FLAT",
         TolKind::Straightness => "STRGHT",
@@ -831,27 +831,44 @@ impl Writer<'_> {
         let mut primary: Option<usize> = None;
         for step in &al.steps {
             let g = &sp.groups[step.group];
-            let Some((label, ..)) = self.feats.get(&(si, step.group, step.block)).cloned() else {
-                continue;
-            };
             self.select(g);
-            if let Some(b) = g.blocks.get(step.block) {
-                let n = step.points.len();
-                self.o.oper(&format!(
-                    "BY HAND: {n} TOUCH{} ON {}",
-                    if n == 1 { "" } else { "ES" },
-                    self.face_words(b.face)
-                ));
-            }
-            let manual = self.manual_feature(&label, step, primary);
+            // The feature touched, its touches, and the face the operator is told of.
+            let (label, pts, face) = match (step.block, &step.extra) {
+                (Some(bi), _) => {
+                    let Some((label, ..)) = self.feats.get(&(si, step.group, bi)).cloned() else {
+                        continue;
+                    };
+                    let Some(b) = g.blocks.get(bi) else {
+                        continue;
+                    };
+                    let pts: Vec<(P3, V3)> = step
+                        .points
+                        .iter()
+                        .map(|&k| (hlip.points[k].position, hlip.points[k].normal))
+                        .collect();
+                    (label, pts, b.face)
+                }
+                (None, Some(extra)) => {
+                    let label = self.extra_nominal(si, extra);
+                    (label, extra.touches.clone(), extra.face)
+                }
+                (None, None) => continue,
+            };
+            let n = pts.len();
+            self.o.oper(&format!(
+                "BY HAND: {n} TOUCH{} ON {}",
+                if n == 1 { "" } else { "ES" },
+                self.face_words(face)
+            ));
+            let manual = self.manual_feature(&label, &pts, primary);
             self.o.stmt(&format!(
                 "MEAS/{},F({}),{}",
                 manual.meas,
                 manual.label,
-                step.points.len()
+                pts.len()
             ));
-            for &k in &step.points {
-                ptmeas(&mut self.o, hlip, k);
+            for (p, n) in &pts {
+                ptmeas_at(&mut self.o, p, n);
             }
             self.o.stmt("ENDMES");
             if primary.is_none() {
@@ -872,12 +889,12 @@ impl Writer<'_> {
                 )) => Some(*axis),
                 _ => None,
             };
-            let face = g
-                .blocks
-                .get(step.block)
+            let face_nominal = step
+                .block
+                .and_then(|bi| g.blocks.get(bi))
                 .and_then(|b| nominal_of(self.input, b));
             let against = matches!(
-                (axis(self.nominals.get(&label)), axis(face.as_ref())),
+                (axis(self.nominals.get(&label)), axis(face_nominal.as_ref())),
                 (Some(a), Some(b)) if a.dot(&b) < 0.0
             );
             let keywords: Vec<String> = step
@@ -891,7 +908,6 @@ impl Writer<'_> {
                     },
                 )
                 .collect();
-            fa.push(format!("FA({label}),{}", keywords.join(",")));
             let manual_keywords: Vec<String> = keywords
                 .iter()
                 .map(|k| match (&manual.line_dir, k.ends_with("DIR")) {
@@ -899,11 +915,14 @@ impl Writer<'_> {
                     _ => k.clone(),
                 })
                 .collect();
-            fa_manual.push(format!(
-                "FA({}),{}",
-                manual.label,
-                manual_keywords.join(",")
-            ));
+            let manual_fa = format!("FA({}),{}", manual.label, manual_keywords.join(","));
+            // A face touched by hand only stays what the DCC alignment takes it from.
+            if step.block.is_some() {
+                fa.push(format!("FA({}),{}", label, keywords.join(",")));
+            } else {
+                fa.push(manual_fa.clone());
+            }
+            fa_manual.push(manual_fa);
         }
         let shifts: Vec<String> = al
             .trans
@@ -919,7 +938,7 @@ impl Writer<'_> {
             .iter()
             .filter_map(|st| {
                 self.feats
-                    .get(&(si, st.group, st.block))
+                    .get(&(si, st.group, st.block?))
                     .map(|f| f.0.clone())
             })
             .collect();
@@ -932,6 +951,27 @@ impl Writer<'_> {
         });
     }
 
+    /// The nominal of a face touched by hand only to align (`F(AL1_TOP)=FEAT/PLANE,…`),
+    /// declared where the alignment measures it.
+    fn extra_nominal(&mut self, si: usize, extra: &crate::path::ExtraFace) -> String {
+        let face = &self.input.geometry.faces[extra.face.0];
+        let label = self
+            .labels
+            .fresh("F", &format!("AL{}_{}", si + 1, face.name));
+        let n = extra.touches.len().max(1) as f64;
+        let mean = P3::from(
+            extra
+                .touches
+                .iter()
+                .fold(V3::zeros(), |s, (p, _)| s + p.coords)
+                / n,
+        );
+        let nominal = Nominal::Surface(face.surface.clone(), mean);
+        self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
+        self.nominals.insert(label.clone(), nominal);
+        label
+    }
+
     /// The feature a manual alignment step touches, in the DMIS kind its touches
     /// determine: the block's own feature where they do (3 on a plane, circles on two
     /// levels of a bore); else a feature of its own, defined here — a line for 2 touches
@@ -939,16 +979,15 @@ impl Writer<'_> {
     /// bore touched at one level. DMIS fits no plane to 2 points and no cylinder to one
     /// circle (`MEAS/PLANE` needs 3, Hexagon's PC-DMIS help: "a plane is defined by 3
     /// points"), so neither does a controller running this program.
-    fn manual_feature(
-        &mut self,
-        label: &str,
-        step: &crate::path::AlignStep,
-        primary: Option<usize>,
-    ) -> Manual {
-        let hlip = self.input.hlip;
+    fn manual_feature(&mut self, label: &str, pts: &[(P3, V3)], primary: Option<usize>) -> Manual {
         let nominal = self.nominals.get(label).cloned();
-        let pts: Vec<&crate::plan::PlanPoint> =
-            step.points.iter().map(|&k| &hlip.points[k]).collect();
+        let pts: Vec<Touched> = pts
+            .iter()
+            .map(|(position, normal)| Touched {
+                position: *position,
+                normal: *normal,
+            })
+            .collect();
         let own = |meas: &'static str| Manual {
             label: label.to_string(),
             meas,
@@ -1413,6 +1452,19 @@ fn ptmeas(o: &mut Out, hlip: &crate::plan::Hlip, k: usize) {
         xyz(&p.position),
         ijk(&p.normal)
     ));
+}
+
+/// A touch by hand: where, and the surface's outward normal there.
+#[derive(Clone, Copy)]
+struct Touched {
+    position: P3,
+    normal: V3,
+}
+
+/// `PTMEAS` at a contact point with its outward normal.
+fn ptmeas_at(o: &mut Out, p: &P3, n: &V3) {
+    o.at = None;
+    o.stmt(&format!("PTMEAS/CART,{},{}", xyz(p), ijk(n)));
 }
 
 /// The `ROTATE` statements that turn the machine's frame into the part's at its nominal

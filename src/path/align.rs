@@ -15,7 +15,7 @@
 
 use super::{Hlip, SetupPath};
 use crate::access::Contact;
-use crate::geometry::{Surface, P3, V3};
+use crate::geometry::{FaceId, Surface, P3, V3};
 use crate::graph::Node;
 use crate::model::FeatureId;
 use crate::plan::Input;
@@ -36,12 +36,25 @@ pub struct Alignment {
 pub struct AlignStep {
     /// The group (index into [`SetupPath::groups`]) whose sensor touches it.
     pub group: usize,
-    /// The block in that group.
-    pub block: usize,
-    /// Points touched (indices into [`Hlip::points`]).
+    /// The block in that group; `None` for a face the setup measures nothing on, touched
+    /// by hand only ([`AlignStep::extra`]).
+    pub block: Option<usize>,
+    /// Points touched (indices into [`Hlip::points`]), for a block.
     pub points: Vec<usize>,
+    /// A face outside the plan and its touches (contact point, outward normal): what the
+    /// setup's own features leave free comes from such faces.
+    pub extra: Option<ExtraFace>,
     /// What it fixes: `ZDIR`, `-XDIR`, `YORIG`, ….
     pub keywords: Vec<String>,
+}
+
+/// A face of the part the operator touches only to align it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExtraFace {
+    /// The face.
+    pub face: FaceId,
+    /// Its touches: contact point and outward normal (part frame).
+    pub touches: Vec<(P3, V3)>,
 }
 
 const AXES: [char; 3] = ['X', 'Y', 'Z'];
@@ -111,8 +124,19 @@ fn resting_datum(input: &Input, up: V3, table: f64) -> Option<usize> {
     part.datums.iter().position(|d| rests(d.feature))
 }
 
-/// Chooses the alignment of one setup from its groups' blocks.
-pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
+/// Where the operator can touch the part by hand in a setup: the tip's radius, and
+/// whether a touch at a contact point with an outward normal is clear (the probe held
+/// as the setup's first group holds it, approaching along the normal).
+pub struct Touchable<'a> {
+    /// The tip radius (mm).
+    pub tip: f64,
+    /// The check.
+    pub clear: &'a dyn Fn(&P3, &V3) -> bool,
+}
+
+/// Chooses the alignment of one setup from its groups' blocks, completed from other
+/// faces of the part where they leave something free.
+pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath, touch: &Touchable) -> Alignment {
     let geometry = input.geometry;
     // Features whose tolerances refer to datums: aligned on, such a feature sets the
     // frame its own tolerance is read in (moved, it would read perfect).
@@ -355,8 +379,9 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
             }
             out.steps.push(AlignStep {
                 group: *gi,
-                block: *bi,
+                block: Some(*bi),
                 points,
+                extra: None,
                 keywords,
             });
             break;
@@ -402,13 +427,36 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
             }
             out.steps.push(AlignStep {
                 group: gi,
-                block: bi,
+                block: Some(bi),
                 points,
+                extra: None,
                 keywords,
             });
             break;
         }
     }
+    let used_faces: Vec<FaceId> = out
+        .steps
+        .iter()
+        .filter_map(|st| {
+            let b = sp.groups.get(st.group)?.blocks.get(st.block?)?;
+            (b.contact == Contact::Part).then_some(b.face)
+        })
+        .collect();
+    let group = out.steps.first().map_or(0, |st| st.group);
+    let mut free = Free {
+        dirs: &mut dirs,
+        origins: &mut origins,
+    };
+    complete(
+        input,
+        setup.up,
+        group,
+        &used_faces,
+        touch,
+        &mut out,
+        &mut free,
+    );
     if dirs.is_empty() {
         out.missing.push("the part's orientation".into());
     } else if dirs.len() == 1 {
@@ -421,4 +469,185 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath) -> Alignment {
         }
     }
     out
+}
+
+/// What an alignment has fixed so far: directions (part axes) and origins.
+struct Free<'a> {
+    dirs: &'a mut Vec<usize>,
+    origins: &'a mut [bool; 3],
+}
+
+/// Completes an alignment from faces the setup does not measure: the largest plane
+/// that fixes what is free, touched where the operator can reach it — 3 touches on a
+/// primary, 2 along a secondary (across the primary direction, as far apart as the
+/// face allows), 1 near the middle of a tertiary. Nothing then depends on the operator
+/// squaring the part or placing it at a nominal position: the 3-2-1 alignment of
+/// coordinate metrology (Hocken & Pereira, *Coordinate Measuring Machines and
+/// Systems*, 2nd ed., §13.3: a part coordinate system takes all six degrees of
+/// freedom from features of the part).
+fn complete(
+    input: &Input,
+    up: V3,
+    group: usize,
+    used: &[FaceId],
+    touch: &Touchable,
+    out: &mut Alignment,
+    free: &mut Free,
+) {
+    let g = input.geometry;
+    // Candidate planes: along a part axis, not facing the table, by area.
+    let mut planes: Vec<(FaceId, usize, bool, f64)> = g
+        .faces
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !used.contains(&FaceId(*i)))
+        .filter_map(|(i, f)| match &f.surface {
+            Surface::Plane { normal, origin } if normal.dot(&up) > -1e-6 => {
+                axis_of(normal).map(|(k, pos)| (FaceId(i), k, pos, origin[k]))
+            }
+            _ => None,
+        })
+        .collect();
+    planes.sort_by(|a, b| {
+        g.faces[b.0 .0]
+            .area
+            .total_cmp(&g.faces[a.0 .0].area)
+            .then(a.0.cmp(&b.0))
+    });
+    let sampler = crate::sample::Sampler::new(g, touch.tip + 1.0);
+    let strategy = crate::model::Strategy {
+        method: crate::model::SampleMethod::Uniform,
+        points: Some(25),
+        inset: None,
+    };
+    // The points of a face the probe can touch.
+    let reachable = |f: FaceId| -> Vec<(P3, V3)> {
+        sampler
+            .sample(f, &strategy)
+            .into_iter()
+            .filter(|p| (touch.clear)(&p.tip_centre(touch.tip), &p.normal))
+            .map(|p| (p.position, p.normal))
+            .collect()
+    };
+    let push =
+        |out: &mut Alignment, face: FaceId, touches: Vec<(P3, V3)>, keywords: Vec<String>| {
+            out.steps.push(AlignStep {
+                group,
+                block: None,
+                points: Vec::new(),
+                extra: Some(ExtraFace { face, touches }),
+                keywords,
+            });
+        };
+    let mut taken: Vec<FaceId> = Vec::new();
+    // A primary: the largest plane facing up.
+    if free.dirs.is_empty() {
+        let want = axis_of(&up);
+        for &(f, k, pos, at) in &planes {
+            if Some((k, pos)) != want {
+                continue;
+            }
+            let pts = reachable(f);
+            let Some(chosen) = farthest(&pts, 3) else {
+                continue;
+            };
+            if !spans_plane(&chosen) {
+                continue;
+            }
+            push(out, f, chosen, vec![dir_word(k, pos), orig_word(k)]);
+            free.dirs.push(k);
+            free.origins[k] = true;
+            out.trans.push((AXES[k], at));
+            taken.push(f);
+            break;
+        }
+    }
+    // A secondary: a plane across the primary, two touches along it.
+    if free.dirs.len() == 1 {
+        let p = free.dirs[0];
+        for &(f, k, pos, at) in &planes {
+            if k == p || taken.contains(&f) {
+                continue;
+            }
+            let along = V3::ith(p, 1.0).cross(&V3::ith(k, 1.0));
+            let pts = reachable(f);
+            let mut best: Option<(f64, [usize; 2])> = None;
+            for i in 0..pts.len() {
+                for j in i + 1..pts.len() {
+                    let d = (pts[j].0 - pts[i].0).dot(&along).abs();
+                    if best.is_none_or(|(x, _)| d > x + 1e-9) {
+                        best = Some((d, [i, j]));
+                    }
+                }
+            }
+            // Two touches closer than this say little of the turn.
+            let Some((d, [i, j])) = best.filter(|b| b.0 >= 5.0) else {
+                continue;
+            };
+            let _ = d;
+            let mut keywords = vec![dir_word(k, pos)];
+            if !free.origins[k] {
+                keywords.push(orig_word(k));
+                free.origins[k] = true;
+                out.trans.push((AXES[k], at));
+            }
+            push(out, f, vec![pts[i], pts[j]], keywords);
+            free.dirs.push(k);
+            taken.push(f);
+            break;
+        }
+    }
+    // Tertiaries: one touch for each origin still free, once the frame's directions
+    // are fixed.
+    if free.dirs.len() >= 2 {
+        for k in 0..3 {
+            if free.origins[k] {
+                continue;
+            }
+            for &(f, kk, _, at) in &planes {
+                if kk != k || taken.contains(&f) {
+                    continue;
+                }
+                let pts = reachable(f);
+                let c = g.faces[f.0].centroid;
+                let Some(&p) = pts
+                    .iter()
+                    .min_by(|a, b| (a.0 - c).norm().total_cmp(&(b.0 - c).norm()))
+                else {
+                    continue;
+                };
+                push(out, f, vec![p], vec![orig_word(k)]);
+                free.origins[k] = true;
+                out.trans.push((AXES[k], at));
+                taken.push(f);
+                break;
+            }
+        }
+    }
+}
+
+/// `n` of `pts`, the first then each farthest from those chosen.
+fn farthest(pts: &[(P3, V3)], n: usize) -> Option<Vec<(P3, V3)>> {
+    if pts.len() < n {
+        return None;
+    }
+    let mut chosen = vec![pts[0]];
+    while chosen.len() < n {
+        let next = pts.iter().filter(|p| !chosen.contains(p)).max_by(|a, b| {
+            let d = |x: &(P3, V3)| {
+                chosen
+                    .iter()
+                    .map(|c| (x.0 - c.0).norm())
+                    .fold(f64::INFINITY, f64::min)
+            };
+            d(a).total_cmp(&d(b))
+        })?;
+        chosen.push(*next);
+    }
+    Some(chosen)
+}
+
+/// Three points far enough from a line to fix a plane (a triangle of some area).
+fn spans_plane(p: &[(P3, V3)]) -> bool {
+    p.len() >= 3 && (p[1].0 - p[0].0).cross(&(p[2].0 - p[0].0)).norm() > 25.0
 }

@@ -25,7 +25,7 @@ mod render;
 mod roadmap;
 pub mod tour;
 
-pub use align::{AlignStep, Alignment};
+pub use align::{AlignStep, Alignment, ExtraFace};
 pub use errors::PathError;
 pub use render::json;
 
@@ -464,7 +464,20 @@ fn join(
         }
     }
     for sp in &mut setups {
-        sp.alignment = align::align(input, hlip, sp);
+        // By hand, the operator holds the probe as the setup's first group does.
+        let first = groups.iter().find(|g| g.setup == sp.setup);
+        let pose =
+            first.map(|g| Pose::new(scene, g.probe, g.dir, g.up, g.table).with_fixture(g.fixture));
+        let standoff = motion.prehit.max(motion.retract);
+        let clear = |c: &P3, n: &V3| {
+            pose.as_ref()
+                .is_some_and(|p| p.approach(c, n, standoff, Contact::Part).is_ok())
+        };
+        let touch = align::Touchable {
+            tip: first.map_or(1.0, |g| g.probe.tip_radius),
+            clear: &clear,
+        };
+        sp.alignment = align::align(input, hlip, sp, &touch);
         for g in &sp.groups {
             for b in &g.blocks {
                 for t in &b.touches {
@@ -933,7 +946,7 @@ fn self_aligned(input: &Input, sp: &SetupPath, diags: &mut Diagnostics) {
         let Some(b) = sp
             .groups
             .get(step.group)
-            .and_then(|g| g.blocks.get(step.block))
+            .and_then(|g| g.blocks.get(step.block?))
         else {
             continue;
         };
