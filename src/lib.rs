@@ -830,38 +830,68 @@ pub fn verify(
         if checked.has_errors() {
             break;
         }
-        let prog = match dmis::read(file, &text) {
-            Ok(p) => p,
-            Err(errors) => {
-                for e in errors {
-                    diags.push(e);
-                }
-                continue;
-            }
-        };
-        let plan = match simulate::plan_of(&checked.model, &prog, file, &text) {
-            Ok(k) => k,
-            Err(e) => {
-                diags.push(e);
-                continue;
-            }
-        };
-        let part = checked.model.plans[plan].part.0;
-        let Some(data) = parts.get(part).and_then(|p| p.as_ref()) else {
-            continue;
-        };
-        let bench = verify::Bench {
-            model: &checked.model,
-            part,
-            geometry: &data.geometry,
-            feature_faces: &data.feature_faces,
-            fixtures: &data.fixtures,
-            program: &prog,
-            file,
-            text: &text,
-        };
-        results.push(verify::verify(&bench, opts));
+        if let Some(v) = verify_program(&checked.model, &parts, file, &text, opts, &mut diags) {
+            results.push(v);
+        }
     }
     checked.absorb(diags);
     Verified { checked, results }
+}
+
+/// The battery on one program of a built [`Run`] (the golden cases' `verify.txt`).
+pub fn verify_built(
+    run: &Run,
+    built: &Built,
+    opts: &verify::Options,
+) -> Option<verify::Verification> {
+    let mut diags = diag::Diagnostics::new();
+    let file = source::FileId(u32::MAX);
+    verify_program(
+        &run.checked.model,
+        &run.parts,
+        file,
+        &built.dmis,
+        opts,
+        &mut diags,
+    )
+}
+
+/// The battery on a program's text; what stops it before any run is a diagnostic.
+fn verify_program(
+    model: &model::Model,
+    parts: &[Option<PartData>],
+    file: source::FileId,
+    text: &str,
+    opts: &verify::Options,
+    diags: &mut diag::Diagnostics,
+) -> Option<verify::Verification> {
+    let prog = match dmis::read(file, text) {
+        Ok(p) => p,
+        Err(errors) => {
+            for e in errors {
+                diags.push(e);
+            }
+            return None;
+        }
+    };
+    let plan = match simulate::plan_of(model, &prog, file, text) {
+        Ok(k) => k,
+        Err(e) => {
+            diags.push(e);
+            return None;
+        }
+    };
+    let part = model.plans[plan].part.0;
+    let data = parts.get(part).and_then(|p| p.as_ref())?;
+    let bench = verify::Bench {
+        model,
+        part,
+        geometry: &data.geometry,
+        feature_faces: &data.feature_faces,
+        fixtures: &data.fixtures,
+        program: &prog,
+        file,
+        text,
+    };
+    Some(verify::verify(&bench, opts))
 }

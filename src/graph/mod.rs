@@ -300,6 +300,9 @@ fn strategy_for(input: &Input, face: FaceId, owners: &[FeatureId]) -> Strategy {
     }
     let kind = input.geometry.faces[face.0].surface.kind();
     let base = input.sampling.strategy(kind);
+    if base.method == crate::model::SampleMethod::Spread {
+        return spread_for(input, kind, owners, base);
+    }
     let form = input.part.tolerances.iter().any(|t| {
         matches!(t.kind, TolKind::Flatness | TolKind::Straightness)
             && t.targets.iter().any(|f| owners.contains(f))
@@ -315,6 +318,49 @@ fn strategy_for(input: &Input, face: FaceId, owners: &[FeatureId]) -> Strategy {
         ..base
     }
 }
+
+/// `spread` on a face whose tolerances read its form or orientation (elsewhere Fan &
+/// Leu's rule); its count: its own rule ([`crate::sample`]), at least twice NPL Good
+/// Practice Guide No. 41's counts (18 on a plane, 24 on a cylinder or cone) where a
+/// tolerance on the face's features has a zone under [`TIGHT_ZONE`] mm: the tighter the
+/// tolerance, the smaller the deviation the points must see.
+fn spread_for(input: &Input, kind: SurfaceKind, owners: &[FeatureId], base: Strategy) -> Strategy {
+    // Only form and orientation are read across the face: a face whose tolerances
+    // locate or size it keeps Fan & Leu's points, which a probe reaches more easily.
+    let reads_across = input.part.tolerances.iter().any(|t| {
+        matches!(
+            t.kind,
+            TolKind::Flatness
+                | TolKind::Straightness
+                | TolKind::ProfileLine
+                | TolKind::ProfileSurface
+                | TolKind::Perpendicularity
+                | TolKind::Parallelism
+                | TolKind::Angularity
+                | TolKind::Cylindricity
+                | TolKind::TotalRunout
+        ) && t.targets.iter().any(|f| owners.contains(f))
+    });
+    if !reads_across {
+        return Strategy {
+            method: crate::model::SampleMethod::FanLeu,
+            ..base
+        };
+    }
+    let tight = input.part.tolerances.iter().any(|t| {
+        matches!(t.value, crate::model::TolValue::Zone { width, .. } if width < TIGHT_ZONE)
+            && t.targets.iter().any(|f| owners.contains(f))
+    });
+    let points = match (tight, kind) {
+        (true, SurfaceKind::Plane) => Some(18),
+        (true, SurfaceKind::Cylinder | SurfaceKind::Cone) => Some(24),
+        _ => base.points,
+    };
+    Strategy { points, ..base }
+}
+
+/// A zone under this (mm) doubles `spread`'s points on the face.
+pub const TIGHT_ZONE: f64 = 0.05;
 
 /// The fewest points a plane whose flatness is toleranced gets unless the spec says
 /// otherwise for its feature: a 3 × 3 grid, the least that sees a face bow or twist.

@@ -90,7 +90,7 @@ pub struct Model {
     pub scanners: Vec<Scanner>,
     /// Plans declared in the root files (imported files' plans are not run).
     pub plans: Vec<Plan>,
-    /// `std::sampling::fan_leu`, the sampling of a plan that names none and of a part
+    /// `std::sampling::spread`, the sampling of a plan that names none and of a part
     /// sampled without a plan.
     pub default_sampling: Option<SamplingId>,
     /// What the resolver learnt about the source text, for the editor (`inspc lsp`).
@@ -479,6 +479,9 @@ impl SurfaceKind {
 pub enum SampleMethod {
     /// Fan & Leu's rules: 4 points on a plane, 8 on a cylinder or cone.
     FanLeu,
+    /// Spread to the face's usable edges: a grid on a plane, circles at both ends and
+    /// between on a cylinder or cone (`std::sampling::spread`, the default).
+    Spread,
     /// A uniform grid.
     Uniform,
     /// A Hammersley sequence.

@@ -417,6 +417,7 @@ impl Model {
 fn strategy_text(s: &Strategy) -> String {
     let m = match s.method {
         SampleMethod::FanLeu => "fan_leu",
+        SampleMethod::Spread => "spread",
         SampleMethod::Uniform => "uniform",
         SampleMethod::Hammersley => "hammersley",
     };

@@ -495,12 +495,24 @@ fn complete(
     free: &mut Free,
 ) {
     let g = input.geometry;
+    // A face of a feature whose tolerance refers to datums would set the frame it is
+    // read in (moved, it would read in place): such faces are never taken.
+    let part = &input.model.parts[input.plan.part.0];
+    let datum_features: Vec<FeatureId> = part.datums.iter().map(|d| d.feature).collect();
+    let read_in_frame: Vec<FaceId> = part
+        .tolerances
+        .iter()
+        .filter(|t| !t.datums.is_empty())
+        .flat_map(|t| t.targets.iter())
+        .filter(|f| !datum_features.contains(f))
+        .flat_map(|f| faces_in_graph(input, *f))
+        .collect();
     // Candidate planes: along a part axis, not facing the table, by area.
     let mut planes: Vec<(FaceId, usize, bool, f64)> = g
         .faces
         .iter()
         .enumerate()
-        .filter(|(i, _)| !used.contains(&FaceId(*i)))
+        .filter(|(i, _)| !used.contains(&FaceId(*i)) && !read_in_frame.contains(&FaceId(*i)))
         .filter_map(|(i, f)| match &f.surface {
             Surface::Plane { normal, origin } if normal.dot(&up) > -1e-6 => {
                 axis_of(normal).map(|(k, pos)| (FaceId(i), k, pos, origin[k]))
@@ -540,13 +552,16 @@ fn complete(
             });
         };
     let mut taken: Vec<FaceId> = Vec::new();
-    // A primary: the largest plane facing up.
+    // A primary: the plane facing most nearly up (a setup on a sine plate has no face
+    // straight up), the largest first among equals.
     if free.dirs.is_empty() {
-        let want = axis_of(&up);
-        for &(f, k, pos, at) in &planes {
-            if Some((k, pos)) != want {
-                continue;
-            }
+        let facing = |k: usize, pos: bool| if pos { up[k] } else { -up[k] };
+        let mut primaries: Vec<_> = planes.clone();
+        primaries.sort_by(|a, b| {
+            let (fa, fb) = (facing(a.1, a.2), facing(b.1, b.2));
+            (fb * 1e3).round().total_cmp(&(fa * 1e3).round())
+        });
+        for &(f, k, pos, at) in &primaries {
             let pts = reachable(f);
             let Some(chosen) = farthest(&pts, 3) else {
                 continue;
@@ -624,6 +639,67 @@ fn complete(
             }
         }
     }
+    if let Some((f, pts, keywords, trans)) = sphere_origins(g, &reachable, free) {
+        push(out, f, pts, keywords);
+        out.trans.extend(trans);
+    }
+}
+
+/// The origins a sphere of the part gives, where planes left some free: its centre,
+/// from 4 touches spread over the part of it the probe reaches.
+fn sphere_origins(
+    g: &crate::geometry::PartGeometry,
+    reachable: &dyn Fn(FaceId) -> Vec<(P3, V3)>,
+    free: &mut Free,
+) -> Option<(FaceId, Vec<(P3, V3)>, Vec<String>, Vec<(char, f64)>)> {
+    if free.origins.iter().all(|o| *o) {
+        return None;
+    }
+    let mut spheres: Vec<(FaceId, P3)> = g
+        .faces
+        .iter()
+        .enumerate()
+        .filter_map(|(i, f)| match f.surface {
+            Surface::Sphere { center, .. } => Some((FaceId(i), center)),
+            _ => None,
+        })
+        .collect();
+    spheres.sort_by(|a, b| {
+        g.faces[b.0 .0]
+            .area
+            .total_cmp(&g.faces[a.0 .0].area)
+            .then(a.0.cmp(&b.0))
+    });
+    for (f, centre) in spheres {
+        let Some(pts) = farthest(&reachable(f), 4) else {
+            continue;
+        };
+        let free_k: Vec<usize> = (0..3).filter(|&k| !free.origins[k]).collect();
+        for &k in &free_k {
+            free.origins[k] = true;
+        }
+        return Some((
+            f,
+            pts,
+            free_k.iter().map(|&k| orig_word(k)).collect(),
+            free_k.iter().map(|&k| (AXES[k], centre[k])).collect(),
+        ));
+    }
+    None
+}
+
+/// The faces the measurement graph gives feature `f`.
+fn faces_in_graph(input: &Input, f: FeatureId) -> Vec<FaceId> {
+    let graph = input.graph;
+    graph
+        .nodes()
+        .filter(|(_, n)| matches!(n, Node::Feature { feature, .. } if *feature == f))
+        .flat_map(|(i, _)| graph.children(i))
+        .filter_map(|(c, _)| match &graph.graph[c] {
+            Node::Face { face, .. } => Some(*face),
+            _ => None,
+        })
+        .collect()
 }
 
 /// `n` of `pts`, the first then each farthest from those chosen.

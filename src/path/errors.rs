@@ -37,9 +37,23 @@ pub enum PathError {
         setup: usize,
         datums: String,
     },
+    #[error("setup {setup} of plan `{plan}` cannot be aligned on the part: nothing the operator can touch fixes {missing}")]
+    #[diagnostic(
+        code(insp::path::alignment_incomplete),
+        severity(Warning),
+        help("the alignment takes 3-2-1 from planes along the part's axes, bores along them and spheres; {missing} stays where the operator puts the part, so a part placed off reads off. Where the part is symmetric about that axis nothing depends on it; else give it a feature to touch (a flat, an end face), or a fixture that locates it")
+    )]
+    AlignmentIncomplete {
+        #[label("setup {setup} of this plan")]
+        span: Span,
+        plan: String,
+        setup: usize,
+        missing: String,
+    },
 }
 
 crate::located!(PathError {
     NoPath,
-    SelfAligned
+    SelfAligned,
+    AlignmentIncomplete
 });

@@ -224,6 +224,14 @@ pub fn plan(
         Ok(llip) => {
             for sp in &llip.setups {
                 self_aligned(input, sp, diags);
+                if !sp.alignment.missing.is_empty() {
+                    diags.push(PathError::AlignmentIncomplete {
+                        span: input.plan.span,
+                        plan: input.plan.name.clone(),
+                        setup: sp.setup + 1,
+                        missing: and_list(&sp.alignment.missing),
+                    });
+                }
             }
             Some(llip)
         }
@@ -502,6 +510,15 @@ fn join(
         },
         setups,
     })
+}
+
+/// `a`, `a and b`, `a, b and c`.
+fn and_list(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [a] => a.clone(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+    }
 }
 
 /// The shares of the plan's margin a stand-off tries, largest first.

@@ -717,13 +717,14 @@ pub(super) fn strategy(
     };
     let method = match callee.name.as_str() {
         "fan_leu" => SampleMethod::FanLeu,
+        "spread" => SampleMethod::Spread,
         "uniform" => SampleMethod::Uniform,
         "hammersley" => SampleMethod::Hammersley,
         other => {
             let help = suggest::help_for_unknown(
                 "sampling method",
                 other,
-                ["fan_leu", "uniform", "hammersley"],
+                ["fan_leu", "spread", "uniform", "hammersley"],
             );
             cx.err(E::UnknownName {
                 span: callee.span,
@@ -734,12 +735,12 @@ pub(super) fn strategy(
             return None;
         }
     };
-    if method == SampleMethod::FanLeu
+    if matches!(method, SampleMethod::FanLeu | SampleMethod::Spread)
         && matches!(surface, Some(SurfaceKind::Sphere | SurfaceKind::Freeform))
     {
         cx.err(E::OutOfRange {
             span: callee.span,
-            what: "Fan & Leu sampling".into(),
+            what: format!("`{}` sampling", callee.name),
             value: format!("on a {}", surface.map_or("", SurfaceKind::keyword)),
             range: "its rules cover planes, cylinders and cones".into(),
             help: "use `uniform(points N)` or `hammersley(points N)` for this surface type".into(),
@@ -780,7 +781,7 @@ pub(super) fn strategy(
             }
         }
     }
-    if method != SampleMethod::FanLeu
+    if !matches!(method, SampleMethod::FanLeu | SampleMethod::Spread)
         && points.is_none()
         && !args
             .iter()

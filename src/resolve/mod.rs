@@ -128,7 +128,7 @@ pub fn resolve(
     index.names.dedup();
     model.index = index;
     model.default_sampling = r
-        .std_item("std::sampling", "fan_leu", Kind::Sampling)
+        .std_item("std::sampling", "spread", Kind::Sampling)
         .map(crate::model::SamplingId);
     model
 }

@@ -40,7 +40,7 @@ pub(super) fn lower(
     };
     let sampling = match pp.get("sampling") {
         Some(v) => r.lookup_value(cx, module, v, Kind::Sampling),
-        None => r.std_item("std::sampling", "fan_leu", Kind::Sampling),
+        None => r.std_item("std::sampling", "spread", Kind::Sampling),
     };
     let mut outputs = Outputs::default();
     if let Some(v) = pp.get("output") {

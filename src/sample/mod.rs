@@ -119,7 +119,13 @@ impl<'a> Sampler<'a> {
             (SampleMethod::FanLeu, Surface::Cylinder { .. } | Surface::Cone { .. }) => {
                 place.fan_leu_round(strategy.points.map_or(4, |n| n.div_ceil(2).max(1)) as usize)
             }
-            (SampleMethod::FanLeu, _) => place.pool(
+            (SampleMethod::Spread, Surface::Plane { .. }) => {
+                place.spread_plane(strategy.points.map(|n| n as usize))
+            }
+            (SampleMethod::Spread, Surface::Cylinder { .. } | Surface::Cone { .. }) => {
+                place.spread_round(strategy.points.map(|n| n as usize))
+            }
+            (SampleMethod::FanLeu | SampleMethod::Spread, _) => place.pool(
                 SampleMethod::Hammersley,
                 strategy.points.unwrap_or(9) as usize,
                 None,
@@ -184,6 +190,45 @@ impl<'a> Sampler<'a> {
             }
         }
         pick_evenly(best, n)
+    }
+}
+
+/// How far beyond the tip's radius `spread` keeps its outer points from a face's edges
+/// (mm): the default `motion { margin }` and half a millimetre more, so that a ball at a
+/// blind bore's last circle keeps more than the plan's margin from its floor, and a
+/// chamfer or burr stays clear of it.
+pub const EDGE_CLEARANCE: f64 = 1.5;
+
+/// `spread`'s distance between rows (mm).
+pub const SPREAD_SPACING: f64 = 25.0;
+
+/// `spread`'s most rows along one side.
+pub const SPREAD_MAX_ROWS: usize = 7;
+
+/// Rows of a `spread` grid over a usable `a` × `b` mm: one every [`SPREAD_SPACING`], at
+/// least 3 each way (2 on a strip under 4 mm, 1 under 1 mm), denser until there are
+/// `want` points.
+fn spread_rows(a: f64, b: f64, want: Option<usize>) -> (usize, usize) {
+    let least = |x: f64| {
+        if x < 1.0 {
+            1
+        } else if x < 4.0 {
+            2
+        } else {
+            3
+        }
+    };
+    let rows = |x: f64, s: f64| {
+        ((x / s).ceil() as usize + 1).clamp(least(x), SPREAD_MAX_ROWS.max(least(x)))
+    };
+    let mut s = SPREAD_SPACING;
+    loop {
+        let (na, nb) = (rows(a, s), rows(b, s));
+        let full = (na >= SPREAD_MAX_ROWS || a < 1.0) && (nb >= SPREAD_MAX_ROWS || b < 1.0);
+        if want.is_none_or(|w| na * nb >= w) || full || s < 0.5 {
+            return (na, nb);
+        }
+        s *= 0.8;
     }
 }
 
@@ -338,6 +383,74 @@ impl Place<'_, '_> {
                     k as f64 / per_circle as f64
                 } else {
                     (k as f64 + 0.5) / per_circle as f64
+                };
+                targets.push((c.u.0 + f * span, v));
+            }
+        }
+        self.place_all(&targets)
+    }
+
+    /// `std::sampling::spread` on a plane: a grid over the face's rectangle whose outer
+    /// rows keep [`EDGE_CLEARANCE`] beyond the margin from its edges, a row every
+    /// [`SPREAD_SPACING`] mm, at least 3 rows each way where the face is wide enough
+    /// (2, then 1, on a narrower strip), at most [`SPREAD_MAX_ROWS`]; denser until the
+    /// grid holds `want` points where the graph asks for more. Points that fall off the
+    /// face (a hole, an L-shaped face) move inwards by Fan & Leu's search.
+    fn spread_plane(&self, want: Option<usize>) -> Vec<Fpoint> {
+        let c = self.chart;
+        let (eu, ev) = c.extent_mm();
+        let edge = self.margin + EDGE_CLEARANCE;
+        let (iu, iv) = (edge.min(NARROW_SHARE * eu), edge.min(NARROW_SHARE * ev));
+        let (uu, uv) = (eu - 2.0 * iu, ev - 2.0 * iv);
+        let (nu, nv) = spread_rows(uu, uv, want);
+        let at = |i: usize, n: usize| {
+            if n == 1 {
+                0.5
+            } else {
+                i as f64 / (n - 1) as f64
+            }
+        };
+        let (su, sv) = c.scale();
+        let mut targets = Vec::new();
+        for j in 0..nv {
+            for i in 0..nu {
+                targets.push((
+                    c.u.0 + (iu + at(i, nu) * uu) / su,
+                    c.v.0 + (iv + at(j, nv) * uv) / sv,
+                ));
+            }
+        }
+        self.place_all(&targets)
+    }
+
+    /// `std::sampling::spread` on a cylinder or cone: circles at both usable ends of
+    /// its length (the margin and [`EDGE_CLEARANCE`] in) and between, a circle every
+    /// [`SPREAD_SPACING`] mm, at least 3 where the length allows; at least 4 points a
+    /// circle, more on a large one.
+    fn spread_round(&self, want: Option<usize>) -> Vec<Fpoint> {
+        let c = self.chart;
+        let (eu, ev) = c.extent_mm();
+        let (_, sv) = c.scale();
+        let edge = (self.margin + EDGE_CLEARANCE).min(NARROW_SHARE * ev);
+        let usable = ev - 2.0 * edge;
+        let (around, heights) = spread_rows(eu, usable, want);
+        let around = around.max(4);
+        let span = c.u.1 - c.u.0;
+        let mut targets = Vec::new();
+        for j in 0..heights {
+            let t = if heights == 1 {
+                0.5
+            } else {
+                j as f64 / (heights - 1) as f64
+            };
+            let v = c.v.0 + (edge + t * usable) / sv;
+            for k in 0..around {
+                // Circles turned against each other by half a step: the points of two
+                // circles do not line up along the axis.
+                let f = if c.periodic_u {
+                    (k as f64 + 0.5 * (j % 2) as f64) / around as f64
+                } else {
+                    (k as f64 + 0.5) / around as f64
                 };
                 targets.push((c.u.0 + f * span, v));
             }

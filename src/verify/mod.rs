@@ -126,7 +126,12 @@ pub fn verify(bench: &Bench, opts: &Options) -> Verification {
                     jobs.push((tols.len(), vi, k, v.lines));
                 }
             }
-            if matches!(t.value, TolValue::Size { .. }) {
+            if matches!(
+                t.kind,
+                crate::model::TolKind::Diameter
+                    | crate::model::TolKind::Radius
+                    | crate::model::TolKind::Width
+            ) {
                 let scale = if t.kind == crate::model::TolKind::Radius {
                     2.0
                 } else {
@@ -167,6 +172,9 @@ pub fn verify(bench: &Bench, opts: &Options) -> Verification {
         .collect();
     for ((ti, li), tried) in limit_jobs.into_iter().zip(limit_runs) {
         tols[ti].limits[li].2 = Some(tried);
+    }
+    for t in &mut tols {
+        t.drop_rejected();
     }
     Verification {
         plan: nominal
@@ -231,13 +239,12 @@ fn run(bench: &Bench, lines: &[String]) -> Tried {
         ) {
             Ok(d) => d,
             Err(e) => {
+                let why = e.first().map(|e| e.to_string()).unwrap_or_default();
                 return Tried {
                     report: None,
-                    stopped: Some(format!(
-                        "the battery wrote a deviation the simulator rejects: {}",
-                        e.first().map(|e| e.to_string()).unwrap_or_default()
-                    )),
-                }
+                    stopped: Some(format!("the virtual part cannot take it: {why}")),
+                    rejected: Some(why),
+                };
             }
         }
     };
@@ -255,10 +262,12 @@ fn run(bench: &Bench, lines: &[String]) -> Tried {
         Ok(r) => Tried {
             report: Some(r),
             stopped: None,
+            rejected: None,
         },
         Err(errors) => Tried {
             report: None,
             stopped: Some(stop_text(&errors, bench.text)),
+            rejected: None,
         },
     }
 }

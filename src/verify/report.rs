@@ -12,6 +12,9 @@ pub struct Tried {
     pub report: Option<Report>,
     /// Why it stopped, when it did.
     pub stopped: Option<String>,
+    /// The virtual part cannot take the deviation (a size change on faces that have no
+    /// size to grow): not tried, and no fault of the program.
+    pub rejected: Option<String>,
 }
 
 /// One placement tried.
@@ -109,7 +112,8 @@ impl VariantResult {
         let (Some(a), Some(b)) = (Self::read(&self.at_in), Self::read(&self.at_out)) else {
             return f64::INFINITY;
         };
-        let (fa, fb) = (a.value / self.unit, b.value / self.unit);
+        // By magnitude: a turn or a move may read on either side of nominal.
+        let (fa, fb) = ((a.value / self.unit).abs(), (b.value / self.unit).abs());
         if fb - fa > 1e-9 {
             IN_AT + (OUT_AT - IN_AT) * (1.0 - fa) / (fb - fa)
         } else {
@@ -186,6 +190,17 @@ impl TolResult {
                 .all(|l| l.2.as_ref().is_some_and(|t| t.stopped.is_none()))
     }
 
+    /// Drops the trials the virtual part could not take.
+    pub fn drop_rejected(&mut self) {
+        let rejected = |t: &Option<(Vec<String>, Tried, Option<Reading>)>| {
+            t.as_ref().is_some_and(|x| x.1.rejected.is_some())
+        };
+        self.variants
+            .retain(|v| !rejected(&v.at_in) && !rejected(&v.at_out));
+        self.limits
+            .retain(|l| l.2.as_ref().is_none_or(|t| t.rejected.is_none()));
+    }
+
     /// The worst factor any of its deviations is detected from.
     fn detects_from(&self) -> f64 {
         self.variants
@@ -246,14 +261,16 @@ impl Verification {
                 return s;
             }
             Some(r) => {
-                let out: Vec<&str> = r
+                let mut out: Vec<&str> = r
                     .rows
                     .iter()
-                    .filter(|r| !r.pass())
+                    .filter(|r| !r.pass() && !r.unjudged())
                     .map(|r| r.tolerance.as_str())
                     .collect();
+                out.dedup();
+                let unjudged = r.rows.iter().filter(|r| r.unjudged()).count();
                 s += &format!(
-                    "nominal: {} setups, {} touches, {} tolerance outputs, {} read out{}\n",
+                    "nominal: {} setups, {} touches, {} tolerance outputs, {} read out{}, {} not judged\n",
                     r.setups,
                     r.touches,
                     r.rows.len(),
@@ -262,7 +279,8 @@ impl Verification {
                         String::new()
                     } else {
                         format!(" ({})", out.join(", "))
-                    }
+                    },
+                    unjudged
                 );
             }
         }

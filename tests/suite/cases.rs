@@ -174,6 +174,19 @@ fn run_case(c: &Case) -> Outcome {
         let program: String = run.built.iter().map(|b| b.dmis.clone()).collect();
         files.push(("plan.txt", plan));
         files.push(("program.dmi", program));
+        // `inspc verify` on every program: its report is a snapshot (6 placements keep
+        // the suite short; the CLI's default is 20).
+        let opts = inspc::verify::Options {
+            placements: 6,
+            ..Default::default()
+        };
+        let verified: String = run
+            .built
+            .iter()
+            .filter_map(|b| inspc::verify_built(&run, b, &opts))
+            .map(|v| v.text())
+            .collect();
+        files.push(("verify.txt", verified));
         // The build's warnings past the front end's (model.txt has those).
         let warnings = render(&run.checked);
         let front_end = render(&front);
@@ -375,6 +388,9 @@ fn programs_read_back() {
         for s in &b.llip.setups {
             for step in &s.alignment.steps {
                 want.extend(step.points.iter().map(|&k| b.hlip.points[k].position));
+                if let Some(extra) = &step.extra {
+                    want.extend(extra.touches.iter().map(|(p, _)| *p));
+                }
             }
             for g in &s.groups {
                 for bl in &g.blocks {

@@ -29,5 +29,6 @@ mod scan;
 mod simulate;
 mod step;
 mod tours;
+mod verify;
 mod view;
 mod vscode;

@@ -1,0 +1,100 @@
+//! `inspc verify` where the answer is known: a clean program, a program that cannot see
+//! a tilt (the feature sets its own frame), the sampling that decides whether a bow is
+//! seen, and the same report on every run.
+
+use inspc::source::FsWorld;
+use inspc::verify::{Options, Verification};
+use std::path::Path;
+
+fn verify(spec: &Path, placements: usize) -> Vec<Verification> {
+    let opts = Options {
+        placements,
+        ..Default::default()
+    };
+    let run = inspc::verify(
+        &FsWorld,
+        spec,
+        None,
+        &inspc::plan::PlanOptions::default(),
+        &opts,
+    );
+    assert!(
+        !run.checked.has_errors(),
+        "{}: {:?}",
+        spec.display(),
+        run.checked
+            .diagnostics
+            .iter()
+            .map(|d| d.message())
+            .collect::<Vec<_>>()
+    );
+    run.results
+}
+
+/// F2 (the seed's slots, perpendicular to the top): found wherever it lies, both
+/// tilts read out at twice the zone and in at half.
+#[test]
+fn f2_reads_right_wherever_it_lies() {
+    let v = verify(Path::new("examples/f2.insp"), 8);
+    assert_eq!(v.len(), 1);
+    let text = v[0].text();
+    assert_eq!(v[0].problems(), 0, "{text}");
+    assert!(
+        text.contains("8 within ±5 mm and ±3°: 0 stopped, 0 changed a verdict"),
+        "{text}"
+    );
+}
+
+/// F3's side hole has a setup of its own where datum A cannot be touched: its own axis
+/// sets the frame, and a tilted hole reads parallel. The battery says so.
+#[test]
+fn a_feature_that_sets_its_own_frame_is_caught() {
+    let v = verify(Path::new("examples/f3_fixed.insp"), 2);
+    let text = v[0].text();
+    assert!(v[0].problems() > 0, "{text}");
+    assert!(
+        text.contains("T2 side_hole tilted across") && text.contains("at 2x"),
+        "{text}"
+    );
+}
+
+/// A block whose top has a flatness tolerance: Fan & Leu's four points (and the fill
+/// inside its fifth inset) miss most of a bow, the default `spread` grid sees it.
+#[test]
+fn spread_points_see_a_bow_that_fan_and_leu_miss() {
+    let dir = std::env::temp_dir().join(format!("inspc_verify_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = |sampling: &str| {
+        format!(
+            "use std::heads::PH6\nuse std::probes::TP20_D2_L20\n{sampling}\n\
+             part block {{\n    units mm\n    stock box(100, 80, 40)\n    feature top = stock.top\n    \
+             tolerance flat = flatness(top, 0.02 mm)\n}}\n\
+             cmm lab {{\n    table {{ z 0 mm, size (1000 mm, 700 mm) }}\n    ram {{ radius 35 mm, length 600 mm }}\n    \
+             head PH6\n    probes [p1: TP20_D2_L20]\n}}\n\
+             plan block_plan {{\n    part block\n    cmm lab\n{}}}\n",
+            if sampling.is_empty() { "" } else { "    sampling fan_leu\n" }
+        )
+    };
+    let fan = dir.join("fan.insp");
+    let spread = dir.join("spread.insp");
+    std::fs::write(&fan, spec("use std::sampling::fan_leu")).unwrap();
+    std::fs::write(&spread, spec("")).unwrap();
+    let f = verify(&fan, 1);
+    let s = verify(&spread, 1);
+    let (ft, st) = (f[0].text(), s[0].text());
+    assert!(
+        ft.contains("bow on top at 2x"),
+        "Fan & Leu should miss the bow:\n{ft}"
+    );
+    assert_eq!(s[0].problems(), 0, "spread should see it:\n{st}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The report is a function of the spec: two runs print the same bytes.
+#[test]
+fn the_report_is_the_same_every_run() {
+    let spec = Path::new("examples/f4.insp");
+    let a: Vec<String> = verify(spec, 3).iter().map(|v| v.text()).collect();
+    let b: Vec<String> = verify(spec, 3).iter().map(|v| v.text()).collect();
+    assert_eq!(a, b);
+}
