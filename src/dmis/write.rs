@@ -112,6 +112,20 @@ impl Nominal {
         }
     }
 
+    /// The fewest touches that fit the surface: 3 on a plane, 4 on a sphere, 6 on a
+    /// cylinder (two circles of 3) or a cone.
+    fn least_touches(&self) -> usize {
+        match self {
+            Nominal::Table(..) => 3,
+            Nominal::Surface(s, _) => match s {
+                Surface::Plane { .. } => 3,
+                Surface::Sphere { .. } => 4,
+                Surface::Cylinder { .. } | Surface::Cone { .. } => 6,
+                Surface::Freeform => 1,
+            },
+        }
+    }
+
     /// The `FEAT` statement's parameters.
     fn feat(&self) -> String {
         let side = |convex: bool| if convex { "OUTER" } else { "INNER" };
@@ -534,6 +548,30 @@ impl Writer<'_> {
                 }
                 seen.extend(pts);
                 rounds_of.last_mut().expect("a round").push(*k);
+            }
+            // A round of fewer touches than its surface needs fits nothing (one touch
+            // is no plane): it joins the round before it, or after it for the first.
+            let least = nominal.least_touches();
+            let touches = |keys: &[BlockKey]| -> usize {
+                keys.iter()
+                    .map(|k| block(k).touches.len().max(block(k).passes.len() * least))
+                    .sum()
+            };
+            let mut r = 0;
+            while rounds_of.len() > 1 && r < rounds_of.len() {
+                if touches(&rounds_of[r]) >= least {
+                    r += 1;
+                    continue;
+                }
+                let keys = rounds_of.remove(r);
+                let into = r.saturating_sub(1).min(rounds_of.len() - 1);
+                if r == 0 {
+                    let mut joined = keys;
+                    joined.append(&mut rounds_of[0]);
+                    rounds_of[0] = joined;
+                } else {
+                    rounds_of[into].extend(keys);
+                }
             }
             let full = self.labels.fresh("F", &name);
             self.o.stmt(&format!("F({full})=FEAT/{}", nominal.feat()));

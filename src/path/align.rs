@@ -366,6 +366,12 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath, touch: &Touchable) -> A
                     }
                 }
                 (_, Shape::Cylinder { axis, .. }, _) => round(pts, *axis, 1, n),
+                // A primary plane: the widest triangle of its points (the farthest ones
+                // may lie on one line, which fixes no plane).
+                (0, Shape::Plane { .. }, _) => {
+                    let pos: Vec<P3> = pts.iter().map(|&k| hlip.points[k].position).collect();
+                    widest_triangle(&pos).map(|t| t.iter().map(|&i| pts[i]).collect())
+                }
                 _ => spread(pts, n),
             };
             let Some(points) = points else {
@@ -615,7 +621,7 @@ fn complete(
     // Tertiaries: one touch for each origin still free, once the frame's directions
     // are fixed.
     if free.dirs.len() >= 2 {
-        for k in 0..3 {
+        for (k, axis) in AXES.iter().enumerate() {
             if free.origins[k] {
                 continue;
             }
@@ -633,7 +639,7 @@ fn complete(
                 };
                 push(out, f, vec![p], vec![orig_word(k)]);
                 free.origins[k] = true;
-                out.trans.push((AXES[k], at));
+                out.trans.push((*axis, at));
                 taken.push(f);
                 break;
             }
@@ -645,13 +651,16 @@ fn complete(
     }
 }
 
+/// A sphere touched for the origins: its face, touches, keywords and origin shifts.
+type SphereStep = (FaceId, Vec<(P3, V3)>, Vec<String>, Vec<(char, f64)>);
+
 /// The origins a sphere of the part gives, where planes left some free: its centre,
 /// from 4 touches spread over the part of it the probe reaches.
 fn sphere_origins(
     g: &crate::geometry::PartGeometry,
     reachable: &dyn Fn(FaceId) -> Vec<(P3, V3)>,
     free: &mut Free,
-) -> Option<(FaceId, Vec<(P3, V3)>, Vec<String>, Vec<(char, f64)>)> {
+) -> Option<SphereStep> {
     if free.origins.iter().all(|o| *o) {
         return None;
     }
@@ -700,6 +709,37 @@ fn faces_in_graph(input: &Input, f: FeatureId) -> Vec<FaceId> {
             _ => None,
         })
         .collect()
+}
+
+/// Three of `p` (indices) spanning a wide triangle: the farthest from the first, the
+/// one farthest from the line through those two, then the first point moved to the one
+/// farthest from the line through the other two. `None` when every point lies on one
+/// line (less than 25 mm² of triangle).
+fn widest_triangle(p: &[P3]) -> Option<[usize; 3]> {
+    if p.len() < 3 {
+        return None;
+    }
+    let far = |from: usize| {
+        (0..p.len())
+            .max_by(|&a, &b| {
+                (p[a] - p[from])
+                    .norm()
+                    .total_cmp(&(p[b] - p[from]).norm())
+                    .then(b.cmp(&a))
+            })
+            .unwrap_or(0)
+    };
+    let area = |a: usize, b: usize, c: usize| (p[b] - p[a]).cross(&(p[c] - p[a])).norm();
+    let third = |a: usize, b: usize| {
+        (0..p.len())
+            .max_by(|&x, &y| area(a, b, x).total_cmp(&area(a, b, y)).then(y.cmp(&x)))
+            .unwrap_or(0)
+    };
+    let a = far(0);
+    let b = far(a);
+    let c = third(a, b);
+    let a = third(b, c);
+    (area(a, b, c) > 25.0 && a != b && b != c && a != c).then_some([a, b, c])
 }
 
 /// `n` of `pts`, the first then each farthest from those chosen.

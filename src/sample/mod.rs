@@ -193,11 +193,15 @@ impl<'a> Sampler<'a> {
     }
 }
 
-/// How far beyond the tip's radius `spread` keeps its outer points from a face's edges
-/// (mm): the default `motion { margin }` and half a millimetre more, so that a ball at a
-/// blind bore's last circle keeps more than the plan's margin from its floor, and a
-/// chamfer or burr stays clear of it.
-pub const EDGE_CLEARANCE: f64 = 1.5;
+/// How far beyond the tip's radius `spread` keeps its outer points from a plane's
+/// edges (mm): a chamfer or burr stays clear of the ball.
+pub const EDGE_CLEARANCE: f64 = 0.5;
+
+/// How far beyond the tip's radius `spread` keeps a cylinder's or cone's end circles
+/// from its ends (mm): the default `motion { margin }` and half a millimetre more, so
+/// that a ball at a blind bore's last circle keeps more than the plan's margin from its
+/// floor.
+pub const END_CLEARANCE: f64 = 1.5;
 
 /// `spread`'s distance between rows (mm).
 pub const SPREAD_SPACING: f64 = 25.0;
@@ -206,11 +210,11 @@ pub const SPREAD_SPACING: f64 = 25.0;
 pub const SPREAD_MAX_ROWS: usize = 7;
 
 /// Rows of a `spread` grid over a usable `a` × `b` mm: one every [`SPREAD_SPACING`], at
-/// least 3 each way (2 on a strip under 4 mm, 1 under 1 mm), denser until there are
-/// `want` points.
+/// least 3 each way (2 on a strip under 4 mm: points in one row fix no plane), denser
+/// until there are `want` points.
 fn spread_rows(a: f64, b: f64, want: Option<usize>) -> (usize, usize) {
     let least = |x: f64| {
-        if x < 1.0 {
+        if x < 1e-6 {
             1
         } else if x < 4.0 {
             2
@@ -224,7 +228,7 @@ fn spread_rows(a: f64, b: f64, want: Option<usize>) -> (usize, usize) {
     let mut s = SPREAD_SPACING;
     loop {
         let (na, nb) = (rows(a, s), rows(b, s));
-        let full = (na >= SPREAD_MAX_ROWS || a < 1.0) && (nb >= SPREAD_MAX_ROWS || b < 1.0);
+        let full = (na >= SPREAD_MAX_ROWS || a < 4.0) && (nb >= SPREAD_MAX_ROWS || b < 4.0);
         if want.is_none_or(|w| na * nb >= w) || full || s < 0.5 {
             return (na, nb);
         }
@@ -424,14 +428,14 @@ impl Place<'_, '_> {
     }
 
     /// `std::sampling::spread` on a cylinder or cone: circles at both usable ends of
-    /// its length (the margin and [`EDGE_CLEARANCE`] in) and between, a circle every
+    /// its length (the margin and [`END_CLEARANCE`] in) and between, a circle every
     /// [`SPREAD_SPACING`] mm, at least 3 where the length allows; at least 4 points a
     /// circle, more on a large one.
     fn spread_round(&self, want: Option<usize>) -> Vec<Fpoint> {
         let c = self.chart;
         let (eu, ev) = c.extent_mm();
         let (_, sv) = c.scale();
-        let edge = (self.margin + EDGE_CLEARANCE).min(NARROW_SHARE * ev);
+        let edge = (self.margin + END_CLEARANCE).min(NARROW_SHARE * ev);
         let usable = ev - 2.0 * edge;
         let (around, heights) = spread_rows(eu, usable, want);
         let around = around.max(4);
