@@ -483,8 +483,8 @@ struct Free<'a> {
     origins: &'a mut [bool; 3],
 }
 
-/// Completes an alignment from faces the setup does not measure: the largest plane
-/// that fixes what is free, touched where the operator can reach it — 3 touches on a
+/// Completes an alignment from faces the setup does not measure: the plane that fixes
+/// what is free (datum faces first, then faces no tolerance reads, the largest first), touched where the operator can reach it — 3 touches on a
 /// primary, 2 along a secondary (across the primary direction, as far apart as the
 /// face allows), 1 near the middle of a tertiary. Nothing then depends on the operator
 /// squaring the part or placing it at a nominal position: the 3-2-1 alignment of
@@ -526,10 +526,31 @@ fn complete(
             _ => None,
         })
         .collect();
+    // Datum faces first, then faces no tolerance reads (a deviation of a toleranced
+    // face would move the frame the others are read in), each the largest first.
+    let datum_faces: Vec<FaceId> = datum_features
+        .iter()
+        .flat_map(|f| faces_in_graph(input, *f))
+        .collect();
+    let toleranced: Vec<FaceId> = part
+        .tolerances
+        .iter()
+        .flat_map(|t| t.targets.iter())
+        .flat_map(|f| faces_in_graph(input, *f))
+        .collect();
+    let rank = |f: FaceId| {
+        if datum_faces.contains(&f) {
+            0
+        } else if toleranced.contains(&f) {
+            2
+        } else {
+            1
+        }
+    };
     planes.sort_by(|a, b| {
-        g.faces[b.0 .0]
-            .area
-            .total_cmp(&g.faces[a.0 .0].area)
+        rank(a.0)
+            .cmp(&rank(b.0))
+            .then(g.faces[b.0 .0].area.total_cmp(&g.faces[a.0 .0].area))
             .then(a.0.cmp(&b.0))
     });
     let sampler = crate::sample::Sampler::new(g, touch.tip + 1.0);

@@ -740,7 +740,11 @@ pub(super) fn strategy(
     {
         cx.err(E::OutOfRange {
             span: callee.span,
-            what: format!("`{}` sampling", callee.name),
+            what: if method == SampleMethod::FanLeu {
+                "Fan & Leu sampling".into()
+            } else {
+                format!("`{}` sampling", callee.name)
+            },
             value: format!("on a {}", surface.map_or("", SurfaceKind::keyword)),
             range: "its rules cover planes, cylinders and cones".into(),
             help: "use `uniform(points N)` or `hammersley(points N)` for this surface type".into(),
