@@ -629,6 +629,33 @@ pub fn check(world: &dyn source::World, roots: &[PathBuf]) -> Checked {
     }
 }
 
+/// Reads a file a run names outside the spec (a program, a deviations file) into the
+/// source map; an unreadable one is still added, empty, for its diagnostic to point at.
+fn read_beside(
+    world: &dyn source::World,
+    checked: &mut Checked,
+    path: &Path,
+    kind: source::FileKind,
+) -> Result<source::FileId, source::io::IoError> {
+    let shown = path.display().to_string();
+    match world.read(path, kind) {
+        Ok(b) => {
+            let text = String::from_utf8_lossy(&b).into_owned();
+            Ok(checked.sources.add(shown, Some(path.to_path_buf()), text))
+        }
+        Err(e) => {
+            let file = checked
+                .sources
+                .add(shown.clone(), Some(path.to_path_buf()), String::new());
+            Err(source::io::IoError::Unreadable {
+                file,
+                path: shown,
+                reason: e.0,
+            })
+        }
+    }
+}
+
 /// A program run on the virtual CMM (see [`simulate`]).
 pub struct Simulated {
     /// The spec's front end and every diagnostic of the run (the program's and the
@@ -649,26 +676,8 @@ pub fn simulate(
 ) -> Simulated {
     let (mut checked, parts) = check_geometry(world, &[spec.to_path_buf()]);
     let mut diags = diag::Diagnostics::new();
-    // Reads a file the run names outside the spec into the source map.
     let read = |checked: &mut Checked, path: &Path, kind: source::FileKind| {
-        let shown = path.display().to_string();
-        match world.read(path, kind) {
-            Ok(b) => {
-                let text = String::from_utf8_lossy(&b).into_owned();
-                Ok(checked.sources.add(shown, Some(path.to_path_buf()), text))
-            }
-            Err(e) => {
-                let file =
-                    checked
-                        .sources
-                        .add(shown.clone(), Some(path.to_path_buf()), String::new());
-                Err(source::io::IoError::Unreadable {
-                    file,
-                    path: shown,
-                    reason: e.0,
-                })
-            }
-        }
+        read_beside(world, checked, path, kind)
     };
     let finish = |mut checked: Checked, diags: diag::Diagnostics, report| {
         checked.absorb(diags);
@@ -795,26 +804,14 @@ pub fn verify(
         }
         Some(path) => {
             let (mut checked, parts) = check_geometry(world, &roots);
-            let shown = path.display().to_string();
-            match world.read(path, source::FileKind::Dmis) {
-                Ok(b) => {
-                    let text = String::from_utf8_lossy(&b).into_owned();
-                    let id = checked
-                        .sources
-                        .add(shown, Some(path.to_path_buf()), text.clone());
+            match read_beside(world, &mut checked, path, source::FileKind::Dmis) {
+                Ok(id) => {
+                    let text = checked.sources.get(id).text.clone();
                     (checked, parts, vec![(id, text)])
                 }
                 Err(e) => {
-                    let file =
-                        checked
-                            .sources
-                            .add(shown.clone(), Some(path.to_path_buf()), String::new());
                     let mut diags = diag::Diagnostics::new();
-                    diags.push(source::io::IoError::Unreadable {
-                        file,
-                        path: shown,
-                        reason: e.0,
-                    });
+                    diags.push(e);
                     checked.absorb(diags);
                     return Verified {
                         checked,
@@ -883,15 +880,19 @@ fn verify_program(
     };
     let part = model.plans[plan].part.0;
     let data = parts.get(part).and_then(|p| p.as_ref())?;
+    let nominal = simulate::Deviations::nominal(data.geometry.faces.len());
     let bench = verify::Bench {
-        model,
         part,
-        geometry: &data.geometry,
-        feature_faces: &data.feature_faces,
-        fixtures: &data.fixtures,
-        program: &prog,
-        file,
-        text,
+        sim: simulate::Input {
+            model,
+            geometry: &data.geometry,
+            feature_faces: &data.feature_faces,
+            fixtures: &data.fixtures,
+            program: &prog,
+            file,
+            text,
+            deviations: &nominal,
+        },
     };
     Some(verify::verify(&bench, opts))
 }

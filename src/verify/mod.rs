@@ -24,31 +24,18 @@ pub mod trials;
 pub use report::Verification;
 
 use crate::dmis::text::Labels;
-use crate::geometry::{FaceId, FixtureMesh, PartGeometry};
 use crate::model::{Model, TolValue};
-use crate::simulate::{self, Deviations, Report};
-use crate::source::FileId;
+use crate::simulate::{self, Report};
 use rayon::prelude::*;
 use report::{Placed, TolResult, Tried};
 
-/// What the battery runs against: a spec's part and one program of it.
+/// What the battery runs against: a spec's part and one program of it, as the virtual
+/// CMM takes them (its deviations are each trial's own).
 pub struct Bench<'a> {
-    /// The spec's model.
-    pub model: &'a Model,
     /// The part (index into the model's parts).
     pub part: usize,
-    /// Its geometry.
-    pub geometry: &'a PartGeometry,
-    /// Per feature, its faces.
-    pub feature_faces: &'a [Vec<FaceId>],
-    /// The plan's fixtures placed with the part.
-    pub fixtures: &'a [FixtureMesh],
-    /// The program.
-    pub program: &'a crate::dmis::Program,
-    /// Its file and text.
-    pub file: FileId,
-    /// The program's text.
-    pub text: &'a str,
+    /// The program on the nominal part.
+    pub sim: simulate::Input<'a>,
 }
 
 /// How hard the battery tries.
@@ -79,9 +66,9 @@ const IN_AT: f64 = 0.5;
 
 /// Runs the battery.
 pub fn verify(bench: &Bench, opts: &Options) -> Verification {
-    let part = &bench.model.parts[bench.part];
+    let part = &bench.sim.model.parts[bench.part];
     let nominal = run(bench, &[]);
-    let labels = tolerance_labels(bench.model, bench.part);
+    let labels = tolerance_labels(bench.sim.model, bench.part);
     // The placements.
     let placements: Vec<Vec<String>> = (0..opts.placements)
         .map(|i| placement(i as u64, opts))
@@ -115,8 +102,14 @@ pub fn verify(bench: &Bench, opts: &Options) -> Verification {
         let mut result = TolResult::new(ti, label, t, zone, !rows.is_empty());
         if !rows.is_empty() {
             for k in [IN_AT, OUT_AT] {
-                let variants =
-                    trials::forbidden(part, bench.geometry, bench.feature_faces, t, zone, k);
+                let variants = trials::forbidden(
+                    part,
+                    bench.sim.geometry,
+                    bench.sim.feature_faces,
+                    t,
+                    zone,
+                    k,
+                );
                 for (vi, v) in variants.into_iter().enumerate() {
                     if k == IN_AT {
                         result
@@ -226,37 +219,28 @@ fn mix(mut z: u64) -> u64 {
 /// One run of the program with the deviations `lines`.
 fn run(bench: &Bench, lines: &[String]) -> Tried {
     let text = lines.join("\n");
-    let part = &bench.model.parts[bench.part];
-    let deviations = if lines.is_empty() {
-        Deviations::nominal(bench.geometry.faces.len())
-    } else {
-        match simulate::deviation::parse(
-            bench.file,
-            &text,
-            part,
-            bench.geometry,
-            bench.feature_faces,
-        ) {
-            Ok(d) => d,
-            Err(e) => {
-                let why = e.first().map(|e| e.to_string()).unwrap_or_default();
-                return Tried {
-                    report: None,
-                    stopped: Some(format!("the virtual part cannot take it: {why}")),
-                    rejected: Some(why),
-                };
-            }
+    let part = &bench.sim.model.parts[bench.part];
+    // No lines parse to the nominal part.
+    let deviations = match simulate::deviation::parse(
+        bench.sim.file,
+        &text,
+        part,
+        bench.sim.geometry,
+        bench.sim.feature_faces,
+    ) {
+        Ok(d) => d,
+        Err(e) => {
+            let why = e.first().map(|e| e.to_string()).unwrap_or_default();
+            return Tried {
+                report: None,
+                stopped: Some(format!("the virtual part cannot take it: {why}")),
+                rejected: Some(why),
+            };
         }
     };
     let input = simulate::Input {
-        model: bench.model,
-        geometry: bench.geometry,
-        feature_faces: bench.feature_faces,
-        fixtures: bench.fixtures,
-        program: bench.program,
-        file: bench.file,
-        text: bench.text,
         deviations: &deviations,
+        ..bench.sim
     };
     match simulate::simulate(&input, &simulate::Options::default()) {
         Ok(r) => Tried {
@@ -266,7 +250,7 @@ fn run(bench: &Bench, lines: &[String]) -> Tried {
         },
         Err(errors) => Tried {
             report: None,
-            stopped: Some(stop_text(&errors, bench.text)),
+            stopped: Some(stop_text(&errors, bench.sim.text)),
             rejected: None,
         },
     }
