@@ -2,21 +2,21 @@
 //! lines of a deviations file (`inspc simulate --deviations`), so that every trial the
 //! battery reports can be rerun by hand.
 //!
-//! What each tolerance forbids follows the zone definitions of ASME Y14.5-2018 (and
-//! ISO 1101:2017, which agrees for these cases):
+//! What each tolerance forbids follows the zone definitions of ASME Y14.5-2018 (cited by
+//! chapter; ISO 1101:2017 agrees for these cases):
 //!
 //! | tolerance | zone (Y14.5-2018) | deviation tried at `k` × the zone `t` |
 //! | --- | --- | --- |
-//! | flatness, straightness | two parallel planes `t` apart (§8.4.2, §8.4.1) | each plane of the feature bowed by `k·t` (its centre stands out `k·t`, its farthest corner not at all: true flatness `k·t`) |
-//! | profile with datums | a uniform boundary `t` wide about the true profile, located by the datums (§11.3) | each plane shifted `k·t/2` out, each curved face grown `k·t` in diameter |
-//! | profile without datums | the same zone, free to float: form only (§11.3.2) | each plane bowed `k·t` |
-//! | perpendicularity, parallelism, angularity | two planes (or a cylinder for Ø) `t` apart at the basic orientation (§9.2) | the feature tilted so that its far ends differ by `k·t` across its extent, about each of the two axes across it |
-//! | position, concentricity, coaxiality, symmetry, runout | a zone `t` wide (Ø `t`) centred at the true position or on the datum axis (§10.2, §12.3) | the feature moved `k·t/2` off its true position, along each direction across it |
-//! | size (Ø, R, width) | its limits (§5.8, Rule #1) | the size grown by `k` × the upper and `k` × the lower deviation |
+//! | flatness, straightness | two parallel planes `t` apart (ch. 8, form) | each plane of the feature bowed by `k·t` (its centre stands out `k·t`, its farthest corner not at all: true flatness `k·t`) |
+//! | profile with datums | a uniform boundary `t` wide about the true profile, located by the datums (ch. 11, profile) | each plane shifted `k·t/2` out, each curved face grown `k·t` in diameter |
+//! | profile without datums | the same zone, free to float: form only (ch. 11) | each plane bowed `k·t` |
+//! | perpendicularity, parallelism, angularity | two planes (or a cylinder for Ø) `t` apart at the basic orientation (ch. 9, orientation) | the feature tilted so that its far ends differ by `k·t` across its extent, about each of the two axes across it |
+//! | position, concentricity, coaxiality, symmetry, runout | a zone `t` wide (Ø `t`) centred at the true position or on the datum axis (ch. 10, location; ch. 12, runout) | the feature moved `k·t/2` off its true position, along each direction across it |
+//! | size (Ø, R, width) | its limits (ch. 5, Rule #1) | the size grown by `k` × the upper and `k` × the lower deviation |
 //! | distance, angle | its limits | the second feature moved (turned) by `k` × each deviation |
 //!
 //! `t` is the zone as the program judges it on the nominal part: with a material
-//! modifier, the zone plus the bonus the nominal size gives (§10.3), read from the
+//! modifier, the zone plus the bonus the nominal size gives (ch. 10), read from the
 //! nominal run. Circularity and cylindricity need lobed or tapered surfaces, which the
 //! virtual part does not model: they are listed as not tried.
 
@@ -186,7 +186,7 @@ pub fn forbidden(
 
 /// What a tolerance's datum reference frame holds: a frame leaves free the turn about a
 /// lone datum's normal or axis and every move it has no datum against (ASME Y14.5-2018
-/// §7.11: the degrees of freedom a datum reference frame constrains are those its datum
+/// ch. 7, datum reference frames: the degrees of freedom a datum reference frame constrains are those its datum
 /// features arrest; a zone is oriented and located only in those).
 struct Frame {
     /// Directions the datum features arrest moves along (orthonormal).
