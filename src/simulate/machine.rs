@@ -1184,10 +1184,7 @@ impl Machine<'_> {
         let dev: &Deviations = self.input.deviations;
         let mut best: Option<(f64, Contact, Option<FaceId>)> = None;
         if let Some(mesh) = self.scene.mesh() {
-            let foot = c0 - n * r;
-            let ray = Ray::new(foot, -n);
-            let hit =
-                mesh.cast_ray_and_get_normal(&Isometry3::identity(), &ray, travel + 1.0, false);
+            let hit = foot_ray(mesh, &(c0 - n * r), n, travel + 1.0);
             if let Some(hit) = hit {
                 let tri = match hit.feature {
                     parry3d_f64::shape::FeatureId::Face(i) => i as usize % g.triangles.len().max(1),
@@ -1897,6 +1894,24 @@ fn nominal(params: &[String]) -> Option<Nominal> {
         convex,
         word: word.to_string(),
         numbers: v,
+    })
+}
+
+/// The face under the ball's foot, by a ray along `-n`. A ray through a shared edge or
+/// vertex of the tessellation can slip between its triangles (a touch programmed on the
+/// line where a face's facets meet); the ray is then cast again from four points a
+/// tenth of a micrometre beside the foot, in a fixed order.
+fn foot_ray(
+    mesh: &parry3d_f64::shape::TriMesh,
+    foot: &P3,
+    n: &V3,
+    reach: f64,
+) -> Option<parry3d_f64::query::RayIntersection> {
+    const NUDGE: f64 = 1e-4;
+    let (u, v) = fit::across(n);
+    [V3::zeros(), u, -u, v, -v].into_iter().find_map(|d| {
+        let ray = Ray::new(foot + d * NUDGE, -n);
+        mesh.cast_ray_and_get_normal(&Isometry3::identity(), &ray, reach, false)
     })
 }
 
