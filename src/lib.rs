@@ -511,12 +511,17 @@ fn paths_of(
         };
         let report = |done: usize, total: usize| progress("paths", done, total);
         let mut bans_all: Vec<plan::Ban> = Vec::new();
-        for attempt in 0..=REPLANS {
+        for attempt in 0.. {
             let mut moves = diag::Diagnostics::new();
             let mut bans = Vec::new();
             let scene = memo.scene(input.geometry);
             let llip = path::plan(&input, &hlip, &scene, &report, &mut moves, &mut bans);
-            if llip.is_some() || bans.is_empty() || attempt == REPLANS {
+            // A plan validated with the part turned (robust to it set off square) that
+            // the path stage could not route after every re-plan gives way to one more,
+            // validated at the nominal pose only: one the path stage routes, whose
+            // setups say how square to set the part.
+            let last = attempt >= REPLANS && !(attempt == REPLANS && memo.turned());
+            if llip.is_some() || bans.is_empty() || last {
                 diags.extend(own);
                 diags.extend(moves);
                 if let Some(llip) = llip {
@@ -525,6 +530,9 @@ fn paths_of(
                 break;
             }
             bans_all.extend(bans);
+            if attempt == REPLANS {
+                memo.give_up_turned();
+            }
             let again = plan::PlanOptions {
                 bans: bans_all.clone(),
                 ..opts.clone()

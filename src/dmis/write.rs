@@ -844,6 +844,16 @@ impl Writer<'_> {
             let face = self.face_words(*f);
             self.o.oper(&format!("REST {face} ON THE TABLE"));
         }
+        match setup.square_within {
+            Some(w) if w > 0.0 => self.o.oper(&format!(
+                "SQUARE IT TO THE MACHINE AXES WITHIN {} DEG: TURNED MORE, THE STYLUS HITS THE PART",
+                crate::dmis::text::num(w)
+            )),
+            Some(_) => self.o.oper(
+                "SQUARE IT EXACTLY TO THE MACHINE AXES (AGAINST A STOP): TURNED AT ALL, THE STYLUS HITS THE PART",
+            ),
+            None => {}
+        }
         let al = &sp.alignment;
         if !al.missing.is_empty() {
             self.o.oper(&format!(

@@ -124,10 +124,14 @@ fn resting_datum(input: &Input, up: V3, table: f64) -> Option<usize> {
     part.datums.iter().position(|d| rests(d.feature))
 }
 
-/// Where the operator can touch the part by hand in a setup: the tip's radius, and
-/// whether a touch at a contact point with an outward normal is clear (the probe held
-/// as the setup's first group holds it, approaching along the normal).
+/// Where the operator can touch the part by hand with one group's probe: the tip's
+/// radius, and whether a touch at a contact point with an outward normal is clear (the
+/// probe held as the group holds it, approaching along the normal).
 pub struct Touchable<'a> {
+    /// The probe (rack slot): groups of one probe along one direction touch alike.
+    pub probe: usize,
+    /// The probe's direction, tip to head (part frame).
+    pub dir: V3,
     /// The tip radius (mm).
     pub tip: f64,
     /// The check.
@@ -136,7 +140,7 @@ pub struct Touchable<'a> {
 
 /// Chooses the alignment of one setup from its groups' blocks, completed from other
 /// faces of the part where they leave something free.
-pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath, touch: &Touchable) -> Alignment {
+pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath, touch: &[Touchable]) -> Alignment {
     let geometry = input.geometry;
     // Features whose tolerances refer to datums: aligned on, such a feature sets the
     // frame its own tolerance is read in (moved, it would read perfect).
@@ -496,29 +500,20 @@ fn complete(
     up: V3,
     group: usize,
     used: &[FaceId],
-    touch: &Touchable,
+    touch: &[Touchable],
     out: &mut Alignment,
     free: &mut Free,
 ) {
     let g = input.geometry;
-    // A face of a feature whose tolerance refers to datums would set the frame it is
-    // read in (moved, it would read in place): such faces are never taken.
     let part = &input.model.parts[input.plan.part.0];
     let datum_features: Vec<FeatureId> = part.datums.iter().map(|d| d.feature).collect();
-    let read_in_frame: Vec<FaceId> = part
-        .tolerances
-        .iter()
-        .filter(|t| !t.datums.is_empty())
-        .flat_map(|t| t.targets.iter())
-        .filter(|f| !datum_features.contains(f))
-        .flat_map(|f| faces_in_graph(input, *f))
-        .collect();
+    let left_free = LeftFree::of(input);
     // Candidate planes: along a part axis, not facing the table, by area.
     let mut planes: Vec<(FaceId, usize, bool, f64)> = g
         .faces
         .iter()
         .enumerate()
-        .filter(|(i, _)| !used.contains(&FaceId(*i)) && !read_in_frame.contains(&FaceId(*i)))
+        .filter(|(i, _)| !used.contains(&FaceId(*i)))
         .filter_map(|(i, f)| match &f.surface {
             Surface::Plane { normal, origin } if normal.dot(&up) > -1e-6 => {
                 axis_of(normal).map(|(k, pos)| (FaceId(i), k, pos, origin[k]))
@@ -553,25 +548,44 @@ fn complete(
             .then(g.faces[b.0 .0].area.total_cmp(&g.faces[a.0 .0].area))
             .then(a.0.cmp(&b.0))
     });
-    let sampler = crate::sample::Sampler::new(g, touch.tip + 1.0);
+    let largest_tip = touch.iter().map(|t| t.tip).fold(0.0, f64::max);
+    let sampler = crate::sample::Sampler::new(g, largest_tip + 1.0);
+    // The groups whose probe the operator may touch with: the first step's, then the
+    // setup's others in order (the writer selects each step's sensor).
+    let mut order: Vec<usize> = Vec::new();
+    for gi in std::iter::once(group).chain(0..touch.len()) {
+        let same = |o: &usize| touch[*o].probe == touch[gi].probe && (touch[*o].dir - touch[gi].dir).norm() < 1e-6;
+        if gi < touch.len() && !order.iter().any(same) {
+            order.push(gi);
+        }
+    }
     let strategy = crate::model::Strategy {
         method: crate::model::SampleMethod::Uniform,
         points: Some(25),
         inset: None,
     };
-    // The points of a face the probe can touch.
-    let reachable = |f: FaceId| -> Vec<(P3, V3)> {
-        sampler
-            .sample(f, &strategy)
-            .into_iter()
-            .filter(|p| (touch.clear)(&p.tip_centre(touch.tip), &p.normal))
+    // The points of a face group `gi`'s probe can touch: the face's samples (once a
+    // face), those the stylus does not stand behind, then those whose approach is clear.
+    let samples = std::cell::RefCell::new(std::collections::BTreeMap::new());
+    let reachable = |f: FaceId, gi: usize| -> Vec<(P3, V3)> {
+        let t = &touch[gi];
+        let mut samples = samples.borrow_mut();
+        let pts = samples
+            .entry(f)
+            .or_insert_with(|| sampler.sample(f, &strategy));
+        pts.iter()
+            .filter(|p| p.normal.dot(&t.dir) > BEHIND)
+            .filter(|p| (t.clear)(&p.tip_centre(t.tip), &p.normal))
             .map(|p| (p.position, p.normal))
             .collect()
     };
-    let push =
-        |out: &mut Alignment, face: FaceId, touches: Vec<(P3, V3)>, keywords: Vec<String>| {
+    let push = |out: &mut Alignment,
+                gi: usize,
+                face: FaceId,
+                touches: Vec<(P3, V3)>,
+                keywords: Vec<String>| {
             out.steps.push(AlignStep {
-                group,
+                group: gi,
                 block: None,
                 points: Vec::new(),
                 extra: Some(ExtraFace { face, touches }),
@@ -588,31 +602,44 @@ fn complete(
             let (fa, fb) = (facing(a.1, a.2), facing(b.1, b.2));
             (fb * 1e3).round().total_cmp(&(fa * 1e3).round())
         });
-        for &(f, k, pos, at) in &primaries {
-            let pts = reachable(f);
-            let Some(chosen) = farthest(&pts, 3) else {
-                continue;
-            };
-            if !spans_plane(&chosen) {
-                continue;
+        'primary: for &gi in &order {
+            for &(f, k, pos, at) in &primaries {
+                if !left_free.may_fix(f, &Fixes::primary(k)) {
+                    continue;
+                }
+                let pts = reachable(f, gi);
+                let Some(chosen) = farthest(&pts, 3) else {
+                    continue;
+                };
+                if !spans_plane(&chosen) {
+                    continue;
+                }
+                push(out, gi, f, chosen, vec![dir_word(k, pos), orig_word(k)]);
+                free.dirs.push(k);
+                free.origins[k] = true;
+                out.trans.push((AXES[k], at));
+                taken.push(f);
+                break 'primary;
             }
-            push(out, f, chosen, vec![dir_word(k, pos), orig_word(k)]);
-            free.dirs.push(k);
-            free.origins[k] = true;
-            out.trans.push((AXES[k], at));
-            taken.push(f);
-            break;
         }
     }
     // A secondary: a plane across the primary, two touches along it.
     if free.dirs.len() == 1 {
         let p = free.dirs[0];
-        for &(f, k, pos, at) in &planes {
+        let tries = order.iter().flat_map(|&gi| planes.iter().map(move |pl| (gi, pl)));
+        for (gi, &(f, k, pos, at)) in tries {
             if k == p || taken.contains(&f) {
                 continue;
             }
+            let fixes = Fixes {
+                turns: vec![p],
+                moves: if free.origins[k] { vec![] } else { vec![k] },
+            };
+            if !left_free.may_fix(f, &fixes) {
+                continue;
+            }
             let along = V3::ith(p, 1.0).cross(&V3::ith(k, 1.0));
-            let pts = reachable(f);
+            let pts = reachable(f, gi);
             let mut best: Option<(f64, [usize; 2])> = None;
             for i in 0..pts.len() {
                 for j in i + 1..pts.len() {
@@ -633,7 +660,7 @@ fn complete(
                 free.origins[k] = true;
                 out.trans.push((AXES[k], at));
             }
-            push(out, f, vec![pts[i], pts[j]], keywords);
+            push(out, gi, f, vec![pts[i], pts[j]], keywords);
             free.dirs.push(k);
             taken.push(f);
             break;
@@ -646,11 +673,16 @@ fn complete(
             if free.origins[k] {
                 continue;
             }
-            for &(f, kk, _, at) in &planes {
-                if kk != k || taken.contains(&f) {
+            let tries = order.iter().flat_map(|&gi| planes.iter().map(move |pl| (gi, pl)));
+            for (gi, &(f, kk, _, at)) in tries {
+                let fixes = Fixes {
+                    turns: vec![],
+                    moves: vec![k],
+                };
+                if kk != k || taken.contains(&f) || !left_free.may_fix(f, &fixes) {
                     continue;
                 }
-                let pts = reachable(f);
+                let pts = reachable(f, gi);
                 let c = g.faces[f.0].centroid;
                 let Some(&p) = pts
                     .iter()
@@ -658,7 +690,7 @@ fn complete(
                 else {
                     continue;
                 };
-                push(out, f, vec![p], vec![orig_word(k)]);
+                push(out, gi, f, vec![p], vec![orig_word(k)]);
                 free.origins[k] = true;
                 out.trans.push((*axis, at));
                 taken.push(f);
@@ -666,9 +698,98 @@ fn complete(
             }
         }
     }
-    if let Some((f, pts, keywords, trans)) = sphere_origins(g, &reachable, free) {
-        push(out, f, pts, keywords);
-        out.trans.extend(trans);
+    for &gi in &order {
+        if let Some((f, pts, keywords, trans)) = sphere_origins(g, &|f| reachable(f, gi), free) {
+            push(out, gi, f, pts, keywords);
+            out.trans.extend(trans);
+            break;
+        }
+    }
+}
+
+/// The least cosine between a face's outward normal and the probe's direction (tip to
+/// head) at which the probe may touch it: below, the stylus stands behind the face (a
+/// face under an overhang for a vertical stylus), and no pose need be checked.
+const BEHIND: f64 = -0.3;
+
+/// The degrees of freedom a face touched by hand fixes: turns about part axes and
+/// moves along them.
+struct Fixes {
+    turns: Vec<usize>,
+    moves: Vec<usize>,
+}
+
+impl Fixes {
+    /// A primary plane square to axis `k`: the turns about the other two, the move
+    /// along `k`.
+    fn primary(k: usize) -> Fixes {
+        Fixes {
+            turns: (0..3).filter(|&j| j != k).collect(),
+            moves: vec![k],
+        }
+    }
+}
+
+/// Per face, what the datum reference frames of its location and profile tolerances
+/// leave free: (moves, turns). A frame fixes only the degrees of freedom its datum
+/// features constrain (ASME Y14.5-2018, ch. 7: a primary plane alone leaves the moves
+/// along it and the turn about its normal free); the evaluation reads what is left in
+/// the program's alignment ([`crate::simulate::evaluate`]), so a face aligned on in a
+/// degree of freedom its own frame leaves free would read in place in it. Form and
+/// orientation tolerances do not depend on the alignment, nor do those of datum
+/// features (the frame is built on them).
+struct LeftFree {
+    faces: Vec<(FaceId, Vec<V3>, Vec<V3>)>,
+}
+
+impl LeftFree {
+    fn of(input: &Input) -> LeftFree {
+        use crate::model::TolKind;
+        use crate::simulate::fit::Shape as Fitted;
+        let part = &input.model.parts[input.plan.part.0];
+        let datum_features: Vec<FeatureId> = part.datums.iter().map(|d| d.feature).collect();
+        let nominal = |f: FeatureId| -> Option<Fitted> {
+            let face = *faces_in_graph(input, f).first()?;
+            Fitted::of_surface(&input.geometry.faces.get(face.0)?.surface).map(|x| x.0)
+        };
+        let mut faces = Vec::new();
+        for t in &part.tolerances {
+            let located = matches!(
+                t.kind,
+                TolKind::Position
+                    | TolKind::Concentricity
+                    | TolKind::Coaxiality
+                    | TolKind::Symmetry
+                    | TolKind::ProfileLine
+                    | TolKind::ProfileSurface
+            );
+            if t.datums.is_empty() || !located {
+                continue;
+            }
+            let shapes: Vec<(Fitted, Fitted)> = t
+                .datums
+                .iter()
+                .filter_map(|d| nominal(part.datums[d.datum.0].feature))
+                .map(|s| (s.clone(), s))
+                .collect();
+            let drf = crate::simulate::evaluate::drf(&shapes);
+            for f in t.targets.iter().filter(|f| !datum_features.contains(f)) {
+                for face in faces_in_graph(input, *f) {
+                    faces.push((face, drf.free_t.clone(), drf.free_r.clone()));
+                }
+            }
+        }
+        LeftFree { faces }
+    }
+
+    /// Whether `face` may fix `fixes`: no frame of its tolerances leaves one of them
+    /// free.
+    fn may_fix(&self, face: FaceId, fixes: &Fixes) -> bool {
+        self.faces.iter().filter(|x| x.0 == face).all(|(_, moves, turns)| {
+            let moved = |k: usize| moves.iter().any(|m| m[k].abs() > 1e-3);
+            let turned = |k: usize| turns.iter().any(|t| t[k].abs() > 0.999);
+            !fixes.moves.iter().any(|&k| moved(k)) && !fixes.turns.iter().any(|&k| turned(k))
+        })
     }
 }
 

@@ -472,19 +472,32 @@ fn join(
         }
     }
     for sp in &mut setups {
-        // By hand, the operator holds the probe as the setup's first group does.
-        let first = groups.iter().find(|g| g.setup == sp.setup);
-        let pose =
-            first.map(|g| Pose::new(scene, g.probe, g.dir, g.up, g.table).with_fixture(g.fixture));
+        // By hand, the operator holds the probe as one of the setup's groups does.
         let standoff = motion.prehit.max(motion.retract);
-        let clear = |c: &P3, n: &V3| {
-            pose.as_ref()
-                .is_some_and(|p| p.approach(c, n, standoff, Contact::Part).is_ok())
-        };
-        let touch = align::Touchable {
-            tip: first.map_or(1.0, |g| g.probe.tip_radius),
-            clear: &clear,
-        };
+        let poses: Vec<(Pose, &GroupIn)> = groups
+            .iter()
+            .filter(|g| g.setup == sp.setup)
+            .map(|g| {
+                let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table).with_fixture(g.fixture);
+                (pose, g)
+            })
+            .collect();
+        let clears: Vec<_> = poses
+            .iter()
+            .map(|(pose, _)| {
+                move |c: &P3, n: &V3| pose.approach(c, n, standoff, Contact::Part).is_ok()
+            })
+            .collect();
+        let touch: Vec<align::Touchable> = poses
+            .iter()
+            .zip(&clears)
+            .map(|((_, g), clear)| align::Touchable {
+                probe: g.slot.0,
+                dir: g.dir,
+                tip: g.probe.tip_radius,
+                clear,
+            })
+            .collect();
         sp.alignment = align::align(input, hlip, sp, &touch);
         for g in &sp.groups {
             for b in &g.blocks {

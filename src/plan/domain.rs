@@ -230,9 +230,10 @@ impl GridCells {
 
 /// What one planning of an input computes that a later planning of the same input (a
 /// re-plan after the path stage bans a configuration) can reuse: the pure results only —
-/// cones of a point and probe, depth maps of a setup — never what learning changed. A
-/// memo belongs to one [`super::Input`]; the re-plan gives byte-identical knowledge
-/// without computing it again.
+/// cones of a point and probe, depth maps of a setup — never what learning changed —
+/// and whether a plan validated with the part turned was found at all. A memo belongs
+/// to one [`super::Input`]; the re-plan gives byte-identical knowledge without
+/// computing it again.
 #[derive(Default)]
 pub struct Memo {
     /// The initial knowledge of every (graph point, probe).
@@ -251,9 +252,23 @@ pub struct Memo {
     caps: BTreeMap<(usize, usize), CubeMap>,
     /// The part as obstacle.
     scene: Option<Scene>,
+    /// A plan validated with the part turned was sought and not found: the re-plans of
+    /// the same input (which only add bans) do not seek it again.
+    pub(crate) unturnable: bool,
 }
 
 impl Memo {
+    /// Later plannings of this input validate at the nominal pose only.
+    pub fn give_up_turned(&mut self) {
+        self.unturnable = true;
+    }
+
+    /// Whether the last planning of this input found a plan validated with the part
+    /// turned (none has given it up).
+    pub fn turned(&self) -> bool {
+        !self.unturnable
+    }
+
     /// The part as obstacle, built on first use (a memo belongs to one input, so to one
     /// part): re-plans and the path stage share it instead of building its hierarchy
     /// again.

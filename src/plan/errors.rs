@@ -55,6 +55,21 @@ pub enum PlanError {
         why: String,
         help: String,
     },
+    #[error("setup {setup} of `{plan}` runs only with the part set square to the machine axes {within}, not within {full}°: turned more, the stylus hits the part at {touches}")]
+    #[diagnostic(
+        code(insp::plan::placement_sensitive),
+        severity(Warning),
+        help("the setup's prompt asks the operator to square the part {within}; a stop or fixture that squares it, or a stylus with more room beside its stem at these faces, lets the program find the part anywhere within {full}°")
+    )]
+    PlacementSensitive {
+        #[label("this plan")]
+        span: Span,
+        plan: String,
+        setup: usize,
+        within: String,
+        full: String,
+        touches: String,
+    },
     #[error("part `{part}` does not fit on the table of `{cmm}`: its smallest footprint is {footprint}, the table {table}")]
     #[diagnostic(
         code(insp::plan::part_off_table),
@@ -129,6 +144,7 @@ crate::located!(PlanError {
     UninspectableFaceAllowed,
     NoConvergence,
     PointsLeftOut,
+    PlacementSensitive,
     NoPlan,
     PartOffTable,
     ProbeTooLong,

@@ -110,6 +110,11 @@ pub struct SetupNode {
     pub fixture: Vec<Solid>,
     /// The probes used, in order.
     pub probes: Vec<ProbeNode>,
+    /// How square to the machine axes (degrees about the vertical) the operator must
+    /// set the part, where some touch collides with it turned less than the placement
+    /// every program is validated for ([`super::placement`]); `None` when it runs
+    /// anywhere within that.
+    pub square_within: Option<f64>,
 }
 
 /// One sensor in a setup: a touch probe, or a laser scanner.
@@ -354,6 +359,7 @@ pub(crate) fn assemble(input: &Input, k: &mut Knowledge, m: &Machine, run: &Roun
             table: round(held.table),
             fixture: held.solids,
             probes: pnodes,
+            square_within: None,
         });
     }
     let probe_changes = seq.windows(2).filter(|w| w[0].0 != w[1].0).count();

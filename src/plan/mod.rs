@@ -20,6 +20,7 @@ mod explain;
 mod fallback;
 mod hlip;
 mod machine;
+mod placement;
 pub mod poses;
 mod render;
 mod scan;
@@ -373,7 +374,7 @@ pub fn plan_with(
     loop {
         let skip: BTreeSet<FaceId> = lasers.iter().flat_map(|l| l.faces.clone()).collect();
         let mut own = Diagnostics::new();
-        let Some(mut hlip) = plan_touch(input, opts, memo, &skip, &mut own) else {
+        let Some(mut hlip) = plan_placed(input, opts, memo, &skip, &mut own) else {
             diags.extend(own);
             return None;
         };
@@ -426,12 +427,47 @@ pub fn plan_with(
     }
 }
 
-/// The touch plan of every face but `skip` (those a scanner measures).
+/// How many configurations of a point may collide with the part turned (and not at its
+/// nominal pose) before the point takes one clear at the nominal pose alone: an
+/// indexed head offers the next orientation 7.5° away, which seldom clears what the
+/// first did not.
+const FRAGILE_AFTER: usize = 6;
+
+/// The touch plan of every face but `skip`, robust to the part set turned about the
+/// vertical: first with every touch validated at [`validate::PLACEMENT_TURN`] either way
+/// as well as at the nominal pose, but for points [`FRAGILE_AFTER`] configurations of
+/// which collided only turned; where that finds no plan (the configurations it turned
+/// down were a point's last), the plan validated at the nominal pose. The setups say how
+/// square the operator must set the part ([`hlip::SetupNode::square_within`]) and the
+/// warning `insp::plan::placement_sensitive` which touches ask it.
+fn plan_placed(
+    input: &Input,
+    opts: &PlanOptions,
+    memo: &mut Memo,
+    skip: &BTreeSet<FaceId>,
+    diags: &mut Diagnostics,
+) -> Option<Hlip> {
+    if !memo.unturnable {
+        let mut robust = Diagnostics::new();
+        let turn = validate::PLACEMENT_TURN;
+        if let Some(hlip) = plan_touch(input, opts, memo, skip, turn, &mut robust) {
+            diags.extend(robust);
+            return Some(hlip);
+        }
+        memo.unturnable = true;
+    }
+    plan_touch(input, opts, memo, skip, 0.0, diags)
+}
+
+/// The touch plan of every face but `skip` (those a scanner measures), each touch
+/// validated with the part turned `turn` degrees either way about the vertical. With a
+/// turn, a search that does not settle gives no plan (the caller plans again without).
 fn plan_touch(
     input: &Input,
     opts: &PlanOptions,
     memo: &mut Memo,
     skip: &BTreeSet<FaceId>,
+    turn: f64,
     diags: &mut Diagnostics,
 ) -> Option<Hlip> {
     let (model, plan, g) = (input.model, input.plan, input.graph);
@@ -476,6 +512,9 @@ fn plan_touch(
         memo,
     );
     let mut validated: BTreeSet<Pip> = BTreeSet::new();
+    // Per point, the configurations that collided only with the part turned: after
+    // FRAGILE_AFTER of them the point takes one clear at the nominal pose alone.
+    let mut turned_fails: BTreeMap<usize, usize> = BTreeMap::new();
     let mut last = String::from("no round was run");
     // The round whose plan had the fewest touches that failed validation: what the plan
     // falls back on, less those touches, if no round settles.
@@ -571,11 +610,16 @@ fn plan_touch(
             .iter()
             .map(|(p, _)| (p.setup, k.held(p.setup).clone()))
             .collect();
-        let checked: Vec<(Pip, Result<(), _>)> = pips
+        // (touch, result, whether it failed only with the part turned)
+        let checked: Vec<(Pip, Result<(), _>, bool)> = pips
             .par_iter()
             .map(|(p, up)| {
-                let r = validate::check(&k, &machine, p, up, &held[&p.setup], &opts.bans);
-                (*p, r)
+                let tries = turned_fails.get(&p.point).copied().unwrap_or(0);
+                let t = if tries < FRAGILE_AFTER { turn } else { 0.0 };
+                let check = |t| validate::check(&k, &machine, p, up, &held[&p.setup], &opts.bans, t);
+                let r = check(t);
+                let turned_only = r.is_err() && t > 0.0 && check(0.0).is_ok();
+                (*p, r, turned_only)
             })
             .collect();
         let mut invalid = Vec::new();
@@ -584,7 +628,10 @@ fn plan_touch(
         let mut failed: BTreeMap<String, (usize, String)> = BTreeMap::new();
         let mut causes: BTreeMap<FaceId, (usize, usize, crate::access::pose::Blocker)> =
             BTreeMap::new();
-        for (p, what) in checked {
+        for (p, what, turned_only) in checked {
+            if turned_only {
+                *turned_fails.entry(p.point).or_default() += 1;
+            }
             match what {
                 Ok(()) => {
                     validated.insert(p);
@@ -627,6 +674,9 @@ fn plan_touch(
                 exact_budget: opts.exact_budget,
             };
             let mut hlip = assemble(input, &mut k, &machine, &round);
+            // Touches validated turned are clear turned; the others are measured.
+            let fragile = |p: &Pip| turn == 0.0 || turned_fails.get(&p.point) >= Some(&FRAGILE_AFTER);
+            placement::square_within(input, &mut k, &machine, &best.1, &fragile, &mut hlip, diags);
             if hlip.summary.setups > hlip.summary.min_setups.0 {
                 let forcing = forcing_levels(&root, &mut k, &machine, hierarchy, &best.1);
                 hlip.summary.more_setups = Some(forcing.unwrap_or_else(|| {
@@ -662,6 +712,9 @@ fn plan_touch(
             });
         }
         learn(&mut k, &machine, invalid);
+    }
+    if turn > 0.0 {
+        return None;
     }
     if let Some(f) = fallback {
         if let Some(hlip) = f.settle(input, &mut k, &machine, opts, diags) {

@@ -313,6 +313,7 @@ pub(crate) fn plan_scans(
             table,
             fixture: solids,
             probes: vec![],
+            square_within: None,
         });
     }
     let setup_of = |p: &Placed| {

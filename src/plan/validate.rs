@@ -6,6 +6,16 @@
 use super::domain::{Held, Knowledge, Machine};
 use crate::access::pose::{orientation_dir, Blocker};
 use crate::geometry::V3;
+use nalgebra::{Rotation3, Unit};
+
+/// How far (degrees) the operator may set the part turned about the vertical from the
+/// pose the setup's prompt asks for, and the program still run: the placement `inspc
+/// verify` tries. The program follows the part (its alignment finds it), but an indexed
+/// probe keeps its machine direction, so in the part's frame the stylus stands turned
+/// by as much; a stylus fitted deep into a bore with little room beside its stem touches
+/// the wall. Placing a part on a table by eye, square to the machine axes, to within
+/// 3° is what an operator does without a fixture (the target of issue 44).
+pub(crate) const PLACEMENT_TURN: f64 = 3.0;
 
 /// A primitive inspection plan.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -20,7 +30,8 @@ pub(crate) struct Pip {
     pub orient: usize,
 }
 
-/// Checks one PIP in setup `up` held as `held` says; what collides, if anything.
+/// Checks one PIP in setup `up` held as `held` says, and with the part turned `turn`
+/// degrees either way about the vertical; what collides, if anything.
 pub(crate) fn check(
     k: &Knowledge,
     m: &Machine,
@@ -28,6 +39,7 @@ pub(crate) fn check(
     up: &V3,
     held: &Held,
     bans: &[super::Ban],
+    turn: f64,
 ) -> Result<(), Blocker> {
     let dir = if m.head.indexable() {
         let (a, b) = m.grid[pip.orient];
@@ -38,5 +50,52 @@ pub(crate) fn check(
     if bans.iter().any(|b| b.is(pip.point, pip.probe, up, &dir)) {
         return Err(Blocker::Path);
     }
-    k.pose_check(m, pip.point, pip.probe, dir, *up, held)
+    k.pose_check(m, pip.point, pip.probe, dir, *up, held)?;
+    clear_turned(k, m, pip, &dir, up, held, turn)
+}
+
+/// Whether the touch stays clear with the part turned `turn` degrees either way about
+/// the vertical (the stylus turned the other way in the part's frame). A probe along
+/// the vertical turns into itself.
+fn clear_turned(
+    k: &Knowledge,
+    m: &Machine,
+    pip: &Pip,
+    dir: &V3,
+    up: &V3,
+    held: &Held,
+    turn: f64,
+) -> Result<(), Blocker> {
+    if turn <= 0.0 || dir.cross(up).norm() < 1e-9 {
+        return Ok(());
+    }
+    let axis = Unit::new_normalize(*up);
+    for sign in [1.0, -1.0] {
+        let turned = Rotation3::from_axis_angle(&axis, sign * turn.to_radians()) * dir;
+        k.pose_check(m, pip.point, pip.probe, turned, *up, held)?;
+    }
+    Ok(())
+}
+
+/// The largest of the turns tried (degrees: `turn`, then 2, 1, 0.5, 0.25 and 0.1 where
+/// smaller) with which the touch stays clear; 0 when only the nominal pose is.
+pub(crate) fn tolerated_turn(
+    k: &Knowledge,
+    m: &Machine,
+    pip: &Pip,
+    up: &V3,
+    held: &Held,
+    turn: f64,
+) -> f64 {
+    let dir = if m.head.indexable() {
+        let (a, b) = m.grid[pip.orient];
+        orientation_dir(up, a, b)
+    } else {
+        *up
+    };
+    [turn, 2.0, 1.0, 0.5, 0.25, 0.1]
+        .into_iter()
+        .filter(|&t| t <= turn)
+        .find(|&t| clear_turned(k, m, pip, &dir, up, held, t).is_ok())
+        .unwrap_or(0.0)
 }
