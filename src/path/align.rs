@@ -488,9 +488,12 @@ struct Free<'a> {
 }
 
 /// Completes an alignment from faces the setup does not measure: the plane that fixes
-/// what is free (datum faces first, then faces no tolerance reads, the largest first), touched where the operator can reach it — 3 touches on a
-/// primary, 2 along a secondary (across the primary direction, as far apart as the
-/// face allows), 1 near the middle of a tertiary. Nothing then depends on the operator
+/// what is free (datum faces first, then faces no tolerance reads, then toleranced
+/// faces for what their frames fix ([`LeftFree`]), the largest first in each), touched
+/// where the operator can reach it with one of the setup's probe orientations (the
+/// first step's first) — 3 touches on a primary, 2 along a secondary (across the
+/// primary direction, as far apart as the face allows), 1 near the middle of a
+/// tertiary. Nothing then depends on the operator
 /// squaring the part or placing it at a nominal position: the 3-2-1 alignment of
 /// coordinate metrology (Hocken & Pereira, *Coordinate Measuring Machines and
 /// Systems*, 2nd ed., §13.3: a part coordinate system takes all six degrees of
@@ -554,7 +557,9 @@ fn complete(
     // setup's others in order (the writer selects each step's sensor).
     let mut order: Vec<usize> = Vec::new();
     for gi in std::iter::once(group).chain(0..touch.len()) {
-        let same = |o: &usize| touch[*o].probe == touch[gi].probe && (touch[*o].dir - touch[gi].dir).norm() < 1e-6;
+        let same = |o: &usize| {
+            touch[*o].probe == touch[gi].probe && (touch[*o].dir - touch[gi].dir).norm() < 1e-6
+        };
         if gi < touch.len() && !order.iter().any(same) {
             order.push(gi);
         }
@@ -584,14 +589,14 @@ fn complete(
                 face: FaceId,
                 touches: Vec<(P3, V3)>,
                 keywords: Vec<String>| {
-            out.steps.push(AlignStep {
-                group: gi,
-                block: None,
-                points: Vec::new(),
-                extra: Some(ExtraFace { face, touches }),
-                keywords,
-            });
-        };
+        out.steps.push(AlignStep {
+            group: gi,
+            block: None,
+            points: Vec::new(),
+            extra: Some(ExtraFace { face, touches }),
+            keywords,
+        });
+    };
     let mut taken: Vec<FaceId> = Vec::new();
     // A primary: the plane facing most nearly up (a setup on a sine plate has no face
     // straight up), the largest first among equals.
@@ -626,7 +631,9 @@ fn complete(
     // A secondary: a plane across the primary, two touches along it.
     if free.dirs.len() == 1 {
         let p = free.dirs[0];
-        let tries = order.iter().flat_map(|&gi| planes.iter().map(move |pl| (gi, pl)));
+        let tries = order
+            .iter()
+            .flat_map(|&gi| planes.iter().map(move |pl| (gi, pl)));
         for (gi, &(f, k, pos, at)) in tries {
             if k == p || taken.contains(&f) {
                 continue;
@@ -673,7 +680,9 @@ fn complete(
             if free.origins[k] {
                 continue;
             }
-            let tries = order.iter().flat_map(|&gi| planes.iter().map(move |pl| (gi, pl)));
+            let tries = order
+                .iter()
+                .flat_map(|&gi| planes.iter().map(move |pl| (gi, pl)));
             for (gi, &(f, kk, _, at)) in tries {
                 let fixes = Fixes {
                     turns: vec![],
@@ -785,11 +794,14 @@ impl LeftFree {
     /// Whether `face` may fix `fixes`: no frame of its tolerances leaves one of them
     /// free.
     fn may_fix(&self, face: FaceId, fixes: &Fixes) -> bool {
-        self.faces.iter().filter(|x| x.0 == face).all(|(_, moves, turns)| {
-            let moved = |k: usize| moves.iter().any(|m| m[k].abs() > 1e-3);
-            let turned = |k: usize| turns.iter().any(|t| t[k].abs() > 0.999);
-            !fixes.moves.iter().any(|&k| moved(k)) && !fixes.turns.iter().any(|&k| turned(k))
-        })
+        self.faces
+            .iter()
+            .filter(|x| x.0 == face)
+            .all(|(_, moves, turns)| {
+                let moved = |k: usize| moves.iter().any(|m| m[k].abs() > 1e-3);
+                let turned = |k: usize| turns.iter().any(|t| t[k].abs() > 0.999);
+                !fixes.moves.iter().any(|&k| moved(k)) && !fixes.turns.iter().any(|&k| turned(k))
+            })
     }
 }
 

@@ -616,7 +616,8 @@ fn plan_touch(
             .map(|(p, up)| {
                 let tries = turned_fails.get(&p.point).copied().unwrap_or(0);
                 let t = if tries < FRAGILE_AFTER { turn } else { 0.0 };
-                let check = |t| validate::check(&k, &machine, p, up, &held[&p.setup], &opts.bans, t);
+                let check =
+                    |t| validate::check(&k, &machine, p, up, &held[&p.setup], &opts.bans, t);
                 let r = check(t);
                 let turned_only = r.is_err() && t > 0.0 && check(0.0).is_ok();
                 (*p, r, turned_only)
@@ -675,7 +676,8 @@ fn plan_touch(
             };
             let mut hlip = assemble(input, &mut k, &machine, &round);
             // Touches validated turned are clear turned; the others are measured.
-            let fragile = |p: &Pip| turn == 0.0 || turned_fails.get(&p.point) >= Some(&FRAGILE_AFTER);
+            let fragile =
+                |p: &Pip| turn == 0.0 || turned_fails.get(&p.point) >= Some(&FRAGILE_AFTER);
             placement::square_within(input, &mut k, &machine, &best.1, &fragile, &mut hlip, diags);
             if hlip.summary.setups > hlip.summary.min_setups.0 {
                 let forcing = forcing_levels(&root, &mut k, &machine, hierarchy, &best.1);

@@ -46,20 +46,17 @@ pub(super) fn square_within(
         .collect();
     // Per setup (index into the plan's setups): the least turn, and per (face, probe)
     // the touches that ask for less than the full one.
-    let mut by_setup: BTreeMap<usize, (f64, BTreeMap<(String, String), usize>)> =
-        BTreeMap::new();
+    let mut by_setup: BTreeMap<usize, (f64, BTreeMap<(String, String), usize>)> = BTreeMap::new();
     for ((p, up), t) in pips.iter().zip(turns) {
         if t >= PLACEMENT_TURN {
             continue;
         }
-        let Some(si) = hlip
-            .setups
-            .iter()
-            .position(|s| (s.up - up).norm() < 1e-6)
-        else {
+        let Some(si) = hlip.setups.iter().position(|s| (s.up - up).norm() < 1e-6) else {
             continue;
         };
-        let e = by_setup.entry(si).or_insert((PLACEMENT_TURN, BTreeMap::new()));
+        let e = by_setup
+            .entry(si)
+            .or_insert((PLACEMENT_TURN, BTreeMap::new()));
         e.0 = e.0.min(t);
         let key = (face_name(input, k, p.point), m.probes[p.probe].name.clone());
         *e.1.entry(key).or_default() += 1;
