@@ -877,8 +877,19 @@ impl Writer<'_> {
         let mut fa_manual = Vec::new();
         // The part axis the primary's direction fixes, once measured.
         let mut primary: Option<usize> = None;
-        for step in &al.steps {
+        for (k, step) in al.steps.iter().enumerate() {
             let g = &sp.groups[step.group];
+            // By hand, the operator brings the probe out before the head indexes (or the
+            // probe changes) between two features: the ball may be down a bore.
+            let moved = al.steps[..k]
+                .last()
+                .is_some_and(|prev| sensor_key(&sp.groups[prev.group]) != sensor_key(g));
+            if moved {
+                self.o.oper(
+                    "RAISE THE PROBE CLEAR ABOVE THE PART, THEN CONTINUE: THE HEAD TURNS THE PROBE FOR THE NEXT FEATURE",
+                );
+                self.o.stmt("PAUSE");
+            }
             self.select(g);
             // The feature touched, its touches, and the face the operator is told of.
             let (label, pts, face) = match (step.block, &step.extra) {
