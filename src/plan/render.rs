@@ -103,8 +103,11 @@ impl<'a> Names<'a> {
                 placement,
             } => {
                 let (label, id) = &self.model.cmms[self.plan.cmm.0].fixtures[*slot];
-                let kind = &self.model.fixtures[id.0].kind;
-                let name = format!("fixture {label} ({})", kind.word());
+                // The fixture as the rack names it (an angle plate is a sine plate at
+                // 90°: its own name, not its kind's, is what the operator fetches).
+                let fixture = &self.model.fixtures[id.0];
+                let kind = &fixture.kind;
+                let name = format!("fixture {label} ({})", fixture.name);
                 match kind {
                     FixtureKind::Vise { .. } if fs.len() >= 2 => format!(
                         "{name}: jaws on {} and {}, resting on {}",
