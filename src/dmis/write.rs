@@ -914,10 +914,13 @@ impl Writer<'_> {
                 (None, None) => continue,
             };
             let n = pts.len();
+            // Two touches are a line, whose direction runs from the first to the second:
+            // touched the other way round, the axis it sets turns over.
             self.o.oper(&format!(
-                "BY HAND: {n} TOUCH{} ON {}",
+                "BY HAND: {n} TOUCH{} ON {}{}",
                 if n == 1 { "" } else { "ES" },
-                self.face_words(face)
+                self.face_words(face),
+                if n == 2 { ", IN THE ORDER SHOWN" } else { "" }
             ));
             let manual = self.manual_feature(&label, &pts, primary);
             self.o.stmt(&format!(
