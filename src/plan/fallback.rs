@@ -161,6 +161,6 @@ fn relocate(
                 setup: s,
                 orient: o,
             };
-            validate::check(k, m, &try_, &up, held, bans, 0.0).is_ok()
+            validate::check(k, m, &try_, &up, held, bans).is_ok()
         })
 }

@@ -616,11 +616,15 @@ fn plan_touch(
             .map(|(p, up)| {
                 let tries = turned_fails.get(&p.point).copied().unwrap_or(0);
                 let t = if tries < FRAGILE_AFTER { turn } else { 0.0 };
-                let check =
-                    |t| validate::check(&k, &machine, p, up, &held[&p.setup], &opts.bans, t);
-                let r = check(t);
-                let turned_only = r.is_err() && t > 0.0 && check(0.0).is_ok();
-                (*p, r, turned_only)
+                let held = &held[&p.setup];
+                match validate::check(&k, &machine, p, up, held, &opts.bans) {
+                    Err(e) => (*p, Err(e), false),
+                    Ok(()) => {
+                        let turned = validate::clear_turned(&k, &machine, p, up, held, t);
+                        let turned_only = turned.is_err();
+                        (*p, turned, turned_only)
+                    }
+                }
             })
             .collect();
         let mut invalid = Vec::new();

@@ -1,6 +1,7 @@
 //! How square the operator must set the part: the touches of a plan validated at the
-//! nominal pose only ([`super::plan_placed`]'s second try) that collide with the part
-//! turned [`PLACEMENT_TURN`] about the vertical, and the turn each setup tolerates.
+//! nominal pose only (a point whose configurations collided turned, or every touch of
+//! [`super::plan_placed`]'s second try) that collide with the part turned
+//! [`PLACEMENT_TURN`] about the vertical, and the turn each setup tolerates.
 
 use super::domain::{Knowledge, Machine};
 use super::explain::face_name;

@@ -30,8 +30,7 @@ pub(crate) struct Pip {
     pub orient: usize,
 }
 
-/// Checks one PIP in setup `up` held as `held` says, and with the part turned `turn`
-/// degrees either way about the vertical; what collides, if anything.
+/// Checks one PIP in setup `up` held as `held` says; what collides, if anything.
 pub(crate) fn check(
     k: &Knowledge,
     m: &Machine,
@@ -39,33 +38,36 @@ pub(crate) fn check(
     up: &V3,
     held: &Held,
     bans: &[super::Ban],
-    turn: f64,
 ) -> Result<(), Blocker> {
-    let dir = if m.head.indexable() {
+    let dir = probe_dir(m, pip, up);
+    if bans.iter().any(|b| b.is(pip.point, pip.probe, up, &dir)) {
+        return Err(Blocker::Path);
+    }
+    k.pose_check(m, pip.point, pip.probe, dir, *up, held)
+}
+
+/// The probe's direction (tip to head, part frame) of a PIP in setup `up`.
+fn probe_dir(m: &Machine, pip: &Pip, up: &V3) -> V3 {
+    if m.head.indexable() {
         let (a, b) = m.grid[pip.orient];
         orientation_dir(up, a, b)
     } else {
         *up
-    };
-    if bans.iter().any(|b| b.is(pip.point, pip.probe, up, &dir)) {
-        return Err(Blocker::Path);
     }
-    k.pose_check(m, pip.point, pip.probe, dir, *up, held)?;
-    clear_turned(k, m, pip, &dir, up, held, turn)
 }
 
-/// Whether the touch stays clear with the part turned `turn` degrees either way about
-/// the vertical (the stylus turned the other way in the part's frame). A probe along
-/// the vertical turns into itself.
-fn clear_turned(
+/// Whether a PIP that [`check`] passed stays clear with the part turned `turn` degrees
+/// either way about the vertical (the stylus turned the other way in the part's frame).
+/// A probe along the vertical turns into itself.
+pub(crate) fn clear_turned(
     k: &Knowledge,
     m: &Machine,
     pip: &Pip,
-    dir: &V3,
     up: &V3,
     held: &Held,
     turn: f64,
 ) -> Result<(), Blocker> {
+    let dir = probe_dir(m, pip, up);
     if turn <= 0.0 || dir.cross(up).norm() < 1e-9 {
         return Ok(());
     }
@@ -87,15 +89,9 @@ pub(crate) fn tolerated_turn(
     held: &Held,
     turn: f64,
 ) -> f64 {
-    let dir = if m.head.indexable() {
-        let (a, b) = m.grid[pip.orient];
-        orientation_dir(up, a, b)
-    } else {
-        *up
-    };
     [turn, 2.0, 1.0, 0.5, 0.25, 0.1]
         .into_iter()
         .filter(|&t| t <= turn)
-        .find(|&t| clear_turned(k, m, pip, &dir, up, held, t).is_ok())
+        .find(|&t| clear_turned(k, m, pip, up, held, t).is_ok())
         .unwrap_or(0.0)
 }
