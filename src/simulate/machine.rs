@@ -88,6 +88,21 @@ fn line_span(file: crate::source::FileId, text: &str, at: usize) -> Span {
     Span::new(file, at, end.max(at))
 }
 
+/// The point of a block's nominal surface nearest `x` (program frame): along the
+/// shape's normal for a plane, cylinder, cone or sphere; on the nominal mesh for a
+/// free-form surface (or none known); `x` itself when neither says.
+fn nominal_foot(nominal: Option<&Shape>, mesh: Option<&parry3d_f64::shape::TriMesh>, x: &P3) -> P3 {
+    if let Some(shape) = nominal.filter(|s| !matches!(s, Shape::Surface)) {
+        if let Some(n) = shape.normal_at(x) {
+            return x - n * shape.signed(x);
+        }
+    }
+    match mesh {
+        Some(m) => m.project_local_point(x, false).point,
+        None => *x,
+    }
+}
+
 /// A feature measured, in the machine frame of its setup.
 #[derive(Debug, Clone)]
 struct Stored {
@@ -1110,7 +1125,10 @@ impl Machine<'_> {
                         .normal_at(&c)
                         .unwrap_or(dir)
                         .normalize();
-                    if !crate::access::scan::sees(&self.scene, &c, &n, &dir, &optics) {
+                    // Seen from where the nominal surface is: the scene is the nominal
+                    // part, and a face set back behind it is not hidden by itself.
+                    let seen_at = nominal_foot(nominal.as_ref(), self.scene.mesh(), &c);
+                    if !crate::access::scan::sees(&self.scene, &seen_at, &n, &dir, &optics) {
                         continue;
                     }
                     // A point on a face of another surface (a fillet, the next wall) is
@@ -1152,8 +1170,14 @@ impl Machine<'_> {
                 0.0
             };
             let q = cw + nw * noise;
+            // A scanned point's nominal is the nominal surface's point nearest it (its
+            // foot along the nominal's normal), as a scan is compared with the CAD model
+            // (ISO 1101:2017 §18: profile deviations are normal to the nominal surface);
+            // the point found is where the actual surface is.
+            let at = prog * cw;
+            let foot = nominal_foot(nominal.as_ref(), self.scene.mesh(), &at);
             if let Some(b) = self.block.as_mut() {
-                b.touches.push((prog * cw, prog * nw, q, nw, 0.0));
+                b.touches.push((foot, prog * nw, q, nw, 0.0));
                 b.scanned = true;
             }
             self.scanned += 1;
