@@ -11,7 +11,10 @@
 //!   read as RFS. What the datums leave free is held by the program's alignment, as a
 //!   CMM reports in its current alignment (so a pattern located from datum A alone
 //!   still has its holes' places): only an orientation zone turns freely about a lone
-//!   primary direction, and a profile with no datums is best-fitted in all six.
+//!   primary direction, and a profile's zone floats (least squares over the touches'
+//!   deviations, never less than the minimax float) in every degree of freedom its
+//!   datums leave free — all six with none — as ASME Y14.5-2018 ch. 11 locates and
+//!   orients a profile zone only as far as its datum reference frame constrains it.
 //! - **Form** (flatness, straightness, circularity, cylindricity) is the range of the
 //!   touches' residuals from the least-squares fit: never less than the minimum zone.
 //!   Straightness uses the whole surface; circularity takes each circle of touches.
@@ -394,7 +397,9 @@ pub fn evaluate(def: &TolDef, targets: &[Target], datums: &[(Shape, Shape)]) -> 
     };
     let mut drf = drf(datums);
     let moved = first.measured.moved(&drf.to_nominal);
-    // Free translations and, but for orientation, free rotations stay the alignment's.
+    // A profile's zone floats in what its datums leave free; for the other kinds free
+    // translations and, but for orientation, free rotations stay the alignment's.
+    let float = (drf.free_t.clone(), drf.free_r.clone());
     let free_r = std::mem::take(&mut drf.free_r);
     drf.free_t.clear();
     if datums.is_empty() {
@@ -434,7 +439,7 @@ pub fn evaluate(def: &TolDef, targets: &[Target], datums: &[(Shape, Shape)]) -> 
             let mut e: Vec<f64> = t.iter().map(|(p, n, q)| (q - p).dot(n)).collect();
             let n: Vec<V3> = t.iter().map(|x| x.1).collect();
             let q: Vec<P3> = t.iter().map(|x| x.2).collect();
-            best_fit(&mut e, &n, &q, &drf.free_t, &drf.free_r);
+            best_fit(&mut e, &n, &q, &float.0, &float.1);
             let worst = e.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             zone(2.0 * worst, width, None)
         }
