@@ -27,7 +27,8 @@
 //!   doubled (a Ø zone); MMC adds the bonus of the feature's departure from its MMC
 //!   size when the program outputs the feature's size tolerance too, else it is RFS.
 //! - **Profile**: each touch's deviation along its nominal vector from its nominal
-//!   point, in the datum frame; the zone is equal-bilateral (twice the largest).
+//!   point, in the datum frame, over every feature the `OUTPUT` names (the surfaces
+//!   of one profile are one zone); the zone is equal-bilateral (twice the largest).
 //! - **Runout**: radial (or, for a face across the axis, axial) deviations about the
 //!   primary datum's axis; circular runout is taken as total (over every circle).
 //! - **Size**: least-squares diameter, radius or width; distances between planes along
@@ -435,10 +436,17 @@ pub fn evaluate(def: &TolDef, targets: &[Target], datums: &[(Shape, Shape)]) -> 
             zone(worst, width, None)
         }
         "PROFS" | "PROFL" => {
-            let t = &moved.touches;
-            let mut e: Vec<f64> = t.iter().map(|(p, n, q)| (q - p).dot(n)).collect();
-            let n: Vec<V3> = t.iter().map(|x| x.1).collect();
-            let q: Vec<P3> = t.iter().map(|x| x.2).collect();
+            // One zone over every surface the statement names: a profile of several
+            // surfaces (a boss's six sides) is one zone, floating as one.
+            let (mut e, mut n, mut q) = (Vec::new(), Vec::new(), Vec::new());
+            for target in targets {
+                let moved = target.measured.moved(&drf.to_nominal);
+                for (p, v, x) in &moved.touches {
+                    e.push((x - p).dot(v));
+                    n.push(*v);
+                    q.push(*x);
+                }
+            }
             best_fit(&mut e, &n, &q, &float.0, &float.1);
             let worst = e.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             zone(2.0 * worst, width, None)
