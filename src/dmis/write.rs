@@ -1324,7 +1324,7 @@ impl Writer<'_> {
         self.pending.extend(g.records.iter().copied());
         let pending = std::mem::take(&mut self.pending);
         for r in pending {
-            if self.ready(r) {
+            if self.ready(r, (si, gi)) {
                 self.output(r, &in_group);
             } else {
                 self.pending.push(r);
@@ -1333,8 +1333,10 @@ impl Writer<'_> {
     }
 
     /// Whether every measured surface of tolerance `r`'s features and datum features
-    /// is complete.
-    fn ready(&self, r: ToleranceId) -> bool {
+    /// is complete after group `at` (setup, group): a surface completed in an earlier
+    /// setup that this setup measures again in a later group (a datum measured anew
+    /// where it is read, see [`crate::plan`]'s `remeasure`) is read at that measurement.
+    fn ready(&self, r: ToleranceId, at: (usize, usize)) -> bool {
         let part = self.names.part();
         let t = &part.tolerances[r.0];
         let features: Vec<FeatureId> = t
@@ -1347,7 +1349,14 @@ impl Writer<'_> {
             .iter()
             .enumerate()
             .filter(|(_, s)| s.feature.is_some_and(|f| features.contains(&f)))
-            .all(|(k, _)| self.done.contains(&k))
+            .all(|(k, s)| {
+                let from_before = self.done_in.get(&k) != Some(&at.0);
+                let again_later = s
+                    .rounds
+                    .iter()
+                    .any(|round| round.last.0 == at.0 && round.last.1 > at.1);
+                self.done.contains(&k) && !(from_before && again_later)
+            })
     }
 
     /// `OUTPUT` of a tolerance over its features' labels: those measured in this group,
@@ -1391,8 +1400,21 @@ impl Writer<'_> {
             }
             labels
         };
+        let profile = matches!(t.kind, TolKind::ProfileLine | TolKind::ProfileSurface);
         let mut lines = Vec::new();
-        if t.targets.len() > 1 {
+        if profile {
+            // A profile of several surfaces is one zone over them all (Y14.5-2018
+            // ch. 11): one `OUTPUT` naming every surface.
+            let fa: Vec<String> = t
+                .targets
+                .iter()
+                .flat_map(|&f| labels_of(f))
+                .map(|l| format!("FA({l})"))
+                .collect();
+            if !fa.is_empty() {
+                lines.push(format!("OUTPUT/{},TA({tl})", fa.join(",")));
+            }
+        } else if t.targets.len() > 1 {
             let fa: Vec<String> = t
                 .targets
                 .iter()

@@ -70,6 +70,20 @@ pub enum PlanError {
         full: String,
         touches: String,
     },
+    #[error("tolerance `{tolerance}` reads its feature in setup {setup} against {datums}, which no probe reaches there: the plan measures {measured}")]
+    #[diagnostic(
+        code(insp::plan::datum_in_other_setup),
+        severity(Warning),
+        help("setup {setup}'s alignment, built on that setup's own features, carries the datum over as drawn, so an error between the feature and the datum can read as none; give the head an orientation or the rack a probe that reaches the datum in setup {setup}, or hold the part so that one setup presents both")
+    )]
+    DatumInOtherSetup {
+        #[label("read against a datum measured in another setup")]
+        span: Span,
+        tolerance: String,
+        datums: String,
+        setup: usize,
+        measured: String,
+    },
     #[error("part `{part}` does not fit on the table of `{cmm}`: its smallest footprint is {footprint}, the table {table}")]
     #[diagnostic(
         code(insp::plan::part_off_table),
@@ -145,6 +159,7 @@ crate::located!(PlanError {
     NoConvergence,
     PointsLeftOut,
     PlacementSensitive,
+    DatumInOtherSetup,
     NoPlan,
     PartOffTable,
     ProbeTooLong,
