@@ -314,6 +314,11 @@ struct Writer<'a> {
     tols: Vec<String>,
     /// Per feature, the labels measured so far.
     measured: BTreeMap<Option<FeatureId>, Vec<String>>,
+    /// Per datum, the setup its latest `DATDEF` was written in.
+    defined_in: BTreeMap<crate::model::DatumId, usize>,
+    /// Labels of the table standing in for a datum face: a datum, never a toleranced
+    /// surface.
+    table_labels: std::collections::BTreeSet<String>,
 }
 
 /// Writes the program.
@@ -348,6 +353,8 @@ pub fn write(input: &Input) -> String {
         datums: Vec::new(),
         tols: Vec::new(),
         measured: BTreeMap::new(),
+        defined_in: BTreeMap::new(),
+        table_labels: std::collections::BTreeSet::new(),
     };
     w.header();
     w.sensor_definitions();
@@ -574,6 +581,9 @@ impl Writer<'_> {
                 }
             }
             let full = self.labels.fresh("F", &name);
+            if contact == Contact::Table {
+                self.table_labels.insert(full.clone());
+            }
             self.o.stmt(&format!("F({full})=FEAT/{}", nominal.feat()));
             self.nominals.insert(full.clone(), nominal.clone());
             self.faces_of.entry(feature).or_default().push(full.clone());
@@ -914,12 +924,17 @@ impl Writer<'_> {
                 (None, None) => continue,
             };
             let n = pts.len();
+            // The table beside the part stands in for the face resting on it.
+            let on = if self.table_labels.contains(&label) {
+                format!("THE TABLE BESIDE THE PART (FOR {})", self.face_words(face))
+            } else {
+                self.face_words(face)
+            };
             // Two touches are a line, whose direction runs from the first to the second:
             // touched the other way round, the axis it sets turns over.
             self.o.oper(&format!(
-                "BY HAND: {n} TOUCH{} ON {}{}",
+                "BY HAND: {n} TOUCH{} ON {on}{}",
                 if n == 1 { "" } else { "ES" },
-                self.face_words(face),
                 if n == 2 { ", IN THE ORDER SHOWN" } else { "" }
             ));
             let manual = self.manual_feature(&label, &pts, primary);
@@ -1316,6 +1331,7 @@ impl Writer<'_> {
         }
         // Datums measured here, then the tolerances this group completes.
         for (d, label) in datums_here {
+            self.defined_in.insert(d, si);
             let dl = &self.datums[d.0];
             self.o.stmt(&format!("DATDEF/FA({label}),DAT({dl})"));
         }
@@ -1339,16 +1355,24 @@ impl Writer<'_> {
     fn ready(&self, r: ToleranceId, at: (usize, usize)) -> bool {
         let part = self.names.part();
         let t = &part.tolerances[r.0];
-        let features: Vec<FeatureId> = t
-            .targets
+        // A datum defined in this setup is the one the tolerance reads: its surfaces
+        // measured in other setups are not waited for. The table standing in for a
+        // toleranced feature (as another tolerance's datum) is not the feature.
+        let datums: Vec<FeatureId> = t
+            .datums
             .iter()
-            .copied()
-            .chain(t.datums.iter().map(|d| part.datums[d.datum.0].feature))
+            .filter(|d| self.defined_in.get(&d.datum) != Some(&at.0))
+            .map(|d| part.datums[d.datum.0].feature)
             .collect();
         self.surfs
             .iter()
             .enumerate()
-            .filter(|(_, s)| s.feature.is_some_and(|f| features.contains(&f)))
+            .filter(|(_, s)| {
+                s.feature.is_some_and(|f| {
+                    datums.contains(&f)
+                        || (t.targets.contains(&f) && !self.table_labels.contains(&s.full))
+                })
+            })
             .all(|(k, s)| {
                 let from_before = self.done_in.get(&k) != Some(&at.0);
                 let again_later = s
@@ -1398,6 +1422,8 @@ impl Writer<'_> {
                     labels.push(l.clone());
                 }
             }
+            // The table stands in for a datum; the tolerance is the part's surface's.
+            labels.retain(|l| !self.table_labels.contains(l));
             labels
         };
         let profile = matches!(t.kind, TolKind::ProfileLine | TolKind::ProfileSurface);

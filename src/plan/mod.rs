@@ -21,8 +21,8 @@ mod fallback;
 mod hlip;
 mod machine;
 mod placement;
-mod remeasure;
 pub mod poses;
+mod remeasure;
 mod render;
 mod scan;
 mod solve;
@@ -673,8 +673,9 @@ fn plan_touch(
                 audit(&mut k, &machine, &best.1)
             );
             // Datums measured again where the tolerances read against them are.
-            let again =
-                remeasure::datums_where_read(input, &mut k, &machine, &best.1, turn, &opts.bans, diags);
+            let again = remeasure::datums_where_read(
+                input, &mut k, &machine, &best.1, turn, &opts.bans, diags,
+            );
             let branches: Vec<Branch> = best.1.iter().cloned().chain(again).collect();
             let round = Round {
                 branches: &branches,
@@ -687,7 +688,9 @@ fn plan_touch(
             // Touches validated turned are clear turned; the others are measured.
             let fragile =
                 |p: &Pip| turn == 0.0 || turned_fails.get(&p.point) >= Some(&FRAGILE_AFTER);
-            placement::square_within(input, &mut k, &machine, &branches, &fragile, &mut hlip, diags);
+            placement::square_within(
+                input, &mut k, &machine, &branches, &fragile, &mut hlip, diags,
+            );
             if hlip.summary.setups > hlip.summary.min_setups.0 {
                 let forcing = forcing_levels(&root, &mut k, &machine, hierarchy, &best.1);
                 hlip.summary.more_setups = Some(forcing.unwrap_or_else(|| {

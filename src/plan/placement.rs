@@ -14,6 +14,9 @@ use crate::model::fmt_num;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
+/// Touches per (face, probe) that ask for the part squarer.
+type Touches = BTreeMap<(String, String), usize>;
+
 /// Sets [`super::hlip::SetupNode::square_within`] of each setup some touch of which
 /// stays clear only with the part nearer square than [`PLACEMENT_TURN`], and warns of
 /// it. Only the `fragile` touches are tried: the others were validated turned.
@@ -47,7 +50,7 @@ pub(super) fn square_within(
         .collect();
     // Per setup (index into the plan's setups): the least turn, and per (face, probe)
     // the touches that ask for less than the full one.
-    let mut by_setup: BTreeMap<usize, (f64, BTreeMap<(String, String), usize>)> = BTreeMap::new();
+    let mut by_setup: BTreeMap<usize, (f64, Touches)> = BTreeMap::new();
     for ((p, up), t) in pips.iter().zip(turns) {
         if t >= PLACEMENT_TURN {
             continue;

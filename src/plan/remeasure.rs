@@ -106,8 +106,10 @@ pub(super) fn datums_where_read(
             Some(chosen) => extra.extend(branches_of(cell, up, datum, &tols, chosen)),
             None => {
                 for &r in &tols {
-                    let setups: Vec<String> =
-                        measured[&datum].keys().map(|s| (s + 1).to_string()).collect();
+                    let setups: Vec<String> = measured[&datum]
+                        .keys()
+                        .map(|s| (s + 1).to_string())
+                        .collect();
                     let s = if setups.len() == 1 { "" } else { "s" };
                     unreached
                         .entry(r)
@@ -208,14 +210,13 @@ fn measure_in(
             Some(t) => k.tables[t].points.clone(),
             None => plan_points.iter().copied().collect(),
         };
-        let Some(&first) = points.first() else {
-            return None;
-        };
+        let &first = points.first()?;
         let mut tries = configs.clone();
         if m.head.indexable() && table.is_none() {
             let probes: Vec<usize> = configs.iter().map(|c| c.0).collect();
             for p in probes {
-                for o in k.orientations(first, p, cell, &up, m).ones() {
+                let reach = k.orientations(first, p, cell, &up, m);
+                for o in reach.ones() {
                     if !tries.contains(&(p, o)) {
                         tries.push((p, o));
                     }
@@ -230,21 +231,23 @@ fn measure_in(
         };
         let mut best: Option<Again> = None;
         for (probe, orient) in tries {
-            let ok: Vec<usize> = points
-                .iter()
-                .copied()
-                .filter(|&point| {
-                    clear(
-                        k,
-                        &Pip {
-                            point,
-                            probe,
-                            setup: cell,
-                            orient,
-                        },
-                    )
-                })
-                .collect();
+            // A configuration is dropped as soon as it cannot beat the best so far.
+            let beat = need.max(best.as_ref().map_or(0, |b| b.points.len() + 1));
+            let mut ok: Vec<usize> = Vec::new();
+            for (i, &point) in points.iter().enumerate() {
+                if ok.len() + (points.len() - i) < beat {
+                    break;
+                }
+                let pip = Pip {
+                    point,
+                    probe,
+                    setup: cell,
+                    orient,
+                };
+                if clear(k, &pip) {
+                    ok.push(point);
+                }
+            }
             if ok.len() >= need && best.as_ref().is_none_or(|b| ok.len() > b.points.len()) {
                 let all = ok.len() == points.len();
                 best = Some(Again {
