@@ -658,7 +658,7 @@ type Visit<'a> = dyn FnMut(Option<ToleranceId>, Option<FeatureId>, FaceId, Conta
 
 /// Walks an instance tree, calling `f(tolerance, feature, face, contact, points)` for
 /// every face or table visit.
-fn collect(i: &Inst, tol: Option<ToleranceId>, feat: Option<FeatureId>, f: &mut Visit) {
+pub(super) fn collect(i: &Inst, tol: Option<ToleranceId>, feat: Option<FeatureId>, f: &mut Visit) {
     match &i.kind {
         Kind::Tol(t) => i
             .children

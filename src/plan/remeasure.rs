@@ -21,6 +21,7 @@
 //! features read against it, the plan says so ([`PlanError::DatumInOtherSetup`]).
 
 use super::domain::{Knowledge, Machine};
+use super::hlip::collect;
 use super::solve::{Branch, Inst, Kind};
 use super::validate::{self, Pip};
 use super::{min_points, Ban, Input, PlanError};
@@ -56,7 +57,8 @@ pub(super) fn datums_where_read(
     let setup_of = |cell: usize| cells.iter().position(|c| c.0 == cell).unwrap_or(0);
     let mut measured: Measured = BTreeMap::new();
     for b in branches {
-        visits(&b.tree, None, &mut |feature, face, points| {
+        collect(&b.tree, None, None, &mut |_, feature, face, _, points| {
+            let Some(feature) = feature else { return };
             measured
                 .entry(feature)
                 .or_default()
@@ -148,21 +150,6 @@ pub(super) fn datums_where_read(
         });
     }
     extra
-}
-
-/// Calls `f` with (feature, face, points) for every face of the tree.
-fn visits(i: &Inst, feature: Option<FeatureId>, f: &mut dyn FnMut(FeatureId, FaceId, &[usize])) {
-    match &i.kind {
-        Kind::Feature(x) => i.children.iter().for_each(|c| visits(c, Some(*x), f)),
-        Kind::Face { face, .. } | Kind::Table { face } => {
-            let mut pts = Vec::new();
-            super::solve::leaves(i, &mut pts);
-            if let Some(feature) = feature {
-                f(feature, *face, &pts);
-            }
-        }
-        _ => i.children.iter().for_each(|c| visits(c, feature, f)),
-    }
 }
 
 /// A face measured again: its configuration (probe, orientation), whether it is the
