@@ -1172,7 +1172,7 @@ impl Machine<'_> {
             let q = cw + nw * noise;
             // A scanned point's nominal is the nominal surface's point nearest it (its
             // foot along the nominal's normal), as a scan is compared with the CAD model
-            // (ISO 1101:2017 §18: profile deviations are normal to the nominal surface);
+            // (ASME Y14.5-2018 ch. 11: a profile zone lies normal to the true profile);
             // the point found is where the actual surface is.
             let at = prog * cw;
             let foot = nominal_foot(nominal.as_ref(), self.scene.mesh(), &at);
