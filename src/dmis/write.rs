@@ -246,6 +246,8 @@ struct Surf {
     rounds: Vec<Round>,
     /// Its feature.
     feature: Option<FeatureId>,
+    /// Whether the table stands in for it (a datum face the part rests on).
+    on_table: bool,
 }
 
 /// One measurement of a surface: the blocks up to the one that touches a point again.
@@ -540,6 +542,7 @@ impl Writer<'_> {
                     full: String::new(),
                     rounds,
                     feature,
+                    on_table: contact == Contact::Table,
                 });
                 continue;
             }
@@ -632,6 +635,7 @@ impl Writer<'_> {
                 full,
                 rounds,
                 feature,
+                on_table: contact == Contact::Table,
             });
         }
         self.centre_planes();
@@ -687,11 +691,17 @@ impl Writer<'_> {
 
     /// A feature made of two opposed parallel planes (a slot, a tab) is a feature of
     /// size: its width, position, symmetry and orientation belong to the pair, a
-    /// `FEAT/PARPLN` constructed from the two walls once both are measured.
+    /// `FEAT/PARPLN` constructed from the two walls once both are measured. A wall the
+    /// part rests on in some setup is still one of the two: the table's surface stands
+    /// in for it there, not as a third wall.
     fn centre_planes(&mut self) {
         let cos = (0.1f64).to_radians().cos();
         for (f, surfs) in self.surfaces_by_feature() {
-            let [a, b] = surfs[..] else { continue };
+            let walls: Vec<usize> = surfs
+                .into_iter()
+                .filter(|&k| !self.surfs[k].on_table)
+                .collect();
+            let [a, b] = walls[..] else { continue };
             // Each wall's centre, a point of its plane and its normal.
             let plane = |k: usize| match self.nominals.get(&self.surfs[k].full) {
                 Some(Nominal::Surface(Surface::Plane { origin, normal }, c)) => {
@@ -1210,8 +1220,9 @@ impl Writer<'_> {
                 continue;
             };
             let meas = self.nominals.get(&label).map_or("PLANE", Nominal::meas);
-            // A narrow block approaches and retracts by its own, shorter stand-off.
-            let narrow = b.standoff < motion.prehit.max(motion.retract) - 1e-9;
+            // A block with its own stand-off (shorter in a narrow bore, longer where the
+            // tolerance lets the surface stand proud) approaches and retracts by it.
+            let narrow = (b.standoff - motion.prehit.max(motion.retract)).abs() > 1e-9;
             let joined = !self.surfs[surf].rounds[round].partials.is_empty();
             if !b.passes.is_empty() {
                 let target = if joined {

@@ -343,6 +343,10 @@ fn linearise<'a>(
                         }
                     }
                 }
+                let pose = Pose::new(scene, probe, dir, up, table).with_fixture(&s.fixture);
+                for b in &mut blocks {
+                    outlast(input, hlip, (scene, probe, &pose), b, standoff);
+                }
                 let has_datum = blocks.iter().any(|b| b.datum.is_some());
                 setup_groups.push(GroupIn {
                     setup: si,
@@ -924,6 +928,81 @@ fn first_clear(pose: &Pose, x: &P3, tries: Vec<Vec<P3>>) -> (Option<Vec<P3>>, us
         })
     });
     (found, checks)
+}
+
+/// How far a touch's surface may stand from its nominal on a part the program must
+/// still measure and report (mm): twice the largest excursion the feature's tolerances
+/// allow — half a profile's zone (equally disposed, ASME Y14.5-2018 §11.3.1), the radius
+/// of a position's Ø zone, an orientation's or form's zone, a size's or distance's
+/// farther limit — so that a part out by as much again as its tolerance reads OUT
+/// rather than stopping the run with the probe already in the material.
+fn excursion(input: &Input, feature: FeatureId) -> f64 {
+    let part = &input.model.parts[input.plan.part.0];
+    part.tolerances
+        .iter()
+        .filter(|t| t.targets.contains(&feature))
+        .map(|t| match (&t.value, t.kind) {
+            (_, TolKind::Angle) => 0.0,
+            (crate::model::TolValue::Zone { width, .. }, k) => match k {
+                TolKind::ProfileLine | TolKind::ProfileSurface | TolKind::Position => width / 2.0,
+                _ => *width,
+            },
+            (
+                crate::model::TolValue::Size {
+                    nominal,
+                    lower,
+                    upper,
+                },
+                k,
+            ) => {
+                let far = (upper - nominal).abs().max((nominal - lower).abs());
+                // A diameter's wall moves by half its change.
+                if k == TolKind::Diameter {
+                    far / 2.0
+                } else {
+                    far
+                }
+            }
+        })
+        .fold(0.0, f64::max)
+        * 2.0
+}
+
+/// Lengthens a block's stand-off where its feature's tolerances allow its surface to
+/// stand proud of the nominal by more than the stand-off leaves room for
+/// ([`excursion`]): the approach then starts the motion margin beyond that (DMIS
+/// `SNSET/APPRCH`; PC-DMIS's prehit distance is set the same way, larger than the
+/// deviation expected). Where the longer approach (validated as the planner validated
+/// the standard one, [`Pose::approach`]) or the free space in front of a point does not
+/// allow it, the block keeps the stand-off it had.
+fn outlast(
+    input: &Input,
+    hlip: &Hlip,
+    (scene, probe, pose): (&Scene, &ProbeShape, &Pose),
+    b: &mut BlockPath,
+    standoff: f64,
+) {
+    let Some(feature) = b.feature else { return };
+    if b.contact != Contact::Part || !b.passes.is_empty() || b.standoff < standoff - 1e-9 {
+        return;
+    }
+    let want = excursion(input, feature) + input.plan.motion.margin;
+    if want <= standoff {
+        return;
+    }
+    let points: Vec<usize> = b.touches.iter().map(|t| t.point).collect();
+    let longer = block_standoff(scene, hlip, &points, want, probe);
+    if longer <= standoff + 1e-9 {
+        return;
+    }
+    let clear = points.iter().all(|&k| {
+        let p = &hlip.points[k];
+        let c = p.position + p.normal * probe.tip_radius;
+        pose.approach(&c, &p.normal, longer, Contact::Part).is_ok()
+    });
+    if clear {
+        b.standoff = longer;
+    }
 }
 
 /// A block's stand-off: `standoff`, or half the free space in front of its points when

@@ -826,6 +826,27 @@ fn learn(k: &mut Knowledge, m: &Machine, mut fails: Vec<(usize, usize, usize, Op
     }
 }
 
+/// Whether points spread across an area, not along a line: a plane fitted to them is
+/// determined. The second principal spread must be at least [`LEAST_SPREAD`].
+pub(super) fn spans_area(points: &[&crate::geometry::P3]) -> bool {
+    if points.len() < 3 {
+        return false;
+    }
+    let n = points.len() as f64;
+    let c = points.iter().fold(V3::zeros(), |s, p| s + p.coords) / n;
+    let cov = points.iter().fold(nalgebra::Matrix3::zeros(), |m, p| {
+        let d = p.coords - c;
+        m + d * d.transpose()
+    }) / n;
+    let mut e: Vec<f64> = cov.symmetric_eigenvalues().iter().copied().collect();
+    e.sort_by(|a, b| b.total_cmp(a));
+    e[1].max(0.0).sqrt() >= LEAST_SPREAD
+}
+
+/// The least spread (mm, standard deviation across the points' main direction) a
+/// plane's points keep when points drop out.
+const LEAST_SPREAD: f64 = 0.5;
+
 /// How many points per face and probe get the whole probe's cones in one round.
 const ACQUIRE_PER_FACE: usize = 2;
 
@@ -881,18 +902,31 @@ fn filter(
             bad.push(FaceId(face));
             continue;
         }
+        let floor = need.max(pts.len().div_ceil(2));
+        // Those left must still fix the face's surface (never a plane on a line).
+        let plane = matches!(
+            geo.faces[face].surface,
+            crate::geometry::Surface::Plane { .. }
+        );
         let mut sorted: Vec<usize> = keep.iter().map(|x| x.1).collect();
         sorted.sort_unstable();
         let median = sorted[sorted.len() / 2];
-        let floor = need.max(pts.len().div_ceil(2));
         keep.sort_by_key(|&(p, s)| (s, p));
-        let mut left = keep.len();
+        let mut kept: Vec<usize> = keep.iter().map(|&(p, _)| p).collect();
         for &(p, s) in &keep {
-            if left <= floor || s * 20 >= median {
+            if kept.len() <= floor || s * 20 >= median {
                 break;
             }
+            let rest: Vec<&crate::geometry::P3> = kept
+                .iter()
+                .filter(|&&q| q != p)
+                .map(|&q| &g.fpoints[q].position)
+                .collect();
+            if plane && !spans_area(&rest) {
+                continue;
+            }
+            kept.retain(|&q| q != p);
             dropped.insert(p);
-            left -= 1;
         }
     }
     (dropped, bad)

@@ -235,7 +235,19 @@ fn measure_in(
                     ok.push(point);
                 }
             }
-            if ok.len() >= need && best.as_ref().is_none_or(|b| ok.len() > b.points.len()) {
+            // A plane's touches must fix it: a row of points along one line does not.
+            let fixes = table.is_some()
+                || !matches!(
+                    geometry.faces[face.0].surface,
+                    crate::geometry::Surface::Plane { .. }
+                )
+                || super::spans_area(
+                    &ok.iter()
+                        .map(|&q| &k.points[q].position)
+                        .collect::<Vec<_>>(),
+                );
+            if fixes && ok.len() >= need && best.as_ref().is_none_or(|b| ok.len() > b.points.len())
+            {
                 let all = ok.len() == points.len();
                 best = Some(Again {
                     face,
