@@ -318,9 +318,6 @@ struct Writer<'a> {
     measured: BTreeMap<Option<FeatureId>, Vec<String>>,
     /// Per datum, the setup its latest `DATDEF` was written in.
     defined_in: BTreeMap<crate::model::DatumId, usize>,
-    /// Labels of the table standing in for a datum face: a datum, never a toleranced
-    /// surface.
-    table_labels: std::collections::BTreeSet<String>,
 }
 
 /// Writes the program.
@@ -356,7 +353,6 @@ pub fn write(input: &Input) -> String {
         tols: Vec::new(),
         measured: BTreeMap::new(),
         defined_in: BTreeMap::new(),
-        table_labels: std::collections::BTreeSet::new(),
     };
     w.header();
     w.sensor_definitions();
@@ -584,9 +580,6 @@ impl Writer<'_> {
                 }
             }
             let full = self.labels.fresh("F", &name);
-            if contact == Contact::Table {
-                self.table_labels.insert(full.clone());
-            }
             self.o.stmt(&format!("F({full})=FEAT/{}", nominal.feat()));
             self.nominals.insert(full.clone(), nominal.clone());
             self.faces_of.entry(feature).or_default().push(full.clone());
@@ -676,6 +669,12 @@ impl Writer<'_> {
                 .stmt(&format!("F({label})=FEAT/PATERN,{}", members.join(",")));
             self.patterns.insert(f, (label, surfs));
         }
+    }
+
+    /// Whether `label` is the table standing in for a datum face: a datum, never a
+    /// toleranced surface.
+    fn is_table(&self, label: &str) -> bool {
+        self.surfs.iter().any(|s| s.on_table && s.full == label)
     }
 
     /// Per feature, its surfaces (indices into `surfs`) in program order.
@@ -935,7 +934,7 @@ impl Writer<'_> {
             };
             let n = pts.len();
             // The table beside the part stands in for the face resting on it.
-            let on = if self.table_labels.contains(&label) {
+            let on = if self.is_table(&label) {
                 format!("THE TABLE BESIDE THE PART (FOR {})", self.face_words(face))
             } else {
                 self.face_words(face)
@@ -1379,10 +1378,8 @@ impl Writer<'_> {
             .iter()
             .enumerate()
             .filter(|(_, s)| {
-                s.feature.is_some_and(|f| {
-                    datums.contains(&f)
-                        || (t.targets.contains(&f) && !self.table_labels.contains(&s.full))
-                })
+                s.feature
+                    .is_some_and(|f| datums.contains(&f) || (t.targets.contains(&f) && !s.on_table))
             })
             .all(|(k, s)| {
                 let from_before = self.done_in.get(&k) != Some(&at.0);
@@ -1434,7 +1431,7 @@ impl Writer<'_> {
                 }
             }
             // The table stands in for a datum; the tolerance is the part's surface's.
-            labels.retain(|l| !self.table_labels.contains(l));
+            labels.retain(|l| !self.is_table(l));
             labels
         };
         let profile = matches!(t.kind, TolKind::ProfileLine | TolKind::ProfileSurface);

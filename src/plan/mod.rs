@@ -917,13 +917,15 @@ fn filter(
             if kept.len() <= floor || s * 20 >= median {
                 break;
             }
-            let rest: Vec<&crate::geometry::P3> = kept
-                .iter()
-                .filter(|&&q| q != p)
-                .map(|&q| &g.fpoints[q].position)
-                .collect();
-            if plane && !spans_area(&rest) {
-                continue;
+            if plane {
+                let rest: Vec<&crate::geometry::P3> = kept
+                    .iter()
+                    .filter(|&&q| q != p)
+                    .map(|&q| &g.fpoints[q].position)
+                    .collect();
+                if !spans_area(&rest) {
+                    continue;
+                }
             }
             kept.retain(|&q| q != p);
             dropped.insert(p);
