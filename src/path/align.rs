@@ -4,7 +4,8 @@
 //! the part's frame from them. Features are chosen among those the setup inspects:
 //! datum features first in datum order, then features no tolerance reads against a datum
 //! (a feature the frame is built on reads perfect in it), then the rest, the largest
-//! faces first in each; a plane parallel to the table ranks with the datum the part
+//! faces first in each — the rest, and faces the setup measures only part of, only
+//! where the others and the part's untouched faces leave something free ([`align`]); a plane parallel to the table ranks with the datum the part
 //! rests on; a plane qualifies when its normal is a part axis, a cylinder
 //! when its axis is, so that every feature maps onto `XDIR`/`YDIR`/`ZDIR` and
 //! `XORIG`/`YORIG`/`ZORIG`. A secondary plane comes before a bore (it fixes the turn);
@@ -139,8 +140,32 @@ pub struct Touchable<'a> {
 }
 
 /// Chooses the alignment of one setup from its groups' blocks, completed from other
-/// faces of the part where they leave something free.
+/// faces of the part where they leave something free. Two kinds of block are aligned
+/// on only where the setup's other blocks and the part's other faces cannot fix all six
+/// degrees of freedom: a feature whose tolerance reads it against datums (the frame
+/// would move with it, and a shift or tilt of it would read as none: CTC 02's F51, the
+/// secondary of a setup, read 0 under a profile shifted twice its zone), and a face
+/// whose points this setup takes only some of (the rest taken in another setup's frame:
+/// aligned on one end of a bore, the setup moves that end back to nominal and the fit
+/// over both ends reads a tilt at half its size, CTC 02's datum H). A face touched by
+/// hand only is no worse a datum for the frame than a block the program measures.
 pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath, touch: &[Touchable]) -> Alignment {
+    let without = align_on(input, hlip, sp, touch, false);
+    if without.missing.is_empty() && !without.steps.is_empty() {
+        return without;
+    }
+    align_on(input, hlip, sp, touch, true)
+}
+
+/// [`align`] with or without the blocks of features whose tolerances read them
+/// against datums.
+fn align_on(
+    input: &Input,
+    hlip: &Hlip,
+    sp: &SetupPath,
+    touch: &[Touchable],
+    on_referenced: bool,
+) -> Alignment {
     let geometry = input.geometry;
     // Features whose tolerances refer to datums: aligned on, such a feature sets the
     // frame its own tolerance is read in (moved, it would read perfect).
@@ -161,6 +186,13 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath, touch: &[Touchable]) ->
     // Candidates: (rank, -area, group, block, shape, points in tour order); the rank is
     // datum features first in datum order, then features no tolerance reads against
     // datums, then the rest.
+    let elsewhere = points_elsewhere(hlip, sp.setup);
+    let here: Vec<usize> = sp
+        .groups
+        .iter()
+        .flat_map(|g| &g.blocks)
+        .flat_map(|b| b.touches.iter().map(|t| t.point))
+        .collect();
     let mut cands = Vec::new();
     for (gi, g) in sp.groups.iter().enumerate() {
         for (bi, b) in g.blocks.iter().enumerate() {
@@ -168,6 +200,12 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath, touch: &[Touchable]) ->
             let Some(&first) = points.first() else {
                 continue;
             };
+            let split = elsewhere
+                .get(&b.face)
+                .is_some_and(|pts| pts.iter().any(|p| !here.contains(p)));
+            if split && !on_referenced && b.contact == Contact::Part {
+                continue;
+            }
             let f = geometry.faces.get(b.face.0);
             let shape = if b.contact == Contact::Table {
                 let p = &hlip.points[first];
@@ -201,7 +239,12 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath, touch: &[Touchable]) ->
             // to the one it rests on.
             let mut rank = match (b.datum, b.feature) {
                 (Some(d), _) => (0, d.0, 0),
-                (None, Some(f)) if referenced.contains(&f) => (2, 0, 0),
+                (None, Some(f)) if referenced.contains(&f) => {
+                    if !on_referenced {
+                        continue;
+                    }
+                    (2, 0, 0)
+                }
                 _ => (1, 0, 0),
             };
             if let (Some(r), Shape::Plane { axis, .. }) = (resting, &shape) {
@@ -477,6 +520,27 @@ pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath, touch: &[Touchable]) ->
         if !origins[k] {
             out.missing.push(format!("the {} origin", AXES[k]));
         }
+    }
+    out
+}
+
+/// Per face, the points other setups than `setup` take on it.
+fn points_elsewhere(hlip: &Hlip, setup: usize) -> std::collections::BTreeMap<FaceId, Vec<usize>> {
+    let mut out: std::collections::BTreeMap<FaceId, Vec<usize>> = Default::default();
+    let visits = hlip
+        .setups
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != setup)
+        .flat_map(|(_, s)| &s.probes)
+        .flat_map(|p| &p.orients)
+        .flat_map(|o| &o.inspections)
+        .flat_map(|i| &i.faces)
+        .filter(|v| v.contact == Contact::Part);
+    for v in visits {
+        out.entry(v.face)
+            .or_default()
+            .extend(v.points.iter().copied());
     }
     out
 }

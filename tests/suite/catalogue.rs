@@ -25,6 +25,7 @@ const NO_SPEC_EXAMPLE: &[(&str, &str)] = &[
     ("insp::plan::uninspectable_face_allowed", "needs `--allow-unmeasured` on the command line: tests/suite/cli.rs"),
     ("insp::plan::no_convergence", "a guard: generate-and-test removes a configuration every round, and every example and NIST part settles well inside the limit"),
     ("insp::plan::points_left_out", "needs `--rounds` cut short: the golden case fallback_best_plan_found"),
+    ("insp::path::self_aligned", "arises only where no other face completes a setup's frame: the golden cases real_nist_ftc_08 and import_nist_ctc_01"),
     ("insp::path::no_path", "a touch that validates can almost always back out the way it came; src/path/roadmap.rs tests a sealed goal"),
     ("insp::dmis::long_line", "a DMIS file, not a spec: src/dmis/read/"),
     ("insp::dmis::syntax", "a DMIS file, not a spec: src/dmis/read/"),

@@ -452,11 +452,14 @@ plan f2_again {{
     std::fs::write(
         &p,
         text.replace(
-            "MEAS/LINE,F(LARGE_SLOT_1_LN),2",
-            "MEAS/PLANE,F(LARGE_SLOT_1),2",
+            "MEAS/LINE,F(AL1_STOCK_FRON_2),2",
+            "MEAS/PLANE,F(AL1_STOCK_FRONT),2",
         )
-        .replace("DATDEF/FA(LARGE_SLOT_1_LN),", "DATDEF/FA(LARGE_SLOT_1),")
-        .replace("DAT(AL1_2),YDIR", "DAT(AL1_2),-XDIR"),
+        .replace(
+            "DATDEF/FA(AL1_STOCK_FRON_2),",
+            "DATDEF/FA(AL1_STOCK_FRONT),",
+        )
+        .replace("DAT(AL1_2),XDIR", "DAT(AL1_2),-YDIR"),
     )
     .expect("write");
     assert_eq!(

@@ -7,6 +7,10 @@ use inspc::verify::{Options, Verification};
 use std::path::Path;
 
 fn verify(spec: &Path, placements: usize) -> Vec<Verification> {
+    verify_program(spec, None, placements)
+}
+
+fn verify_program(spec: &Path, program: Option<&Path>, placements: usize) -> Vec<Verification> {
     let opts = Options {
         placements,
         ..Default::default()
@@ -14,7 +18,7 @@ fn verify(spec: &Path, placements: usize) -> Vec<Verification> {
     let run = inspc::verify(
         &FsWorld,
         spec,
-        None,
+        program,
         &inspc::plan::PlanOptions::default(),
         &opts,
     );
@@ -45,11 +49,30 @@ fn f2_reads_right_wherever_it_lies() {
     );
 }
 
-/// F3's side hole has a setup of its own where datum A cannot be touched: its own axis
-/// sets the frame, and a tilted hole reads parallel. The battery says so.
+/// F3's side hole has a setup of its own where no programmed touch reaches datum A. The
+/// plan aligns that setup on the stock's faces; a program that aligns it again on the
+/// hole itself (as inspc's did) makes the hole set its own frame, and a tilted hole
+/// reads parallel. The battery says so.
 #[test]
 fn a_feature_that_sets_its_own_frame_is_caught() {
-    let v = verify(Path::new("examples/f3_fixed.insp"), 2);
+    let spec = Path::new("examples/f3_fixed.insp");
+    assert_eq!(verify(spec, 1)[0].problems(), 0);
+    let golden = std::fs::read_to_string("tests/cases/example_f3_fixed/program.dmi").unwrap();
+    let own = "DATDEF/FA(AL2_STOCK_FRON_2),DAT(AL2_DCC_3)\n\
+               D(SETUP2_DCC)=DATSET/DAT(AL2_DCC_1),XDIR,XORIG,DAT(AL2_DCC_2),YDIR,ZORIG,$\n\
+               DAT(AL2_DCC_3),YORIG\n\
+               D(PART2_DCC)=TRANS/XORIG,-100.0,ZORIG,-50.0,YORIG,0.0\n";
+    let on_hole = "DATDEF/FA(SIDE_HOLE),DAT(AL2_DCC_3)\n\
+                   D(SETUP2_DCC)=DATSET/DAT(AL2_DCC_3),-XDIR,YORIG,ZORIG,DAT(AL2_DCC_2),YDIR,$\n\
+                   DAT(AL2_DCC_1),XORIG\n\
+                   D(PART2_DCC)=TRANS/YORIG,-30.0,ZORIG,-25.0,XORIG,-100.0\n";
+    assert!(golden.contains(own), "the golden program's setup 2 changed");
+    let dir = std::env::temp_dir().join(format!("inspc_self_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let program = dir.join("on_hole.dmi");
+    std::fs::write(&program, golden.replace(own, on_hole)).unwrap();
+    let v = verify_program(spec, Some(&program), 2);
+    std::fs::remove_dir_all(&dir).ok();
     let text = v[0].text();
     assert!(v[0].problems() > 0, "{text}");
     assert!(
