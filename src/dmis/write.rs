@@ -318,6 +318,8 @@ struct Writer<'a> {
     measured: BTreeMap<Option<FeatureId>, Vec<String>>,
     /// Per datum, the setup its latest `DATDEF` was written in.
     defined_in: BTreeMap<crate::model::DatumId, usize>,
+    /// Per drilled hole (a bore ending in a cone), its constructed full-diameter circle.
+    depths: BTreeMap<FeatureId, String>,
 }
 
 /// Writes the program.
@@ -339,6 +341,7 @@ pub fn write(input: &Input) -> String {
         surfs: Vec::new(),
         points: BTreeMap::new(),
         pairs: BTreeMap::new(),
+        depths: BTreeMap::new(),
         patterns: BTreeMap::new(),
         done_in: BTreeMap::new(),
         realign: None,
@@ -1212,6 +1215,10 @@ impl Writer<'_> {
             self.o.goto(p);
         }
         let mut in_group: Vec<String> = Vec::new();
+        // The stand-off of the last block that had its own, not yet set back: consecutive
+        // blocks with the same stand-off share one `SNSET`, and a reset is written only
+        // before a block that approaches by the default (or at the group's end).
+        let mut own: Option<f64> = None;
         // Per datum measured here, the label that completes its surface.
         let mut datums_here: Vec<(crate::model::DatumId, String)> = Vec::new();
         for (bi, b) in g.blocks.iter().enumerate() {
@@ -1223,6 +1230,16 @@ impl Writer<'_> {
             // tolerance lets the surface stand proud) approaches and retracts by it.
             let narrow = (b.standoff - motion.prehit.max(motion.retract)).abs() > 1e-9;
             let joined = !self.surfs[surf].rounds[round].partials.is_empty();
+            let wanted = (narrow && b.passes.is_empty()).then_some(b.standoff);
+            if own.is_some() && own != wanted {
+                if wanted.is_none() {
+                    self.o
+                        .stmt(&format!("SNSET/APPRCH,{}", real(motion.prehit)));
+                    self.o
+                        .stmt(&format!("SNSET/RETRCT,{}", real(motion.retract)));
+                }
+                own = None;
+            }
             if !b.passes.is_empty() {
                 let target = if joined {
                     self.points[&((si, gi, bi), usize::MAX)].clone()
@@ -1232,9 +1249,10 @@ impl Writer<'_> {
                 self.scan(g, b, &target, meas);
             } else {
                 let o = &mut self.o;
-                if narrow {
+                if narrow && own.is_none() {
                     o.stmt(&format!("SNSET/APPRCH,{}", real(b.standoff)));
                     o.stmt(&format!("SNSET/RETRCT,{}", real(b.standoff)));
+                    own = wanted;
                 }
                 if !joined {
                     o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
@@ -1258,10 +1276,6 @@ impl Writer<'_> {
                 }
                 if !joined {
                     o.stmt("ENDMES");
-                }
-                if narrow {
-                    o.stmt(&format!("SNSET/APPRCH,{}", real(motion.prehit)));
-                    o.stmt(&format!("SNSET/RETRCT,{}", real(motion.retract)));
                 }
             }
             // The last block of a round in points joins them into the whole.
@@ -1325,6 +1339,12 @@ impl Writer<'_> {
                 }
             }
             in_group.push(done);
+        }
+        if own.is_some() {
+            self.o
+                .stmt(&format!("SNSET/APPRCH,{}", real(motion.prehit)));
+            self.o
+                .stmt(&format!("SNSET/RETRCT,{}", real(motion.retract)));
         }
         for p in &g.exit {
             self.o.goto(p);
@@ -1391,12 +1411,72 @@ impl Writer<'_> {
             })
     }
 
+    /// Where a distance reaches a drilled hole — a bore and the cone its drill point
+    /// leaves, on one axis — the circle where the full diameter ends, constructed as the
+    /// intersection of the two (`CONST/CIRCLE,F(c),INTOF,FA(bore),FA(cone)`, the form of
+    /// the "Supported DMIS Commands" tables vendors publish, e.g. PTC Creo's). A blind
+    /// hole's depth is the depth of its full diameter, not of the drill point (ASME
+    /// Y14.5, dimensioning of blind holes): a distance to the cone's apex reads FTC 06's
+    /// 12.7 mm drill depth as 14.6. `None` for any other feature.
+    fn full_diameter(&mut self, f: FeatureId, labels: &[String]) -> Option<String> {
+        if let Some(l) = self.depths.get(&f) {
+            return Some(l.clone());
+        }
+        let surface = |l: &String| match self.nominals.get(l) {
+            Some(Nominal::Surface(s, _)) => Some((l.clone(), s.clone())),
+            _ => None,
+        };
+        let bore = labels
+            .iter()
+            .filter_map(surface)
+            .find_map(|(l, s)| match s {
+                Surface::Cylinder {
+                    origin,
+                    axis,
+                    radius,
+                    convex: false,
+                } => Some((l, origin, axis, radius)),
+                _ => None,
+            })?;
+        let cone = labels
+            .iter()
+            .filter_map(surface)
+            .find_map(|(l, s)| match s {
+                Surface::Cone {
+                    apex,
+                    axis,
+                    half_angle,
+                    convex: false,
+                } => Some((l, apex, axis, half_angle)),
+                _ => None,
+            })?;
+        let ((bl, origin, axis, radius), (cl, apex, cone_axis, half)) = (bore, cone);
+        // One axis: parallel, the apex on the bore's axis.
+        let off = (apex - origin) - axis * (apex - origin).dot(&axis);
+        if axis.dot(&cone_axis).abs() < 1.0 - 1e-6 || off.norm() > 1e-3 || half.tan() < 1e-6 {
+            return None;
+        }
+        let centre = apex + cone_axis * (radius / half.tan());
+        let name = self.names.feature(Some(f)).to_string();
+        let label = self.labels.fresh("F", &format!("{name}_FULL"));
+        self.o.stmt(&format!(
+            "F({label})=FEAT/CIRCLE,INNER,CART,{},{},{}",
+            xyz(&centre),
+            ijk(&axis),
+            real(2.0 * radius)
+        ));
+        self.o
+            .stmt(&format!("CONST/CIRCLE,F({label}),INTOF,FA({bl}),FA({cl})"));
+        self.depths.insert(f, label.clone());
+        Some(label)
+    }
+
     /// `OUTPUT` of a tolerance over its features' labels: those measured in this group,
     /// else those measured before.
     fn output(&mut self, r: ToleranceId, in_group: &[String]) {
         let part = self.names.part();
         let t = &part.tolerances[r.0];
-        let tl = &self.tols[r.0];
+        let tl = &self.tols[r.0].clone();
         // Form and profile tolerances apply to each wall of a slot; the others to the pair.
         let per_wall = matches!(
             t.kind,
@@ -1449,12 +1529,17 @@ impl Writer<'_> {
                 lines.push(format!("OUTPUT/{},TA({tl})", fa.join(",")));
             }
         } else if t.targets.len() > 1 {
-            let fa: Vec<String> = t
-                .targets
-                .iter()
-                .filter_map(|&f| labels_of(f).into_iter().next())
-                .map(|l| format!("FA({l})"))
-                .collect();
+            let firsts: Vec<(FeatureId, Vec<String>)> =
+                t.targets.iter().map(|&f| (f, labels_of(f))).collect();
+            let mut fa = Vec::new();
+            for (f, labels) in firsts {
+                let depth = (t.kind == TolKind::Distance)
+                    .then(|| self.full_diameter(f, &labels))
+                    .flatten();
+                if let Some(l) = depth.or_else(|| labels.first().cloned()) {
+                    fa.push(format!("FA({l})"));
+                }
+            }
             if fa.len() == t.targets.len() {
                 lines.push(format!("OUTPUT/{},TA({tl})", fa.join(",")));
             }

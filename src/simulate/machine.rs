@@ -1431,7 +1431,26 @@ impl Machine<'_> {
             .flat_map(|s| s.touches.iter().copied())
             .collect();
         let pts: Vec<P3> = touches.iter().map(|t| t.2).collect();
+        let intof = params.get(2).map(String::as_str) == Some("INTOF");
         let fitted = match word.as_str() {
+            "CIRCLE" if intof => {
+                let [bore, cone] = &sources[..] else {
+                    return Err(self.bad(
+                        at,
+                        "an intersection circle takes two features",
+                        "write `CONST/CIRCLE,F(c),INTOF,FA(bore),FA(cone)`",
+                    ));
+                };
+                let circle = full_diameter(&bore.shape, &cone.shape).ok_or_else(|| {
+                    self.bad(
+                        at,
+                        "these features meet in no circle",
+                        "intersect a bore with the cone on its axis",
+                    )
+                })?;
+                // The circle is the features' intersection, not a fit over their points.
+                return self.store_constructed(label, circle);
+            }
             "PARPLN" => {
                 let [a, b] = &sources[..] else {
                     return Err(self.bad(
@@ -1505,6 +1524,19 @@ impl Machine<'_> {
             shape,
             touches,
             median,
+        }
+        .moved(&self.frame);
+        let setup = self.aligns.len();
+        self.actuals.insert(label, Stored { m, setup });
+        Ok(())
+    }
+
+    /// A constructed feature with no points of its own, in the program frame.
+    fn store_constructed(&mut self, label: String, shape: Shape) -> Result<(), SimError> {
+        let m = Measured {
+            shape,
+            touches: Vec::new(),
+            median: Vec::new(),
         }
         .moved(&self.frame);
         let setup = self.aligns.len();
@@ -1939,6 +1971,24 @@ fn foot_ray(
     })
 }
 
+/// The circle where a bore meets the cone on its axis (a drilled hole's full diameter
+/// ends there): on the cone's axis, where the cone's radius is the bore's; held as the
+/// cylinder it is a section of, as a `FEAT/CIRCLE` nominal is. `None` unless the
+/// features are a cylinder and a cone whose axes agree within 1°.
+fn full_diameter(bore: &Shape, cone: &Shape) -> Option<Shape> {
+    let (Shape::Cylinder { a, r, .. }, Shape::Cone { apex, a: ca, half }) = (bore, cone) else {
+        return None;
+    };
+    if a.dot(ca).abs() < 1f64.to_radians().cos() || half.tan() < 1e-9 {
+        return None;
+    }
+    Some(Shape::Cylinder {
+        p: apex + ca * (r / half.tan()),
+        a: *a,
+        r: *r,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1951,6 +2001,33 @@ mod tests {
         assert_eq!(xs, ys);
         let mut c = Rng(8);
         assert_ne!(xs[0], c.gauss());
+    }
+
+    /// FTC 06's drilled holes: Ø6.35, a 118° point whose apex lies 1.9077 mm past the
+    /// end of the full diameter (3.175 / tan 59°).
+    #[test]
+    fn a_drilled_hole_ends_where_the_cone_is_as_wide_as_the_bore() {
+        let bore = Shape::Cylinder {
+            p: P3::new(76.2, 78.74, -158.75),
+            a: -V3::y(),
+            r: 3.175,
+        };
+        let cone = Shape::Cone {
+            apex: P3::new(76.2, 70.4823, -158.75),
+            a: V3::y(),
+            half: 59f64.to_radians(),
+        };
+        let Some(Shape::Cylinder { p, r, .. }) = full_diameter(&bore, &cone) else {
+            panic!("no circle");
+        };
+        assert!((p - P3::new(76.2, 72.39, -158.75)).norm() < 1e-3, "{p}");
+        assert_eq!(r, 3.175);
+        let askew = Shape::Cone {
+            apex: P3::new(76.2, 70.4823, -158.75),
+            a: V3::x(),
+            half: 59f64.to_radians(),
+        };
+        assert!(full_diameter(&bore, &askew).is_none());
     }
 
     #[test]
