@@ -147,8 +147,12 @@ pub struct Touchable<'a> {
 /// secondary of a setup, read 0 under a profile shifted twice its zone), and a face
 /// whose points this setup takes only some of (the rest taken in another setup's frame:
 /// aligned on one end of a bore, the setup moves that end back to nominal and the fit
-/// over both ends reads a tilt at half its size, CTC 02's datum H). A face touched by
-/// hand only is no worse a datum for the frame than a block the program measures.
+/// over both ends reads a tilt at half its size, CTC 02's datum H), and a face of a
+/// feature a tolerance reads against datums the setup does not measure, whatever datum
+/// shares the face (FTC 08's datum F, one hole of a pattern located to D, B, C: the
+/// frame carried B and C over as drawn, and the pattern moved twice its zone read in).
+/// A face touched by hand only is no worse a datum for the frame than a block the
+/// program measures.
 pub fn align(input: &Input, hlip: &Hlip, sp: &SetupPath, touch: &[Touchable]) -> Alignment {
     let without = align_on(input, hlip, sp, touch, false);
     if without.missing.is_empty() && !without.steps.is_empty() {
@@ -186,6 +190,27 @@ fn align_on(
     // Candidates: (rank, -area, group, block, shape, points in tour order); the rank is
     // datum features first in datum order, then features no tolerance reads against
     // datums, then the rest.
+    // Faces of features a tolerance reads against datums this setup does not measure
+    // (a datum bore that is also one of a toleranced pattern's holes): the frame would
+    // carry those datums over as drawn and move with the face.
+    let here_features: Vec<FeatureId> = sp
+        .groups
+        .iter()
+        .flat_map(|g| g.blocks.iter().filter_map(|b| b.feature))
+        .collect();
+    let carried: Vec<FaceId> = part
+        .tolerances
+        .iter()
+        .filter(|t| {
+            !t.datums.is_empty()
+                && !t
+                    .datums
+                    .iter()
+                    .all(|d| here_features.contains(&part.datums[d.datum.0].feature))
+        })
+        .flat_map(|t| t.targets.iter())
+        .flat_map(|f| faces_in_graph(input, *f))
+        .collect();
     let elsewhere = points_elsewhere(hlip, sp.setup);
     let here: Vec<usize> = sp
         .groups
@@ -203,7 +228,8 @@ fn align_on(
             let split = elsewhere
                 .get(&b.face)
                 .is_some_and(|pts| pts.iter().any(|p| !here.contains(p)));
-            if split && !on_referenced && b.contact == Contact::Part {
+            if (split || carried.contains(&b.face)) && !on_referenced && b.contact == Contact::Part
+            {
                 continue;
             }
             let f = geometry.faces.get(b.face.0);

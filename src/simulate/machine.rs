@@ -1200,74 +1200,141 @@ impl Machine<'_> {
         Some((face, (proj.point - x).norm()))
     }
 
-    /// The first contact of the tip ball moving from centre `c0` along `−n` (part
-    /// frame) within `travel`: the part's face the foot of the ball meets on the mesh,
-    /// found exactly on its actual surface; or the table.
-    fn search_surface(&self, ctx: &SetupCtx, c0: &P3, n: &V3, r: f64, travel: f64) -> Found {
+    /// Where the ball moving from `c0` along `−n` meets `face`'s actual surface within
+    /// `travel` (the distance moved), if it does; `Err` when the ball starts inside the
+    /// part there (`inside` asks for that check: the approach point in the material).
+    #[allow(clippy::too_many_arguments)]
+    fn contact_on(
+        &self,
+        mesh: &parry3d_f64::shape::TriMesh,
+        face: FaceId,
+        c0: &P3,
+        n: &V3,
+        r: f64,
+        travel: f64,
+        inside: bool,
+    ) -> Result<Option<f64>, ()> {
         let g = self.input.geometry;
         let dev: &Deviations = self.input.deviations;
+        let surface = dev.surface(g, face);
+        let bow = dev.bow_of(g, face);
+        Ok(match Shape::of_surface(&surface) {
+            Some((shape, convex)) => {
+                // The distance on the solid's free side, less any bow.
+                let k = if convex { 1.0 } else { -1.0 };
+                let gap = |t: f64| {
+                    let x = c0 - n * t;
+                    let lift = match (bow, shape.direction()) {
+                        (Some(b), Some(normal)) => b.at(&normal, &x),
+                        _ => 0.0,
+                    };
+                    k * shape.signed(&x) - lift - r
+                };
+                // A plane above the approach point, or the ball there in the part (a
+                // concave face's distance is that of the whole bore: an approach point
+                // past a fillet's axis is in the open).
+                let planar = matches!(shape, Shape::Plane { .. });
+                if gap(0.0) <= 0.0 {
+                    if !inside {
+                        // A neighbour's surface the ball starts behind (its extension
+                        // past the face): not the face the ball meets.
+                        return Ok(None);
+                    }
+                    if planar || self.scene.distance(c0) < r {
+                        return Err(());
+                    }
+                }
+                first_root(&gap, travel)
+            }
+            None => {
+                // Free-form: the ball swept against the triangles, moved with the face.
+                // Not the foot's ray: off the programmed point in a fillet, the ball meets
+                // the facets beside the foot first.
+                let m = dev
+                    .faces
+                    .get(face.0)
+                    .map(|c| c.motion)
+                    .unwrap_or_else(Isometry3::identity);
+                let at = Isometry3::from_parts(
+                    Translation3::from((m.inverse() * c0).coords),
+                    UnitQuaternion::identity(),
+                );
+                let hit = cast_shapes(
+                    &at,
+                    &(m.inverse() * -n),
+                    &Ball::new(r),
+                    &Isometry3::identity(),
+                    &V3::zeros(),
+                    mesh,
+                    ShapeCastOptions::with_max_time_of_impact(travel),
+                );
+                hit.ok()
+                    .flatten()
+                    .map(|h| h.time_of_impact)
+                    .filter(|t| *t <= travel)
+            }
+        })
+    }
+
+    /// The first contact of the tip ball moving from centre `c0` along `−n` (part
+    /// frame) within `travel`: the part's face the foot of the ball meets on the mesh,
+    /// found exactly on its actual surface; or the table. Where the ball cannot reach
+    /// that face (a corner radius hardly larger than the ball, the part set off by
+    /// more than the ball's play in it), it stops on the face it meets first, as a
+    /// machine's probe does: of the faces whose facets lie near its path, the nearest
+    /// contact on their actual surfaces.
+    fn search_surface(&self, ctx: &SetupCtx, c0: &P3, n: &V3, r: f64, travel: f64) -> Found {
+        let g = self.input.geometry;
         let mut best: Option<(f64, Contact, Option<FaceId>)> = None;
         if let Some(mesh) = self.scene.mesh() {
-            let hit = foot_ray(mesh, &(c0 - n * r), n, travel + 1.0);
-            if let Some(hit) = hit {
-                let tri = match hit.feature {
-                    parry3d_f64::shape::FeatureId::Face(i) => i as usize % g.triangles.len().max(1),
-                    _ => 0,
-                };
-                let face = FaceId(g.tri_face.get(tri).copied().unwrap_or(0) as usize);
-                let surface = dev.surface(g, face);
-                let bow = dev.bow_of(g, face);
-                let t = match Shape::of_surface(&surface) {
-                    Some((shape, convex)) => {
-                        // The distance on the solid's free side, less any bow.
-                        let k = if convex { 1.0 } else { -1.0 };
-                        let gap = |t: f64| {
-                            let x = c0 - n * t;
-                            let lift = match (bow, shape.direction()) {
-                                (Some(b), Some(normal)) => b.at(&normal, &x),
-                                _ => 0.0,
-                            };
-                            k * shape.signed(&x) - lift - r
-                        };
-                        // A plane above the approach point, or the ball there in the
-                        // part (a concave face's distance is that of the whole bore: an
-                        // approach point past a fillet's axis is in the open).
-                        let planar = matches!(shape, Shape::Plane { .. });
-                        if gap(0.0) <= 0.0 && (planar || self.scene.distance(c0) < r) {
-                            return Found::Inside;
+            let face_of = |i: u32| {
+                FaceId(
+                    g.tri_face
+                        .get(i as usize % g.triangles.len().max(1))
+                        .copied()
+                        .unwrap_or(0) as usize,
+                )
+            };
+            let foot =
+                foot_ray(mesh, &(c0 - n * r), n, travel + 1.0).map(|hit| match hit.feature {
+                    parry3d_f64::shape::FeatureId::Face(i) => face_of(i),
+                    _ => face_of(0),
+                });
+            if let Some(face) = foot {
+                match self.contact_on(mesh, face, c0, n, r, travel, true) {
+                    Err(()) => return Found::Inside,
+                    Ok(Some(t)) => best = Some((t, Contact::Part, Some(face))),
+                    Ok(None) => {}
+                }
+            }
+            // (A scanner's ray, r = 0, keeps to the face under it: a point past a
+            // deviated face's edge is not the feature's.)
+            if best.is_none() && r > 0.0 {
+                // The faces whose facets come near the ball's path, the foot's own
+                // (moved away from the ball, it is not met at all) left out; the
+                // nearest contact on their actual surfaces.
+                let end = c0 - n * travel;
+                let lo = c0.inf(&end).coords.add_scalar(-r);
+                let hi = c0.sup(&end).coords.add_scalar(r);
+                let mut near: Vec<FaceId> = Vec::new();
+                for (t, tri) in g.triangles.iter().enumerate() {
+                    let vs = tri.map(|i| g.vertices[i as usize].coords);
+                    let meets = (0..3).all(|k| {
+                        let min = vs.iter().map(|v| v[k]).fold(f64::INFINITY, f64::min);
+                        let max = vs.iter().map(|v| v[k]).fold(f64::NEG_INFINITY, f64::max);
+                        min <= hi[k] && max >= lo[k]
+                    });
+                    let f = face_of(t as u32);
+                    if meets && Some(f) != foot && !near.contains(&f) {
+                        near.push(f);
+                    }
+                }
+                for face in near {
+                    if let Ok(Some(t)) = self.contact_on(mesh, face, c0, n, r, travel, false) {
+                        if best.is_none_or(|(b, ..)| t < b) {
+                            best = Some((t, Contact::Part, Some(face)));
                         }
-                        first_root(&gap, travel)
                     }
-                    None => {
-                        // Free-form: the ball swept against the triangles, moved with
-                        // the face. Not the foot's ray: off the programmed point in a
-                        // fillet, the ball meets the facets beside the foot first.
-                        let m = dev
-                            .faces
-                            .get(face.0)
-                            .map(|c| c.motion)
-                            .unwrap_or_else(Isometry3::identity);
-                        let at = Isometry3::from_parts(
-                            Translation3::from((m.inverse() * c0).coords),
-                            UnitQuaternion::identity(),
-                        );
-                        let hit = cast_shapes(
-                            &at,
-                            &(m.inverse() * -n),
-                            &Ball::new(r),
-                            &Isometry3::identity(),
-                            &V3::zeros(),
-                            mesh,
-                            ShapeCastOptions::with_max_time_of_impact(travel),
-                        );
-                        hit.ok()
-                            .flatten()
-                            .map(|h| h.time_of_impact)
-                            .filter(|t| *t <= travel)
-                    }
-                };
-                if let Some(t) = t {
-                    best = Some((t, Contact::Part, Some(face)));
                 }
             }
         }
