@@ -28,6 +28,12 @@ struct Out {
 }
 
 impl Out {
+    /// `SNSET/APPRCH` and `SNSET/RETRCT`: the stand-off touches approach and retract by.
+    fn standoff(&mut self, approach: f64, retract: f64) {
+        self.stmt(&format!("SNSET/APPRCH,{}", real(approach)));
+        self.stmt(&format!("SNSET/RETRCT,{}", real(retract)));
+    }
+
     fn stmt(&mut self, s: &str) {
         for line in wrap(s) {
             self.text.push_str(&line);
@@ -418,8 +424,7 @@ impl Writer<'_> {
         o.stmt("FEDRAT/POSVEL,MPM,1.8");
         o.stmt("FEDRAT/MESVEL,MMPS,3.0");
         o.stmt("PRCOMP/ON");
-        o.stmt(&format!("SNSET/APPRCH,{}", real(motion.prehit)));
-        o.stmt(&format!("SNSET/RETRCT,{}", real(motion.retract)));
+        o.standoff(motion.prehit, motion.retract);
         o.stmt(&format!("SNSET/SEARCH,{}", real(motion.search)));
         o.stmt(&format!("SNSET/CLRSRF,{}", real(motion.clearance)));
     }
@@ -1215,9 +1220,9 @@ impl Writer<'_> {
             self.o.goto(p);
         }
         let mut in_group: Vec<String> = Vec::new();
-        // The stand-off of the last block that had its own, not yet set back: consecutive
-        // blocks with the same stand-off share one `SNSET`, and a reset is written only
-        // before a block that approaches by the default (or at the group's end).
+        // The block's own stand-off in force (`None`: the default): consecutive blocks
+        // with the same stand-off share one `SNSET`, and the default comes back before
+        // a block that approaches by it, or at the group's end.
         let mut own: Option<f64> = None;
         // Per datum measured here, the label that completes its surface.
         let mut datums_here: Vec<(crate::model::DatumId, String)> = Vec::new();
@@ -1231,14 +1236,12 @@ impl Writer<'_> {
             let narrow = (b.standoff - motion.prehit.max(motion.retract)).abs() > 1e-9;
             let joined = !self.surfs[surf].rounds[round].partials.is_empty();
             let wanted = (narrow && b.passes.is_empty()).then_some(b.standoff);
-            if own.is_some() && own != wanted {
-                if wanted.is_none() {
-                    self.o
-                        .stmt(&format!("SNSET/APPRCH,{}", real(motion.prehit)));
-                    self.o
-                        .stmt(&format!("SNSET/RETRCT,{}", real(motion.retract)));
+            if own != wanted {
+                match wanted {
+                    Some(s) => self.o.standoff(s, s),
+                    None => self.o.standoff(motion.prehit, motion.retract),
                 }
-                own = None;
+                own = wanted;
             }
             if !b.passes.is_empty() {
                 let target = if joined {
@@ -1249,11 +1252,6 @@ impl Writer<'_> {
                 self.scan(g, b, &target, meas);
             } else {
                 let o = &mut self.o;
-                if narrow && own.is_none() {
-                    o.stmt(&format!("SNSET/APPRCH,{}", real(b.standoff)));
-                    o.stmt(&format!("SNSET/RETRCT,{}", real(b.standoff)));
-                    own = wanted;
-                }
                 if !joined {
                     o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
                 }
@@ -1341,10 +1339,7 @@ impl Writer<'_> {
             in_group.push(done);
         }
         if own.is_some() {
-            self.o
-                .stmt(&format!("SNSET/APPRCH,{}", real(motion.prehit)));
-            self.o
-                .stmt(&format!("SNSET/RETRCT,{}", real(motion.retract)));
+            self.o.standoff(motion.prehit, motion.retract);
         }
         for p in &g.exit {
             self.o.goto(p);
@@ -1422,35 +1417,31 @@ impl Writer<'_> {
         if let Some(l) = self.depths.get(&f) {
             return Some(l.clone());
         }
-        let surface = |l: &String| match self.nominals.get(l) {
-            Some(Nominal::Surface(s, _)) => Some((l.clone(), s.clone())),
-            _ => None,
-        };
-        let bore = labels
-            .iter()
-            .filter_map(surface)
-            .find_map(|(l, s)| match s {
-                Surface::Cylinder {
-                    origin,
-                    axis,
-                    radius,
-                    convex: false,
-                } => Some((l, origin, axis, radius)),
-                _ => None,
-            })?;
-        let cone = labels
-            .iter()
-            .filter_map(surface)
-            .find_map(|(l, s)| match s {
-                Surface::Cone {
-                    apex,
-                    axis,
-                    half_angle,
-                    convex: false,
-                } => Some((l, apex, axis, half_angle)),
-                _ => None,
-            })?;
-        let ((bl, origin, axis, radius), (cl, apex, cone_axis, half)) = (bore, cone);
+        let (mut bore, mut cone) = (None, None);
+        for l in labels {
+            match self.nominals.get(l) {
+                Some(Nominal::Surface(
+                    Surface::Cylinder {
+                        origin,
+                        axis,
+                        radius,
+                        convex: false,
+                    },
+                    _,
+                )) if bore.is_none() => bore = Some((l, *origin, *axis, *radius)),
+                Some(Nominal::Surface(
+                    Surface::Cone {
+                        apex,
+                        axis,
+                        half_angle,
+                        convex: false,
+                    },
+                    _,
+                )) if cone.is_none() => cone = Some((l, *apex, *axis, *half_angle)),
+                _ => {}
+            }
+        }
+        let ((bl, origin, axis, radius), (cl, apex, cone_axis, half)) = (bore?, cone?);
         // One axis: parallel, the apex on the bore's axis.
         let off = (apex - origin) - axis * (apex - origin).dot(&axis);
         if axis.dot(&cone_axis).abs() < 1.0 - 1e-6 || off.norm() > 1e-3 || half.tan() < 1e-6 {
@@ -1476,7 +1467,7 @@ impl Writer<'_> {
     fn output(&mut self, r: ToleranceId, in_group: &[String]) {
         let part = self.names.part();
         let t = &part.tolerances[r.0];
-        let tl = &self.tols[r.0].clone();
+        let tl = self.tols[r.0].clone();
         // Form and profile tolerances apply to each wall of a slot; the others to the pair.
         let per_wall = matches!(
             t.kind,

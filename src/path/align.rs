@@ -187,17 +187,10 @@ fn align_on(
     let setup = &hlip.setups[sp.setup];
     let resting = resting_datum(input, setup.up, setup.table);
     let vertical = axis_of(&setup.up).map(|(k, _)| k);
-    // Candidates: (rank, -area, group, block, shape, points in tour order); the rank is
-    // datum features first in datum order, then features no tolerance reads against
-    // datums, then the rest.
     // Faces of features a tolerance reads against datums this setup does not measure
     // (a datum bore that is also one of a toleranced pattern's holes): the frame would
     // carry those datums over as drawn and move with the face.
-    let here_features: Vec<FeatureId> = sp
-        .groups
-        .iter()
-        .flat_map(|g| g.blocks.iter().filter_map(|b| b.feature))
-        .collect();
+    let here_features = sp.features();
     let carried: Vec<FaceId> = part
         .tolerances
         .iter()
@@ -212,12 +205,15 @@ fn align_on(
         .flat_map(|f| faces_in_graph(input, *f))
         .collect();
     let elsewhere = points_elsewhere(hlip, sp.setup);
-    let here: Vec<usize> = sp
+    let here: std::collections::BTreeSet<usize> = sp
         .groups
         .iter()
         .flat_map(|g| &g.blocks)
         .flat_map(|b| b.touches.iter().map(|t| t.point))
         .collect();
+    // Candidates: (rank, -area, group, block, shape, points in tour order); the rank is
+    // datum features first in datum order, then features no tolerance reads against
+    // datums, then the rest.
     let mut cands = Vec::new();
     for (gi, g) in sp.groups.iter().enumerate() {
         for (bi, b) in g.blocks.iter().enumerate() {

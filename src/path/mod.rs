@@ -60,6 +60,16 @@ pub struct SetupPath {
     pub groups: Vec<GroupPath>,
 }
 
+impl SetupPath {
+    /// The features the setup's blocks measure, in block order (repeats kept).
+    pub(crate) fn features(&self) -> Vec<FeatureId> {
+        self.groups
+            .iter()
+            .flat_map(|g| g.blocks.iter().filter_map(|b| b.feature))
+            .collect()
+    }
+}
+
 /// One (probe, orientation) group: its entry, blocks of touches, and exit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GroupPath {
@@ -1045,11 +1055,7 @@ fn lift(pose: &Pose, x: &P3, g: &GroupIn) -> (Option<Vec<P3>>, usize) {
 /// them and the alignment would not matter).
 fn self_aligned(input: &Input, sp: &SetupPath, diags: &mut Diagnostics) {
     let part = &input.model.parts[input.plan.part.0];
-    let measured: Vec<FeatureId> = sp
-        .groups
-        .iter()
-        .flat_map(|g| g.blocks.iter().filter_map(|b| b.feature))
-        .collect();
+    let measured = sp.features();
     let mut warned: Vec<usize> = Vec::new();
     for step in &sp.alignment.steps {
         let Some(b) = sp

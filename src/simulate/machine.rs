@@ -15,8 +15,9 @@ use crate::model::{Model, Plan};
 use crate::plan::poses::Setups;
 use crate::source::Span;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, Unit, UnitQuaternion};
+use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::query::{cast_shapes, PointQuery, Ray, RayCast, ShapeCastOptions};
-use parry3d_f64::shape::Ball;
+use parry3d_f64::shape::{Ball, Triangle};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// What the virtual CMM runs.
@@ -1314,18 +1315,15 @@ impl Machine<'_> {
                 // (moved away from the ball, it is not met at all) left out; the
                 // nearest contact on their actual surfaces.
                 let end = c0 - n * travel;
-                let lo = c0.inf(&end).coords.add_scalar(-r);
-                let hi = c0.sup(&end).coords.add_scalar(r);
+                let path = Aabb::new(c0.inf(&end), c0.sup(&end)).loosened(r);
                 let mut near: Vec<FaceId> = Vec::new();
-                for (t, tri) in g.triangles.iter().enumerate() {
-                    let vs = tri.map(|i| g.vertices[i as usize].coords);
-                    let meets = (0..3).all(|k| {
-                        let min = vs.iter().map(|v| v[k]).fold(f64::INFINITY, f64::min);
-                        let max = vs.iter().map(|v| v[k]).fold(f64::NEG_INFINITY, f64::max);
-                        min <= hi[k] && max >= lo[k]
-                    });
-                    let f = face_of(t as u32);
-                    if meets && Some(f) != foot && !near.contains(&f) {
+                for (tri, &f) in g.triangles.iter().zip(&g.tri_face) {
+                    let [a, b, c] = tri.map(|i| g.vertices[i as usize]);
+                    let f = FaceId(f as usize);
+                    if Some(f) != foot
+                        && !near.contains(&f)
+                        && path.intersects(&Triangle::new(a, b, c).local_aabb())
+                    {
                         near.push(f);
                     }
                 }
