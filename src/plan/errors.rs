@@ -55,6 +55,22 @@ pub enum PlanError {
         why: String,
         help: String,
     },
+    #[error("tolerance `{tolerance}` reads the axis of `{feature}` over {touched} mm of the {sampled} mm its points on face `{face}` span: the points beyond no probe reaches, so a tilt reads at {share} % of its size")]
+    #[diagnostic(
+        code(insp::plan::short_axis),
+        severity(Warning),
+        help("a longer stylus or an extension in the rack reaches the far end, or a fixture that presents the bore along one of the head's orientations; until then a tilt of the axis reads smaller than it is by that share")
+    )]
+    ShortAxis {
+        #[label("this tolerance")]
+        span: Span,
+        tolerance: String,
+        feature: String,
+        face: String,
+        touched: String,
+        sampled: String,
+        share: String,
+    },
     #[error("setup {setup} of `{plan}` runs only with the part set square to the machine axes {within}, not within {full}°: turned more, the stylus hits the part at {touches}")]
     #[diagnostic(
         code(insp::plan::placement_sensitive),
@@ -158,6 +174,7 @@ crate::located!(PlanError {
     UninspectableFaceAllowed,
     NoConvergence,
     PointsLeftOut,
+    ShortAxis,
     PlacementSensitive,
     DatumInOtherSetup,
     NoPlan,
