@@ -237,6 +237,16 @@ fn sensor_key(g: &GroupPath) -> SensorKey {
     (g.probe, num(g.a), num(g.b))
 }
 
+/// The sensor that touches one step of a hand alignment: its group's, or the group's
+/// probe with the head indexed to the step's own orientation.
+fn step_sensor(sp: &crate::path::SetupPath, step: &crate::path::AlignStep) -> SensorKey {
+    let g = &sp.groups[step.group];
+    match step.orient {
+        Some((a, b)) => (g.probe, num(a), num(b)),
+        None => sensor_key(g),
+    }
+}
+
 /// A block's place in the program: (setup, group, block).
 type BlockKey = (usize, usize, usize);
 
@@ -439,19 +449,33 @@ impl Writer<'_> {
         let probes = crate::access::ProbeShape::of_cmm(input.model, cmm);
         let scanners = crate::access::scan::ScannerShape::of_cmm(input.model, cmm);
         self.o.comment("sensors");
-        for g in input.llip.setups.iter().flat_map(|s| &s.groups) {
-            let key = sensor_key(g);
+        // The groups' sensors, then orientations the head takes only to align by hand.
+        let wanted: Vec<(SlotId, f64, f64)> = input
+            .llip
+            .setups
+            .iter()
+            .flat_map(|s| s.groups.iter().map(|g| (g.probe, g.a, g.b)))
+            .chain(input.llip.setups.iter().flat_map(|s| {
+                s.alignment
+                    .steps
+                    .iter()
+                    .filter_map(|st| Some((s.groups.get(st.group)?.probe, st.orient?)))
+                    .map(|(p, (a, b))| (p, a, b))
+            }))
+            .collect();
+        for (probe, a, b) in wanted {
+            let key = (probe, num(a), num(b));
             if self.sensors.contains_key(&key) {
                 continue;
             }
-            let (kind, len, diam) = match probes.get(g.probe.0) {
+            let (kind, len, diam) = match probes.get(probe.0) {
                 Some(p) => ("PROBE", real(p.reach()), real(2.0 * p.tip_radius)),
-                None => match scanners.get(g.probe.0 - probes.len()) {
+                None => match scanners.get(probe.0 - probes.len()) {
                     Some(s) => ("LASER", real(s.optics.standoff), real(s.optics.stripe)),
                     None => continue,
                 },
             };
-            let label_text = self.names.probe(g.probe);
+            let label_text = self.names.probe(probe);
             let name = if self.indexable() {
                 format!("{label_text}_A{}B{}", key.1, key.2)
                     .replace('-', "M")
@@ -467,8 +491,8 @@ impl Writer<'_> {
                 // tip's diameter (docs/dmis.md).
                 self.o.stmt(&format!(
                     "S({label})=SNSDEF/{kind},INDEX,POL,{},{},0.0,0.0,1.0,{len},{diam}",
-                    real(g.a),
-                    real(g.b),
+                    real(a),
+                    real(b),
                 ));
             } else {
                 self.o.stmt(&format!(
@@ -895,7 +919,7 @@ impl Writer<'_> {
         self.o.stmt("MODE/MAN");
         // The probe first (fitted if it is not on the head), then how to align.
         if let Some(step) = al.steps.first() {
-            self.select(&sp.groups[step.group]);
+            self.select_key(step_sensor(sp, step));
         }
         self.o.oper(
             "ALIGN BY HAND: TOUCH EACH POINT THE CONTROLLER SHOWS, FEATURE BY FEATURE, THEN LEAVE THE PROBE ABOVE THE PART",
@@ -906,18 +930,19 @@ impl Writer<'_> {
         let mut primary: Option<usize> = None;
         for (k, step) in al.steps.iter().enumerate() {
             let g = &sp.groups[step.group];
+            let key = step_sensor(sp, step);
             // By hand, the operator brings the probe out before the head indexes (or the
             // probe changes) between two features: the ball may be down a bore.
             let moved = al.steps[..k]
                 .last()
-                .is_some_and(|prev| sensor_key(&sp.groups[prev.group]) != sensor_key(g));
+                .is_some_and(|prev| step_sensor(sp, prev) != key);
             if moved {
                 self.o.oper(
                     "RAISE THE PROBE CLEAR ABOVE THE PART, THEN CONTINUE: THE HEAD TURNS THE PROBE FOR THE NEXT FEATURE",
                 );
                 self.o.stmt("PAUSE");
             }
-            self.select(g);
+            self.select_key(key);
             // The feature touched, its touches, and the face the operator is told of.
             let (label, pts, face) = match (step.block, &step.extra) {
                 (Some(bi), _) => {
@@ -1602,20 +1627,27 @@ impl Writer<'_> {
     /// controller running with the wrong stylus would drive it into the part by the
     /// difference in length.
     fn select(&mut self, g: &GroupPath) {
-        let Some(s) = self.sensors.get(&sensor_key(g)).cloned() else {
+        self.select_key(sensor_key(g));
+    }
+
+    /// [`Writer::select`] by the sensor's key: a group's, or an orientation the head
+    /// takes only for the hand alignment.
+    fn select_key(&mut self, key: SensorKey) {
+        let probe = key.0;
+        let Some(s) = self.sensors.get(&key).cloned() else {
             return;
         };
         if self.current_sensor.as_ref() == Some(&s) {
             return;
         }
-        if self.current_probe != Some(g.probe) {
+        if self.current_probe != Some(probe) {
             let cmm = &self.input.model.cmms[self.input.plan.cmm.0];
             let what = cmm
                 .probes
-                .get(g.probe.0)
+                .get(probe.0)
                 .map(|(_, id)| self.input.model.probes[id.0].name.clone());
-            let label = self.names.probe(g.probe);
-            let kind = if self.names.is_scanner(g.probe) {
+            let label = self.names.probe(probe);
+            let kind = if self.names.is_scanner(probe) {
                 "SCANNER"
             } else {
                 "PROBE"
@@ -1634,7 +1666,7 @@ impl Writer<'_> {
         self.o.at = None;
         self.o.stmt(&format!("SNSLCT/S({s})"));
         self.current_sensor = Some(s);
-        self.current_probe = Some(g.probe);
+        self.current_probe = Some(probe);
     }
 }
 

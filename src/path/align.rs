@@ -11,8 +11,11 @@
 //! `XORIG`/`YORIG`/`ZORIG`. A secondary plane comes before a bore (it fixes the turn);
 //! a cylinder along a fixed direction (a bore in the primary face) can stand in for the
 //! origins across it, and where a datum bore will, a non-datum secondary plane gives
-//! only its direction; a sphere gives all three origins. Whatever the features leave free is named in [`Alignment::missing`]
-//! and becomes an operator instruction.
+//! only its direction; a sphere gives all three origins. What the setup's features leave
+//! free comes from other faces the operator touches by hand ([`complete`]) — with the
+//! setup's own probe orientations, or on an indexable head with one the head indexes to
+//! for that touch alone ([`Touchable::orient`]). Whatever stays free is named in
+//! [`Alignment::missing`] and becomes an operator instruction.
 
 use super::{Hlip, SetupPath};
 use crate::access::Contact;
@@ -37,6 +40,9 @@ pub struct Alignment {
 pub struct AlignStep {
     /// The group (index into [`SetupPath::groups`]) whose sensor touches it.
     pub group: usize,
+    /// The head's A and B where the touch takes another orientation than the group's
+    /// (a face no group of the setup faces: the head indexes to touch it by hand).
+    pub orient: Option<(f64, f64)>,
     /// The block in that group; `None` for a face the setup measures nothing on, touched
     /// by hand only ([`AlignStep::extra`]).
     pub block: Option<usize>,
@@ -127,8 +133,14 @@ fn resting_datum(input: &Input, up: V3, table: f64) -> Option<usize> {
 
 /// Where the operator can touch the part by hand with one group's probe: the tip's
 /// radius, and whether a touch at a contact point with an outward normal is clear (the
-/// probe held as the group holds it, approaching along the normal).
+/// probe held as the group holds it, or with the head indexed to `orient`, approaching
+/// along the normal).
 pub struct Touchable<'a> {
+    /// The group (index into [`SetupPath::groups`]) whose probe it is.
+    pub group: usize,
+    /// The head's A and B where they are not the group's: an orientation the setup
+    /// measures nothing in, taken only to touch a face the alignment needs.
+    pub orient: Option<(f64, f64)>,
     /// The probe (rack slot): groups of one probe along one direction touch alike.
     pub probe: usize,
     /// The probe's direction, tip to head (part frame).
@@ -454,6 +466,7 @@ fn align_on(
             }
             out.steps.push(AlignStep {
                 group: *gi,
+                orient: None,
                 block: Some(*bi),
                 points,
                 extra: None,
@@ -502,6 +515,7 @@ fn align_on(
             }
             out.steps.push(AlignStep {
                 group: gi,
+                orient: None,
                 block: Some(bi),
                 points,
                 extra: None,
@@ -676,7 +690,8 @@ fn complete(
                 touches: Vec<(P3, V3)>,
                 keywords: Vec<String>| {
         out.steps.push(AlignStep {
-            group: gi,
+            group: touch[gi].group,
+            orient: touch[gi].orient,
             block: None,
             points: Vec::new(),
             extra: Some(ExtraFace { face, touches }),

@@ -486,29 +486,42 @@ fn join(
         }
     }
     for sp in &mut setups {
-        // By hand, the operator holds the probe as one of the setup's groups does.
+        // By hand, the operator holds the probe as one of the setup's groups does, or
+        // indexes the head to an orientation taken only to align.
         let standoff = motion.prehit.max(motion.retract);
-        let poses: Vec<(Pose, &GroupIn)> = groups
+        let own: Vec<&GroupIn> = groups.iter().filter(|g| g.setup == sp.setup).collect();
+        let held: Vec<HandHeld> = own
             .iter()
-            .filter(|g| g.setup == sp.setup)
-            .map(|g| {
-                let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table).with_fixture(g.fixture);
-                (pose, g)
+            .enumerate()
+            .map(|(gi, g)| (gi, None, g.dir))
+            .chain(
+                align_orients(input, &own)
+                    .into_iter()
+                    .map(|(gi, a, b, dir)| (gi, Some((a, b)), dir)),
+            )
+            .map(|(gi, orient, dir)| {
+                let g = own[gi];
+                HandHeld {
+                    pose: Pose::new(scene, g.probe, dir, g.up, g.table).with_fixture(g.fixture),
+                    group: gi,
+                    orient,
+                    dir,
+                }
             })
             .collect();
-        let clears: Vec<_> = poses
+        let clears: Vec<_> = held
             .iter()
-            .map(|(pose, _)| {
-                move |c: &P3, n: &V3| pose.approach(c, n, standoff, Contact::Part).is_ok()
-            })
+            .map(|h| move |c: &P3, n: &V3| h.pose.approach(c, n, standoff, Contact::Part).is_ok())
             .collect();
-        let touch: Vec<align::Touchable> = poses
+        let touch: Vec<align::Touchable> = held
             .iter()
             .zip(&clears)
-            .map(|((_, g), clear)| align::Touchable {
-                probe: g.slot.0,
-                dir: g.dir,
-                tip: g.probe.tip_radius,
+            .map(|(h, clear)| align::Touchable {
+                group: h.group,
+                orient: h.orient,
+                probe: own[h.group].slot.0,
+                dir: h.dir,
+                tip: own[h.group].probe.tip_radius,
                 clear,
             })
             .collect();
@@ -538,6 +551,57 @@ fn join(
         setups,
     })
 }
+
+/// Head orientations the operator may index to for the hand alignment beyond the
+/// setup's own: per probe of the setup, the grid orientation nearest each part axis
+/// (within [`ALIGN_ORIENT_CONE`]) that no group of that probe already takes. A setup
+/// whose groups all look at one face from above can still be turned square by a touch
+/// on a side face (3-2-1 needs faces along three axes); what the head cannot face stays
+/// free and is said. `(group, A, B, direction)`: the group whose probe it is.
+fn align_orients(input: &Input, groups: &[&GroupIn]) -> Vec<(usize, f64, f64, V3)> {
+    let cmm = &input.model.cmms[input.plan.cmm.0];
+    let grid = input.model.heads[cmm.head.0].orientations();
+    let mut out: Vec<(usize, f64, f64, V3)> = Vec::new();
+    for (gi, g) in groups.iter().enumerate() {
+        let first = groups.iter().position(|o| o.slot == g.slot) == Some(gi);
+        if !first || g.blocks.iter().any(|b| !b.passes.is_empty()) {
+            continue;
+        }
+        for k in 0..6 {
+            let mut axis = V3::zeros();
+            axis[k / 2] = if k % 2 == 0 { 1.0 } else { -1.0 };
+            let best = grid
+                .iter()
+                .map(|&(a, b)| (a, b, crate::access::pose::orientation_dir(&g.up, a, b)))
+                .max_by(|x, y| x.2.dot(&axis).total_cmp(&y.2.dot(&axis)));
+            let Some((a, b, dir)) = best else { continue };
+            let taken = |d: &V3| (d - dir).norm() < 1e-6;
+            if dir.dot(&axis) < ALIGN_ORIENT_CONE.to_radians().cos()
+                || groups.iter().any(|o| o.slot == g.slot && taken(&o.dir))
+                || out
+                    .iter()
+                    .any(|o| groups[o.0].slot == g.slot && taken(&o.3))
+            {
+                continue;
+            }
+            out.push((gi, a, b, dir));
+        }
+    }
+    out
+}
+
+/// How the operator holds the probe for a hand touch: as group `group` does, or with the
+/// head indexed to `orient` ([`align_orients`]).
+struct HandHeld<'a> {
+    pose: Pose<'a>,
+    group: usize,
+    orient: Option<(f64, f64)>,
+    dir: V3,
+}
+
+/// How far (degrees) an orientation [`align_orients`] offers may stand from the part
+/// axis it is for.
+const ALIGN_ORIENT_CONE: f64 = 20.0;
 
 /// `a`, `a and b`, `a, b and c`.
 fn and_list(items: &[String]) -> String {
