@@ -398,18 +398,22 @@ fn centroid(g: &PartGeometry, faces: &[FaceId]) -> P3 {
     P3::from(sum / area.max(1e-12))
 }
 
-/// The direction the second feature moves to lengthen a distance: its plane's normal
-/// turned away from the first, else the line between their centroids.
+/// The direction the second feature moves to lengthen a distance, the direction the
+/// distance is measured in: the second's plane normal, else the first's (the distance
+/// from a plane to a hole's axis is the perpendicular one, so the hole moves square to
+/// the plane: moved along the line from the plane's centroid, FTC 06's drilled hole went
+/// 2.5 mm along and 0.57 mm across and hit the probe), else the line between their
+/// centroids across the second's axis (between two axes, square to them), turned away
+/// from the first.
 fn apart(g: &PartGeometry, f1: &[FaceId], f2: &[FaceId]) -> V3 {
     let d = centroid(g, f2) - centroid(g, f1);
-    match orientation(g, f2) {
-        Some((n, true)) => {
-            if n.dot(&d) < 0.0 {
-                -n
-            } else {
-                n
-            }
-        }
+    let away = |n: V3| if n.dot(&d) < 0.0 { -n } else { n };
+    match (orientation(g, f1), orientation(g, f2)) {
+        (_, Some((n, true))) | (Some((n, true)), _) => away(n),
+        (_, Some((axis, false))) => (d - axis * axis.dot(&d))
+            .try_normalize(1e-9)
+            .or_else(|| d.try_normalize(1e-9))
+            .unwrap_or_else(V3::x),
         _ => d.try_normalize(1e-9).unwrap_or_else(V3::x),
     }
 }
