@@ -1049,6 +1049,18 @@ impl Writer<'_> {
             .map(|(k, v)| format!("{k}ORIG,{}", real(-v)))
             .collect();
         self.datset(&format!("SETUP{}", si + 1), &fa_manual, &shifts);
+        // The measuring run starts with the setup's first group: where the head turns
+        // or the probe changes for it, the operator first brings the probe out, as
+        // between two hand features.
+        let last = al.steps.last().map(|st| step_sensor(sp, st));
+        if let (Some(last), Some(first)) = (last, sp.groups.first()) {
+            if last != sensor_key(first) {
+                self.o.oper(
+                    "RAISE THE PROBE CLEAR ABOVE THE PART, THEN CONTINUE: THE MEASURING RUN STARTS WITH ANOTHER PROBE ORIENTATION",
+                );
+                self.o.stmt("PAUSE");
+            }
+        }
         self.o.stmt("MODE/PROG,MAN");
         // Once the program has measured the alignment features itself, it aligns again
         // on those measurements: the hand-touched points only start it.
