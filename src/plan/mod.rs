@@ -13,6 +13,7 @@
 //! visits sets in graph order, ties go to the lower index, and parallel work (cones,
 //! validation) is collected in input order.
 
+mod axes;
 pub mod cluster;
 mod domain;
 mod errors;
@@ -285,82 +286,8 @@ fn account(
         }
     }
     hlip.summary.tolerances = (measured, part.tolerances.len());
-    short_axes(input, &touches, &faces_of, diags);
+    axes::short_axes(input, &touches, &faces_of, diags);
     hlip
-}
-
-/// Warns of each tolerance that reads a round face's axis ([`reads_axis`]) over less of
-/// its length than sampling spread points along: points deeper in a bore than any probe
-/// reaches drop out silently, and the axis fitted to the rest reads a tilt at the share
-/// of the length they span (CTC 02's F33, Ø40 × 49 for a 50 mm stylus: its circles at
-/// 810 and 787.5 read a tilt of twice its zone as 0.93 of it).
-fn short_axes(
-    input: &Input,
-    touches: &BTreeMap<FaceId, BTreeSet<usize>>,
-    faces_of: &BTreeMap<crate::model::FeatureId, Vec<FaceId>>,
-    diags: &mut Diagnostics,
-) {
-    use crate::geometry::Surface;
-    let part = &input.model.parts[input.plan.part.0];
-    let g = input.graph;
-    for t in part.tolerances.iter().filter(|t| reads_axis(t.kind)) {
-        for f in &t.targets {
-            for &face in faces_of.get(f).into_iter().flatten() {
-                let (origin, axis) = match &input.geometry.faces[face.0].surface {
-                    Surface::Cylinder { origin, axis, .. } => (origin, axis),
-                    Surface::Cone { apex, axis, .. } => (apex, axis),
-                    _ => continue,
-                };
-                let span = |pts: &mut dyn Iterator<Item = usize>| {
-                    let (lo, hi) = pts
-                        .map(|p| (g.fpoints[p].position - origin).dot(axis))
-                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| {
-                            (lo.min(t), hi.max(t))
-                        });
-                    (hi - lo).max(0.0)
-                };
-                let Some(touched) = touches.get(&face).filter(|t| !t.is_empty()) else {
-                    continue;
-                };
-                let sampled = span(&mut face_points(g, face).into_iter());
-                let reached = span(&mut touched.iter().copied());
-                if sampled < 1e-6 || reached >= SHORT_AXIS_SHARE * sampled {
-                    continue;
-                }
-                let mm = |x: f64| crate::model::fmt_num((x * 10.0).round() / 10.0);
-                diags.push(PlanError::ShortAxis {
-                    span: t.span,
-                    tolerance: t.name.clone(),
-                    feature: part.features[f.0].name.clone(),
-                    face: input.geometry.faces[face.0].name.clone(),
-                    touched: mm(reached),
-                    sampled: mm(sampled),
-                    share: crate::model::fmt_num((100.0 * reached / sampled).round()),
-                });
-            }
-        }
-    }
-}
-
-/// The share of the sampled length below which [`short_axes`] warns.
-const SHORT_AXIS_SHARE: f64 = 0.8;
-
-/// Whether a tolerance of this kind reads its feature's axis (orientation, location,
-/// runout, coaxiality, cylindricity), not only a size.
-fn reads_axis(kind: crate::model::TolKind) -> bool {
-    use crate::model::TolKind as K;
-    matches!(
-        kind,
-        K::Perpendicularity
-            | K::Parallelism
-            | K::Angularity
-            | K::Position
-            | K::Concentricity
-            | K::Coaxiality
-            | K::CircularRunout
-            | K::TotalRunout
-            | K::Cylindricity
-    )
 }
 
 /// Why a plan has more setups than the proven minimum, when the hierarchy is the cause:
@@ -598,9 +525,9 @@ fn plan_touch(
     // Faces no probe inspects, left out under `allow_unmeasured`, and those a scanner
     // measures.
     let mut skipped: BTreeSet<FaceId> = skip.clone();
-    let axes = axis_faces(g, &input.model.parts[input.plan.part.0]);
+    let read_axes = axes::axis_faces(g, &input.model.parts[input.plan.part.0]);
     for iteration in 1..=opts.max_iterations {
-        let (dropped, bad) = filter(g, input.geometry, &k, &machine, &skipped, &axes);
+        let (dropped, bad) = filter(g, input.geometry, &k, &machine, &skipped, &read_axes);
         if !bad.is_empty() {
             // Know the whole probe before blaming a face.
             let pairs: Vec<(usize, usize)> = bad
@@ -611,12 +538,12 @@ fn plan_touch(
             let before = k.acquired;
             k.acquire_many(&pairs, &machine);
             if k.acquired > before && iteration < opts.max_iterations {
-                let (_, bad2) = filter(g, input.geometry, &k, &machine, &skipped, &axes);
+                let (_, bad2) = filter(g, input.geometry, &k, &machine, &skipped, &read_axes);
                 if bad2.is_empty() {
                     continue;
                 }
             }
-            let (_, bad) = filter(g, input.geometry, &k, &machine, &skipped, &axes);
+            let (_, bad) = filter(g, input.geometry, &k, &machine, &skipped, &read_axes);
             for &face in &bad {
                 report_face(input, &k, &machine, face, opts.allow_unmeasured, diags);
             }
@@ -902,66 +829,6 @@ fn learn(k: &mut Knowledge, m: &Machine, mut fails: Vec<(usize, usize, usize, Op
     }
 }
 
-/// The faces whose axis a tolerance reads: those of a datum feature and of a feature
-/// toleranced for orientation, location, runout or cylindricity. A size alone is read
-/// from any circle; these are read along the axis.
-fn axis_faces(g: &MeasurementGraph, part: &crate::model::Part) -> BTreeSet<FaceId> {
-    use crate::graph::{Edge, Node};
-    let mut faces = BTreeSet::new();
-    for (n, node) in g.nodes() {
-        let Node::Tolerance(t) = node else { continue };
-        for (f, edge) in g.children(n) {
-            if edge == Edge::Datum || (edge == Edge::Target && reads_axis(part.tolerances[*t].kind))
-            {
-                faces.extend(
-                    g.children(f)
-                        .into_iter()
-                        .filter_map(|(c, _)| match g.graph[c] {
-                            Node::Face { face, .. } => Some(face),
-                            _ => None,
-                        }),
-                );
-            }
-        }
-    }
-    faces
-}
-
-/// The points of a cylinder or cone at either end of the axial span of `points` (within
-/// [`END_CIRCLE_BAND`]): the circles that fix its axis. A tilt is read over the length
-/// between them, so the rarity rule of [`filter`] keeps them, on the faces whose axis a
-/// tolerance reads ([`axis_faces`]), while any setup reaches them: a Ø12 × 25 blind bore whose deepest circle only a probe along its axis reaches
-/// read its perpendicularity over 40 % of its length without it (a tilt at twice the
-/// zone read in). Empty for other surfaces.
-fn end_circles(
-    g: &MeasurementGraph,
-    surface: &crate::geometry::Surface,
-    points: &[(usize, usize)],
-) -> BTreeSet<usize> {
-    use crate::geometry::Surface;
-    let (origin, axis) = match surface {
-        Surface::Cylinder { origin, axis, .. } => (origin, axis),
-        Surface::Cone { apex, axis, .. } => (apex, axis),
-        _ => return BTreeSet::new(),
-    };
-    let at = |p: usize| (g.fpoints[p].position - origin).dot(axis);
-    let (lo, hi) = points
-        .iter()
-        .map(|&(p, _)| at(p))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| {
-            (lo.min(t), hi.max(t))
-        });
-    points
-        .iter()
-        .map(|&(p, _)| p)
-        .filter(|&p| at(p) - lo <= END_CIRCLE_BAND || hi - at(p) <= END_CIRCLE_BAND)
-        .collect()
-}
-
-/// How far along the axis (mm) a round face's point may be from its span's end and
-/// still belong to that end's circle.
-const END_CIRCLE_BAND: f64 = 0.5;
-
 /// Whether points spread across an area, not along a line: a plane fitted to them is
 /// determined. The second principal spread must be at least [`LEAST_SPREAD`].
 pub(super) fn spans_area(points: &[&crate::geometry::P3]) -> bool {
@@ -994,8 +861,9 @@ pub(crate) fn face_points(g: &MeasurementGraph, face: FaceId) -> Vec<usize> {
 }
 
 /// Drops fpoints no probe reaches and, while a face keeps enough, those reached from
-/// under a twentieth of the face's median count of setups (ch. 3.6.3). Returns the
-/// dropped fpoints and the faces left with too few. The `skipped` faces (left out under
+/// under a twentieth of the face's median count of setups (ch. 3.6.3) — but not the end
+/// circles of a face in `read_axes` ([`axes::end_circles`]). Returns the dropped fpoints
+/// and the faces left with too few. The `skipped` faces (left out under
 /// `allow_unmeasured`) drop all their points.
 fn filter(
     g: &MeasurementGraph,
@@ -1003,7 +871,7 @@ fn filter(
     k: &Knowledge,
     m: &Machine,
     skipped: &BTreeSet<FaceId>,
-    axes: &BTreeSet<FaceId>,
+    read_axes: &BTreeSet<FaceId>,
 ) -> (BTreeSet<usize>, Vec<FaceId>) {
     let mut by_face: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
     for (i, f) in g.fpoints.iter().enumerate() {
@@ -1048,8 +916,8 @@ fn filter(
         let mut sorted: Vec<usize> = keep.iter().map(|x| x.1).collect();
         sorted.sort_unstable();
         let median = sorted[sorted.len() / 2];
-        let ends = if axes.contains(&FaceId(face)) {
-            end_circles(g, &geo.faces[face].surface, &keep)
+        let ends = if read_axes.contains(&FaceId(face)) {
+            axes::end_circles(g, &geo.faces[face].surface, &keep)
         } else {
             BTreeSet::new()
         };
