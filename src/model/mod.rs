@@ -568,6 +568,16 @@ pub struct OrientPref {
     pub span: Span,
 }
 
+impl OrientPref {
+    /// Whether it names the head orientation `(a, b)`: the same A, and the same B up to
+    /// whole turns (any B at A = 0, where B turns the probe about itself).
+    pub fn names(&self, a: f64, b: f64) -> bool {
+        let turn = (b - self.b).rem_euclid(360.0);
+        (a - self.a).abs() < 1e-6
+            && (!(1e-6..=360.0 - 1e-6).contains(&turn) || a.abs() < 1e-9 && self.a.abs() < 1e-9)
+    }
+}
+
 /// A probe preference: a cost override or a ban.
 #[derive(Debug, Clone)]
 pub struct ProbePref {

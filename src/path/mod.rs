@@ -554,13 +554,25 @@ fn join(
 
 /// Head orientations the operator may index to for the hand alignment beyond the
 /// setup's own: per probe of the setup, the grid orientation nearest each part axis
-/// (within [`ALIGN_ORIENT_CONE`]) that no group of that probe already takes. A setup
+/// (within [`ALIGN_ORIENT_CONE`]) that no group of that probe already takes and the
+/// plan does not forbid. A setup
 /// whose groups all look at one face from above can still be turned square by a touch
 /// on a side face (3-2-1 needs faces along three axes); what the head cannot face stays
 /// free and is said. `(group, A, B, direction)`: the group whose probe it is.
 fn align_orients(input: &Input, groups: &[&GroupIn]) -> Vec<(usize, f64, f64, V3)> {
     let cmm = &input.model.cmms[input.plan.cmm.0];
-    let grid = input.model.heads[cmm.head.0].orientations();
+    // The head's orientations less those the plan forbids.
+    let grid: Vec<(f64, f64)> = input.model.heads[cmm.head.0]
+        .orientations()
+        .into_iter()
+        .filter(|&(a, b)| {
+            !input
+                .plan
+                .orientations
+                .iter()
+                .any(|o| matches!(o.stance, crate::model::Stance::Forbid) && o.names(a, b))
+        })
+        .collect();
     let mut out: Vec<(usize, f64, f64, V3)> = Vec::new();
     for (gi, g) in groups.iter().enumerate() {
         let first = groups.iter().position(|o| o.slot == g.slot) == Some(gi);

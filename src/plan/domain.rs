@@ -81,11 +81,7 @@ impl Machine {
         let mut grid_weight = vec![0.5; grid.len()];
         for o in &plan.orientations {
             for (k, g) in grid.iter().enumerate() {
-                let same = (g.0 - o.a).abs() < 1e-6
-                    && ((g.1 - o.b).rem_euclid(360.0) < 1e-6
-                        || (g.1 - o.b).rem_euclid(360.0) > 360.0 - 1e-6
-                        || g.0.abs() < 1e-9 && o.a.abs() < 1e-9);
-                if same {
+                if o.names(g.0, g.1) {
                     match o.stance {
                         Stance::Forbid => grid_allowed.remove(k),
                         Stance::Prefer(w) => grid_weight[k] = w,
