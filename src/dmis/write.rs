@@ -440,9 +440,10 @@ impl Writer<'_> {
     }
 
     /// One sensor per probe (per probe and A/B on an indexable head), in order of first
-    /// use. A laser scanner is `SNSDEF/LASER` in the form of a probe's, its stand-off in
-    /// the length's place and its stripe's width in the diameter's (see ARCHITECTURE,
-    /// "Scans in DMIS").
+    /// use by the measuring groups, then those only a hand alignment indexes to. A laser
+    /// scanner is `SNSDEF/LASER` in the form of a probe's, its stand-off in the length's
+    /// place and its stripe's width in the diameter's (see ARCHITECTURE, "Scans in
+    /// DMIS").
     fn sensor_definitions(&mut self) {
         let input = self.input;
         let cmm = &input.model.cmms[input.plan.cmm.0];
