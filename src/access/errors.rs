@@ -51,7 +51,7 @@ pub enum AccessError {
     },
 }
 
-crate::located!(AccessError {
+crate::diag::located!(AccessError {
     UnknownFace,
     NoPoint,
     UnknownProbe,

@@ -27,7 +27,6 @@ pub trait Located {
 /// Implements [`Located`] for an error enum whose every variant has a primary
 /// `span: Span` field: `located!(PlanError { UninspectableFace, NoConvergence, NoPlan })`.
 /// A variant added without a `span` does not compile, nor does one left out of the list.
-#[macro_export]
 macro_rules! located {
     ($ty:ty { $($variant:ident),* $(,)? }) => {
         impl $crate::diag::Located for $ty {
@@ -38,6 +37,20 @@ macro_rules! located {
             }
         }
     };
+}
+pub(crate) use located;
+
+/// An IO error belongs to the file it could not read or write.
+impl Located for crate::source::io::IoError {
+    fn file(&self) -> FileId {
+        match self {
+            crate::source::io::IoError::Unreadable { file, .. }
+            | crate::source::io::IoError::Unwritable { file, .. }
+            | crate::source::io::IoError::NotAFile { file, .. }
+            | crate::source::io::IoError::OverwritesInput { file, .. }
+            | crate::source::io::IoError::SameOutput { file, .. } => *file,
+        }
+    }
 }
 
 /// The file of a primary span (for [`located!`]).

@@ -329,7 +329,7 @@ pub enum GeometryError {
     },
 }
 
-crate::located!(GeometryError {
+crate::diag::located!(GeometryError {
     MeshUnreadable,
     MeshCorrupt,
     MeshNotClosed,
@@ -374,17 +374,17 @@ pub enum MeshError {
     /// Over the size limit.
     TooLarge(String),
     /// A STEP file that cannot be read or meshed.
-    Step(super::step::StepError),
+    Step(super::step::error::StepError),
     /// A QIF file that cannot be read or meshed.
-    Qif(super::qif::QifError),
+    Qif(super::qif::error::QifError),
 }
 
 impl MeshError {
     /// The diagnostics, pointing at the spec's mesh path: one, or one per face of a
     /// STEP file that could not be meshed.
     pub fn at(self, span: Span, path: &std::path::Path) -> Vec<GeometryError> {
-        use super::qif::QifError as Q;
-        use super::step::StepError as S;
+        use super::qif::error::QifError as Q;
+        use super::step::error::StepError as S;
         let path = shown_path(path);
         vec![match self {
             MeshError::Unreadable(reason) => GeometryError::MeshUnreadable { span, path, reason },

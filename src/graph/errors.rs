@@ -46,7 +46,7 @@ pub enum GraphError {
     },
 }
 
-crate::located!(GraphError {
+crate::diag::located!(GraphError {
     TooManyPoints,
     NoPoints,
     WrongSurface,

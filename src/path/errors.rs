@@ -52,7 +52,7 @@ pub enum PathError {
     },
 }
 
-crate::located!(PathError {
+crate::diag::located!(PathError {
     NoPath,
     SelfAligned,
     AlignmentIncomplete

@@ -167,7 +167,7 @@ pub enum PlanError {
     },
 }
 
-crate::located!(PlanError {
+crate::diag::located!(PlanError {
     Unmeasured,
     UnmeasuredAllowed,
     UninspectableFace,

@@ -436,7 +436,7 @@ pub enum ResolveError {
     },
 }
 
-crate::located!(ResolveError {
+crate::diag::located!(ResolveError {
     UnknownName,
     WrongKind,
     DuplicateName,

@@ -112,7 +112,7 @@ pub enum SimError {
     },
 }
 
-crate::located!(SimError {
+crate::diag::located!(SimError {
     Collision,
     NoSurface,
     InsidePart,

@@ -56,15 +56,3 @@ pub enum IoError {
         second: String,
     },
 }
-
-impl crate::diag::Located for IoError {
-    fn file(&self) -> FileId {
-        match self {
-            IoError::Unreadable { file, .. }
-            | IoError::Unwritable { file, .. }
-            | IoError::NotAFile { file, .. }
-            | IoError::OverwritesInput { file, .. }
-            | IoError::SameOutput { file, .. } => *file,
-        }
-    }
-}

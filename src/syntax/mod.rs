@@ -80,7 +80,7 @@ pub enum SyntaxError {
     },
 }
 
-crate::located!(SyntaxError {
+crate::diag::located!(SyntaxError {
     Unexpected,
     InvalidNumber,
     TooDeep,

@@ -228,7 +228,7 @@ pub enum DmisError {
     },
 }
 
-crate::located!(DmisError {
+crate::diag::located!(DmisError {
     LongLine,
     Syntax,
     BadLabel,
