@@ -4,7 +4,7 @@
 //! parametrised about it so a handful of points converges in a few steps. Points on one
 //! circle fix no axis direction: the direction (and a cone's angle) then stay nominal.
 
-use crate::geometry::{P3, V3};
+use super::{P3, V3};
 use nalgebra::{DMatrix, DVector, Matrix3, SymmetricEigen};
 
 /// A fitted (or nominal) shape, in whatever frame its points are. Directions are unit

@@ -12,7 +12,9 @@
 //! operation's faces in declaration order, pattern instances in order; for meshes, the
 //! file's group order or the segmentation's seed order.
 
+pub mod cmm_fit;
 mod csg;
+pub mod drf;
 mod errors;
 pub mod fit;
 mod fixture;
@@ -24,13 +26,15 @@ mod report;
 pub mod segment;
 mod select;
 pub mod step;
+mod weld;
 
 pub use errors::{GeometryError, MeshError};
 pub use fixture::{place_fixture, FixtureMesh, CONTACT_MM};
-pub use mesh_io::{read_mesh, RawMesh};
+pub use mesh_io::read_mesh;
 pub use query::{edge_triangles, line_triangle, segment_distance, FaceIndex};
 pub use report::{describe, faces_json, faces_table};
 pub use select::resolve_faces;
+pub use weld::RawMesh;
 
 use crate::diag::Diagnostics;
 use crate::model::{self, Geometry as Source};

@@ -43,6 +43,11 @@ pub struct Part {
     pub span: Span,
 }
 
+/// The chord tolerance a STEP or QIF part is meshed to when its spec gives none (mm):
+/// the reference meshes' (OpenCASCADE, linear deflection 0.1 mm), so that a CAD part
+/// plans as its mesh did.
+pub const DEFAULT_CHORD_MM: f64 = 0.1;
+
 /// The geometry source.
 #[derive(Debug, Clone)]
 pub enum Geometry {
@@ -55,7 +60,7 @@ pub enum Geometry {
         /// mm per file unit (STL, OBJ; a STEP or QIF file states its own).
         unit_mm: f64,
         /// For a STEP or QIF file, the chord tolerance it is meshed to (mm), when the
-        /// spec gives one.
+        /// spec gives one ([`DEFAULT_CHORD_MM`] when it does not).
         chord_mm: Option<f64>,
         /// Where the path was written.
         span: Span,

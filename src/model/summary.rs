@@ -457,7 +457,7 @@ fn part_summary(o: &mut String, p: &Part) {
             match CadKind::of_path(path) {
                 Some(_) => format!(
                     "CAD {name} (in the file's unit, chord {} mm)",
-                    fmt_num(chord_mm.unwrap_or(crate::geometry::step::RESOLUTION.chord_mm))
+                    fmt_num(chord_mm.unwrap_or(super::DEFAULT_CHORD_MM))
                 ),
                 None => format!("mesh {name} (× {} mm)", fmt_num(*unit_mm)),
             }

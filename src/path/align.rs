@@ -860,7 +860,7 @@ impl Fixes {
 /// leave free: (moves, turns). A frame fixes only the degrees of freedom its datum
 /// features constrain (ASME Y14.5-2018, ch. 7: a primary plane alone leaves the moves
 /// along it and the turn about its normal free); the evaluation reads what is left in
-/// the program's alignment ([`crate::simulate::evaluate`]), so a face aligned on in a
+/// the program's alignment ([`crate::geometry::drf`]), so a face aligned on in a
 /// degree of freedom its own frame leaves free would read in place in it. Form and
 /// orientation tolerances do not depend on the alignment, nor do those of datum
 /// features (the frame is built on them).
@@ -870,8 +870,8 @@ struct LeftFree {
 
 impl LeftFree {
     fn of(input: &Input) -> LeftFree {
+        use crate::geometry::cmm_fit::Shape as Fitted;
         use crate::model::TolKind;
-        use crate::simulate::fit::Shape as Fitted;
         let part = &input.model.parts[input.plan.part.0];
         let datum_features: Vec<FeatureId> = part.datums.iter().map(|d| d.feature).collect();
         let nominal = |f: FeatureId| -> Option<Fitted> {
@@ -898,7 +898,7 @@ impl LeftFree {
                 .filter_map(|d| nominal(part.datums[d.datum.0].feature))
                 .map(|s| (s.clone(), s))
                 .collect();
-            let drf = crate::simulate::evaluate::drf(&shapes);
+            let drf = crate::geometry::drf::drf(&shapes);
             for f in t.targets.iter().filter(|f| !datum_features.contains(f)) {
                 for face in faces_in_graph(input, *f) {
                     faces.push((face, drf.free_t.clone(), drf.free_r.clone()));

@@ -21,11 +21,12 @@
 pub mod deviation;
 mod errors;
 pub mod evaluate;
-pub mod fit;
 mod machine;
 mod qif;
 mod report;
 
+/// The fits of measured points, shared with the path stage's alignment.
+pub(crate) use crate::geometry::cmm_fit as fit;
 pub use deviation::Deviations;
 pub use errors::SimError;
 pub use machine::{plan_of, simulate};

@@ -12,106 +12,27 @@
 //! accessibility analysis see through the part.
 
 pub(super) mod brep;
+pub(in crate::geometry) mod error;
 pub(super) mod geom;
 mod p21;
 pub mod pmi;
 pub(super) mod tess;
 
+pub use error::StepError;
 pub use tess::Resolution;
 
-use super::mesh_io::{weld, RawMesh};
+use super::weld::{weld, RawMesh};
 use super::{Surface, P3};
 use crate::geometry::errors::MeshError;
 use std::collections::{BTreeSet, HashMap};
 
 /// The resolution parts are meshed at: the reference meshes' (OpenCASCADE, linear
-/// deflection 0.1 mm, angular 0.5 rad), so that a STEP part plans as its mesh did.
+/// deflection [`crate::model::DEFAULT_CHORD_MM`], angular 0.5 rad), so that a STEP part
+/// plans as its mesh did.
 pub const RESOLUTION: Resolution = Resolution {
-    chord_mm: 0.1,
+    chord_mm: crate::model::DEFAULT_CHORD_MM,
     angle_rad: 0.5,
 };
-
-/// Why a STEP file could not be read.
-#[derive(Debug, Clone, PartialEq)]
-pub enum StepError {
-    /// Not valid Part 21 text.
-    Syntax {
-        /// 1-based line.
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// No solid or sheet body.
-    NoSolid,
-    /// A reference to an instance the file does not define.
-    Missing {
-        /// The missing instance.
-        id: u64,
-        /// The instance that refers to it.
-        from: Option<u64>,
-    },
-    /// An instance whose parameters are not what its type needs.
-    Malformed {
-        /// The instance.
-        id: u64,
-        /// Its line.
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A curve or surface type inspc does not evaluate.
-    Unsupported {
-        /// The instance.
-        id: u64,
-        /// Its line.
-        line: usize,
-        /// `surface SURFACE_OF_REVOLUTION`.
-        what: String,
-    },
-    /// The length or angle unit cannot be determined.
-    Unit(String),
-    /// Faces that could not be meshed: (1-based face number, instance, why).
-    Faces(Vec<(usize, u64, String)>),
-}
-
-impl std::fmt::Display for StepError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            StepError::Syntax { line, message } => write!(f, "line {line}: {message}"),
-            StepError::NoSolid => write!(
-                f,
-                "it holds no solid (MANIFOLD_SOLID_BREP) and no sheet body"
-            ),
-            StepError::Missing {
-                id,
-                from: Some(from),
-            } => {
-                write!(f, "#{from} refers to #{id}, which the file does not define")
-            }
-            StepError::Missing { id, from: None } => {
-                write!(f, "#{id} is referred to but not defined")
-            }
-            StepError::Malformed { id, line, message } => {
-                write!(f, "#{id} (line {line}): {message}")
-            }
-            StepError::Unsupported { id, line, what } => {
-                write!(
-                    f,
-                    "#{id} (line {line}) is a {what}, which inspc does not evaluate"
-                )
-            }
-            StepError::Unit(m) => write!(f, "{m}"),
-            StepError::Faces(list) => {
-                let (n, id, why) = &list[0];
-                write!(f, "face_{n} (#{id}) cannot be meshed: {why}")?;
-                if list.len() > 1 {
-                    write!(f, " (and {} more faces)", list.len() - 1)?;
-                }
-                Ok(())
-            }
-        }
-    }
-}
 
 /// A CAD part (STEP or QIF) read and meshed.
 #[derive(Debug, Clone)]
