@@ -204,10 +204,8 @@ impl CubeMap {
     /// The pixel a direction falls in.
     pub fn pixel_of(&self, d: &V3) -> Pixel {
         let (face, u, v) = face_uv(d);
-        let at = |x: f64| {
-            super::raster::floor_i((x + 1.0) / 2.0 * self.n as f64).clamp(0, self.n as i64 - 1)
-                as u32
-        };
+        let at =
+            |x: f64| floor_i((x + 1.0) / 2.0 * self.n as f64).clamp(0, self.n as i64 - 1) as u32;
         Pixel {
             face,
             i: at(u),
@@ -983,6 +981,19 @@ fn pixel_directions(like: &CubeMap) -> Arc<[V3]> {
             (0..n).map(|k| like.direction(like.cell(k))).collect()
         })
         .clone()
+}
+
+/// `x.floor() as i64` without the libm call the baseline x86-64 target makes of
+/// `floor` (no SSE4.1 rounding): the same integer for every `x`, NaN and infinities
+/// saturating as the cast does. The rasterizer calls it for every span.
+#[inline]
+pub(super) fn floor_i(x: f64) -> i64 {
+    let i = x as i64;
+    if (i as f64) > x {
+        i.saturating_sub(1)
+    } else {
+        i
+    }
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 //! every pixel whose cell the shadow touches, so a blocked direction anywhere in a pixel
 //! blocks the pixel; the pessimistic abstractions grow from it.
 
-use super::cubemap::CubeMap;
+use super::cubemap::{floor_i, CubeMap};
 use crate::geometry::V3;
 
 /// Which pixels a shadow marks.
@@ -331,19 +331,6 @@ fn raster_convex(
 #[inline]
 fn clamped_floor(y: f64, n: i64) -> i64 {
     y.max(0.0).min((n - 1) as f64) as i64
-}
-
-/// `x.floor() as i64` without the libm call the baseline x86-64 target makes of
-/// `floor` (no SSE4.1 rounding): the same integer for every `x`, NaN and infinities
-/// saturating as the cast does. The rasterizer calls it for every span.
-#[inline]
-pub(super) fn floor_i(x: f64) -> i64 {
-    let i = x as i64;
-    if (i as f64) > x {
-        i.saturating_sub(1)
-    } else {
-        i
-    }
 }
 
 /// `x.ceil() as i64`, as [`floor_i`].

@@ -1,7 +1,8 @@
 //! Explaining a failed plan: for a face no configuration inspects, which probe came
 //! closest, from where, and what stopped it.
 
-use super::domain::{Knowledge, Machine};
+use super::knowledge::Knowledge;
+use super::machine::Machine;
 use super::{face_points, min_points, solve, Input, PlanError};
 use crate::diag::Diagnostics;
 use crate::geometry::{FaceId, V3};

@@ -5,8 +5,9 @@
 //! naming the face, the probe and what it hit. Every touch of the result validated.
 
 use super::cluster::Strategy;
-use super::domain::{Knowledge, Machine};
 use super::hlip::{assemble, Round};
+use super::knowledge::Knowledge;
+use super::machine::Machine;
 use super::solve::{self, Branch};
 use super::validate::{self, Pip};
 use super::{explain, Hlip, Input, PlanOptions};

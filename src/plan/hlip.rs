@@ -6,7 +6,8 @@
 //! printed and the plan the path stage moves by are the same numbers.
 
 use super::cluster::{min_hitting_set, Strategy};
-use super::domain::{Knowledge, Machine};
+use super::knowledge::Knowledge;
+use super::machine::Machine;
 use super::poses::Holder;
 use super::solve::{self, Branch, Inst, Kind};
 use super::Input;

@@ -13,118 +13,17 @@
 //! and the rejected configuration is removed.
 
 use super::cluster::{Bits, Set};
-use crate::access::pose::{above_table, frame, table_height, Blocker, Contact, Head, Pose};
+use super::machine::Machine;
+use super::memo::{Dom, Memo};
+use crate::access::pose::{above_table, frame, table_height, Blocker, Contact, Pose};
 use crate::access::{self, tip_fits, Cell, ConeOptions, CubeMap, ProbeShape, Scene, SecondMap};
 use crate::geometry::{FaceId, Surface, P3, V3};
-use crate::model::{HeadKind, Model, Plan, Stance};
+use crate::model::{Plan, Stance};
 use crate::sample::Fpoint;
 
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::atomic::{AtomicU32, Ordering};
-
-/// The machine as the planner sees it.
-pub(crate) struct Machine {
-    /// Probe shapes in rack order.
-    pub probes: Vec<ProbeShape>,
-    /// Probe costs (plan overrides applied).
-    pub costs: Vec<f64>,
-    /// Probes the plan allows.
-    pub allowed: Vec<bool>,
-    /// The head: fixed, or indexing on `grid`.
-    pub head: Head,
-    /// The head's A/B grid (degrees); one (0, 0) for a fixed head.
-    pub grid: Vec<(f64, f64)>,
-    /// The grid's probe directions in the machine frame (`access::head_direction`),
-    /// computed once: the planner asks for them per point, probe and setup.
-    pub grid_dirs: Vec<V3>,
-    /// Each grid direction's angle (radians) from the head's axis, the machine's z (A up
-    /// to rounding), and whether they never decrease along the grid.
-    pub grid_polar: (Vec<f64>, bool),
-    /// The grid orientations the plan allows.
-    pub grid_allowed: Bits,
-    /// Preference weights of grid orientations (0.5 when unspecified).
-    pub grid_weight: Vec<f64>,
-    /// The largest A (degrees).
-    pub a_max: f64,
-}
-
-impl Machine {
-    pub(crate) fn new(model: &Model, plan: &Plan) -> Machine {
-        let cmm = &model.cmms[plan.cmm.0];
-        let head = &model.heads[cmm.head.0];
-        let probes = ProbeShape::of_cmm(model, cmm);
-        let mut costs: Vec<f64> = cmm
-            .probes
-            .iter()
-            .map(|(_, p)| model.probes[p.0].cost)
-            .collect();
-        let mut allowed = vec![true; probes.len()];
-        for pref in &plan.probes {
-            if let Some(k) = cmm.probes.iter().position(|(l, _)| *l == pref.label) {
-                match pref.stance {
-                    Stance::Forbid => allowed[k] = false,
-                    Stance::Prefer(Some(c)) => costs[k] = c,
-                    Stance::Prefer(None) => {}
-                }
-            }
-        }
-        let (kind, a_max) = match head.kind {
-            HeadKind::Fixed => (Head::Fixed, 0.0),
-            HeadKind::Indexable { a, .. } => (Head::Indexable, a[1]),
-        };
-        let grid = match kind {
-            Head::Indexable => head.orientations(),
-            Head::Fixed => vec![(0.0, 0.0)],
-        };
-        let mut grid_allowed = Bits::full(grid.len());
-        let mut grid_weight = vec![0.5; grid.len()];
-        for o in &plan.orientations {
-            for (k, g) in grid.iter().enumerate() {
-                if o.names(g.0, g.1) {
-                    match o.stance {
-                        Stance::Forbid => grid_allowed.remove(k),
-                        Stance::Prefer(w) => grid_weight[k] = w,
-                    }
-                }
-            }
-        }
-        let grid_dirs: Vec<V3> = grid
-            .iter()
-            .map(|&(a, b)| access::head_direction(a, b))
-            .collect();
-        let polar: Vec<f64> = grid_dirs
-            .iter()
-            .map(|d| d.z.clamp(-1.0, 1.0).acos())
-            .collect();
-        let sorted = polar.is_sorted();
-        Machine {
-            grid_polar: (polar, sorted),
-            probes,
-            costs,
-            allowed,
-            head: kind,
-            grid,
-            grid_dirs,
-            grid_allowed,
-            grid_weight,
-            a_max,
-        }
-    }
-}
-
-/// How much is known about one (fpoint, probe).
-#[derive(Debug, Clone)]
-pub(crate) struct Dom {
-    /// The tip fits at the contact and at the retract point.
-    pub tip: bool,
-    /// Setups: the straight probe's cone, or D2 for a bent probe.
-    pub setup: CubeMap,
-    /// D1, for a bent probe.
-    pub d1: Option<CubeMap>,
-    /// Whether the whole probe's cones replaced the half-line approximation.
-    pub full: bool,
-}
 
 /// Putting a planar datum face on the table (ch. 3.6.2).
 #[derive(Debug, Clone)]
@@ -221,57 +120,6 @@ impl GridCells {
         let cell = like.index(like.cell_of_indexed(pref, &(self.to_part * d)));
         self.cells[k].store(cell as u32, Ordering::Relaxed);
         cell
-    }
-}
-
-/// What one planning of an input computes that a later planning of the same input (a
-/// re-plan after the path stage bans a configuration) can reuse: the pure results only —
-/// cones of a point and probe, depth maps of a setup — never what learning changed —
-/// and whether a plan validated with the part turned was found at all. A memo belongs
-/// to one [`super::Input`]; the re-plan gives byte-identical knowledge without
-/// computing it again.
-#[derive(Default)]
-pub struct Memo {
-    /// The initial knowledge of every (graph point, probe).
-    initial: Option<Vec<Vec<Dom>>>,
-    /// The whole probe's cones per (point, probe).
-    cones: BTreeMap<(usize, usize), access::PointCones>,
-    /// The second component's depth map per setup cell.
-    second: BTreeMap<usize, SecondMap>,
-    /// [`Knowledge::orientations`] as first computed, per (point, probe, setup cell,
-    /// whether the whole probe's cones were acquired): D1 is a function of those.
-    orientations: BTreeMap<(usize, usize, usize, bool), Bits>,
-    /// The scanners' face cones and coverages.
-    pub(crate) scans: super::scan::Memo,
-    /// D2's cap over a bent probe's D1 once acquired, per (point, probe): D1 is then
-    /// the first D1 and the whole probe's approach cone, both kept here.
-    caps: BTreeMap<(usize, usize), CubeMap>,
-    /// The part as obstacle.
-    scene: Option<Scene>,
-    /// A plan validated with the part turned was sought and not found: the re-plans of
-    /// the same input (which only add bans) do not seek it again.
-    pub(crate) unturnable: bool,
-}
-
-impl Memo {
-    /// Later plannings of this input validate at the nominal pose only.
-    pub fn give_up_turned(&mut self) {
-        self.unturnable = true;
-    }
-
-    /// Whether the last planning of this input found a plan validated with the part
-    /// turned (none has given it up).
-    pub fn turned(&self) -> bool {
-        !self.unturnable
-    }
-
-    /// The part as obstacle, built on first use (a memo belongs to one input, so to one
-    /// part): re-plans and the path stage share it instead of building its hierarchy
-    /// again.
-    pub fn scene(&mut self, geometry: &crate::geometry::PartGeometry) -> Scene {
-        self.scene
-            .get_or_insert_with(|| Scene::of_part(geometry))
-            .clone()
     }
 }
 

@@ -15,12 +15,13 @@
 
 mod axes;
 pub mod cluster;
-mod domain;
 mod errors;
 mod explain;
 mod fallback;
 mod hlip;
+mod knowledge;
 mod machine;
+mod memo;
 mod placement;
 pub mod poses;
 mod remeasure;
@@ -42,11 +43,12 @@ use crate::geometry::{FaceId, PartGeometry, V3};
 use crate::graph::{MeasurementGraph, Node};
 use crate::model::{Model, Plan, PlanId, SurfaceKind};
 use cluster::Strategy;
-pub use domain::Memo;
-use domain::{Knowledge, Machine};
 use explain::{face_name, report_face};
 use fallback::Fallback;
 use hlip::{assemble, Round};
+use knowledge::Knowledge;
+use machine::Machine;
+pub use memo::Memo;
 use rayon::prelude::*;
 use solve::Branch;
 use std::collections::{BTreeMap, BTreeSet};
@@ -610,7 +612,7 @@ fn plan_touch(
         pips.sort_by_key(|(p, _)| *p);
         pips.dedup_by_key(|(p, _)| *p);
         pips.retain(|(p, _)| !validated.contains(p));
-        let held: BTreeMap<usize, domain::Held> = pips
+        let held: BTreeMap<usize, knowledge::Held> = pips
             .iter()
             .map(|(p, _)| (p.setup, k.held(p.setup).clone()))
             .collect();

@@ -3,9 +3,10 @@
 //! [`super::plan_placed`]'s second try) that collide with the part turned
 //! [`PLACEMENT_TURN`] about the vertical, and the turn each setup tolerates.
 
-use super::domain::{Knowledge, Machine};
 use super::explain::face_name;
 use super::hlip::Hlip;
+use super::knowledge::Knowledge;
+use super::machine::Machine;
 use super::solve::{self, Branch};
 use super::validate::{tolerated_turn, Pip, PLACEMENT_TURN};
 use super::{Input, PlanError};
@@ -39,7 +40,7 @@ pub(super) fn square_within(
                 .filter(|(p, _)| fragile(p)),
         );
     }
-    let held: BTreeMap<usize, super::domain::Held> = pips
+    let held: BTreeMap<usize, super::knowledge::Held> = pips
         .iter()
         .map(|(p, _)| (p.setup, k.held(p.setup).clone()))
         .collect();

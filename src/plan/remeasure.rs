@@ -20,8 +20,9 @@
 //! and Systems*, 2nd ed., ch. 13). Where no probe reaches a datum in the setup of the
 //! features read against it, the plan says so ([`PlanError::DatumInOtherSetup`]).
 
-use super::domain::{Knowledge, Machine};
 use super::hlip::collect;
+use super::knowledge::Knowledge;
+use super::machine::Machine;
 use super::solve::{Branch, Inst, Kind};
 use super::validate::{self, Pip};
 use super::{min_points, Ban, Input, PlanError};

@@ -18,6 +18,7 @@
 //! coarser than that, and each face costs a few hundred cones.
 
 use super::hlip::{quantise, ScanPass, ScannedFace};
+use super::memo::ScanMemo;
 use super::poses::Setups;
 use super::{FaceVisit, Hlip, Input, Inspection, OrientNode, ProbeNode, SetupNode};
 use crate::access::pose::{frame, Contact, Head, Pose};
@@ -79,32 +80,6 @@ pub(crate) fn lasers(input: &Input) -> Vec<Laser> {
         .collect()
 }
 
-impl Memo {
-    /// The coverage of `face` by scanner `scanner` in setup `up`, computed by `cover`
-    /// the first time, on the face's cones drawn by `cones` the first time it is asked
-    /// in any setup.
-    fn get(
-        &mut self,
-        (scanner, face): (usize, FaceId),
-        up: &V3,
-        cones: &dyn Fn() -> FaceCones,
-        cover: &dyn Fn(&FaceCones, &V3) -> FaceCoverage,
-    ) -> FaceCoverage {
-        let key = (
-            scanner,
-            face.0,
-            [up.x, up.y, up.z].map(|c| (c * 1e9).round() as i64),
-        );
-        if let Some(c) = self.coverages.get(&key) {
-            return c.clone();
-        }
-        let cones = self.cones.entry((scanner, face.0)).or_insert_with(cones);
-        let c = cover(cones, up);
-        self.coverages.insert(key, c.clone());
-        c
-    }
-}
-
 /// A face no setup covers as the plan asks: the best share of its area any setup gave.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Uncovered {
@@ -114,15 +89,6 @@ pub(crate) struct Uncovered {
     pub face: FaceId,
     /// The best coverage found.
     pub best: f64,
-}
-
-/// The coverages computed, by scanner, face and setup direction (to a nanometre), for
-/// the plan made again after features went back to touch (its setups are mostly the
-/// same), and the faces' cones, which every setup's coverage shares.
-#[derive(Default)]
-pub(crate) struct Memo {
-    coverages: std::collections::BTreeMap<(usize, usize, [i64; 3]), FaceCoverage>,
-    cones: std::collections::BTreeMap<(usize, usize), FaceCones>,
 }
 
 /// Where a face is scanned: the setup and the coverage there.
@@ -141,7 +107,7 @@ pub(crate) fn plan_scans(
     hlip: &mut Hlip,
     lasers: &[Laser],
     opts: &super::PlanOptions,
-    memo: &mut Memo,
+    memo: &mut ScanMemo,
 ) -> Vec<Uncovered> {
     if lasers.is_empty() {
         return Vec::new();
@@ -150,7 +116,7 @@ pub(crate) fn plan_scans(
     let cmm = &model.cmms[plan.cmm.0];
     let shapes = ScannerShape::of_cmm(model, cmm);
     let scene = Scene::of_part(g);
-    let machine = super::domain::Machine::new(model, plan);
+    let machine = super::machine::Machine::new(model, plan);
     // The orientations the plan allows (one (0, 0) on a fixed head).
     let grid: Vec<(f64, f64)> = machine
         .grid_allowed

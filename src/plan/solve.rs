@@ -10,7 +10,8 @@
 //! clusters up unmerged.
 
 use super::cluster::{cluster, Bits, Set, Strategy};
-use super::domain::{Knowledge, Machine};
+use super::knowledge::Knowledge;
+use super::machine::Machine;
 use crate::access::{Cell, CubeMap};
 use crate::geometry::{FaceId, V3};
 use crate::graph::{Edge, MeasurementGraph, Node};

@@ -3,7 +3,8 @@
 //! point to the contact, every other component is tested along the approach, the part is
 //! an obstacle and the table is a plane under the part in that setup.
 
-use super::domain::{Held, Knowledge, Machine};
+use super::knowledge::{Held, Knowledge};
+use super::machine::Machine;
 use crate::access::pose::{orientation_dir, Blocker};
 use crate::geometry::V3;
 use nalgebra::{Rotation3, Unit};
