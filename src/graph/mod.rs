@@ -92,6 +92,13 @@ pub struct MeasurementGraph {
 pub const MAX_POINTS: usize = 5_000;
 
 impl MeasurementGraph {
+    /// The fpoints of a face, by index.
+    pub fn face_points(&self, face: FaceId) -> Vec<usize> {
+        (0..self.fpoints.len())
+            .filter(|&i| self.fpoints[i].face == face)
+            .collect()
+    }
+
     /// The nodes of a kind, in order.
     pub fn nodes(&self) -> impl Iterator<Item = (NodeIndex, &Node)> {
         self.graph.node_indices().map(move |i| (i, &self.graph[i]))

@@ -6,7 +6,7 @@
 //! length it keeps.
 
 use super::errors::PlanError;
-use super::{face_points, Input};
+use super::Input;
 use crate::diag::Diagnostics;
 use crate::geometry::FaceId;
 use crate::graph::MeasurementGraph;
@@ -45,7 +45,7 @@ pub(super) fn short_axes(
                 let Some(touched) = touches.get(&face).filter(|t| !t.is_empty()) else {
                     continue;
                 };
-                let sampled = span(&mut face_points(g, face).into_iter());
+                let sampled = span(&mut g.face_points(face).into_iter());
                 let reached = span(&mut touched.iter().copied());
                 if sampled < 1e-6 || reached >= SHORT_AXIS_SHARE * sampled {
                     continue;

@@ -1,13 +1,16 @@
 //! Explaining a failed plan: for a face no configuration inspects, which probe came
 //! closest, from where, and what stopped it.
 
+use super::filter::min_points;
 use super::knowledge::Knowledge;
 use super::machine::Machine;
-use super::{face_points, min_points, solve, Input, PlanError};
+use super::{poses, solve, Input, PlanError};
 use crate::diag::Diagnostics;
+use crate::geometry::PartGeometry;
 use crate::geometry::{FaceId, V3};
 use crate::graph::Node;
 use crate::model::fmt_num;
+use crate::model::{Model, Plan};
 
 /// The face a point lies on, in words ("the table under ..." for a table point).
 pub(super) fn face_name(input: &Input, k: &Knowledge, point: usize) -> String {
@@ -45,7 +48,7 @@ pub(super) fn report_face(
 ) {
     let part = &input.model.parts[input.plan.part.0];
     let feature = owner(input, face).map(|f| &part.features[f.0]);
-    let pts = face_points(input.graph, face);
+    let pts = input.graph.face_points(face);
     let name = input.geometry.faces[face.0].name.clone();
     let need = min_points(input.geometry.faces[face.0].surface.kind()).min(pts.len());
     // Per probe: how many points it reaches in a setup the part can be put in, how
@@ -212,7 +215,7 @@ pub(super) fn report_left_out(
     use crate::access::pose::Blocker;
     let part = &input.model.parts[input.plan.part.0];
     let feature = owner(input, face).map(|f| &part.features[f.0]);
-    let total = face_points(input.graph, face).len();
+    let total = input.graph.face_points(face).len();
     let help = match blocker {
         Blocker::Tip => "the tip meets the part on its way in or out: shorten `motion { retract }` and `prehit`, or use a smaller tip",
         Blocker::TipOnTable | Blocker::ComponentOnTable(_) => {
@@ -249,4 +252,25 @@ pub(super) fn report_left_out(
         },
         help: help.into(),
     });
+}
+
+/// The setups plan `plan` may use on `geometry`, in words: the poses on the table (and
+/// why the others are excluded) and what the plan's fixtures can hold.
+pub fn explain_setups(
+    model: &Model,
+    plan: &Plan,
+    geometry: &PartGeometry,
+    fixtures: &[crate::geometry::FixtureMesh],
+) -> String {
+    let labels: Vec<String> = model.cmms[plan.cmm.0]
+        .fixtures
+        .iter()
+        .map(|(l, _)| l.clone())
+        .collect();
+    format!(
+        "setups of plan {} (part {}):\n{}",
+        plan.name,
+        model.parts[plan.part.0].name,
+        poses::Setups::new(model, plan, geometry, fixtures).explain(&labels)
+    )
 }

@@ -20,12 +20,13 @@
 //! and Systems*, 2nd ed., ch. 13). Where no probe reaches a datum in the setup of the
 //! features read against it, the plan says so ([`PlanError::DatumInOtherSetup`]).
 
+use super::filter::min_points;
 use super::hlip::collect;
 use super::knowledge::Knowledge;
 use super::machine::Machine;
 use super::solve::{Branch, Inst, Kind};
 use super::validate::{self, Pip};
-use super::{min_points, Ban, Input, PlanError};
+use super::{Ban, Input, PlanError};
 use crate::diag::Diagnostics;
 use crate::geometry::{FaceId, PartGeometry, V3};
 use crate::model::FeatureId;
@@ -242,7 +243,7 @@ fn measure_in(
                     geometry.faces[face.0].surface,
                     crate::geometry::Surface::Plane { .. }
                 )
-                || super::spans_area(
+                || super::filter::spans_area(
                     &ok.iter()
                         .map(|&q| &k.points[q].position)
                         .collect::<Vec<_>>(),

@@ -1,0 +1,153 @@
+//! What the plan measures: per tolerance, whether every face of its features and datum
+//! features is touched with the points its fit needs or scanned, and for each one that
+//! is not, the diagnostic naming the first face it misses and why.
+
+use super::filter::min_points;
+use super::{axes, scan, Hlip, Input, PlanError, PlanOptions};
+use crate::diag::Diagnostics;
+use crate::geometry::FaceId;
+use crate::graph::Node;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Counts the tolerances the plan measures — every face of their features and datum
+/// features touched or scanned — and reports each one it does not (an error unless
+/// `allow_unmeasured`), naming the first face it misses and why; `uncovered` are the
+/// faces the plan asked the scanner for that it cannot cover enough.
+pub(super) fn account(
+    input: &Input,
+    mut hlip: Hlip,
+    opts: &PlanOptions,
+    uncovered: &[scan::Uncovered],
+    diags: &mut Diagnostics,
+) -> Hlip {
+    let part = &input.model.parts[input.plan.part.0];
+    let g = input.graph;
+    // Per face the distinct points the plan touches on it (or on the table under it).
+    let mut touches: BTreeMap<FaceId, BTreeSet<usize>> = BTreeMap::new();
+    for s in &hlip.setups {
+        for p in &s.probes {
+            for o in &p.orients {
+                for i in &o.inspections {
+                    for f in &i.faces {
+                        touches.entry(f.face).or_default().extend(&f.points);
+                    }
+                }
+            }
+        }
+    }
+    // Per feature its faces, per face whether sampling gave it points.
+    let mut faces_of: BTreeMap<crate::model::FeatureId, Vec<FaceId>> = BTreeMap::new();
+    let mut sampled: BTreeSet<FaceId> = BTreeSet::new();
+    for (n, node) in g.nodes() {
+        match node {
+            Node::Feature { feature, .. } => {
+                for (c, _) in g.children(n) {
+                    if let Node::Face { face, .. } = g.graph[c] {
+                        faces_of.entry(*feature).or_default().push(face);
+                    }
+                }
+            }
+            Node::Face { face, .. } if !g.children(n).is_empty() => {
+                sampled.insert(*face);
+            }
+            _ => {}
+        }
+    }
+    // A face is measured with as many points as its surface's fit needs (fewer only
+    // where sampling gave it fewer).
+    let mut touched: BTreeSet<FaceId> = touches
+        .iter()
+        .filter(|(face, pts)| {
+            let sampled = g.face_points(**face).len();
+            let need = min_points(input.geometry.faces[face.0].surface.kind()).min(sampled.max(1));
+            pts.len() >= need
+        })
+        .map(|(face, _)| *face)
+        .collect();
+    // A scanned face is measured: the scan stage placed it only where its passes reach
+    // the plan's coverage.
+    touched.extend(hlip.scans.iter().map(|s| s.face));
+    let mut measured = 0;
+    for t in &part.tolerances {
+        let features = t
+            .targets
+            .iter()
+            .copied()
+            .chain(t.datums.iter().map(|d| part.datums[d.datum.0].feature));
+        let missing = features.into_iter().find_map(|f| {
+            faces_of
+                .get(&f)
+                .into_iter()
+                .flatten()
+                .find(|face| !touched.contains(face))
+                .map(|&face| (f, face))
+        });
+        let Some((f, face)) = missing else {
+            measured += 1;
+            continue;
+        };
+        let few = touches.get(&face).map_or(0, |p| p.len());
+        let short = uncovered.iter().find(|u| u.feature == f);
+        let (why, help) = if let Some(u) = short {
+            (
+                format!(
+                    "is asked of the laser scanner, which sees {} % of {} at best (the plan asks {} %)",
+                    crate::model::fmt_num((u.best * 1000.0).round() / 10.0),
+                    if u.face == face {
+                        "it".to_string()
+                    } else {
+                        format!("face {}", input.geometry.faces[u.face.0].name)
+                    },
+                    crate::model::fmt_num((input.plan.scan_coverage * 1000.0).round() / 10.0)
+                ),
+                "touch it instead (`sensors { … touch }`), hold the part so the scanner sees more of it (a fixture), or lower `scan_coverage`".to_string(),
+            )
+        } else if few > 0 {
+            (
+                format!(
+                    "gets {few} {} in the plan, fewer than its surface's fit needs",
+                    if few == 1 { "touch" } else { "touches" }
+                ),
+                "its other points were left out as hard to reach; a probe that reaches more of them, or more points (`sample`), keeps it".to_string(),
+            )
+        } else if sampled.contains(&face) {
+            (
+                "gets no touch in the plan".to_string(),
+                "its points were dropped as hard to reach; a probe that reaches more of them, or more points (`sample`), keeps it".to_string(),
+            )
+        } else {
+            (
+                "gets no measuring point".to_string(),
+                "no point of it keeps the sampling margin from its edges; lower the sampling inset"
+                    .to_string(),
+            )
+        };
+        let (tolerance, feature, face) = (
+            t.name.clone(),
+            part.features[f.0].name.clone(),
+            input.geometry.faces[face.0].name.clone(),
+        );
+        if opts.allow_unmeasured {
+            diags.push(PlanError::UnmeasuredAllowed {
+                span: t.span,
+                tolerance,
+                feature,
+                face,
+                why,
+                help,
+            });
+        } else {
+            diags.push(PlanError::Unmeasured {
+                span: t.span,
+                tolerance,
+                feature,
+                face,
+                why,
+                help,
+            });
+        }
+    }
+    hlip.summary.tolerances = (measured, part.tolerances.len());
+    axes::short_axes(input, &touches, &faces_of, diags);
+    hlip
+}

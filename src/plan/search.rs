@@ -1,0 +1,539 @@
+//! The generate-and-test loop (Spitz, ch. 3 and 4): per round, filter the points,
+//! unfold the graph, cluster it with every strategy ([`super::cluster`]), keep the best
+//! plan by the hierarchy's violation counts, validate its touches with parry
+//! ([`super::validate`]) — with the part turned as well as at its nominal pose — and
+//! teach the knowledge base what failed, until a round validates or the fallback
+//! ([`super::fallback`]) settles on the best plan found. Around it, the rounds with the
+//! laser scanner: features its setups cannot cover go back to the touch probes.
+
+use super::account::account;
+use super::cluster::{self, Strategy};
+use super::explain::{face_name, report_face};
+use super::fallback::Fallback;
+use super::filter::filter;
+use super::hlip::{assemble, Round};
+use super::knowledge::{self, Knowledge};
+use super::machine::Machine;
+use super::memo::Memo;
+use super::solve::{self, Branch};
+use super::validate::{self, Pip};
+use super::{axes, placement, poses, remeasure, scan, Hlip, Input, PlanError, PlanOptions};
+use crate::diag::Diagnostics;
+use crate::geometry::{FaceId, V3};
+use crate::graph::Node;
+use rayon::prelude::*;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// [`plan`], keeping in `memo` the cones and depth maps it computes and reusing those a
+/// previous planning of the same `input` left there (the re-plans after the path stage's
+/// bans). The plan is the one [`plan`] gives.
+///
+/// The features the sensor selection gave a laser scanner are left out of the touch plan
+/// and scanned in its setups ([`scan`]); those the selection chose by its rule and no
+/// setup lets the scanner cover go back to the touch probes, and the plan is made again
+/// with them until none is sent back. A feature sent back that the scanner covers in
+/// the final plan's setups is scanned after all, its touches dropped.
+pub fn plan_with(
+    input: &Input,
+    opts: &PlanOptions,
+    memo: &mut Memo,
+    diags: &mut Diagnostics,
+) -> Option<Hlip> {
+    let all = scan::lasers(input);
+    let mut lasers = all.clone();
+    let mut back: Vec<scan::Uncovered> = Vec::new();
+    loop {
+        let skip: BTreeSet<FaceId> = lasers.iter().flat_map(|l| l.faces.clone()).collect();
+        let mut own = Diagnostics::new();
+        let Some(mut hlip) = plan_placed(input, opts, memo, &skip, &mut own) else {
+            diags.extend(own);
+            return None;
+        };
+        // The features sent back are offered to the scanner again: this plan's setups are
+        // not the ones that left them short.
+        let offered: Vec<scan::Laser> = all
+            .iter()
+            .filter(|l| {
+                lasers.iter().any(|x| x.feature == l.feature)
+                    || back.iter().any(|u| u.feature == l.feature)
+            })
+            .cloned()
+            .collect();
+        let uncovered = scan::plan_scans(input, &mut hlip, &offered, opts, &mut memo.scans);
+        let asked = |f: crate::model::FeatureId| all.iter().any(|l| l.feature == f && l.asked);
+        let to_touch: Vec<&scan::Uncovered> = uncovered
+            .iter()
+            .filter(|u| !asked(u.feature) && !back.iter().any(|b| b.feature == u.feature))
+            .collect();
+        // Until none is left: the plan made again holds other setups, where other faces
+        // may fall short. Each round sends at least one feature back, so this ends.
+        if !to_touch.is_empty() {
+            back.extend(to_touch.into_iter().cloned());
+            lasers.retain(|l| !back.iter().any(|u| u.feature == l.feature));
+            continue;
+        }
+        // A feature sent back that the scanner covers in this plan's setups is scanned
+        // there: its touches leave the plan.
+        let rescanned: BTreeSet<(crate::model::FeatureId, FaceId)> = hlip
+            .scans
+            .iter()
+            .filter(|x| back.iter().any(|u| u.feature == x.feature))
+            .map(|x| (x.feature, x.face))
+            .collect();
+        if !rescanned.is_empty() {
+            hlip.drop_touches(&rescanned);
+            let head = hlip.head;
+            scan::recount(&mut hlip, head);
+        }
+        back.retain(|u| !hlip.scans.iter().any(|x| x.feature == u.feature));
+        // The best coverage any round's setups gave.
+        for u in back.iter_mut() {
+            if let Some(now) = uncovered.iter().find(|x| x.face == u.face) {
+                u.best = u.best.max(now.best);
+            }
+        }
+        diags.extend(own);
+        hlip.to_touch = back.iter().map(|u| (u.feature, u.face, u.best)).collect();
+        return Some(account(input, hlip, opts, &uncovered, diags));
+    }
+}
+
+/// How many configurations of a point may collide with the part turned (and not at its
+/// nominal pose) before the point takes one clear at the nominal pose alone: an
+/// indexed head offers the next orientation 7.5° away, which seldom clears what the
+/// first did not.
+const FRAGILE_AFTER: usize = 6;
+
+/// The touch plan of every face but `skip`, robust to the part set turned about the
+/// vertical: first with every touch validated at [`validate::PLACEMENT_TURN`] either way
+/// as well as at the nominal pose, but for points [`FRAGILE_AFTER`] configurations of
+/// which collided only turned; where that finds no plan (the configurations it turned
+/// down were a point's last), the plan validated at the nominal pose. The setups say how
+/// square the operator must set the part ([`hlip::SetupNode::square_within`]) and the
+/// warning `insp::plan::placement_sensitive` which touches ask it.
+fn plan_placed(
+    input: &Input,
+    opts: &PlanOptions,
+    memo: &mut Memo,
+    skip: &BTreeSet<FaceId>,
+    diags: &mut Diagnostics,
+) -> Option<Hlip> {
+    if !memo.unturnable {
+        let mut robust = Diagnostics::new();
+        let turn = validate::PLACEMENT_TURN;
+        if let Some(hlip) = plan_touch(input, opts, memo, skip, turn, &mut robust) {
+            diags.extend(robust);
+            return Some(hlip);
+        }
+        memo.unturnable = true;
+    }
+    plan_touch(input, opts, memo, skip, 0.0, diags)
+}
+
+/// The touch plan of every face but `skip` (those a scanner measures), each touch
+/// validated with the part turned `turn` degrees either way about the vertical. With a
+/// turn, a search that does not settle gives no plan (the caller plans again without).
+fn plan_touch(
+    input: &Input,
+    opts: &PlanOptions,
+    memo: &mut Memo,
+    skip: &BTreeSet<FaceId>,
+    turn: f64,
+    diags: &mut Diagnostics,
+) -> Option<Hlip> {
+    let (model, plan, g) = (input.model, input.plan, input.graph);
+    let hierarchy = &model.hierarchies[plan.hierarchy.0];
+    let machine = Machine::new(model, plan);
+    let setups = poses::Setups::new(model, plan, input.geometry, input.fixtures);
+    // Datum faces that can rest on the table.
+    let mut table_faces: Vec<FaceId> = Vec::new();
+    for (n, node) in g.nodes() {
+        if let Node::Feature { datums, .. } = node {
+            if datums.is_empty() {
+                continue;
+            }
+            for (c, _) in g.children(n) {
+                if let Node::Face {
+                    face,
+                    on_table: true,
+                } = g.graph[c]
+                {
+                    if !table_faces.contains(&face) {
+                        table_faces.push(face);
+                    }
+                }
+            }
+        }
+    }
+    let cone_opts = crate::access::ConeOptions {
+        n: opts.n,
+        // The approach validated is the longer of the pre-hit and retract moves.
+        retract: input.plan.motion.prehit.max(input.plan.motion.retract),
+        backend: opts.backend,
+        ..Default::default()
+    };
+    let mut k = Knowledge::new(
+        plan,
+        &machine,
+        input.geometry,
+        &g.fpoints,
+        &table_faces,
+        setups,
+        cone_opts,
+        memo,
+    );
+    let mut validated: BTreeSet<Pip> = BTreeSet::new();
+    // Per point, the configurations that collided only with the part turned: after
+    // FRAGILE_AFTER of them the point takes one clear at the nominal pose alone.
+    let mut turned_fails: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut last = String::from("no round was run");
+    // The round whose plan had the fewest touches that failed validation: what the plan
+    // falls back on, less those touches, if no round settles.
+    let mut fallback: Option<Fallback> = None;
+    // Faces no probe inspects, left out under `allow_unmeasured`, and those a scanner
+    // measures.
+    let mut skipped: BTreeSet<FaceId> = skip.clone();
+    let read_axes = axes::axis_faces(g, &input.model.parts[input.plan.part.0]);
+    for iteration in 1..=opts.max_iterations {
+        let (dropped, bad) = filter(g, input.geometry, &k, &machine, &skipped, &read_axes);
+        if !bad.is_empty() {
+            // Know the whole probe before blaming a face.
+            let pairs: Vec<(usize, usize)> = bad
+                .iter()
+                .flat_map(|f| g.face_points(*f))
+                .flat_map(|f| (0..machine.probes.len()).map(move |p| (f, p)))
+                .collect();
+            let before = k.acquired;
+            k.acquire_many(&pairs, &machine);
+            if k.acquired > before && iteration < opts.max_iterations {
+                let (_, bad2) = filter(g, input.geometry, &k, &machine, &skipped, &read_axes);
+                if bad2.is_empty() {
+                    continue;
+                }
+            }
+            let (_, bad) = filter(g, input.geometry, &k, &machine, &skipped, &read_axes);
+            for &face in &bad {
+                report_face(input, &k, &machine, face, opts.allow_unmeasured, diags);
+            }
+            if !opts.allow_unmeasured {
+                return None;
+            }
+            // Plan the rest; the tolerances on these faces are reported unmeasured.
+            skipped.extend(bad);
+            continue;
+        }
+        let Some(root) = solve::unfold(g, &k, &machine, &dropped) else {
+            let round = Round {
+                branches: &[],
+                iterations: iteration,
+                dropped: dropped.len(),
+                strategy: None,
+                exact_budget: opts.exact_budget,
+            };
+            return Some(assemble(input, &mut k, &machine, &round));
+        };
+        let mut results: Vec<(Strategy, Vec<Branch>)> = Vec::new();
+        let mut failures = Vec::new();
+        let sets = solve::setup_sets(&root, &k, &machine);
+        let trees = solve::setup_trees(&root, &k, hierarchy, &sets);
+        for (strategy, tree) in Strategy::ALL.into_iter().zip(trees) {
+            match solve::solve(&root, &mut k, &machine, hierarchy, strategy, tree) {
+                Ok(b) => results.push((strategy, b)),
+                Err(f) => failures.extend(f),
+            }
+        }
+        if results.is_empty() {
+            last = format!("{} points found no probe orientation", failures.len());
+            learn(
+                &mut k,
+                &machine,
+                failures
+                    .iter()
+                    .map(|f| (f.point, f.probe, f.setup, f.orient))
+                    .collect(),
+            );
+            continue;
+        }
+        let best = results
+            .iter()
+            .min_by_key(|(_, b)| score(b, &machine, hierarchy))
+            .map(|(s, b)| (*s, b.clone()))
+            .expect("at least one result");
+        let mut pips: Vec<(Pip, V3)> = Vec::new();
+        for b in &best.1 {
+            let mut pts = Vec::new();
+            solve::leaves(&b.tree, &mut pts);
+            for p in pts {
+                pips.push((
+                    Pip {
+                        point: p,
+                        probe: b.probe,
+                        setup: b.setup,
+                        orient: b.orient,
+                    },
+                    b.up,
+                ));
+            }
+        }
+        pips.sort_by_key(|(p, _)| *p);
+        pips.dedup_by_key(|(p, _)| *p);
+        pips.retain(|(p, _)| !validated.contains(p));
+        let held: BTreeMap<usize, knowledge::Held> = pips
+            .iter()
+            .map(|(p, _)| (p.setup, k.held(p.setup).clone()))
+            .collect();
+        // (touch, result, whether it failed only with the part turned)
+        let checked: Vec<(Pip, Result<(), _>, bool)> = pips
+            .par_iter()
+            .map(|(p, up)| {
+                let tries = turned_fails.get(&p.point).copied().unwrap_or(0);
+                let t = if tries < FRAGILE_AFTER { turn } else { 0.0 };
+                let held = &held[&p.setup];
+                match validate::check(&k, &machine, p, up, held, &opts.bans) {
+                    Err(e) => (*p, Err(e), false),
+                    Ok(()) => {
+                        let turned = validate::clear_turned(&k, &machine, p, up, held, t);
+                        let turned_only = turned.is_err();
+                        (*p, turned, turned_only)
+                    }
+                }
+            })
+            .collect();
+        let mut invalid = Vec::new();
+        let mut left: BTreeSet<Pip> = BTreeSet::new();
+        // Per face, the touches that failed and the first cause, for the diagnostic.
+        let mut failed: BTreeMap<String, (usize, String)> = BTreeMap::new();
+        let mut causes: BTreeMap<FaceId, (usize, usize, crate::access::pose::Blocker)> =
+            BTreeMap::new();
+        for (p, what, turned_only) in checked {
+            if turned_only {
+                *turned_fails.entry(p.point).or_default() += 1;
+            }
+            match what {
+                Ok(()) => {
+                    validated.insert(p);
+                }
+                Err(w) => {
+                    left.insert(p);
+                    causes
+                        .entry(k.points[p.point].face)
+                        .or_insert_with(|| (0, p.probe, w.clone()))
+                        .0 += 1;
+                    let e = failed
+                        .entry(face_name(input, &k, p.point))
+                        .or_insert_with(|| {
+                            (
+                                0,
+                                format!("probe {} hits {w}", machine.probes[p.probe].name),
+                            )
+                        });
+                    e.0 += 1;
+                    invalid.push((
+                        p.point,
+                        p.probe,
+                        p.setup,
+                        machine.head.indexable().then_some(p.orient),
+                    ));
+                }
+            }
+        }
+        if invalid.is_empty() {
+            debug_assert!(
+                audit(&mut k, &machine, &best.1).is_empty(),
+                "{:?}",
+                audit(&mut k, &machine, &best.1)
+            );
+            // Datums measured again where the tolerances read against them are.
+            let again = remeasure::datums_where_read(
+                input, &mut k, &machine, &best.1, turn, &opts.bans, diags,
+            );
+            let branches: Vec<Branch> = best.1.iter().cloned().chain(again).collect();
+            let round = Round {
+                branches: &branches,
+                iterations: iteration,
+                dropped: dropped.len(),
+                strategy: Some(best.0),
+                exact_budget: opts.exact_budget,
+            };
+            let mut hlip = assemble(input, &mut k, &machine, &round);
+            // Touches validated turned are clear turned; the others are measured.
+            let fragile =
+                |p: &Pip| turn == 0.0 || turned_fails.get(&p.point) >= Some(&FRAGILE_AFTER);
+            placement::square_within(
+                input, &mut k, &machine, &branches, &fragile, &mut hlip, diags,
+            );
+            if hlip.summary.setups > hlip.summary.min_setups.0 {
+                let forcing = forcing_levels(&root, &mut k, &machine, hierarchy, &best.1);
+                hlip.summary.more_setups = Some(forcing.unwrap_or_else(|| {
+                    "no clustering found fewer; the minimum may need setups the hierarchy's order does not reach".into()
+                }));
+            }
+            return Some(hlip);
+        }
+        if !failed.is_empty() {
+            let faces: Vec<String> = failed
+                .iter()
+                .take(4)
+                .map(|(face, (n, why))| format!("{face} ({n} touches; {why})"))
+                .collect();
+            let more = failed.len().saturating_sub(4);
+            last = format!(
+                "in the last round touches failed on {}{}",
+                faces.join(", "),
+                if more > 0 {
+                    format!(" and {more} more faces")
+                } else {
+                    String::new()
+                }
+            );
+        }
+        if fallback.as_ref().is_none_or(|f| left.len() <= f.left.len()) {
+            fallback = Some(Fallback {
+                branches: best.1.clone(),
+                left,
+                causes,
+                strategy: best.0,
+                dropped: dropped.len(),
+            });
+        }
+        learn(&mut k, &machine, invalid);
+    }
+    if turn > 0.0 {
+        return None;
+    }
+    if let Some(f) = fallback {
+        if let Some(hlip) = f.settle(input, &mut k, &machine, opts, diags) {
+            return Some(hlip);
+        }
+    }
+    diags.push(PlanError::NoConvergence {
+        span: plan.span,
+        plan: plan.name.clone(),
+        iterations: opts.max_iterations,
+        last,
+    });
+    None
+}
+
+/// The configurations of a plan that lie outside their point's domain (there should be
+/// none): setup in the point's setups (or its table alternative), probe among those
+/// reaching it there, orientation in D1′.
+fn audit(k: &mut Knowledge, m: &Machine, branches: &[Branch]) -> Vec<String> {
+    let mut out = Vec::new();
+    for b in branches {
+        let mut pts = Vec::new();
+        solve::leaves(&b.tree, &mut pts);
+        for f in pts {
+            let ok = if f >= k.graph_points {
+                k.tables
+                    .iter()
+                    .any(|t| t.points.contains(&f) && t.cell == b.setup && t.alive)
+            } else {
+                cluster::Set::has(&k.setups(f, m), b.setup)
+                    && cluster::Set::has(&k.probes(f, b.setup, m), b.probe)
+            };
+            let o_ok = cluster::Set::has(&k.orientations(f, b.probe, b.setup, &b.up, m), b.orient);
+            if !ok || !o_ok {
+                out.push(format!(
+                    "point {f}: setup {} probe {} orientation {}",
+                    b.setup, b.probe, b.orient
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// What makes one plan better than another: the hierarchy's violations level by level,
+/// then fewer setups, probe changes and orientation changes.
+fn score(
+    b: &[Branch],
+    m: &Machine,
+    h: &crate::model::Hierarchy,
+) -> (Vec<u64>, usize, usize, usize) {
+    let v = solve::violations(b, m, h);
+    let setups: BTreeSet<usize> = b.iter().map(|x| x.setup).collect();
+    let (pc, oc) = changes(b, m);
+    (v, setups.len(), pc, oc)
+}
+
+/// Probe and orientation changes of branches taken in order.
+fn changes(b: &[Branch], m: &Machine) -> (usize, usize) {
+    let mut pc = 0;
+    let mut oc = 0;
+    for w in b.windows(2) {
+        pc += usize::from(w[0].probe != w[1].probe);
+        oc += usize::from(m.head.indexable() && m.grid[w[0].orient] != m.grid[w[1].orient]);
+    }
+    (pc, oc)
+}
+
+/// Teaches the knowledge base what failed: whole-probe cones for points known only by
+/// half-lines (in parallel), removal of the configuration for the others.
+fn learn(k: &mut Knowledge, m: &Machine, mut fails: Vec<(usize, usize, usize, Option<usize>)>) {
+    fails.sort();
+    fails.dedup();
+    let full: Vec<bool> = fails
+        .iter()
+        .map(|&(f, p, _, _)| f >= k.graph_points || k.dom[f][p].full)
+        .collect();
+    // Neighbours on a face fail together and are clustered together (ch. 4.2): better
+    // knowledge of a few of them usually moves the whole face, so acquire at most
+    // ACQUIRE_PER_FACE points per face and probe in a round.
+    let mut per_face: BTreeMap<(usize, usize), usize> = BTreeMap::new();
+    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    for (&(f, p, _, _), &full) in fails.iter().zip(&full) {
+        let n = per_face.entry((k.points[f].face.0, p)).or_default();
+        if !full && *n < ACQUIRE_PER_FACE && !pairs.contains(&(f, p)) {
+            *n += 1;
+            pairs.push((f, p));
+        }
+    }
+    k.acquire_many(&pairs, m);
+    for (&(f, p, s, o), full) in fails.iter().zip(full) {
+        if full {
+            k.reject(f, p, s, o, m);
+        }
+    }
+}
+
+/// How many points per face and probe get the whole probe's cones in one round.
+const ACQUIRE_PER_FACE: usize = 2;
+
+/// Why a plan has more setups than the proven minimum, when the hierarchy is the cause:
+/// clustered again without its per-tolerance and per-feature `same_setup` levels (the
+/// `(*, *)` level kept), the plan needs fewer setups; those levels are named.
+fn forcing_levels(
+    root: &solve::Inst,
+    k: &mut Knowledge,
+    m: &Machine,
+    h: &crate::model::Hierarchy,
+    branches: &[Branch],
+) -> Option<String> {
+    use crate::model::{Group, SameVar};
+    let count = |b: &[Branch]| b.iter().map(|x| x.setup).collect::<BTreeSet<_>>().len();
+    let used = count(branches);
+    let grouped = |l: &&crate::model::Level| l.var == SameVar::Setup && l.group != Group::All;
+    let names: Vec<String> = h.levels.iter().filter(grouped).map(|l| l.text()).collect();
+    if names.is_empty() {
+        return None;
+    }
+    let mut relaxed = h.clone();
+    relaxed.levels.retain(|l| !grouped(&l));
+    let sets = solve::setup_sets(root, k, m);
+    let trees = solve::setup_trees(root, k, &relaxed, &sets);
+    let fewest = Strategy::ALL
+        .into_iter()
+        .zip(trees)
+        .filter_map(|(s, tree)| solve::solve(root, k, m, &relaxed, s, tree).ok())
+        .map(|b| count(&b))
+        .min()?;
+    (fewest < used).then(|| {
+        format!(
+            "{} {} for {used} setups; without {} {fewest} would do",
+            names.join(", "),
+            if names.len() == 1 { "asks" } else { "ask" },
+            if names.len() == 1 { "it" } else { "them" }
+        )
+    })
+}
