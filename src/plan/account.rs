@@ -6,7 +6,8 @@ use super::filter::min_points;
 use super::{axes, scan, Hlip, Input, PlanError, PlanOptions};
 use crate::diag::Diagnostics;
 use crate::geometry::FaceId;
-use crate::graph::Node;
+use crate::graph::{MeasurementGraph, Node};
+use crate::model::FeatureId;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Counts the tolerances the plan measures — every face of their features and datum
@@ -22,37 +23,8 @@ pub(super) fn account(
 ) -> Hlip {
     let part = &input.model.parts[input.plan.part.0];
     let g = input.graph;
-    // Per face the distinct points the plan touches on it (or on the table under it).
-    let mut touches: BTreeMap<FaceId, BTreeSet<usize>> = BTreeMap::new();
-    for s in &hlip.setups {
-        for p in &s.probes {
-            for o in &p.orients {
-                for i in &o.inspections {
-                    for f in &i.faces {
-                        touches.entry(f.face).or_default().extend(&f.points);
-                    }
-                }
-            }
-        }
-    }
-    // Per feature its faces, per face whether sampling gave it points.
-    let mut faces_of: BTreeMap<crate::model::FeatureId, Vec<FaceId>> = BTreeMap::new();
-    let mut sampled: BTreeSet<FaceId> = BTreeSet::new();
-    for (n, node) in g.nodes() {
-        match node {
-            Node::Feature { feature, .. } => {
-                for (c, _) in g.children(n) {
-                    if let Node::Face { face, .. } = g.graph[c] {
-                        faces_of.entry(*feature).or_default().push(face);
-                    }
-                }
-            }
-            Node::Face { face, .. } if !g.children(n).is_empty() => {
-                sampled.insert(*face);
-            }
-            _ => {}
-        }
-    }
+    let touches = touches(&hlip);
+    let (faces_of, sampled) = faces_of(g);
     // A face is measured with as many points as its surface's fit needs (fewer only
     // where sampling gave it fewer).
     let mut touched: BTreeSet<FaceId> = touches
@@ -86,42 +58,7 @@ pub(super) fn account(
             measured += 1;
             continue;
         };
-        let few = touches.get(&face).map_or(0, |p| p.len());
-        let short = uncovered.iter().find(|u| u.feature == f);
-        let (why, help) = if let Some(u) = short {
-            (
-                format!(
-                    "is asked of the laser scanner, which sees {} % of {} at best (the plan asks {} %)",
-                    crate::model::fmt_num((u.best * 1000.0).round() / 10.0),
-                    if u.face == face {
-                        "it".to_string()
-                    } else {
-                        format!("face {}", input.geometry.faces[u.face.0].name)
-                    },
-                    crate::model::fmt_num((input.plan.scan_coverage * 1000.0).round() / 10.0)
-                ),
-                "touch it instead (`sensors { … touch }`), hold the part so the scanner sees more of it (a fixture), or lower `scan_coverage`".to_string(),
-            )
-        } else if few > 0 {
-            (
-                format!(
-                    "gets {few} {} in the plan, fewer than its surface's fit needs",
-                    if few == 1 { "touch" } else { "touches" }
-                ),
-                "its other points were left out as hard to reach; a probe that reaches more of them, or more points (`sample`), keeps it".to_string(),
-            )
-        } else if sampled.contains(&face) {
-            (
-                "gets no touch in the plan".to_string(),
-                "its points were dropped as hard to reach; a probe that reaches more of them, or more points (`sample`), keeps it".to_string(),
-            )
-        } else {
-            (
-                "gets no measuring point".to_string(),
-                "no point of it keeps the sampling margin from its edges; lower the sampling inset"
-                    .to_string(),
-            )
-        };
+        let (why, help) = unmeasured_reason(input, &touches, &sampled, uncovered, f, face);
         let (tolerance, feature, face) = (
             t.name.clone(),
             part.features[f.0].name.clone(),
@@ -150,4 +87,92 @@ pub(super) fn account(
     hlip.summary.tolerances = (measured, part.tolerances.len());
     axes::short_axes(input, &touches, &faces_of, diags);
     hlip
+}
+
+/// Per face the distinct points the plan touches on it (or on the table under it).
+fn touches(hlip: &Hlip) -> BTreeMap<FaceId, BTreeSet<usize>> {
+    let mut touches: BTreeMap<FaceId, BTreeSet<usize>> = BTreeMap::new();
+    for s in &hlip.setups {
+        for p in &s.probes {
+            for o in &p.orients {
+                for i in &o.inspections {
+                    for f in &i.faces {
+                        touches.entry(f.face).or_default().extend(&f.points);
+                    }
+                }
+            }
+        }
+    }
+    touches
+}
+
+/// Per feature its faces, and the faces sampling gave points.
+fn faces_of(g: &MeasurementGraph) -> (BTreeMap<FeatureId, Vec<FaceId>>, BTreeSet<FaceId>) {
+    let mut faces_of: BTreeMap<FeatureId, Vec<FaceId>> = BTreeMap::new();
+    let mut sampled: BTreeSet<FaceId> = BTreeSet::new();
+    for (n, node) in g.nodes() {
+        match node {
+            Node::Feature { feature, .. } => {
+                for (c, _) in g.children(n) {
+                    if let Node::Face { face, .. } = g.graph[c] {
+                        faces_of.entry(*feature).or_default().push(face);
+                    }
+                }
+            }
+            Node::Face { face, .. } if !g.children(n).is_empty() => {
+                sampled.insert(*face);
+            }
+            _ => {}
+        }
+    }
+    (faces_of, sampled)
+}
+
+/// Why feature `f`'s `face` is not measured, and what would measure it: the scanner
+/// covers too little of it, too few or no touches are left on it, or sampling gave it no
+/// point.
+fn unmeasured_reason(
+    input: &Input,
+    touches: &BTreeMap<FaceId, BTreeSet<usize>>,
+    sampled: &BTreeSet<FaceId>,
+    uncovered: &[scan::Uncovered],
+    f: FeatureId,
+    face: FaceId,
+) -> (String, String) {
+    let few = touches.get(&face).map_or(0, |p| p.len());
+    let short = uncovered.iter().find(|u| u.feature == f);
+    if let Some(u) = short {
+        (
+            format!(
+                "is asked of the laser scanner, which sees {} % of {} at best (the plan asks {} %)",
+                crate::model::fmt_num((u.best * 1000.0).round() / 10.0),
+                if u.face == face {
+                    "it".to_string()
+                } else {
+                    format!("face {}", input.geometry.faces[u.face.0].name)
+                },
+                crate::model::fmt_num((input.plan.scan_coverage * 1000.0).round() / 10.0)
+            ),
+            "touch it instead (`sensors { … touch }`), hold the part so the scanner sees more of it (a fixture), or lower `scan_coverage`".to_string(),
+        )
+    } else if few > 0 {
+        (
+            format!(
+                "gets {few} {} in the plan, fewer than its surface's fit needs",
+                if few == 1 { "touch" } else { "touches" }
+            ),
+            "its other points were left out as hard to reach; a probe that reaches more of them, or more points (`sample`), keeps it".to_string(),
+        )
+    } else if sampled.contains(&face) {
+        (
+            "gets no touch in the plan".to_string(),
+            "its points were dropped as hard to reach; a probe that reaches more of them, or more points (`sample`), keeps it".to_string(),
+        )
+    } else {
+        (
+            "gets no measuring point".to_string(),
+            "no point of it keeps the sampling margin from its edges; lower the sampling inset"
+                .to_string(),
+        )
+    }
 }

@@ -23,6 +23,7 @@ use crate::geometry::{FaceId, V3};
 use crate::graph::Node;
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
+use std::ops::ControlFlow;
 
 /// [`plan`], keeping in `memo` the cones and depth maps it computes and reusing those a
 /// previous planning of the same `input` left there (the re-plans after the path stage's
@@ -141,11 +142,61 @@ fn plan_touch(
     turn: f64,
     diags: &mut Diagnostics,
 ) -> Option<Hlip> {
-    let (model, plan, g) = (input.model, input.plan, input.graph);
-    let hierarchy = &model.hierarchies[plan.hierarchy.0];
+    let (model, plan) = (input.model, input.plan);
     let machine = Machine::new(model, plan);
+    let mut k = knowledge(input, opts, &machine, memo);
+    let mut search = Search {
+        input,
+        opts,
+        machine: &machine,
+        hierarchy: &model.hierarchies[plan.hierarchy.0],
+        turn,
+        validated: BTreeSet::new(),
+        turned_fails: BTreeMap::new(),
+        last: String::from("no round was run"),
+        fallback: None,
+        skipped: skip.clone(),
+        read_axes: axes::axis_faces(input.graph, &model.parts[plan.part.0]),
+    };
+    for iteration in 1..=opts.max_iterations {
+        if let ControlFlow::Break(hlip) = search.round(&mut k, iteration, diags) {
+            return hlip;
+        }
+    }
+    search.give_up(&mut k, diags)
+}
+
+/// The knowledge base the search starts from: the plan's setups, the datum faces that
+/// can rest on the table, and the cones' options.
+fn knowledge<'a>(
+    input: &'a Input,
+    opts: &PlanOptions,
+    machine: &Machine,
+    memo: &'a mut Memo,
+) -> Knowledge<'a> {
+    let (model, plan, g) = (input.model, input.plan, input.graph);
     let setups = poses::Setups::new(model, plan, input.geometry, input.fixtures);
-    // Datum faces that can rest on the table.
+    let cone_opts = crate::access::ConeOptions {
+        n: opts.n,
+        // The approach validated is the longer of the pre-hit and retract moves.
+        retract: input.plan.motion.prehit.max(input.plan.motion.retract),
+        backend: opts.backend,
+        ..Default::default()
+    };
+    Knowledge::new(
+        plan,
+        machine,
+        input.geometry,
+        &g.fpoints,
+        &datum_table_faces(g),
+        setups,
+        cone_opts,
+        memo,
+    )
+}
+
+/// The faces of datum features that can rest on the table, in graph order.
+fn datum_table_faces(g: &crate::graph::MeasurementGraph) -> Vec<FaceId> {
     let mut table_faces: Vec<FaceId> = Vec::new();
     for (n, node) in g.nodes() {
         if let Node::Feature { datums, .. } = node {
@@ -165,102 +216,199 @@ fn plan_touch(
             }
         }
     }
-    let cone_opts = crate::access::ConeOptions {
-        n: opts.n,
-        // The approach validated is the longer of the pre-hit and retract moves.
-        retract: input.plan.motion.prehit.max(input.plan.motion.retract),
-        backend: opts.backend,
-        ..Default::default()
-    };
-    let mut k = Knowledge::new(
-        plan,
-        &machine,
-        input.geometry,
-        &g.fpoints,
-        &table_faces,
-        setups,
-        cone_opts,
-        memo,
-    );
-    let mut validated: BTreeSet<Pip> = BTreeSet::new();
-    // Per point, the configurations that collided only with the part turned: after
-    // FRAGILE_AFTER of them the point takes one clear at the nominal pose alone.
-    let mut turned_fails: BTreeMap<usize, usize> = BTreeMap::new();
-    let mut last = String::from("no round was run");
-    // The round whose plan had the fewest touches that failed validation: what the plan
-    // falls back on, less those touches, if no round settles.
-    let mut fallback: Option<Fallback> = None;
-    // Faces no probe inspects, left out under `allow_unmeasured`, and those a scanner
-    // measures.
-    let mut skipped: BTreeSet<FaceId> = skip.clone();
-    let read_axes = axes::axis_faces(g, &input.model.parts[input.plan.part.0]);
-    for iteration in 1..=opts.max_iterations {
-        let (dropped, bad) = filter(g, input.geometry, &k, &machine, &skipped, &read_axes);
+    table_faces
+}
+
+/// What a round of the search leads to: another round (`Continue`), or the search's
+/// answer (`Break`).
+type Next = ControlFlow<Option<Hlip>>;
+
+/// The state the rounds of one search share.
+struct Search<'a> {
+    input: &'a Input<'a>,
+    opts: &'a PlanOptions,
+    machine: &'a Machine,
+    hierarchy: &'a crate::model::Hierarchy,
+    /// Degrees the part is turned either way when touches are validated.
+    turn: f64,
+    validated: BTreeSet<Pip>,
+    /// Per point, the configurations that collided only with the part turned: after
+    /// FRAGILE_AFTER of them the point takes one clear at the nominal pose alone.
+    turned_fails: BTreeMap<usize, usize>,
+    /// Why the last round failed, for the diagnostic when none settles.
+    last: String,
+    /// The round whose plan had the fewest touches that failed validation: what the plan
+    /// falls back on, less those touches, if no round settles.
+    fallback: Option<Fallback>,
+    /// Faces no probe inspects, left out under `allow_unmeasured`, and those a scanner
+    /// measures.
+    skipped: BTreeSet<FaceId>,
+    /// Faces whose axis a tolerance reads ([`axes::axis_faces`]).
+    read_axes: BTreeSet<FaceId>,
+}
+
+/// The touches of a round's plan that failed validation, sorted for what follows.
+struct Failures {
+    /// (point, probe, setup, orientation where the head indexes), for learning.
+    invalid: Vec<(usize, usize, usize, Option<usize>)>,
+    /// The touches that failed.
+    left: BTreeSet<Pip>,
+    /// Per face name, the touches that failed and the first cause, for the diagnostic.
+    failed: BTreeMap<String, (usize, String)>,
+    /// Per face, the touches that failed, the probe and the first blocker.
+    causes: BTreeMap<FaceId, (usize, usize, crate::access::pose::Blocker)>,
+}
+
+impl Search<'_> {
+    /// One round of generate and test.
+    fn round(&mut self, k: &mut Knowledge, iteration: usize, diags: &mut Diagnostics) -> Next {
+        let (input, machine) = (self.input, self.machine);
+        let g = input.graph;
+        let (dropped, bad) = filter(
+            g,
+            input.geometry,
+            k,
+            machine,
+            &self.skipped,
+            &self.read_axes,
+        );
         if !bad.is_empty() {
-            // Know the whole probe before blaming a face.
-            let pairs: Vec<(usize, usize)> = bad
-                .iter()
-                .flat_map(|f| g.face_points(*f))
-                .flat_map(|f| (0..machine.probes.len()).map(move |p| (f, p)))
-                .collect();
-            let before = k.acquired;
-            k.acquire_many(&pairs, &machine);
-            if k.acquired > before && iteration < opts.max_iterations {
-                let (_, bad2) = filter(g, input.geometry, &k, &machine, &skipped, &read_axes);
-                if bad2.is_empty() {
-                    continue;
-                }
-            }
-            let (_, bad) = filter(g, input.geometry, &k, &machine, &skipped, &read_axes);
-            for &face in &bad {
-                report_face(input, &k, &machine, face, opts.allow_unmeasured, diags);
-            }
-            if !opts.allow_unmeasured {
-                return None;
-            }
-            // Plan the rest; the tolerances on these faces are reported unmeasured.
-            skipped.extend(bad);
-            continue;
+            return self.faces_short(k, iteration, bad, diags);
         }
-        let Some(root) = solve::unfold(g, &k, &machine, &dropped) else {
+        let Some(root) = solve::unfold(g, k, machine, &dropped) else {
             let round = Round {
                 branches: &[],
                 iterations: iteration,
                 dropped: dropped.len(),
                 strategy: None,
-                exact_budget: opts.exact_budget,
+                exact_budget: self.opts.exact_budget,
             };
-            return Some(assemble(input, &mut k, &machine, &round));
+            return ControlFlow::Break(Some(assemble(input, k, machine, &round)));
         };
+        let Some(best) = self.cluster(&root, k) else {
+            return ControlFlow::Continue(());
+        };
+        let failures = self.validate(k, &best.1);
+        if failures.invalid.is_empty() {
+            let hlip = self.settle(k, &root, &best, iteration, dropped.len(), diags);
+            return ControlFlow::Break(Some(hlip));
+        }
+        if !failures.failed.is_empty() {
+            self.last = last_failures(&failures.failed);
+        }
+        if self
+            .fallback
+            .as_ref()
+            .is_none_or(|f| failures.left.len() <= f.left.len())
+        {
+            self.fallback = Some(Fallback {
+                branches: best.1.clone(),
+                left: failures.left,
+                causes: failures.causes,
+                strategy: best.0,
+                dropped: dropped.len(),
+            });
+        }
+        learn(k, machine, failures.invalid);
+        ControlFlow::Continue(())
+    }
+
+    /// Faces left with too few points: the whole probe's cones are acquired for their
+    /// points before a face is blamed; those still short are reported, and without
+    /// `allow_unmeasured` the search ends.
+    fn faces_short(
+        &mut self,
+        k: &mut Knowledge,
+        iteration: usize,
+        bad: Vec<FaceId>,
+        diags: &mut Diagnostics,
+    ) -> Next {
+        let (input, machine, opts) = (self.input, self.machine, self.opts);
+        let g = input.graph;
+        // Know the whole probe before blaming a face.
+        let pairs: Vec<(usize, usize)> = bad
+            .iter()
+            .flat_map(|f| g.face_points(*f))
+            .flat_map(|f| (0..machine.probes.len()).map(move |p| (f, p)))
+            .collect();
+        let before = k.acquired;
+        k.acquire_many(&pairs, machine);
+        if k.acquired > before && iteration < opts.max_iterations {
+            let (_, bad2) = filter(
+                g,
+                input.geometry,
+                k,
+                machine,
+                &self.skipped,
+                &self.read_axes,
+            );
+            if bad2.is_empty() {
+                return ControlFlow::Continue(());
+            }
+        }
+        let (_, bad) = filter(
+            g,
+            input.geometry,
+            k,
+            machine,
+            &self.skipped,
+            &self.read_axes,
+        );
+        for &face in &bad {
+            report_face(input, k, machine, face, opts.allow_unmeasured, diags);
+        }
+        if !opts.allow_unmeasured {
+            return ControlFlow::Break(None);
+        }
+        // Plan the rest; the tolerances on these faces are reported unmeasured.
+        self.skipped.extend(bad);
+        ControlFlow::Continue(())
+    }
+
+    /// The best clustering of `root` over every strategy; when none gives a plan, what
+    /// failed is learnt and the round ends.
+    fn cluster(
+        &mut self,
+        root: &solve::Inst,
+        k: &mut Knowledge,
+    ) -> Option<(Strategy, Vec<Branch>)> {
+        let (machine, hierarchy) = (self.machine, self.hierarchy);
         let mut results: Vec<(Strategy, Vec<Branch>)> = Vec::new();
         let mut failures = Vec::new();
-        let sets = solve::setup_sets(&root, &k, &machine);
-        let trees = solve::setup_trees(&root, &k, hierarchy, &sets);
+        let sets = solve::setup_sets(root, k, machine);
+        let trees = solve::setup_trees(root, k, hierarchy, &sets);
         for (strategy, tree) in Strategy::ALL.into_iter().zip(trees) {
-            match solve::solve(&root, &mut k, &machine, hierarchy, strategy, tree) {
+            match solve::solve(root, k, machine, hierarchy, strategy, tree) {
                 Ok(b) => results.push((strategy, b)),
                 Err(f) => failures.extend(f),
             }
         }
         if results.is_empty() {
-            last = format!("{} points found no probe orientation", failures.len());
+            self.last = format!("{} points found no probe orientation", failures.len());
             learn(
-                &mut k,
-                &machine,
+                k,
+                machine,
                 failures
                     .iter()
                     .map(|f| (f.point, f.probe, f.setup, f.orient))
                     .collect(),
             );
-            continue;
+            return None;
         }
         let best = results
             .iter()
-            .min_by_key(|(_, b)| score(b, &machine, hierarchy))
+            .min_by_key(|(_, b)| score(b, machine, hierarchy))
             .map(|(s, b)| (*s, b.clone()))
             .expect("at least one result");
+        Some(best)
+    }
+
+    /// Validates the touches of `branches` not validated before, in parallel, each at
+    /// the nominal pose and (but for fragile points) with the part turned.
+    fn validate(&mut self, k: &mut Knowledge, branches: &[Branch]) -> Failures {
+        let (input, machine, opts) = (self.input, self.machine, self.opts);
         let mut pips: Vec<(Pip, V3)> = Vec::new();
-        for b in &best.1 {
+        for b in branches {
             let mut pts = Vec::new();
             solve::leaves(&b.tree, &mut pts);
             for p in pts {
@@ -277,11 +425,13 @@ fn plan_touch(
         }
         pips.sort_by_key(|(p, _)| *p);
         pips.dedup_by_key(|(p, _)| *p);
-        pips.retain(|(p, _)| !validated.contains(p));
+        pips.retain(|(p, _)| !self.validated.contains(p));
         let held: BTreeMap<usize, knowledge::Held> = pips
             .iter()
             .map(|(p, _)| (p.setup, k.held(p.setup).clone()))
             .collect();
+        let (turn, turned_fails) = (self.turn, &self.turned_fails);
+        let k = &*k;
         // (touch, result, whether it failed only with the part turned)
         let checked: Vec<(Pip, Result<(), _>, bool)> = pips
             .par_iter()
@@ -289,38 +439,40 @@ fn plan_touch(
                 let tries = turned_fails.get(&p.point).copied().unwrap_or(0);
                 let t = if tries < FRAGILE_AFTER { turn } else { 0.0 };
                 let held = &held[&p.setup];
-                match validate::check(&k, &machine, p, up, held, &opts.bans) {
+                match validate::check(k, machine, p, up, held, &opts.bans) {
                     Err(e) => (*p, Err(e), false),
                     Ok(()) => {
-                        let turned = validate::clear_turned(&k, &machine, p, up, held, t);
+                        let turned = validate::clear_turned(k, machine, p, up, held, t);
                         let turned_only = turned.is_err();
                         (*p, turned, turned_only)
                     }
                 }
             })
             .collect();
-        let mut invalid = Vec::new();
-        let mut left: BTreeSet<Pip> = BTreeSet::new();
-        // Per face, the touches that failed and the first cause, for the diagnostic.
-        let mut failed: BTreeMap<String, (usize, String)> = BTreeMap::new();
-        let mut causes: BTreeMap<FaceId, (usize, usize, crate::access::pose::Blocker)> =
-            BTreeMap::new();
+        let mut failures = Failures {
+            invalid: Vec::new(),
+            left: BTreeSet::new(),
+            failed: BTreeMap::new(),
+            causes: BTreeMap::new(),
+        };
         for (p, what, turned_only) in checked {
             if turned_only {
-                *turned_fails.entry(p.point).or_default() += 1;
+                *self.turned_fails.entry(p.point).or_default() += 1;
             }
             match what {
                 Ok(()) => {
-                    validated.insert(p);
+                    self.validated.insert(p);
                 }
                 Err(w) => {
-                    left.insert(p);
-                    causes
+                    failures.left.insert(p);
+                    failures
+                        .causes
                         .entry(k.points[p.point].face)
                         .or_insert_with(|| (0, p.probe, w.clone()))
                         .0 += 1;
-                    let e = failed
-                        .entry(face_name(input, &k, p.point))
+                    let e = failures
+                        .failed
+                        .entry(face_name(input, k, p.point))
                         .or_insert_with(|| {
                             (
                                 0,
@@ -328,7 +480,7 @@ fn plan_touch(
                             )
                         });
                     e.0 += 1;
-                    invalid.push((
+                    failures.invalid.push((
                         p.point,
                         p.probe,
                         p.setup,
@@ -337,82 +489,91 @@ fn plan_touch(
                 }
             }
         }
-        if invalid.is_empty() {
-            debug_assert!(
-                audit(&mut k, &machine, &best.1).is_empty(),
-                "{:?}",
-                audit(&mut k, &machine, &best.1)
-            );
-            // Datums measured again where the tolerances read against them are.
-            let again = remeasure::datums_where_read(
-                input, &mut k, &machine, &best.1, turn, &opts.bans, diags,
-            );
-            let branches: Vec<Branch> = best.1.iter().cloned().chain(again).collect();
-            let round = Round {
-                branches: &branches,
-                iterations: iteration,
-                dropped: dropped.len(),
-                strategy: Some(best.0),
-                exact_budget: opts.exact_budget,
-            };
-            let mut hlip = assemble(input, &mut k, &machine, &round);
-            // Touches validated turned are clear turned; the others are measured.
-            let fragile =
-                |p: &Pip| turn == 0.0 || turned_fails.get(&p.point) >= Some(&FRAGILE_AFTER);
-            placement::square_within(
-                input, &mut k, &machine, &branches, &fragile, &mut hlip, diags,
-            );
-            if hlip.summary.setups > hlip.summary.min_setups.0 {
-                let forcing = forcing_levels(&root, &mut k, &machine, hierarchy, &best.1);
-                hlip.summary.more_setups = Some(forcing.unwrap_or_else(|| {
-                    "no clustering found fewer; the minimum may need setups the hierarchy's order does not reach".into()
-                }));
+        failures
+    }
+
+    /// The plan of a round whose touches all validated: the datums measured again where
+    /// they are read, the setups' squareness, and why it needs more setups than the
+    /// minimum.
+    fn settle(
+        &self,
+        k: &mut Knowledge,
+        root: &solve::Inst,
+        best: &(Strategy, Vec<Branch>),
+        iteration: usize,
+        dropped: usize,
+        diags: &mut Diagnostics,
+    ) -> Hlip {
+        let (input, machine, opts, turn) = (self.input, self.machine, self.opts, self.turn);
+        debug_assert!(
+            audit(k, machine, &best.1).is_empty(),
+            "{:?}",
+            audit(k, machine, &best.1)
+        );
+        // Datums measured again where the tolerances read against them are.
+        let again =
+            remeasure::datums_where_read(input, k, machine, &best.1, turn, &opts.bans, diags);
+        let branches: Vec<Branch> = best.1.iter().cloned().chain(again).collect();
+        let round = Round {
+            branches: &branches,
+            iterations: iteration,
+            dropped,
+            strategy: Some(best.0),
+            exact_budget: opts.exact_budget,
+        };
+        let mut hlip = assemble(input, k, machine, &round);
+        // Touches validated turned are clear turned; the others are measured.
+        let turned_fails = &self.turned_fails;
+        let fragile = |p: &Pip| turn == 0.0 || turned_fails.get(&p.point) >= Some(&FRAGILE_AFTER);
+        placement::square_within(input, k, machine, &branches, &fragile, &mut hlip, diags);
+        if hlip.summary.setups > hlip.summary.min_setups.0 {
+            let forcing = forcing_levels(root, k, machine, self.hierarchy, &best.1);
+            hlip.summary.more_setups = Some(forcing.unwrap_or_else(|| {
+                "no clustering found fewer; the minimum may need setups the hierarchy's order does not reach".into()
+            }));
+        }
+        hlip
+    }
+
+    /// No round settled: with a turn, no plan (the caller plans again without); else the
+    /// best plan found, or the diagnostic saying why the last round failed.
+    fn give_up(self, k: &mut Knowledge, diags: &mut Diagnostics) -> Option<Hlip> {
+        if self.turn > 0.0 {
+            return None;
+        }
+        if let Some(f) = self.fallback {
+            if let Some(hlip) = f.settle(self.input, k, self.machine, self.opts, diags) {
+                return Some(hlip);
             }
-            return Some(hlip);
         }
-        if !failed.is_empty() {
-            let faces: Vec<String> = failed
-                .iter()
-                .take(4)
-                .map(|(face, (n, why))| format!("{face} ({n} touches; {why})"))
-                .collect();
-            let more = failed.len().saturating_sub(4);
-            last = format!(
-                "in the last round touches failed on {}{}",
-                faces.join(", "),
-                if more > 0 {
-                    format!(" and {more} more faces")
-                } else {
-                    String::new()
-                }
-            );
-        }
-        if fallback.as_ref().is_none_or(|f| left.len() <= f.left.len()) {
-            fallback = Some(Fallback {
-                branches: best.1.clone(),
-                left,
-                causes,
-                strategy: best.0,
-                dropped: dropped.len(),
-            });
-        }
-        learn(&mut k, &machine, invalid);
+        let plan = self.input.plan;
+        diags.push(PlanError::NoConvergence {
+            span: plan.span,
+            plan: plan.name.clone(),
+            iterations: self.opts.max_iterations,
+            last: self.last,
+        });
+        None
     }
-    if turn > 0.0 {
-        return None;
-    }
-    if let Some(f) = fallback {
-        if let Some(hlip) = f.settle(input, &mut k, &machine, opts, diags) {
-            return Some(hlip);
+}
+
+/// The faces whose touches failed in the last round, four at most, for the diagnostic.
+fn last_failures(failed: &BTreeMap<String, (usize, String)>) -> String {
+    let faces: Vec<String> = failed
+        .iter()
+        .take(4)
+        .map(|(face, (n, why))| format!("{face} ({n} touches; {why})"))
+        .collect();
+    let more = failed.len().saturating_sub(4);
+    format!(
+        "in the last round touches failed on {}{}",
+        faces.join(", "),
+        if more > 0 {
+            format!(" and {more} more faces")
+        } else {
+            String::new()
         }
-    }
-    diags.push(PlanError::NoConvergence {
-        span: plan.span,
-        plan: plan.name.clone(),
-        iterations: opts.max_iterations,
-        last,
-    });
-    None
+    )
 }
 
 /// The configurations of a plan that lie outside their point's domain (there should be
