@@ -203,9 +203,9 @@ fn run_case(c: &Case) -> Outcome {
     }
 }
 
-/// Whether slow cases are skipped (`INSPC_QUICK=1`, for development; CI runs them all).
+/// Whether slow cases are skipped (without `INSPC_SLOW`, the local loop; CI runs them all).
 fn quick() -> bool {
-    std::env::var_os("INSPC_QUICK").is_some()
+    !common::slow()
 }
 
 /// Every case, run once: side by side, each on a one-thread pool.

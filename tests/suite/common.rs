@@ -174,6 +174,23 @@ pub fn check_src(src: &str) -> Diags {
 }
 
 /// The NIST parts are expected in ../shared/parts/ beside the repository, as CI has them.
+/// Whether the slow and external tests run: the golden cases marked `slow` (NIST CTC 02,
+/// FTC 06, FTC 08), the deviation battery on the real parts, the GPU backend on lavapipe,
+/// the browser and the VS Code extension's npm build. Set `INSPC_SLOW=1` to run them
+/// (`.ci/run` does, so CI runs everything); plain `cargo test` is the fast local loop.
+pub fn slow() -> bool {
+    std::env::var_os("INSPC_SLOW").is_some()
+}
+
+/// True, having said so, when `what` is skipped because `INSPC_SLOW` is not set.
+pub fn skip_unless_slow(what: &str) -> bool {
+    let skip = !slow();
+    if skip {
+        eprintln!("skipped (set INSPC_SLOW=1 to run it): {what}");
+    }
+    skip
+}
+
 pub fn require_shared_parts() {
     assert!(
         std::path::Path::new("../shared/parts/nist_ctc_01_asme1_ap242-e1.obj").exists(),

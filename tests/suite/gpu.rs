@@ -4,13 +4,17 @@
 //! blocked, and the two agree on ≥ 99.9 % of the cells.
 //!
 //! Runs wherever wgpu finds an adapter: Mesa's lavapipe, which `.ci/run` installs, or a
-//! real GPU. Without one the tests say so and pass, unless `INSPC_REQUIRE_GPU` is set
-//! (`.ci/run` sets it, so CI cannot skip them silently).
+//! real GPU, under `INSPC_SLOW=1` (`.ci/run` sets it). Without an adapter the tests say so and
+//! pass, unless `INSPC_REQUIRE_GPU` is set (`.ci/run` sets it, so CI cannot skip them
+//! silently).
 
 use inspc::access::{axes, gpu, Backend, Component, Cpu, CubeMap, ProbeShape, Query, Scene};
 use inspc::geometry::{P3, V3};
 
 fn device() -> Option<&'static inspc::access::Gpu> {
+    if crate::common::skip_unless_slow("the GPU backend's tests") {
+        return None;
+    }
     match gpu() {
         Ok(g) => Some(g),
         Err(why) => {
@@ -182,6 +186,9 @@ fn batched_point_cones_are_the_per_point_cones() {
 /// says which adapter it used; `--backend auto` builds wherever it runs.
 #[test]
 fn build_on_the_gpu_backend() {
+    if crate::common::skip_unless_slow("inspc build on the GPU backend") {
+        return;
+    }
     let dir = std::env::temp_dir().join(format!("inspc-gpu-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let run = |backend: &str| {

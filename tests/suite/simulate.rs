@@ -69,7 +69,7 @@ const F2: (&str, &str) = ("examples/f2.insp", "tests/cases/example_f2/program.dm
 /// Every golden program, run at nominal: all in, every deviation within 2 µm.
 #[test]
 fn every_golden_program_measures_its_part_in_tolerance() {
-    let quick = std::env::var_os("INSPC_QUICK").is_some();
+    let quick = !crate::common::slow();
     let mut cases: Vec<PathBuf> = std::fs::read_dir("tests/cases")
         .expect("cases")
         .map(|e| e.expect("entry").path())
@@ -211,7 +211,7 @@ fn scanned_features_are_judged_from_their_clouds() {
 /// by a micrometre at nominal already, so only the targets are asked to change there.
 #[test]
 fn deviations_on_real_parts_fail_exactly_their_tolerances() {
-    if std::env::var_os("INSPC_QUICK").is_some() {
+    if crate::common::skip_unless_slow("deviations on the real parts") {
         return;
     }
     // A bowed face_15 fails both tolerances it carries (its flatness and its profile).

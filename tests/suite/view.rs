@@ -87,7 +87,7 @@ fn specs() -> Vec<(PathBuf, bool)> {
         .map(|p| (p, true))
         .collect();
     crate::common::require_shared_parts();
-    let quick = std::env::var_os("INSPC_QUICK").is_some();
+    let quick = !crate::common::slow();
     for name in ["nist_ctc_01", "nist_ctc_02", "nist_ftc_06", "nist_ftc_08"] {
         if quick && matches!(name, "nist_ctc_02" | "nist_ftc_06") {
             continue;
@@ -100,8 +100,8 @@ fn specs() -> Vec<(PathBuf, bool)> {
 
 #[test]
 fn every_example_and_real_part_views_in_a_headless_browser() {
-    let chrome = chromium();
-    if chrome.is_none() {
+    let chrome = chromium().filter(|_| !crate::common::skip_unless_slow("the pages in Chromium"));
+    if chrome.is_none() && crate::common::slow() {
         assert!(
             std::env::var_os("INSPC_REQUIRE_CHROMIUM").is_none(),
             "INSPC_REQUIRE_CHROMIUM is set but Chromium is not found"

@@ -26,6 +26,9 @@ fn npm(dir: &Path, args: &[&str]) {
 
 #[test]
 fn the_extension_builds_and_its_tests_pass() {
+    if crate::common::skip_unless_slow("the VS Code extension's npm build and tests") {
+        return;
+    }
     let has_npm = Command::new("npm")
         .arg("--version")
         .output()
