@@ -2,9 +2,14 @@
 //! unfolded cube-map image.
 
 use super::errors::AccessError;
-use super::*;
+use super::{
+    axes, gac, gac_halfline, orientations_in, point_cones, scan, scan_cones, tip_fits, Cell,
+    ConeOptions, Cpu, CubeMap, Head, ProbeShape, ScannerShape, Scene,
+};
 use crate::diag::Diagnostics;
+use crate::geometry::{PartGeometry, V3};
 use crate::model::fmt_num;
+use crate::sample::Fpoint;
 use std::fmt::Write;
 
 /// Which fpoint, which probe, what resolution.
