@@ -11,6 +11,20 @@
 //! validation rejects a configuration, the point's domain is replaced by the whole
 //! probe's cones (every component at contact and retract point, and the weak GAC D2),
 //! and the rejected configuration is removed.
+//!
+//! **Decision: exact directions.** The axes, preferred setups, table setups and up to
+//! 48 face axes (±, of cylinders and cones) and plane normals are preferred directions
+//! of every cone: a stylus often clears a hole only along its axis, which no pixel
+//! centre hits. Rasterized probe cones block a preferred direction conservatively; on
+//! acquisition the ones the half-line allowed are re-tested exactly by validation.
+//!
+//! **Decision: preferences are exact directions.** A preferred setup is a preferred
+//! direction of every cone; a forbidden setup removes the setups within `FORBID_ANGLE`
+//! (10°) of it.
+//!
+//! **Decision: the table alternative** (ch. 3.6.2). Datum faces that can rest on the
+//! table (`graph`'s `on_table`) get the setup −n in their domain; when it is chosen,
+//! four points on the table around the face's footprint replace the face.
 
 use super::cluster::{Bits, Set};
 use crate::access::pose::{above_table, frame, table_height, Blocker, Contact, Head, Pose};
