@@ -1,4 +1,8 @@
 //! The virtual CMM's interpreter: one pass over the program's statements.
+//!
+//! A distance to a drilled hole's full diameter
+//! (`CONST/CIRCLE,F(c),INTOF,FA(bore),FA(cone)`, see the DMIS writer) intersects the
+//! measured cone with the measured bore's radius (`full_diameter`).
 
 use super::deviation::Deviations;
 use super::errors::SimError;
