@@ -42,6 +42,18 @@
 //! whatever a shadow of dilation k ≤ j would add), and a D2 sample stops when it can no
 //! longer add anything. `tests/suite/access.rs` compares the hierarchy with
 //! triangle-by-triangle drawing (`blocked_plain`) on every example and two real parts.
+//!
+//! Triangles straddling a truncated component's start are split (4 levels) and the near
+//! pieces dropped; a split piece's children that fall in its middle child's band are
+//! drawn as one convex polygon (the midpoints kept as corners, so its shadow is the
+//! union of theirs), four in one band as the piece itself, and a piece whose whole
+//! shadow is already marked is not split. A prism is convex, so its faces that face the
+//! viewpoint project onto its outline's projection: one polygon for up to seven faces.
+//! [`blocked_within`] is right on given cells alone: a shadow in band k, or a node,
+//! whose footprint meets no pixel of those cells' growth k cannot mark one and is
+//! passed over (`Focus`). [`draw`] (which polygons go into which map, through a
+//! `Canvas`) and [`finish`] (bands grown, preferred directions) are two halves, so
+//! another rasterizer can sit between them.
 
 use super::cubemap::{CubeMap, Disc};
 use super::probe::Component;

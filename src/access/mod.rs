@@ -28,6 +28,13 @@
 //! setup, and a sample stops drawing once the cells still needed are blocked. D1′ reads
 //! a 96 × 96 depth map ([`SecondMap`]) dilated by the largest second-component radius,
 //! so it is pessimistic.
+//!
+//! `gac_with` is a union of components, each after the first drawn only where those
+//! before leave the probe free (the retract point only where the contact does);
+//! `point_cones` is the cone at the contact ∩ the cone at the retract point (D1 for
+//! bent probes) plus D2; `cones` and the batched `gac_halfline_many` and
+//! `point_cones_many` keep input order, so a batching backend gets every query of many
+//! points in one call.
 
 mod cpu;
 mod cubemap;

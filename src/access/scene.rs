@@ -1,6 +1,11 @@
 //! The obstacle a cone is computed against: the part's triangles (and the table, once a
 //! setup places one), with what culling needs, and a parry mesh for exact queries.
 //!
+//! The bounding-volume hierarchy ([`Bvh`]): median splits, four triangles a leaf, per
+//! node a box, a ball holding its triangles' balls and, on a closed mesh, a cone of
+//! normals; triangles over a quarter of the scene (a table) are kept apart and drawn
+//! first.
+//!
 //! **Decision: capsules and cylinders decided by our own tests.** parry 0.25's
 //! capsule–triangle intersection test answers "no" for about 1 in 1,500 pairs with a
 //! corner well inside the capsule (either order of the shapes; tested), so `meets_axis`

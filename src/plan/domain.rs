@@ -25,6 +25,12 @@
 //! **Decision: the table alternative** (ch. 3.6.2). Datum faces that can rest on the
 //! table (`graph`'s `on_table`) get the setup −n in their domain; when it is chosen,
 //! four points on the table around the face's footprint replace the face.
+//!
+//! Every point's setups are masked by the realisable setups (`poses`); the stable
+//! poses' directions are exact cells of the cube maps, and the setup cell's `Held`
+//! (holder, table, fixture solids) is what validation poses against. D1′ on the A/B
+//! grid comes from one depth map per setup (`access::SecondMap`), cached per (point,
+//! probe, setup), and keeps the probe off the table.
 
 use super::cluster::{Bits, Set};
 use crate::access::pose::{above_table, frame, table_height, Blocker, Contact, Head, Pose};

@@ -1,6 +1,12 @@
 //! Stage 8, the planner (seed ch. 3 and 4): measurement graph + machine → high-level
 //! inspection plan (HLIP): setups, probes, probe orientations, and what each inspects.
 //!
+//! The four strategies are weighted, smallest first, graph order and reverse; the round
+//! keeps the best plan by the hierarchy's violations, then setups and changes, and
+//! validates its PIPs in parallel, each once. [`plan_with`] and a [`Memo`] keep the
+//! pure results (cones, D2 caps, depth maps, grid orientations, the scene) for a
+//! re-plan of the same input; the path stage's attempts share its scene.
+//!
 //! Generate and test: the knowledge base ([`domain`]) holds each fpoint's domain per
 //! probe, starting from cheap half-line cones; the solver ([`solve`]) clusters up the
 //! graph under the plan's constraint hierarchy with several deterministic clustering
