@@ -3,6 +3,37 @@
 //! `.insp` specs in, DMIS programs out. See `ARCHITECTURE.md` for the pipeline; each
 //! stage is a module with one documented entry point:
 //! [`syntax::parse`] → [`load::load`] → [`resolve::resolve`] → [`model::Model`].
+//!
+//! The driver decides what lies between the stages: which parts get geometry (those the
+//! root files declare or their plans name), the margin each plan samples with
+//! ([`sampling_margin`]), the surface checks after geometry ([`graph::check_surfaces`]:
+//! a flatness on a cylinder is an error before any sampling), one measurement graph per
+//! plan and per root part no plan names (sampled with `std::sampling::fan_leu`), and
+//! that such a part is `insp::plan::no_plan` when a build is asked for. Each stage runs
+//! only when the stages before it left no error. `run(…, Until)` keeps every stage's
+//! result, so the golden tests snapshot every stage from one run.
+//!
+//! **Architecture Invariant:** a stage imports earlier stages only, with two exceptions
+//! that keep one owner per rule: `path::align` asks `simulate::evaluate` what a datum
+//! frame leaves free (so alignment and evaluation agree), and `model::summary` prints
+//! `geometry::step`'s default chord. Ids go down the pipeline; names come back only
+//! through `plan::Names`.
+//!
+//! **Decision: fpoints are probe-independent.** They keep a margin from face edges
+//! equal to the largest tip radius of the plan's machine (1 mm without a plan), Fan &
+//! Leu's `r`, so that every probe's tip fits; the sampler narrows it on a narrow face
+//! and halves it on a face it leaves empty (see [`sample`]). Whether a tip fits at a
+//! point is left to accessibility, which can say which probe fails and why. A face
+//! whose candidates all fail is a warning (`insp::graph::no_points`).
+//!
+//! **Decision: the path stage is one more test.** A touch the planner validated but no
+//! collision-free move reaches (the roadmap finds no way in, or no way up to the
+//! clearance plane) bans that configuration (point, probe, setup, probe direction), and
+//! the plan is made again with it failing validation, at most `REPLANS` (3) times
+//! (`paths_of`); the diagnostics of the last try are the ones reported. A re-plan
+//! reuses the first planning's pure results (`plan::Memo`: cones, D2 caps, depth maps,
+//! grid orientations, the scene), so it costs clustering and validation only: one
+//! unreachable touch costs a re-plan, not the program.
 #![warn(missing_docs)]
 
 pub mod access;

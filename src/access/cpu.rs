@@ -6,8 +6,8 @@
 //!   farther than its farthest cannot touch it (bounding spheres, then the exact distance);
 //! - **facing**: for a component that starts at the viewpoint, a triangle of a closed
 //!   solid facing away from it is skipped — a half-line entering the solid, or a grown one
-//!   first touching it, does so through a triangle that faces the viewpoint (proof in
-//!   ARCHITECTURE.md);
+//!   first touching it, does so through a triangle that faces the viewpoint (proof
+//!   below);
 //! - **shadow**: a bare half-line marks the triangle's shadow at pixel centres; a
 //!   component of radius ρ marks every pixel its shadow touches and dilates it by
 //!   asin(ρ / distance), rounded up to whole pixels, in bands so each band grows once;
@@ -18,6 +18,42 @@
 //! of its own: a node whose footprint is already marked in a band grown at least as far
 //! as any of its triangles' is hidden ([`draw`]). [`blocked_until`] stops once given
 //! cells are blocked, for callers that need only those.
+//!
+//! **Decision: cone semantics.** A pixel stands for its centre direction (the
+//! verification samples there). The bare half-line is rasterized at centres, so it is
+//! exact; grown components are rasterized over whole cells and dilated, so they are
+//! pessimistic, as the seed's abstractions are. `refine` (opt-in,
+//! `ConeOptions::exact_boundary`) makes the reached boundary exact with parry, at about
+//! 10 µs a pixel.
+//!
+//! **Decision: back-face culling is exact** for a component that starts at the
+//! viewpoint c, with c outside the solid S grown by ρ. Let q be the first point where
+//! the half-line from c along d enters S ⊕ B(ρ); its nearest surface point s has q − s
+//! = ρ·w with w in the normal cone at s (a convex edge or a face; a reflex edge is
+//! never nearest), and d·w ≤ 0 at entry. Then w·(c − s) = w·(c − q) + ρ ≥ ρ > 0, so
+//! some triangle at s faces c, and a triangle facing away can be skipped. The rule is
+//! off for open meshes (FTC 08) and for truncated components, whose start is not c.
+//!
+//! **Decision: speed-ups keep the maps bit-identical.** A cheaper but coarser (or less
+//! pessimistic) D2 changes plans, often for the worse: the rasterized cones' pessimism
+//! acts as a margin the planner's search relies on. So culling here is only ever of
+//! what cannot change a map: a hierarchy node is skipped when its footprint is marked
+//! in a band grown at least as far (a pixel in band j is grown j times, so it covers
+//! whatever a shadow of dilation k ≤ j would add), and a D2 sample stops when it can no
+//! longer add anything. `tests/suite/access.rs` compares the hierarchy with
+//! triangle-by-triangle drawing (`blocked_plain`) on every example and two real parts.
+//!
+//! Triangles straddling a truncated component's start are split (4 levels) and the near
+//! pieces dropped; a split piece's children that fall in its middle child's band are
+//! drawn as one convex polygon (the midpoints kept as corners, so its shadow is the
+//! union of theirs), four in one band as the piece itself, and a piece whose whole
+//! shadow is already marked is not split. A prism is convex, so its faces that face the
+//! viewpoint project onto its outline's projection: one polygon for up to seven faces.
+//! [`blocked_within`] is right on given cells alone: a shadow in band k, or a node,
+//! whose footprint meets no pixel of those cells' growth k cannot mark one and is
+//! passed over (`Focus`). [`draw`] (which polygons go into which map, through a
+//! `Canvas`) and [`finish`] (bands grown, preferred directions) are two halves, so
+//! another rasterizer can sit between them.
 
 use super::cubemap::{CubeMap, Disc};
 use super::probe::Component;

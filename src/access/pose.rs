@@ -11,6 +11,24 @@
 //! **Architecture Invariant:** no other module poses a probe or states a clearance to
 //! part or table; `tests/suite/cases.rs` re-checks every move of every golden program through
 //! [`Pose::segment`].
+//!
+//! **Decision: tip fit.** The ball fits when the mesh is at least [`TIP_CLEARANCE`]
+//! (0.9) r from its centre: the fpoint lies on the exact surface, and the facets of a
+//! concave face are up to the tessellation's chord error nearer.
+//!
+//! **Decision: moves keep a margin** (`motion { margin }`, 1 mm). Every shape of the
+//! probe is grown by it for part and fixture, and the table is kept at least that far,
+//! on every move but the touch itself (the sweep from stand-off to contact, which
+//! validation checks at 0.9 r). A stand-off its feature leaves less room around keeps
+//! the largest of 1, ½, ¼, ⅛ or 0 of the margin that fits (`Pose::set_tight`); a move
+//! keeps the smaller margin of its two ends, so validation, path search and the golden
+//! re-check use one rule.
+//!
+//! **Decision: backing off in narrow features.** The tip backs off a contact by the
+//! pre-hit/retract distance, or by half the free space in front of it when that is less
+//! (it waits on a small bore's axis, not past the far wall), and needs [`MIN_TRAVEL`]
+//! (0.25 mm) to back off at all: a Ø4 ball does not "fit" a 4 mm slot. The cones,
+//! validation and the path stage all call [`backoff`].
 
 use super::{component_hits, head_direction, Component, End, ProbeShape, Scene};
 use crate::geometry::{P3, V3};

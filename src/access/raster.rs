@@ -12,6 +12,10 @@
 //! both neighbours) — the cone then samples the exact GAC at pixel centres. `Cells` marks
 //! every pixel whose cell the shadow touches, so a blocked direction anywhere in a pixel
 //! blocks the pixel; the pessimistic abstractions grow from it.
+//!
+//! A shadow whose bounding box is already all marked is not drawn (OR is idempotent),
+//! nor one whose box misses the pixels that matter when a caller names them, and a
+//! `Cells` shadow inside one pixel marks it without the row walk.
 
 use super::cubemap::{floor_i, CubeMap};
 use crate::geometry::V3;

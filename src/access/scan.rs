@@ -8,7 +8,8 @@
 //! drawn cell-conservatively, the housing as a flat component from the stand-off out, a
 //! second component (head and ram) as a bent probe's D2. At every pixel centre the cone
 //! never calls visible what exact ray casts block ([`sees`] is the exact test;
-//! `tests/suite/access.rs` compares the two).
+//! `tests/suite/scan.rs` compares the two on every example and the four NIST parts, and
+//! `tests/suite/gpu.rs` the GPU backend's scanner cones with the CPU's).
 //!
 //! **Decision:** the camera's line of sight is d turned by the triangulation angle
 //! towards the surface normal, in the plane of d and the normal (about any axis square to

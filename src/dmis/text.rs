@@ -1,5 +1,11 @@
 //! The lexical rules of the DMIS we write, in one place: the number formatter, labels,
 //! quoted text and comments, and line continuation. The reader checks the same rules.
+//!
+//! [`num`] writes 4 decimals without trailing zeros or `-0`, and [`real`] the same with
+//! its decimal point, for every DMIS real; labels are legal `[A-Z][A-Z0-9_]{0,15}` and
+//! unique per namespace whatever the spec's names (`Labels::fresh`); quoted text is
+//! printable ASCII, drawing signs as words (`plain`); lines stay within 80 characters,
+//! broken after a comma with a trailing `$` (`wrap`).
 
 use std::collections::BTreeSet;
 

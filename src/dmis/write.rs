@@ -1,4 +1,4 @@
-//! The DMIS 5.3 writer: LLIP + spec → program text (DESIGN.md, DMIS conventions).
+//! The DMIS 5.3 writer: LLIP + spec → program text.
 //!
 //! Layout: header and units, approach/retract/search/clearance, one sensor per probe (per
 //! A/B for an indexable head), the nominal of every surface measured (a feature's faces
@@ -9,6 +9,104 @@
 //! for each tolerance whose surfaces are all complete, its `TOL` (once, after the
 //! `DATDEF`s it names) and `OUTPUT`; `ENDFIL` last. Coordinates are in the part frame: after each
 //! setup's `DATSET`, a `TRANS` puts the origin back at the part's.
+//!
+//! Every statement form is one `docs/dmis.md` lists with the public source it was
+//! checked against (NIST's I++ programs, the QIF community's DMIS bindings, PTC Creo's
+//! and CMM Quarterly's references).
+//!
+//! **Decision: setups.** The program defines the machine's frame first
+//! (`D(MACHINE)=DATSET/MCS`, as NIST's programs define `D(START)`), and each setup
+//! after the first starts with `RECALL/D(MACHINE)`; a setup whose part is turned writes
+//! the turn as `ROTATE`s about Z, X, Z (`D(NOMk)`), so the manual points that follow,
+//! in part coordinates, mean the part at its nominal place on that setup's machine
+//! axes, and the virtual CMM reads the setup from them. Each probe the program selects
+//! is fitted by the operator at a `PAUSE`. A setup's prompt names its holder by the
+//! rack's label and the fixture's own name, not its kind (`HOLD IT BY FIXTURE VISE
+//! (VISE_150): JAWS ON …`: an angle plate is modelled as a sine plate at 90°, and the
+//! operator fetches the angle plate), and says where the part's +X points on the
+//! machine.
+//!
+//! **Decision: manual alignment in DMIS.** A manual step measures the feature kind its
+//! touches determine (`manual_feature`): a secondary plane's two points, which lie
+//! along it across the primary (two points one above the other would leave the turn
+//! unmeasured), as a line; a tertiary's one as a point; a bore touched at one height as
+//! a circle — never a plane or cylinder they cannot fix; a primary cylinder or a sphere
+//! needs a block of at least 3 (4) touches. `DATSET` names its features through datum
+//! labels (`DATDEF/FA(x),DAT(AL1_1)` first), as DMIS's `DATSET` takes no feature
+//! directly; the reader and the virtual CMM also take `FA()` there. A `DATSET`
+//! direction is the `FEAT`'s: its sign turns where a split bore's touched half runs
+//! against the feature's first face. A head orientation indexed for a hand touch alone
+//! (`path::align_orients`) gets its own sensor, selected for that step, and faces
+//! touched by hand only to align are declared where the alignment measures them.
+//!
+//! **Decision: coordinates are the part frame.** After each setup's `DATSET` (axes and
+//! origins from the alignment features), `TRANS` moves the origin back to the part's,
+//! so every nominal, `GOTO` and `PTMEAS` is written once in part coordinates. Once the
+//! program has measured every alignment feature of the setup itself, the same `DATSET`
+//! and `TRANS` follow again on those measurements (`D(SETUPn_DCC)`): the hand-touched
+//! points only start the alignment. One DCC pass, not a loop: its touches land within
+//! the search distance of a part placed 5 mm and 3° off, and every tolerance then reads
+//! what it reads in place to 10 µm (`a_part_placed_off_is_found_by_the_alignment` in
+//! `tests/suite/simulate.rs`); a second pass would touch every alignment feature again
+//! for a change below that. The DCC realignment keeps the manual features of faces
+//! touched by hand only. A setup whose features leave rotations or origins free says so
+//! to the operator (`TEXT/OPER`: place the part at its nominal position).
+//!
+//! **Decision: one DMIS feature per surface.** A feature's faces that lie on one
+//! surface (`PartGeometry::one_surface`: a bore in two halves that touch along their
+//! seam, a plane the CAD split, coplanar pads) are one block in the path stage and one
+//! `FEAT`; coaxial holes that do not touch are each their own (`<FEATURE>_1`, …), and a
+//! tolerance on the feature is output for every one of its surfaces. A surface whose
+//! points the plan splits between groups is measured as `FEAT/POINT`s (a block of one
+//! or two touches fits no cylinder) and joined by `CONST/<type>,F(X),BF,FA(X_P1),…` at
+//! its last block; a block that touches a point again (a datum measured anew with
+//! another probe) starts a new measurement of the surface. `TOL` is written just before
+//! its first `OUTPUT`, which waits until every surface of the tolerance's features and
+//! datum features is complete, so `DATDEF` comes first; an `OUTPUT` already written is
+//! not repeated when a tolerance is recorded in several groups. A feature of two
+//! opposed parallel planes (a slot, a tab) is a feature of size:
+//! `CONST/PARPLN,F(X_MID),BF,…` from its walls once both are measured, which `DATDEF`
+//! and every tolerance but form and profile (each wall) name. A datum feature of
+//! several parallel bores or pins (FTC 06's F, FTC 08's G) is a pattern:
+//! `F(X)=FEAT/PATERN,F(X_1),…` and, once every member is measured in the setup,
+//! `CONST/PATERN,F(X),BF,FA(X_1),…` before `DAT(F)=DATDEF/FA(X)`; the datum is the
+//! pattern's axis, centre and clocking, not its first hole.
+//!
+//! **Decision: sensors and words.** `SNSDEF/PROBE,FIXED,CART,0,0,-L,0,0,1,D` and
+//! `SNSDEF/PROBE,INDEX,POL,A,B,VEC,i,j,k,L,D` (L tip centre to head, D tip diameter,
+//! the vector tip to head in machine axes); `DATSET` direction words `XDIR`… with a
+//! leading `-` for a negative normal; a datum on the table is `<FEATURE>_T` (the table
+//! plane); free-form faces are `GSURF`. Probe changes happen on the clearance plane;
+//! the rack is not modelled.
+//!
+//! **Decision: stand-offs.** A block whose stand-off differs from the program's
+//! (`path::outlast`: a narrow bore, a feature whose tolerances let it stand proud) gets
+//! its own `SNSET/APPRCH` and `RETRCT`; consecutive blocks of one stand-off share one
+//! `SNSET`, and the default comes back before the next block that approaches by it, or
+//! at the group's end (`group`).
+//!
+//! **Decision: drill depth.** A distance to a drilled hole (a bore and, on its axis,
+//! the cone its drill point leaves) reaches the circle where the full diameter ends,
+//! constructed as `CONST/CIRCLE,F(c),INTOF,FA(bore),FA(cone)` (`full_diameter`): a
+//! blind hole's depth is that of its full diameter (ASME Y14.5), and a distance to the
+//! cone's apex reads a good part's drill depth long (FTC 06's 12.7 mm depths as 14.6,
+//! OUT).
+//!
+//! **Decision: datums measured again.** Where a setup measures again a datum its
+//! tolerances read (`plan::remeasure`), the writer starts a new round of the surface
+//! there (`DATDEF` again) and outputs the setup's tolerances after it (`ready`).
+//!
+//! **Decision: scans.** DMIS 5.3 measures along a path with `PAMEAS` inside a `MEAS`
+//! block, the path defined beforehand
+//! (`P(label)=PATH/LINE,CART,x1,y1,z1,x2,y2,z2,i,j,k`: start, end and the scanner's
+//! direction from the surface), as vendors' DMIS (RationalDMIS, Creo's CMM output)
+//! writes scans; a `MEAS` block that scans announces the cloud's size at the scanner's
+//! spacing, which the standard leaves to the machine (`dmis::read` does not count it).
+//! The scanner is `S(label)=SNSDEF/LASER,…` in the form of the probe definitions, the
+//! stand-off in the length's place and the stripe's width in the diameter's: a
+//! controller maps the label to its calibrated sensor as it does for probes. A face
+//! scanned from several views is one partial feature per view joined by a best-fit
+//! `CONST`, as split touches are.
 
 use super::text::{num, plain, real, wrap, Labels};
 use super::Input;
@@ -442,8 +540,8 @@ impl Writer<'_> {
     /// One sensor per probe (per probe and A/B on an indexable head), in order of first
     /// use by the measuring groups, then those only a hand alignment indexes to. A laser
     /// scanner is `SNSDEF/LASER` in the form of a probe's, its stand-off in the length's
-    /// place and its stripe's width in the diameter's (see ARCHITECTURE, "Scans in
-    /// DMIS").
+    /// place and its stripe's width in the diameter's (see the module's decision on
+    /// scans).
     fn sensor_definitions(&mut self) {
         let input = self.input;
         let cmm = &input.model.cmms[input.plan.cmm.0];

@@ -1,6 +1,16 @@
 //! Constructive parts: stock and machining operations combined by boolean operations,
 //! then every output triangle classified onto the named face whose exact surface it
 //! lies on.
+//!
+//! **Decision: mesh booleans by boolmesh** (a pure-Rust port of Manifold, pinned
+//! `=0.1.10`; MPL-2.0; glam inside, converted at its boundary only). Manifold's C++
+//! bindings would keep face provenance but need a C++ build in CI; csgrs is BSP-based
+//! and slower. boolmesh returns no provenance, so this file recovers it: a triangle
+//! belongs to the named face whose exact surface holds all its corners (within the 0.05
+//! mm tessellation tolerance for curved faces), whose outward normal agrees with the
+//! triangle's, and whose primitive bounds contain it. Consecutive disjoint tools of one
+//! kind are batched into one boolean: swiss_block's 100 holes are one subtraction, an
+//! order of magnitude faster than one at a time.
 
 use super::errors::GeometryError as E;
 use super::primitives::{

@@ -1,6 +1,11 @@
 //! Fixtures made from a mesh (`fixture X { kind mesh, mesh "nest.stl", up +z }`): the mesh
 //! read in the part's frame and checked against the part — it must touch the part (its
 //! locating faces, which it covers) and must not cut into it.
+//!
+//! A fixture that cuts into the part is `insp::geometry::fixture_overlaps_part`, one
+//! that touches no face `insp::geometry::fixture_misses_part`; its locating faces are
+//! those with at least [`MIN_CONTACT_MM2`] (1 mm²) within [`CONTACT_MM`] (0.05 mm) of
+//! it. The planner offers that one pose (`plan::poses`).
 
 use super::errors::{self, GeometryError};
 use super::{FaceId, PartGeometry, P3};

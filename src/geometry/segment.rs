@@ -4,8 +4,9 @@
 //! Segmentation: triangles whose normals agree within [`FLAT_DEG`] and that touch form
 //! flat patches. A flat patch bordered mostly by gentle creases (under [`SMOOTH_DEG`])
 //! is a facet of a curved face; neighbouring facets join into curved regions. Every
-//! region is fitted ([`super::fit::best`]); a curved region no surface fits falls back
-//! to its flat patches.
+//! region is fitted ([`super::fit::best`]: the simplest surface that fits with agreeing
+//! normals); a curved region no surface fits is split by growing sub-regions, facet by
+//! facet, while one surface still fits them.
 
 use super::fit::{self, Patch};
 use super::{PartGeometry, RawMesh, Surface, P3, V3};

@@ -11,6 +11,31 @@
 //! **Architecture Invariant:** node order is deterministic: the part, then tolerances in
 //! declaration order with their features as first named, then the remaining features,
 //! then faces as their features first list them, then each face's fpoints.
+//!
+//! **Decision: points where the tolerance looks.** Each face's strategy is the override
+//! of the first feature (in declaration order) that lists the face, else the plan's
+//! sampling for its surface type. Under `std::sampling::spread`, the default, a face
+//! whose form or orientation is toleranced gets points to its usable edges
+//! (`spread_for`), because Fan & Leu's fifth-inset points read a bow of twice a
+//! flatness zone as half of it and a tilt at 60 % of its span; with a zone under
+//! [`TIGHT_ZONE`] it gets at least twice NPL Good Practice Guide No. 41's counts
+//! (Flack, *CMM measurement strategies*, 2001). Faces that are only located or sized
+//! keep Fan & Leu's points, which a probe reaches more easily (spread on every face,
+//! FTC 06 and FTC 08 read from STEP get points by edges no path reaches). Plans that
+//! name `fan_leu` (the seed's examples) keep it.
+//!
+//! **Decision: form needs more than four points.** Under `fan_leu`, a plane whose
+//! flatness or straightness is toleranced gets at least [`FORM_POINTS`] (9) unless its
+//! feature has its own strategy: four corner points of one rectangle lie on a plane
+//! whatever the face does between them, so a bowed face reads flat.
+//!
+//! **Decision: datum faces on the table.** A planar datum face is `on_table` when no
+//! vertex of the part lies more than 1e-6 of the part's size (plus three times a mesh
+//! face's fit RMS) outside its plane.
+//!
+//! [`check_surfaces`] rejects tolerances on faces of the wrong surface type
+//! (`insp::graph::wrong_surface`: flatness on a cylinder, a diameter on a plane) before
+//! any sampling.
 
 mod errors;
 mod render;

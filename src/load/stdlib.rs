@@ -1,4 +1,8 @@
 //! The standard library, embedded in the binary from `stdlib/`.
+//!
+//! **Decision: catalogue figures** in `stdlib/` are Renishaw's published ranges
+//! (PH9/PH10: A 0–105°, B ±180°, 7.5° steps, 720 orientations) and rounded envelopes;
+//! the stdlib's comments say so.
 
 /// Every standard module: its `use` name and its source.
 pub const STD_MODULES: &[(&str, &str)] = &[

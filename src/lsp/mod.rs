@@ -9,6 +9,14 @@
 //! save in a child process (`inspc lsp --plan FILE`), killed when the next save or a
 //! close comes first: a slow plan never blocks typing and a stale one never lands.
 //! Its diagnostics show while the text is the one planned; hovers show its results.
+//!
+//! **Decision: rust-analyzer's `lsp-server` and `lsp-types`.** A synchronous message
+//! loop fits stages that are pure functions, with no async runtime to carry. Planning
+//! in a child process that the next save or a close kills is cancellation without
+//! threading a flag through the planner, and a planner that can never take the server
+//! down. Hovers read the plan's JSON (per face: setup, probe, orientation, points; per
+//! tolerance: the setups that record it). Definitions into the stdlib open a read-only
+//! copy written once per version under the temp directory.
 
 mod complete;
 mod hover;

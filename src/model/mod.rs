@@ -8,6 +8,12 @@
 //! **Architecture Invariant:** the model holds no spans except for diagnostics later
 //! stages may raise (planning failures point at the face or level at fault), and no
 //! `HashMap`: iteration order is declaration order everywhere.
+//!
+//! **Decision: motion defaults** (`motion { … }` in a plan, [`Motion`]): prehit and
+//! retract 2 mm, search 4 mm, clearance 20 mm, margin 1 mm. A TP20's pre-travel is well
+//! under a millimetre, and 2 mm keeps touches short. The clearance plane holds the head
+//! at `top + clearance + longest reach` in every group of a setup, so any probe in any
+//! orientation swings clear when the sensor changes there.
 
 mod part;
 mod summary;

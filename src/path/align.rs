@@ -16,6 +16,50 @@
 //! setup's own probe orientations, or on an indexable head with one the head indexes to
 //! for that touch alone ([`Touchable::orient`]). Whatever stays free is named in
 //! [`Alignment::missing`] and becomes an operator instruction.
+//!
+//! **Decision: every setup aligned on the part.** What the setup's own features leave
+//! free is taken from other faces of the part the operator can touch ([`complete`]),
+//! not left to the operator's squaring: the target is a part placed anywhere within ±5
+//! mm and ±3°. Datum faces first, then faces no tolerance reads (a bowed toleranced
+//! face would turn the frame the others are read in), then toleranced faces, each only
+//! for degrees of freedom every frame of its location and profile tolerances fixes
+//! (`LeftFree`: a frame fixes only what its datum features constrain, ASME Y14.5-2018
+//! ch. 7; the evaluation reads what it leaves free in the alignment,
+//! `simulate::evaluate::drf`, so a face aligned on in such a degree of freedom would
+//! read in place in it). The steps: the plane facing most nearly up, a plane across it
+//! touched twice along it, one touch per free origin, a sphere's centre; each touch
+//! checked with `Pose::approach`, points from the `spread` grid; each step carries its
+//! own touches (`AlignStep::extra`). These faces are touched by hand only; the DCC
+//! realignment keeps their manual features (measuring them under DCC would need paths
+//! the planner never planned). On an indexable head the operator may also index the
+//! head for such a touch: per probe of the setup, the grid orientation nearest each
+//! part axis that no group takes (`path::align_orients`, within 20°), offered after the
+//! setup's own orientations — a setup that measures one face from above otherwise has
+//! nothing to fix its turn.
+//!
+//! **Decision: long lines, clear of edges.** A hand-touched secondary line is first
+//! sought a tenth of the part long (5–50 mm, `long_line`) on a face no tolerance reads:
+//! a touch's error over the line turns the frame (a 6.4 mm line beside a bore turned a
+//! frame 0.45° for 0.05 mm), and a long line on a profiled face moves the frame with
+//! the profile. Hand touches keep `HAND_EDGE` (5 mm) beyond the tip from the face's
+//! edges where three touchable points remain that way. Where the measuring run starts
+//! in another orientation than the last hand touch, the operator is told to raise the
+//! probe first. What stays free is `insp::path::alignment_incomplete`.
+//!
+//! **Decision: what a setup aligns on.** A feature the frame is built on reads perfect
+//! in it (a moved feature aligned on in a setup without its datums passed its profile),
+//! so the setup first aligns without two kinds of block — a feature a tolerance reads
+//! against datums, even when a datum shares its face (FTC 08's datum F is one of the
+//! holes of a pattern located to D, B and C), and a face whose points the setup takes
+//! only some of (the rest in another setup's frame) — completing from faces touched by
+//! hand; only where that leaves a degree of freedom does it use them, and
+//! `insp::path::self_aligned` warns. A plane parallel to the table ranks with the datum
+//! plane the part rests on, just after its own table-plane touches: a side datum turned
+//! 0.5° swings the far end of a long part millimetres (FTC 06 resting on A, framed on
+//! B, drove the stylus into the part), while a plane parallel to A reads B's
+//! perpendicularity and nothing else. Hand touches on a bore are circles spread round
+//! it (one circle; two for a primary axis), not the four points farthest apart in
+//! space, which can lie on one line and leave the centre across them unknown.
 
 use super::{Hlip, SetupPath};
 use crate::access::Contact;

@@ -4,6 +4,12 @@
 //! sampling spread ([`short_axes`]). A tilt is read over the length between a bore's
 //! extreme circles: a program that drops the deepest reads a tilt at the share of the
 //! length it keeps.
+//!
+//! **Decision:** the rarity rule spares a round face's end circles where its axis is
+//! read: a blind datum bore whose deepest circle only a probe along its axis reaches
+//! read a tilt of twice its zone as under half of it without them. Points no probe
+//! reaches still drop (a bore 47 mm deep for a 50 mm stylus reads its tilt over half
+//! its length), and `insp::plan::short_axis` says so.
 
 use super::errors::PlanError;
 use super::Input;

@@ -3,6 +3,12 @@
 //! those touches moved to another configuration that validates (a setup the plan already
 //! has, any probe, any orientation), and the few that none takes left out with a warning
 //! naming the face, the probe and what it hit. Every touch of the result validated.
+//!
+//! **Decision: always an answer.** `--rounds N` sets the limit (40). Each touch that
+//! failed moves to the first configuration that validates in a setup the plan already
+//! has (its own configurations first, then any probe and orientation); the rest are
+//! left out with a warning per face (`insp::plan::points_left_out`). Only a search in
+//! which no round got as far as validation ends in `insp::plan::no_convergence`.
 
 use super::cluster::Strategy;
 use super::hlip::{assemble, Round};

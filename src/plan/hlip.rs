@@ -4,6 +4,16 @@
 //!
 //! Coordinates are *quantised* to 1 / [`STEPS_PER_MM`] once, here: the plan that is
 //! printed and the plan the path stage moves by are the same numbers.
+//!
+//! **Decision: setups are named by the part direction that faces the ram** (`prefer
+//! setup +z` puts the part's +z up), as in the seed's listings.
+//!
+//! **Decision: the proven minimum** of setups (`min_setups`, a line of the summary)
+//! counts only realisable setups in which some probe reaches a point with its stylus
+//! off the table (the cones do not see the table); a point higher above the table than
+//! the probe is long is assumed reached, so it stays a lower bound. For a plan of one
+//! or two setups it is proven from the plan's own setups and the cells every point
+//! shares, without every point's whole setup set.
 
 use super::cluster::{min_hitting_set, Strategy};
 use super::knowledge::Knowledge;

@@ -11,6 +11,26 @@
 //! validation rejects a configuration, the point's domain is replaced by the whole
 //! probe's cones (every component at contact and retract point, and the weak GAC D2),
 //! and the rejected configuration is removed.
+//!
+//! **Decision: exact directions.** The axes, preferred setups, table setups and up to
+//! 48 face axes (±, of cylinders and cones) and plane normals are preferred directions
+//! of every cone: a stylus often clears a hole only along its axis, which no pixel
+//! centre hits. Rasterized probe cones block a preferred direction conservatively; on
+//! acquisition the ones the half-line allowed are re-tested exactly by validation.
+//!
+//! **Decision: preferences are exact directions.** A preferred setup is a preferred
+//! direction of every cone; a forbidden setup removes the setups within `FORBID_ANGLE`
+//! (10°) of it.
+//!
+//! **Decision: the table alternative** (ch. 3.6.2). Datum faces that can rest on the
+//! table (`graph`'s `on_table`) get the setup −n in their domain; when it is chosen,
+//! four points on the table around the face's footprint replace the face.
+//!
+//! Every point's setups are masked by the realisable setups (`poses`); the stable
+//! poses' directions are exact cells of the cube maps, and the setup cell's `Held`
+//! (holder, table, fixture solids) is what validation poses against. D1′ on the A/B
+//! grid comes from one depth map per setup (`access::SecondMap`), cached per (point,
+//! probe, setup), and keeps the probe off the table.
 
 use super::cluster::{Bits, Set};
 use super::machine::Machine;

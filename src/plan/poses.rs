@@ -1,7 +1,7 @@
 //! Setups an operator can realise (issue 14): the part resting on the table in a stable
 //! pose. Spitz treats a setup as any direction and assumes a fixture exists; a CMM user
 //! has a table and gravity, so the planner chooses among these poses only (and those of
-//! the fixtures a plan names, see [`super::fixture`]).
+//! the fixtures a plan names, see [`Setups`]).
 //!
 //! A pose rests the part on a facet of its convex hull. Its *support polygon* is the
 //! convex hull of the points that really touch the table there: vertices of part faces
@@ -14,6 +14,34 @@
 //!
 //! **Architecture Invariant:** a function of the geometry alone; poses come out in a
 //! fixed order (largest support area first, then by direction).
+//!
+//! **Decision: setups are physical.** A setup is a stable pose on the table or a named
+//! fixture's pose; Spitz's "any direction, a fixture exists" is what a plan says by
+//! naming a fixture (the swiss sphere's plans name a chuck). Ten degrees to tip
+//! excludes a disc on its rim, a shaft on its end and a thin plate on its edge. The
+//! table alone comes first, then the plan's fixtures in the order it names them: a vise
+//! clamps two opposite bounding faces, the part on a flat face square to them; a chuck
+//! holds an outer cylinder at the part's end, axis vertical, or a sphere in any
+//! direction; V-blocks hold an outer cylinder at the part's bottom, axis horizontal,
+//! turned in 15° steps; a sine or angle plate tilts a flat face within its range.
+//! Fixtures are solids for validation and moves only — the cones do not see them, so a
+//! fixture failure removes the configuration at once, and every other orientation of
+//! that setup is validated again then. Their solids are a little larger than real ones
+//! (25 mm jaws, a plate 30 mm past the part). A fixture from a mesh (`kind mesh`,
+//! `geometry::fixture`) offers its one pose, the mesh a parry obstacle, the table under
+//! its lowest point.
+//!
+//! **Decision: a plate holds a part as an operator clamps it.** A sine or angle plate
+//! clamps one of the part's broad flat faces (at least a quarter of the largest one's
+//! support; at most the 8 largest), with that face's longest edge against the plate's
+//! rail, square to it or at 45° (a parallel or a 45° block), tilted within the plate's
+//! range; the planner tries those poses exactly (the range's ends and every 5°). Any
+//! cube-map direction at an allowed angle from any flat face is not a pose: it would
+//! let plans clamp a plate by a chamfer or tilt a part about an arbitrary axis, which
+//! no operator does. The plan says how the part lies ("tilted 60°, its longest edge
+//! along the hinge"). A tilted plate's solid runs up its own plane from the table (its
+//! hinge the fixture's `height` under the part) to 30 mm past the part's top, so the
+//! table lies where the real one does.
 
 use crate::access::pose::Solid;
 use crate::geometry::{FaceId, FixtureMesh, PartGeometry, Surface, P3, V3};

@@ -19,6 +19,10 @@
 //! are evaluated against them there (Hocken & Pereira, *Coordinate Measuring Machines
 //! and Systems*, 2nd ed., ch. 13). Where no probe reaches a datum in the setup of the
 //! features read against it, the plan says so ([`PlanError::DatumInOtherSetup`]).
+//!
+//! Where no probe reaches the datum, the program still reports the tolerance and the
+//! warning names the tolerance, the datums and their setups. A feature measured across
+//! setups is left as it is (joined through the setups' alignments).
 
 use super::filter::min_points;
 use super::hlip::collect;

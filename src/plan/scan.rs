@@ -16,6 +16,23 @@
 //! **Decision:** coverage is judged at a cube-map resolution of at most 32 (cones of
 //! 6 × 32² directions, 2.8° pixels): the scanner's incidence limit and stripe are far
 //! coarser than that, and each face costs a few hundred cones.
+//!
+//! **Decision: a scan stage after the touch plan, not a slot of the solver.** The
+//! scanner's unit is a face's area (coverage, passes), not an fpoint, and Zhao et al.
+//! plan it per face too; so the scanner's faces are planned here, after the touch plan,
+//! rather than as a slot of the solver with per-fpoint domains. The hierarchy still
+//! holds: a face goes to a setup the touch plan already has when that covers it (setups
+//! first), the scanner is one sensor node per setup after the probes (its slot the
+//! rack's probe count plus its index), and views are few by the greedy cover. What this
+//! gives up: the solver cannot trade a touch setup for a scan. The touch plan made
+//! without the scanner's faces may hold setups none of them suits (FTC 08: every upward
+//! face goes to the scanner, so the touch plan has no `+z`): features sent back are
+//! planned for touch, and the rounds go on until none is sent back; then each feature
+//! sent back is offered to the scanner again in the final setups, and one it covers
+//! there is scanned and its touches leave the plan (`Hlip::drop_touches`). A face's
+//! cones do not depend on the setup: they are drawn once per face and kept in the memo
+//! with the coverages, so re-plans after path bans reuse them. Each pass is checked
+//! with `Pose::segment` as the path stage will run it.
 
 use super::hlip::{quantise, ScanPass, ScannedFace};
 use super::memo::ScanMemo;

@@ -8,6 +8,19 @@
 //! each variable is clustered: faces always; features for a `(T, F, *)` level; tolerances
 //! for `(T, *)`; the part for `(*, *)`. A node without its level passes its children's
 //! clusters up unmerged.
+//!
+//! **Decision: violations** count, per level, pairs of leaf measurements (tolerance,
+//! feature, face, fpoint) of one group with different values; an orientation's value is
+//! its probe direction in the part frame, so two setups differ in orientation too.
+//! Order problems in a hierarchy (a probe level above a setup level) are refused by the
+//! resolver, never reordered here.
+//!
+//! **Decision: selection.** In the weighted strategy a cell weighs its preference's
+//! weight, other cells 0.5. A setup is picked (`pick_setup`) among the cluster's
+//! underlying set: preferred setups by weight, then the axes (+z, −z, +x, −x, +y, −y),
+//! then table setups, then the pixel deepest inside the cluster. Probe costs weigh
+//! 1/cost and the cheapest probe of a cluster is chosen; orientation preferences weigh
+//! like setups, then the smallest A wins.
 
 use super::cluster::{cluster, Bits, Set, Strategy};
 use super::knowledge::Knowledge;

@@ -2,6 +2,10 @@
 //! fpoint — posed and checked by [`crate::access::pose`]: the tip sweeps from the retract
 //! point to the contact, every other component is tested along the approach, the part is
 //! an obstacle and the table is a plane under the part in that setup.
+//!
+//! Each PIP is validated at the nominal pose and with the part turned
+//! [`PLACEMENT_TURN`] (3°) either way about the vertical (the stylus then stands turned
+//! the other way in the part's frame): see `plan_placed` for why.
 
 use super::knowledge::{Held, Knowledge};
 use super::machine::Machine;

@@ -1,6 +1,10 @@
 //! Datums: a datum's declaration (`datum A = feature`), references to datums in
 //! tolerances and frames (`A`, `B(mmc)`), material modifiers, and the rule that a
 //! reference frame names each datum once.
+//!
+//! **Decision:** datums are capital letters other than I, O and Q, as ASME Y14.5 names
+//! them (a warning otherwise). A datum on a face expression rather than a named feature
+//! gets a feature of its own.
 
 use super::errors::ResolveError as E;
 use super::faces::face_expr;

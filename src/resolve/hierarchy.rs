@@ -1,4 +1,10 @@
 //! Constraint hierarchies (Spitz ch. 3.4): levels, groups and the order the solver needs.
+//!
+//! **Decision: hierarchy order.** The solver fixes setups, then probes, then
+//! orientations (Spitz 3.5), so a hierarchy that ranks a `same_probe` level above a
+//! `same_setup` level (or `same_orient` above either) is an error
+//! (`insp::resolve::hierarchy_order`), never silently reordered. `(T, *, *)` is
+//! accepted as `(T, *)`, and `same_orien` as `same_orient`.
 
 use super::errors::ResolveError as E;
 use super::props::Cx;

@@ -9,6 +9,9 @@
 //!
 //! **Architecture Invariant:** `resolve` reads no file contents; it only asks the
 //! [`World`] whether a mesh file exists. Geometry is evaluated by a later stage.
+//!
+//! **Decision: plans in imported files are not run.** A file can be imported for its
+//! parts and machines without planning them: only the root files' plans are bound.
 
 mod catalogue;
 mod datum;

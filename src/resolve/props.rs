@@ -1,5 +1,8 @@
 //! Properties and quantities: the schema mechanism every catalogue item uses, and unit
 //! conversion to millimetres and degrees.
+//!
+//! **Decision: units.** Inside a part, bare numbers take the part's `units`; elsewhere
+//! lengths and angles need a unit (a bare `0` is allowed). Percentages are ratios.
 
 use super::errors::ResolveError as E;
 use crate::diag::{suggest, Diagnostics};

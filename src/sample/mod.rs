@@ -17,6 +17,14 @@
 //!   not cover, get Hammersley points (9 and 16).
 //! - **Uniform**: a grid of about `points` points, its outer rows at the inset.
 //! - **Hammersley** (Zhao et al. 2011): `x = i/N, y = Φ₂(i)`, area-uniform on the face.
+//! - **Spread** (`std::sampling::spread`, the default where a face's form or
+//!   orientation is toleranced: `graph::spread_for`): on a plane a grid whose outer
+//!   rows keep the margin and [`EDGE_CLEARANCE`] from the edges, a row every
+//!   [`SPREAD_SPACING`] mm, at least 3 × 3; on a cylinder or cone circles at both ends
+//!   and between, the margin and [`EDGE_CLEARANCE`] in from an open end (a through
+//!   bore's mouth) and [`END_CLEARANCE`] from a closed one (a blind bore's floor, a
+//!   boss's shoulder: material past the end where the tip's centre would be, told by
+//!   the solid's winding number).
 //!
 //! Where a grid or sequence loses points to holes, a denser one is drawn and `points` of
 //! its accepted points are kept, evenly by index. Free-form faces are sampled on their
@@ -24,6 +32,17 @@
 //!
 //! **Architecture Invariant:** sampling is a pure function of the geometry, the face,
 //! the strategy and the margin; the same inputs give the same points in the same order.
+//!
+//! **Decision: Fan & Leu beyond their paper.** Their rules cover planes, cylinders and
+//! cones; a sphere or free-form face under `fan_leu` gets Hammersley points (9 and 16).
+//! On a partial cylinder (a half bore of a mesh, a slot end) the 4 points of a circle
+//! spread over the face's arc rather than 90° apart.
+//!
+//! **Decision: narrow faces still get points.** The margin is at most `NARROW_SHARE`
+//! (0.45) of the face's smaller extent on each side, so a face narrower than the tip
+//! keeps its points towards its mid-line; a face no point of which keeps the margin is
+//! sampled again with the margin halved, down to [`MIN_MARGIN_MM`] (a 1 mm ring gets
+//! its mid-line). Which probe fits there is the planner's question, not the sampler's.
 
 mod chart;
 

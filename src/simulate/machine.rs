@@ -1,4 +1,39 @@
 //! The virtual CMM's interpreter: one pass over the program's statements.
+//!
+//! Sensors are matched to the plan's probes by tip and length. Each setup's `RECALL` of
+//! the machine's frame and its `ROTATE`s before its `PAUSE` give the part's nominal
+//! place (the operator's placement error from the deviations on top); manual touches
+//! land where the program shows them on the part; every move under `MODE/PROG` is swept
+//! by `access::Pose` (part, table under the setup's holder, fixture). Each `PTMEAS` is
+//! searched from its approach point along its vector on the face the ball's foot meets
+//! in the mesh, and solved exactly on that face's deviated analytic surface (a
+//! free-form face: the ball swept against its moved triangles); where the ball cannot
+//! reach that face (a corner radius hardly larger than the ball, the part set off by
+//! more than the ball's play in it) it stops where it first meets another face whose
+//! facets lie near its path, on that face's actual surface, as a machine's probe does.
+//! The approach is then checked against the nominal mesh from where the tip stops, or
+//! from where the ball clears the touched face's nominal triangles when that face lies
+//! deeper. Features are fitted to tip centres and offset by the tip radius; `CONST`
+//! makes best fits, centre planes and patterns (a datum of parallel bores is their mean
+//! axis through the centroid of their axes, the members giving its clocking); `DATSET`
+//! takes directions primary first, then secondary projected, origins at the feature's
+//! location along each axis named and the rest from the current frame.
+//!
+//! A scanner (`SNSDEF/LASER`) runs `PAMEAS` along a `PATH/LINE`: the housing swept from
+//! start to end, the stripe sampled at the scanner's spacing (thinned evenly to
+//! `CLOUD`, about 40 stripes of 10 points a pass) by rays along its direction onto the
+//! actual surfaces, a point kept within the depth of field, seen by laser and camera
+//! (`access::scan::sees`) and on a face whose surface is the block's nominal, with the
+//! scanner's noise. A program written elsewhere (NIST's `simple_in.dms`) runs against
+//! the spec's only plan whatever its `DMISMN` says: its first setup starts at its first
+//! motion where its alignment puts the part (`DATSET/MCS`, the machine's frame), the
+//! probe it selects first is on the ram before its first `SNSLCT`, fixed probes match
+//! in either `SNSDEF` sign convention, and `FEAT/CIRCLE` is fitted as a cylinder's
+//! section about the nominal axis.
+//!
+//! A distance to a drilled hole's full diameter
+//! (`CONST/CIRCLE,F(c),INTOF,FA(bore),FA(cone)`, see the DMIS writer) intersects the
+//! measured cone with the measured bore's radius (`full_diameter`).
 
 use super::deviation::Deviations;
 use super::errors::SimError;

@@ -19,6 +19,9 @@
 //! modifier, the zone plus the bonus the nominal size gives (ch. 10), read from the
 //! nominal run. Circularity and cylindricity need lobed or tapered surfaces, which the
 //! virtual part does not model: they are listed as not tried.
+//!
+//! A datum frame's free turn and moves are not tried (`Frame`): a position to datum A
+//! alone does not locate a bore across A.
 
 use crate::geometry::{FaceId, PartGeometry, Surface, P3, V3};
 use crate::model::{Part, TolKind, TolValue, Tolerance};

@@ -8,6 +8,22 @@
 //!
 //! [`Gpu::new`] finds a headless adapter (Vulkan: a real GPU, or Mesa's lavapipe on a
 //! machine without one).
+//!
+//! **Decision: rasterize the CPU's polygons, not rays.** An exact per-pixel test on the
+//! GPU would call free what the CPU's rounded-up dilations block, so the two would
+//! disagree on whole bands of pixels; rasterizing the CPU's own polygons agrees on
+//! 99.99 % of cells (the rest blocked on the GPU only). The per-triangle decisions
+//! (culling, splitting, bands, prisms) stay on the CPU: they are branchy, cheap, and
+//! shared by both backends, so their conservativeness is proved once.
+//!
+//! **Decision: `--backend cpu` is the default.** f32 rounding on the GPU can block a
+//! few more pixels and so change a plan's choices; "same input, same bytes on any
+//! machine" holds for the default, and `auto`/`gpu` trade it for speed where there is a
+//! GPU. `auto` takes hardware adapters only: on lavapipe the shader runs several times
+//! slower than the CPU backend (one thread per polygon, whose loops diverge on
+//! llvmpipe's SIMD lanes). Vulkan only (wgpu's `vulkan` feature): it is what lavapipe
+//! offers and what Linux CMM workstations have; each further wgpu backend is one
+//! feature flag.
 
 use super::cpu::{self, Canvas, Drawn};
 use super::cubemap::CubeMap;

@@ -2,8 +2,8 @@
 //! builds: faces of the solid bodies in shell order with their exact surfaces, edges with
 //! their curves, all in millimetres.
 //!
-//! QIF gives a face no sense flag; its loops are oriented (the face lies left of them
-//! seen from outside), so the sense is told from the bounds in [`super::read`].
+//! QIF gives a face no sense flag, and its loops do not say which side the material is
+//! on: the senses come from the topology in [`super::read`] (the module's decision).
 
 use super::xml::Node;
 use super::QifError;

@@ -10,6 +10,32 @@
 //! Unknown elements are skipped. A document of another QIF major version, a face that
 //! cannot be meshed, a reference to a missing id: each is an error naming what is wrong,
 //! never a silently missing face.
+//!
+//! **Decision: one B-rep, senses from the topology.** QIF 3 (`part p { mesh "x.qif" }`)
+//! is read into the STEP reader's `Brep` and meshed by the same tessellator, so both
+//! formats make the same faces (the suite matches every QIF face of the three NIST QIF
+//! files to its STEP face: type, area, centroid, sense). quick-xml reads the document
+//! into a small element tree. Faces are those of the visible `SOLID` bodies in shell
+//! order (sheet bodies only when there is no solid; hidden bodies are construction
+//! geometry: FTC 08's QIF keeps the STEP file's stray sheet face there). Forced by the
+//! files:
+//! - QIF gives a face no sense flag and its loops run counter-clockwise in the
+//!   surface's parameters whatever side the material is on, so the senses come from the
+//!   topology: each edge between two faces must be walked in opposite directions once
+//!   both faces are oriented, which fixes every face of a shell from one, and a shell
+//!   whose volume comes out negative is turned; a conflict is a `qif_face` error.
+//! - `Product/Header/ScaleCoefficient` draws the geometry at a scale (FTC 08's QIF is
+//!   at 2:1); the part is the geometry divided by it.
+//! - PMI values are in `PMILinearUnit` where the file names one (FTC 06: inch values in
+//!   a millimetre model), else through each value's `linearUnit`.
+//!
+//! Characteristics follow characteristic nominal → feature nominals →
+//! `EntityInternalIds` (faces, or edges as their curved faces); datums follow their
+//! feature nominals or their targets' feature nominals; composite frames' second
+//! segments become lower segments; the angle of a two-plane feature is the angle
+//! between its planes, as STEP files state it. Surfaces: plane, cylinder, cone, sphere,
+//! torus; curves: segment, circular arc, NURBS, polyline and aggregates of them; NURBS
+//! surfaces and meshed faces are `qif_unsupported`.
 
 mod brep;
 pub(in crate::geometry) mod error;

@@ -10,6 +10,25 @@
 //! **Architecture Invariant:** a face that cannot be meshed is an error naming its
 //! instance number, never a silently missing face: a hole in the mesh would let the
 //! accessibility analysis see through the part.
+//!
+//! **Decision: our own reader and tessellator, with spade for the triangulation.** The
+//! candidate stack (truck-stepio + truck-meshalgo) rejects the empty lists `()` most
+//! AP242 files hold (ruststep#256), fails on some faces and panics on small spheres;
+//! patching a fork of three crates costs more than the subset we need. `p21.rs` parses
+//! any Part 21 file (simple and complex instances, every parameter kind). `brep.rs`
+//! reads solids (`MANIFOLD_SOLID_BREP`, `BREP_WITH_VOIDS`), then sheet bodies, in file
+//! order, each shell's faces in list order (the NIST reference meshes number faces this
+//! way, except CTC 02's, which follow OpenCASCADE's order), with lengths and angles
+//! through the units of the representation that holds the solid (FTC 08 is in inches,
+//! CTC 01's cones in degrees); the spec's `units` do not apply to a STEP file, which
+//! states its own. Sheet bodies beside a solid are construction geometry (FTC 08's QIF
+//! keeps the same face in a hidden body): they keep their numbers after the solid's
+//! faces, so PMI links to them are recognised and reported, but they are not meshed —
+//! no probe touches them and no move avoids them. Sheet bodies alone are the part.
+//! Surfaces: plane, cylinder, cone, sphere, torus (also degenerate), B-spline
+//! (rational, closed); curves: line, circle, ellipse, B-spline, polyline, and the
+//! trimmed, surface and seam wrappers. Resolution ([`RESOLUTION`]): 0.1 mm chord and
+//! 0.5 rad, the reference meshes' own.
 
 pub(super) mod brep;
 pub(in crate::geometry) mod error;

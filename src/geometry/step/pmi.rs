@@ -7,6 +7,21 @@
 //! related side), datum targets (`FEATURE_FOR_DATUM_TARGET_RELATIONSHIP`) and dimensional
 //! sizes used as toleranced aspects. Reading never fails: what cannot be linked or read
 //! is a line in [`Pmi::notes`], so a caller can say so instead of guessing.
+//!
+//! **Decision: links followed, gaps said, targets located.**
+//! `ITEM_IDENTIFIED_REPRESENTATION_USAGE` is followed with its
+//! `SET_REPRESENTATION_ITEM` (where CTC 01 links datums B and C, which the NIST
+//! reference JSON lost). An aspect named by an edge (CTC 02's holes by their rims) is
+//! the edge's curved faces. Datum systems read compartments with common datums
+//! (`COMMON_DATUM_LIST`) and their modifiers, or AP214's `DATUM_REFERENCE` by
+//! precedence. Measures go through their own unit (FTC 06's PMI is in inches in a
+//! millimetre model). Datums set up only by targets on supplemental geometry (FTC 06's
+//! G, H, J, K; CTC 02's A, B, C, K) are located by sampling each target (point, line,
+//! circle, circular curve, rectangle) from its placement and size and taking the faces
+//! within 0.5 mm; when the sizes in their stated unit put the target off the part and
+//! in the model's unit on it (FTC 06 writes Ø25.4 mm with an inch unit), the model's
+//! unit is used and a note says so. Nothing is dropped silently: `inspc import` writes
+//! every note into the spec's header.
 
 use super::brep::unit_factor;
 use super::p21::{Instance, Param, P21};

@@ -11,6 +11,19 @@
 //! that each go once round (a band of a bore with no seam edge) is cut along a line
 //! between them; a face bounded by one such loop (a spherical cap, a cone to its apex)
 //! is closed at the pole on its side.
+//!
+//! **Decision: inside by crossings, refined against the exact surface.** Each face is
+//! triangulated in its parameter plane by spade's constrained Delaunay triangulation;
+//! inside is decided by counting bound crossings from the hull, not by a
+//! point-in-polygon test, which slivers between nearly collinear points fool. It is
+//! then refined by splitting the longest edge of any triangle whose centroid or edge
+//! midpoints stray more than the chord tolerance from the exact surface or whose corner
+//! normals differ by more than the angle limit. Two loops that each go round are joined
+//! by a cut that is itself cut to the tolerance on both sides; one loop that goes round
+//! is closed at the pole on the face's side (its left, seen from the face's normal); a
+//! pole inside a loop becomes a run of points along the pole. Cylinders and cones are
+//! triangulated with v squeezed `RULED_STRETCH` (8) times, so triangles run along their
+//! straight lines.
 
 use super::brep::{Bound, Brep, Edge, Face};
 use super::geom::{unwrap_near, Curve, Surf};
