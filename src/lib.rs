@@ -13,11 +13,9 @@
 //! only when the stages before it left no error. `run(…, Until)` keeps every stage's
 //! result, so the golden tests snapshot every stage from one run.
 //!
-//! **Architecture Invariant:** a stage imports earlier stages only, with two exceptions
-//! that keep one owner per rule: `path::align` asks `simulate::evaluate` what a datum
-//! frame leaves free (so alignment and evaluation agree), and `model::summary` prints
-//! `geometry::step`'s default chord. Ids go down the pipeline; names come back only
-//! through `plan::Names`.
+//! **Architecture Invariant:** a stage imports earlier stages only, and no two files of
+//! a folder import each other round a circle (`tests/suite/architecture.rs`). Ids go
+//! down the pipeline; names come back only through `plan::Names`.
 //!
 //! **Decision: fpoints are probe-independent.** They keep a margin from face edges
 //! equal to the largest tip radius of the plan's machine (1 mm without a plan), Fan &

@@ -25,7 +25,7 @@ pub fn cones(
         .collect()
 }
 
-/// [`gac_halfline`] at many points (as tip centres), in their order: on a batching
+/// [`super::gac_halfline`] at many points (as tip centres), in their order: on a batching
 /// backend in one pass, otherwise in parallel.
 pub fn gac_halfline_many(
     backend: &dyn Backend,

@@ -20,12 +20,12 @@ pub struct ConeOptions {
     /// How many points of dD1 the weak GAC D2 samples.
     pub d2_samples: usize,
     /// Refine the grown components' cones with exact parry tests at their boundaries
-    /// ([`refine`]): slower, and exact at the pixel centres it reaches.
+    /// ([`super::refine`]): slower, and exact at the pixel centres it reaches.
     pub exact_boundary: bool,
     /// Which backend rasterizes the shadows.
     pub backend: BackendKind,
     /// The setups D2 is asked about, when the caller masks it by them (the planner: the
-    /// realisable, unforbidden ones); D2 may then leave out other cells (see [`d2`]).
+    /// realisable, unforbidden ones); D2 may then leave out other cells (see [`super::d2`]).
     pub d2_wanted: Option<Arc<D2Wanted>>,
 }
 

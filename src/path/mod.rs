@@ -7,7 +7,7 @@
 //!   point); the planner validated that approach, so it is not checked again
 //!   (ch. 5.4.1);
 //! - stand-offs are joined by a roadmap ([`roadmap`]) built with the CMM local planner
-//!   and enhanced until connected; every segment is checked with parry ([`sweep`]);
+//!   and enhanced until connected; every segment is checked with parry (`Pose::segment`);
 //! - the visiting order is a tour over the roadmap's shortest paths ([`tour`]), one
 //!   block of points per feature face (a DMIS `MEAS` block), datum features first;
 //! - a group starts and ends on the clearance plane above the part, and moves between

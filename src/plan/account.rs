@@ -1,6 +1,12 @@
 //! What the plan measures: per tolerance, whether every face of its features and datum
 //! features is touched with the points its fit needs or scanned, and for each one that
 //! is not, the diagnostic naming the first face it misses and why.
+//!
+//! **Decision: unmeasured tolerances are errors** (`account`). After planning, every
+//! face of every feature and datum feature of each tolerance must be touched; one that
+//! is not fails the build (`insp::plan::unmeasured`) unless `--allow-unmeasured`, which
+//! also plans around a face no probe inspects
+//! (`insp::plan::uninspectable_face_allowed`) instead of stopping.
 
 use super::filter::min_points;
 use super::{axes, scan, Hlip, Input, PlanError, PlanOptions};

@@ -3,6 +3,16 @@
 //! (Spitz, ch. 3.6.3) — but never the end circles of a read axis ([`super::axes`]), nor
 //! so many that a plane's points fall on a line. The fewest points each surface kind's
 //! fit needs ([`min_points`]) is the floor everywhere in the planner.
+//!
+//! **Decision: filtering** (ch. 3.6.3, `filter`) drops fpoints no probe reaches, and
+//! those reached from under a twentieth of the face's median setups while the face
+//! keeps half its points and its minimum (3 on a plane, 5 on a cylinder, 6 on a cone, 4
+//! on a sphere); a face below its minimum is `insp::plan::uninspectable_face`. The end
+//! circles of a round face whose axis a tolerance or datum reads are spared
+//! (`axes::end_circles`). Where points drop, or a datum is measured again on the points
+//! one setup reaches (`remeasure`), a plane keeps points spread across an area
+//! (`spans_area`: a second principal spread of at least 0.5 mm), never a row a plane
+//! cannot be fitted to.
 
 use super::axes;
 use super::knowledge::Knowledge;

@@ -25,7 +25,7 @@ pub struct PlanOptions {
 }
 
 /// A touch configuration the path stage could not reach: the point (index into
-/// [`Hlip::points`]), the probe (rack index), the setup's up direction and the probe's
+/// [`super::Hlip::points`]), the probe (rack index), the setup's up direction and the probe's
 /// direction, both in the part frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Ban {

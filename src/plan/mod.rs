@@ -7,58 +7,25 @@
 //! pure results (cones, D2 caps, depth maps, grid orientations, the scene) for a
 //! re-plan of the same input; the path stage's attempts share its scene.
 //!
-//! Generate and test: the knowledge base ([`domain`]) holds each fpoint's domain per
-//! probe, starting from cheap half-line cones; the solver ([`solve`]) clusters up the
-//! graph under the plan's constraint hierarchy with several deterministic clustering
-//! strategies ([`cluster`]) and keeps the best plan by the hierarchy's violation counts;
-//! every primitive inspection plan of it is validated with parry ([`validate`]); what
-//! fails teaches the knowledge base (the whole probe's cones, then removal of the
-//! configuration) and the loop repeats. The entry point is [`plan`].
+//! Generate and test ([`search`]): the knowledge base ([`knowledge`]) holds each fpoint's
+//! domain per probe, starting from cheap half-line cones; the solver ([`solve`]) clusters
+//! up the graph under the plan's constraint hierarchy with several deterministic
+//! clustering strategies ([`cluster`]) and keeps the best plan by the hierarchy's
+//! violation counts; every primitive inspection plan of it is validated with parry
+//! ([`validate`]); what fails teaches the knowledge base (the whole probe's cones, then
+//! removal of the configuration) and the loop repeats. The entry point is [`plan`].
+//!
+//! The files: [`input`] what planning takes; [`search`] the rounds; [`filter`] which
+//! points a round plans; [`knowledge`] and [`memo`] what is known and what a re-plan
+//! reuses; [`machine`] the machine as the planner sees it; [`solve`] and [`cluster`] the
+//! clustering; [`validate`] and [`placement`] the checks of a touch; [`hlip`] and
+//! [`render`] the result; [`account`] what it measures; [`remeasure`], [`axes`],
+//! [`poses`], [`scan`], [`fallback`] and [`explain`] the rules named for them.
 //!
 //! **Architecture Invariant:** the result is a function of the input alone: clustering
 //! visits sets in graph order, ties go to the lower index, and parallel work (cones,
 //! validation) is collected in input order.
 //!
-//! **Decision: learning.** A failed PIP first buys its point the whole probe's cones
-//! (at most two points per face and probe a round: neighbours cluster together, ch.
-//! 4.2); once the point has them, the failing setup is removed (its pixel and
-//! neighbours for a fixed head; a 5° cap for a bent probe with no orientation left
-//! there) (`learn`).
-//!
-//! **Decision: filtering** (ch. 3.6.3, `filter`) drops fpoints no probe reaches, and
-//! those reached from under a twentieth of the face's median setups while the face
-//! keeps half its points and its minimum (3 on a plane, 5 on a cylinder, 6 on a cone, 4
-//! on a sphere); a face below its minimum is `insp::plan::uninspectable_face`. The end
-//! circles of a round face whose axis a tolerance or datum reads are spared
-//! (`axes::end_circles`). Where points drop, or a datum is measured again on the points
-//! one setup reaches (`remeasure`), a plane keeps points spread across an area
-//! (`spans_area`: a second principal spread of at least 0.5 mm), never a row a plane
-//! cannot be fitted to.
-//!
-//! **Decision: how plans are compared** (`score`): the hierarchy's levels first
-//! (violated same-constraints, level by level), then setups, probe changes, orientation
-//! changes. Preferences act inside clustering: a preferred setup is picked for a
-//! cluster whenever its underlying set holds it (`solve::pick_setup`), so it is used
-//! whenever a plan there costs no more than one elsewhere at every level above.
-//!
-//! **Decision: robust to the part set off square** (`plan_placed`). The program follows
-//! the part (its alignment finds it), but an indexed probe keeps its machine direction:
-//! with the part turned about the vertical the stylus stands turned in the part's
-//! frame, and a stylus deep in a bore with little room beside its stem touches the
-//! wall. Every touch is validated also with the part turned `validate::PLACEMENT_TURN`
-//! (3°, a part set by eye) either way; a point whose configurations collide only turned
-//! takes one clear at the nominal pose after `FRAGILE_AFTER` (6) tries, and where no
-//! turned plan settles (or none the path stage routes after its re-plans,
-//! `Memo::give_up_turned`) the plan is made at the nominal pose. A setup with touches
-//! clear only nearer square says by how much in its prompt and warns
-//! `insp::plan::placement_sensitive` (`placement`). The turned validation triples the
-//! pose checks, and a part no turned plan settles for is planned twice.
-//!
-//! **Decision: unmeasured tolerances are errors** (`account`). After planning, every
-//! face of every feature and datum feature of each tolerance must be touched; one that
-//! is not fails the build (`insp::plan::unmeasured`) unless `--allow-unmeasured`, which
-//! also plans around a face no probe inspects
-//! (`insp::plan::uninspectable_face_allowed`) instead of stopping.
 
 mod account;
 mod axes;

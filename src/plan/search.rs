@@ -5,6 +5,31 @@
 //! teach the knowledge base what failed, until a round validates or the fallback
 //! ([`super::fallback`]) settles on the best plan found. Around it, the rounds with the
 //! laser scanner: features its setups cannot cover go back to the touch probes.
+//!
+//! **Decision: learning.** A failed PIP first buys its point the whole probe's cones
+//! (at most two points per face and probe a round: neighbours cluster together, ch.
+//! 4.2); once the point has them, the failing setup is removed (its pixel and
+//! neighbours for a fixed head; a 5° cap for a bent probe with no orientation left
+//! there) (`learn`).
+//!
+//! **Decision: how plans are compared** (`score`): the hierarchy's levels first
+//! (violated same-constraints, level by level), then setups, probe changes, orientation
+//! changes. Preferences act inside clustering: a preferred setup is picked for a
+//! cluster whenever its underlying set holds it (`solve::pick_setup`), so it is used
+//! whenever a plan there costs no more than one elsewhere at every level above.
+//!
+//! **Decision: robust to the part set off square** (`plan_placed`). The program follows
+//! the part (its alignment finds it), but an indexed probe keeps its machine direction:
+//! with the part turned about the vertical the stylus stands turned in the part's
+//! frame, and a stylus deep in a bore with little room beside its stem touches the
+//! wall. Every touch is validated also with the part turned `validate::PLACEMENT_TURN`
+//! (3°, a part set by eye) either way; a point whose configurations collide only turned
+//! takes one clear at the nominal pose after `FRAGILE_AFTER` (6) tries, and where no
+//! turned plan settles (or none the path stage routes after its re-plans,
+//! `Memo::give_up_turned`) the plan is made at the nominal pose. A setup with touches
+//! clear only nearer square says by how much in its prompt and warns
+//! `insp::plan::placement_sensitive` (`placement`). The turned validation triples the
+//! pose checks, and a part no turned plan settles for is planned twice.
 
 use super::account::account;
 use super::cluster::{self, Strategy};
@@ -25,9 +50,9 @@ use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
 use std::ops::ControlFlow;
 
-/// [`plan`], keeping in `memo` the cones and depth maps it computes and reusing those a
+/// [`super::plan`], keeping in `memo` the cones and depth maps it computes and reusing those a
 /// previous planning of the same `input` left there (the re-plans after the path stage's
-/// bans). The plan is the one [`plan`] gives.
+/// bans). The plan is the one [`super::plan`] gives.
 ///
 /// The features the sensor selection gave a laser scanner are left out of the touch plan
 /// and scanned in its setups ([`scan`]); those the selection chose by its rule and no
