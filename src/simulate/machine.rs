@@ -358,6 +358,11 @@ fn label_of(p: &str) -> Option<&str> {
     rest.strip_suffix(')')
 }
 
+/// The `k`th parameter, or nothing.
+fn param(params: &[String], k: usize) -> &str {
+    params.get(k).map(String::as_str).unwrap_or("")
+}
+
 fn nums(params: &[String]) -> Vec<f64> {
     params
         .iter()
@@ -385,7 +390,6 @@ impl Machine<'_> {
         params: &[String],
         at: usize,
     ) -> Result<(), SimError> {
-        let word = |k: usize| params.get(k).map(String::as_str).unwrap_or("");
         if crate::dmis::word(major) != crate::dmis::Word::Runs {
             // The reader warned on it: DMIS the virtual CMM does not run, or not DMIS.
             return Ok(());
@@ -405,7 +409,7 @@ impl Machine<'_> {
                 }
             }
             "UNITS" => {
-                if word(0) != "MM" {
+                if param(params, 0) != "MM" {
                     return Err(self.unsupported(at, &format!("UNITS/{}", params.join(","))));
                 }
             }
@@ -414,136 +418,18 @@ impl Machine<'_> {
                     params.iter().any(|p| p == "MAN") && !params.iter().any(|p| p == "PROG");
                 self.at = None;
             }
-            "SNSET" => {
-                let v = nums(&params[1.min(params.len())..]).first().copied();
-                match (word(0), v) {
-                    ("APPRCH", Some(v)) => self.apprch = v,
-                    ("RETRCT", Some(v)) => self.retrct = v,
-                    ("SEARCH", Some(v)) => self.search = v,
-                    ("CLRSRF", Some(_)) => {}
-                    _ => return Err(self.unsupported(at, &format!("SNSET/{}", params.join(",")))),
-                }
-            }
-            "SNSDEF" => {
-                let Some((_, l)) = label else {
-                    return Err(self.bad(
-                        at,
-                        "SNSDEF without a label",
-                        "write `S(label)=SNSDEF/…`",
-                    ));
-                };
-                let s = self.sensor_def(l, params, at)?;
-                self.sensors.insert(l.clone(), s);
-            }
-            "SNSLCT" => {
-                let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
-                let Some(s) = self.sensors.get(l).copied() else {
-                    return Err(self.bad(
-                        at,
-                        &format!("sensor `{l}` is not defined"),
-                        "define it with SNSDEF first",
-                    ));
-                };
-                self.sensor = Some(s);
-                self.at = None;
-            }
-            "FEAT" => {
-                let Some((_, l)) = label else {
-                    return Err(self.bad(at, "FEAT without a label", "write `F(label)=FEAT/…`"));
-                };
-                if word(0) == "PATERN" {
-                    let members: Vec<String> = params[1..]
-                        .iter()
-                        .filter_map(|p| label_of(p))
-                        .map(str::to_string)
-                        .collect();
-                    let shapes: Vec<Shape> = members
-                        .iter()
-                        .filter_map(|m| self.nominals.get(m).map(|n| n.shape.clone()))
-                        .collect();
-                    let shape = (shapes.len() == members.len())
-                        .then(|| fit::pattern(&shapes))
-                        .flatten()
-                        .ok_or_else(|| {
-                            self.bad(
-                                at,
-                                "a pattern's members must be cylinders defined before it",
-                                "write `F(p)=FEAT/PATERN,F(bore1),F(bore2),…` after their FEATs",
-                            )
-                        })?;
-                    let convex = members
-                        .first()
-                        .and_then(|m| self.nominals.get(m))
-                        .is_some_and(|n| n.convex);
-                    self.nominals.insert(
-                        l.clone(),
-                        Nominal {
-                            shape,
-                            convex,
-                            word: "PATERN".into(),
-                            numbers: Vec::new(),
-                        },
-                    );
-                    self.patterns.insert(l.clone(), members);
-                } else {
-                    let n = nominal(params)
-                        .ok_or_else(|| self.unsupported(at, &format!("FEAT/{}", word(0))))?;
-                    self.nominals.insert(l.clone(), n);
-                }
-            }
-            "TOL" => {
-                let Some((_, l)) = label else {
-                    return Err(self.bad(at, "TOL without a label", "write `T(label)=TOL/…`"));
-                };
-                let def = TolDef::parse(params)
-                    .ok_or_else(|| self.unsupported(at, &format!("TOL/{}", params.join(","))))?;
-                self.tols.insert(l.clone(), def);
-                let words = params[1..]
-                    .iter()
-                    .filter(|p| {
-                        matches!(p.as_str(), "2D" | "3D" | "MMC" | "LMC" | "RFS")
-                            || p.starts_with("DAT(")
-                    })
-                    .cloned()
-                    .collect();
-                self.tol_words.insert(l.clone(), words);
-            }
+            "SNSET" => self.snset(params, at)?,
+            "SNSDEF" => self.snsdef(label, params, at)?,
+            "SNSLCT" => self.snslct(params, at)?,
+            "FEAT" => self.feat(label, params, at)?,
+            "TOL" => self.tol(label, params, at)?,
             // A `PAUSE` after the part was let go (`RECALL` of the machine's frame), or
             // before any setup, is the next setup's placing; any other waits for the
             // operator (a probe changed by hand), who may move the ram meanwhile.
             "PAUSE" if self.setup.is_none() || self.between => self.start_setup(at)?,
             "PAUSE" => self.at = None,
-            "RECALL" => {
-                let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
-                self.frame = if l == "MCS" {
-                    Isometry3::identity()
-                } else {
-                    *self.saved.get(l).ok_or_else(|| {
-                        self.bad(
-                            at,
-                            &format!("alignment `{l}` is not defined"),
-                            "RECALL an alignment saved before",
-                        )
-                    })?
-                };
-                self.between = l == "MCS" || self.machine_frames.contains(l);
-                self.realigned(label);
-            }
-            "ROTATE" => {
-                let axis = match word(0) {
-                    "XAXIS" => V3::x(),
-                    "YAXIS" => V3::y(),
-                    "ZAXIS" => V3::z(),
-                    _ => return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(",")))),
-                };
-                let Some(angle) = params.get(1).and_then(|p| p.parse::<f64>().ok()) else {
-                    return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(","))));
-                };
-                let q =
-                    UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), angle.to_radians());
-                self.frame = Isometry3::from_parts(self.frame.translation, self.frame.rotation * q);
-                self.realigned(label);
-            }
+            "RECALL" => self.recall(label, params, at)?,
+            "ROTATE" => self.rotate(label, params, at)?,
             // `DATSET/MCS`: the machine's own axes and origin (NIST's `simple_in.dms`).
             "DATSET" if params.len() == 1 && params[0] == "MCS" => {
                 self.frame = Isometry3::identity();
@@ -556,38 +442,8 @@ impl Machine<'_> {
                 self.frame = self.datset(params, at)?;
                 self.realigned(label);
             }
-            "TRANS" => {
-                let mut o = self.frame.translation.vector;
-                for pair in params.chunks(2) {
-                    let k = match pair[0].as_str() {
-                        "XORIG" => 0,
-                        "YORIG" => 1,
-                        "ZORIG" => 2,
-                        _ => {
-                            return Err(self.unsupported(at, &format!("TRANS/{}", params.join(","))))
-                        }
-                    };
-                    let v = pair
-                        .get(1)
-                        .and_then(|p| p.parse::<f64>().ok())
-                        .ok_or_else(|| {
-                            self.bad(at, "TRANS without a value", "write `TRANS/XORIG,value`")
-                        })?;
-                    o += self.frame.rotation * (V3::ith(k, 1.0) * v);
-                }
-                self.frame = Isometry3::from_parts(Translation3::from(o), self.frame.rotation);
-                self.realigned(label);
-            }
-            "GOTO" => {
-                let v = nums(params);
-                if v.len() != 3 {
-                    return Err(self.bad(at, "GOTO takes x, y, z", "write `GOTO/x,y,z`"));
-                }
-                if !self.manual {
-                    let q = self.frame * P3::new(v[0], v[1], v[2]);
-                    self.move_to(q, at, "moving here")?;
-                }
-            }
+            "TRANS" => self.trans(label, params, at)?,
+            "GOTO" => self.goto(params, at)?,
             "MEAS" => {
                 let l = params
                     .get(1)
@@ -596,7 +452,7 @@ impl Machine<'_> {
                     .to_string();
                 self.block = Some(Block {
                     label: l,
-                    word: word(0).to_string(),
+                    word: param(params, 0).to_string(),
                     touches: Vec::new(),
                     at,
                     scanned: false,
@@ -605,7 +461,7 @@ impl Machine<'_> {
             "PTMEAS" => self.ptmeas(params, at)?,
             "PATH" => {
                 let v = nums(params);
-                let (Some((_, l)), "LINE", 9) = (label, word(0), v.len()) else {
+                let (Some((_, l)), "LINE", 9) = (label, param(params, 0), v.len()) else {
                     return Err(self.unsupported(at, &format!("PATH/{}", params.join(","))));
                 };
                 let (a, b) = (P3::new(v[0], v[1], v[2]), P3::new(v[3], v[4], v[5]));
@@ -614,46 +470,263 @@ impl Machine<'_> {
             "PAMEAS" => self.pameas(params, at)?,
             "ENDMES" => self.endmes(at)?,
             "CONST" => self.construct(params, at)?,
-            // `DATDEF/FA(f),DAT(x)` (ANSI/DMIS 105.2; NIST's and the QIF bindings' form):
-            // the datum is the last parameter.
-            "DATDEF" => {
-                let Some(d) = params
-                    .last()
-                    .filter(|p| p.starts_with("DAT("))
-                    .and_then(|p| label_of(p))
-                    .map(str::to_string)
-                else {
-                    return Err(self.bad(
-                        at,
-                        "DATDEF without the datum it defines",
-                        "write `DATDEF/FA(label),DAT(A)`",
-                    ));
-                };
-                let l = params
-                    .first()
-                    .and_then(|p| label_of(p))
-                    .unwrap_or("")
-                    .to_string();
-                let f = self.actuals.get(&l).cloned().ok_or_else(|| {
-                    self.bad(
-                        at,
-                        &format!("feature `{l}` is not measured"),
-                        "measure a datum feature before DATDEF",
-                    )
-                })?;
-                let members: Vec<Labelled> = self
-                    .patterns
-                    .get(&l)
-                    .into_iter()
-                    .flatten()
-                    .filter_map(|m| Some((self.actuals.get(m).cloned()?, m.clone())))
-                    .collect();
-                let all = std::iter::once((f, l)).chain(members).collect();
-                self.datums.insert(d, all);
-            }
+            "DATDEF" => self.datdef(params, at)?,
             "OUTPUT" => self.output(params, at)?,
             other => return Err(self.unsupported(at, other)),
         }
+        Ok(())
+    }
+
+    /// `SNSET/APPRCH|RETRCT|SEARCH|CLRSRF,d`: the touch distances (a clearance
+    /// surface is the controller's own business).
+    fn snset(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let v = nums(&params[1.min(params.len())..]).first().copied();
+        match (param(params, 0), v) {
+            ("APPRCH", Some(v)) => self.apprch = v,
+            ("RETRCT", Some(v)) => self.retrct = v,
+            ("SEARCH", Some(v)) => self.search = v,
+            ("CLRSRF", Some(_)) => {}
+            _ => return Err(self.unsupported(at, &format!("SNSET/{}", params.join(",")))),
+        }
+        Ok(())
+    }
+
+    /// `S(label)=SNSDEF/…`: the rack's sensor of that definition, under its label.
+    fn snsdef(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let Some((_, l)) = label else {
+            return Err(self.bad(at, "SNSDEF without a label", "write `S(label)=SNSDEF/…`"));
+        };
+        let s = self.sensor_def(l, params, at)?;
+        self.sensors.insert(l.clone(), s);
+        Ok(())
+    }
+
+    /// `SNSLCT/S(label)`: the sensor defined under that label, on the ram.
+    fn snslct(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
+        let Some(s) = self.sensors.get(l).copied() else {
+            return Err(self.bad(
+                at,
+                &format!("sensor `{l}` is not defined"),
+                "define it with SNSDEF first",
+            ));
+        };
+        self.sensor = Some(s);
+        self.at = None;
+        Ok(())
+    }
+
+    /// `F(label)=FEAT/…`: a feature's nominal, a pattern's from its members'.
+    fn feat(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let Some((_, l)) = label else {
+            return Err(self.bad(at, "FEAT without a label", "write `F(label)=FEAT/…`"));
+        };
+        if param(params, 0) == "PATERN" {
+            let (n, members) = self.pattern(params, at)?;
+            self.nominals.insert(l.clone(), n);
+            self.patterns.insert(l.clone(), members);
+        } else {
+            let n = nominal(params)
+                .ok_or_else(|| self.unsupported(at, &format!("FEAT/{}", param(params, 0))))?;
+            self.nominals.insert(l.clone(), n);
+        }
+        Ok(())
+    }
+
+    /// `FEAT/PATERN,F(m1),F(m2),…`: the pattern's nominal, fitted to its members'
+    /// (cylinders defined before it), and their labels.
+    fn pattern(&self, params: &[String], at: usize) -> Result<(Nominal, Vec<String>), SimError> {
+        let members: Vec<String> = params[1..]
+            .iter()
+            .filter_map(|p| label_of(p))
+            .map(str::to_string)
+            .collect();
+        let shapes: Vec<Shape> = members
+            .iter()
+            .filter_map(|m| self.nominals.get(m).map(|n| n.shape.clone()))
+            .collect();
+        let shape = (shapes.len() == members.len())
+            .then(|| fit::pattern(&shapes))
+            .flatten()
+            .ok_or_else(|| {
+                self.bad(
+                    at,
+                    "a pattern's members must be cylinders defined before it",
+                    "write `F(p)=FEAT/PATERN,F(bore1),F(bore2),…` after their FEATs",
+                )
+            })?;
+        let convex = members
+            .first()
+            .and_then(|m| self.nominals.get(m))
+            .is_some_and(|n| n.convex);
+        let n = Nominal {
+            shape,
+            convex,
+            word: "PATERN".into(),
+            numbers: Vec::new(),
+        };
+        Ok((n, members))
+    }
+
+    /// `T(label)=TOL/…`: the tolerance, and the words its report row repeats.
+    fn tol(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let Some((_, l)) = label else {
+            return Err(self.bad(at, "TOL without a label", "write `T(label)=TOL/…`"));
+        };
+        let def = TolDef::parse(params)
+            .ok_or_else(|| self.unsupported(at, &format!("TOL/{}", params.join(","))))?;
+        self.tols.insert(l.clone(), def);
+        let words = params[1..]
+            .iter()
+            .filter(|p| {
+                matches!(p.as_str(), "2D" | "3D" | "MMC" | "LMC" | "RFS") || p.starts_with("DAT(")
+            })
+            .cloned()
+            .collect();
+        self.tol_words.insert(l.clone(), words);
+        Ok(())
+    }
+
+    /// `RECALL/D(label)`: a saved alignment, or the machine's own (`D(MCS)`), which lets
+    /// the part go until the next setup's `PAUSE`.
+    fn recall(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
+        self.frame = if l == "MCS" {
+            Isometry3::identity()
+        } else {
+            *self.saved.get(l).ok_or_else(|| {
+                self.bad(
+                    at,
+                    &format!("alignment `{l}` is not defined"),
+                    "RECALL an alignment saved before",
+                )
+            })?
+        };
+        self.between = l == "MCS" || self.machine_frames.contains(l);
+        self.realigned(label);
+        Ok(())
+    }
+
+    /// `ROTATE/XAXIS|YAXIS|ZAXIS,deg`: the alignment turned about one of its axes.
+    fn rotate(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let axis = match param(params, 0) {
+            "XAXIS" => V3::x(),
+            "YAXIS" => V3::y(),
+            "ZAXIS" => V3::z(),
+            _ => return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(",")))),
+        };
+        let Some(angle) = params.get(1).and_then(|p| p.parse::<f64>().ok()) else {
+            return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(","))));
+        };
+        let q = UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), angle.to_radians());
+        self.frame = Isometry3::from_parts(self.frame.translation, self.frame.rotation * q);
+        self.realigned(label);
+        Ok(())
+    }
+
+    /// `TRANS/XORIG,x[,YORIG,y…]`: the alignment's origin moved along its axes.
+    fn trans(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let mut o = self.frame.translation.vector;
+        for pair in params.chunks(2) {
+            let k = match pair[0].as_str() {
+                "XORIG" => 0,
+                "YORIG" => 1,
+                "ZORIG" => 2,
+                _ => return Err(self.unsupported(at, &format!("TRANS/{}", params.join(",")))),
+            };
+            let v = pair
+                .get(1)
+                .and_then(|p| p.parse::<f64>().ok())
+                .ok_or_else(|| {
+                    self.bad(at, "TRANS without a value", "write `TRANS/XORIG,value`")
+                })?;
+            o += self.frame.rotation * (V3::ith(k, 1.0) * v);
+        }
+        self.frame = Isometry3::from_parts(Translation3::from(o), self.frame.rotation);
+        self.realigned(label);
+        Ok(())
+    }
+
+    /// `GOTO/x,y,z`: a move under `MODE/PROG`; by hand, the operator's business.
+    fn goto(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let v = nums(params);
+        if v.len() != 3 {
+            return Err(self.bad(at, "GOTO takes x, y, z", "write `GOTO/x,y,z`"));
+        }
+        if !self.manual {
+            let q = self.frame * P3::new(v[0], v[1], v[2]);
+            self.move_to(q, at, "moving here")?;
+        }
+        Ok(())
+    }
+
+    /// `DATDEF/FA(f),DAT(x)` (ANSI/DMIS 105.2; NIST's and the QIF bindings' form): the
+    /// datum, the last parameter, is the measured feature and, for a pattern, its
+    /// members after it.
+    fn datdef(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let Some(d) = params
+            .last()
+            .filter(|p| p.starts_with("DAT("))
+            .and_then(|p| label_of(p))
+            .map(str::to_string)
+        else {
+            return Err(self.bad(
+                at,
+                "DATDEF without the datum it defines",
+                "write `DATDEF/FA(label),DAT(A)`",
+            ));
+        };
+        let l = params
+            .first()
+            .and_then(|p| label_of(p))
+            .unwrap_or("")
+            .to_string();
+        let f = self.actuals.get(&l).cloned().ok_or_else(|| {
+            self.bad(
+                at,
+                &format!("feature `{l}` is not measured"),
+                "measure a datum feature before DATDEF",
+            )
+        })?;
+        let members: Vec<Labelled> = self
+            .patterns
+            .get(&l)
+            .into_iter()
+            .flatten()
+            .filter_map(|m| Some((self.actuals.get(m).cloned()?, m.clone())))
+            .collect();
+        let all = std::iter::once((f, l)).chain(members).collect();
+        self.datums.insert(d, all);
         Ok(())
     }
 
