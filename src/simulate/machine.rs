@@ -139,6 +139,10 @@ struct Block {
     scanned: bool,
 }
 
+/// What `DATSET`'s keywords ask for: directions by axis (0 for x), and the shapes that
+/// give the origin along an axis.
+type DatsetTargets = (Vec<(usize, V3)>, Vec<(usize, Shape)>);
+
 /// A nominal from `FEAT`: its shape (program frame) and whether it is convex.
 #[derive(Debug, Clone)]
 struct Nominal {
@@ -1685,9 +1689,22 @@ impl Machine<'_> {
     /// `DATSET/FA(f),[-]XDIR,XORIG,…`: the frame whose axes and origin the features
     /// give; what they leave free comes from the current frame.
     fn datset(&self, params: &[String], at: usize) -> Result<Isometry3<f64>, SimError> {
-        // `DAT(x)` stands for the feature its `DATDEF` named (DMIS's DATSET names
-        // features through datum labels); `FA(x)` directly is read too.
-        let params: Vec<String> = params
+        let params = self.datums_as_features(params, at)?;
+        let (dirs, origins) = self.datset_targets(&params, at)?;
+        let axes = self.datset_axes(&dirs, at)?;
+        let o = self.datset_origin(&axes, &origins, at)?;
+        let r = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&axes));
+        Ok(Isometry3::from_parts(
+            Translation3::from(o),
+            UnitQuaternion::from_rotation_matrix(&r),
+        ))
+    }
+
+    /// `DATSET`'s parameters with each `DAT(x)` written as the feature its `DATDEF`
+    /// named, `FA(f)` (DMIS's DATSET names features through datum labels; `FA(x)`
+    /// directly is read too).
+    fn datums_as_features(&self, params: &[String], at: usize) -> Result<Vec<String>, SimError> {
+        params
             .iter()
             .map(
                 |p| match p.strip_prefix("DAT(").and_then(|r| r.strip_suffix(')')) {
@@ -1702,8 +1719,13 @@ impl Machine<'_> {
                     None => Ok(p.clone()),
                 },
             )
-            .collect::<Result<_, _>>()?;
-        let params = &params[..];
+            .collect()
+    }
+
+    /// What `DATSET`'s keywords ask of the features before them (machine frame): the
+    /// directions by axis (0 for x), each the way its nominal points, and the shapes
+    /// that give the origin along an axis.
+    fn datset_targets(&self, params: &[String], at: usize) -> Result<DatsetTargets, SimError> {
         let mut dirs: Vec<(usize, V3)> = Vec::new();
         let mut origins: Vec<(usize, Shape)> = Vec::new();
         let mut cur: Option<Measured> = None;
@@ -1754,10 +1776,17 @@ impl Machine<'_> {
                 return Err(self.unsupported(at, &format!("DATSET keyword {p}")));
             }
         }
+        Ok((dirs, origins))
+    }
+
+    /// The new frame's axes: the first two directions `dirs` names, each made square
+    /// to those before it; the axes they leave free from the current frame, across
+    /// them; the third the cross product of the other two.
+    fn datset_axes(&self, dirs: &[(usize, V3)], at: usize) -> Result<[V3; 3], SimError> {
         let old = self.frame.rotation.to_rotation_matrix().into_inner();
         let mut e: [Option<V3>; 3] = [None, None, None];
         let mut order: Vec<usize> = Vec::new();
-        for (k, d) in &dirs {
+        for (k, d) in dirs {
             if e[*k].is_some() {
                 continue;
             }
@@ -1799,10 +1828,18 @@ impl Machine<'_> {
         let third = (0..3).find(|j| e[*j].is_none()).unwrap_or(2);
         let (a, b) = ((third + 1) % 3, (third + 2) % 3);
         e[third] = Some(e[a].expect("two axes").cross(&e[b].expect("two axes")));
-        let axes = [e[0].expect("x"), e[1].expect("y"), e[2].expect("z")];
-        // Origin: along each axis an ORIG names, the feature's location (a plane's
-        // touched centroid, a point of an axis, a centre); along the others the old
-        // origin's.
+        Ok([e[0].expect("x"), e[1].expect("y"), e[2].expect("z")])
+    }
+
+    /// The new frame's origin: along each axis an ORIG names, the feature's location
+    /// (a plane's touched centroid, a point of an axis, a centre); along the others
+    /// the old origin's.
+    fn datset_origin(
+        &self,
+        axes: &[V3; 3],
+        origins: &[(usize, Shape)],
+        at: usize,
+    ) -> Result<V3, SimError> {
         let o_old = self.frame.translation.vector;
         let mut m = Matrix3::zeros();
         let mut rhs = V3::zeros();
@@ -1821,18 +1858,13 @@ impl Machine<'_> {
             m.set_row(k, &axes[k].transpose());
             rhs[k] = axes[k].dot(&at);
         }
-        let Some(o) = m.lu().solve(&rhs) else {
-            return Err(self.bad(
+        m.lu().solve(&rhs).ok_or_else(|| {
+            self.bad(
                 at,
                 "DATSET origins do not meet in a point",
                 "each origin must come from a feature across its axis",
-            ));
-        };
-        let r = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&axes));
-        Ok(Isometry3::from_parts(
-            Translation3::from(o),
-            UnitQuaternion::from_rotation_matrix(&r),
-        ))
+            )
+        })
     }
 
     /// `OUTPUT/FA(…)[,FA(…)],TA(t)`: the tolerance evaluated on its features as the
