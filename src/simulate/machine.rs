@@ -993,6 +993,53 @@ impl Machine<'_> {
     /// A touch: approach, search for the surface, record the tip centre.
     fn ptmeas(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
         self.ensure_setup(at)?;
+        let (p, n) = self.touch_point(params, at)?;
+        let s = self.sensor(at)?;
+        let r = self.probes[s.slot].tip_radius;
+        let ctx = self.ctx(at)?;
+        // Where the touch is on the part: the operator touches the point shown on the
+        // part itself; the machine goes where the alignment puts it.
+        let (pp, np) = if self.manual {
+            (p, n)
+        } else {
+            let inv = ctx.place.inverse() * self.frame;
+            (inv * p, inv * n)
+        };
+        let appr = if self.manual {
+            self.hand_approach(ctx, pp, np, r)
+        } else {
+            self.apprch
+        };
+        let c0 = pp + np * (r + appr);
+        if !self.manual {
+            self.move_to(ctx.place * c0, at, "on the way to the approach point")?;
+        }
+        let ctx = self.ctx(at)?;
+        let travel = appr + self.search;
+        let found = self.touch_contact(ctx, &c0, &np, r, travel, at)?;
+        let centre = found.0;
+        if !self.manual {
+            self.check_touch_approach(ctx, s, pp + np * r, &np, found, at)?;
+        }
+        let place = ctx.place;
+        let nw = self.frame.rotation * n;
+        let noise = if self.opts.noise > 0.0 {
+            self.opts.noise * self.rng.gauss()
+        } else {
+            0.0
+        };
+        let cw = place * centre + nw * noise;
+        self.touches += 1;
+        self.at = (!self.manual).then(|| centre + np * self.retrct);
+        if let Some(b) = self.block.as_mut() {
+            b.touches.push((p, n, cw, nw, r));
+        }
+        Ok(())
+    }
+
+    /// `PTMEAS/CART,x,y,z,i,j,k`'s point and unit vector (program frame), in an open
+    /// `MEAS` block.
+    fn touch_point(&self, params: &[String], at: usize) -> Result<(P3, V3), SimError> {
         let v = nums(params);
         if v.len() != 6 {
             return Err(self.bad(
@@ -1018,99 +1065,94 @@ impl Machine<'_> {
                     "give the surface's outward vector",
                 )
             })?;
-        let s = self.sensor(at)?;
+        Ok((p, n))
+    }
+
+    /// By hand, the operator starts as near the surface as there is room for: the
+    /// first of `SNSET/APPRCH`, 2, 4 and 8 times it, then a half down to a sixteenth of
+    /// it, whose search does not start in the material (`APPRCH` when none does).
+    fn hand_approach(&self, ctx: &SetupCtx, pp: P3, np: V3, r: f64) -> f64 {
+        let a = self.apprch;
+        let tries = [
+            a,
+            2.0 * a,
+            4.0 * a,
+            8.0 * a,
+            a / 2.0,
+            a / 4.0,
+            a / 8.0,
+            a / 16.0,
+        ];
+        tries
+            .into_iter()
+            .find(|&x| {
+                let c = pp + np * (r + x);
+                !matches!(
+                    self.search_surface(ctx, &c, &np, r, x + self.search),
+                    Found::Inside
+                )
+            })
+            .unwrap_or(a)
+    }
+
+    /// The contact of a touch's search from `c0` along `−np` within `travel` (part
+    /// frame): the tip centre, what it touched and the part's face; an error when the
+    /// search starts inside the part or meets nothing.
+    fn touch_contact(
+        &self,
+        ctx: &SetupCtx,
+        c0: &P3,
+        np: &V3,
+        r: f64,
+        travel: f64,
+        at: usize,
+    ) -> Result<(P3, Contact, Option<FaceId>), SimError> {
+        match self.search_surface(ctx, c0, np, r, travel) {
+            Found::Contact(c, k, f) => Ok((c, k, f)),
+            Found::Inside => Err(SimError::InsidePart {
+                span: self.span(at),
+            }),
+            Found::Nothing => Err(SimError::NoSurface {
+                span: self.span(at),
+                travel: crate::dmis::text::num(travel),
+            }),
+        }
+    }
+
+    /// Under `MODE/PROG`, the touch's approach to the contact `found` swept with the
+    /// probe: from the nominal tip centre `nominal` or, where the actual surface stands
+    /// proud of it, from the contact.
+    fn check_touch_approach(
+        &self,
+        ctx: &SetupCtx,
+        s: Sensor,
+        nominal: P3,
+        np: &V3,
+        (centre, contact, touched): (P3, Contact, Option<FaceId>),
+        at: usize,
+    ) -> Result<(), SimError> {
         let r = self.probes[s.slot].tip_radius;
-        let ctx = self.ctx(at)?;
-        // Where the touch is on the part: the operator touches the point shown on the
-        // part itself; the machine goes where the alignment puts it.
-        let (pp, np) = if self.manual {
-            (p, n)
+        // The tip stops at the actual surface: where that stands proud of the
+        // nominal (a moved face, or a frame off by a moved datum) the approach ends
+        // there, on the machine's first contact; where it lies deeper the search
+        // itself covered the way down from the nominal touch.
+        let mut outer = if (centre - nominal).dot(np) > 0.0 {
+            centre
         } else {
-            let inv = ctx.place.inverse() * self.frame;
-            (inv * p, inv * n)
+            nominal
         };
-        // By hand, the operator starts as near the surface as there is room for.
-        let mut appr = self.apprch;
-        if self.manual {
-            let a = self.apprch;
-            let tries = [
-                a,
-                2.0 * a,
-                4.0 * a,
-                8.0 * a,
-                a / 2.0,
-                a / 4.0,
-                a / 8.0,
-                a / 16.0,
-            ];
-            appr = tries
-                .into_iter()
-                .find(|&x| {
-                    let c = pp + np * (r + x);
-                    !matches!(
-                        self.search_surface(ctx, &c, &np, r, x + self.search),
-                        Found::Inside
-                    )
-                })
-                .unwrap_or(a);
-        }
-        let c0 = pp + np * (r + appr);
-        if !self.manual {
-            self.move_to(ctx.place * c0, at, "on the way to the approach point")?;
-        }
-        let ctx = self.ctx(at)?;
-        let travel = appr + self.search;
-        let (centre, contact, touched) = match self.search_surface(ctx, &c0, &np, r, travel) {
-            Found::Contact(c, k, f) => (c, k, f),
-            Found::Inside => {
-                return Err(SimError::InsidePart {
-                    span: self.span(at),
-                })
-            }
-            Found::Nothing => {
-                return Err(SimError::NoSurface {
-                    span: self.span(at),
-                    travel: crate::dmis::text::num(travel),
-                })
-            }
-        };
-        if !self.manual {
-            // The tip stops at the actual surface: where that stands proud of the
-            // nominal (a moved face, or a frame off by a moved datum) the approach ends
-            // there, on the machine's first contact; where it lies deeper the search
-            // itself covered the way down from the nominal touch.
-            let nominal = pp + np * r;
-            let mut outer = if (centre - nominal).dot(&np) > 0.0 {
-                centre
-            } else {
-                nominal
-            };
-            // The scene is the nominal part: where the touched face itself lies deeper
-            // (tilted, or the frame off), the ball is nearer its nominal triangles than
-            // a tip is allowed to be, and no material is there. The check starts where
-            // the ball clears them.
-            if let Some((face, d)) = self.nearest_face(&outer) {
-                if Some(face) == touched && d < r {
-                    outer += np * (r - d);
-                }
-            }
-            let pose = self.pose(ctx, s);
-            if let Err(b) = pose.approach(&outer, &np, self.apprch, contact) {
-                return Err(self.collision(at, b, "on the touch's approach"));
+        // The scene is the nominal part: where the touched face itself lies deeper
+        // (tilted, or the frame off), the ball is nearer its nominal triangles than
+        // a tip is allowed to be, and no material is there. The check starts where
+        // the ball clears them.
+        if let Some((face, d)) = self.nearest_face(&outer) {
+            if Some(face) == touched && d < r {
+                outer += np * (r - d);
             }
         }
-        let place = ctx.place;
-        let nw = self.frame.rotation * n;
-        let noise = if self.opts.noise > 0.0 {
-            self.opts.noise * self.rng.gauss()
-        } else {
-            0.0
-        };
-        let cw = place * centre + nw * noise;
-        self.touches += 1;
-        self.at = (!self.manual).then(|| centre + np * self.retrct);
-        if let Some(b) = self.block.as_mut() {
-            b.touches.push((p, n, cw, nw, r));
+        let pose = self.pose(ctx, s);
+        if let Err(b) = pose.approach(&outer, np, self.apprch, contact) {
+            return Err(self.collision(at, b, "on the touch's approach"));
         }
         Ok(())
     }
