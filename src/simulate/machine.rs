@@ -143,6 +143,21 @@ struct Block {
 /// give the origin along an axis.
 type DatsetTargets = (Vec<(usize, V3)>, Vec<(usize, Shape)>);
 
+/// One scan pass of `PAMEAS`, in the part frame of its setup.
+struct Pass {
+    /// Where it starts, and the run to its end.
+    start: P3,
+    run: V3,
+    /// The scanner's direction (from the surface towards it), and across its stripe.
+    dir: V3,
+    across: V3,
+    optics: Optics,
+    /// The block's nominal, which the points kept lie on.
+    nominal: Option<Shape>,
+    /// Part frame → machine.
+    place: Isometry3<f64>,
+}
+
 /// A nominal from `FEAT`: its shape (program frame) and whether it is convex.
 #[derive(Debug, Clone)]
 struct Nominal {
@@ -1167,8 +1182,54 @@ impl Machine<'_> {
     /// has noise: the larger of the run's and half the scanner's accuracy.
     fn pameas(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
         self.ensure_setup(at)?;
+        let ((s, e), sensor, optics, accuracy) = self.scan_pass(params, at)?;
+        let ctx = self.ctx(at)?;
+        let inv = ctx.place.inverse() * self.frame;
+        let (sp, ep) = (inv * s, inv * e);
+        let place = ctx.place;
+        self.move_to(place * sp, at, "on the way to the pass")?;
+        self.move_to(place * ep, at, "along the scan pass")?;
+        let ctx = self.ctx(at)?;
+        let dir = self.sensor_dir(ctx, sensor);
+        let run = ep - sp;
+        let motion = run
+            .try_normalize(1e-9)
+            .unwrap_or_else(|| fit::across(&dir).0);
+        let across = dir.cross(&motion).normalize();
+        // The block's nominal in the part frame (the program's frame is the part's).
+        let nominal = self
+            .block
+            .as_ref()
+            .and_then(|b| self.nominals.get(&b.label))
+            .map(|n| n.shape.clone());
+        let pass = Pass {
+            start: sp,
+            run,
+            dir,
+            across,
+            optics,
+            nominal,
+            place,
+        };
+        let cloud = self.thinned_cloud(ctx, &pass);
+        let sigma = if self.opts.noise > 0.0 {
+            self.opts.noise.max(accuracy / 2.0)
+        } else {
+            0.0
+        };
+        self.record_scan(cloud, sigma, pass.nominal.as_ref());
+        Ok(())
+    }
+
+    /// `PAMEAS/P(path)`'s path (start and end, program frame), and the scanner on the
+    /// ram that runs it with its optics and accuracy, in an open `MEAS` block.
+    fn scan_pass(
+        &self,
+        params: &[String],
+        at: usize,
+    ) -> Result<((P3, P3), Sensor, Optics, f64), SimError> {
         let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
-        let Some(&(s, e)) = self.paths.get(l) else {
+        let Some(&path) = self.paths.get(l) else {
             return Err(self.bad(
                 at,
                 &format!("path `{l}` is not defined"),
@@ -1190,98 +1251,102 @@ impl Machine<'_> {
                 "select a scanner (`SNSDEF/LASER`) with SNSLCT before its passes",
             ));
         };
-        let ctx = self.ctx(at)?;
-        let inv = ctx.place.inverse() * self.frame;
-        let (sp, ep) = (inv * s, inv * e);
-        let place = ctx.place;
-        self.move_to(place * sp, at, "on the way to the pass")?;
-        self.move_to(place * ep, at, "along the scan pass")?;
-        let ctx = self.ctx(at)?;
-        let dir = self.sensor_dir(ctx, sensor);
-        let run = ep - sp;
-        let motion = run
-            .try_normalize(1e-9)
-            .unwrap_or_else(|| fit::across(&dir).0);
-        let across = dir.cross(&motion).normalize();
+        Ok((path, sensor, optics, accuracy))
+    }
+
+    /// The pass's points (machine frame, with their normals), thinned to [`CLOUD`]; on
+    /// a feature narrower than the thinned stripe (a strip the pass runs along) or
+    /// shorter than its spacing, sampled 4 and 16 times as densely across and along,
+    /// up to the scanner's own spacing, until the points lie on three stripes and three
+    /// positions along them.
+    fn thinned_cloud(&self, ctx: &SetupCtx, pass: &Pass) -> Vec<(P3, V3)> {
+        let optics = &pass.optics;
         let most = (
-            ((run.norm() / optics.spacing[1]).floor() as usize).max(1),
+            ((pass.run.norm() / optics.spacing[1]).floor() as usize).max(1),
             ((optics.stripe / optics.spacing[0]).floor() as usize).max(1),
         );
-        // The block's nominal in the part frame (the program's frame is the part's).
-        let nominal = self
-            .block
-            .as_ref()
-            .and_then(|b| self.nominals.get(&b.label))
-            .map(|n| n.shape.clone());
-        let g = self.input.geometry;
-        let near = optics.standoff - optics.depth / 2.0;
-        let sigma = if self.opts.noise > 0.0 {
-            self.opts.noise.max(accuracy / 2.0)
-        } else {
-            0.0
-        };
-        // The stripe sampled `along_n` + 1 times, `across_n` + 1 points each: the points
-        // kept, and on how many stripes and stripe positions they lie.
-        let sample = |along_n: usize, across_n: usize| {
-            let mut cloud = Vec::new();
-            let (mut rows, mut cols) = (BTreeSet::new(), BTreeSet::new());
-            for i in 0..=along_n {
-                for j in 0..=across_n {
-                    let f = sp
-                        + run * (i as f64 / along_n as f64)
-                        + across * (optics.stripe * (j as f64 / across_n as f64 - 0.5));
-                    let c0 = f + dir * optics.standoff;
-                    let travel = optics.standoff + optics.depth / 2.0;
-                    let Found::Contact(c, Contact::Part, Some(face)) =
-                        self.search_surface(ctx, &c0, &dir, 0.0, travel)
-                    else {
-                        continue;
-                    };
-                    if (c0 - c).dot(&dir) < near {
-                        continue;
-                    }
-                    let n = g.faces[face.0]
-                        .surface
-                        .normal_at(&c)
-                        .unwrap_or(dir)
-                        .normalize();
-                    // Seen from where the nominal surface is: the scene is the nominal
-                    // part, and a face set back behind it is not hidden by itself.
-                    let seen_at = nominal_foot(nominal.as_ref(), self.scene.mesh(), &c);
-                    if !crate::access::scan::sees(&self.scene, &seen_at, &n, &dir, &optics) {
-                        continue;
-                    }
-                    // A point on a face of another surface (a fillet, the next wall) is
-                    // not the feature's; a free-form nominal keeps every point.
-                    let own = match (&nominal, Shape::of_surface(&g.faces[face.0].surface)) {
-                        (Some(Shape::Surface) | None, _) => true,
-                        (Some(shape), Some((surface, _))) => shape.same_surface(&surface, CLIP),
-                        (Some(_), None) => false,
-                    };
-                    if !own {
-                        continue;
-                    }
-                    rows.insert(i);
-                    cols.insert(j);
-                    cloud.push((place * c, place.rotation * n));
-                }
-            }
-            (cloud, rows.len().min(cols.len()))
-        };
-        // Thinned to CLOUD; on a feature narrower than the thinned stripe (a strip the
-        // pass runs along) or shorter than its spacing, sampled 4 and 16 times as
-        // densely across and along, up to the scanner's own spacing, until the points
-        // lie on three stripes and three positions along them.
         let mut cloud = Vec::new();
         for k in [1, 4, 16] {
             let (along_n, across_n) = ((CLOUD.0 * k).min(most.0), (CLOUD.1 * k).min(most.1));
-            let (points, spread) = sample(along_n, across_n);
+            let (points, spread) = self.sample_pass(ctx, pass, along_n, across_n);
             cloud = points;
             let finest = along_n == most.0 && across_n == most.1;
             if spread >= 3 || finest {
                 break;
             }
         }
+        cloud
+    }
+
+    /// The stripe sampled `along_n` + 1 times, `across_n` + 1 points each: the points
+    /// kept (machine frame, with their normals), and on how many stripes and stripe
+    /// positions they lie (the fewer).
+    fn sample_pass(
+        &self,
+        ctx: &SetupCtx,
+        pass: &Pass,
+        along_n: usize,
+        across_n: usize,
+    ) -> (Vec<(P3, V3)>, usize) {
+        let mut cloud = Vec::new();
+        let (mut rows, mut cols) = (BTreeSet::new(), BTreeSet::new());
+        for i in 0..=along_n {
+            for j in 0..=across_n {
+                let f = pass.start
+                    + pass.run * (i as f64 / along_n as f64)
+                    + pass.across * (pass.optics.stripe * (j as f64 / across_n as f64 - 0.5));
+                let Some((c, n)) = self.scanned_point(ctx, pass, f) else {
+                    continue;
+                };
+                rows.insert(i);
+                cols.insert(j);
+                cloud.push((pass.place * c, pass.place.rotation * n));
+            }
+        }
+        (cloud, rows.len().min(cols.len()))
+    }
+
+    /// The point of the actual part the laser meets from `f` on the stripe, and the
+    /// normal there (part frame), when the pass keeps it: in the depth of field, seen
+    /// by laser and camera, and on the block's nominal surface ([`CLIP`]).
+    fn scanned_point(&self, ctx: &SetupCtx, pass: &Pass, f: P3) -> Option<(P3, V3)> {
+        let g = self.input.geometry;
+        let (optics, dir) = (&pass.optics, pass.dir);
+        let near = optics.standoff - optics.depth / 2.0;
+        let c0 = f + dir * optics.standoff;
+        let travel = optics.standoff + optics.depth / 2.0;
+        let Found::Contact(c, Contact::Part, Some(face)) =
+            self.search_surface(ctx, &c0, &dir, 0.0, travel)
+        else {
+            return None;
+        };
+        if (c0 - c).dot(&dir) < near {
+            return None;
+        }
+        let n = g.faces[face.0]
+            .surface
+            .normal_at(&c)
+            .unwrap_or(dir)
+            .normalize();
+        // Seen from where the nominal surface is: the scene is the nominal
+        // part, and a face set back behind it is not hidden by itself.
+        let seen_at = nominal_foot(pass.nominal.as_ref(), self.scene.mesh(), &c);
+        if !crate::access::scan::sees(&self.scene, &seen_at, &n, &dir, optics) {
+            return None;
+        }
+        // A point on a face of another surface (a fillet, the next wall) is
+        // not the feature's; a free-form nominal keeps every point.
+        let own = match (&pass.nominal, Shape::of_surface(&g.faces[face.0].surface)) {
+            (Some(Shape::Surface) | None, _) => true,
+            (Some(shape), Some((surface, _))) => shape.same_surface(&surface, CLIP),
+            (Some(_), None) => false,
+        };
+        own.then_some((c, n))
+    }
+
+    /// The pass's points (machine frame) in the open block, each with the noise of
+    /// `sigma` along its normal, against its nominal: the foot on `nominal`.
+    fn record_scan(&mut self, cloud: Vec<(P3, V3)>, sigma: f64, nominal: Option<&Shape>) {
         let prog = self.frame.inverse();
         for (cw, nw) in cloud {
             let noise = if sigma > 0.0 {
@@ -1295,7 +1360,7 @@ impl Machine<'_> {
             // (ASME Y14.5-2018 ch. 11: a profile zone lies normal to the true profile);
             // the point found is where the actual surface is.
             let at = prog * cw;
-            let foot = nominal_foot(nominal.as_ref(), self.scene.mesh(), &at);
+            let foot = nominal_foot(nominal, self.scene.mesh(), &at);
             if let Some(b) = self.block.as_mut() {
                 b.touches.push((foot, prog * nw, q, nw, 0.0));
                 b.scanned = true;
@@ -1305,7 +1370,6 @@ impl Machine<'_> {
         if let Some(b) = self.block.as_mut() {
             b.scanned = true;
         }
-        Ok(())
     }
 
     /// The part's face nearest `x` (part frame) on the nominal mesh, and its distance.
