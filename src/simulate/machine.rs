@@ -1682,69 +1682,11 @@ impl Machine<'_> {
         let intof = params.get(2).map(String::as_str) == Some("INTOF");
         let fitted = match word.as_str() {
             "CIRCLE" if intof => {
-                let [bore, cone] = &sources[..] else {
-                    return Err(self.bad(
-                        at,
-                        "an intersection circle takes two features",
-                        "write `CONST/CIRCLE,F(c),INTOF,FA(bore),FA(cone)`",
-                    ));
-                };
-                let circle = full_diameter(&bore.shape, &cone.shape).ok_or_else(|| {
-                    self.bad(
-                        at,
-                        "these features meet in no circle",
-                        "intersect a bore with the cone on its axis",
-                    )
-                })?;
                 // The circle is the features' intersection, not a fit over their points.
+                let circle = self.intersection_circle(&sources, at)?;
                 return self.store_constructed(label, circle);
             }
-            "PARPLN" => {
-                let [a, b] = &sources[..] else {
-                    return Err(self.bad(
-                        at,
-                        "a centre plane takes two walls",
-                        "write `CONST/PARPLN,F(mid),BF,FA(wall1),FA(wall2)`",
-                    ));
-                };
-                let (Shape::Plane { p: pa, n: na }, Shape::Plane { p: pb, n: nb }) =
-                    (&a.shape, &b.shape)
-                else {
-                    return Err(self.bad(
-                        at,
-                        "a centre plane's walls must be planes",
-                        "construct it from two measured planes",
-                    ));
-                };
-                let Some(nn) = nominal.shape.direction() else {
-                    return Err(self.bad(
-                        at,
-                        "a centre plane's nominal has no normal",
-                        "define it as FEAT/PARPLN",
-                    ));
-                };
-                let mut n = (na - nb).normalize();
-                if n.dot(&nn) < 0.0 {
-                    n = -n;
-                }
-                let centroid = |m: &Measured| {
-                    P3::from(
-                        m.touches.iter().fold(V3::zeros(), |s, t| s + t.2.coords)
-                            / m.touches.len().max(1) as f64,
-                    )
-                };
-                let (ca, cb) = (centroid(a), centroid(b));
-                let qa = ca - nb * (ca - pb).dot(nb);
-                let qb = cb - na * (cb - pa).dot(na);
-                let width = ((qa - ca).norm() + (qb - cb).norm()) / 2.0;
-                let mid = P3::from((ca.coords + qa.coords + cb.coords + qb.coords) / 4.0);
-                let mut median = Vec::new();
-                for (m, p, nw) in [(a, pa, na), (b, pb, nb)] {
-                    let s0 = (mid - p).dot(&n) / nw.dot(&n);
-                    median.extend(m.touches.iter().map(|t| t.2 + nw * s0));
-                }
-                Some((Shape::Parpln { p: mid, n, width }, median))
-            }
+            "PARPLN" => Some(self.centre_plane(&sources, &nominal, at)?),
             "PLANE" => {
                 fit::plane(&pts, &nominal.shape.direction().unwrap_or(V3::z())).map(|s| (s, vec![]))
             }
@@ -1777,6 +1719,79 @@ impl Machine<'_> {
         let setup = self.aligns.len();
         self.actuals.insert(label, Stored { m, setup });
         Ok(())
+    }
+
+    /// `CONST/CIRCLE,F(c),INTOF,FA(bore),FA(cone)`: the circle where the bore meets
+    /// the cone on its axis.
+    fn intersection_circle(&self, sources: &[Measured], at: usize) -> Result<Shape, SimError> {
+        let [bore, cone] = sources else {
+            return Err(self.bad(
+                at,
+                "an intersection circle takes two features",
+                "write `CONST/CIRCLE,F(c),INTOF,FA(bore),FA(cone)`",
+            ));
+        };
+        full_diameter(&bore.shape, &cone.shape).ok_or_else(|| {
+            self.bad(
+                at,
+                "these features meet in no circle",
+                "intersect a bore with the cone on its axis",
+            )
+        })
+    }
+
+    /// `CONST/PARPLN,F(mid),BF,FA(wall1),FA(wall2)`: the plane midway between two
+    /// measured walls, facing the way its nominal does, their width apart, and the
+    /// walls' points moved onto it (its median points).
+    fn centre_plane(
+        &self,
+        sources: &[Measured],
+        nominal: &Nominal,
+        at: usize,
+    ) -> Result<(Shape, Vec<P3>), SimError> {
+        let [a, b] = sources else {
+            return Err(self.bad(
+                at,
+                "a centre plane takes two walls",
+                "write `CONST/PARPLN,F(mid),BF,FA(wall1),FA(wall2)`",
+            ));
+        };
+        let (Shape::Plane { p: pa, n: na }, Shape::Plane { p: pb, n: nb }) = (&a.shape, &b.shape)
+        else {
+            return Err(self.bad(
+                at,
+                "a centre plane's walls must be planes",
+                "construct it from two measured planes",
+            ));
+        };
+        let Some(nn) = nominal.shape.direction() else {
+            return Err(self.bad(
+                at,
+                "a centre plane's nominal has no normal",
+                "define it as FEAT/PARPLN",
+            ));
+        };
+        let mut n = (na - nb).normalize();
+        if n.dot(&nn) < 0.0 {
+            n = -n;
+        }
+        let centroid = |m: &Measured| {
+            P3::from(
+                m.touches.iter().fold(V3::zeros(), |s, t| s + t.2.coords)
+                    / m.touches.len().max(1) as f64,
+            )
+        };
+        let (ca, cb) = (centroid(a), centroid(b));
+        let qa = ca - nb * (ca - pb).dot(nb);
+        let qb = cb - na * (cb - pa).dot(na);
+        let width = ((qa - ca).norm() + (qb - cb).norm()) / 2.0;
+        let mid = P3::from((ca.coords + qa.coords + cb.coords + qb.coords) / 4.0);
+        let mut median = Vec::new();
+        for (m, p, nw) in [(a, pa, na), (b, pb, nb)] {
+            let s0 = (mid - p).dot(&n) / nw.dot(&n);
+            median.extend(m.touches.iter().map(|t| t.2 + nw * s0));
+        }
+        Ok((Shape::Parpln { p: mid, n, width }, median))
     }
 
     /// A constructed feature with no points of its own, in the program frame.
