@@ -274,6 +274,15 @@ struct Round {
     last: BlockKey,
 }
 
+/// A surface about to be declared: its label's base, nominal and feature, and whether
+/// the table stands in for it.
+struct SurfaceOf {
+    name: String,
+    nominal: Nominal,
+    feature: Option<FeatureId>,
+    on_table: bool,
+}
+
 /// A setup's alignment, to repeat on the program's own measurements of its features.
 struct Realign {
     setup: usize,
@@ -509,27 +518,8 @@ impl Writer<'_> {
     /// one per partial where the program measures a surface in several blocks.
     fn nominals(&mut self) {
         let llip = self.input.llip;
-        let geometry = self.input.geometry;
         self.o.comment("nominals");
-        // The surfaces, in program order: (feature, contact, face, blocks).
-        let mut surfs: Vec<(Option<FeatureId>, Contact, FaceId, Vec<BlockKey>)> = Vec::new();
-        for (si, sp) in llip.setups.iter().enumerate() {
-            for (gi, g) in sp.groups.iter().enumerate() {
-                for (bi, b) in g.blocks.iter().enumerate() {
-                    let same = |f: FaceId| {
-                        f == b.face
-                            || (b.contact == Contact::Part && geometry.one_surface(f, b.face))
-                    };
-                    match surfs
-                        .iter_mut()
-                        .find(|s| s.0 == b.feature && s.1 == b.contact && same(s.2))
-                    {
-                        Some(s) => s.3.push((si, gi, bi)),
-                        None => surfs.push((b.feature, b.contact, b.face, vec![(si, gi, bi)])),
-                    }
-                }
-            }
-        }
+        let surfs = self.surfaces_in_order();
         let block = |k: &BlockKey| &llip.setups[k.0].groups[k.1].blocks[k.2];
         let mut count: BTreeMap<Option<FeatureId>, usize> = BTreeMap::new();
         for s in &surfs {
@@ -552,120 +542,142 @@ impl Writer<'_> {
             } else {
                 name
             };
-            let id = self.surfs.len();
-            // A free-form surface has no best fit to join: each block stands alone.
-            if matches!(nominal, Nominal::Surface(Surface::Freeform, _)) && blocks.len() > 1 {
-                let mut rounds = Vec::new();
-                for (j, k) in blocks.iter().enumerate() {
-                    let label = self.labels.fresh("F", &format!("{name}_{}", j + 1));
-                    self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
-                    self.nominals.insert(label.clone(), nominal.clone());
-                    self.feats.insert(*k, (label.clone(), id, j));
-                    self.faces_of.entry(feature).or_default().push(label);
-                    rounds.push(Round {
-                        partials: vec![],
-                        last: *k,
-                    });
-                }
-                self.surfs.push(Surf {
-                    full: String::new(),
-                    rounds,
-                    feature,
-                    on_table: contact == Contact::Table,
-                });
-                continue;
-            }
-            // Rounds: a block that touches a point again (a datum measured anew with
-            // another probe) starts a new round, which measures the surface anew.
-            let mut rounds_of: Vec<Vec<BlockKey>> = Vec::new();
-            let mut seen: std::collections::BTreeSet<usize> = std::collections::BTreeSet::new();
-            for k in &blocks {
-                let pts: Vec<usize> = block(k).touches.iter().map(|t| t.point).collect();
-                if rounds_of.is_empty() || pts.iter().any(|p| seen.contains(p)) {
-                    rounds_of.push(Vec::new());
-                    seen.clear();
-                }
-                seen.extend(pts);
-                rounds_of.last_mut().expect("a round").push(*k);
-            }
-            // A round of fewer touches than its surface needs fits nothing (one touch
-            // is no plane): it joins the round before it, or after it for the first.
-            let least = nominal.least_touches();
-            let touches = |keys: &[BlockKey]| -> usize {
-                keys.iter()
-                    .map(|k| block(k).touches.len().max(block(k).passes.len() * least))
-                    .sum()
-            };
-            let mut r = 0;
-            while rounds_of.len() > 1 && r < rounds_of.len() {
-                if touches(&rounds_of[r]) >= least {
-                    r += 1;
-                    continue;
-                }
-                let keys = rounds_of.remove(r);
-                let into = r.saturating_sub(1).min(rounds_of.len() - 1);
-                if r == 0 {
-                    let mut joined = keys;
-                    joined.append(&mut rounds_of[0]);
-                    rounds_of[0] = joined;
-                } else {
-                    rounds_of[into].extend(keys);
-                }
-            }
-            let full = self.labels.fresh("F", &name);
-            self.o.stmt(&format!("F({full})=FEAT/{}", nominal.feat()));
-            self.nominals.insert(full.clone(), nominal.clone());
-            self.faces_of.entry(feature).or_default().push(full.clone());
-            // A round of several blocks measures points (`FEAT/POINT`): a block of one
-            // or two touches fits no cylinder; a best-fit `CONST` over them all is the
-            // surface.
-            let mut rounds = Vec::new();
-            let mut n = 0;
-            for (r, keys) in rounds_of.iter().enumerate() {
-                let mut partials = Vec::new();
-                for k in keys {
-                    self.feats.insert(*k, (full.clone(), id, r));
-                    if keys.len() == 1 {
-                        continue;
-                    }
-                    // A scanned block of a surface scanned from several views measures
-                    // the surface itself: the best fit joins the views' clouds.
-                    if !block(k).passes.is_empty() {
-                        n += 1;
-                        let label = self.labels.fresh("F", &format!("{name}_S{n}"));
-                        self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
-                        self.nominals.insert(label.clone(), nominal.clone());
-                        self.points.insert((*k, usize::MAX), label.clone());
-                        partials.push(label);
-                        continue;
-                    }
-                    for (ti, t) in block(k).touches.iter().enumerate() {
-                        n += 1;
-                        let label = self.labels.fresh("F", &format!("{name}_P{n}"));
-                        let p = &self.input.hlip.points[t.point];
-                        self.o.stmt(&format!(
-                            "F({label})=FEAT/POINT,CART,{},{}",
-                            xyz(&p.position),
-                            ijk(&p.normal)
-                        ));
-                        self.points.insert((*k, ti), label.clone());
-                        partials.push(label);
-                    }
-                }
-                rounds.push(Round {
-                    partials,
-                    last: *keys.last().expect("a round has a block"),
-                });
-            }
-            self.surfs.push(Surf {
-                full,
-                rounds,
+            let surface = SurfaceOf {
+                name,
+                nominal,
                 feature,
                 on_table: contact == Contact::Table,
-            });
+            };
+            // A free-form surface has no best fit to join: each block stands alone.
+            if matches!(surface.nominal, Nominal::Surface(Surface::Freeform, _)) && blocks.len() > 1
+            {
+                self.freeform_nominals(surface, &blocks);
+                continue;
+            }
+            let rounds = measuring_rounds(llip, &blocks, surface.nominal.least_touches());
+            self.surface_nominals(surface, &rounds);
         }
         self.centre_planes();
         self.datum_patterns();
+    }
+
+    /// The surfaces the program measures, in program order: (feature, contact, face,
+    /// blocks); a feature's blocks on one surface of the part measure one.
+    fn surfaces_in_order(&self) -> Vec<(Option<FeatureId>, Contact, FaceId, Vec<BlockKey>)> {
+        let geometry = self.input.geometry;
+        let mut surfs: Vec<(Option<FeatureId>, Contact, FaceId, Vec<BlockKey>)> = Vec::new();
+        for (si, sp) in self.input.llip.setups.iter().enumerate() {
+            for (gi, g) in sp.groups.iter().enumerate() {
+                for (bi, b) in g.blocks.iter().enumerate() {
+                    let same = |f: FaceId| {
+                        f == b.face
+                            || (b.contact == Contact::Part && geometry.one_surface(f, b.face))
+                    };
+                    match surfs
+                        .iter_mut()
+                        .find(|s| s.0 == b.feature && s.1 == b.contact && same(s.2))
+                    {
+                        Some(s) => s.3.push((si, gi, bi)),
+                        None => surfs.push((b.feature, b.contact, b.face, vec![(si, gi, bi)])),
+                    }
+                }
+            }
+        }
+        surfs
+    }
+
+    /// A free-form surface measured in several blocks: one `FEAT/GSURF` per block, each
+    /// its own feature and round.
+    fn freeform_nominals(&mut self, surface: SurfaceOf, blocks: &[BlockKey]) {
+        let SurfaceOf {
+            name,
+            nominal,
+            feature,
+            on_table,
+        } = surface;
+        let id = self.surfs.len();
+        let mut rounds = Vec::new();
+        for (j, k) in blocks.iter().enumerate() {
+            let label = self.labels.fresh("F", &format!("{name}_{}", j + 1));
+            self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
+            self.nominals.insert(label.clone(), nominal.clone());
+            self.feats.insert(*k, (label.clone(), id, j));
+            self.faces_of.entry(feature).or_default().push(label);
+            rounds.push(Round {
+                partials: vec![],
+                last: *k,
+            });
+        }
+        self.surfs.push(Surf {
+            full: String::new(),
+            rounds,
+            feature,
+            on_table,
+        });
+    }
+
+    /// A surface's `FEAT` and, per round of several blocks, its partials: a
+    /// `FEAT/POINT` per touch (a block of one or two touches fits no cylinder), or the
+    /// surface itself per scanned block; a best-fit `CONST` over them all is the
+    /// surface.
+    fn surface_nominals(&mut self, surface: SurfaceOf, rounds_of: &[Vec<BlockKey>]) {
+        let llip = self.input.llip;
+        let block = |k: &BlockKey| &llip.setups[k.0].groups[k.1].blocks[k.2];
+        let SurfaceOf {
+            name,
+            nominal,
+            feature,
+            on_table,
+        } = surface;
+        let id = self.surfs.len();
+        let full = self.labels.fresh("F", &name);
+        self.o.stmt(&format!("F({full})=FEAT/{}", nominal.feat()));
+        self.nominals.insert(full.clone(), nominal.clone());
+        self.faces_of.entry(feature).or_default().push(full.clone());
+        let mut rounds = Vec::new();
+        let mut n = 0;
+        for (r, keys) in rounds_of.iter().enumerate() {
+            let mut partials = Vec::new();
+            for k in keys {
+                self.feats.insert(*k, (full.clone(), id, r));
+                if keys.len() == 1 {
+                    continue;
+                }
+                // A scanned block of a surface scanned from several views measures
+                // the surface itself: the best fit joins the views' clouds.
+                if !block(k).passes.is_empty() {
+                    n += 1;
+                    let label = self.labels.fresh("F", &format!("{name}_S{n}"));
+                    self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
+                    self.nominals.insert(label.clone(), nominal.clone());
+                    self.points.insert((*k, usize::MAX), label.clone());
+                    partials.push(label);
+                    continue;
+                }
+                for (ti, t) in block(k).touches.iter().enumerate() {
+                    n += 1;
+                    let label = self.labels.fresh("F", &format!("{name}_P{n}"));
+                    let p = &self.input.hlip.points[t.point];
+                    self.o.stmt(&format!(
+                        "F({label})=FEAT/POINT,CART,{},{}",
+                        xyz(&p.position),
+                        ijk(&p.normal)
+                    ));
+                    self.points.insert((*k, ti), label.clone());
+                    partials.push(label);
+                }
+            }
+            rounds.push(Round {
+                partials,
+                last: *keys.last().expect("a round has a block"),
+            });
+        }
+        self.surfs.push(Surf {
+            full,
+            rounds,
+            feature,
+            on_table,
+        });
     }
 
     /// A datum feature of several parallel bores or pins (a pattern of holes) is one
@@ -1746,6 +1758,51 @@ fn nominal_of(input: &Input, b: &BlockPath) -> Option<Nominal> {
     }
     let face = input.geometry.faces.get(b.face.0)?;
     Some(Nominal::Surface(face.surface.clone(), face.centroid))
+}
+
+/// A surface's blocks in rounds: a block that touches a point again (a datum measured
+/// anew with another probe) starts a new round, which measures the surface anew. A
+/// round of fewer touches than the surface needs (`least`) fits nothing (one touch is
+/// no plane): it joins the round before it, or after it for the first.
+fn measuring_rounds(
+    llip: &crate::path::Llip,
+    blocks: &[BlockKey],
+    least: usize,
+) -> Vec<Vec<BlockKey>> {
+    let block = |k: &BlockKey| &llip.setups[k.0].groups[k.1].blocks[k.2];
+    let mut rounds_of: Vec<Vec<BlockKey>> = Vec::new();
+    let mut seen: std::collections::BTreeSet<usize> = std::collections::BTreeSet::new();
+    for k in blocks {
+        let pts: Vec<usize> = block(k).touches.iter().map(|t| t.point).collect();
+        if rounds_of.is_empty() || pts.iter().any(|p| seen.contains(p)) {
+            rounds_of.push(Vec::new());
+            seen.clear();
+        }
+        seen.extend(pts);
+        rounds_of.last_mut().expect("a round").push(*k);
+    }
+    let touches = |keys: &[BlockKey]| -> usize {
+        keys.iter()
+            .map(|k| block(k).touches.len().max(block(k).passes.len() * least))
+            .sum()
+    };
+    let mut r = 0;
+    while rounds_of.len() > 1 && r < rounds_of.len() {
+        if touches(&rounds_of[r]) >= least {
+            r += 1;
+            continue;
+        }
+        let keys = rounds_of.remove(r);
+        let into = r.saturating_sub(1).min(rounds_of.len() - 1);
+        if r == 0 {
+            let mut joined = keys;
+            joined.append(&mut rounds_of[0]);
+            rounds_of[0] = joined;
+        } else {
+            rounds_of[into].extend(keys);
+        }
+    }
+    rounds_of
 }
 
 /// A number rounded to 1e-3, without `-0`.
