@@ -274,6 +274,10 @@ struct Round {
     last: BlockKey,
 }
 
+/// A feature touched by hand to align: its label, its touches (point, normal) and
+/// the face the operator is told of.
+type HandFeature = (String, Vec<(P3, V3)>, FaceId);
+
 /// A surface about to be declared: its label's base, nominal and feature, and whether
 /// the table stands in for it.
 struct SurfaceOf {
@@ -868,8 +872,19 @@ impl Writer<'_> {
 
     /// A setup's operator prompt, its manual alignment and `DATSET`.
     fn setup(&mut self, si: usize, setups_n: usize, sp: &SetupPath) {
-        let hlip = self.input.hlip;
-        let setup = &hlip.setups[sp.setup];
+        self.place_part(si, setups_n, sp);
+        if sp.alignment.steps.is_empty() {
+            return;
+        }
+        let (fa, fa_manual) = self.hand_alignment(si, sp);
+        self.start_measuring(si, sp, fa, &fa_manual);
+    }
+
+    /// The setup's nominal frame (`RECALL` of the machine's, then `ROTATE`s) and the
+    /// operator's placing of the part: which way up, held by what, turned how, resting
+    /// on which faces and squared how closely; then `PAUSE`.
+    fn place_part(&mut self, si: usize, setups_n: usize, sp: &SetupPath) {
+        let setup = &self.input.hlip.setups[sp.setup];
         self.o.comment(&format!("setup {} of {setups_n}", si + 1));
         // The frame the manual points are written in: the part's own, at its nominal
         // place in this setup (machine axes turned by the setup's rotation).
@@ -926,9 +941,13 @@ impl Writer<'_> {
             ));
         }
         self.o.stmt("PAUSE");
-        if al.steps.is_empty() {
-            return;
-        }
+    }
+
+    /// The setup's alignment by hand (`MODE/MAN`), feature by feature: the `DATSET`
+    /// parameters of its features, as the DCC alignment takes them and as the manual
+    /// one does.
+    fn hand_alignment(&mut self, si: usize, sp: &SetupPath) -> (Vec<String>, Vec<String>) {
+        let al = &sp.alignment;
         self.o.stmt("MODE/MAN");
         // The probe first (fitted if it is not on the head), then how to align.
         if let Some(step) = al.steps.first() {
@@ -941,127 +960,185 @@ impl Writer<'_> {
         let mut fa_manual = Vec::new();
         // The part axis the primary's direction fixes, once measured.
         let mut primary: Option<usize> = None;
-        for (k, step) in al.steps.iter().enumerate() {
-            let g = &sp.groups[step.group];
-            let key = step_sensor(sp, step);
-            // By hand, the operator brings the probe out before the head indexes (or the
-            // probe changes) between two features: the ball may be down a bore.
-            let moved = al.steps[..k]
-                .last()
-                .is_some_and(|prev| step_sensor(sp, prev) != key);
-            if moved {
-                self.o.oper(
-                    "RAISE THE PROBE CLEAR ABOVE THE PART, THEN CONTINUE: THE HEAD TURNS THE PROBE FOR THE NEXT FEATURE",
-                );
-                self.o.stmt("PAUSE");
+        for k in 0..al.steps.len() {
+            if let Some((dcc, manual)) = self.hand_step(si, sp, k, &mut primary) {
+                fa.push(dcc);
+                fa_manual.push(manual);
             }
-            self.select_key(key);
-            // The feature touched, its touches, and the face the operator is told of.
-            let (label, pts, face) = match (step.block, &step.extra) {
-                (Some(bi), _) => {
-                    let Some((label, ..)) = self.feats.get(&(si, step.group, bi)).cloned() else {
-                        continue;
-                    };
-                    let Some(b) = g.blocks.get(bi) else {
-                        continue;
-                    };
-                    let pts: Vec<(P3, V3)> = step
-                        .points
-                        .iter()
-                        .map(|&k| (hlip.points[k].position, hlip.points[k].normal))
-                        .collect();
-                    (label, pts, b.face)
-                }
-                (None, Some(extra)) => {
-                    let label = self.extra_nominal(si, extra);
-                    (label, extra.touches.clone(), extra.face)
-                }
-                (None, None) => continue,
-            };
-            let n = pts.len();
-            // The table beside the part stands in for the face resting on it.
-            let on = if self.is_table(&label) {
-                format!("THE TABLE BESIDE THE PART (FOR {})", self.face_words(face))
-            } else {
-                self.face_words(face)
-            };
-            // Two touches are a line, whose direction runs from the first to the second:
-            // touched the other way round, the axis it sets turns over.
-            self.o.oper(&format!(
-                "BY HAND: {n} TOUCH{} ON {on}{}",
-                if n == 1 { "" } else { "ES" },
-                if n == 2 { ", IN THE ORDER SHOWN" } else { "" }
-            ));
-            let manual = self.manual_feature(&label, &pts, primary);
-            self.o.stmt(&format!(
-                "MEAS/{},F({}),{}",
-                manual.meas,
-                manual.label,
-                pts.len()
-            ));
-            for (p, n) in &pts {
-                ptmeas_at(&mut self.o, p, n);
-            }
-            self.o.stmt("ENDMES");
-            if primary.is_none() {
-                primary = step
-                    .keywords
-                    .iter()
-                    .find(|k| k.ends_with("DIR"))
-                    .and_then(|k| k.trim_start_matches('-').chars().next())
-                    .and_then(|c| "XYZ".find(c));
-            }
-            // A direction is the `FEAT`'s: where the feature's nominal axis (its first
-            // face's) runs against the touched face's (the other half of a split bore),
-            // the keyword's sign turns with it.
-            let axis = |n: Option<&Nominal>| match n {
-                Some(Nominal::Surface(
-                    Surface::Cylinder { axis, .. } | Surface::Cone { axis, .. },
-                    _,
-                )) => Some(*axis),
-                _ => None,
-            };
-            let face_nominal = step
-                .block
-                .and_then(|bi| g.blocks.get(bi))
-                .and_then(|b| nominal_of(self.input, b));
-            let against = matches!(
-                (axis(self.nominals.get(&label)), axis(face_nominal.as_ref())),
-                (Some(a), Some(b)) if a.dot(&b) < 0.0
+        }
+        (fa, fa_manual)
+    }
+
+    /// Step `k` of the hand alignment: the probe brought out where the head turns or
+    /// the probe changes, the feature touched, and its `DATSET` parameters for the DCC
+    /// alignment and for the manual one; `None` for a step with nothing to touch.
+    fn hand_step(
+        &mut self,
+        si: usize,
+        sp: &SetupPath,
+        k: usize,
+        primary: &mut Option<usize>,
+    ) -> Option<(String, String)> {
+        let al = &sp.alignment;
+        let step = &al.steps[k];
+        let key = step_sensor(sp, step);
+        // By hand, the operator brings the probe out before the head indexes (or the
+        // probe changes) between two features: the ball may be down a bore.
+        let moved = al.steps[..k]
+            .last()
+            .is_some_and(|prev| step_sensor(sp, prev) != key);
+        if moved {
+            self.o.oper(
+                "RAISE THE PROBE CLEAR ABOVE THE PART, THEN CONTINUE: THE HEAD TURNS THE PROBE FOR THE NEXT FEATURE",
             );
-            let keywords: Vec<String> = step
+            self.o.stmt("PAUSE");
+        }
+        self.select_key(key);
+        let (label, pts, face) = self.hand_feature(si, sp, step)?;
+        let manual = self.hand_touches(&label, &pts, face, *primary);
+        if primary.is_none() {
+            *primary = step
                 .keywords
                 .iter()
-                .map(
-                    |k| match (against, k.ends_with("DIR"), k.strip_prefix('-')) {
-                        (true, true, Some(k)) => k.to_string(),
-                        (true, true, None) => format!("-{k}"),
-                        _ => k.clone(),
-                    },
-                )
-                .collect();
-            let manual_keywords: Vec<String> = keywords
-                .iter()
-                .map(|k| match (&manual.line_dir, k.ends_with("DIR")) {
-                    (Some(d), true) => d.clone(),
-                    _ => k.clone(),
-                })
-                .collect();
-            let manual_fa = format!("FA({}),{}", manual.label, manual_keywords.join(","));
-            // A face touched by hand only stays what the DCC alignment takes it from.
-            if step.block.is_some() {
-                fa.push(format!("FA({}),{}", label, keywords.join(",")));
-            } else {
-                fa.push(manual_fa.clone());
-            }
-            fa_manual.push(manual_fa);
+                .find(|k| k.ends_with("DIR"))
+                .and_then(|k| k.trim_start_matches('-').chars().next())
+                .and_then(|c| "XYZ".find(c));
         }
+        let keywords = self.step_keywords(sp, step, &label);
+        let manual_keywords: Vec<String> = keywords
+            .iter()
+            .map(|k| match (&manual.line_dir, k.ends_with("DIR")) {
+                (Some(d), true) => d.clone(),
+                _ => k.clone(),
+            })
+            .collect();
+        let manual_fa = format!("FA({}),{}", manual.label, manual_keywords.join(","));
+        // A face touched by hand only stays what the DCC alignment takes it from.
+        let fa = if step.block.is_some() {
+            format!("FA({}),{}", label, keywords.join(","))
+        } else {
+            manual_fa.clone()
+        };
+        Some((fa, manual_fa))
+    }
+
+    /// The feature a hand step touches, its touches, and the face the operator is told
+    /// of: a block's feature, or a face touched only to align (declared here).
+    fn hand_feature(
+        &mut self,
+        si: usize,
+        sp: &SetupPath,
+        step: &crate::path::AlignStep,
+    ) -> Option<HandFeature> {
+        let hlip = self.input.hlip;
+        match (step.block, &step.extra) {
+            (Some(bi), _) => {
+                let (label, ..) = self.feats.get(&(si, step.group, bi)).cloned()?;
+                let b = sp.groups[step.group].blocks.get(bi)?;
+                let pts: Vec<(P3, V3)> = step
+                    .points
+                    .iter()
+                    .map(|&k| (hlip.points[k].position, hlip.points[k].normal))
+                    .collect();
+                Some((label, pts, b.face))
+            }
+            (None, Some(extra)) => {
+                let label = self.extra_nominal(si, extra);
+                Some((label, extra.touches.clone(), extra.face))
+            }
+            (None, None) => None,
+        }
+    }
+
+    /// The operator told where to touch, and the `MEAS` block of the touches by hand.
+    fn hand_touches(
+        &mut self,
+        label: &str,
+        pts: &[(P3, V3)],
+        face: FaceId,
+        primary: Option<usize>,
+    ) -> Manual {
+        let n = pts.len();
+        // The table beside the part stands in for the face resting on it.
+        let on = if self.is_table(label) {
+            format!("THE TABLE BESIDE THE PART (FOR {})", self.face_words(face))
+        } else {
+            self.face_words(face)
+        };
+        // Two touches are a line, whose direction runs from the first to the second:
+        // touched the other way round, the axis it sets turns over.
+        self.o.oper(&format!(
+            "BY HAND: {n} TOUCH{} ON {on}{}",
+            if n == 1 { "" } else { "ES" },
+            if n == 2 { ", IN THE ORDER SHOWN" } else { "" }
+        ));
+        let manual = self.manual_feature(label, pts, primary);
+        self.o.stmt(&format!(
+            "MEAS/{},F({}),{}",
+            manual.meas,
+            manual.label,
+            pts.len()
+        ));
+        for (p, n) in pts {
+            ptmeas_at(&mut self.o, p, n);
+        }
+        self.o.stmt("ENDMES");
+        manual
+    }
+
+    /// A hand step's `DATSET` keywords for feature `label`. A direction is the
+    /// `FEAT`'s: where the feature's nominal axis (its first face's) runs against the
+    /// touched face's (the other half of a split bore), the keyword's sign turns with it.
+    fn step_keywords(
+        &self,
+        sp: &SetupPath,
+        step: &crate::path::AlignStep,
+        label: &str,
+    ) -> Vec<String> {
+        let axis = |n: Option<&Nominal>| match n {
+            Some(Nominal::Surface(
+                Surface::Cylinder { axis, .. } | Surface::Cone { axis, .. },
+                _,
+            )) => Some(*axis),
+            _ => None,
+        };
+        let face_nominal = step
+            .block
+            .and_then(|bi| sp.groups[step.group].blocks.get(bi))
+            .and_then(|b| nominal_of(self.input, b));
+        let against = matches!(
+            (axis(self.nominals.get(label)), axis(face_nominal.as_ref())),
+            (Some(a), Some(b)) if a.dot(&b) < 0.0
+        );
+        step.keywords
+            .iter()
+            .map(
+                |k| match (against, k.ends_with("DIR"), k.strip_prefix('-')) {
+                    (true, true, Some(k)) => k.to_string(),
+                    (true, true, None) => format!("-{k}"),
+                    _ => k.clone(),
+                },
+            )
+            .collect()
+    }
+
+    /// After the hand alignment: its `DATSET` and `TRANS`, the probe brought out where
+    /// the measuring run starts with another orientation, `MODE/PROG,MAN`, and the
+    /// alignment kept (`fa`) to repeat on the program's own measurements.
+    fn start_measuring(
+        &mut self,
+        si: usize,
+        sp: &SetupPath,
+        fa: Vec<String>,
+        fa_manual: &[String],
+    ) {
+        let al = &sp.alignment;
         let shifts: Vec<String> = al
             .trans
             .iter()
             .map(|(k, v)| format!("{k}ORIG,{}", real(-v)))
             .collect();
-        self.datset(&format!("SETUP{}", si + 1), &fa_manual, &shifts);
+        self.datset(&format!("SETUP{}", si + 1), fa_manual, &shifts);
         // The measuring run starts with the setup's first group: where the head turns
         // or the probe changes for it, the operator first brings the probe out, as
         // between two hand features.
