@@ -1330,7 +1330,7 @@ impl Writer<'_> {
     /// A group: its sensor, entry, `MEAS` blocks and exit, the datums it measured and
     /// the tolerances it completes.
     fn group(&mut self, (si, gi): (usize, usize), g: &GroupPath) {
-        let (hlip, motion) = (self.input.hlip, self.input.llip.motion);
+        let motion = self.input.llip.motion;
         let angles = if self.indexable() {
             format!(" at a{} b{}", num(g.a), num(g.b))
         } else {
@@ -1378,86 +1378,16 @@ impl Writer<'_> {
                 };
                 self.scan(g, b, &target, meas);
             } else {
-                let o = &mut self.o;
-                if !joined {
-                    o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
-                }
-                for (ti, t) in b.touches.iter().enumerate() {
-                    if joined {
-                        let point = &self.points[&((si, gi, bi), ti)];
-                        o.stmt(&format!("MEAS/POINT,F({point}),1"));
-                    }
-                    for v in &t.via {
-                        o.goto(v);
-                    }
-                    o.goto(&t.standoff);
-                    ptmeas(o, hlip, t.point);
-                    if !narrow && motion.retract < motion.prehit {
-                        o.goto(&t.standoff);
-                    }
-                    if joined {
-                        o.stmt("ENDMES");
-                    }
-                }
-                if !joined {
-                    o.stmt("ENDMES");
-                }
+                self.touch_block((si, gi, bi), b, &label, meas, joined, narrow);
             }
-            // The last block of a round in points joins them into the whole.
-            let s = &self.surfs[surf];
-            let r = &s.rounds[round];
-            let complete = if r.partials.is_empty() {
-                Some(label.clone())
-            } else if r.last == (si, gi, bi) {
-                let fa: Vec<String> = r.partials.iter().map(|l| format!("FA({l})")).collect();
-                let full = s.full.clone();
-                self.o
-                    .stmt(&format!("CONST/{meas},F({full}),BF,{}", fa.join(",")));
-                Some(full)
-            } else {
-                None
-            };
-            let Some(mut done) = complete else {
+            let Some(done) = self.complete_round((si, gi, bi), surf, round, &label, meas) else {
                 // Measured anew: not complete until the round's last block.
                 self.done.remove(&surf);
                 continue;
             };
-            self.done.insert(surf);
-            self.done_in.insert(surf, si);
-            if let Some(r) = self.realign.as_mut() {
-                r.measured.insert(done.clone());
-            }
-            // The second wall of a slot or tab makes the pair.
-            if let Some((pair, walls)) = b.feature.and_then(|f| self.pairs.get(&f)).cloned() {
-                if !walls.iter().all(|w| self.done.contains(w)) {
-                    continue;
-                }
-                let fa: Vec<String> = walls
-                    .iter()
-                    .map(|w| format!("FA({})", self.surfs[*w].full))
-                    .collect();
-                self.o
-                    .stmt(&format!("CONST/PARPLN,F({pair}),BF,{}", fa.join(",")));
-                done = pair;
-            }
-            let list = self.measured.entry(b.feature).or_default();
-            if !list.contains(&done) {
-                list.push(done.clone());
-            }
-            // A datum pattern is its datum once every member is measured in this setup.
-            let mut datum_label = Some(done.clone());
-            if let Some((pat, members)) = b.feature.and_then(|f| self.patterns.get(&f)).cloned() {
-                datum_label = None;
-                if members.iter().all(|m| self.done_in.get(m) == Some(&si)) {
-                    let fa: Vec<String> = members
-                        .iter()
-                        .map(|m| format!("FA({})", self.surfs[*m].full))
-                        .collect();
-                    self.o
-                        .stmt(&format!("CONST/PATERN,F({pat}),BF,{}", fa.join(",")));
-                    datum_label = Some(pat);
-                }
-            }
+            let Some((done, datum_label)) = self.surface_done(si, surf, b, done) else {
+                continue;
+            };
             if let (Some(d), Some(l)) = (b.datum, datum_label) {
                 if !datums_here.iter().any(|(x, _)| *x == d) {
                     datums_here.push((d, l));
@@ -1471,7 +1401,135 @@ impl Writer<'_> {
         for p in &g.exit {
             self.o.goto(p);
         }
-        // The DCC alignment, once every alignment feature is measured under the program.
+        self.realign_once_measured(si);
+        // Datums measured here, then the tolerances this group completes.
+        for (d, label) in datums_here {
+            self.defined_in.insert(d, si);
+            let dl = &self.datums[d.0];
+            self.o.stmt(&format!("DATDEF/FA({label}),DAT({dl})"));
+        }
+        self.output_ready((si, gi), g, &in_group);
+    }
+
+    /// A block of touches: one `MEAS` of the feature, or, where the round is joined
+    /// from points, one `MEAS/POINT` per touch; each touch from its stand-off point by
+    /// way of its via points.
+    fn touch_block(
+        &mut self,
+        key: BlockKey,
+        b: &BlockPath,
+        label: &str,
+        meas: &str,
+        joined: bool,
+        narrow: bool,
+    ) {
+        let (hlip, motion) = (self.input.hlip, self.input.llip.motion);
+        let o = &mut self.o;
+        if !joined {
+            o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
+        }
+        for (ti, t) in b.touches.iter().enumerate() {
+            if joined {
+                let point = &self.points[&(key, ti)];
+                o.stmt(&format!("MEAS/POINT,F({point}),1"));
+            }
+            for v in &t.via {
+                o.goto(v);
+            }
+            o.goto(&t.standoff);
+            ptmeas(o, hlip, t.point);
+            if !narrow && motion.retract < motion.prehit {
+                o.goto(&t.standoff);
+            }
+            if joined {
+                o.stmt("ENDMES");
+            }
+        }
+        if !joined {
+            o.stmt("ENDMES");
+        }
+    }
+
+    /// The label that completes the surface's round with block `key`: the block's own
+    /// feature, or at a joined round's last block the best-fit `CONST` over its points;
+    /// `None` before that block.
+    fn complete_round(
+        &mut self,
+        key: BlockKey,
+        surf: usize,
+        round: usize,
+        label: &str,
+        meas: &str,
+    ) -> Option<String> {
+        let s = &self.surfs[surf];
+        let r = &s.rounds[round];
+        if r.partials.is_empty() {
+            Some(label.to_string())
+        } else if r.last == key {
+            let fa: Vec<String> = r.partials.iter().map(|l| format!("FA({l})")).collect();
+            let full = s.full.clone();
+            self.o
+                .stmt(&format!("CONST/{meas},F({full}),BF,{}", fa.join(",")));
+            Some(full)
+        } else {
+            None
+        }
+    }
+
+    /// Surface `surf` complete in setup `si` as `done`: the second wall of a slot or tab
+    /// makes the pair (`CONST/PARPLN`), and the last member of a datum pattern measured
+    /// in the setup the pattern (`CONST/PATERN`). The label the feature is measured by
+    /// now, and the one its datum takes (none for a pattern not yet whole); `None` while
+    /// a pair waits for its other wall.
+    fn surface_done(
+        &mut self,
+        si: usize,
+        surf: usize,
+        b: &BlockPath,
+        mut done: String,
+    ) -> Option<(String, Option<String>)> {
+        self.done.insert(surf);
+        self.done_in.insert(surf, si);
+        if let Some(r) = self.realign.as_mut() {
+            r.measured.insert(done.clone());
+        }
+        // The second wall of a slot or tab makes the pair.
+        if let Some((pair, walls)) = b.feature.and_then(|f| self.pairs.get(&f)).cloned() {
+            if !walls.iter().all(|w| self.done.contains(w)) {
+                return None;
+            }
+            let fa: Vec<String> = walls
+                .iter()
+                .map(|w| format!("FA({})", self.surfs[*w].full))
+                .collect();
+            self.o
+                .stmt(&format!("CONST/PARPLN,F({pair}),BF,{}", fa.join(",")));
+            done = pair;
+        }
+        let list = self.measured.entry(b.feature).or_default();
+        if !list.contains(&done) {
+            list.push(done.clone());
+        }
+        // A datum pattern is its datum once every member is measured in this setup.
+        let mut datum_label = Some(done.clone());
+        if let Some((pat, members)) = b.feature.and_then(|f| self.patterns.get(&f)).cloned() {
+            datum_label = None;
+            if members.iter().all(|m| self.done_in.get(m) == Some(&si)) {
+                let fa: Vec<String> = members
+                    .iter()
+                    .map(|m| format!("FA({})", self.surfs[*m].full))
+                    .collect();
+                self.o
+                    .stmt(&format!("CONST/PATERN,F({pat}),BF,{}", fa.join(",")));
+                datum_label = Some(pat);
+            }
+        }
+        Some((done, datum_label))
+    }
+
+    /// The DCC alignment of setup `si`, once every alignment feature is measured under
+    /// the program.
+    fn realign_once_measured(&mut self, si: usize) {
         if let Some(r) = self.realign.take() {
             if r.setup == si && r.labels.iter().all(|l| r.measured.contains(l)) {
                 self.o
@@ -1481,19 +1539,17 @@ impl Writer<'_> {
                 self.realign = Some(r);
             }
         }
-        // Datums measured here, then the tolerances this group completes.
-        for (d, label) in datums_here {
-            self.defined_in.insert(d, si);
-            let dl = &self.datums[d.0];
-            self.o.stmt(&format!("DATDEF/FA({label}),DAT({dl})"));
-        }
-        // A tolerance is output once every surface of its features and datum features
-        // is complete (a surface joined from points completes at its last block).
+    }
+
+    /// The group's tolerances, and those pending from before, output where ready: once
+    /// every surface of their features and datum features is complete (a surface
+    /// joined from points completes at its last block); the others stay pending.
+    fn output_ready(&mut self, at: (usize, usize), g: &GroupPath, in_group: &[String]) {
         self.pending.extend(g.records.iter().copied());
         let pending = std::mem::take(&mut self.pending);
         for r in pending {
-            if self.ready(r, (si, gi)) {
-                self.output(r, &in_group);
+            if self.ready(r, at) {
+                self.output(r, in_group);
             } else {
                 self.pending.push(r);
             }
