@@ -372,6 +372,19 @@ struct Round {
     last: BlockKey,
 }
 
+/// A feature touched by hand to align: its label, its touches (point, normal) and
+/// the face the operator is told of.
+type HandFeature = (String, Vec<(P3, V3)>, FaceId);
+
+/// A surface about to be declared: its label's base, nominal and feature, and whether
+/// the table stands in for it.
+struct SurfaceOf {
+    name: String,
+    nominal: Nominal,
+    feature: Option<FeatureId>,
+    on_table: bool,
+}
+
 /// A setup's alignment, to repeat on the program's own measurements of its features.
 struct Realign {
     setup: usize,
@@ -607,27 +620,8 @@ impl Writer<'_> {
     /// one per partial where the program measures a surface in several blocks.
     fn nominals(&mut self) {
         let llip = self.input.llip;
-        let geometry = self.input.geometry;
         self.o.comment("nominals");
-        // The surfaces, in program order: (feature, contact, face, blocks).
-        let mut surfs: Vec<(Option<FeatureId>, Contact, FaceId, Vec<BlockKey>)> = Vec::new();
-        for (si, sp) in llip.setups.iter().enumerate() {
-            for (gi, g) in sp.groups.iter().enumerate() {
-                for (bi, b) in g.blocks.iter().enumerate() {
-                    let same = |f: FaceId| {
-                        f == b.face
-                            || (b.contact == Contact::Part && geometry.one_surface(f, b.face))
-                    };
-                    match surfs
-                        .iter_mut()
-                        .find(|s| s.0 == b.feature && s.1 == b.contact && same(s.2))
-                    {
-                        Some(s) => s.3.push((si, gi, bi)),
-                        None => surfs.push((b.feature, b.contact, b.face, vec![(si, gi, bi)])),
-                    }
-                }
-            }
-        }
+        let surfs = self.surfaces_in_order();
         let block = |k: &BlockKey| &llip.setups[k.0].groups[k.1].blocks[k.2];
         let mut count: BTreeMap<Option<FeatureId>, usize> = BTreeMap::new();
         for s in &surfs {
@@ -650,120 +644,142 @@ impl Writer<'_> {
             } else {
                 name
             };
-            let id = self.surfs.len();
-            // A free-form surface has no best fit to join: each block stands alone.
-            if matches!(nominal, Nominal::Surface(Surface::Freeform, _)) && blocks.len() > 1 {
-                let mut rounds = Vec::new();
-                for (j, k) in blocks.iter().enumerate() {
-                    let label = self.labels.fresh("F", &format!("{name}_{}", j + 1));
-                    self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
-                    self.nominals.insert(label.clone(), nominal.clone());
-                    self.feats.insert(*k, (label.clone(), id, j));
-                    self.faces_of.entry(feature).or_default().push(label);
-                    rounds.push(Round {
-                        partials: vec![],
-                        last: *k,
-                    });
-                }
-                self.surfs.push(Surf {
-                    full: String::new(),
-                    rounds,
-                    feature,
-                    on_table: contact == Contact::Table,
-                });
-                continue;
-            }
-            // Rounds: a block that touches a point again (a datum measured anew with
-            // another probe) starts a new round, which measures the surface anew.
-            let mut rounds_of: Vec<Vec<BlockKey>> = Vec::new();
-            let mut seen: std::collections::BTreeSet<usize> = std::collections::BTreeSet::new();
-            for k in &blocks {
-                let pts: Vec<usize> = block(k).touches.iter().map(|t| t.point).collect();
-                if rounds_of.is_empty() || pts.iter().any(|p| seen.contains(p)) {
-                    rounds_of.push(Vec::new());
-                    seen.clear();
-                }
-                seen.extend(pts);
-                rounds_of.last_mut().expect("a round").push(*k);
-            }
-            // A round of fewer touches than its surface needs fits nothing (one touch
-            // is no plane): it joins the round before it, or after it for the first.
-            let least = nominal.least_touches();
-            let touches = |keys: &[BlockKey]| -> usize {
-                keys.iter()
-                    .map(|k| block(k).touches.len().max(block(k).passes.len() * least))
-                    .sum()
-            };
-            let mut r = 0;
-            while rounds_of.len() > 1 && r < rounds_of.len() {
-                if touches(&rounds_of[r]) >= least {
-                    r += 1;
-                    continue;
-                }
-                let keys = rounds_of.remove(r);
-                let into = r.saturating_sub(1).min(rounds_of.len() - 1);
-                if r == 0 {
-                    let mut joined = keys;
-                    joined.append(&mut rounds_of[0]);
-                    rounds_of[0] = joined;
-                } else {
-                    rounds_of[into].extend(keys);
-                }
-            }
-            let full = self.labels.fresh("F", &name);
-            self.o.stmt(&format!("F({full})=FEAT/{}", nominal.feat()));
-            self.nominals.insert(full.clone(), nominal.clone());
-            self.faces_of.entry(feature).or_default().push(full.clone());
-            // A round of several blocks measures points (`FEAT/POINT`): a block of one
-            // or two touches fits no cylinder; a best-fit `CONST` over them all is the
-            // surface.
-            let mut rounds = Vec::new();
-            let mut n = 0;
-            for (r, keys) in rounds_of.iter().enumerate() {
-                let mut partials = Vec::new();
-                for k in keys {
-                    self.feats.insert(*k, (full.clone(), id, r));
-                    if keys.len() == 1 {
-                        continue;
-                    }
-                    // A scanned block of a surface scanned from several views measures
-                    // the surface itself: the best fit joins the views' clouds.
-                    if !block(k).passes.is_empty() {
-                        n += 1;
-                        let label = self.labels.fresh("F", &format!("{name}_S{n}"));
-                        self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
-                        self.nominals.insert(label.clone(), nominal.clone());
-                        self.points.insert((*k, usize::MAX), label.clone());
-                        partials.push(label);
-                        continue;
-                    }
-                    for (ti, t) in block(k).touches.iter().enumerate() {
-                        n += 1;
-                        let label = self.labels.fresh("F", &format!("{name}_P{n}"));
-                        let p = &self.input.hlip.points[t.point];
-                        self.o.stmt(&format!(
-                            "F({label})=FEAT/POINT,CART,{},{}",
-                            xyz(&p.position),
-                            ijk(&p.normal)
-                        ));
-                        self.points.insert((*k, ti), label.clone());
-                        partials.push(label);
-                    }
-                }
-                rounds.push(Round {
-                    partials,
-                    last: *keys.last().expect("a round has a block"),
-                });
-            }
-            self.surfs.push(Surf {
-                full,
-                rounds,
+            let surface = SurfaceOf {
+                name,
+                nominal,
                 feature,
                 on_table: contact == Contact::Table,
-            });
+            };
+            // A free-form surface has no best fit to join: each block stands alone.
+            if matches!(surface.nominal, Nominal::Surface(Surface::Freeform, _)) && blocks.len() > 1
+            {
+                self.freeform_nominals(surface, &blocks);
+                continue;
+            }
+            let rounds = measuring_rounds(llip, &blocks, surface.nominal.least_touches());
+            self.surface_nominals(surface, &rounds);
         }
         self.centre_planes();
         self.datum_patterns();
+    }
+
+    /// The surfaces the program measures, in program order: (feature, contact, face,
+    /// blocks); a feature's blocks on one surface of the part measure one.
+    fn surfaces_in_order(&self) -> Vec<(Option<FeatureId>, Contact, FaceId, Vec<BlockKey>)> {
+        let geometry = self.input.geometry;
+        let mut surfs: Vec<(Option<FeatureId>, Contact, FaceId, Vec<BlockKey>)> = Vec::new();
+        for (si, sp) in self.input.llip.setups.iter().enumerate() {
+            for (gi, g) in sp.groups.iter().enumerate() {
+                for (bi, b) in g.blocks.iter().enumerate() {
+                    let same = |f: FaceId| {
+                        f == b.face
+                            || (b.contact == Contact::Part && geometry.one_surface(f, b.face))
+                    };
+                    match surfs
+                        .iter_mut()
+                        .find(|s| s.0 == b.feature && s.1 == b.contact && same(s.2))
+                    {
+                        Some(s) => s.3.push((si, gi, bi)),
+                        None => surfs.push((b.feature, b.contact, b.face, vec![(si, gi, bi)])),
+                    }
+                }
+            }
+        }
+        surfs
+    }
+
+    /// A free-form surface measured in several blocks: one `FEAT/GSURF` per block, each
+    /// its own feature and round.
+    fn freeform_nominals(&mut self, surface: SurfaceOf, blocks: &[BlockKey]) {
+        let SurfaceOf {
+            name,
+            nominal,
+            feature,
+            on_table,
+        } = surface;
+        let id = self.surfs.len();
+        let mut rounds = Vec::new();
+        for (j, k) in blocks.iter().enumerate() {
+            let label = self.labels.fresh("F", &format!("{name}_{}", j + 1));
+            self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
+            self.nominals.insert(label.clone(), nominal.clone());
+            self.feats.insert(*k, (label.clone(), id, j));
+            self.faces_of.entry(feature).or_default().push(label);
+            rounds.push(Round {
+                partials: vec![],
+                last: *k,
+            });
+        }
+        self.surfs.push(Surf {
+            full: String::new(),
+            rounds,
+            feature,
+            on_table,
+        });
+    }
+
+    /// A surface's `FEAT` and, per round of several blocks, its partials: a
+    /// `FEAT/POINT` per touch (a block of one or two touches fits no cylinder), or the
+    /// surface itself per scanned block; a best-fit `CONST` over them all is the
+    /// surface.
+    fn surface_nominals(&mut self, surface: SurfaceOf, rounds_of: &[Vec<BlockKey>]) {
+        let llip = self.input.llip;
+        let block = |k: &BlockKey| &llip.setups[k.0].groups[k.1].blocks[k.2];
+        let SurfaceOf {
+            name,
+            nominal,
+            feature,
+            on_table,
+        } = surface;
+        let id = self.surfs.len();
+        let full = self.labels.fresh("F", &name);
+        self.o.stmt(&format!("F({full})=FEAT/{}", nominal.feat()));
+        self.nominals.insert(full.clone(), nominal.clone());
+        self.faces_of.entry(feature).or_default().push(full.clone());
+        let mut rounds = Vec::new();
+        let mut n = 0;
+        for (r, keys) in rounds_of.iter().enumerate() {
+            let mut partials = Vec::new();
+            for k in keys {
+                self.feats.insert(*k, (full.clone(), id, r));
+                if keys.len() == 1 {
+                    continue;
+                }
+                // A scanned block of a surface scanned from several views measures
+                // the surface itself: the best fit joins the views' clouds.
+                if !block(k).passes.is_empty() {
+                    n += 1;
+                    let label = self.labels.fresh("F", &format!("{name}_S{n}"));
+                    self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
+                    self.nominals.insert(label.clone(), nominal.clone());
+                    self.points.insert((*k, usize::MAX), label.clone());
+                    partials.push(label);
+                    continue;
+                }
+                for (ti, t) in block(k).touches.iter().enumerate() {
+                    n += 1;
+                    let label = self.labels.fresh("F", &format!("{name}_P{n}"));
+                    let p = &self.input.hlip.points[t.point];
+                    self.o.stmt(&format!(
+                        "F({label})=FEAT/POINT,CART,{},{}",
+                        xyz(&p.position),
+                        ijk(&p.normal)
+                    ));
+                    self.points.insert((*k, ti), label.clone());
+                    partials.push(label);
+                }
+            }
+            rounds.push(Round {
+                partials,
+                last: *keys.last().expect("a round has a block"),
+            });
+        }
+        self.surfs.push(Surf {
+            full,
+            rounds,
+            feature,
+            on_table,
+        });
     }
 
     /// A datum feature of several parallel bores or pins (a pattern of holes) is one
@@ -954,8 +970,19 @@ impl Writer<'_> {
 
     /// A setup's operator prompt, its manual alignment and `DATSET`.
     fn setup(&mut self, si: usize, setups_n: usize, sp: &SetupPath) {
-        let hlip = self.input.hlip;
-        let setup = &hlip.setups[sp.setup];
+        self.place_part(si, setups_n, sp);
+        if sp.alignment.steps.is_empty() {
+            return;
+        }
+        let (fa, fa_manual) = self.hand_alignment(si, sp);
+        self.start_measuring(si, sp, fa, &fa_manual);
+    }
+
+    /// The setup's nominal frame (`RECALL` of the machine's, then `ROTATE`s) and the
+    /// operator's placing of the part: which way up, held by what, turned how, resting
+    /// on which faces and squared how closely; then `PAUSE`.
+    fn place_part(&mut self, si: usize, setups_n: usize, sp: &SetupPath) {
+        let setup = &self.input.hlip.setups[sp.setup];
         self.o.comment(&format!("setup {} of {setups_n}", si + 1));
         // The frame the manual points are written in: the part's own, at its nominal
         // place in this setup (machine axes turned by the setup's rotation).
@@ -1012,9 +1039,13 @@ impl Writer<'_> {
             ));
         }
         self.o.stmt("PAUSE");
-        if al.steps.is_empty() {
-            return;
-        }
+    }
+
+    /// The setup's alignment by hand (`MODE/MAN`), feature by feature: the `DATSET`
+    /// parameters of its features, as the DCC alignment takes them and as the manual
+    /// one does.
+    fn hand_alignment(&mut self, si: usize, sp: &SetupPath) -> (Vec<String>, Vec<String>) {
+        let al = &sp.alignment;
         self.o.stmt("MODE/MAN");
         // The probe first (fitted if it is not on the head), then how to align.
         if let Some(step) = al.steps.first() {
@@ -1027,127 +1058,185 @@ impl Writer<'_> {
         let mut fa_manual = Vec::new();
         // The part axis the primary's direction fixes, once measured.
         let mut primary: Option<usize> = None;
-        for (k, step) in al.steps.iter().enumerate() {
-            let g = &sp.groups[step.group];
-            let key = step_sensor(sp, step);
-            // By hand, the operator brings the probe out before the head indexes (or the
-            // probe changes) between two features: the ball may be down a bore.
-            let moved = al.steps[..k]
-                .last()
-                .is_some_and(|prev| step_sensor(sp, prev) != key);
-            if moved {
-                self.o.oper(
-                    "RAISE THE PROBE CLEAR ABOVE THE PART, THEN CONTINUE: THE HEAD TURNS THE PROBE FOR THE NEXT FEATURE",
-                );
-                self.o.stmt("PAUSE");
+        for k in 0..al.steps.len() {
+            if let Some((dcc, manual)) = self.hand_step(si, sp, k, &mut primary) {
+                fa.push(dcc);
+                fa_manual.push(manual);
             }
-            self.select_key(key);
-            // The feature touched, its touches, and the face the operator is told of.
-            let (label, pts, face) = match (step.block, &step.extra) {
-                (Some(bi), _) => {
-                    let Some((label, ..)) = self.feats.get(&(si, step.group, bi)).cloned() else {
-                        continue;
-                    };
-                    let Some(b) = g.blocks.get(bi) else {
-                        continue;
-                    };
-                    let pts: Vec<(P3, V3)> = step
-                        .points
-                        .iter()
-                        .map(|&k| (hlip.points[k].position, hlip.points[k].normal))
-                        .collect();
-                    (label, pts, b.face)
-                }
-                (None, Some(extra)) => {
-                    let label = self.extra_nominal(si, extra);
-                    (label, extra.touches.clone(), extra.face)
-                }
-                (None, None) => continue,
-            };
-            let n = pts.len();
-            // The table beside the part stands in for the face resting on it.
-            let on = if self.is_table(&label) {
-                format!("THE TABLE BESIDE THE PART (FOR {})", self.face_words(face))
-            } else {
-                self.face_words(face)
-            };
-            // Two touches are a line, whose direction runs from the first to the second:
-            // touched the other way round, the axis it sets turns over.
-            self.o.oper(&format!(
-                "BY HAND: {n} TOUCH{} ON {on}{}",
-                if n == 1 { "" } else { "ES" },
-                if n == 2 { ", IN THE ORDER SHOWN" } else { "" }
-            ));
-            let manual = self.manual_feature(&label, &pts, primary);
-            self.o.stmt(&format!(
-                "MEAS/{},F({}),{}",
-                manual.meas,
-                manual.label,
-                pts.len()
-            ));
-            for (p, n) in &pts {
-                ptmeas_at(&mut self.o, p, n);
-            }
-            self.o.stmt("ENDMES");
-            if primary.is_none() {
-                primary = step
-                    .keywords
-                    .iter()
-                    .find(|k| k.ends_with("DIR"))
-                    .and_then(|k| k.trim_start_matches('-').chars().next())
-                    .and_then(|c| "XYZ".find(c));
-            }
-            // A direction is the `FEAT`'s: where the feature's nominal axis (its first
-            // face's) runs against the touched face's (the other half of a split bore),
-            // the keyword's sign turns with it.
-            let axis = |n: Option<&Nominal>| match n {
-                Some(Nominal::Surface(
-                    Surface::Cylinder { axis, .. } | Surface::Cone { axis, .. },
-                    _,
-                )) => Some(*axis),
-                _ => None,
-            };
-            let face_nominal = step
-                .block
-                .and_then(|bi| g.blocks.get(bi))
-                .and_then(|b| nominal_of(self.input, b));
-            let against = matches!(
-                (axis(self.nominals.get(&label)), axis(face_nominal.as_ref())),
-                (Some(a), Some(b)) if a.dot(&b) < 0.0
+        }
+        (fa, fa_manual)
+    }
+
+    /// Step `k` of the hand alignment: the probe brought out where the head turns or
+    /// the probe changes, the feature touched, and its `DATSET` parameters for the DCC
+    /// alignment and for the manual one; `None` for a step with nothing to touch.
+    fn hand_step(
+        &mut self,
+        si: usize,
+        sp: &SetupPath,
+        k: usize,
+        primary: &mut Option<usize>,
+    ) -> Option<(String, String)> {
+        let al = &sp.alignment;
+        let step = &al.steps[k];
+        let key = step_sensor(sp, step);
+        // By hand, the operator brings the probe out before the head indexes (or the
+        // probe changes) between two features: the ball may be down a bore.
+        let moved = al.steps[..k]
+            .last()
+            .is_some_and(|prev| step_sensor(sp, prev) != key);
+        if moved {
+            self.o.oper(
+                "RAISE THE PROBE CLEAR ABOVE THE PART, THEN CONTINUE: THE HEAD TURNS THE PROBE FOR THE NEXT FEATURE",
             );
-            let keywords: Vec<String> = step
+            self.o.stmt("PAUSE");
+        }
+        self.select_key(key);
+        let (label, pts, face) = self.hand_feature(si, sp, step)?;
+        let manual = self.hand_touches(&label, &pts, face, *primary);
+        if primary.is_none() {
+            *primary = step
                 .keywords
                 .iter()
-                .map(
-                    |k| match (against, k.ends_with("DIR"), k.strip_prefix('-')) {
-                        (true, true, Some(k)) => k.to_string(),
-                        (true, true, None) => format!("-{k}"),
-                        _ => k.clone(),
-                    },
-                )
-                .collect();
-            let manual_keywords: Vec<String> = keywords
-                .iter()
-                .map(|k| match (&manual.line_dir, k.ends_with("DIR")) {
-                    (Some(d), true) => d.clone(),
-                    _ => k.clone(),
-                })
-                .collect();
-            let manual_fa = format!("FA({}),{}", manual.label, manual_keywords.join(","));
-            // A face touched by hand only stays what the DCC alignment takes it from.
-            if step.block.is_some() {
-                fa.push(format!("FA({}),{}", label, keywords.join(",")));
-            } else {
-                fa.push(manual_fa.clone());
-            }
-            fa_manual.push(manual_fa);
+                .find(|k| k.ends_with("DIR"))
+                .and_then(|k| k.trim_start_matches('-').chars().next())
+                .and_then(|c| "XYZ".find(c));
         }
+        let keywords = self.step_keywords(sp, step, &label);
+        let manual_keywords: Vec<String> = keywords
+            .iter()
+            .map(|k| match (&manual.line_dir, k.ends_with("DIR")) {
+                (Some(d), true) => d.clone(),
+                _ => k.clone(),
+            })
+            .collect();
+        let manual_fa = format!("FA({}),{}", manual.label, manual_keywords.join(","));
+        // A face touched by hand only stays what the DCC alignment takes it from.
+        let fa = if step.block.is_some() {
+            format!("FA({}),{}", label, keywords.join(","))
+        } else {
+            manual_fa.clone()
+        };
+        Some((fa, manual_fa))
+    }
+
+    /// The feature a hand step touches, its touches, and the face the operator is told
+    /// of: a block's feature, or a face touched only to align (declared here).
+    fn hand_feature(
+        &mut self,
+        si: usize,
+        sp: &SetupPath,
+        step: &crate::path::AlignStep,
+    ) -> Option<HandFeature> {
+        let hlip = self.input.hlip;
+        match (step.block, &step.extra) {
+            (Some(bi), _) => {
+                let (label, ..) = self.feats.get(&(si, step.group, bi)).cloned()?;
+                let b = sp.groups[step.group].blocks.get(bi)?;
+                let pts: Vec<(P3, V3)> = step
+                    .points
+                    .iter()
+                    .map(|&k| (hlip.points[k].position, hlip.points[k].normal))
+                    .collect();
+                Some((label, pts, b.face))
+            }
+            (None, Some(extra)) => {
+                let label = self.extra_nominal(si, extra);
+                Some((label, extra.touches.clone(), extra.face))
+            }
+            (None, None) => None,
+        }
+    }
+
+    /// The operator told where to touch, and the `MEAS` block of the touches by hand.
+    fn hand_touches(
+        &mut self,
+        label: &str,
+        pts: &[(P3, V3)],
+        face: FaceId,
+        primary: Option<usize>,
+    ) -> Manual {
+        let n = pts.len();
+        // The table beside the part stands in for the face resting on it.
+        let on = if self.is_table(label) {
+            format!("THE TABLE BESIDE THE PART (FOR {})", self.face_words(face))
+        } else {
+            self.face_words(face)
+        };
+        // Two touches are a line, whose direction runs from the first to the second:
+        // touched the other way round, the axis it sets turns over.
+        self.o.oper(&format!(
+            "BY HAND: {n} TOUCH{} ON {on}{}",
+            if n == 1 { "" } else { "ES" },
+            if n == 2 { ", IN THE ORDER SHOWN" } else { "" }
+        ));
+        let manual = self.manual_feature(label, pts, primary);
+        self.o.stmt(&format!(
+            "MEAS/{},F({}),{}",
+            manual.meas,
+            manual.label,
+            pts.len()
+        ));
+        for (p, n) in pts {
+            ptmeas_at(&mut self.o, p, n);
+        }
+        self.o.stmt("ENDMES");
+        manual
+    }
+
+    /// A hand step's `DATSET` keywords for feature `label`. A direction is the
+    /// `FEAT`'s: where the feature's nominal axis (its first face's) runs against the
+    /// touched face's (the other half of a split bore), the keyword's sign turns with it.
+    fn step_keywords(
+        &self,
+        sp: &SetupPath,
+        step: &crate::path::AlignStep,
+        label: &str,
+    ) -> Vec<String> {
+        let axis = |n: Option<&Nominal>| match n {
+            Some(Nominal::Surface(
+                Surface::Cylinder { axis, .. } | Surface::Cone { axis, .. },
+                _,
+            )) => Some(*axis),
+            _ => None,
+        };
+        let face_nominal = step
+            .block
+            .and_then(|bi| sp.groups[step.group].blocks.get(bi))
+            .and_then(|b| nominal_of(self.input, b));
+        let against = matches!(
+            (axis(self.nominals.get(label)), axis(face_nominal.as_ref())),
+            (Some(a), Some(b)) if a.dot(&b) < 0.0
+        );
+        step.keywords
+            .iter()
+            .map(
+                |k| match (against, k.ends_with("DIR"), k.strip_prefix('-')) {
+                    (true, true, Some(k)) => k.to_string(),
+                    (true, true, None) => format!("-{k}"),
+                    _ => k.clone(),
+                },
+            )
+            .collect()
+    }
+
+    /// After the hand alignment: its `DATSET` and `TRANS`, the probe brought out where
+    /// the measuring run starts with another orientation, `MODE/PROG,MAN`, and the
+    /// alignment kept (`fa`) to repeat on the program's own measurements.
+    fn start_measuring(
+        &mut self,
+        si: usize,
+        sp: &SetupPath,
+        fa: Vec<String>,
+        fa_manual: &[String],
+    ) {
+        let al = &sp.alignment;
         let shifts: Vec<String> = al
             .trans
             .iter()
             .map(|(k, v)| format!("{k}ORIG,{}", real(-v)))
             .collect();
-        self.datset(&format!("SETUP{}", si + 1), &fa_manual, &shifts);
+        self.datset(&format!("SETUP{}", si + 1), fa_manual, &shifts);
         // The measuring run starts with the setup's first group: where the head turns
         // or the probe changes for it, the operator first brings the probe out, as
         // between two hand features.
@@ -1339,7 +1428,7 @@ impl Writer<'_> {
     /// A group: its sensor, entry, `MEAS` blocks and exit, the datums it measured and
     /// the tolerances it completes.
     fn group(&mut self, (si, gi): (usize, usize), g: &GroupPath) {
-        let (hlip, motion) = (self.input.hlip, self.input.llip.motion);
+        let motion = self.input.llip.motion;
         let angles = if self.indexable() {
             format!(" at a{} b{}", num(g.a), num(g.b))
         } else {
@@ -1387,86 +1476,16 @@ impl Writer<'_> {
                 };
                 self.scan(g, b, &target, meas);
             } else {
-                let o = &mut self.o;
-                if !joined {
-                    o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
-                }
-                for (ti, t) in b.touches.iter().enumerate() {
-                    if joined {
-                        let point = &self.points[&((si, gi, bi), ti)];
-                        o.stmt(&format!("MEAS/POINT,F({point}),1"));
-                    }
-                    for v in &t.via {
-                        o.goto(v);
-                    }
-                    o.goto(&t.standoff);
-                    ptmeas(o, hlip, t.point);
-                    if !narrow && motion.retract < motion.prehit {
-                        o.goto(&t.standoff);
-                    }
-                    if joined {
-                        o.stmt("ENDMES");
-                    }
-                }
-                if !joined {
-                    o.stmt("ENDMES");
-                }
+                self.touch_block((si, gi, bi), b, &label, meas, joined, narrow);
             }
-            // The last block of a round in points joins them into the whole.
-            let s = &self.surfs[surf];
-            let r = &s.rounds[round];
-            let complete = if r.partials.is_empty() {
-                Some(label.clone())
-            } else if r.last == (si, gi, bi) {
-                let fa: Vec<String> = r.partials.iter().map(|l| format!("FA({l})")).collect();
-                let full = s.full.clone();
-                self.o
-                    .stmt(&format!("CONST/{meas},F({full}),BF,{}", fa.join(",")));
-                Some(full)
-            } else {
-                None
-            };
-            let Some(mut done) = complete else {
+            let Some(done) = self.complete_round((si, gi, bi), surf, round, &label, meas) else {
                 // Measured anew: not complete until the round's last block.
                 self.done.remove(&surf);
                 continue;
             };
-            self.done.insert(surf);
-            self.done_in.insert(surf, si);
-            if let Some(r) = self.realign.as_mut() {
-                r.measured.insert(done.clone());
-            }
-            // The second wall of a slot or tab makes the pair.
-            if let Some((pair, walls)) = b.feature.and_then(|f| self.pairs.get(&f)).cloned() {
-                if !walls.iter().all(|w| self.done.contains(w)) {
-                    continue;
-                }
-                let fa: Vec<String> = walls
-                    .iter()
-                    .map(|w| format!("FA({})", self.surfs[*w].full))
-                    .collect();
-                self.o
-                    .stmt(&format!("CONST/PARPLN,F({pair}),BF,{}", fa.join(",")));
-                done = pair;
-            }
-            let list = self.measured.entry(b.feature).or_default();
-            if !list.contains(&done) {
-                list.push(done.clone());
-            }
-            // A datum pattern is its datum once every member is measured in this setup.
-            let mut datum_label = Some(done.clone());
-            if let Some((pat, members)) = b.feature.and_then(|f| self.patterns.get(&f)).cloned() {
-                datum_label = None;
-                if members.iter().all(|m| self.done_in.get(m) == Some(&si)) {
-                    let fa: Vec<String> = members
-                        .iter()
-                        .map(|m| format!("FA({})", self.surfs[*m].full))
-                        .collect();
-                    self.o
-                        .stmt(&format!("CONST/PATERN,F({pat}),BF,{}", fa.join(",")));
-                    datum_label = Some(pat);
-                }
-            }
+            let Some((done, datum_label)) = self.surface_done(si, surf, b, done) else {
+                continue;
+            };
             if let (Some(d), Some(l)) = (b.datum, datum_label) {
                 if !datums_here.iter().any(|(x, _)| *x == d) {
                     datums_here.push((d, l));
@@ -1480,7 +1499,135 @@ impl Writer<'_> {
         for p in &g.exit {
             self.o.goto(p);
         }
-        // The DCC alignment, once every alignment feature is measured under the program.
+        self.realign_once_measured(si);
+        // Datums measured here, then the tolerances this group completes.
+        for (d, label) in datums_here {
+            self.defined_in.insert(d, si);
+            let dl = &self.datums[d.0];
+            self.o.stmt(&format!("DATDEF/FA({label}),DAT({dl})"));
+        }
+        self.output_ready((si, gi), g, &in_group);
+    }
+
+    /// A block of touches: one `MEAS` of the feature, or, where the round is joined
+    /// from points, one `MEAS/POINT` per touch; each touch from its stand-off point by
+    /// way of its via points.
+    fn touch_block(
+        &mut self,
+        key: BlockKey,
+        b: &BlockPath,
+        label: &str,
+        meas: &str,
+        joined: bool,
+        narrow: bool,
+    ) {
+        let (hlip, motion) = (self.input.hlip, self.input.llip.motion);
+        let o = &mut self.o;
+        if !joined {
+            o.stmt(&format!("MEAS/{meas},F({label}),{}", b.touches.len()));
+        }
+        for (ti, t) in b.touches.iter().enumerate() {
+            if joined {
+                let point = &self.points[&(key, ti)];
+                o.stmt(&format!("MEAS/POINT,F({point}),1"));
+            }
+            for v in &t.via {
+                o.goto(v);
+            }
+            o.goto(&t.standoff);
+            ptmeas(o, hlip, t.point);
+            if !narrow && motion.retract < motion.prehit {
+                o.goto(&t.standoff);
+            }
+            if joined {
+                o.stmt("ENDMES");
+            }
+        }
+        if !joined {
+            o.stmt("ENDMES");
+        }
+    }
+
+    /// The label that completes the surface's round with block `key`: the block's own
+    /// feature, or at a joined round's last block the best-fit `CONST` over its points;
+    /// `None` before that block.
+    fn complete_round(
+        &mut self,
+        key: BlockKey,
+        surf: usize,
+        round: usize,
+        label: &str,
+        meas: &str,
+    ) -> Option<String> {
+        let s = &self.surfs[surf];
+        let r = &s.rounds[round];
+        if r.partials.is_empty() {
+            Some(label.to_string())
+        } else if r.last == key {
+            let fa: Vec<String> = r.partials.iter().map(|l| format!("FA({l})")).collect();
+            let full = s.full.clone();
+            self.o
+                .stmt(&format!("CONST/{meas},F({full}),BF,{}", fa.join(",")));
+            Some(full)
+        } else {
+            None
+        }
+    }
+
+    /// Surface `surf` complete in setup `si` as `done`: the second wall of a slot or tab
+    /// makes the pair (`CONST/PARPLN`), and the last member of a datum pattern measured
+    /// in the setup the pattern (`CONST/PATERN`). The label the feature is measured by
+    /// now, and the one its datum takes (none for a pattern not yet whole); `None` while
+    /// a pair waits for its other wall.
+    fn surface_done(
+        &mut self,
+        si: usize,
+        surf: usize,
+        b: &BlockPath,
+        mut done: String,
+    ) -> Option<(String, Option<String>)> {
+        self.done.insert(surf);
+        self.done_in.insert(surf, si);
+        if let Some(r) = self.realign.as_mut() {
+            r.measured.insert(done.clone());
+        }
+        // The second wall of a slot or tab makes the pair.
+        if let Some((pair, walls)) = b.feature.and_then(|f| self.pairs.get(&f)).cloned() {
+            if !walls.iter().all(|w| self.done.contains(w)) {
+                return None;
+            }
+            let fa: Vec<String> = walls
+                .iter()
+                .map(|w| format!("FA({})", self.surfs[*w].full))
+                .collect();
+            self.o
+                .stmt(&format!("CONST/PARPLN,F({pair}),BF,{}", fa.join(",")));
+            done = pair;
+        }
+        let list = self.measured.entry(b.feature).or_default();
+        if !list.contains(&done) {
+            list.push(done.clone());
+        }
+        // A datum pattern is its datum once every member is measured in this setup.
+        let mut datum_label = Some(done.clone());
+        if let Some((pat, members)) = b.feature.and_then(|f| self.patterns.get(&f)).cloned() {
+            datum_label = None;
+            if members.iter().all(|m| self.done_in.get(m) == Some(&si)) {
+                let fa: Vec<String> = members
+                    .iter()
+                    .map(|m| format!("FA({})", self.surfs[*m].full))
+                    .collect();
+                self.o
+                    .stmt(&format!("CONST/PATERN,F({pat}),BF,{}", fa.join(",")));
+                datum_label = Some(pat);
+            }
+        }
+        Some((done, datum_label))
+    }
+
+    /// The DCC alignment of setup `si`, once every alignment feature is measured under
+    /// the program.
+    fn realign_once_measured(&mut self, si: usize) {
         if let Some(r) = self.realign.take() {
             if r.setup == si && r.labels.iter().all(|l| r.measured.contains(l)) {
                 self.o
@@ -1490,19 +1637,17 @@ impl Writer<'_> {
                 self.realign = Some(r);
             }
         }
-        // Datums measured here, then the tolerances this group completes.
-        for (d, label) in datums_here {
-            self.defined_in.insert(d, si);
-            let dl = &self.datums[d.0];
-            self.o.stmt(&format!("DATDEF/FA({label}),DAT({dl})"));
-        }
-        // A tolerance is output once every surface of its features and datum features
-        // is complete (a surface joined from points completes at its last block).
+    }
+
+    /// The group's tolerances, and those pending from before, output where ready: once
+    /// every surface of their features and datum features is complete (a surface
+    /// joined from points completes at its last block); the others stay pending.
+    fn output_ready(&mut self, at: (usize, usize), g: &GroupPath, in_group: &[String]) {
         self.pending.extend(g.records.iter().copied());
         let pending = std::mem::take(&mut self.pending);
         for r in pending {
-            if self.ready(r, (si, gi)) {
-                self.output(r, &in_group);
+            if self.ready(r, at) {
+                self.output(r, in_group);
             } else {
                 self.pending.push(r);
             }
@@ -1844,6 +1989,51 @@ fn nominal_of(input: &Input, b: &BlockPath) -> Option<Nominal> {
     }
     let face = input.geometry.faces.get(b.face.0)?;
     Some(Nominal::Surface(face.surface.clone(), face.centroid))
+}
+
+/// A surface's blocks in rounds: a block that touches a point again (a datum measured
+/// anew with another probe) starts a new round, which measures the surface anew. A
+/// round of fewer touches than the surface needs (`least`) fits nothing (one touch is
+/// no plane): it joins the round before it, or after it for the first.
+fn measuring_rounds(
+    llip: &crate::path::Llip,
+    blocks: &[BlockKey],
+    least: usize,
+) -> Vec<Vec<BlockKey>> {
+    let block = |k: &BlockKey| &llip.setups[k.0].groups[k.1].blocks[k.2];
+    let mut rounds_of: Vec<Vec<BlockKey>> = Vec::new();
+    let mut seen: std::collections::BTreeSet<usize> = std::collections::BTreeSet::new();
+    for k in blocks {
+        let pts: Vec<usize> = block(k).touches.iter().map(|t| t.point).collect();
+        if rounds_of.is_empty() || pts.iter().any(|p| seen.contains(p)) {
+            rounds_of.push(Vec::new());
+            seen.clear();
+        }
+        seen.extend(pts);
+        rounds_of.last_mut().expect("a round").push(*k);
+    }
+    let touches = |keys: &[BlockKey]| -> usize {
+        keys.iter()
+            .map(|k| block(k).touches.len().max(block(k).passes.len() * least))
+            .sum()
+    };
+    let mut r = 0;
+    while rounds_of.len() > 1 && r < rounds_of.len() {
+        if touches(&rounds_of[r]) >= least {
+            r += 1;
+            continue;
+        }
+        let keys = rounds_of.remove(r);
+        let into = r.saturating_sub(1).min(rounds_of.len() - 1);
+        if r == 0 {
+            let mut joined = keys;
+            joined.append(&mut rounds_of[0]);
+            rounds_of[0] = joined;
+        } else {
+            rounds_of[into].extend(keys);
+        }
+    }
+    rounds_of
 }
 
 /// A number rounded to 1e-3, without `-0`.

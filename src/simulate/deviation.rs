@@ -369,6 +369,8 @@ impl Cur<'_> {
     }
 }
 
+/// One line of the file: what it changes (`part`, `setup`, `feature`, `face`), read
+/// into `dev`.
 fn one_line(
     toks: &[(Tok, usize, usize)],
     dev: &mut Deviations,
@@ -389,273 +391,8 @@ fn one_line(
         ));
     };
     match kind.as_str() {
-        "part" | "setup" => {
-            let setup = if kind == "setup" {
-                let (s, e) = c.span();
-                match c.num() {
-                    Some(n) if n >= 1.0 && n.fract() == 0.0 => Some(n as usize),
-                    _ => {
-                        return Err(bad(
-                            s,
-                            e,
-                            "`setup` takes the setup's number, from 1",
-                            "expected a whole number",
-                            USAGE,
-                        ))
-                    }
-                }
-            } else {
-                None
-            };
-            let (s, e) = c.span();
-            let mut p = Placement::default();
-            match c.word().as_deref() {
-                Some("move") => {
-                    let Some(v) = c.tuple(2) else {
-                        let (s, e) = c.span();
-                        return Err(bad(s, e, "`move` of the part takes its shift on the table", "expected `(x, y)`", "the part moves in the table's plane: `part move (5, 0) mm`"));
-                    };
-                    c.unit(&["mm"]);
-                    p.shift = [v[0], v[1]];
-                }
-                Some("turn") => {
-                    let Some(a) = c.num() else {
-                        let (s, e) = c.span();
-                        return Err(bad(s, e, "`turn` takes an angle in degrees", "expected a number", "`part turn 3 deg`"));
-                    };
-                    c.unit(&["deg"]);
-                    p.turn = a;
-                }
-                _ => return Err(bad(s, e, "the part on the table can `move` or `turn`", "expected `move` or `turn`", "the part rests on the table: it moves in its plane and turns about the vertical")),
-            }
-            match setup {
-                Some(k) => dev.setups.push((k, p)),
-                None => {
-                    dev.placement.shift[0] += p.shift[0];
-                    dev.placement.shift[1] += p.shift[1];
-                    dev.placement.turn += p.turn;
-                }
-            }
-        }
-        "feature" | "face" => {
-            let (ns, ne) = c.span();
-            let Some(name) = c.word() else {
-                return Err(bad(
-                    ns,
-                    ne,
-                    &format!("`{kind}` takes a name"),
-                    "expected a name",
-                    USAGE,
-                ));
-            };
-            let faces: Vec<FaceId> = if kind == "feature" {
-                match part.features.iter().position(|f| f.name == name) {
-                    Some(k) => feature_faces.get(k).cloned().unwrap_or_default(),
-                    None => {
-                        let names: Vec<&str> =
-                            part.features.iter().map(|f| f.name.as_str()).collect();
-                        let help = match crate::diag::suggest::did_you_mean(
-                            &name,
-                            names.iter().copied(),
-                        ) {
-                            Some(s) => format!("did you mean `{s}`?"),
-                            None => {
-                                format!("part `{}` has features {}", part.name, names.join(", "))
-                            }
-                        };
-                        return Err(bad(
-                            ns,
-                            ne,
-                            &format!("part `{}` has no feature `{name}`", part.name),
-                            "unknown feature",
-                            &help,
-                        ));
-                    }
-                }
-            } else {
-                match g.faces.iter().position(|f| f.name == name) {
-                    Some(k) => vec![FaceId(k)],
-                    None => {
-                        let help = match crate::diag::suggest::did_you_mean(
-                            &name,
-                            g.faces.iter().map(|f| f.name.as_str()),
-                        ) {
-                            Some(s) => format!("did you mean `{s}`?"),
-                            None => "`inspc faces SPEC` lists the part's faces".into(),
-                        };
-                        return Err(bad(
-                            ns,
-                            ne,
-                            &format!("part `{}` has no face `{name}`", part.name),
-                            "unknown face",
-                            &help,
-                        ));
-                    }
-                }
-            };
-            if faces.is_empty() {
-                return Err(bad(
-                    ns,
-                    ne,
-                    &format!("feature `{name}` has no faces to change"),
-                    "no faces",
-                    USAGE,
-                ));
-            }
-            let centroid = {
-                let (mut s, mut w) = (V3::zeros(), 0.0);
-                for f in &faces {
-                    let face = &g.faces[f.0];
-                    s += face.centroid.coords * face.area;
-                    w += face.area;
-                }
-                P3::from(s / w.max(1e-12))
-            };
-            let (vs, ve) = c.span();
-            let verb = c.word();
-            let change: Vec<(FaceId, FaceChange)> = match verb.as_deref() {
-                Some("move") => {
-                    let Some(v) = c.tuple(3) else {
-                        let (s, e) = c.span();
-                        return Err(bad(
-                            s,
-                            e,
-                            "`move` takes a translation",
-                            "expected `(x, y, z)`",
-                            "`feature bore move (0.3, 0, 0) mm`, in the part frame",
-                        ));
-                    };
-                    c.unit(&["mm"]);
-                    let m = Isometry3::from_parts(
-                        Translation3::new(v[0], v[1], v[2]),
-                        UnitQuaternion::identity(),
-                    );
-                    rigid(&faces, m)
-                }
-                Some("tilt") => {
-                    let Some(a) = c.num() else {
-                        let (s, e) = c.span();
-                        return Err(bad(
-                            s,
-                            e,
-                            "`tilt` takes an angle in degrees",
-                            "expected a number",
-                            "`feature top tilt 0.2 deg about (0, 1, 0)`",
-                        ));
-                    };
-                    c.unit(&["deg"]);
-                    let (s, e) = c.span();
-                    let axis = if c.word().as_deref() == Some("about") {
-                        c.tuple(3)
-                    } else {
-                        None
-                    };
-                    let Some(axis) =
-                        axis.and_then(|v| Unit::try_new(V3::new(v[0], v[1], v[2]), 1e-12))
-                    else {
-                        return Err(bad(s, e, "`tilt` needs the axis it turns about", "expected `about (x, y, z)`", "the axis passes through the feature's centroid: `tilt 0.2 deg about (0, 1, 0)`"));
-                    };
-                    let r = UnitQuaternion::from_axis_angle(&axis, a.to_radians());
-                    // About the centroid: x ↦ c + R (x − c).
-                    let m = Isometry3::from_parts(
-                        Translation3::from(centroid.coords - r * centroid.coords),
-                        r,
-                    );
-                    rigid(&faces, m)
-                }
-                Some("shift") => {
-                    let Some(d) = c.num() else {
-                        let (s, e) = c.span();
-                        return Err(bad(
-                            s,
-                            e,
-                            "`shift` takes a distance",
-                            "expected a number",
-                            "`face stock.top shift 0.1 mm` moves a plane along its outward normal",
-                        ));
-                    };
-                    c.unit(&["mm"]);
-                    let mut out = Vec::new();
-                    for f in &faces {
-                        let Surface::Plane { normal, .. } = g.faces[f.0].surface else {
-                            return Err(bad(vs, ve, &format!("`shift` moves planes along their normal; `{}` is not a plane", g.faces[f.0].name), "not a plane", "move other faces with `move (x, y, z)`, or change their size with `grow`"));
-                        };
-                        let t = normal * d;
-                        out.push((
-                            *f,
-                            FaceChange {
-                                motion: Isometry3::from_parts(
-                                    Translation3::from(t),
-                                    UnitQuaternion::identity(),
-                                ),
-                                grow: 0.0,
-                                bow: 0.0,
-                            },
-                        ));
-                    }
-                    out
-                }
-                Some("bow") => {
-                    let Some(d) = c.num() else {
-                        let (s, e) = c.span();
-                        return Err(bad(s, e, "`bow` takes a height", "expected a number", "`face stock.top bow 0.1 mm`: the plane's centre stands out by that much"));
-                    };
-                    c.unit(&["mm"]);
-                    let mut out = Vec::new();
-                    for f in &faces {
-                        if !matches!(g.faces[f.0].surface, Surface::Plane { .. }) {
-                            return Err(bad(
-                                vs,
-                                ve,
-                                &format!(
-                                    "`bow` bends planes; `{}` is not a plane",
-                                    g.faces[f.0].name
-                                ),
-                                "not a plane",
-                                "change other faces with `move`, `tilt` or `grow`",
-                            ));
-                        }
-                        out.push((
-                            *f,
-                            FaceChange {
-                                bow: d,
-                                ..FaceChange::default()
-                            },
-                        ));
-                    }
-                    out
-                }
-                Some("grow") => {
-                    let Some(d) = c.num() else {
-                        let (s, e) = c.span();
-                        return Err(bad(
-                            s,
-                            e,
-                            "`grow` takes a size change",
-                            "expected a number",
-                            "`feature bore grow 0.05 mm` grows a diameter or a slot's width",
-                        ));
-                    };
-                    c.unit(&["mm"]);
-                    grow(g, &faces, d).ok_or_else(|| bad(vs, ve, &format!("`{name}` has no size to grow"), "no size", "`grow` changes a cylinder's, cone's or sphere's diameter, or the width between two opposed planes"))?
-                }
-                _ => {
-                    return Err(bad(
-                        vs,
-                        ve,
-                        "a feature or face can `move`, `tilt`, `shift` or `grow`",
-                        "expected a change",
-                        USAGE,
-                    ))
-                }
-            };
-            for (f, ch) in change {
-                let cur = &mut dev.faces[f.0];
-                cur.motion = ch.motion * cur.motion;
-                cur.grow += ch.grow;
-                cur.bow += ch.bow;
-            }
-        }
+        "part" | "setup" => placement_line(&mut c, &kind, dev, bad)?,
+        "feature" | "face" => face_line(&mut c, &kind, dev, part, g, feature_faces, bad)?,
         _ => {
             return Err(bad(
                 s0,
@@ -677,6 +414,397 @@ fn one_line(
         ));
     }
     Ok(())
+}
+
+/// `part move|turn …` or `setup N move|turn …`: the part's placement on the table, for
+/// every setup or for one.
+fn placement_line(
+    c: &mut Cur,
+    kind: &str,
+    dev: &mut Deviations,
+    bad: &Bad,
+) -> Result<(), SimError> {
+    let setup = if kind == "setup" {
+        Some(setup_number(c, bad)?)
+    } else {
+        None
+    };
+    let p = placement(c, bad)?;
+    match setup {
+        Some(k) => dev.setups.push((k, p)),
+        None => {
+            dev.placement.shift[0] += p.shift[0];
+            dev.placement.shift[1] += p.shift[1];
+            dev.placement.turn += p.turn;
+        }
+    }
+    Ok(())
+}
+
+/// The setup's number after `setup`, from 1.
+fn setup_number(c: &mut Cur, bad: &Bad) -> Result<usize, SimError> {
+    let (s, e) = c.span();
+    match c.num() {
+        Some(n) if n >= 1.0 && n.fract() == 0.0 => Ok(n as usize),
+        _ => Err(bad(
+            s,
+            e,
+            "`setup` takes the setup's number, from 1",
+            "expected a whole number",
+            USAGE,
+        )),
+    }
+}
+
+/// `move (x, y)` or `turn DEG`: how the part lies off on the table.
+fn placement(c: &mut Cur, bad: &Bad) -> Result<Placement, SimError> {
+    let (s, e) = c.span();
+    let mut p = Placement::default();
+    match c.word().as_deref() {
+        Some("move") => {
+            let Some(v) = c.tuple(2) else {
+                let (s, e) = c.span();
+                return Err(bad(
+                    s,
+                    e,
+                    "`move` of the part takes its shift on the table",
+                    "expected `(x, y)`",
+                    "the part moves in the table's plane: `part move (5, 0) mm`",
+                ));
+            };
+            c.unit(&["mm"]);
+            p.shift = [v[0], v[1]];
+        }
+        Some("turn") => {
+            let Some(a) = c.num() else {
+                let (s, e) = c.span();
+                return Err(bad(
+                    s,
+                    e,
+                    "`turn` takes an angle in degrees",
+                    "expected a number",
+                    "`part turn 3 deg`",
+                ));
+            };
+            c.unit(&["deg"]);
+            p.turn = a;
+        }
+        _ => {
+            return Err(bad(
+                s,
+                e,
+                "the part on the table can `move` or `turn`",
+                "expected `move` or `turn`",
+                "the part rests on the table: it moves in its plane and turns about the vertical",
+            ))
+        }
+    }
+    Ok(p)
+}
+
+/// `feature NAME …` or `face NAME …`: a change to the faces it names, composed with
+/// their changes so far.
+fn face_line(
+    c: &mut Cur,
+    kind: &str,
+    dev: &mut Deviations,
+    part: &Part,
+    g: &PartGeometry,
+    feature_faces: &[Vec<FaceId>],
+    bad: &Bad,
+) -> Result<(), SimError> {
+    let (ns, ne) = c.span();
+    let Some(name) = c.word() else {
+        return Err(bad(
+            ns,
+            ne,
+            &format!("`{kind}` takes a name"),
+            "expected a name",
+            USAGE,
+        ));
+    };
+    let faces = if kind == "feature" {
+        feature_faces_named(&name, (ns, ne), part, feature_faces, bad)?
+    } else {
+        face_named(&name, (ns, ne), part, g, bad)?
+    };
+    if faces.is_empty() {
+        return Err(bad(
+            ns,
+            ne,
+            &format!("feature `{name}` has no faces to change"),
+            "no faces",
+            USAGE,
+        ));
+    }
+    for (f, ch) in face_change(c, &name, &faces, g, bad)? {
+        let cur = &mut dev.faces[f.0];
+        cur.motion = ch.motion * cur.motion;
+        cur.grow += ch.grow;
+        cur.bow += ch.bow;
+    }
+    Ok(())
+}
+
+/// The faces of the part's feature `name`, written at `ns..ne`.
+fn feature_faces_named(
+    name: &str,
+    (ns, ne): (usize, usize),
+    part: &Part,
+    feature_faces: &[Vec<FaceId>],
+    bad: &Bad,
+) -> Result<Vec<FaceId>, SimError> {
+    match part.features.iter().position(|f| f.name == name) {
+        Some(k) => Ok(feature_faces.get(k).cloned().unwrap_or_default()),
+        None => {
+            let names: Vec<&str> = part.features.iter().map(|f| f.name.as_str()).collect();
+            let help = match crate::diag::suggest::did_you_mean(name, names.iter().copied()) {
+                Some(s) => format!("did you mean `{s}`?"),
+                None => {
+                    format!("part `{}` has features {}", part.name, names.join(", "))
+                }
+            };
+            Err(bad(
+                ns,
+                ne,
+                &format!("part `{}` has no feature `{name}`", part.name),
+                "unknown feature",
+                &help,
+            ))
+        }
+    }
+}
+
+/// The part's face `name`, written at `ns..ne`, alone.
+fn face_named(
+    name: &str,
+    (ns, ne): (usize, usize),
+    part: &Part,
+    g: &PartGeometry,
+    bad: &Bad,
+) -> Result<Vec<FaceId>, SimError> {
+    match g.faces.iter().position(|f| f.name == name) {
+        Some(k) => Ok(vec![FaceId(k)]),
+        None => {
+            let help = match crate::diag::suggest::did_you_mean(
+                name,
+                g.faces.iter().map(|f| f.name.as_str()),
+            ) {
+                Some(s) => format!("did you mean `{s}`?"),
+                None => "`inspc faces SPEC` lists the part's faces".into(),
+            };
+            Err(bad(
+                ns,
+                ne,
+                &format!("part `{}` has no face `{name}`", part.name),
+                "unknown face",
+                &help,
+            ))
+        }
+    }
+}
+
+/// The change the verb after a feature's or face's name says (`move`, `tilt`,
+/// `shift`, `bow`, `grow`), per face of `faces`.
+fn face_change(
+    c: &mut Cur,
+    name: &str,
+    faces: &[FaceId],
+    g: &PartGeometry,
+    bad: &Bad,
+) -> Result<Vec<(FaceId, FaceChange)>, SimError> {
+    let verb_at = c.span();
+    let (vs, ve) = verb_at;
+    match c.word().as_deref() {
+        Some("move") => move_change(c, faces, bad),
+        Some("tilt") => tilt_change(c, faces, area_centroid(g, faces), bad),
+        Some("shift") => shift_change(c, faces, g, verb_at, bad),
+        Some("bow") => bow_change(c, faces, g, verb_at, bad),
+        Some("grow") => {
+            let Some(d) = c.num() else {
+                let (s, e) = c.span();
+                return Err(bad(
+                    s,
+                    e,
+                    "`grow` takes a size change",
+                    "expected a number",
+                    "`feature bore grow 0.05 mm` grows a diameter or a slot's width",
+                ));
+            };
+            c.unit(&["mm"]);
+            grow(g, faces, d).ok_or_else(|| bad(vs, ve, &format!("`{name}` has no size to grow"), "no size", "`grow` changes a cylinder's, cone's or sphere's diameter, or the width between two opposed planes"))
+        }
+        _ => Err(bad(
+            vs,
+            ve,
+            "a feature or face can `move`, `tilt`, `shift` or `grow`",
+            "expected a change",
+            USAGE,
+        )),
+    }
+}
+
+/// The faces' centroid, weighted by their areas.
+fn area_centroid(g: &PartGeometry, faces: &[FaceId]) -> P3 {
+    let (mut s, mut w) = (V3::zeros(), 0.0);
+    for f in faces {
+        let face = &g.faces[f.0];
+        s += face.centroid.coords * face.area;
+        w += face.area;
+    }
+    P3::from(s / w.max(1e-12))
+}
+
+/// `move (x, y, z)`: every face translated (part frame).
+fn move_change(
+    c: &mut Cur,
+    faces: &[FaceId],
+    bad: &Bad,
+) -> Result<Vec<(FaceId, FaceChange)>, SimError> {
+    let Some(v) = c.tuple(3) else {
+        let (s, e) = c.span();
+        return Err(bad(
+            s,
+            e,
+            "`move` takes a translation",
+            "expected `(x, y, z)`",
+            "`feature bore move (0.3, 0, 0) mm`, in the part frame",
+        ));
+    };
+    c.unit(&["mm"]);
+    let m = Isometry3::from_parts(
+        Translation3::new(v[0], v[1], v[2]),
+        UnitQuaternion::identity(),
+    );
+    Ok(rigid(faces, m))
+}
+
+/// `tilt DEG about (x, y, z)`: every face turned about the axis through `centroid`.
+fn tilt_change(
+    c: &mut Cur,
+    faces: &[FaceId],
+    centroid: P3,
+    bad: &Bad,
+) -> Result<Vec<(FaceId, FaceChange)>, SimError> {
+    let Some(a) = c.num() else {
+        let (s, e) = c.span();
+        return Err(bad(
+            s,
+            e,
+            "`tilt` takes an angle in degrees",
+            "expected a number",
+            "`feature top tilt 0.2 deg about (0, 1, 0)`",
+        ));
+    };
+    c.unit(&["deg"]);
+    let (s, e) = c.span();
+    let axis = if c.word().as_deref() == Some("about") {
+        c.tuple(3)
+    } else {
+        None
+    };
+    let Some(axis) = axis.and_then(|v| Unit::try_new(V3::new(v[0], v[1], v[2]), 1e-12)) else {
+        return Err(bad(
+            s,
+            e,
+            "`tilt` needs the axis it turns about",
+            "expected `about (x, y, z)`",
+            "the axis passes through the feature's centroid: `tilt 0.2 deg about (0, 1, 0)`",
+        ));
+    };
+    let r = UnitQuaternion::from_axis_angle(&axis, a.to_radians());
+    // About the centroid: x ↦ c + R (x − c).
+    let m = Isometry3::from_parts(Translation3::from(centroid.coords - r * centroid.coords), r);
+    Ok(rigid(faces, m))
+}
+
+/// `shift MM`: every face, a plane, moved along its outward normal; the verb, at
+/// `vs..ve`, is blamed for a face that is not one.
+fn shift_change(
+    c: &mut Cur,
+    faces: &[FaceId],
+    g: &PartGeometry,
+    (vs, ve): (usize, usize),
+    bad: &Bad,
+) -> Result<Vec<(FaceId, FaceChange)>, SimError> {
+    let Some(d) = c.num() else {
+        let (s, e) = c.span();
+        return Err(bad(
+            s,
+            e,
+            "`shift` takes a distance",
+            "expected a number",
+            "`face stock.top shift 0.1 mm` moves a plane along its outward normal",
+        ));
+    };
+    c.unit(&["mm"]);
+    let mut out = Vec::new();
+    for f in faces {
+        let Surface::Plane { normal, .. } = g.faces[f.0].surface else {
+            return Err(bad(
+                vs,
+                ve,
+                &format!(
+                    "`shift` moves planes along their normal; `{}` is not a plane",
+                    g.faces[f.0].name
+                ),
+                "not a plane",
+                "move other faces with `move (x, y, z)`, or change their size with `grow`",
+            ));
+        };
+        let t = normal * d;
+        out.push((
+            *f,
+            FaceChange {
+                motion: Isometry3::from_parts(Translation3::from(t), UnitQuaternion::identity()),
+                grow: 0.0,
+                bow: 0.0,
+            },
+        ));
+    }
+    Ok(out)
+}
+
+/// `bow MM`: every face, a plane, bent so its centre stands out; the verb, at
+/// `vs..ve`, is blamed for a face that is not one.
+fn bow_change(
+    c: &mut Cur,
+    faces: &[FaceId],
+    g: &PartGeometry,
+    (vs, ve): (usize, usize),
+    bad: &Bad,
+) -> Result<Vec<(FaceId, FaceChange)>, SimError> {
+    let Some(d) = c.num() else {
+        let (s, e) = c.span();
+        return Err(bad(
+            s,
+            e,
+            "`bow` takes a height",
+            "expected a number",
+            "`face stock.top bow 0.1 mm`: the plane's centre stands out by that much",
+        ));
+    };
+    c.unit(&["mm"]);
+    let mut out = Vec::new();
+    for f in faces {
+        if !matches!(g.faces[f.0].surface, Surface::Plane { .. }) {
+            return Err(bad(
+                vs,
+                ve,
+                &format!("`bow` bends planes; `{}` is not a plane", g.faces[f.0].name),
+                "not a plane",
+                "change other faces with `move`, `tilt` or `grow`",
+            ));
+        }
+        out.push((
+            *f,
+            FaceChange {
+                bow: d,
+                ..FaceChange::default()
+            },
+        ));
+    }
+    Ok(out)
 }
 
 /// Every face moved by `m`.

@@ -298,43 +298,8 @@ pub fn evaluate(def: &TolDef, targets: &[Target], datums: &[(Shape, Shape)]) -> 
             let pts = first.measured.points();
             zone(range(pts.iter().map(|q| s.signed(q))), width, None)
         }
-        "CIRLTY" => {
-            let s = &first.measured.shape;
-            let Some(a) = s.direction() else {
-                return zone(
-                    range(first.measured.points().iter().map(|q| s.signed(q))),
-                    width,
-                    None,
-                );
-            };
-            let mut circles: std::collections::BTreeMap<i64, Vec<f64>> = Default::default();
-            for q in first.measured.points() {
-                let h = (q.coords.dot(&a) * 100.0).round() as i64;
-                circles.entry(h).or_default().push(s.signed(&q));
-            }
-            let worst = circles
-                .values()
-                .filter(|v| v.len() >= 3)
-                .map(|v| range(v.iter().copied()))
-                .fold(0.0, f64::max);
-            zone(worst, width, None)
-        }
-        "PROFS" | "PROFL" => {
-            // One zone over every surface the statement names: a profile of several
-            // surfaces (a boss's six sides) is one zone, floating as one.
-            let (mut e, mut n, mut q) = (Vec::new(), Vec::new(), Vec::new());
-            for target in targets {
-                let moved = target.measured.moved(&drf.to_nominal);
-                for (p, v, x) in &moved.touches {
-                    e.push((x - p).dot(v));
-                    n.push(*v);
-                    q.push(*x);
-                }
-            }
-            best_fit(&mut e, &n, &q, &float.0, &float.1);
-            let worst = e.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            zone(2.0 * worst, width, None)
-        }
+        "CIRLTY" => circularity(first.measured, width),
+        "PROFS" | "PROFL" => profile(targets, &drf, &float, width),
         "PERP" | "PARLEL" | "ANGLR" => {
             let o = Drf {
                 free_r,
@@ -342,55 +307,8 @@ pub fn evaluate(def: &TolDef, targets: &[Target], datums: &[(Shape, Shape)]) -> 
             };
             orientation(&o, &moved, first.nominal, width)
         }
-        "POS" | "CONCEN" | "COAXL" | "SYM" => {
-            let mut out = location(&drf, &moved, first.nominal, width);
-            if def.word == "POS" && def.material.as_deref() == Some("MMC") {
-                match (first.size, first.measured.shape.size()) {
-                    (Some((nom, lo, hi)), Some(actual)) => {
-                        let mmc = if first.convex { nom + hi } else { nom + lo };
-                        out.limits.1 += (actual - mmc).abs();
-                    }
-                    _ => {
-                        out.note = Some("MMC read as RFS: the program outputs no size tolerance of this feature".into());
-                    }
-                }
-            }
-            out
-        }
-        "CRNOUT" | "TRNOUT" => {
-            let axis = datums
-                .first()
-                .and_then(|(_, n)| match n {
-                    Shape::Cylinder { p, a, .. } => Some((*p, *a)),
-                    Shape::Cone { apex, a, .. } => Some((*apex, *a)),
-                    _ => None,
-                })
-                .or(match first.nominal {
-                    Shape::Cylinder { p, a, .. } => Some((*p, *a)),
-                    _ => None,
-                });
-            let Some((o, a)) = axis else {
-                return na("runout needs a datum axis");
-            };
-            let radial = |q: &P3| {
-                let d = q - o;
-                (d - a * d.dot(&a)).norm()
-            };
-            let axial = matches!(first.nominal, Shape::Plane { n, .. } if n.dot(&a).abs() > 0.9);
-            let e = moved.touches.iter().map(|(p, _, q)| {
-                if axial {
-                    (q - p).dot(&a)
-                } else {
-                    radial(q) - radial(p)
-                }
-            });
-            zone(
-                range(e),
-                width,
-                (def.word == "CRNOUT")
-                    .then(|| "circular runout taken over every circle at once (total)".to_string()),
-            )
-        }
+        "POS" | "CONCEN" | "COAXL" | "SYM" => position(def, first, &drf, &moved, width),
+        "CRNOUT" | "TRNOUT" => runout(def, first, datums, &moved, width),
         "DIAM" | "RAD" | "WIDTH" => {
             let (Some(a), Some(n)) = (first.measured.shape.size(), first.nominal.size()) else {
                 return na("the feature has no size");
@@ -398,61 +316,172 @@ pub fn evaluate(def: &TolDef, targets: &[Target], datums: &[(Shape, Shape)]) -> 
             let k = if def.word == "RAD" { 0.5 } else { 1.0 };
             size(n * k, a * k, def)
         }
-        "DISTB" => {
-            let (nom, act) = match targets {
-                [a, b] => (
-                    distance(
-                        a.nominal,
-                        b.nominal,
-                        Some(&b.measured.touches.iter().map(|t| t.0).collect::<Vec<_>>()),
-                    ),
-                    distance(
-                        &a.measured.shape,
-                        &b.measured.shape,
-                        Some(&b.measured.points()),
-                    ),
-                ),
-                [a] => (a.nominal.size(), a.measured.shape.size()),
-                _ => (None, None),
-            };
-            match (nom, act) {
-                (Some(n), Some(a)) => {
-                    let mut o = size(def.nominal.unwrap_or(n), a, def);
-                    if (def.nominal.unwrap_or(n) - n).abs() > 1e-3 {
-                        o.note = Some(format!(
-                            "the nominal {} differs from the geometry's {}",
-                            crate::dmis::text::num(o.nominal),
-                            crate::dmis::text::num(n)
-                        ));
-                    }
-                    o
-                }
-                _ => na("no distance between these features"),
-            }
-        }
-        "ANGLB" => {
-            let [a, b] = targets else {
-                return na("an angle takes two features");
-            };
-            let (Some(na_), Some(nb), Some(ma), Some(mb)) = (
-                a.nominal.direction(),
-                b.nominal.direction(),
-                a.measured.shape.direction(),
-                b.measured.shape.direction(),
-            ) else {
-                return na("an angle takes two features with directions");
-            };
-            let nominal = def.nominal.unwrap_or_else(|| angle(&na_, &nb));
-            let raw = angle(&ma, &mb);
-            let actual = if (raw - nominal).abs() <= (180.0 - raw - nominal).abs() {
-                raw
-            } else {
-                180.0 - raw
-            };
-            size(nominal, actual, def)
-        }
+        "DISTB" => distance_between(def, targets),
+        "ANGLB" => angle_between(def, targets),
         other => na(&format!("`{other}` is not evaluated")),
     }
+}
+
+/// Circularity: the worst range of the points' distances from the shape over the
+/// circles they lie on (points grouped by their height along its axis, to 0.01 mm);
+/// over all points for a shape without an axis.
+fn circularity(m: &Measured, width: f64) -> Outcome {
+    let s = &m.shape;
+    let Some(a) = s.direction() else {
+        return zone(range(m.points().iter().map(|q| s.signed(q))), width, None);
+    };
+    let mut circles: std::collections::BTreeMap<i64, Vec<f64>> = Default::default();
+    for q in m.points() {
+        let h = (q.coords.dot(&a) * 100.0).round() as i64;
+        circles.entry(h).or_default().push(s.signed(&q));
+    }
+    let worst = circles
+        .values()
+        .filter(|v| v.len() >= 3)
+        .map(|v| range(v.iter().copied()))
+        .fold(0.0, f64::max);
+    zone(worst, width, None)
+}
+
+/// A profile: one zone over every surface the statement names (a boss's six sides is
+/// one zone, floating as one) in the motions `float` (translations, rotations) its
+/// datums leave free.
+fn profile(targets: &[Target], drf: &Drf, float: &(Vec<V3>, Vec<V3>), width: f64) -> Outcome {
+    let (mut e, mut n, mut q) = (Vec::new(), Vec::new(), Vec::new());
+    for target in targets {
+        let moved = target.measured.moved(&drf.to_nominal);
+        for (p, v, x) in &moved.touches {
+            e.push((x - p).dot(v));
+            n.push(*v);
+            q.push(*x);
+        }
+    }
+    best_fit(&mut e, &n, &q, &float.0, &float.1);
+    let worst = e.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    zone(2.0 * worst, width, None)
+}
+
+/// A location (position, concentricity, coaxiality, symmetry) of `moved`, the first
+/// target in its datums' frame; a position at MMC gains its bonus from the feature's
+/// size tolerance.
+fn position(def: &TolDef, first: &Target, drf: &Drf, moved: &Measured, width: f64) -> Outcome {
+    let mut out = location(drf, moved, first.nominal, width);
+    if def.word == "POS" && def.material.as_deref() == Some("MMC") {
+        match (first.size, first.measured.shape.size()) {
+            (Some((nom, lo, hi)), Some(actual)) => {
+                let mmc = if first.convex { nom + hi } else { nom + lo };
+                out.limits.1 += (actual - mmc).abs();
+            }
+            _ => {
+                out.note = Some(
+                    "MMC read as RFS: the program outputs no size tolerance of this feature".into(),
+                );
+            }
+        }
+    }
+    out
+}
+
+/// Runout about the first datum's axis (or the feature's own): radial, or axial on a
+/// face square to the axis; circular runout is taken as total.
+fn runout(
+    def: &TolDef,
+    first: &Target,
+    datums: &[(Shape, Shape)],
+    moved: &Measured,
+    width: f64,
+) -> Outcome {
+    let axis = datums
+        .first()
+        .and_then(|(_, n)| match n {
+            Shape::Cylinder { p, a, .. } => Some((*p, *a)),
+            Shape::Cone { apex, a, .. } => Some((*apex, *a)),
+            _ => None,
+        })
+        .or(match first.nominal {
+            Shape::Cylinder { p, a, .. } => Some((*p, *a)),
+            _ => None,
+        });
+    let Some((o, a)) = axis else {
+        return na("runout needs a datum axis");
+    };
+    let radial = |q: &P3| {
+        let d = q - o;
+        (d - a * d.dot(&a)).norm()
+    };
+    let axial = matches!(first.nominal, Shape::Plane { n, .. } if n.dot(&a).abs() > 0.9);
+    let e = moved.touches.iter().map(|(p, _, q)| {
+        if axial {
+            (q - p).dot(&a)
+        } else {
+            radial(q) - radial(p)
+        }
+    });
+    zone(
+        range(e),
+        width,
+        (def.word == "CRNOUT")
+            .then(|| "circular runout taken over every circle at once (total)".to_string()),
+    )
+}
+
+/// `DISTB`: the distance between two features, or one feature's size, against the
+/// tolerance's nominal (noted where that differs from the geometry's).
+fn distance_between(def: &TolDef, targets: &[Target]) -> Outcome {
+    let (nom, act) = match targets {
+        [a, b] => (
+            distance(
+                a.nominal,
+                b.nominal,
+                Some(&b.measured.touches.iter().map(|t| t.0).collect::<Vec<_>>()),
+            ),
+            distance(
+                &a.measured.shape,
+                &b.measured.shape,
+                Some(&b.measured.points()),
+            ),
+        ),
+        [a] => (a.nominal.size(), a.measured.shape.size()),
+        _ => (None, None),
+    };
+    match (nom, act) {
+        (Some(n), Some(a)) => {
+            let mut o = size(def.nominal.unwrap_or(n), a, def);
+            if (def.nominal.unwrap_or(n) - n).abs() > 1e-3 {
+                o.note = Some(format!(
+                    "the nominal {} differs from the geometry's {}",
+                    crate::dmis::text::num(o.nominal),
+                    crate::dmis::text::num(n)
+                ));
+            }
+            o
+        }
+        _ => na("no distance between these features"),
+    }
+}
+
+/// `ANGLB`: the angle between two features' directions, taken the way round nearer
+/// the nominal.
+fn angle_between(def: &TolDef, targets: &[Target]) -> Outcome {
+    let [a, b] = targets else {
+        return na("an angle takes two features");
+    };
+    let (Some(na_), Some(nb), Some(ma), Some(mb)) = (
+        a.nominal.direction(),
+        b.nominal.direction(),
+        a.measured.shape.direction(),
+        b.measured.shape.direction(),
+    ) else {
+        return na("an angle takes two features with directions");
+    };
+    let nominal = def.nominal.unwrap_or_else(|| angle(&na_, &nb));
+    let raw = angle(&ma, &mb);
+    let actual = if (raw - nominal).abs() <= (180.0 - raw - nominal).abs() {
+        raw
+    } else {
+        180.0 - raw
+    };
+    size(nominal, actual, def)
 }
 
 fn na(why: &str) -> Outcome {

@@ -174,6 +174,25 @@ struct Block {
     scanned: bool,
 }
 
+/// What `DATSET`'s keywords ask for: directions by axis (0 for x), and the shapes that
+/// give the origin along an axis.
+type DatsetTargets = (Vec<(usize, V3)>, Vec<(usize, Shape)>);
+
+/// One scan pass of `PAMEAS`, in the part frame of its setup.
+struct Pass {
+    /// Where it starts, and the run to its end.
+    start: P3,
+    run: V3,
+    /// The scanner's direction (from the surface towards it), and across its stripe.
+    dir: V3,
+    across: V3,
+    optics: Optics,
+    /// The block's nominal, which the points kept lie on.
+    nominal: Option<Shape>,
+    /// Part frame → machine.
+    place: Isometry3<f64>,
+}
+
 /// A nominal from `FEAT`: its shape (program frame) and whether it is convex.
 #[derive(Debug, Clone)]
 struct Nominal {
@@ -393,6 +412,11 @@ fn label_of(p: &str) -> Option<&str> {
     rest.strip_suffix(')')
 }
 
+/// The `k`th parameter, or nothing.
+fn param(params: &[String], k: usize) -> &str {
+    params.get(k).map(String::as_str).unwrap_or("")
+}
+
 fn nums(params: &[String]) -> Vec<f64> {
     params
         .iter()
@@ -420,7 +444,6 @@ impl Machine<'_> {
         params: &[String],
         at: usize,
     ) -> Result<(), SimError> {
-        let word = |k: usize| params.get(k).map(String::as_str).unwrap_or("");
         if crate::dmis::word(major) != crate::dmis::Word::Runs {
             // The reader warned on it: DMIS the virtual CMM does not run, or not DMIS.
             return Ok(());
@@ -440,7 +463,7 @@ impl Machine<'_> {
                 }
             }
             "UNITS" => {
-                if word(0) != "MM" {
+                if param(params, 0) != "MM" {
                     return Err(self.unsupported(at, &format!("UNITS/{}", params.join(","))));
                 }
             }
@@ -449,136 +472,18 @@ impl Machine<'_> {
                     params.iter().any(|p| p == "MAN") && !params.iter().any(|p| p == "PROG");
                 self.at = None;
             }
-            "SNSET" => {
-                let v = nums(&params[1.min(params.len())..]).first().copied();
-                match (word(0), v) {
-                    ("APPRCH", Some(v)) => self.apprch = v,
-                    ("RETRCT", Some(v)) => self.retrct = v,
-                    ("SEARCH", Some(v)) => self.search = v,
-                    ("CLRSRF", Some(_)) => {}
-                    _ => return Err(self.unsupported(at, &format!("SNSET/{}", params.join(",")))),
-                }
-            }
-            "SNSDEF" => {
-                let Some((_, l)) = label else {
-                    return Err(self.bad(
-                        at,
-                        "SNSDEF without a label",
-                        "write `S(label)=SNSDEF/…`",
-                    ));
-                };
-                let s = self.sensor_def(l, params, at)?;
-                self.sensors.insert(l.clone(), s);
-            }
-            "SNSLCT" => {
-                let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
-                let Some(s) = self.sensors.get(l).copied() else {
-                    return Err(self.bad(
-                        at,
-                        &format!("sensor `{l}` is not defined"),
-                        "define it with SNSDEF first",
-                    ));
-                };
-                self.sensor = Some(s);
-                self.at = None;
-            }
-            "FEAT" => {
-                let Some((_, l)) = label else {
-                    return Err(self.bad(at, "FEAT without a label", "write `F(label)=FEAT/…`"));
-                };
-                if word(0) == "PATERN" {
-                    let members: Vec<String> = params[1..]
-                        .iter()
-                        .filter_map(|p| label_of(p))
-                        .map(str::to_string)
-                        .collect();
-                    let shapes: Vec<Shape> = members
-                        .iter()
-                        .filter_map(|m| self.nominals.get(m).map(|n| n.shape.clone()))
-                        .collect();
-                    let shape = (shapes.len() == members.len())
-                        .then(|| fit::pattern(&shapes))
-                        .flatten()
-                        .ok_or_else(|| {
-                            self.bad(
-                                at,
-                                "a pattern's members must be cylinders defined before it",
-                                "write `F(p)=FEAT/PATERN,F(bore1),F(bore2),…` after their FEATs",
-                            )
-                        })?;
-                    let convex = members
-                        .first()
-                        .and_then(|m| self.nominals.get(m))
-                        .is_some_and(|n| n.convex);
-                    self.nominals.insert(
-                        l.clone(),
-                        Nominal {
-                            shape,
-                            convex,
-                            word: "PATERN".into(),
-                            numbers: Vec::new(),
-                        },
-                    );
-                    self.patterns.insert(l.clone(), members);
-                } else {
-                    let n = nominal(params)
-                        .ok_or_else(|| self.unsupported(at, &format!("FEAT/{}", word(0))))?;
-                    self.nominals.insert(l.clone(), n);
-                }
-            }
-            "TOL" => {
-                let Some((_, l)) = label else {
-                    return Err(self.bad(at, "TOL without a label", "write `T(label)=TOL/…`"));
-                };
-                let def = TolDef::parse(params)
-                    .ok_or_else(|| self.unsupported(at, &format!("TOL/{}", params.join(","))))?;
-                self.tols.insert(l.clone(), def);
-                let words = params[1..]
-                    .iter()
-                    .filter(|p| {
-                        matches!(p.as_str(), "2D" | "3D" | "MMC" | "LMC" | "RFS")
-                            || p.starts_with("DAT(")
-                    })
-                    .cloned()
-                    .collect();
-                self.tol_words.insert(l.clone(), words);
-            }
+            "SNSET" => self.snset(params, at)?,
+            "SNSDEF" => self.snsdef(label, params, at)?,
+            "SNSLCT" => self.snslct(params, at)?,
+            "FEAT" => self.feat(label, params, at)?,
+            "TOL" => self.tol(label, params, at)?,
             // A `PAUSE` after the part was let go (`RECALL` of the machine's frame), or
             // before any setup, is the next setup's placing; any other waits for the
             // operator (a probe changed by hand), who may move the ram meanwhile.
             "PAUSE" if self.setup.is_none() || self.between => self.start_setup(at)?,
             "PAUSE" => self.at = None,
-            "RECALL" => {
-                let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
-                self.frame = if l == "MCS" {
-                    Isometry3::identity()
-                } else {
-                    *self.saved.get(l).ok_or_else(|| {
-                        self.bad(
-                            at,
-                            &format!("alignment `{l}` is not defined"),
-                            "RECALL an alignment saved before",
-                        )
-                    })?
-                };
-                self.between = l == "MCS" || self.machine_frames.contains(l);
-                self.realigned(label);
-            }
-            "ROTATE" => {
-                let axis = match word(0) {
-                    "XAXIS" => V3::x(),
-                    "YAXIS" => V3::y(),
-                    "ZAXIS" => V3::z(),
-                    _ => return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(",")))),
-                };
-                let Some(angle) = params.get(1).and_then(|p| p.parse::<f64>().ok()) else {
-                    return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(","))));
-                };
-                let q =
-                    UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), angle.to_radians());
-                self.frame = Isometry3::from_parts(self.frame.translation, self.frame.rotation * q);
-                self.realigned(label);
-            }
+            "RECALL" => self.recall(label, params, at)?,
+            "ROTATE" => self.rotate(label, params, at)?,
             // `DATSET/MCS`: the machine's own axes and origin (NIST's `simple_in.dms`).
             "DATSET" if params.len() == 1 && params[0] == "MCS" => {
                 self.frame = Isometry3::identity();
@@ -591,38 +496,8 @@ impl Machine<'_> {
                 self.frame = self.datset(params, at)?;
                 self.realigned(label);
             }
-            "TRANS" => {
-                let mut o = self.frame.translation.vector;
-                for pair in params.chunks(2) {
-                    let k = match pair[0].as_str() {
-                        "XORIG" => 0,
-                        "YORIG" => 1,
-                        "ZORIG" => 2,
-                        _ => {
-                            return Err(self.unsupported(at, &format!("TRANS/{}", params.join(","))))
-                        }
-                    };
-                    let v = pair
-                        .get(1)
-                        .and_then(|p| p.parse::<f64>().ok())
-                        .ok_or_else(|| {
-                            self.bad(at, "TRANS without a value", "write `TRANS/XORIG,value`")
-                        })?;
-                    o += self.frame.rotation * (V3::ith(k, 1.0) * v);
-                }
-                self.frame = Isometry3::from_parts(Translation3::from(o), self.frame.rotation);
-                self.realigned(label);
-            }
-            "GOTO" => {
-                let v = nums(params);
-                if v.len() != 3 {
-                    return Err(self.bad(at, "GOTO takes x, y, z", "write `GOTO/x,y,z`"));
-                }
-                if !self.manual {
-                    let q = self.frame * P3::new(v[0], v[1], v[2]);
-                    self.move_to(q, at, "moving here")?;
-                }
-            }
+            "TRANS" => self.trans(label, params, at)?,
+            "GOTO" => self.goto(params, at)?,
             "MEAS" => {
                 let l = params
                     .get(1)
@@ -631,7 +506,7 @@ impl Machine<'_> {
                     .to_string();
                 self.block = Some(Block {
                     label: l,
-                    word: word(0).to_string(),
+                    word: param(params, 0).to_string(),
                     touches: Vec::new(),
                     at,
                     scanned: false,
@@ -640,7 +515,7 @@ impl Machine<'_> {
             "PTMEAS" => self.ptmeas(params, at)?,
             "PATH" => {
                 let v = nums(params);
-                let (Some((_, l)), "LINE", 9) = (label, word(0), v.len()) else {
+                let (Some((_, l)), "LINE", 9) = (label, param(params, 0), v.len()) else {
                     return Err(self.unsupported(at, &format!("PATH/{}", params.join(","))));
                 };
                 let (a, b) = (P3::new(v[0], v[1], v[2]), P3::new(v[3], v[4], v[5]));
@@ -649,46 +524,263 @@ impl Machine<'_> {
             "PAMEAS" => self.pameas(params, at)?,
             "ENDMES" => self.endmes(at)?,
             "CONST" => self.construct(params, at)?,
-            // `DATDEF/FA(f),DAT(x)` (ANSI/DMIS 105.2; NIST's and the QIF bindings' form):
-            // the datum is the last parameter.
-            "DATDEF" => {
-                let Some(d) = params
-                    .last()
-                    .filter(|p| p.starts_with("DAT("))
-                    .and_then(|p| label_of(p))
-                    .map(str::to_string)
-                else {
-                    return Err(self.bad(
-                        at,
-                        "DATDEF without the datum it defines",
-                        "write `DATDEF/FA(label),DAT(A)`",
-                    ));
-                };
-                let l = params
-                    .first()
-                    .and_then(|p| label_of(p))
-                    .unwrap_or("")
-                    .to_string();
-                let f = self.actuals.get(&l).cloned().ok_or_else(|| {
-                    self.bad(
-                        at,
-                        &format!("feature `{l}` is not measured"),
-                        "measure a datum feature before DATDEF",
-                    )
-                })?;
-                let members: Vec<Labelled> = self
-                    .patterns
-                    .get(&l)
-                    .into_iter()
-                    .flatten()
-                    .filter_map(|m| Some((self.actuals.get(m).cloned()?, m.clone())))
-                    .collect();
-                let all = std::iter::once((f, l)).chain(members).collect();
-                self.datums.insert(d, all);
-            }
+            "DATDEF" => self.datdef(params, at)?,
             "OUTPUT" => self.output(params, at)?,
             other => return Err(self.unsupported(at, other)),
         }
+        Ok(())
+    }
+
+    /// `SNSET/APPRCH|RETRCT|SEARCH|CLRSRF,d`: the touch distances (a clearance
+    /// surface is the controller's own business).
+    fn snset(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let v = nums(&params[1.min(params.len())..]).first().copied();
+        match (param(params, 0), v) {
+            ("APPRCH", Some(v)) => self.apprch = v,
+            ("RETRCT", Some(v)) => self.retrct = v,
+            ("SEARCH", Some(v)) => self.search = v,
+            ("CLRSRF", Some(_)) => {}
+            _ => return Err(self.unsupported(at, &format!("SNSET/{}", params.join(",")))),
+        }
+        Ok(())
+    }
+
+    /// `S(label)=SNSDEF/…`: the rack's sensor of that definition, under its label.
+    fn snsdef(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let Some((_, l)) = label else {
+            return Err(self.bad(at, "SNSDEF without a label", "write `S(label)=SNSDEF/…`"));
+        };
+        let s = self.sensor_def(l, params, at)?;
+        self.sensors.insert(l.clone(), s);
+        Ok(())
+    }
+
+    /// `SNSLCT/S(label)`: the sensor defined under that label, on the ram.
+    fn snslct(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
+        let Some(s) = self.sensors.get(l).copied() else {
+            return Err(self.bad(
+                at,
+                &format!("sensor `{l}` is not defined"),
+                "define it with SNSDEF first",
+            ));
+        };
+        self.sensor = Some(s);
+        self.at = None;
+        Ok(())
+    }
+
+    /// `F(label)=FEAT/…`: a feature's nominal, a pattern's from its members'.
+    fn feat(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let Some((_, l)) = label else {
+            return Err(self.bad(at, "FEAT without a label", "write `F(label)=FEAT/…`"));
+        };
+        if param(params, 0) == "PATERN" {
+            let (n, members) = self.pattern(params, at)?;
+            self.nominals.insert(l.clone(), n);
+            self.patterns.insert(l.clone(), members);
+        } else {
+            let n = nominal(params)
+                .ok_or_else(|| self.unsupported(at, &format!("FEAT/{}", param(params, 0))))?;
+            self.nominals.insert(l.clone(), n);
+        }
+        Ok(())
+    }
+
+    /// `FEAT/PATERN,F(m1),F(m2),…`: the pattern's nominal, fitted to its members'
+    /// (cylinders defined before it), and their labels.
+    fn pattern(&self, params: &[String], at: usize) -> Result<(Nominal, Vec<String>), SimError> {
+        let members: Vec<String> = params[1..]
+            .iter()
+            .filter_map(|p| label_of(p))
+            .map(str::to_string)
+            .collect();
+        let shapes: Vec<Shape> = members
+            .iter()
+            .filter_map(|m| self.nominals.get(m).map(|n| n.shape.clone()))
+            .collect();
+        let shape = (shapes.len() == members.len())
+            .then(|| fit::pattern(&shapes))
+            .flatten()
+            .ok_or_else(|| {
+                self.bad(
+                    at,
+                    "a pattern's members must be cylinders defined before it",
+                    "write `F(p)=FEAT/PATERN,F(bore1),F(bore2),…` after their FEATs",
+                )
+            })?;
+        let convex = members
+            .first()
+            .and_then(|m| self.nominals.get(m))
+            .is_some_and(|n| n.convex);
+        let n = Nominal {
+            shape,
+            convex,
+            word: "PATERN".into(),
+            numbers: Vec::new(),
+        };
+        Ok((n, members))
+    }
+
+    /// `T(label)=TOL/…`: the tolerance, and the words its report row repeats.
+    fn tol(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let Some((_, l)) = label else {
+            return Err(self.bad(at, "TOL without a label", "write `T(label)=TOL/…`"));
+        };
+        let def = TolDef::parse(params)
+            .ok_or_else(|| self.unsupported(at, &format!("TOL/{}", params.join(","))))?;
+        self.tols.insert(l.clone(), def);
+        let words = params[1..]
+            .iter()
+            .filter(|p| {
+                matches!(p.as_str(), "2D" | "3D" | "MMC" | "LMC" | "RFS") || p.starts_with("DAT(")
+            })
+            .cloned()
+            .collect();
+        self.tol_words.insert(l.clone(), words);
+        Ok(())
+    }
+
+    /// `RECALL/D(label)`: a saved alignment, or the machine's own (`D(MCS)`), which lets
+    /// the part go until the next setup's `PAUSE`.
+    fn recall(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
+        self.frame = if l == "MCS" {
+            Isometry3::identity()
+        } else {
+            *self.saved.get(l).ok_or_else(|| {
+                self.bad(
+                    at,
+                    &format!("alignment `{l}` is not defined"),
+                    "RECALL an alignment saved before",
+                )
+            })?
+        };
+        self.between = l == "MCS" || self.machine_frames.contains(l);
+        self.realigned(label);
+        Ok(())
+    }
+
+    /// `ROTATE/XAXIS|YAXIS|ZAXIS,deg`: the alignment turned about one of its axes.
+    fn rotate(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let axis = match param(params, 0) {
+            "XAXIS" => V3::x(),
+            "YAXIS" => V3::y(),
+            "ZAXIS" => V3::z(),
+            _ => return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(",")))),
+        };
+        let Some(angle) = params.get(1).and_then(|p| p.parse::<f64>().ok()) else {
+            return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(","))));
+        };
+        let q = UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), angle.to_radians());
+        self.frame = Isometry3::from_parts(self.frame.translation, self.frame.rotation * q);
+        self.realigned(label);
+        Ok(())
+    }
+
+    /// `TRANS/XORIG,x[,YORIG,y…]`: the alignment's origin moved along its axes.
+    fn trans(
+        &mut self,
+        label: Option<&(String, String)>,
+        params: &[String],
+        at: usize,
+    ) -> Result<(), SimError> {
+        let mut o = self.frame.translation.vector;
+        for pair in params.chunks(2) {
+            let k = match pair[0].as_str() {
+                "XORIG" => 0,
+                "YORIG" => 1,
+                "ZORIG" => 2,
+                _ => return Err(self.unsupported(at, &format!("TRANS/{}", params.join(",")))),
+            };
+            let v = pair
+                .get(1)
+                .and_then(|p| p.parse::<f64>().ok())
+                .ok_or_else(|| {
+                    self.bad(at, "TRANS without a value", "write `TRANS/XORIG,value`")
+                })?;
+            o += self.frame.rotation * (V3::ith(k, 1.0) * v);
+        }
+        self.frame = Isometry3::from_parts(Translation3::from(o), self.frame.rotation);
+        self.realigned(label);
+        Ok(())
+    }
+
+    /// `GOTO/x,y,z`: a move under `MODE/PROG`; by hand, the operator's business.
+    fn goto(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let v = nums(params);
+        if v.len() != 3 {
+            return Err(self.bad(at, "GOTO takes x, y, z", "write `GOTO/x,y,z`"));
+        }
+        if !self.manual {
+            let q = self.frame * P3::new(v[0], v[1], v[2]);
+            self.move_to(q, at, "moving here")?;
+        }
+        Ok(())
+    }
+
+    /// `DATDEF/FA(f),DAT(x)` (ANSI/DMIS 105.2; NIST's and the QIF bindings' form): the
+    /// datum, the last parameter, is the measured feature and, for a pattern, its
+    /// members after it.
+    fn datdef(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
+        let Some(d) = params
+            .last()
+            .filter(|p| p.starts_with("DAT("))
+            .and_then(|p| label_of(p))
+            .map(str::to_string)
+        else {
+            return Err(self.bad(
+                at,
+                "DATDEF without the datum it defines",
+                "write `DATDEF/FA(label),DAT(A)`",
+            ));
+        };
+        let l = params
+            .first()
+            .and_then(|p| label_of(p))
+            .unwrap_or("")
+            .to_string();
+        let f = self.actuals.get(&l).cloned().ok_or_else(|| {
+            self.bad(
+                at,
+                &format!("feature `{l}` is not measured"),
+                "measure a datum feature before DATDEF",
+            )
+        })?;
+        let members: Vec<Labelled> = self
+            .patterns
+            .get(&l)
+            .into_iter()
+            .flatten()
+            .filter_map(|m| Some((self.actuals.get(m).cloned()?, m.clone())))
+            .collect();
+        let all = std::iter::once((f, l)).chain(members).collect();
+        self.datums.insert(d, all);
         Ok(())
     }
 
@@ -951,6 +1043,53 @@ impl Machine<'_> {
     /// A touch: approach, search for the surface, record the tip centre.
     fn ptmeas(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
         self.ensure_setup(at)?;
+        let (p, n) = self.touch_point(params, at)?;
+        let s = self.sensor(at)?;
+        let r = self.probes[s.slot].tip_radius;
+        let ctx = self.ctx(at)?;
+        // Where the touch is on the part: the operator touches the point shown on the
+        // part itself; the machine goes where the alignment puts it.
+        let (pp, np) = if self.manual {
+            (p, n)
+        } else {
+            let inv = ctx.place.inverse() * self.frame;
+            (inv * p, inv * n)
+        };
+        let appr = if self.manual {
+            self.hand_approach(ctx, pp, np, r)
+        } else {
+            self.apprch
+        };
+        let c0 = pp + np * (r + appr);
+        if !self.manual {
+            self.move_to(ctx.place * c0, at, "on the way to the approach point")?;
+        }
+        let ctx = self.ctx(at)?;
+        let travel = appr + self.search;
+        let found = self.touch_contact(ctx, &c0, &np, r, travel, at)?;
+        let centre = found.0;
+        if !self.manual {
+            self.check_touch_approach(ctx, s, pp + np * r, &np, found, at)?;
+        }
+        let place = ctx.place;
+        let nw = self.frame.rotation * n;
+        let noise = if self.opts.noise > 0.0 {
+            self.opts.noise * self.rng.gauss()
+        } else {
+            0.0
+        };
+        let cw = place * centre + nw * noise;
+        self.touches += 1;
+        self.at = (!self.manual).then(|| centre + np * self.retrct);
+        if let Some(b) = self.block.as_mut() {
+            b.touches.push((p, n, cw, nw, r));
+        }
+        Ok(())
+    }
+
+    /// `PTMEAS/CART,x,y,z,i,j,k`'s point and unit vector (program frame), in an open
+    /// `MEAS` block.
+    fn touch_point(&self, params: &[String], at: usize) -> Result<(P3, V3), SimError> {
         let v = nums(params);
         if v.len() != 6 {
             return Err(self.bad(
@@ -976,99 +1115,94 @@ impl Machine<'_> {
                     "give the surface's outward vector",
                 )
             })?;
-        let s = self.sensor(at)?;
+        Ok((p, n))
+    }
+
+    /// By hand, the operator starts as near the surface as there is room for: the
+    /// first of `SNSET/APPRCH`, 2, 4 and 8 times it, then a half down to a sixteenth of
+    /// it, whose search does not start in the material (`APPRCH` when none does).
+    fn hand_approach(&self, ctx: &SetupCtx, pp: P3, np: V3, r: f64) -> f64 {
+        let a = self.apprch;
+        let tries = [
+            a,
+            2.0 * a,
+            4.0 * a,
+            8.0 * a,
+            a / 2.0,
+            a / 4.0,
+            a / 8.0,
+            a / 16.0,
+        ];
+        tries
+            .into_iter()
+            .find(|&x| {
+                let c = pp + np * (r + x);
+                !matches!(
+                    self.search_surface(ctx, &c, &np, r, x + self.search),
+                    Found::Inside
+                )
+            })
+            .unwrap_or(a)
+    }
+
+    /// The contact of a touch's search from `c0` along `−np` within `travel` (part
+    /// frame): the tip centre, what it touched and the part's face; an error when the
+    /// search starts inside the part or meets nothing.
+    fn touch_contact(
+        &self,
+        ctx: &SetupCtx,
+        c0: &P3,
+        np: &V3,
+        r: f64,
+        travel: f64,
+        at: usize,
+    ) -> Result<(P3, Contact, Option<FaceId>), SimError> {
+        match self.search_surface(ctx, c0, np, r, travel) {
+            Found::Contact(c, k, f) => Ok((c, k, f)),
+            Found::Inside => Err(SimError::InsidePart {
+                span: self.span(at),
+            }),
+            Found::Nothing => Err(SimError::NoSurface {
+                span: self.span(at),
+                travel: crate::dmis::text::num(travel),
+            }),
+        }
+    }
+
+    /// Under `MODE/PROG`, the touch's approach to the contact `found` swept with the
+    /// probe: from the nominal tip centre `nominal` or, where the actual surface stands
+    /// proud of it, from the contact.
+    fn check_touch_approach(
+        &self,
+        ctx: &SetupCtx,
+        s: Sensor,
+        nominal: P3,
+        np: &V3,
+        (centre, contact, touched): (P3, Contact, Option<FaceId>),
+        at: usize,
+    ) -> Result<(), SimError> {
         let r = self.probes[s.slot].tip_radius;
-        let ctx = self.ctx(at)?;
-        // Where the touch is on the part: the operator touches the point shown on the
-        // part itself; the machine goes where the alignment puts it.
-        let (pp, np) = if self.manual {
-            (p, n)
+        // The tip stops at the actual surface: where that stands proud of the
+        // nominal (a moved face, or a frame off by a moved datum) the approach ends
+        // there, on the machine's first contact; where it lies deeper the search
+        // itself covered the way down from the nominal touch.
+        let mut outer = if (centre - nominal).dot(np) > 0.0 {
+            centre
         } else {
-            let inv = ctx.place.inverse() * self.frame;
-            (inv * p, inv * n)
+            nominal
         };
-        // By hand, the operator starts as near the surface as there is room for.
-        let mut appr = self.apprch;
-        if self.manual {
-            let a = self.apprch;
-            let tries = [
-                a,
-                2.0 * a,
-                4.0 * a,
-                8.0 * a,
-                a / 2.0,
-                a / 4.0,
-                a / 8.0,
-                a / 16.0,
-            ];
-            appr = tries
-                .into_iter()
-                .find(|&x| {
-                    let c = pp + np * (r + x);
-                    !matches!(
-                        self.search_surface(ctx, &c, &np, r, x + self.search),
-                        Found::Inside
-                    )
-                })
-                .unwrap_or(a);
-        }
-        let c0 = pp + np * (r + appr);
-        if !self.manual {
-            self.move_to(ctx.place * c0, at, "on the way to the approach point")?;
-        }
-        let ctx = self.ctx(at)?;
-        let travel = appr + self.search;
-        let (centre, contact, touched) = match self.search_surface(ctx, &c0, &np, r, travel) {
-            Found::Contact(c, k, f) => (c, k, f),
-            Found::Inside => {
-                return Err(SimError::InsidePart {
-                    span: self.span(at),
-                })
-            }
-            Found::Nothing => {
-                return Err(SimError::NoSurface {
-                    span: self.span(at),
-                    travel: crate::dmis::text::num(travel),
-                })
-            }
-        };
-        if !self.manual {
-            // The tip stops at the actual surface: where that stands proud of the
-            // nominal (a moved face, or a frame off by a moved datum) the approach ends
-            // there, on the machine's first contact; where it lies deeper the search
-            // itself covered the way down from the nominal touch.
-            let nominal = pp + np * r;
-            let mut outer = if (centre - nominal).dot(&np) > 0.0 {
-                centre
-            } else {
-                nominal
-            };
-            // The scene is the nominal part: where the touched face itself lies deeper
-            // (tilted, or the frame off), the ball is nearer its nominal triangles than
-            // a tip is allowed to be, and no material is there. The check starts where
-            // the ball clears them.
-            if let Some((face, d)) = self.nearest_face(&outer) {
-                if Some(face) == touched && d < r {
-                    outer += np * (r - d);
-                }
-            }
-            let pose = self.pose(ctx, s);
-            if let Err(b) = pose.approach(&outer, &np, self.apprch, contact) {
-                return Err(self.collision(at, b, "on the touch's approach"));
+        // The scene is the nominal part: where the touched face itself lies deeper
+        // (tilted, or the frame off), the ball is nearer its nominal triangles than
+        // a tip is allowed to be, and no material is there. The check starts where
+        // the ball clears them.
+        if let Some((face, d)) = self.nearest_face(&outer) {
+            if Some(face) == touched && d < r {
+                outer += np * (r - d);
             }
         }
-        let place = ctx.place;
-        let nw = self.frame.rotation * n;
-        let noise = if self.opts.noise > 0.0 {
-            self.opts.noise * self.rng.gauss()
-        } else {
-            0.0
-        };
-        let cw = place * centre + nw * noise;
-        self.touches += 1;
-        self.at = (!self.manual).then(|| centre + np * self.retrct);
-        if let Some(b) = self.block.as_mut() {
-            b.touches.push((p, n, cw, nw, r));
+        let pose = self.pose(ctx, s);
+        if let Err(b) = pose.approach(&outer, np, self.apprch, contact) {
+            return Err(self.collision(at, b, "on the touch's approach"));
         }
         Ok(())
     }
@@ -1083,8 +1217,54 @@ impl Machine<'_> {
     /// has noise: the larger of the run's and half the scanner's accuracy.
     fn pameas(&mut self, params: &[String], at: usize) -> Result<(), SimError> {
         self.ensure_setup(at)?;
+        let ((s, e), sensor, optics, accuracy) = self.scan_pass(params, at)?;
+        let ctx = self.ctx(at)?;
+        let inv = ctx.place.inverse() * self.frame;
+        let (sp, ep) = (inv * s, inv * e);
+        let place = ctx.place;
+        self.move_to(place * sp, at, "on the way to the pass")?;
+        self.move_to(place * ep, at, "along the scan pass")?;
+        let ctx = self.ctx(at)?;
+        let dir = self.sensor_dir(ctx, sensor);
+        let run = ep - sp;
+        let motion = run
+            .try_normalize(1e-9)
+            .unwrap_or_else(|| fit::across(&dir).0);
+        let across = dir.cross(&motion).normalize();
+        // The block's nominal in the part frame (the program's frame is the part's).
+        let nominal = self
+            .block
+            .as_ref()
+            .and_then(|b| self.nominals.get(&b.label))
+            .map(|n| n.shape.clone());
+        let pass = Pass {
+            start: sp,
+            run,
+            dir,
+            across,
+            optics,
+            nominal,
+            place,
+        };
+        let cloud = self.thinned_cloud(ctx, &pass);
+        let sigma = if self.opts.noise > 0.0 {
+            self.opts.noise.max(accuracy / 2.0)
+        } else {
+            0.0
+        };
+        self.record_scan(cloud, sigma, pass.nominal.as_ref());
+        Ok(())
+    }
+
+    /// `PAMEAS/P(path)`'s path (start and end, program frame), and the scanner on the
+    /// ram that runs it with its optics and accuracy, in an open `MEAS` block.
+    fn scan_pass(
+        &self,
+        params: &[String],
+        at: usize,
+    ) -> Result<((P3, P3), Sensor, Optics, f64), SimError> {
         let l = params.first().and_then(|p| label_of(p)).unwrap_or("");
-        let Some(&(s, e)) = self.paths.get(l) else {
+        let Some(&path) = self.paths.get(l) else {
             return Err(self.bad(
                 at,
                 &format!("path `{l}` is not defined"),
@@ -1106,98 +1286,102 @@ impl Machine<'_> {
                 "select a scanner (`SNSDEF/LASER`) with SNSLCT before its passes",
             ));
         };
-        let ctx = self.ctx(at)?;
-        let inv = ctx.place.inverse() * self.frame;
-        let (sp, ep) = (inv * s, inv * e);
-        let place = ctx.place;
-        self.move_to(place * sp, at, "on the way to the pass")?;
-        self.move_to(place * ep, at, "along the scan pass")?;
-        let ctx = self.ctx(at)?;
-        let dir = self.sensor_dir(ctx, sensor);
-        let run = ep - sp;
-        let motion = run
-            .try_normalize(1e-9)
-            .unwrap_or_else(|| fit::across(&dir).0);
-        let across = dir.cross(&motion).normalize();
+        Ok((path, sensor, optics, accuracy))
+    }
+
+    /// The pass's points (machine frame, with their normals), thinned to [`CLOUD`]; on
+    /// a feature narrower than the thinned stripe (a strip the pass runs along) or
+    /// shorter than its spacing, sampled 4 and 16 times as densely across and along,
+    /// up to the scanner's own spacing, until the points lie on three stripes and three
+    /// positions along them.
+    fn thinned_cloud(&self, ctx: &SetupCtx, pass: &Pass) -> Vec<(P3, V3)> {
+        let optics = &pass.optics;
         let most = (
-            ((run.norm() / optics.spacing[1]).floor() as usize).max(1),
+            ((pass.run.norm() / optics.spacing[1]).floor() as usize).max(1),
             ((optics.stripe / optics.spacing[0]).floor() as usize).max(1),
         );
-        // The block's nominal in the part frame (the program's frame is the part's).
-        let nominal = self
-            .block
-            .as_ref()
-            .and_then(|b| self.nominals.get(&b.label))
-            .map(|n| n.shape.clone());
-        let g = self.input.geometry;
-        let near = optics.standoff - optics.depth / 2.0;
-        let sigma = if self.opts.noise > 0.0 {
-            self.opts.noise.max(accuracy / 2.0)
-        } else {
-            0.0
-        };
-        // The stripe sampled `along_n` + 1 times, `across_n` + 1 points each: the points
-        // kept, and on how many stripes and stripe positions they lie.
-        let sample = |along_n: usize, across_n: usize| {
-            let mut cloud = Vec::new();
-            let (mut rows, mut cols) = (BTreeSet::new(), BTreeSet::new());
-            for i in 0..=along_n {
-                for j in 0..=across_n {
-                    let f = sp
-                        + run * (i as f64 / along_n as f64)
-                        + across * (optics.stripe * (j as f64 / across_n as f64 - 0.5));
-                    let c0 = f + dir * optics.standoff;
-                    let travel = optics.standoff + optics.depth / 2.0;
-                    let Found::Contact(c, Contact::Part, Some(face)) =
-                        self.search_surface(ctx, &c0, &dir, 0.0, travel)
-                    else {
-                        continue;
-                    };
-                    if (c0 - c).dot(&dir) < near {
-                        continue;
-                    }
-                    let n = g.faces[face.0]
-                        .surface
-                        .normal_at(&c)
-                        .unwrap_or(dir)
-                        .normalize();
-                    // Seen from where the nominal surface is: the scene is the nominal
-                    // part, and a face set back behind it is not hidden by itself.
-                    let seen_at = nominal_foot(nominal.as_ref(), self.scene.mesh(), &c);
-                    if !crate::access::scan::sees(&self.scene, &seen_at, &n, &dir, &optics) {
-                        continue;
-                    }
-                    // A point on a face of another surface (a fillet, the next wall) is
-                    // not the feature's; a free-form nominal keeps every point.
-                    let own = match (&nominal, Shape::of_surface(&g.faces[face.0].surface)) {
-                        (Some(Shape::Surface) | None, _) => true,
-                        (Some(shape), Some((surface, _))) => shape.same_surface(&surface, CLIP),
-                        (Some(_), None) => false,
-                    };
-                    if !own {
-                        continue;
-                    }
-                    rows.insert(i);
-                    cols.insert(j);
-                    cloud.push((place * c, place.rotation * n));
-                }
-            }
-            (cloud, rows.len().min(cols.len()))
-        };
-        // Thinned to CLOUD; on a feature narrower than the thinned stripe (a strip the
-        // pass runs along) or shorter than its spacing, sampled 4 and 16 times as
-        // densely across and along, up to the scanner's own spacing, until the points
-        // lie on three stripes and three positions along them.
         let mut cloud = Vec::new();
         for k in [1, 4, 16] {
             let (along_n, across_n) = ((CLOUD.0 * k).min(most.0), (CLOUD.1 * k).min(most.1));
-            let (points, spread) = sample(along_n, across_n);
+            let (points, spread) = self.sample_pass(ctx, pass, along_n, across_n);
             cloud = points;
             let finest = along_n == most.0 && across_n == most.1;
             if spread >= 3 || finest {
                 break;
             }
         }
+        cloud
+    }
+
+    /// The stripe sampled `along_n` + 1 times, `across_n` + 1 points each: the points
+    /// kept (machine frame, with their normals), and on how many stripes and stripe
+    /// positions they lie (the fewer).
+    fn sample_pass(
+        &self,
+        ctx: &SetupCtx,
+        pass: &Pass,
+        along_n: usize,
+        across_n: usize,
+    ) -> (Vec<(P3, V3)>, usize) {
+        let mut cloud = Vec::new();
+        let (mut rows, mut cols) = (BTreeSet::new(), BTreeSet::new());
+        for i in 0..=along_n {
+            for j in 0..=across_n {
+                let f = pass.start
+                    + pass.run * (i as f64 / along_n as f64)
+                    + pass.across * (pass.optics.stripe * (j as f64 / across_n as f64 - 0.5));
+                let Some((c, n)) = self.scanned_point(ctx, pass, f) else {
+                    continue;
+                };
+                rows.insert(i);
+                cols.insert(j);
+                cloud.push((pass.place * c, pass.place.rotation * n));
+            }
+        }
+        (cloud, rows.len().min(cols.len()))
+    }
+
+    /// The point of the actual part the laser meets from `f` on the stripe, and the
+    /// normal there (part frame), when the pass keeps it: in the depth of field, seen
+    /// by laser and camera, and on the block's nominal surface ([`CLIP`]).
+    fn scanned_point(&self, ctx: &SetupCtx, pass: &Pass, f: P3) -> Option<(P3, V3)> {
+        let g = self.input.geometry;
+        let (optics, dir) = (&pass.optics, pass.dir);
+        let near = optics.standoff - optics.depth / 2.0;
+        let c0 = f + dir * optics.standoff;
+        let travel = optics.standoff + optics.depth / 2.0;
+        let Found::Contact(c, Contact::Part, Some(face)) =
+            self.search_surface(ctx, &c0, &dir, 0.0, travel)
+        else {
+            return None;
+        };
+        if (c0 - c).dot(&dir) < near {
+            return None;
+        }
+        let n = g.faces[face.0]
+            .surface
+            .normal_at(&c)
+            .unwrap_or(dir)
+            .normalize();
+        // Seen from where the nominal surface is: the scene is the nominal
+        // part, and a face set back behind it is not hidden by itself.
+        let seen_at = nominal_foot(pass.nominal.as_ref(), self.scene.mesh(), &c);
+        if !crate::access::scan::sees(&self.scene, &seen_at, &n, &dir, optics) {
+            return None;
+        }
+        // A point on a face of another surface (a fillet, the next wall) is
+        // not the feature's; a free-form nominal keeps every point.
+        let own = match (&pass.nominal, Shape::of_surface(&g.faces[face.0].surface)) {
+            (Some(Shape::Surface) | None, _) => true,
+            (Some(shape), Some((surface, _))) => shape.same_surface(&surface, CLIP),
+            (Some(_), None) => false,
+        };
+        own.then_some((c, n))
+    }
+
+    /// The pass's points (machine frame) in the open block, each with the noise of
+    /// `sigma` along its normal, against its nominal: the foot on `nominal`.
+    fn record_scan(&mut self, cloud: Vec<(P3, V3)>, sigma: f64, nominal: Option<&Shape>) {
         let prog = self.frame.inverse();
         for (cw, nw) in cloud {
             let noise = if sigma > 0.0 {
@@ -1211,7 +1395,7 @@ impl Machine<'_> {
             // (ASME Y14.5-2018 ch. 11: a profile zone lies normal to the true profile);
             // the point found is where the actual surface is.
             let at = prog * cw;
-            let foot = nominal_foot(nominal.as_ref(), self.scene.mesh(), &at);
+            let foot = nominal_foot(nominal, self.scene.mesh(), &at);
             if let Some(b) = self.block.as_mut() {
                 b.touches.push((foot, prog * nw, q, nw, 0.0));
                 b.scanned = true;
@@ -1221,7 +1405,6 @@ impl Machine<'_> {
         if let Some(b) = self.block.as_mut() {
             b.scanned = true;
         }
-        Ok(())
     }
 
     /// The part's face nearest `x` (part frame) on the nominal mesh, and its distance.
@@ -1534,69 +1717,11 @@ impl Machine<'_> {
         let intof = params.get(2).map(String::as_str) == Some("INTOF");
         let fitted = match word.as_str() {
             "CIRCLE" if intof => {
-                let [bore, cone] = &sources[..] else {
-                    return Err(self.bad(
-                        at,
-                        "an intersection circle takes two features",
-                        "write `CONST/CIRCLE,F(c),INTOF,FA(bore),FA(cone)`",
-                    ));
-                };
-                let circle = full_diameter(&bore.shape, &cone.shape).ok_or_else(|| {
-                    self.bad(
-                        at,
-                        "these features meet in no circle",
-                        "intersect a bore with the cone on its axis",
-                    )
-                })?;
                 // The circle is the features' intersection, not a fit over their points.
+                let circle = self.intersection_circle(&sources, at)?;
                 return self.store_constructed(label, circle);
             }
-            "PARPLN" => {
-                let [a, b] = &sources[..] else {
-                    return Err(self.bad(
-                        at,
-                        "a centre plane takes two walls",
-                        "write `CONST/PARPLN,F(mid),BF,FA(wall1),FA(wall2)`",
-                    ));
-                };
-                let (Shape::Plane { p: pa, n: na }, Shape::Plane { p: pb, n: nb }) =
-                    (&a.shape, &b.shape)
-                else {
-                    return Err(self.bad(
-                        at,
-                        "a centre plane's walls must be planes",
-                        "construct it from two measured planes",
-                    ));
-                };
-                let Some(nn) = nominal.shape.direction() else {
-                    return Err(self.bad(
-                        at,
-                        "a centre plane's nominal has no normal",
-                        "define it as FEAT/PARPLN",
-                    ));
-                };
-                let mut n = (na - nb).normalize();
-                if n.dot(&nn) < 0.0 {
-                    n = -n;
-                }
-                let centroid = |m: &Measured| {
-                    P3::from(
-                        m.touches.iter().fold(V3::zeros(), |s, t| s + t.2.coords)
-                            / m.touches.len().max(1) as f64,
-                    )
-                };
-                let (ca, cb) = (centroid(a), centroid(b));
-                let qa = ca - nb * (ca - pb).dot(nb);
-                let qb = cb - na * (cb - pa).dot(na);
-                let width = ((qa - ca).norm() + (qb - cb).norm()) / 2.0;
-                let mid = P3::from((ca.coords + qa.coords + cb.coords + qb.coords) / 4.0);
-                let mut median = Vec::new();
-                for (m, p, nw) in [(a, pa, na), (b, pb, nb)] {
-                    let s0 = (mid - p).dot(&n) / nw.dot(&n);
-                    median.extend(m.touches.iter().map(|t| t.2 + nw * s0));
-                }
-                Some((Shape::Parpln { p: mid, n, width }, median))
-            }
+            "PARPLN" => Some(self.centre_plane(&sources, &nominal, at)?),
             "PLANE" => {
                 fit::plane(&pts, &nominal.shape.direction().unwrap_or(V3::z())).map(|s| (s, vec![]))
             }
@@ -1631,6 +1756,79 @@ impl Machine<'_> {
         Ok(())
     }
 
+    /// `CONST/CIRCLE,F(c),INTOF,FA(bore),FA(cone)`: the circle where the bore meets
+    /// the cone on its axis.
+    fn intersection_circle(&self, sources: &[Measured], at: usize) -> Result<Shape, SimError> {
+        let [bore, cone] = sources else {
+            return Err(self.bad(
+                at,
+                "an intersection circle takes two features",
+                "write `CONST/CIRCLE,F(c),INTOF,FA(bore),FA(cone)`",
+            ));
+        };
+        full_diameter(&bore.shape, &cone.shape).ok_or_else(|| {
+            self.bad(
+                at,
+                "these features meet in no circle",
+                "intersect a bore with the cone on its axis",
+            )
+        })
+    }
+
+    /// `CONST/PARPLN,F(mid),BF,FA(wall1),FA(wall2)`: the plane midway between two
+    /// measured walls, facing the way its nominal does, their width apart, and the
+    /// walls' points moved onto it (its median points).
+    fn centre_plane(
+        &self,
+        sources: &[Measured],
+        nominal: &Nominal,
+        at: usize,
+    ) -> Result<(Shape, Vec<P3>), SimError> {
+        let [a, b] = sources else {
+            return Err(self.bad(
+                at,
+                "a centre plane takes two walls",
+                "write `CONST/PARPLN,F(mid),BF,FA(wall1),FA(wall2)`",
+            ));
+        };
+        let (Shape::Plane { p: pa, n: na }, Shape::Plane { p: pb, n: nb }) = (&a.shape, &b.shape)
+        else {
+            return Err(self.bad(
+                at,
+                "a centre plane's walls must be planes",
+                "construct it from two measured planes",
+            ));
+        };
+        let Some(nn) = nominal.shape.direction() else {
+            return Err(self.bad(
+                at,
+                "a centre plane's nominal has no normal",
+                "define it as FEAT/PARPLN",
+            ));
+        };
+        let mut n = (na - nb).normalize();
+        if n.dot(&nn) < 0.0 {
+            n = -n;
+        }
+        let centroid = |m: &Measured| {
+            P3::from(
+                m.touches.iter().fold(V3::zeros(), |s, t| s + t.2.coords)
+                    / m.touches.len().max(1) as f64,
+            )
+        };
+        let (ca, cb) = (centroid(a), centroid(b));
+        let qa = ca - nb * (ca - pb).dot(nb);
+        let qb = cb - na * (cb - pa).dot(na);
+        let width = ((qa - ca).norm() + (qb - cb).norm()) / 2.0;
+        let mid = P3::from((ca.coords + qa.coords + cb.coords + qb.coords) / 4.0);
+        let mut median = Vec::new();
+        for (m, p, nw) in [(a, pa, na), (b, pb, nb)] {
+            let s0 = (mid - p).dot(&n) / nw.dot(&n);
+            median.extend(m.touches.iter().map(|t| t.2 + nw * s0));
+        }
+        Ok((Shape::Parpln { p: mid, n, width }, median))
+    }
+
     /// A constructed feature with no points of its own, in the program frame.
     fn store_constructed(&mut self, label: String, shape: Shape) -> Result<(), SimError> {
         let m = Measured {
@@ -1647,9 +1845,22 @@ impl Machine<'_> {
     /// `DATSET/FA(f),[-]XDIR,XORIG,…`: the frame whose axes and origin the features
     /// give; what they leave free comes from the current frame.
     fn datset(&self, params: &[String], at: usize) -> Result<Isometry3<f64>, SimError> {
-        // `DAT(x)` stands for the feature its `DATDEF` named (DMIS's DATSET names
-        // features through datum labels); `FA(x)` directly is read too.
-        let params: Vec<String> = params
+        let params = self.datums_as_features(params, at)?;
+        let (dirs, origins) = self.datset_targets(&params, at)?;
+        let axes = self.datset_axes(&dirs, at)?;
+        let o = self.datset_origin(&axes, &origins, at)?;
+        let r = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&axes));
+        Ok(Isometry3::from_parts(
+            Translation3::from(o),
+            UnitQuaternion::from_rotation_matrix(&r),
+        ))
+    }
+
+    /// `DATSET`'s parameters with each `DAT(x)` written as the feature its `DATDEF`
+    /// named, `FA(f)` (DMIS's DATSET names features through datum labels; `FA(x)`
+    /// directly is read too).
+    fn datums_as_features(&self, params: &[String], at: usize) -> Result<Vec<String>, SimError> {
+        params
             .iter()
             .map(
                 |p| match p.strip_prefix("DAT(").and_then(|r| r.strip_suffix(')')) {
@@ -1664,8 +1875,13 @@ impl Machine<'_> {
                     None => Ok(p.clone()),
                 },
             )
-            .collect::<Result<_, _>>()?;
-        let params = &params[..];
+            .collect()
+    }
+
+    /// What `DATSET`'s keywords ask of the features before them (machine frame): the
+    /// directions by axis (0 for x), each the way its nominal points, and the shapes
+    /// that give the origin along an axis.
+    fn datset_targets(&self, params: &[String], at: usize) -> Result<DatsetTargets, SimError> {
         let mut dirs: Vec<(usize, V3)> = Vec::new();
         let mut origins: Vec<(usize, Shape)> = Vec::new();
         let mut cur: Option<Measured> = None;
@@ -1716,10 +1932,17 @@ impl Machine<'_> {
                 return Err(self.unsupported(at, &format!("DATSET keyword {p}")));
             }
         }
+        Ok((dirs, origins))
+    }
+
+    /// The new frame's axes: the first two directions `dirs` names, each made square
+    /// to those before it; the axes they leave free from the current frame, across
+    /// them; the third the cross product of the other two.
+    fn datset_axes(&self, dirs: &[(usize, V3)], at: usize) -> Result<[V3; 3], SimError> {
         let old = self.frame.rotation.to_rotation_matrix().into_inner();
         let mut e: [Option<V3>; 3] = [None, None, None];
         let mut order: Vec<usize> = Vec::new();
-        for (k, d) in &dirs {
+        for (k, d) in dirs {
             if e[*k].is_some() {
                 continue;
             }
@@ -1761,10 +1984,18 @@ impl Machine<'_> {
         let third = (0..3).find(|j| e[*j].is_none()).unwrap_or(2);
         let (a, b) = ((third + 1) % 3, (third + 2) % 3);
         e[third] = Some(e[a].expect("two axes").cross(&e[b].expect("two axes")));
-        let axes = [e[0].expect("x"), e[1].expect("y"), e[2].expect("z")];
-        // Origin: along each axis an ORIG names, the feature's location (a plane's
-        // touched centroid, a point of an axis, a centre); along the others the old
-        // origin's.
+        Ok([e[0].expect("x"), e[1].expect("y"), e[2].expect("z")])
+    }
+
+    /// The new frame's origin: along each axis an ORIG names, the feature's location
+    /// (a plane's touched centroid, a point of an axis, a centre); along the others
+    /// the old origin's.
+    fn datset_origin(
+        &self,
+        axes: &[V3; 3],
+        origins: &[(usize, Shape)],
+        at: usize,
+    ) -> Result<V3, SimError> {
         let o_old = self.frame.translation.vector;
         let mut m = Matrix3::zeros();
         let mut rhs = V3::zeros();
@@ -1783,18 +2014,13 @@ impl Machine<'_> {
             m.set_row(k, &axes[k].transpose());
             rhs[k] = axes[k].dot(&at);
         }
-        let Some(o) = m.lu().solve(&rhs) else {
-            return Err(self.bad(
+        m.lu().solve(&rhs).ok_or_else(|| {
+            self.bad(
                 at,
                 "DATSET origins do not meet in a point",
                 "each origin must come from a feature across its axis",
-            ));
-        };
-        let r = Rotation3::from_matrix_unchecked(Matrix3::from_columns(&axes));
-        Ok(Isometry3::from_parts(
-            Translation3::from(o),
-            UnitQuaternion::from_rotation_matrix(&r),
-        ))
+            )
+        })
     }
 
     /// `OUTPUT/FA(…)[,FA(…)],TA(t)`: the tolerance evaluated on its features as the

@@ -250,7 +250,6 @@ impl Verification {
     /// The report for people.
     pub fn text(&self) -> String {
         let mut s = String::new();
-        let o = &self.options;
         s += &format!("verify plan {} (part {})\n", self.plan, self.part);
         match &self.nominal.report {
             None => {
@@ -260,106 +259,11 @@ impl Verification {
                 );
                 return s;
             }
-            Some(r) => {
-                let mut out: Vec<&str> = r
-                    .rows
-                    .iter()
-                    .filter(|r| !r.pass() && !r.unjudged())
-                    .map(|r| r.tolerance.as_str())
-                    .collect();
-                out.dedup();
-                let unjudged = r.rows.iter().filter(|r| r.unjudged()).count();
-                s += &format!(
-                    "nominal: {} setups, {} touches, {} tolerance outputs, {} read out{}, {} not judged\n",
-                    r.setups,
-                    r.touches,
-                    r.rows.len(),
-                    out.len(),
-                    if out.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" ({})", out.join(", "))
-                    },
-                    unjudged
-                );
-            }
+            Some(r) => s += &nominal_line(r),
         }
-        let stopped = self.placed.iter().filter(|p| p.stopped.is_some()).count();
-        let changed = self.placed.iter().filter(|p| !p.changed.is_empty()).count();
-        let drift = self
-            .placed
-            .iter()
-            .filter(|p| p.stopped.is_none())
-            .map(|p| p.drift)
-            .fold(0.0, f64::max);
-        s += &format!(
-            "placements: {} within ±{} mm and ±{}°: {} stopped, {} changed a verdict; largest change of an actual {} mm\n",
-            self.placed.len(),
-            fmt_num(o.shift),
-            fmt_num(o.turn),
-            stopped,
-            changed,
-            fmt_num(round(drift))
-        );
+        s += &self.placements_line();
         s += "\n";
-        let mut rows: Vec<[String; 8]> = Vec::new();
-        for t in &self.tolerances {
-            let verdicts = |f: &dyn Fn(&VariantResult) -> bool, word: [&str; 2]| {
-                if t.variants.is_empty() {
-                    "-".to_string()
-                } else {
-                    let bad = t.variants.iter().filter(|v| !f(v)).count();
-                    if bad == 0 {
-                        word[0].to_string()
-                    } else {
-                        format!("{bad} of {} {}", t.variants.len(), word[1])
-                    }
-                }
-            };
-            let result = if !t.output {
-                "not output"
-            } else if t.variants.is_empty() && t.limits.is_empty() {
-                "not tried"
-            } else if t.ok() {
-                "ok"
-            } else {
-                "PROBLEM"
-            };
-            let from = t.detects_from();
-            rows.push([
-                t.label.clone(),
-                crate::dmis::tol_word(t.kind).to_string(),
-                if t.size {
-                    t.value.clone()
-                } else {
-                    fmt_num(round(t.zone))
-                },
-                verdicts(&|v| v.in_ok(), ["in", "out"]),
-                verdicts(&|v| v.out_ok(), ["out", "in"]),
-                if t.variants.is_empty() {
-                    "-".into()
-                } else if from.is_finite() {
-                    format!("{:.2}x", from)
-                } else {
-                    "never".into()
-                },
-                if t.limits.is_empty() {
-                    "-".into()
-                } else {
-                    let hit = t
-                        .limits
-                        .iter()
-                        .filter(|l| l.2.as_ref().is_none_or(|r| r.stopped.is_some()))
-                        .count();
-                    if hit == 0 {
-                        "clear".into()
-                    } else {
-                        format!("{hit} stopped")
-                    }
-                },
-                result.into(),
-            ]);
-        }
+        let rows: Vec<[String; 8]> = self.tolerances.iter().map(tolerance_row).collect();
         s += &table(&rows);
         let problems = self.problem_lines();
         if !problems.is_empty() {
@@ -383,6 +287,29 @@ impl Verification {
             self.problems()
         );
         s
+    }
+
+    /// The placements' line: how many were tried within what, how many stopped or
+    /// changed a verdict, and the largest change of an actual.
+    fn placements_line(&self) -> String {
+        let o = &self.options;
+        let stopped = self.placed.iter().filter(|p| p.stopped.is_some()).count();
+        let changed = self.placed.iter().filter(|p| !p.changed.is_empty()).count();
+        let drift = self
+            .placed
+            .iter()
+            .filter(|p| p.stopped.is_none())
+            .map(|p| p.drift)
+            .fold(0.0, f64::max);
+        format!(
+            "placements: {} within ±{} mm and ±{}°: {} stopped, {} changed a verdict; largest change of an actual {} mm\n",
+            self.placed.len(),
+            fmt_num(o.shift),
+            fmt_num(o.turn),
+            stopped,
+            changed,
+            fmt_num(round(drift))
+        )
     }
 
     /// Each problem in a line, with the deviations that reproduce it.
@@ -488,6 +415,93 @@ impl Verification {
             "problems": self.problems(),
         })
     }
+}
+
+/// The nominal run's line: its setups and touches, the tolerances it outputs, those
+/// read out on the nominal part and those not judged.
+fn nominal_line(r: &Report) -> String {
+    let mut out: Vec<&str> = r
+        .rows
+        .iter()
+        .filter(|r| !r.pass() && !r.unjudged())
+        .map(|r| r.tolerance.as_str())
+        .collect();
+    out.dedup();
+    let unjudged = r.rows.iter().filter(|r| r.unjudged()).count();
+    format!(
+        "nominal: {} setups, {} touches, {} tolerance outputs, {} read out{}, {} not judged\n",
+        r.setups,
+        r.touches,
+        r.rows.len(),
+        out.len(),
+        if out.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", out.join(", "))
+        },
+        unjudged
+    )
+}
+
+/// A tolerance's row of the table: label, kind, zone (or size), the verdicts inside
+/// and outside the zone, the factor it detects from, the size limits' collisions, and
+/// the result.
+fn tolerance_row(t: &TolResult) -> [String; 8] {
+    let verdicts = |f: &dyn Fn(&VariantResult) -> bool, word: [&str; 2]| {
+        if t.variants.is_empty() {
+            "-".to_string()
+        } else {
+            let bad = t.variants.iter().filter(|v| !f(v)).count();
+            if bad == 0 {
+                word[0].to_string()
+            } else {
+                format!("{bad} of {} {}", t.variants.len(), word[1])
+            }
+        }
+    };
+    let result = if !t.output {
+        "not output"
+    } else if t.variants.is_empty() && t.limits.is_empty() {
+        "not tried"
+    } else if t.ok() {
+        "ok"
+    } else {
+        "PROBLEM"
+    };
+    let from = t.detects_from();
+    [
+        t.label.clone(),
+        crate::dmis::tol_word(t.kind).to_string(),
+        if t.size {
+            t.value.clone()
+        } else {
+            fmt_num(round(t.zone))
+        },
+        verdicts(&|v| v.in_ok(), ["in", "out"]),
+        verdicts(&|v| v.out_ok(), ["out", "in"]),
+        if t.variants.is_empty() {
+            "-".into()
+        } else if from.is_finite() {
+            format!("{:.2}x", from)
+        } else {
+            "never".into()
+        },
+        if t.limits.is_empty() {
+            "-".into()
+        } else {
+            let hit = t
+                .limits
+                .iter()
+                .filter(|l| l.2.as_ref().is_none_or(|r| r.stopped.is_some()))
+                .count();
+            if hit == 0 {
+                "clear".into()
+            } else {
+                format!("{hit} stopped")
+            }
+        },
+        result.into(),
+    ]
 }
 
 /// A number, or null when it is infinite.

@@ -49,142 +49,204 @@ pub fn forbidden(
     zone: f64,
     k: f64,
 ) -> Vec<Variant> {
-    let feature = |i: usize| {
-        t.targets
-            .get(i)
-            .map(|f| (&part.features[f.0].name, &feature_faces[f.0][..]))
-    };
     let frame = Frame::of(part, g, feature_faces, t);
-    let mut out = Vec::new();
+    let b = Breaking {
+        part,
+        g,
+        feature_faces,
+        t,
+        zone,
+        k,
+    };
     match t.kind {
-        TolKind::Flatness | TolKind::Straightness => {
-            for (name, faces) in t
-                .targets
-                .iter()
-                .map(|f| (&part.features[f.0].name, &feature_faces[f.0]))
-            {
-                let lines = bows(g, faces, k * zone);
-                if !lines.is_empty() {
-                    out.push(Variant {
-                        what: format!("bow on {name}"),
-                        lines,
-                        unit: zone,
-                    });
-                }
-            }
-        }
-        TolKind::ProfileSurface | TolKind::ProfileLine => {
-            let faces: Vec<FaceId> = t
-                .targets
-                .iter()
-                .flat_map(|f| feature_faces[f.0].iter().copied())
-                .collect();
-            if t.datums.is_empty() {
-                let lines = bows(g, &faces, k * zone);
-                if !lines.is_empty() {
-                    out.push(Variant {
-                        what: "bow".into(),
-                        lines,
-                        unit: zone,
-                    });
-                }
-            } else {
-                let lines = offsets(g, &faces, k * zone / 2.0);
-                if !lines.is_empty() {
-                    out.push(Variant {
-                        what: "surface out".into(),
-                        lines,
-                        unit: zone,
-                    });
-                }
-            }
-        }
+        TolKind::Flatness | TolKind::Straightness => b.bow_variants(),
+        TolKind::ProfileSurface | TolKind::ProfileLine => b.profile_variants(),
         TolKind::Perpendicularity | TolKind::Parallelism | TolKind::Angularity => {
-            for (name, faces) in (0..t.targets.len()).filter_map(feature) {
-                for (axis, across, length) in tilts(g, faces) {
-                    if !frame.fixes_turn(&axis) {
-                        continue;
-                    }
-                    let deg = (k * zone / length).clamp(-1.0, 1.0).asin().to_degrees();
-                    out.push(Variant {
-                        what: format!("{name} tilted across {}", vec_text(&across)),
-                        lines: vec![format!(
-                            "feature {name} tilt {} about {}",
-                            num(deg),
-                            vec_text(&axis)
-                        )],
-                        unit: zone,
-                    });
-                }
-            }
+            b.tilt_variants(&frame)
         }
         TolKind::Position
         | TolKind::Concentricity
         | TolKind::Coaxiality
         | TolKind::Symmetry
         | TolKind::CircularRunout
-        | TolKind::TotalRunout => {
-            for (name, faces) in (0..t.targets.len()).filter_map(feature) {
-                for dir in across(g, faces) {
-                    if !frame.fixes_move(&dir) {
-                        continue;
-                    }
-                    let d = dir * (k * zone / 2.0);
-                    out.push(Variant {
-                        what: format!("{name} moved along {}", vec_text(&dir)),
-                        lines: vec![format!("feature {name} move {}", vec_text(&d))],
-                        unit: zone,
-                    });
-                }
-            }
-        }
-        TolKind::Diameter | TolKind::Radius | TolKind::Width => {
-            let scale = if t.kind == TolKind::Radius { 2.0 } else { 1.0 };
-            for (name, _) in (0..t.targets.len()).filter_map(feature) {
-                for (side, dev) in size_sides(&t.value) {
-                    out.push(Variant {
-                        what: format!("{name} {side}"),
-                        lines: vec![format!("feature {name} grow {}", num(k * dev * scale))],
-                        unit: dev,
-                    });
-                }
-            }
-        }
-        TolKind::Distance => {
-            if let (Some((_, f1)), Some((n2, f2))) = (feature(0), feature(1)) {
-                let dir = apart(g, f1, f2);
-                for (side, dev) in size_sides(&t.value) {
-                    out.push(Variant {
-                        what: format!("{n2} moved to the {side}"),
-                        lines: vec![format!(
-                            "feature {n2} move {}",
-                            vec_text(&(dir * (k * dev)))
-                        )],
-                        unit: dev,
-                    });
-                }
-            }
-        }
-        TolKind::Angle => {
-            if let (Some((_, f1)), Some((n2, f2))) = (feature(0), feature(1)) {
-                if let Some(axis) = hinge(g, f1, f2) {
-                    for (side, dev) in size_sides(&t.value) {
-                        out.push(Variant {
-                            what: format!("{n2} turned to the {side}"),
-                            lines: vec![format!(
-                                "feature {n2} tilt {} about {}",
-                                num(k * dev),
-                                vec_text(&axis)
-                            )],
-                            unit: dev,
-                        });
-                    }
-                }
-            }
-        }
-        TolKind::Circularity | TolKind::Cylindricity => {}
+        | TolKind::TotalRunout => b.move_variants(&frame),
+        TolKind::Diameter | TolKind::Radius | TolKind::Width => b.size_variants(),
+        TolKind::Distance => b.distance_variants(),
+        TolKind::Angle => b.angle_variants(),
+        TolKind::Circularity | TolKind::Cylindricity => Vec::new(),
     }
-    out
+}
+
+/// A tolerance to break at factor `k` of `zone`, on its part.
+struct Breaking<'a> {
+    part: &'a Part,
+    g: &'a PartGeometry,
+    feature_faces: &'a [Vec<FaceId>],
+    t: &'a Tolerance,
+    zone: f64,
+    k: f64,
+}
+
+impl<'a> Breaking<'a> {
+    /// The tolerance's `i`th feature: its name and faces.
+    fn feature(&self, i: usize) -> Option<(&'a String, &'a [FaceId])> {
+        self.t
+            .targets
+            .get(i)
+            .map(|f| (&self.part.features[f.0].name, &self.feature_faces[f.0][..]))
+    }
+
+    /// Its features in order: their names and faces.
+    fn features(&self) -> impl Iterator<Item = (&'a String, &'a [FaceId])> + '_ {
+        (0..self.t.targets.len()).filter_map(|i| self.feature(i))
+    }
+
+    /// Form (flatness, straightness): each feature's planes bowed.
+    fn bow_variants(&self) -> Vec<Variant> {
+        let (g, zone, k) = (self.g, self.zone, self.k);
+        let mut out = Vec::new();
+        for (name, faces) in self.features() {
+            let lines = bows(g, faces, k * zone);
+            if !lines.is_empty() {
+                out.push(Variant {
+                    what: format!("bow on {name}"),
+                    lines,
+                    unit: zone,
+                });
+            }
+        }
+        out
+    }
+
+    /// A profile: without datums, the surfaces' planes bowed (form only); with them,
+    /// every surface moved out by half the zone.
+    fn profile_variants(&self) -> Vec<Variant> {
+        let (g, t, zone, k) = (self.g, self.t, self.zone, self.k);
+        let faces: Vec<FaceId> = t
+            .targets
+            .iter()
+            .flat_map(|f| self.feature_faces[f.0].iter().copied())
+            .collect();
+        let (what, lines) = if t.datums.is_empty() {
+            ("bow", bows(g, &faces, k * zone))
+        } else {
+            ("surface out", offsets(g, &faces, k * zone / 2.0))
+        };
+        if lines.is_empty() {
+            return Vec::new();
+        }
+        vec![Variant {
+            what: what.into(),
+            lines,
+            unit: zone,
+        }]
+    }
+
+    /// An orientation: each feature tilted about each axis across it that `frame`
+    /// fixes the turn about, its far ends `k`·zone apart.
+    fn tilt_variants(&self, frame: &Frame) -> Vec<Variant> {
+        let (g, zone, k) = (self.g, self.zone, self.k);
+        let mut out = Vec::new();
+        for (name, faces) in self.features() {
+            for (axis, across, length) in tilts(g, faces) {
+                if !frame.fixes_turn(&axis) {
+                    continue;
+                }
+                let deg = (k * zone / length).clamp(-1.0, 1.0).asin().to_degrees();
+                out.push(Variant {
+                    what: format!("{name} tilted across {}", vec_text(&across)),
+                    lines: vec![format!(
+                        "feature {name} tilt {} about {}",
+                        num(deg),
+                        vec_text(&axis)
+                    )],
+                    unit: zone,
+                });
+            }
+        }
+        out
+    }
+
+    /// A location or runout: each feature moved half `k`·zone along each direction
+    /// across it that `frame` fixes.
+    fn move_variants(&self, frame: &Frame) -> Vec<Variant> {
+        let (g, zone, k) = (self.g, self.zone, self.k);
+        let mut out = Vec::new();
+        for (name, faces) in self.features() {
+            for dir in across(g, faces) {
+                if !frame.fixes_move(&dir) {
+                    continue;
+                }
+                let d = dir * (k * zone / 2.0);
+                out.push(Variant {
+                    what: format!("{name} moved along {}", vec_text(&dir)),
+                    lines: vec![format!("feature {name} move {}", vec_text(&d))],
+                    unit: zone,
+                });
+            }
+        }
+        out
+    }
+
+    /// A size: each feature grown by `k` × each limit's deviation (a radius's twice).
+    fn size_variants(&self) -> Vec<Variant> {
+        let t = self.t;
+        let scale = if t.kind == TolKind::Radius { 2.0 } else { 1.0 };
+        let mut out = Vec::new();
+        for (name, _) in self.features() {
+            for (side, dev) in size_sides(&t.value) {
+                out.push(Variant {
+                    what: format!("{name} {side}"),
+                    lines: vec![format!("feature {name} grow {}", num(self.k * dev * scale))],
+                    unit: dev,
+                });
+            }
+        }
+        out
+    }
+
+    /// A distance: the second feature moved the way that lengthens it by `k` × each
+    /// limit's deviation.
+    fn distance_variants(&self) -> Vec<Variant> {
+        let (Some((_, f1)), Some((n2, f2))) = (self.feature(0), self.feature(1)) else {
+            return Vec::new();
+        };
+        let dir = apart(self.g, f1, f2);
+        size_sides(&self.t.value)
+            .into_iter()
+            .map(|(side, dev)| Variant {
+                what: format!("{n2} moved to the {side}"),
+                lines: vec![format!(
+                    "feature {n2} move {}",
+                    vec_text(&(dir * (self.k * dev)))
+                )],
+                unit: dev,
+            })
+            .collect()
+    }
+
+    /// An angle: the second feature turned about the hinge between the two by `k` ×
+    /// each limit's deviation.
+    fn angle_variants(&self) -> Vec<Variant> {
+        let (Some((_, f1)), Some((n2, f2))) = (self.feature(0), self.feature(1)) else {
+            return Vec::new();
+        };
+        let Some(axis) = hinge(self.g, f1, f2) else {
+            return Vec::new();
+        };
+        size_sides(&self.t.value)
+            .into_iter()
+            .map(|(side, dev)| Variant {
+                what: format!("{n2} turned to the {side}"),
+                lines: vec![format!(
+                    "feature {n2} tilt {} about {}",
+                    num(self.k * dev),
+                    vec_text(&axis)
+                )],
+                unit: dev,
+            })
+            .collect()
+    }
 }
 
 /// What a tolerance's datum reference frame holds: a frame leaves free the turn about a

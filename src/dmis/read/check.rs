@@ -75,20 +75,84 @@ pub(super) fn check(
     warnings: &mut Vec<DmisError>,
 ) {
     let commands: Vec<Cmd> = statements.iter().filter_map(Statement::command).collect();
-    let structure = |at: usize, what: &str, help: &str| DmisError::Structure {
+    let results_file = matches!(commands.first(), Some((_, "FILNAM", _, _)));
+    first_and_last(&commands, span, errors);
+    let defined = definitions(&commands, span, errors);
+    let mut walk = Walk {
+        span,
+        errors,
+        measured: BTreeSet::new(),
+        saved: BTreeSet::new(),
+        meas: None,
+        blocks: Vec::new(),
+    };
+    for (label, major, params, at) in &commands {
+        let at = *at;
+        warnings.extend(not_run(major, at, span));
+        if *major == "DATDEF" {
+            if let Some(("DAT", d)) = label.as_ref().map(|(k, l)| (k.as_str(), l)) {
+                walk.errors.push(DmisError::DatdefForm {
+                    span: span(at),
+                    datum: d.clone(),
+                    feature: params.first().cloned().unwrap_or_default(),
+                });
+            }
+        }
+        if !results_file {
+            undefined(
+                major,
+                params,
+                at,
+                &defined,
+                &walk.measured,
+                &walk.saved,
+                span,
+                walk.errors,
+            );
+        }
+        if *major == "SAVE" {
+            for (k, l) in refs(params) {
+                if k == "DA" {
+                    walk.saved.insert(l);
+                }
+            }
+        }
+        walk.nesting(major, at);
+        walk.measurement(major, params, at);
+        if matches!(*major, "GOTO" | "PTMEAS") && !numbers_or_words(params) {
+            walk.errors.push(structure(
+                span,
+                at,
+                &format!("{major} with a parameter that is not a number"),
+                "coordinates are plain decimal numbers",
+            ));
+        }
+    }
+    walk.unclosed();
+}
+
+/// A structural error at `at`.
+fn structure(span: &dyn Fn(usize) -> Span, at: usize, what: &str, help: &str) -> DmisError {
+    DmisError::Structure {
         span: span(at),
         what: what.into(),
         help: help.into(),
-    };
-    let results_file = matches!(commands.first(), Some((_, "FILNAM", _, _)));
+    }
+}
+
+/// The program's first statement names it (`DMISMN`, `DMISMD`, or `FILNAM` for a
+/// results file) and its last is `ENDFIL`.
+fn first_and_last(commands: &[Cmd], span: &dyn Fn(usize) -> Span, errors: &mut Vec<DmisError>) {
     match commands.first() {
         Some((_, "DMISMN" | "DMISMD" | "FILNAM", _, _)) => {}
         Some((_, _, _, at)) => errors.push(structure(
+            span,
             *at,
             "the program does not start with DMISMN",
             "start a program with `DMISMN/'name',05.3` (a module with DMISMD)",
         )),
         None => errors.push(structure(
+            span,
             0,
             "the program is empty",
             "start with `DMISMN/'name',05.3` and end with `ENDFIL`",
@@ -97,160 +161,166 @@ pub(super) fn check(
     if let Some((_, m, _, at)) = commands.last() {
         if *m != "ENDFIL" {
             errors.push(structure(
+                span,
                 *at,
                 "the program does not end with ENDFIL",
                 "end the program with `ENDFIL`",
             ));
         }
     }
-    let defined = definitions(&commands, span, errors);
-    let mut measured: BTreeSet<String> = BTreeSet::new();
-    let mut saved: BTreeSet<String> = BTreeSet::new();
-    let mut meas: Option<(usize, Option<usize>, usize)> = None; // (at, announced, touches)
-    let mut blocks: Vec<(&str, usize)> = Vec::new();
-    for (label, major, params, at) in &commands {
-        let at = *at;
-        match word(major) {
-            Word::Runs => {}
-            Word::Reads => warnings.push(DmisError::NotRun {
-                span: span(at),
-                major: major.to_string(),
-            }),
-            Word::Vendor(what) => warnings.push(DmisError::VendorExtension {
-                span: span(at),
-                major: major.to_string(),
-                what: what.to_string(),
-            }),
-            Word::Unknown => warnings.push(DmisError::UnknownStatement {
-                span: span(at),
-                major: major.to_string(),
-            }),
-        }
-        if *major == "DATDEF" {
-            if let Some(("DAT", d)) = label.as_ref().map(|(k, l)| (k.as_str(), l)) {
-                errors.push(DmisError::DatdefForm {
-                    span: span(at),
-                    datum: d.clone(),
-                    feature: params.first().cloned().unwrap_or_default(),
-                });
-            }
-        }
-        if !results_file {
-            undefined(major, params, at, &defined, &measured, &saved, span, errors);
-        }
-        if *major == "SAVE" {
-            for (k, l) in refs(params) {
-                if k == "DA" {
-                    saved.insert(l);
-                }
-            }
-        }
-        if let Some(&(_, close)) = BLOCKS.iter().find(|(open, _)| open == major) {
+}
+
+/// The warning for a statement inspc reads but does not run, a vendor's extension,
+/// or a word that is not DMIS.
+fn not_run(major: &str, at: usize, span: &dyn Fn(usize) -> Span) -> Option<DmisError> {
+    match word(major) {
+        Word::Runs => None,
+        Word::Reads => Some(DmisError::NotRun {
+            span: span(at),
+            major: major.to_string(),
+        }),
+        Word::Vendor(what) => Some(DmisError::VendorExtension {
+            span: span(at),
+            major: major.to_string(),
+            what: what.to_string(),
+        }),
+        Word::Unknown => Some(DmisError::UnknownStatement {
+            span: span(at),
+            major: major.to_string(),
+        }),
+    }
+}
+
+/// What the checks carry from statement to statement.
+struct Walk<'w> {
+    span: &'w dyn Fn(usize) -> Span,
+    errors: &'w mut Vec<DmisError>,
+    /// The features measured or constructed so far (`FA(x)` usable).
+    measured: BTreeSet<String>,
+    /// The alignments saved so far (`DA(x)` usable).
+    saved: BTreeSet<String>,
+    /// The open `MEAS` block: where, the points it announces, the touches so far.
+    meas: Option<(usize, Option<usize>, usize)>,
+    /// The open blocks: the word that closes each, and where it opened.
+    blocks: Vec<(&'static str, usize)>,
+}
+
+impl Walk<'_> {
+    fn structure(&mut self, at: usize, what: &str, help: &str) {
+        self.errors.push(structure(self.span, at, what, help));
+    }
+
+    /// Blocks (`IF`/`ENDIF`, `DO`/`ENDDO`, …) close in the order they opened.
+    fn nesting(&mut self, major: &str, at: usize) {
+        if let Some(&(_, close)) = BLOCKS.iter().find(|(open, _)| *open == major) {
             // `IF` opens a block only in its block form: `IF/(expr)` alone.
-            blocks.push((close, at));
-        } else if BLOCKS.iter().any(|(_, close)| close == major) {
-            match blocks.pop() {
-                Some((close, _)) if close == *major => {}
+            self.blocks.push((close, at));
+        } else if BLOCKS.iter().any(|(_, close)| *close == major) {
+            match self.blocks.pop() {
+                Some((close, _)) if close == major => {}
                 Some((close, open_at)) => {
-                    errors.push(structure(
+                    self.structure(
                         at,
                         &format!("{major} closes a block that {close} should close"),
                         "close blocks in the order they were opened",
-                    ));
-                    blocks.push((close, open_at));
+                    );
+                    self.blocks.push((close, open_at));
                 }
-                None => errors.push(structure(
+                None => self.structure(
                     at,
                     &format!("{major} without the statement that opens its block"),
                     "remove it or open the block",
-                )),
+                ),
             }
         }
-        match (*major, &mut meas) {
+    }
+
+    /// `MEAS` blocks: opened once, holding only moves and touches, as many touches as
+    /// they announce; what `MEAS` and `CONST` make measured.
+    fn measurement(&mut self, major: &str, params: &[String], at: usize) {
+        match (major, &mut self.meas) {
             ("MEAS" | "RMEAS", None) => {
                 let n = params.last().and_then(|n| n.parse::<usize>().ok());
                 if n.is_none() {
-                    errors.push(structure(
+                    self.structure(
                         at,
                         "MEAS without a point count",
                         "write `MEAS/type,F(label),n`",
-                    ));
+                    );
                 }
-                meas = Some((at, n, 0));
+                self.meas = Some((at, n, 0));
                 if let Some((_, l)) = refs(params).first() {
-                    measured.insert(l.clone());
+                    self.measured.insert(l.clone());
                 }
             }
             ("CONST", None) => {
                 // A constructed feature is measured once its sources are.
                 if let Some((_, l)) = refs(params).first() {
-                    measured.insert(l.clone());
+                    self.measured.insert(l.clone());
                 }
             }
-            ("MEAS" | "RMEAS", Some(_)) => errors.push(structure(
+            ("MEAS" | "RMEAS", Some(_)) => self.structure(
                 at,
                 "MEAS inside a MEAS block",
                 "close the block with ENDMES first",
-            )),
+            ),
             ("PTMEAS", Some(m)) => m.2 = m.2.saturating_add(1),
             // A block that scans announces the cloud's size, which DMIS leaves to the
             // machine: its count is not checked.
             ("PAMEAS", Some(m)) => m.2 = usize::MAX,
-            ("PAMEAS", None) => errors.push(structure(
+            ("PAMEAS", None) => self.structure(
                 at,
                 "PAMEAS outside a MEAS block",
                 "put scan passes between MEAS and ENDMES",
-            )),
+            ),
             ("ENDMES", Some((start, n, got))) => {
                 if let Some(n) = *n {
                     if *got != usize::MAX && n != *got {
-                        errors.push(structure(
-                            *start,
+                        let (start, got) = (*start, *got);
+                        self.structure(
+                            start,
                             &format!("MEAS announces {n} points but takes {got}"),
                             "make the count match the PTMEAS statements",
-                        ));
+                        );
                     }
                 }
-                meas = None;
+                self.meas = None;
             }
-            ("ENDMES", None) => errors.push(structure(
-                at,
-                "ENDMES without MEAS",
-                "open the block with MEAS",
-            )),
-            (m, Some(_)) if !IN_MEAS.contains(&m) => errors.push(structure(
+            ("ENDMES", None) => {
+                self.structure(at, "ENDMES without MEAS", "open the block with MEAS")
+            }
+            (m, Some(_)) if !IN_MEAS.contains(&m) => self.structure(
                 at,
                 &format!("{m} inside a MEAS block"),
                 "only moves (GOTO) and touches (PTMEAS, PAMEAS) belong between MEAS and ENDMES",
-            )),
-            ("PTMEAS", None) => errors.push(structure(
+            ),
+            ("PTMEAS", None) => self.structure(
                 at,
                 "PTMEAS outside a MEAS block",
                 "put touches between MEAS and ENDMES",
-            )),
+            ),
             _ => {}
         }
-        if matches!(*major, "GOTO" | "PTMEAS") && !numbers_or_words(params) {
-            errors.push(structure(
+    }
+
+    /// At the program's end: a `MEAS` block and any other block left open.
+    fn unclosed(self) {
+        if let Some((at, _, _)) = self.meas {
+            self.errors.push(structure(
+                self.span,
                 at,
-                &format!("{major} with a parameter that is not a number"),
-                "coordinates are plain decimal numbers",
+                "MEAS block without ENDMES",
+                "close the block with ENDMES",
             ));
         }
-    }
-    if let Some((at, _, _)) = meas {
-        errors.push(structure(
-            at,
-            "MEAS block without ENDMES",
-            "close the block with ENDMES",
-        ));
-    }
-    for (close, at) in blocks {
-        errors.push(structure(
-            at,
-            &format!("a block that is never closed with {close}"),
-            &format!("close it with {close}"),
-        ));
+        for (close, at) in self.blocks {
+            self.errors.push(structure(
+                self.span,
+                at,
+                &format!("a block that is never closed with {close}"),
+                &format!("close it with {close}"),
+            ));
+        }
     }
 }
 
