@@ -44,86 +44,6 @@ fn part(body: &str) -> String {
 // ---- syntax ---------------------------------------------------------------------------
 
 #[test]
-fn syntax_errors_name_expectations_in_words() {
-    let d = check_src("part p {\n    units mm\n    stock box(1, 2, 3\n}\n");
-    assert_eq!(d.len(), 1, "{}", render(&d));
-    assert_eq!(d.only().code, "insp::syntax::unexpected");
-    // Never a raw pest rule name.
-    for raw in ["_stmt", "_item", "quantity", "Rule", "EOI", "ident"] {
-        assert!(
-            !d.only().message.contains(raw),
-            "raw rule name in {:?}",
-            d.only().message
-        );
-    }
-    assert!(
-        d.only().message.contains("expected"),
-        "{}",
-        d.only().message
-    );
-}
-
-#[test]
-fn syntax_error_at_end_of_file_says_so() {
-    let d = check_src("part p {\n    units mm\n");
-    assert_eq!(d.only().code, "insp::syntax::unexpected");
-    assert!(
-        d.only().message.ends_with("found end of file"),
-        "{}",
-        d.only().message
-    );
-    assert!(d.only().help.contains('}'), "{}", d.only().help);
-}
-
-#[test]
-fn syntax_error_names_the_found_token() {
-    let d = check_src("stylus s { tip 2 mm length 20 mm }\n");
-    expect(
-        &d,
-        "insp::syntax::unexpected",
-        "length",
-        "expected `,`, `;`, `}` or a new line, found `length`",
-    );
-    assert_eq!(d[0].help, "statements end at a new line, `;` or `,`");
-}
-
-#[test]
-fn syntax_error_names_missing_literal_tokens() {
-    let d = check_src(&part(
-        "feature top = stock.top\ntolerance T1 flatness(top, 0.1 mm)",
-    ));
-    expect(
-        &d,
-        "insp::syntax::unexpected",
-        "flatness",
-        "expected `=` or a part statement",
-    );
-}
-
-#[test]
-fn unknown_item_keyword() {
-    let d = check_src("probee p { }\n");
-    assert_eq!(d.only().code, "insp::syntax::unexpected");
-    assert!(d.only().message.contains("an item"), "{}", d.only().message);
-}
-
-#[test]
-fn invalid_number_and_escape() {
-    expect_src(
-        "stylus s { tip 1e999 mm, length 20 mm, stem 1 mm }",
-        "insp::syntax::invalid_number",
-        "1e999",
-        "invalid number",
-    );
-    expect_src(
-        "part p { units mm, mesh \"a\\qb.stl\" }",
-        "insp::syntax::invalid_escape",
-        "\\q",
-        "unknown escape",
-    );
-}
-
-#[test]
 fn deep_nesting_is_an_error_not_a_crash() {
     let src = format!(
         "part p {{ units mm, stock box({}1{}) }}",
@@ -135,37 +55,6 @@ fn deep_nesting_is_an_error_not_a_crash() {
 }
 
 // ---- loading --------------------------------------------------------------------------
-
-#[test]
-fn import_cycle_points_at_the_closing_use() {
-    let d = check_files(&[
-        ("a.insp", b"use \"b.insp\"\n"),
-        ("b.insp", b"use \"a.insp\"\n"),
-    ]);
-    expect(
-        &d,
-        "insp::load::import_cycle",
-        "use \"a.insp\"",
-        "a.insp → b.insp → a.insp",
-    );
-    assert_eq!(
-        d.iter()
-            .find(|x| x.code == "insp::load::import_cycle")
-            .unwrap()
-            .file,
-        "b.insp"
-    );
-}
-
-#[test]
-fn unreadable_import() {
-    expect_src(
-        "use \"nowhere/lab.insp\"\n",
-        "insp::load::unreadable",
-        "\"nowhere/lab.insp\"",
-        "cannot read `nowhere/lab.insp`",
-    );
-}
 
 #[test]
 fn unreadable_root_file() {
@@ -186,47 +75,6 @@ fn non_utf8_file_points_at_the_bad_byte() {
         .find(|x| x.code == "insp::load::not_utf8")
         .expect("not_utf8 reported");
     assert_eq!(e.file, "b.insp");
-}
-
-#[test]
-fn error_in_imported_file_points_into_that_file() {
-    let d = check_files(&[
-        ("main.insp", b"use \"lib/styli.insp\"\n"),
-        (
-            "lib/styli.insp",
-            b"stylus s { tip 2 mmm, length 20 mm, stem 1 mm }\n",
-        ),
-    ]);
-    let e = d
-        .iter()
-        .find(|x| x.code == "insp::resolve::unknown_unit")
-        .expect("reported");
-    assert_eq!(e.file, "lib/styli.insp");
-    assert_eq!(e.span_text, "mmm");
-}
-
-#[test]
-fn unknown_std_module_suggests() {
-    let d = check_src("use std::heds::PH6\n");
-    expect(
-        &d,
-        "insp::load::unknown_module",
-        "std::heds",
-        "unknown module `std::heds`",
-    );
-    assert!(d[0].help.contains("std::heads"), "{}", d[0].help);
-}
-
-#[test]
-fn unknown_std_item_suggests() {
-    let d = check_src("use std::heads::PH10\n");
-    expect(
-        &d,
-        "insp::resolve::unknown_name",
-        "PH10",
-        "unknown item `PH10`",
-    );
-    assert!(d[0].help.contains("PH10M"), "{}", d[0].help);
 }
 
 // ---- names ----------------------------------------------------------------------------
