@@ -18,7 +18,7 @@ const ROOT: &str = "main.insp";
 fn annotated_cases() {
     let cases = collect(Path::new(DIR));
     assert!(
-        cases.len() >= 80,
+        cases.len() >= 100,
         "expected the cases under {DIR}, found {}",
         cases.len()
     );
