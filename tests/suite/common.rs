@@ -13,7 +13,13 @@ pub struct Flat {
     pub file: String,
     /// The text under the first label.
     pub span_text: String,
+    /// Where the first label starts and ends: 1-based line and column (counted in
+    /// characters), the end exclusive, as `--message-format json` writes them; `None`
+    /// without a label.
+    pub range: Option<((usize, usize), (usize, usize))>,
     pub warning: bool,
+    /// `error`, `warning` or `advice`.
+    pub severity: &'static str,
 }
 
 /// The diagnostics of one check, with the rule of typst's test runner: once a test
@@ -145,10 +151,9 @@ fn run_files(files: &[(&str, &[u8])], stage: Stage) -> Vec<Flat> {
         .iter()
         .map(|d| {
             let file = checked.sources.get(d.file);
-            let span_text = d
-                .inner
-                .labels()
-                .and_then(|mut l| l.next())
+            let label = d.inner.labels().and_then(|mut l| l.next());
+            let span_text = label
+                .as_ref()
                 .map(|l| {
                     file.text
                         .get(l.offset()..l.offset() + l.len())
@@ -156,13 +161,25 @@ fn run_files(files: &[(&str, &[u8])], stage: Stage) -> Vec<Flat> {
                         .to_string()
                 })
                 .unwrap_or_default();
+            let range = label.map(|l| {
+                (
+                    file.line_col(l.offset()),
+                    file.line_col(l.offset() + l.len()),
+                )
+            });
             Flat {
                 code: d.code(),
                 message: d.message(),
                 help: d.inner.help().map(|h| h.to_string()).unwrap_or_default(),
                 file: file.name.clone(),
                 span_text,
+                range,
                 warning: d.severity() == miette::Severity::Warning,
+                severity: match d.severity() {
+                    miette::Severity::Error => "error",
+                    miette::Severity::Warning => "warning",
+                    miette::Severity::Advice => "advice",
+                },
             }
         })
         .collect()

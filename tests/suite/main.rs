@@ -10,6 +10,7 @@ mod cases;
 mod catalogue;
 mod cli;
 mod cluster_props;
+mod diag_files;
 mod diagnostics;
 mod dmis_foreign;
 mod examples;
