@@ -42,65 +42,14 @@ pub(super) fn lower(
         Some(v) => r.lookup_value(cx, module, v, Kind::Sampling),
         None => r.std_item("std::sampling", "spread", Kind::Sampling),
     };
-    let mut outputs = Outputs::default();
-    if let Some(v) = pp.get("output") {
-        match &v.kind {
-            ValueKind::Block(ops) => {
-                let mut o = Props::new(cx, "`output`", v.span, ops);
-                let mut path = |key: &'static str| {
-                    let s = o.get(key).and_then(|x| cx.string(x))?;
-                    if !stays_inside(&s.value) {
-                        cx.err(E::OutputOutside {
-                            span: s.span,
-                            path: s.value.clone(),
-                        });
-                        return None;
-                    }
-                    Some(s.value.clone())
-                };
-                outputs.dmis = path("dmis");
-                outputs.plan = path("plan");
-                outputs.graph = path("graph");
-                o.finish(cx);
-            }
-            _ => cx.mismatch(v, "a block `{ dmis \"out.dmi\" }`", ""),
-        }
-    }
-    let mut motion = Motion::default();
-    if let Some(v) = pp.get("motion") {
-        match &v.kind {
-            ValueKind::Block(ops) => {
-                let mut o = Props::new(cx, "`motion`", v.span, ops);
-                for (key, slot) in [
-                    ("prehit", &mut motion.prehit),
-                    ("retract", &mut motion.retract),
-                    ("search", &mut motion.search),
-                    ("clearance", &mut motion.clearance),
-                ] {
-                    if let Some(x) = o.get(key).and_then(|x| cx.positive(x, Dim::Length, key)) {
-                        *slot = x;
-                    }
-                }
-                let m = o.get("margin");
-                if let Some((x, v)) = m.and_then(|v| Some((cx.dim(v, Dim::Length)?, v))) {
-                    if x < 0.0 {
-                        cx.err(E::OutOfRange {
-                            span: v.span,
-                            what: "`margin`".into(),
-                            value: format!("{} mm", num(x)),
-                            range: "it must be 0 mm or more".into(),
-                            help: "the least distance moves keep from the part; 0 mm keeps none"
-                                .into(),
-                        });
-                    } else {
-                        motion.margin = x;
-                    }
-                }
-                o.finish(cx);
-            }
-            _ => cx.mismatch(v, "a block `{ prehit 2 mm, retract 2 mm }`", ""),
-        }
-    }
+    let outputs = pp
+        .get("output")
+        .map(|v| output_paths(cx, v))
+        .unwrap_or_default();
+    let motion = pp
+        .get("motion")
+        .map(|v| motion_distances(cx, v))
+        .unwrap_or_default();
     let fixtures_v = pp.get("fixtures");
     let sensors_v = pp.get("sensors");
     let mut sensor_ratio = 10.0;
@@ -305,6 +254,71 @@ pub(super) fn lower(
         }
     }
     Some(plan)
+}
+
+/// `output { dmis "out.dmi", plan "…", graph "…" }`: paths inside the spec's folder.
+fn output_paths(cx: &mut Cx, v: &ast::Value) -> Outputs {
+    let mut outputs = Outputs::default();
+    match &v.kind {
+        ValueKind::Block(ops) => {
+            let mut o = Props::new(cx, "`output`", v.span, ops);
+            let mut path = |key: &'static str| {
+                let s = o.get(key).and_then(|x| cx.string(x))?;
+                if !stays_inside(&s.value) {
+                    cx.err(E::OutputOutside {
+                        span: s.span,
+                        path: s.value.clone(),
+                    });
+                    return None;
+                }
+                Some(s.value.clone())
+            };
+            outputs.dmis = path("dmis");
+            outputs.plan = path("plan");
+            outputs.graph = path("graph");
+            o.finish(cx);
+        }
+        _ => cx.mismatch(v, "a block `{ dmis \"out.dmi\" }`", ""),
+    }
+    outputs
+}
+
+/// `motion { prehit 2 mm, retract 2 mm, … }`: the defaults where a distance is left out
+/// or wrong.
+fn motion_distances(cx: &mut Cx, v: &ast::Value) -> Motion {
+    let mut motion = Motion::default();
+    match &v.kind {
+        ValueKind::Block(ops) => {
+            let mut o = Props::new(cx, "`motion`", v.span, ops);
+            for (key, slot) in [
+                ("prehit", &mut motion.prehit),
+                ("retract", &mut motion.retract),
+                ("search", &mut motion.search),
+                ("clearance", &mut motion.clearance),
+            ] {
+                if let Some(x) = o.get(key).and_then(|x| cx.positive(x, Dim::Length, key)) {
+                    *slot = x;
+                }
+            }
+            let m = o.get("margin");
+            if let Some((x, v)) = m.and_then(|v| Some((cx.dim(v, Dim::Length)?, v))) {
+                if x < 0.0 {
+                    cx.err(E::OutOfRange {
+                        span: v.span,
+                        what: "`margin`".into(),
+                        value: format!("{} mm", num(x)),
+                        range: "it must be 0 mm or more".into(),
+                        help: "the least distance moves keep from the part; 0 mm keeps none".into(),
+                    });
+                } else {
+                    motion.margin = x;
+                }
+            }
+            o.finish(cx);
+        }
+        _ => cx.mismatch(v, "a block `{ prehit 2 mm, retract 2 mm }`", ""),
+    }
+    motion
 }
 
 /// An `(A, B)` orientation checked against the head's range and grid.
