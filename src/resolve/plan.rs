@@ -16,17 +16,7 @@ pub(super) fn lower(
     p: &ast::Plan,
     model: &Model,
 ) -> Option<Plan> {
-    let props: Vec<ast::Prop> = p
-        .stmts
-        .iter()
-        .filter_map(|s| {
-            if let PlanStmt::Prop(pr) = s {
-                Some(pr.clone())
-            } else {
-                None
-            }
-        })
-        .collect();
+    let props = plan_props(p);
     let mut pp = Props::new(cx, format!("plan `{}`", p.name.name), p.name.span, &props);
     let part = pp
         .req(cx, "part", "f2")
@@ -52,39 +42,14 @@ pub(super) fn lower(
         .unwrap_or_default();
     let fixtures_v = pp.get("fixtures");
     let sensors_v = pp.get("sensors");
-    let mut sensor_ratio = 10.0;
-    if let Some(v) = pp.get("sensor_ratio") {
-        if let Some(x) = cx.number(v) {
-            if x <= 0.0 {
-                cx.err(E::OutOfRange {
-                    span: v.span,
-                    what: "`sensor_ratio`".into(),
-                    value: num(x),
-                    range: "it must be more than 0".into(),
-                    help: "tolerance over accuracy: 10 for the usual 1:10 rule, 5 for 1:5".into(),
-                });
-            } else {
-                sensor_ratio = x;
-            }
-        }
-    }
-    let mut scan_coverage = 0.95;
-    if let Some(v) = pp.get("scan_coverage") {
-        if let Some(x) = cx.dim(v, Dim::Ratio) {
-            if x <= 0.0 || x > 1.0 {
-                cx.err(E::OutOfRange {
-                    span: v.span,
-                    what: "`scan_coverage`".into(),
-                    value: format!("{} %", num(x * 100.0)),
-                    range: "a share of the area above 0 % and at most 100 %".into(),
-                    help: "the share of a scanned face's area its passes must see; 95 % is usual"
-                        .into(),
-                });
-            } else {
-                scan_coverage = x;
-            }
-        }
-    }
+    let sensor_ratio = pp
+        .get("sensor_ratio")
+        .and_then(|v| sensor_ratio_value(cx, v))
+        .unwrap_or(10.0);
+    let scan_coverage = pp
+        .get("scan_coverage")
+        .and_then(|v| scan_coverage_value(cx, v))
+        .unwrap_or(0.95);
     pp.finish(cx);
     let (part, cmm, hierarchy, sampling) = (part?, cmm?, hierarchy?, sampling?);
     let the_part = &model.parts[part];
@@ -319,6 +284,52 @@ fn motion_distances(cx: &mut Cx, v: &ast::Value) -> Motion {
         _ => cx.mismatch(v, "a block `{ prehit 2 mm, retract 2 mm }`", ""),
     }
     motion
+}
+
+/// The plan's `key value` properties, without its preferences and overrides.
+fn plan_props(p: &ast::Plan) -> Vec<ast::Prop> {
+    p.stmts
+        .iter()
+        .filter_map(|s| {
+            if let PlanStmt::Prop(pr) = s {
+                Some(pr.clone())
+            } else {
+                None
+            }
+        })
+        .collect()
+}
+
+/// `sensor_ratio 10`: a number above 0, or None after saying why.
+fn sensor_ratio_value(cx: &mut Cx, v: &ast::Value) -> Option<f64> {
+    let x = cx.number(v)?;
+    if x <= 0.0 {
+        cx.err(E::OutOfRange {
+            span: v.span,
+            what: "`sensor_ratio`".into(),
+            value: num(x),
+            range: "it must be more than 0".into(),
+            help: "tolerance over accuracy: 10 for the usual 1:10 rule, 5 for 1:5".into(),
+        });
+        return None;
+    }
+    Some(x)
+}
+
+/// `scan_coverage 95 %`: a share above 0 and at most 1, or None after saying why.
+fn scan_coverage_value(cx: &mut Cx, v: &ast::Value) -> Option<f64> {
+    let x = cx.dim(v, Dim::Ratio)?;
+    if x <= 0.0 || x > 1.0 {
+        cx.err(E::OutOfRange {
+            span: v.span,
+            what: "`scan_coverage`".into(),
+            value: format!("{} %", num(x * 100.0)),
+            range: "a share of the area above 0 % and at most 100 %".into(),
+            help: "the share of a scanned face's area its passes must see; 95 % is usual".into(),
+        });
+        return None;
+    }
+    Some(x)
 }
 
 /// An `(A, B)` orientation checked against the head's range and grid.
