@@ -87,34 +87,7 @@ pub(super) fn lower(
                 feature,
                 strategy: sv,
                 ..
-            } => {
-                let name = path_text(feature);
-                match the_part.features.iter().position(|f| f.name == name) {
-                    Some(i) => {
-                        cx.bind(feature.span, the_part.features[i].span);
-                        if let Some(st) = strategy(cx, sv, None) {
-                            plan.overrides.push((FeatureId(i), st));
-                        }
-                    }
-                    None => {
-                        let help = format!(
-                            "part `{}` has no feature `{name}`; {}",
-                            the_part.name,
-                            suggest::help_for_unknown(
-                                "feature",
-                                &name,
-                                the_part.features.iter().map(|f| f.name.as_str())
-                            )
-                        );
-                        cx.err(E::UnknownName {
-                            span: feature.span,
-                            what: "feature".into(),
-                            name,
-                            help,
-                        });
-                    }
-                }
-            }
+            } => sample_override(cx, &mut plan, the_part, feature, sv),
             PlanStmt::Pref {
                 forbid,
                 kind,
@@ -330,6 +303,42 @@ fn scan_coverage_value(cx: &mut Cx, v: &ast::Value) -> Option<f64> {
         return None;
     }
     Some(x)
+}
+
+/// `sample feature with strategy`: a per-feature override of the plan's sampling.
+fn sample_override(
+    cx: &mut Cx,
+    plan: &mut Plan,
+    part: &Part,
+    feature: &ast::Path,
+    sv: &ast::Value,
+) {
+    let name = path_text(feature);
+    match part.features.iter().position(|f| f.name == name) {
+        Some(i) => {
+            cx.bind(feature.span, part.features[i].span);
+            if let Some(st) = strategy(cx, sv, None) {
+                plan.overrides.push((FeatureId(i), st));
+            }
+        }
+        None => {
+            let help = format!(
+                "part `{}` has no feature `{name}`; {}",
+                part.name,
+                suggest::help_for_unknown(
+                    "feature",
+                    &name,
+                    part.features.iter().map(|f| f.name.as_str())
+                )
+            );
+            cx.err(E::UnknownName {
+                span: feature.span,
+                what: "feature".into(),
+                name,
+                help,
+            });
+        }
+    }
 }
 
 /// An `(A, B)` orientation checked against the head's range and grid.
