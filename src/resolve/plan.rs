@@ -7,6 +7,7 @@ use super::{Kind, Resolver};
 use crate::diag::suggest;
 use crate::load::ModuleId;
 use crate::model::*;
+use crate::source::Span;
 use crate::syntax::ast::{self, PlanStmt, ValueKind};
 
 pub(super) fn lower(
@@ -95,103 +96,32 @@ pub(super) fn lower(
                 opts,
                 span,
             } => {
-                let mut o = Props::new(
-                    cx,
-                    format!(
-                        "`{} {}`",
-                        if *forbid { "forbid" } else { "prefer" },
-                        kind.name
-                    ),
-                    *span,
+                let pref = PrefStmt {
+                    forbid: *forbid,
+                    kind,
+                    value,
                     opts,
-                );
-                match kind.name.as_str() {
-                    "setup" => {
-                        let weight = if *forbid {
-                            None
-                        } else {
-                            o.get("weight").and_then(|v| cx.non_negative(v, "weight"))
-                        };
-                        if let Some(direction) = cx.direction(value) {
-                            plan.setups.push(SetupPref {
-                                direction,
-                                stance: stance(*forbid, weight.unwrap_or(1.0)),
-                                span: *span,
-                            });
-                        }
-                    }
-                    "orientation" => {
-                        let weight = if *forbid {
-                            None
-                        } else {
-                            o.get("weight").and_then(|v| cx.non_negative(v, "weight"))
-                        };
-                        if let Some((a, b)) = orientation(cx, value, head) {
-                            plan.orientations.push(OrientPref {
-                                a,
-                                b,
-                                stance: stance(*forbid, weight.unwrap_or(1.0)),
-                                span: *span,
-                            });
-                        }
-                    }
-                    "probe" => {
-                        let cost = if *forbid {
-                            None
-                        } else {
-                            o.get("cost").and_then(|v| cx.non_negative(v, "cost"))
-                        };
-                        if let Some(label) = cx.name(value) {
-                            if let Some(k) =
-                                the_cmm.probes.iter().position(|(l, _)| *l == label.name)
-                            {
-                                if let Some(&at) = the_cmm.probe_labels.get(k) {
-                                    cx.bind(label.span, at);
-                                }
-                                plan.probes.push(ProbePref {
-                                    label: label.name.clone(),
-                                    stance: stance(*forbid, cost),
-                                    span: *span,
-                                });
-                            } else {
-                                let help = format!(
-                                    "cmm `{}` has no probe `{}`; {}",
-                                    the_cmm.name,
-                                    label.name,
-                                    suggest::help_for_unknown(
-                                        "probe",
-                                        &label.name,
-                                        the_cmm.probes.iter().map(|(l, _)| l.as_str())
-                                    )
-                                );
-                                cx.err(E::UnknownName {
-                                    span: label.span,
-                                    what: "probe".into(),
-                                    name: label.name.clone(),
-                                    help,
-                                });
-                            }
-                        }
-                    }
-                    other => {
-                        let help = suggest::help_for_unknown(
-                            "preference",
-                            other,
-                            ["setup", "orientation", "probe"],
-                        );
-                        cx.err(E::UnknownName {
-                            span: kind.span,
-                            what: "preference".into(),
-                            name: other.into(),
-                            help,
-                        });
-                    }
-                }
-                o.finish(cx);
+                    span: *span,
+                };
+                preference(cx, &mut plan, the_cmm, head, &pref);
             }
         }
     }
     Some(plan)
+}
+
+/// The plan's `key value` properties, without its preferences and overrides.
+fn plan_props(p: &ast::Plan) -> Vec<ast::Prop> {
+    p.stmts
+        .iter()
+        .filter_map(|s| {
+            if let PlanStmt::Prop(pr) = s {
+                Some(pr.clone())
+            } else {
+                None
+            }
+        })
+        .collect()
 }
 
 /// `output { dmis "out.dmi", plan "…", graph "…" }`: paths inside the spec's folder.
@@ -259,20 +189,6 @@ fn motion_distances(cx: &mut Cx, v: &ast::Value) -> Motion {
     motion
 }
 
-/// The plan's `key value` properties, without its preferences and overrides.
-fn plan_props(p: &ast::Plan) -> Vec<ast::Prop> {
-    p.stmts
-        .iter()
-        .filter_map(|s| {
-            if let PlanStmt::Prop(pr) = s {
-                Some(pr.clone())
-            } else {
-                None
-            }
-        })
-        .collect()
-}
-
 /// `sensor_ratio 10`: a number above 0, or None after saying why.
 fn sensor_ratio_value(cx: &mut Cx, v: &ast::Value) -> Option<f64> {
     let x = cx.number(v)?;
@@ -338,6 +254,96 @@ fn sample_override(
                 help,
             });
         }
+    }
+}
+
+/// One `prefer …` or `forbid …` statement of a plan, as written.
+struct PrefStmt<'a> {
+    forbid: bool,
+    kind: &'a ast::Ident,
+    value: &'a ast::Value,
+    opts: &'a [ast::Prop],
+    span: Span,
+}
+
+/// A setup, orientation or probe preference, added to the plan when it checks out.
+fn preference(cx: &mut Cx, plan: &mut Plan, cmm: &Cmm, head: Option<&Head>, s: &PrefStmt) {
+    let verb = if s.forbid { "forbid" } else { "prefer" };
+    let mut o = Props::new(cx, format!("`{verb} {}`", s.kind.name), s.span, s.opts);
+    match s.kind.name.as_str() {
+        "setup" => {
+            let weight = weight(cx, &mut o, s.forbid, "weight");
+            if let Some(direction) = cx.direction(s.value) {
+                plan.setups.push(SetupPref {
+                    direction,
+                    stance: stance(s.forbid, weight.unwrap_or(1.0)),
+                    span: s.span,
+                });
+            }
+        }
+        "orientation" => {
+            let weight = weight(cx, &mut o, s.forbid, "weight");
+            if let Some((a, b)) = orientation(cx, s.value, head) {
+                plan.orientations.push(OrientPref {
+                    a,
+                    b,
+                    stance: stance(s.forbid, weight.unwrap_or(1.0)),
+                    span: s.span,
+                });
+            }
+        }
+        "probe" => {
+            let cost = weight(cx, &mut o, s.forbid, "cost");
+            if let Some(label) = cx.name(s.value) {
+                if let Some(k) = cmm.probes.iter().position(|(l, _)| *l == label.name) {
+                    if let Some(&at) = cmm.probe_labels.get(k) {
+                        cx.bind(label.span, at);
+                    }
+                    plan.probes.push(ProbePref {
+                        label: label.name.clone(),
+                        stance: stance(s.forbid, cost),
+                        span: s.span,
+                    });
+                } else {
+                    let help = format!(
+                        "cmm `{}` has no probe `{}`; {}",
+                        cmm.name,
+                        label.name,
+                        suggest::help_for_unknown(
+                            "probe",
+                            &label.name,
+                            cmm.probes.iter().map(|(l, _)| l.as_str())
+                        )
+                    );
+                    cx.err(E::UnknownName {
+                        span: label.span,
+                        what: "probe".into(),
+                        name: label.name.clone(),
+                        help,
+                    });
+                }
+            }
+        }
+        other => {
+            let help =
+                suggest::help_for_unknown("preference", other, ["setup", "orientation", "probe"]);
+            cx.err(E::UnknownName {
+                span: s.kind.span,
+                what: "preference".into(),
+                name: other.into(),
+                help,
+            });
+        }
+    }
+    o.finish(cx);
+}
+
+/// A preference's `weight` or `cost` (≥ 0); a ban takes none, so there it is no key.
+fn weight(cx: &mut Cx, o: &mut Props, forbid: bool, key: &'static str) -> Option<f64> {
+    if forbid {
+        None
+    } else {
+        o.get(key).and_then(|v| cx.non_negative(v, key))
     }
 }
 
