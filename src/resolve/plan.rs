@@ -294,34 +294,8 @@ fn preference(cx: &mut Cx, plan: &mut Plan, cmm: &Cmm, head: Option<&Head>, s: &
         }
         "probe" => {
             let cost = weight(cx, &mut o, s.forbid, "cost");
-            if let Some(label) = cx.name(s.value) {
-                if let Some(k) = cmm.probes.iter().position(|(l, _)| *l == label.name) {
-                    if let Some(&at) = cmm.probe_labels.get(k) {
-                        cx.bind(label.span, at);
-                    }
-                    plan.probes.push(ProbePref {
-                        label: label.name.clone(),
-                        stance: stance(s.forbid, cost),
-                        span: s.span,
-                    });
-                } else {
-                    let help = format!(
-                        "cmm `{}` has no probe `{}`; {}",
-                        cmm.name,
-                        label.name,
-                        suggest::help_for_unknown(
-                            "probe",
-                            &label.name,
-                            cmm.probes.iter().map(|(l, _)| l.as_str())
-                        )
-                    );
-                    cx.err(E::UnknownName {
-                        span: label.span,
-                        what: "probe".into(),
-                        name: label.name.clone(),
-                        help,
-                    });
-                }
+            if let Some(p) = probe_pref(cx, cmm, s, cost) {
+                plan.probes.push(p);
             }
         }
         other => {
@@ -345,6 +319,38 @@ fn weight(cx: &mut Cx, o: &mut Props, forbid: bool, key: &'static str) -> Option
     } else {
         o.get(key).and_then(|v| cx.non_negative(v, key))
     }
+}
+
+/// `prefer probe p1 cost 2` or `forbid probe p3`: a probe label of the plan's CMM.
+fn probe_pref(cx: &mut Cx, cmm: &Cmm, s: &PrefStmt, cost: Option<f64>) -> Option<ProbePref> {
+    let label = cx.name(s.value)?;
+    let Some(k) = cmm.probes.iter().position(|(l, _)| *l == label.name) else {
+        let help = format!(
+            "cmm `{}` has no probe `{}`; {}",
+            cmm.name,
+            label.name,
+            suggest::help_for_unknown(
+                "probe",
+                &label.name,
+                cmm.probes.iter().map(|(l, _)| l.as_str())
+            )
+        );
+        cx.err(E::UnknownName {
+            span: label.span,
+            what: "probe".into(),
+            name: label.name.clone(),
+            help,
+        });
+        return None;
+    };
+    if let Some(&at) = cmm.probe_labels.get(k) {
+        cx.bind(label.span, at);
+    }
+    Some(ProbePref {
+        label: label.name.clone(),
+        stance: stance(s.forbid, cost),
+        span: s.span,
+    })
 }
 
 /// An `(A, B)` orientation checked against the head's range and grid.
