@@ -127,24 +127,7 @@ pub(super) fn lower(
     name: &ast::Ident,
     call: &ast::Call,
 ) -> Option<Tolerance> {
-    let callee = call.callee.as_ident();
-    let callee_name = callee.map_or_else(|| path_text(&call.callee), |i| i.name.clone());
-    let lookup = if callee_name == "roundness" {
-        "circularity"
-    } else {
-        callee_name.as_str()
-    };
-    let Some(rule) = RULES.iter().find(|r| r.name == lookup) else {
-        let help =
-            suggest::help_for_unknown("tolerance type", &callee_name, RULES.iter().map(|r| r.name));
-        cx.err(E::UnknownName {
-            span: call.callee.span,
-            what: "tolerance type".into(),
-            name: callee_name,
-            help,
-        });
-        return None;
-    };
+    let rule = rule_of(cx, call)?;
     let what = rule.name.to_string();
     let mut targets: Vec<(FeatureId, Span)> = Vec::new();
     let mut value: Option<(TolValue, Span)> = None;
@@ -293,25 +276,7 @@ pub(super) fn lower(
     }
     let Some((value, _)) = value else {
         if ok {
-            let what_value = if rule.size.is_some() {
-                "limits, e.g. `10 mm ± 0.05 mm`"
-            } else {
-                "a tolerance value, e.g. `0.05 mm`"
-            };
-            cx.err(E::MissingArgument {
-                span: call.span,
-                kind: what.clone(),
-                what: what_value.into(),
-                help: format!(
-                    "write `{}(feature, {})`",
-                    rule.name,
-                    if rule.size.is_some() {
-                        "10 mm ± 0.05 mm"
-                    } else {
-                        "0.05 mm"
-                    }
-                ),
-            });
+            missing_value(cx, rule, call);
         }
         return None;
     };
@@ -369,6 +334,44 @@ pub(super) fn lower(
         basic_angle,
         span: name.span,
     })
+}
+
+/// The rule of the tolerance type a call names (`roundness` is `circularity`).
+fn rule_of(cx: &mut Cx, call: &ast::Call) -> Option<&'static Rule> {
+    let callee = call.callee.as_ident();
+    let callee_name = callee.map_or_else(|| path_text(&call.callee), |i| i.name.clone());
+    let lookup = if callee_name == "roundness" {
+        "circularity"
+    } else {
+        callee_name.as_str()
+    };
+    let Some(rule) = RULES.iter().find(|r| r.name == lookup) else {
+        let help =
+            suggest::help_for_unknown("tolerance type", &callee_name, RULES.iter().map(|r| r.name));
+        cx.err(E::UnknownName {
+            span: call.callee.span,
+            what: "tolerance type".into(),
+            name: callee_name,
+            help,
+        });
+        return None;
+    };
+    Some(rule)
+}
+
+/// Says a tolerance has no value: limits for a size, a zone for the others.
+fn missing_value(cx: &mut Cx, rule: &Rule, call: &ast::Call) {
+    let (what_value, example) = if rule.size.is_some() {
+        ("limits, e.g. `10 mm ± 0.05 mm`", "10 mm ± 0.05 mm")
+    } else {
+        ("a tolerance value, e.g. `0.05 mm`", "0.05 mm")
+    };
+    cx.err(E::MissingArgument {
+        span: call.span,
+        kind: rule.name.into(),
+        what: what_value.into(),
+        help: format!("write `{}(feature, {example})`", rule.name),
+    });
 }
 
 fn target(cx: &mut Cx, pc: &PartCx, p: &ast::Path) -> Option<FeatureId> {
