@@ -129,142 +129,19 @@ pub(super) fn lower(
 ) -> Option<Tolerance> {
     let rule = rule_of(cx, call)?;
     let what = rule.name.to_string();
-    let mut targets: Vec<(FeatureId, Span)> = Vec::new();
-    let mut value: Option<(TolValue, Span)> = None;
-    let mut modifier: Option<(Material, Span)> = None;
-    let mut datums: Vec<(DatumRef, Span)> = Vec::new();
-    let mut basic_angle = None;
-    let mut ok = true;
-    // Whether the value has been written (valid or not): targets come before it,
-    // modifiers and datums after.
-    let mut past_value = false;
-    let mut target_failed = false;
-
-    for a in &call.args {
-        match a {
-            ast::Arg::Named(k, v) if k.name == "dia" => {
-                past_value = true;
-                if !rule.dia {
-                    cx.err(E::DiameterZone {
-                        span: k.span,
-                        kind: what.clone(),
-                    });
-                    ok = false;
-                }
-                match zone(cx, v, &what) {
-                    Some(w) => {
-                        value = Some((
-                            TolValue::Zone {
-                                width: w,
-                                diameter: true,
-                            },
-                            v.span,
-                        ))
-                    }
-                    None => ok = false,
-                }
-            }
-            ast::Arg::Named(k, v) if k.name == "basic" => {
-                if rule.kind != K::Angularity {
-                    cx.err(E::UnknownProperty {
-                        span: k.span,
-                        key: "basic".into(),
-                        item: what.clone(),
-                        help: "only angularity takes a basic angle".into(),
-                    });
-                }
-                basic_angle = cx.angle(v);
-            }
-            ast::Arg::Named(k, _) => {
-                let help = suggest::help_for_unknown("argument", &k.name, ["dia", "basic"]);
-                cx.err(E::UnknownProperty {
-                    span: k.span,
-                    key: k.name.clone(),
-                    item: what.clone(),
-                    help,
-                });
-                ok = false;
-            }
-            ast::Arg::Positional(v) => match &v.kind {
-                ValueKind::Quantity(_) | ValueKind::Limits { .. } | ValueKind::Range(..) => {
-                    past_value = true;
-                    let val = if let Some(dim) = rule.size {
-                        size_limits(cx, v, dim)
-                    } else {
-                        zone(cx, v, &what).map(|w| TolValue::Zone {
-                            width: w,
-                            diameter: false,
-                        })
-                    };
-                    match val {
-                        Some(val) => value = Some((val, v.span)),
-                        None => ok = false,
-                    }
-                }
-                ValueKind::Path(p) if !past_value => match target(cx, pc, p) {
-                    Some(f) => targets.push((f, p.span)),
-                    None => {
-                        ok = false;
-                        target_failed = true;
-                    }
-                },
-                ValueKind::Path(p)
-                    if p.as_ident()
-                        .is_some_and(|i| matches!(i.name.as_str(), "MMC" | "LMC" | "RFS"))
-                        && datums.is_empty() =>
-                {
-                    let m = material(cx, p.as_ident()?)?;
-                    if !rule.material && m != Material::Rfs {
-                        cx.err(E::ModifierNotAllowed {
-                            span: p.span,
-                            kind: what.clone(),
-                            modifier: p.head().name.clone(),
-                            help: format!("{what} applies regardless of feature size; material modifiers belong on features of size under orientation, position or coaxiality"),
-                        });
-                        ok = false;
-                    }
-                    modifier = Some((m, p.span));
-                }
-                ValueKind::Path(p)
-                    if p.segs.len() == 1
-                        && matches!(pc.names.get(&p.head().name), Some((Local::Frame(_), _))) =>
-                {
-                    let Some(Local::Frame(i)) = pc.local(cx, p.head()) else {
-                        unreachable!()
-                    };
-                    match pc.part.frames.get(i) {
-                        Some(f) => datums.extend(f.refs.iter().map(|r| (r.clone(), p.span))),
-                        None => ok = false,
-                    }
-                }
-                ValueKind::Path(_) | ValueKind::Call(_) => match datum_ref(cx, pc, v) {
-                    Some(d) => datums.push(d),
-                    None => ok = false,
-                },
-                _ => {
-                    cx.mismatch(
-                        v,
-                        "a feature, a value, a modifier or a datum",
-                        &format!("write e.g. `{}(feature, 0.05 mm, A)`", rule.name),
-                    );
-                    ok = false;
-                }
-            },
-        }
-    }
-
+    let mut args = Args::read(cx, pc, rule, call)?;
     let (min, max) = rule.targets;
-    if !target_failed && (targets.len() < min || targets.len() > max) {
+    if !args.target_failed && (args.targets.len() < min || args.targets.len() > max) {
         let expected = if min == max {
             format!("{min} feature{}", if min == 1 { "" } else { "s" })
         } else {
             format!("{min} or {max} features")
         };
         cx.err(E::Arity {
-            span: targets.get(max).map_or(call.span, |t| t.1),
+            span: args.targets.get(max).map_or(call.span, |t| t.1),
             kind: what.clone(),
             expected,
-            found: format!("{}", targets.len()),
+            found: format!("{}", args.targets.len()),
             help: format!(
                 "the toleranced feature{} come{} first: `{}(…)`",
                 if max > 1 { "s" } else { "" },
@@ -272,17 +149,17 @@ pub(super) fn lower(
                 rule.name
             ),
         });
-        ok = false;
+        args.ok = false;
     }
-    let Some((value, _)) = value else {
-        if ok {
+    let Some((value, _)) = args.value.take() else {
+        if args.ok {
             missing_value(cx, rule, call);
         }
         return None;
     };
     match rule.datums {
         Forbidden => {
-            if let Some((_, span)) = datums.first() {
+            if let Some((_, span)) = args.datums.first() {
                 let help = if rule.size.is_some() {
                     "sizes are checked without a datum frame".to_string()
                 } else {
@@ -293,45 +170,45 @@ pub(super) fn lower(
                     kind: what.clone(),
                     help,
                 });
-                ok = false;
+                args.ok = false;
             }
         }
         // A datum that failed to resolve was reported already: no cascade.
-        Required if datums.is_empty() && ok => {
+        Required if args.datums.is_empty() && args.ok => {
             cx.err(E::DatumsRequired { span: call.span, kind: what.clone(), help: format!("{what} is measured relative to a datum: add one, e.g. `{}(feature, 0.05 mm, A)`", rule.name) });
-            ok = false;
+            args.ok = false;
         }
         _ => {}
     }
-    if rule.kind == K::Angularity && basic_angle.is_none() && ok {
+    if rule.kind == K::Angularity && args.basic_angle.is_none() && args.ok {
         cx.err(E::MissingArgument {
             span: call.span,
             kind: what.clone(),
             what: "its basic angle".into(),
             help: "write `angularity(feature, 0.1 mm, A, basic 30 deg)`".into(),
         });
-        ok = false;
+        args.ok = false;
     }
-    check_unique_datums(cx, &pc.part, &datums);
-    for (d, span) in &datums {
+    check_unique_datums(cx, &pc.part, &args.datums);
+    for (d, span) in &args.datums {
         let df = pc.part.datums[d.datum.0].feature;
-        if let Some((f, _)) = targets.iter().find(|(f, _)| *f == df) {
+        if let Some((f, _)) = args.targets.iter().find(|(f, _)| *f == df) {
             cx.err(E::DatumSelfReference {
                 span: *span,
                 datum: pc.part.datums[d.datum.0].name.clone(),
                 feature: pc.part.features[f.0].name.clone(),
             });
-            ok = false;
+            args.ok = false;
         }
     }
-    ok.then(|| Tolerance {
+    args.ok.then(|| Tolerance {
         name: name.name.clone(),
         kind: rule.kind,
-        targets: targets.into_iter().map(|t| t.0).collect(),
+        targets: args.targets.into_iter().map(|t| t.0).collect(),
         value,
-        modifier: modifier.map(|m| m.0),
-        datums: datums.into_iter().map(|d| d.0).collect(),
-        basic_angle,
+        modifier: args.modifier.map(|m| m.0),
+        datums: args.datums.into_iter().map(|d| d.0).collect(),
+        basic_angle: args.basic_angle,
         span: name.span,
     })
 }
@@ -357,6 +234,165 @@ fn rule_of(cx: &mut Cx, call: &ast::Call) -> Option<&'static Rule> {
         return None;
     };
     Some(rule)
+}
+
+/// A tolerance call's arguments as read in one pass, and whether all of them were good.
+struct Args {
+    targets: Vec<(FeatureId, Span)>,
+    value: Option<(TolValue, Span)>,
+    modifier: Option<(Material, Span)>,
+    datums: Vec<(DatumRef, Span)>,
+    basic_angle: Option<f64>,
+    ok: bool,
+    /// Whether the value has been written (valid or not): targets come before it,
+    /// modifiers and datums after.
+    past_value: bool,
+    target_failed: bool,
+}
+
+impl Args {
+    /// Reads every argument in order; None where a material modifier does not read
+    /// (the tolerance is dropped without further checks).
+    fn read(cx: &mut Cx, pc: &PartCx, rule: &Rule, call: &ast::Call) -> Option<Args> {
+        let mut args = Args {
+            targets: Vec::new(),
+            value: None,
+            modifier: None,
+            datums: Vec::new(),
+            basic_angle: None,
+            ok: true,
+            past_value: false,
+            target_failed: false,
+        };
+        for a in &call.args {
+            match a {
+                ast::Arg::Named(k, v) => args.named(cx, rule, k, v),
+                ast::Arg::Positional(v) => args.positional(cx, pc, rule, v)?,
+            }
+        }
+        Some(args)
+    }
+
+    /// `dia 0.1 mm`, `basic 30 deg`, or an unknown name.
+    fn named(&mut self, cx: &mut Cx, rule: &Rule, k: &ast::Ident, v: &ast::Value) {
+        match k.name.as_str() {
+            "dia" => {
+                self.past_value = true;
+                if !rule.dia {
+                    cx.err(E::DiameterZone {
+                        span: k.span,
+                        kind: rule.name.into(),
+                    });
+                    self.ok = false;
+                }
+                match zone(cx, v, rule.name) {
+                    Some(w) => {
+                        let zone = TolValue::Zone {
+                            width: w,
+                            diameter: true,
+                        };
+                        self.value = Some((zone, v.span));
+                    }
+                    None => self.ok = false,
+                }
+            }
+            "basic" => {
+                if rule.kind != K::Angularity {
+                    cx.err(E::UnknownProperty {
+                        span: k.span,
+                        key: "basic".into(),
+                        item: rule.name.into(),
+                        help: "only angularity takes a basic angle".into(),
+                    });
+                }
+                self.basic_angle = cx.angle(v);
+            }
+            _ => {
+                let help = suggest::help_for_unknown("argument", &k.name, ["dia", "basic"]);
+                cx.err(E::UnknownProperty {
+                    span: k.span,
+                    key: k.name.clone(),
+                    item: rule.name.into(),
+                    help,
+                });
+                self.ok = false;
+            }
+        }
+    }
+
+    /// A value, a toleranced feature, a material modifier, a frame or a datum, told
+    /// apart by form and by where it stands; None where a modifier does not read.
+    fn positional(&mut self, cx: &mut Cx, pc: &PartCx, rule: &Rule, v: &ast::Value) -> Option<()> {
+        match &v.kind {
+            ValueKind::Quantity(_) | ValueKind::Limits { .. } | ValueKind::Range(..) => {
+                self.past_value = true;
+                let val = if let Some(dim) = rule.size {
+                    size_limits(cx, v, dim)
+                } else {
+                    zone(cx, v, rule.name).map(|w| TolValue::Zone {
+                        width: w,
+                        diameter: false,
+                    })
+                };
+                match val {
+                    Some(val) => self.value = Some((val, v.span)),
+                    None => self.ok = false,
+                }
+            }
+            ValueKind::Path(p) if !self.past_value => match target(cx, pc, p) {
+                Some(f) => self.targets.push((f, p.span)),
+                None => {
+                    self.ok = false;
+                    self.target_failed = true;
+                }
+            },
+            ValueKind::Path(p)
+                if p.as_ident()
+                    .is_some_and(|i| matches!(i.name.as_str(), "MMC" | "LMC" | "RFS"))
+                    && self.datums.is_empty() =>
+            {
+                let m = material(cx, p.as_ident()?)?;
+                if !rule.material && m != Material::Rfs {
+                    let what = rule.name;
+                    cx.err(E::ModifierNotAllowed {
+                        span: p.span,
+                        kind: what.into(),
+                        modifier: p.head().name.clone(),
+                        help: format!("{what} applies regardless of feature size; material modifiers belong on features of size under orientation, position or coaxiality"),
+                    });
+                    self.ok = false;
+                }
+                self.modifier = Some((m, p.span));
+            }
+            ValueKind::Path(p)
+                if p.segs.len() == 1
+                    && matches!(pc.names.get(&p.head().name), Some((Local::Frame(_), _))) =>
+            {
+                let Some(Local::Frame(i)) = pc.local(cx, p.head()) else {
+                    unreachable!()
+                };
+                match pc.part.frames.get(i) {
+                    Some(f) => self
+                        .datums
+                        .extend(f.refs.iter().map(|r| (r.clone(), p.span))),
+                    None => self.ok = false,
+                }
+            }
+            ValueKind::Path(_) | ValueKind::Call(_) => match datum_ref(cx, pc, v) {
+                Some(d) => self.datums.push(d),
+                None => self.ok = false,
+            },
+            _ => {
+                cx.mismatch(
+                    v,
+                    "a feature, a value, a modifier or a datum",
+                    &format!("write e.g. `{}(feature, 0.05 mm, A)`", rule.name),
+                );
+                self.ok = false;
+            }
+        }
+        Some(())
+    }
 }
 
 /// Says a tolerance has no value: limits for a size, a zone for the others.
