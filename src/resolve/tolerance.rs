@@ -325,19 +325,7 @@ impl Args {
     fn positional(&mut self, cx: &mut Cx, pc: &PartCx, rule: &Rule, v: &ast::Value) -> Option<()> {
         match &v.kind {
             ValueKind::Quantity(_) | ValueKind::Limits { .. } | ValueKind::Range(..) => {
-                self.past_value = true;
-                let val = if let Some(dim) = rule.size {
-                    size_limits(cx, v, dim)
-                } else {
-                    zone(cx, v, rule.name).map(|w| TolValue::Zone {
-                        width: w,
-                        diameter: false,
-                    })
-                };
-                match val {
-                    Some(val) => self.value = Some((val, v.span)),
-                    None => self.ok = false,
-                }
+                self.value_arg(cx, rule, v);
             }
             ValueKind::Path(p) if !self.past_value => match target(cx, pc, p) {
                 Some(f) => self.targets.push((f, p.span)),
@@ -351,18 +339,7 @@ impl Args {
                     .is_some_and(|i| matches!(i.name.as_str(), "MMC" | "LMC" | "RFS"))
                     && self.datums.is_empty() =>
             {
-                let m = material(cx, p.as_ident()?)?;
-                if !rule.material && m != Material::Rfs {
-                    let what = rule.name;
-                    cx.err(E::ModifierNotAllowed {
-                        span: p.span,
-                        kind: what.into(),
-                        modifier: p.head().name.clone(),
-                        help: format!("{what} applies regardless of feature size; material modifiers belong on features of size under orientation, position or coaxiality"),
-                    });
-                    self.ok = false;
-                }
-                self.modifier = Some((m, p.span));
+                self.modifier_arg(cx, rule, p)?;
             }
             ValueKind::Path(p)
                 if p.segs.len() == 1
@@ -391,6 +368,40 @@ impl Args {
                 self.ok = false;
             }
         }
+        Some(())
+    }
+
+    /// The tolerance's value: limits for a size, a zone width for the others.
+    fn value_arg(&mut self, cx: &mut Cx, rule: &Rule, v: &ast::Value) {
+        self.past_value = true;
+        let val = if let Some(dim) = rule.size {
+            size_limits(cx, v, dim)
+        } else {
+            zone(cx, v, rule.name).map(|w| TolValue::Zone {
+                width: w,
+                diameter: false,
+            })
+        };
+        match val {
+            Some(val) => self.value = Some((val, v.span)),
+            None => self.ok = false,
+        }
+    }
+
+    /// `MMC`, `LMC` or `RFS` on the toleranced feature; None where it does not read.
+    fn modifier_arg(&mut self, cx: &mut Cx, rule: &Rule, p: &ast::Path) -> Option<()> {
+        let m = material(cx, p.as_ident()?)?;
+        if !rule.material && m != Material::Rfs {
+            let what = rule.name;
+            cx.err(E::ModifierNotAllowed {
+                span: p.span,
+                kind: what.into(),
+                modifier: p.head().name.clone(),
+                help: format!("{what} applies regardless of feature size; material modifiers belong on features of size under orientation, position or coaxiality"),
+            });
+            self.ok = false;
+        }
+        self.modifier = Some((m, p.span));
         Some(())
     }
 }
