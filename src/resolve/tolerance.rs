@@ -128,62 +128,19 @@ pub(super) fn lower(
     call: &ast::Call,
 ) -> Option<Tolerance> {
     let rule = rule_of(cx, call)?;
-    let what = rule.name.to_string();
     let mut args = Args::read(cx, pc, rule, call)?;
-    let (min, max) = rule.targets;
-    if !args.target_failed && (args.targets.len() < min || args.targets.len() > max) {
-        let expected = if min == max {
-            format!("{min} feature{}", if min == 1 { "" } else { "s" })
-        } else {
-            format!("{min} or {max} features")
-        };
-        cx.err(E::Arity {
-            span: args.targets.get(max).map_or(call.span, |t| t.1),
-            kind: what.clone(),
-            expected,
-            found: format!("{}", args.targets.len()),
-            help: format!(
-                "the toleranced feature{} come{} first: `{}(…)`",
-                if max > 1 { "s" } else { "" },
-                if max > 1 { "" } else { "s" },
-                rule.name
-            ),
-        });
-        args.ok = false;
-    }
+    args.check_arity(cx, rule, call);
     let Some((value, _)) = args.value.take() else {
         if args.ok {
             missing_value(cx, rule, call);
         }
         return None;
     };
-    match rule.datums {
-        Forbidden => {
-            if let Some((_, span)) = args.datums.first() {
-                let help = if rule.size.is_some() {
-                    "sizes are checked without a datum frame".to_string()
-                } else {
-                    format!("{what} is a form tolerance: it controls the feature on its own")
-                };
-                cx.err(E::DatumsForbidden {
-                    span: *span,
-                    kind: what.clone(),
-                    help,
-                });
-                args.ok = false;
-            }
-        }
-        // A datum that failed to resolve was reported already: no cascade.
-        Required if args.datums.is_empty() && args.ok => {
-            cx.err(E::DatumsRequired { span: call.span, kind: what.clone(), help: format!("{what} is measured relative to a datum: add one, e.g. `{}(feature, 0.05 mm, A)`", rule.name) });
-            args.ok = false;
-        }
-        _ => {}
-    }
+    args.check_datums_allowed(cx, rule, call);
     if rule.kind == K::Angularity && args.basic_angle.is_none() && args.ok {
         cx.err(E::MissingArgument {
             span: call.span,
-            kind: what.clone(),
+            kind: rule.name.into(),
             what: "its basic angle".into(),
             help: "write `angularity(feature, 0.1 mm, A, basic 30 deg)`".into(),
         });
@@ -403,6 +360,61 @@ impl Args {
         }
         self.modifier = Some((m, p.span));
         Some(())
+    }
+
+    /// As many toleranced features as the type takes (unless one already failed).
+    fn check_arity(&mut self, cx: &mut Cx, rule: &Rule, call: &ast::Call) {
+        let (min, max) = rule.targets;
+        let n = self.targets.len();
+        if self.target_failed || (min..=max).contains(&n) {
+            return;
+        }
+        let expected = if min == max {
+            format!("{min} feature{}", if min == 1 { "" } else { "s" })
+        } else {
+            format!("{min} or {max} features")
+        };
+        cx.err(E::Arity {
+            span: self.targets.get(max).map_or(call.span, |t| t.1),
+            kind: rule.name.into(),
+            expected,
+            found: format!("{n}"),
+            help: format!(
+                "the toleranced feature{} come{} first: `{}(…)`",
+                if max > 1 { "s" } else { "" },
+                if max > 1 { "" } else { "s" },
+                rule.name
+            ),
+        });
+        self.ok = false;
+    }
+
+    /// Datums where the type forbids them, or none where it requires them.
+    fn check_datums_allowed(&mut self, cx: &mut Cx, rule: &Rule, call: &ast::Call) {
+        let what = rule.name;
+        match rule.datums {
+            Forbidden => {
+                if let Some((_, span)) = self.datums.first() {
+                    let help = if rule.size.is_some() {
+                        "sizes are checked without a datum frame".to_string()
+                    } else {
+                        format!("{what} is a form tolerance: it controls the feature on its own")
+                    };
+                    cx.err(E::DatumsForbidden {
+                        span: *span,
+                        kind: what.into(),
+                        help,
+                    });
+                    self.ok = false;
+                }
+            }
+            // A datum that failed to resolve was reported already: no cascade.
+            Required if self.datums.is_empty() && self.ok => {
+                cx.err(E::DatumsRequired { span: call.span, kind: what.into(), help: format!("{what} is measured relative to a datum: add one, e.g. `{}(feature, 0.05 mm, A)`", rule.name) });
+                self.ok = false;
+            }
+            _ => {}
+        }
     }
 }
 
