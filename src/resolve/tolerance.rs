@@ -137,27 +137,9 @@ pub(super) fn lower(
         return None;
     };
     args.check_datums_allowed(cx, rule, call);
-    if rule.kind == K::Angularity && args.basic_angle.is_none() && args.ok {
-        cx.err(E::MissingArgument {
-            span: call.span,
-            kind: rule.name.into(),
-            what: "its basic angle".into(),
-            help: "write `angularity(feature, 0.1 mm, A, basic 30 deg)`".into(),
-        });
-        args.ok = false;
-    }
+    args.check_basic_angle(cx, rule, call);
     check_unique_datums(cx, &pc.part, &args.datums);
-    for (d, span) in &args.datums {
-        let df = pc.part.datums[d.datum.0].feature;
-        if let Some((f, _)) = args.targets.iter().find(|(f, _)| *f == df) {
-            cx.err(E::DatumSelfReference {
-                span: *span,
-                datum: pc.part.datums[d.datum.0].name.clone(),
-                feature: pc.part.features[f.0].name.clone(),
-            });
-            args.ok = false;
-        }
-    }
+    args.check_self_reference(cx, pc);
     args.ok.then(|| Tolerance {
         name: name.name.clone(),
         kind: rule.kind,
@@ -414,6 +396,34 @@ impl Args {
                 self.ok = false;
             }
             _ => {}
+        }
+    }
+
+    /// Angularity's basic angle, unless something else failed already.
+    fn check_basic_angle(&mut self, cx: &mut Cx, rule: &Rule, call: &ast::Call) {
+        if rule.kind == K::Angularity && self.basic_angle.is_none() && self.ok {
+            cx.err(E::MissingArgument {
+                span: call.span,
+                kind: rule.name.into(),
+                what: "its basic angle".into(),
+                help: "write `angularity(feature, 0.1 mm, A, basic 30 deg)`".into(),
+            });
+            self.ok = false;
+        }
+    }
+
+    /// No datum whose feature is one the tolerance controls.
+    fn check_self_reference(&mut self, cx: &mut Cx, pc: &PartCx) {
+        for (d, span) in &self.datums {
+            let df = pc.part.datums[d.datum.0].feature;
+            if let Some((f, _)) = self.targets.iter().find(|(f, _)| *f == df) {
+                cx.err(E::DatumSelfReference {
+                    span: *span,
+                    datum: pc.part.datums[d.datum.0].name.clone(),
+                    feature: pc.part.features[f.0].name.clone(),
+                });
+                self.ok = false;
+            }
         }
     }
 }
