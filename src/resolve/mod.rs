@@ -15,6 +15,7 @@ mod datum;
 mod errors;
 mod faces;
 mod hierarchy;
+mod ops;
 mod part;
 mod plan;
 mod props;
