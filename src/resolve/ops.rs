@@ -3,11 +3,76 @@
 
 use super::errors::ResolveError as E;
 use super::props::{call_args, describe, path_text, Cx, Dim, Props};
+use super::scope::PartCx;
 use crate::diag::suggest;
 use crate::model::*;
-use crate::syntax::ast::{self, ValueKind};
+use crate::syntax::ast::{self, PartStmt, ValueKind};
 
-pub(super) fn operation(
+/// Lowers every `cut` and `add` of a part, in order: one [`Op`] per statement, a
+/// placeholder where one fails, so operation indices stay aligned with declarations.
+pub(super) fn lower(cx: &mut Cx, pc: &mut PartCx, is_mesh: bool) {
+    let mut instances: u64 = 0;
+    for s in pc.stmts {
+        let PartStmt::Cut {
+            add,
+            kind,
+            name,
+            props,
+            span,
+        } = s
+        else {
+            continue;
+        };
+        if is_mesh {
+            cx.err(E::NeedsStock {
+                span: *span,
+                what: format!("`{}` {}", if *add { "add" } else { "cut" }, kind.name),
+            });
+        }
+        let op = operation(cx, *add, kind, name, props)
+            .and_then(|o| within_instance_limit(cx, o, &mut instances));
+        pc.part
+            .ops
+            .push(op.unwrap_or_else(|| placeholder(*add, name)));
+    }
+}
+
+/// The part's operations together stay within the instance limit: every instance is
+/// booleaned, sampled and measured. `instances` counts those accepted so far.
+fn within_instance_limit(cx: &mut Cx, o: Op, instances: &mut u64) -> Option<Op> {
+    let n = u64::from(o.pattern.as_ref().map_or(1, Pattern::count));
+    if *instances + n > u64::from(MAX_INSTANCES) {
+        cx.err(E::OutOfRange {
+            span: o.span,
+            what: format!("`{}`", o.name),
+            value: format!("brings the part to {} instances", *instances + n),
+            range: format!("a part has at most {MAX_INSTANCES}"),
+            help: "a CMM program measures each instance; check the pattern counts".into(),
+        });
+        return None;
+    }
+    *instances += n;
+    Some(o)
+}
+
+/// What stands in for an operation that failed (a unit boss), keeping the indices of
+/// the operations after it.
+fn placeholder(add: bool, name: &ast::Ident) -> Op {
+    Op {
+        name: name.name.clone(),
+        action: if add { Action::Add } else { Action::Cut },
+        kind: OpKind::Boss {
+            at: [0.0; 3],
+            axis: [0.0, 0.0, 1.0],
+            diameter: 1.0,
+            height: 1.0,
+        },
+        pattern: None,
+        span: name.span,
+    }
+}
+
+fn operation(
     cx: &mut Cx,
     add: bool,
     kind: &ast::Ident,
@@ -211,7 +276,7 @@ pub(super) fn operation(
 /// The most instances one pattern, or all of a part's operations together, may have:
 /// the booleans triangulate a face pierced by every instance, which grows faster than
 /// linearly (2,000 holes in one face: about 9 s; 10,000: over two minutes).
-pub(super) const MAX_INSTANCES: u32 = 2_000;
+const MAX_INSTANCES: u32 = 2_000;
 
 fn perpendicular(cx: &mut Cx, p: &mut Props, along: Option<Vec3>, into: Option<Vec3>) {
     if let (Some(a), Some(i)) = (along, into) {

@@ -3,10 +3,9 @@
 use super::datum::{check_unique_datums, datum, datum_ref};
 use super::errors::ResolveError as E;
 use super::faces::face_expr;
-use super::ops::{operation, MAX_INSTANCES};
 use super::props::{call_args, path_text, Cx, Dim, Props, UNITS};
 use super::scope::{Local, PartCx};
-use super::{tolerance, Resolver};
+use super::{ops, tolerance, Resolver};
 use crate::diag::suggest;
 use crate::model::*;
 use crate::source::Span;
@@ -95,55 +94,7 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
     };
     declare_locals(cx, &mut pc);
 
-    let mut instances: u64 = 0;
-    for s in &p.stmts {
-        if let PartStmt::Cut {
-            add,
-            kind,
-            name,
-            props,
-            span,
-        } = s
-        {
-            if is_mesh {
-                cx.err(E::NeedsStock {
-                    span: *span,
-                    what: format!("`{}` {}", if *add { "add" } else { "cut" }, kind.name),
-                });
-            }
-            let mut op = operation(cx, *add, kind, name, props);
-            // The part's operations together stay within the instance limit: every
-            // instance is booleaned, sampled and measured.
-            if let Some(o) = &op {
-                let n = u64::from(o.pattern.as_ref().map_or(1, Pattern::count));
-                if instances + n > u64::from(MAX_INSTANCES) {
-                    cx.err(E::OutOfRange {
-                        span: o.span,
-                        what: format!("`{}`", o.name),
-                        value: format!("brings the part to {} instances", instances + n),
-                        range: format!("a part has at most {MAX_INSTANCES}"),
-                        help: "a CMM program measures each instance; check the pattern counts"
-                            .into(),
-                    });
-                    op = None;
-                } else {
-                    instances += n;
-                }
-            }
-            pc.part.ops.push(op.unwrap_or(Op {
-                name: name.name.clone(),
-                action: if *add { Action::Add } else { Action::Cut },
-                kind: OpKind::Boss {
-                    at: [0.0; 3],
-                    axis: [0.0, 0.0, 1.0],
-                    diameter: 1.0,
-                    height: 1.0,
-                },
-                pattern: None,
-                span: name.span,
-            }));
-        }
-    }
+    ops::lower(cx, &mut pc, is_mesh);
 
     for s in &p.stmts {
         match s {
