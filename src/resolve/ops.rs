@@ -72,6 +72,7 @@ fn placeholder(add: bool, name: &ast::Ident) -> Op {
     }
 }
 
+/// One `cut kind name { … }` or `add boss name { … }`; None after saying why.
 fn operation(
     cx: &mut Cx,
     add: bool,
@@ -90,42 +91,13 @@ fn operation(
         });
         return None;
     }
-    let adds = kind.name == "boss";
-    if add != adds {
-        let (verb, fix) = if add { ("add", "cut") } else { ("cut", "add") };
-        cx.err(E::WrongOperation {
-            span: kind.span,
-            kind: format!("a {}", kind.name),
-            op: if adds {
-                "adds material, it cannot be written".into()
-            } else {
-                "removes material, it cannot be written".into()
-            },
-            verb: verb.into(),
-            fix: format!("{fix} {}", kind.name),
-            help: format!("write `{fix} {} {} {{ … }}`", kind.name, name.name),
-        });
-    }
+    check_action(cx, add, kind, name);
     let mut p = Props::new(
         cx,
         format!("{} `{}`", kind.name, name.name),
         name.span,
         props,
     );
-    let dir =
-        |cx: &mut Cx, p: &mut Props, key: &'static str, default: Option<Vec3>| match p.get(key) {
-            Some(v) => cx.direction(v),
-            None if default.is_some() => default,
-            None => p.req(cx, key, "+x").and_then(|v| cx.direction(v)),
-        };
-    let point = |cx: &mut Cx, p: &mut Props| {
-        p.req(cx, "at", "(10, 10, 40)")
-            .and_then(|v| cx.lengths::<3>(v))
-    };
-    let positive = |cx: &mut Cx, p: &mut Props, key: &'static str| {
-        p.req(cx, key, "10")
-            .and_then(|v| cx.positive(v, Dim::Length, key))
-    };
     let op = match kind.name.as_str() {
         "hole" => {
             let radial = p.get("radial").and_then(|v| cx.direction(v));
@@ -143,10 +115,10 @@ fn operation(
                 (None, None) => p.req(cx, "at", "(10, 10, 40)").and(None),
             };
             let axis = match radial {
-                Some(d) => dir(cx, &mut p, "axis", Some([-d[0], -d[1], -d[2]])),
-                None => dir(cx, &mut p, "axis", None),
+                Some(d) => direction(cx, &mut p, "axis", Some([-d[0], -d[1], -d[2]])),
+                None => direction(cx, &mut p, "axis", None),
             };
-            let diameter = positive(cx, &mut p, "diameter");
+            let diameter = positive_length(cx, &mut p, "diameter");
             let depth = match p.req(cx, "depth", "20 mm or `depth through`") {
                 Some(v) if matches!(&v.kind, ValueKind::Path(pp) if pp.as_ident().is_some_and(|i| i.name == "through")) => {
                     Some(Depth::Through)
@@ -162,11 +134,11 @@ fn operation(
             }
         }
         "slot" | "step" => {
-            let at = point(cx, &mut p);
-            let along = dir(cx, &mut p, "along", None);
-            let into = dir(cx, &mut p, "into", Some([0.0, 0.0, -1.0]));
-            let width = positive(cx, &mut p, "width");
-            let depth = positive(cx, &mut p, "depth");
+            let at = at_point(cx, &mut p);
+            let along = direction(cx, &mut p, "along", None);
+            let into = direction(cx, &mut p, "into", Some([0.0, 0.0, -1.0]));
+            let width = positive_length(cx, &mut p, "width");
+            let depth = positive_length(cx, &mut p, "depth");
             perpendicular(cx, &mut p, along, into);
             if kind.name == "slot" {
                 let length = match p.get("length") {
@@ -192,9 +164,9 @@ fn operation(
             }
         }
         "pocket" => {
-            let at = point(cx, &mut p);
-            let along = dir(cx, &mut p, "along", Some([1.0, 0.0, 0.0]));
-            let into = dir(cx, &mut p, "into", Some([0.0, 0.0, -1.0]));
+            let at = at_point(cx, &mut p);
+            let along = direction(cx, &mut p, "along", Some([1.0, 0.0, 0.0]));
+            let into = direction(cx, &mut p, "into", Some([0.0, 0.0, -1.0]));
             perpendicular(cx, &mut p, along, into);
             let size = p.req(cx, "size", "(40, 20)").and_then(|v| {
                 let s = cx.lengths::<2>(v)?;
@@ -209,7 +181,7 @@ fn operation(
                 }
                 Some(s)
             });
-            let depth = positive(cx, &mut p, "depth");
+            let depth = positive_length(cx, &mut p, "depth");
             let corner_radius = match p.get("corner_radius") {
                 Some(v) => cx.length(v).and_then(|x| {
                     if x < 0.0 {
@@ -236,10 +208,10 @@ fn operation(
             }
         }
         _ => {
-            let at = point(cx, &mut p);
-            let axis = dir(cx, &mut p, "axis", Some([0.0, 0.0, 1.0]));
-            let diameter = positive(cx, &mut p, "diameter");
-            let height = positive(cx, &mut p, "height");
+            let at = at_point(cx, &mut p);
+            let axis = direction(cx, &mut p, "axis", Some([0.0, 0.0, 1.0]));
+            let diameter = positive_length(cx, &mut p, "diameter");
+            let height = positive_length(cx, &mut p, "height");
             OpKind::Boss {
                 at: at?,
                 axis: axis?,
@@ -271,6 +243,48 @@ fn operation(
         pattern,
         span: name.span,
     })
+}
+
+/// A boss is added and the other kinds are cut: says so where the spec has it the other
+/// way round.
+fn check_action(cx: &mut Cx, add: bool, kind: &ast::Ident, name: &ast::Ident) {
+    let adds = kind.name == "boss";
+    if add != adds {
+        let (verb, fix) = if add { ("add", "cut") } else { ("cut", "add") };
+        cx.err(E::WrongOperation {
+            span: kind.span,
+            kind: format!("a {}", kind.name),
+            op: if adds {
+                "adds material, it cannot be written".into()
+            } else {
+                "removes material, it cannot be written".into()
+            },
+            verb: verb.into(),
+            fix: format!("{fix} {}", kind.name),
+            help: format!("write `{fix} {} {} {{ … }}`", kind.name, name.name),
+        });
+    }
+}
+
+/// A direction property: `default` where it is left out, or required without one.
+fn direction(cx: &mut Cx, p: &mut Props, key: &'static str, default: Option<Vec3>) -> Option<Vec3> {
+    match p.get(key) {
+        Some(v) => cx.direction(v),
+        None if default.is_some() => default,
+        None => p.req(cx, key, "+x").and_then(|v| cx.direction(v)),
+    }
+}
+
+/// The required `at` point.
+fn at_point(cx: &mut Cx, p: &mut Props) -> Option<Vec3> {
+    p.req(cx, "at", "(10, 10, 40)")
+        .and_then(|v| cx.lengths::<3>(v))
+}
+
+/// A required positive length.
+fn positive_length(cx: &mut Cx, p: &mut Props, key: &'static str) -> Option<f64> {
+    p.req(cx, key, "10")
+        .and_then(|v| cx.positive(v, Dim::Length, key))
 }
 
 /// The most instances one pattern, or all of a part's operations together, may have:
