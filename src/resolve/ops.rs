@@ -99,40 +99,7 @@ fn operation(
         props,
     );
     let op = match kind.name.as_str() {
-        "hole" => {
-            let radial = p.get("radial").and_then(|v| cx.direction(v));
-            let at = match (p.get("at"), radial) {
-                (Some(v), None) => cx.lengths::<3>(v).map(Placement::At),
-                (None, Some(d)) => Some(Placement::Radial(d)),
-                (Some(v), Some(_)) => {
-                    cx.err(E::DuplicateGeometry {
-                        span: v.span,
-                        first: p.get("radial").map_or(v.span, |r| r.span),
-                        part: name.name.clone(),
-                    });
-                    None
-                }
-                (None, None) => p.req(cx, "at", "(10, 10, 40)").and(None),
-            };
-            let axis = match radial {
-                Some(d) => direction(cx, &mut p, "axis", Some([-d[0], -d[1], -d[2]])),
-                None => direction(cx, &mut p, "axis", None),
-            };
-            let diameter = positive_length(cx, &mut p, "diameter");
-            let depth = match p.req(cx, "depth", "20 mm or `depth through`") {
-                Some(v) if matches!(&v.kind, ValueKind::Path(pp) if pp.as_ident().is_some_and(|i| i.name == "through")) => {
-                    Some(Depth::Through)
-                }
-                Some(v) => cx.positive(v, Dim::Length, "depth").map(Depth::Blind),
-                None => None,
-            };
-            OpKind::Hole {
-                at: at?,
-                axis: axis?,
-                diameter: diameter?,
-                depth: depth?,
-            }
-        }
+        "hole" => hole(cx, &mut p, name)?,
         "slot" | "step" => {
             let at = at_point(cx, &mut p);
             let along = direction(cx, &mut p, "along", None);
@@ -163,50 +130,7 @@ fn operation(
                 }
             }
         }
-        "pocket" => {
-            let at = at_point(cx, &mut p);
-            let along = direction(cx, &mut p, "along", Some([1.0, 0.0, 0.0]));
-            let into = direction(cx, &mut p, "into", Some([0.0, 0.0, -1.0]));
-            perpendicular(cx, &mut p, along, into);
-            let size = p.req(cx, "size", "(40, 20)").and_then(|v| {
-                let s = cx.lengths::<2>(v)?;
-                if s.iter().any(|x| *x <= 0.0) {
-                    cx.err(E::NonPositive {
-                        span: v.span,
-                        what: "`size`".into(),
-                        value: describe(v),
-                        help: "a pocket's length and width are positive".into(),
-                    });
-                    return None;
-                }
-                Some(s)
-            });
-            let depth = positive_length(cx, &mut p, "depth");
-            let corner_radius = match p.get("corner_radius") {
-                Some(v) => cx.length(v).and_then(|x| {
-                    if x < 0.0 {
-                        cx.err(E::OutOfRange {
-                            span: v.span,
-                            what: "`corner_radius`".into(),
-                            value: describe(v),
-                            range: "it cannot be negative".into(),
-                            help: "a corner radius is 0 (sharp) or more".into(),
-                        });
-                        return None;
-                    }
-                    Some(x)
-                }),
-                None => Some(0.0),
-            };
-            OpKind::Pocket {
-                at: at?,
-                along: along?,
-                into: into?,
-                size: size?,
-                depth: depth?,
-                corner_radius: corner_radius?,
-            }
-        }
+        "pocket" => pocket(cx, &mut p)?,
         _ => {
             let at = at_point(cx, &mut p);
             let axis = direction(cx, &mut p, "axis", Some([0.0, 0.0, 1.0]));
@@ -285,6 +209,89 @@ fn at_point(cx: &mut Cx, p: &mut Props) -> Option<Vec3> {
 fn positive_length(cx: &mut Cx, p: &mut Props, key: &'static str) -> Option<f64> {
     p.req(cx, key, "10")
         .and_then(|v| cx.positive(v, Dim::Length, key))
+}
+
+/// `cut hole { at (…) or radial +x, axis, diameter, depth 20 mm or depth through }`; the
+/// axis of a radial hole points back along its direction unless given.
+fn hole(cx: &mut Cx, p: &mut Props, name: &ast::Ident) -> Option<OpKind> {
+    let radial = p.get("radial").and_then(|v| cx.direction(v));
+    let at = match (p.get("at"), radial) {
+        (Some(v), None) => cx.lengths::<3>(v).map(Placement::At),
+        (None, Some(d)) => Some(Placement::Radial(d)),
+        (Some(v), Some(_)) => {
+            cx.err(E::DuplicateGeometry {
+                span: v.span,
+                first: p.get("radial").map_or(v.span, |r| r.span),
+                part: name.name.clone(),
+            });
+            None
+        }
+        (None, None) => p.req(cx, "at", "(10, 10, 40)").and(None),
+    };
+    let axis = match radial {
+        Some(d) => direction(cx, p, "axis", Some([-d[0], -d[1], -d[2]])),
+        None => direction(cx, p, "axis", None),
+    };
+    let diameter = positive_length(cx, p, "diameter");
+    let depth = match p.req(cx, "depth", "20 mm or `depth through`") {
+        Some(v) if matches!(&v.kind, ValueKind::Path(pp) if pp.as_ident().is_some_and(|i| i.name == "through")) => {
+            Some(Depth::Through)
+        }
+        Some(v) => cx.positive(v, Dim::Length, "depth").map(Depth::Blind),
+        None => None,
+    };
+    Some(OpKind::Hole {
+        at: at?,
+        axis: axis?,
+        diameter: diameter?,
+        depth: depth?,
+    })
+}
+
+/// `cut pocket { at, along, into, size (l, w), depth, corner_radius }`.
+fn pocket(cx: &mut Cx, p: &mut Props) -> Option<OpKind> {
+    let at = at_point(cx, p);
+    let along = direction(cx, p, "along", Some([1.0, 0.0, 0.0]));
+    let into = direction(cx, p, "into", Some([0.0, 0.0, -1.0]));
+    perpendicular(cx, p, along, into);
+    let size = p.req(cx, "size", "(40, 20)").and_then(|v| {
+        let s = cx.lengths::<2>(v)?;
+        if s.iter().any(|x| *x <= 0.0) {
+            cx.err(E::NonPositive {
+                span: v.span,
+                what: "`size`".into(),
+                value: describe(v),
+                help: "a pocket's length and width are positive".into(),
+            });
+            return None;
+        }
+        Some(s)
+    });
+    let depth = positive_length(cx, p, "depth");
+    let corner_radius = match p.get("corner_radius") {
+        Some(v) => cx.length(v).and_then(|x| {
+            if x < 0.0 {
+                cx.err(E::OutOfRange {
+                    span: v.span,
+                    what: "`corner_radius`".into(),
+                    value: describe(v),
+                    range: "it cannot be negative".into(),
+                    help: "a corner radius is 0 (sharp) or more".into(),
+                });
+                return None;
+            }
+            Some(x)
+        }),
+        None => Some(0.0),
+    };
+    Some(OpKind::Pocket {
+        at: at?,
+        along: along?,
+        into: into?,
+        size: size?,
+        depth: depth?,
+        corner_radius: corner_radius?,
+    })
 }
 
 /// The most instances one pattern, or all of a part's operations together, may have:
