@@ -100,65 +100,11 @@ fn operation(
     );
     let op = match kind.name.as_str() {
         "hole" => hole(cx, &mut p, name)?,
-        "slot" | "step" => {
-            let at = at_point(cx, &mut p);
-            let along = direction(cx, &mut p, "along", None);
-            let into = direction(cx, &mut p, "into", Some([0.0, 0.0, -1.0]));
-            let width = positive_length(cx, &mut p, "width");
-            let depth = positive_length(cx, &mut p, "depth");
-            perpendicular(cx, &mut p, along, into);
-            if kind.name == "slot" {
-                let length = match p.get("length") {
-                    Some(v) => Some(cx.positive(v, Dim::Length, "length")?),
-                    None => None,
-                };
-                OpKind::Slot {
-                    at: at?,
-                    along: along?,
-                    into: into?,
-                    width: width?,
-                    depth: depth?,
-                    length,
-                }
-            } else {
-                OpKind::Step {
-                    at: at?,
-                    along: along?,
-                    into: into?,
-                    width: width?,
-                    depth: depth?,
-                }
-            }
-        }
+        "slot" | "step" => slot_or_step(cx, &mut p, kind)?,
         "pocket" => pocket(cx, &mut p)?,
-        _ => {
-            let at = at_point(cx, &mut p);
-            let axis = direction(cx, &mut p, "axis", Some([0.0, 0.0, 1.0]));
-            let diameter = positive_length(cx, &mut p, "diameter");
-            let height = positive_length(cx, &mut p, "height");
-            OpKind::Boss {
-                at: at?,
-                axis: axis?,
-                diameter: diameter?,
-                height: height?,
-            }
-        }
+        _ => boss(cx, &mut p)?,
     };
-    let pattern = p.get("pattern").and_then(|v| {
-        let pat = pattern(cx, v)?;
-        if pat.count() > MAX_INSTANCES {
-            cx.err(E::OutOfRange {
-                span: v.span,
-                what: "pattern".into(),
-                value: format!("of {} instances", pat.count()),
-                range: format!("at most {MAX_INSTANCES}"),
-                help: "a CMM program measures each instance; split the pattern or check the counts"
-                    .into(),
-            });
-            return None;
-        }
-        Some(pat)
-    });
+    let pattern = p.get("pattern").and_then(|v| pattern_within_limit(cx, v));
     p.finish(cx);
     Some(Op {
         name: name.name.clone(),
@@ -248,6 +194,38 @@ fn hole(cx: &mut Cx, p: &mut Props, name: &ast::Ident) -> Option<OpKind> {
     })
 }
 
+/// `cut slot { at, along, into, width, depth, length }` or `cut step { … }` (no length);
+/// None, before the pattern is read, where a slot's length does not read.
+fn slot_or_step(cx: &mut Cx, p: &mut Props, kind: &ast::Ident) -> Option<OpKind> {
+    let at = at_point(cx, p);
+    let along = direction(cx, p, "along", None);
+    let into = direction(cx, p, "into", Some([0.0, 0.0, -1.0]));
+    let width = positive_length(cx, p, "width");
+    let depth = positive_length(cx, p, "depth");
+    perpendicular(cx, p, along, into);
+    if kind.name != "slot" {
+        return Some(OpKind::Step {
+            at: at?,
+            along: along?,
+            into: into?,
+            width: width?,
+            depth: depth?,
+        });
+    }
+    let length = match p.get("length") {
+        Some(v) => Some(cx.positive(v, Dim::Length, "length")?),
+        None => None,
+    };
+    Some(OpKind::Slot {
+        at: at?,
+        along: along?,
+        into: into?,
+        width: width?,
+        depth: depth?,
+        length,
+    })
+}
+
 /// `cut pocket { at, along, into, size (l, w), depth, corner_radius }`.
 fn pocket(cx: &mut Cx, p: &mut Props) -> Option<OpKind> {
     let at = at_point(cx, p);
@@ -292,6 +270,37 @@ fn pocket(cx: &mut Cx, p: &mut Props) -> Option<OpKind> {
         depth: depth?,
         corner_radius: corner_radius?,
     })
+}
+
+/// `add boss { at, axis, diameter, height }`.
+fn boss(cx: &mut Cx, p: &mut Props) -> Option<OpKind> {
+    let at = at_point(cx, p);
+    let axis = direction(cx, p, "axis", Some([0.0, 0.0, 1.0]));
+    let diameter = positive_length(cx, p, "diameter");
+    let height = positive_length(cx, p, "height");
+    Some(OpKind::Boss {
+        at: at?,
+        axis: axis?,
+        diameter: diameter?,
+        height: height?,
+    })
+}
+
+/// An operation's `pattern`, within the instance limit of one pattern.
+fn pattern_within_limit(cx: &mut Cx, v: &ast::Value) -> Option<Pattern> {
+    let pat = pattern(cx, v)?;
+    if pat.count() > MAX_INSTANCES {
+        cx.err(E::OutOfRange {
+            span: v.span,
+            what: "pattern".into(),
+            value: format!("of {} instances", pat.count()),
+            range: format!("at most {MAX_INSTANCES}"),
+            help: "a CMM program measures each instance; split the pattern or check the counts"
+                .into(),
+        });
+        return None;
+    }
+    Some(pat)
 }
 
 /// The most instances one pattern, or all of a part's operations together, may have:
