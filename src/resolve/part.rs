@@ -25,65 +25,11 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
         span: p.name.span,
     };
     // Units first: they give bare numbers their meaning.
-    let units: Vec<&ast::Ident> = p
-        .stmts
-        .iter()
-        .filter_map(|s| {
-            if let PartStmt::Units(u) = s {
-                Some(u)
-            } else {
-                None
-            }
-        })
-        .collect();
-    match units.as_slice() {
-        [] => cx.err(E::MissingProperty {
-            span: p.name.span,
-            key: "units".into(),
-            item: format!("part `{}`", p.name.name),
-            help: "add `units mm` (or cm, m, um, in): bare numbers in the part are read in these units".into(),
-        }),
-        [u, rest @ ..] => {
-            if let Some(f) = length_unit(cx, u) {
-                part.unit_mm = f;
-            }
-            for dup in rest {
-                cx.err(E::DuplicateProperty { span: dup.span, first: u.span, key: "units".into() });
-            }
-        }
+    if let Some(f) = part_units(cx, p) {
+        part.unit_mm = f;
     }
     cx.unit_mm = Some(part.unit_mm);
-
-    // Geometry source.
-    let mut source_span: Option<Span> = None;
-    let mut have_stock = false;
-    for s in &p.stmts {
-        let (span, geometry) = match s {
-            PartStmt::Stock(call) => (call.span, stock(cx, call)),
-            PartStmt::Mesh { path, props, span } => (*span, mesh(r, cx, path, props, part.unit_mm)),
-            _ => continue,
-        };
-        if let Some(first) = source_span {
-            cx.err(E::DuplicateGeometry {
-                span,
-                first,
-                part: part.name.clone(),
-            });
-            continue;
-        }
-        source_span = Some(span);
-        have_stock = matches!(s, PartStmt::Stock(_));
-        if let Some(g) = geometry {
-            part.geometry = g;
-        }
-    }
-    if source_span.is_none() {
-        cx.err(E::NoGeometry {
-            span: p.name.span,
-            part: part.name.clone(),
-        });
-    }
-    let is_mesh = source_span.is_some() && !have_stock;
+    let is_mesh = read_geometry(r, cx, p, &mut part);
 
     // Declare every local name so references can say what a name is.
     let mut pc = PartCx {
@@ -160,6 +106,78 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
     }
     cx.unit_mm = None;
     pc.part
+}
+
+/// The part's `units`, said once; None (after saying why) where it is missing or not a
+/// length unit.
+fn part_units(cx: &mut Cx, p: &ast::Part) -> Option<f64> {
+    let units: Vec<&ast::Ident> = p
+        .stmts
+        .iter()
+        .filter_map(|s| {
+            if let PartStmt::Units(u) = s {
+                Some(u)
+            } else {
+                None
+            }
+        })
+        .collect();
+    match units.as_slice() {
+        [] => {
+            cx.err(E::MissingProperty {
+                span: p.name.span,
+                key: "units".into(),
+                item: format!("part `{}`", p.name.name),
+                help: "add `units mm` (or cm, m, um, in): bare numbers in the part are read in these units".into(),
+            });
+            None
+        }
+        [u, rest @ ..] => {
+            let f = length_unit(cx, u);
+            for dup in rest {
+                cx.err(E::DuplicateProperty {
+                    span: dup.span,
+                    first: u.span,
+                    key: "units".into(),
+                });
+            }
+            f
+        }
+    }
+}
+
+/// The part's one geometry source, a stock or a mesh, into `part.geometry`; whether it
+/// is a mesh (false where there is none).
+fn read_geometry(r: &Resolver, cx: &mut Cx, p: &ast::Part, part: &mut Part) -> bool {
+    let mut source_span: Option<Span> = None;
+    let mut have_stock = false;
+    for s in &p.stmts {
+        let (span, geometry) = match s {
+            PartStmt::Stock(call) => (call.span, stock(cx, call)),
+            PartStmt::Mesh { path, props, span } => (*span, mesh(r, cx, path, props, part.unit_mm)),
+            _ => continue,
+        };
+        if let Some(first) = source_span {
+            cx.err(E::DuplicateGeometry {
+                span,
+                first,
+                part: part.name.clone(),
+            });
+            continue;
+        }
+        source_span = Some(span);
+        have_stock = matches!(s, PartStmt::Stock(_));
+        if let Some(g) = geometry {
+            part.geometry = g;
+        }
+    }
+    if source_span.is_none() {
+        cx.err(E::NoGeometry {
+            span: p.name.span,
+            part: part.name.clone(),
+        });
+    }
+    source_span.is_some() && !have_stock
 }
 
 pub(super) fn length_unit(cx: &mut Cx, u: &ast::Ident) -> Option<f64> {
