@@ -42,47 +42,7 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
 
     ops::lower(cx, &mut pc, is_mesh);
 
-    for s in &p.stmts {
-        match s {
-            PartStmt::Named {
-                what: what @ (NamedKind::Face | NamedKind::Feature),
-                name,
-                expr,
-                ..
-            } => {
-                let faces = match expr {
-                    Some(e) => face_expr(cx, &pc, e, is_mesh),
-                    None => vec![],
-                };
-                if faces.is_empty() && expr.is_none() {
-                    cx.err(E::EmptyFeature {
-                        span: name.span,
-                        name: name.name.clone(),
-                    });
-                }
-                pc.part.features.push(Feature {
-                    name: name.name.clone(),
-                    faces,
-                    declared: if *what == NamedKind::Face {
-                        Declared::Face
-                    } else {
-                        Declared::Feature
-                    },
-                    span: name.span,
-                });
-                pc.lowered_features += 1;
-            }
-            PartStmt::Named {
-                what: NamedKind::Datum,
-                name,
-                expr,
-                span,
-            } => {
-                datum(cx, &mut pc, name, expr.as_ref(), *span, is_mesh);
-            }
-            _ => {}
-        }
-    }
+    features_and_datums(cx, &mut pc, is_mesh);
     for s in &p.stmts {
         if let PartStmt::Frame { name, refs, .. } = s {
             let refs = refs
@@ -178,6 +138,61 @@ fn read_geometry(r: &Resolver, cx: &mut Cx, p: &ast::Part, part: &mut Part) -> b
         });
     }
     source_span.is_some() && !have_stock
+}
+
+/// Faces, features and datums in declaration order (a feature may use those above it).
+fn features_and_datums(cx: &mut Cx, pc: &mut PartCx, is_mesh: bool) {
+    for s in pc.stmts {
+        match s {
+            PartStmt::Named {
+                what: what @ (NamedKind::Face | NamedKind::Feature),
+                name,
+                expr,
+                ..
+            } => feature(cx, pc, *what, name, expr.as_ref(), is_mesh),
+            PartStmt::Named {
+                what: NamedKind::Datum,
+                name,
+                expr,
+                span,
+            } => {
+                datum(cx, pc, name, expr.as_ref(), *span, is_mesh);
+            }
+            _ => {}
+        }
+    }
+}
+
+/// `face name = …` or `feature name = …`: its faces, reported empty when it names none.
+fn feature(
+    cx: &mut Cx,
+    pc: &mut PartCx,
+    what: NamedKind,
+    name: &ast::Ident,
+    expr: Option<&ast::FaceExpr>,
+    is_mesh: bool,
+) {
+    let faces = match expr {
+        Some(e) => face_expr(cx, pc, e, is_mesh),
+        None => vec![],
+    };
+    if faces.is_empty() && expr.is_none() {
+        cx.err(E::EmptyFeature {
+            span: name.span,
+            name: name.name.clone(),
+        });
+    }
+    pc.part.features.push(Feature {
+        name: name.name.clone(),
+        faces,
+        declared: if what == NamedKind::Face {
+            Declared::Face
+        } else {
+            Declared::Feature
+        },
+        span: name.span,
+    });
+    pc.lowered_features += 1;
 }
 
 pub(super) fn length_unit(cx: &mut Cx, u: &ast::Ident) -> Option<f64> {
