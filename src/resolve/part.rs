@@ -41,29 +41,9 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
     declare_locals(cx, &mut pc);
 
     ops::lower(cx, &mut pc, is_mesh);
-
     features_and_datums(cx, &mut pc, is_mesh);
-    for s in &p.stmts {
-        if let PartStmt::Frame { name, refs, .. } = s {
-            let refs = refs
-                .iter()
-                .filter_map(|e| datum_ref(cx, &pc, &e.value))
-                .collect::<Vec<_>>();
-            check_unique_datums(cx, &pc.part, &refs);
-            pc.part.frames.push(Frame {
-                name: name.name.clone(),
-                refs: refs.into_iter().map(|(d, _)| d).collect(),
-                span: name.span,
-            });
-        }
-    }
-    for s in &p.stmts {
-        if let PartStmt::Tolerance { name, call, .. } = s {
-            if let Some(t) = tolerance::lower(cx, &pc, name, call) {
-                pc.part.tolerances.push(t);
-            }
-        }
-    }
+    frames(cx, &mut pc);
+    tolerances(cx, &mut pc);
     cx.unit_mm = None;
     pc.part
 }
@@ -193,6 +173,35 @@ fn feature(
         span: name.span,
     });
     pc.lowered_features += 1;
+}
+
+/// Every `frame name = [A, B, C]`, each datum once.
+fn frames(cx: &mut Cx, pc: &mut PartCx) {
+    for s in pc.stmts {
+        if let PartStmt::Frame { name, refs, .. } = s {
+            let refs = refs
+                .iter()
+                .filter_map(|e| datum_ref(cx, pc, &e.value))
+                .collect::<Vec<_>>();
+            check_unique_datums(cx, &pc.part, &refs);
+            pc.part.frames.push(Frame {
+                name: name.name.clone(),
+                refs: refs.into_iter().map(|(d, _)| d).collect(),
+                span: name.span,
+            });
+        }
+    }
+}
+
+/// Every `tolerance name = kind(…)` that checks out.
+fn tolerances(cx: &mut Cx, pc: &mut PartCx) {
+    for s in pc.stmts {
+        if let PartStmt::Tolerance { name, call, .. } = s {
+            if let Some(t) = tolerance::lower(cx, pc, name, call) {
+                pc.part.tolerances.push(t);
+            }
+        }
+    }
 }
 
 pub(super) fn length_unit(cx: &mut Cx, u: &ast::Ident) -> Option<f64> {
