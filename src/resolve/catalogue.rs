@@ -1,7 +1,7 @@
 //! Catalogue items: heads, styli, bodies, extensions, probes, CMMs and samplings.
 
 use super::errors::ResolveError as E;
-use super::props::{describe, num, Cx, Dim, Props};
+use super::props::{describe, describe_only, num, Cx, Dim, Props};
 use super::{Kind, Resolver};
 use crate::diag::suggest;
 use crate::load::ModuleId;
@@ -155,15 +155,6 @@ pub(super) fn lower(
         Kind::Part | Kind::Hierarchy | Kind::Plan => unreachable!("not a property item"),
     }
     p.finish(cx);
-}
-
-/// Catalogue text fields that document an item without affecting planning.
-fn describe_only(cx: &mut Cx, p: &mut Props) {
-    for key in ["part_no", "model"] {
-        if let Some(v) = p.get(key) {
-            cx.string(v);
-        }
-    }
 }
 
 fn head(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Head {

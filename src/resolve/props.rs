@@ -504,3 +504,12 @@ pub(super) fn call_args<'c>(
     }
     out
 }
+
+/// Catalogue text fields that document an item without affecting planning.
+pub(super) fn describe_only(cx: &mut Cx, p: &mut Props) {
+    for key in ["part_no", "model"] {
+        if let Some(v) = p.get(key) {
+            cx.string(v);
+        }
+    }
+}
