@@ -14,6 +14,7 @@ mod catalogue;
 mod datum;
 mod errors;
 mod faces;
+mod fixture;
 mod hierarchy;
 mod ops;
 mod part;
