@@ -8,8 +8,6 @@ use crate::diag::suggest;
 use crate::model::*;
 use crate::syntax::ast::{self, ValueKind};
 
-/// A fixture: `kind vise|chuck|vblock|sine_plate`, its sizes, and `height`, how high it holds
-/// the part above the table.
 pub(super) fn fixture(
     r: &Resolver,
     cx: &mut Cx,
@@ -29,45 +27,9 @@ pub(super) fn fixture(
             .and_then(|v| cx.positive(v, Dim::Length, "height"))
             .unwrap_or(100.0)
     };
-    let length = |cx: &mut Cx, p: &mut Props, key: &'static str, example: &str, dflt: f64| {
-        p.req(cx, key, example)
-            .and_then(|v| cx.positive(v, Dim::Length, key))
-            .unwrap_or(dflt)
-    };
     let kind = match word.as_ref().map(|(w, _)| w.as_str()) {
-        Some("vise") => {
-            let opening = length(cx, p, "opening", "160 mm", 100.0);
-            let jaw = p
-                .req(cx, "jaw", "(150 mm, 40 mm)")
-                .and_then(|v| {
-                    let j = cx.lengths::<2>(v)?;
-                    if j.iter().any(|x| *x <= 0.0) {
-                        cx.err(E::NonPositive {
-                            span: v.span,
-                            what: "the jaw size".into(),
-                            value: describe(v),
-                            help: "give the jaws' width and height".into(),
-                        });
-                        return None;
-                    }
-                    Some(j)
-                })
-                .unwrap_or([100.0, 30.0]);
-            FixtureKind::Vise { opening, jaw }
-        }
-        Some("chuck") => {
-            let diameter = p
-                .req(cx, "diameter", "3 mm .. 200 mm")
-                .and_then(|v| length_range(cx, v, "diameter"))
-                .unwrap_or([1.0, 100.0]);
-            let jaws = length(cx, p, "jaws", "20 mm", 20.0);
-            let body = length(cx, p, "body", "200 mm", 200.0);
-            FixtureKind::Chuck {
-                diameter,
-                jaws,
-                body,
-            }
-        }
+        Some("vise") => vise(cx, p),
+        Some("chuck") => chuck(cx, p),
         Some("vblock") => {
             let diameter = p
                 .req(cx, "diameter", "5 mm .. 100 mm")
@@ -130,6 +92,50 @@ pub(super) fn fixture(
         kind,
         height,
         span,
+    }
+}
+
+/// A required positive length, `default` where it is missing or wrong.
+fn length_or(cx: &mut Cx, p: &mut Props, key: &'static str, example: &str, default: f64) -> f64 {
+    p.req(cx, key, example)
+        .and_then(|v| cx.positive(v, Dim::Length, key))
+        .unwrap_or(default)
+}
+
+/// `kind vise`: its `opening` and `jaw (width, height)`.
+fn vise(cx: &mut Cx, p: &mut Props) -> FixtureKind {
+    let opening = length_or(cx, p, "opening", "160 mm", 100.0);
+    let jaw = p
+        .req(cx, "jaw", "(150 mm, 40 mm)")
+        .and_then(|v| {
+            let j = cx.lengths::<2>(v)?;
+            if j.iter().any(|x| *x <= 0.0) {
+                cx.err(E::NonPositive {
+                    span: v.span,
+                    what: "the jaw size".into(),
+                    value: describe(v),
+                    help: "give the jaws' width and height".into(),
+                });
+                return None;
+            }
+            Some(j)
+        })
+        .unwrap_or([100.0, 30.0]);
+    FixtureKind::Vise { opening, jaw }
+}
+
+/// `kind chuck`: the `diameter` range it grips, its `jaws` and `body`.
+fn chuck(cx: &mut Cx, p: &mut Props) -> FixtureKind {
+    let diameter = p
+        .req(cx, "diameter", "3 mm .. 200 mm")
+        .and_then(|v| length_range(cx, v, "diameter"))
+        .unwrap_or([1.0, 100.0]);
+    let jaws = length_or(cx, p, "jaws", "20 mm", 20.0);
+    let body = length_or(cx, p, "body", "200 mm", 200.0);
+    FixtureKind::Chuck {
+        diameter,
+        jaws,
+        body,
     }
 }
 
