@@ -44,30 +44,7 @@ pub(super) fn fixture(
                 .unwrap_or([0.0, 0.0]);
             FixtureKind::SinePlate { tilt }
         }
-        Some("mesh") => {
-            let file = p
-                .req(cx, "mesh", "\"nest.stl\"")
-                .and_then(|v| cx.string(v))
-                .cloned();
-            let unit_mm = p
-                .get("units")
-                .and_then(|v| cx.name(v).cloned())
-                .and_then(|u| super::part::length_unit(cx, &u))
-                .unwrap_or(1.0);
-            let up = p
-                .req(cx, "up", "+z")
-                .and_then(|v| cx.direction(v))
-                .unwrap_or([0.0, 0.0, 1.0]);
-            match file.and_then(|f| super::part::mesh_file(r, cx, &f).map(|path| (path, f.span))) {
-                Some((path, span)) => FixtureKind::Mesh {
-                    path,
-                    unit_mm,
-                    up,
-                    span,
-                },
-                None => FixtureKind::SinePlate { tilt: [0.0, 0.0] },
-            }
-        }
+        Some("mesh") => mesh_nest(r, cx, p),
         Some(other) => {
             if let Some((_, s)) = &word {
                 let help = suggest::help_for_unknown(
@@ -136,6 +113,32 @@ fn chuck(cx: &mut Cx, p: &mut Props) -> FixtureKind {
         diameter,
         jaws,
         body,
+    }
+}
+
+/// `kind mesh`: a nest from a mesh file, its `units` and which way is `up`.
+fn mesh_nest(r: &Resolver, cx: &mut Cx, p: &mut Props) -> FixtureKind {
+    let file = p
+        .req(cx, "mesh", "\"nest.stl\"")
+        .and_then(|v| cx.string(v))
+        .cloned();
+    let unit_mm = p
+        .get("units")
+        .and_then(|v| cx.name(v).cloned())
+        .and_then(|u| super::part::length_unit(cx, &u))
+        .unwrap_or(1.0);
+    let up = p
+        .req(cx, "up", "+z")
+        .and_then(|v| cx.direction(v))
+        .unwrap_or([0.0, 0.0, 1.0]);
+    match file.and_then(|f| super::part::mesh_file(r, cx, &f).map(|path| (path, f.span))) {
+        Some((path, span)) => FixtureKind::Mesh {
+            path,
+            unit_mm,
+            up,
+            span,
+        },
+        None => FixtureKind::SinePlate { tilt: [0.0, 0.0] },
     }
 }
 
