@@ -33,62 +33,26 @@ pub(super) fn lower(
             model.heads.push(head);
         }
         Kind::Stylus => {
-            let tip_ok = p
-                .req(cx, "tip", "2 mm")
-                .and_then(|v| cx.positive(v, Dim::Length, "tip"));
-            let tip = tip_ok.unwrap_or(1.0);
-            let length = p
-                .req(cx, "length", "20 mm")
-                .and_then(|v| cx.positive(v, Dim::Length, "length"))
-                .unwrap_or(1.0);
-            let stem_v = p.req(cx, "stem", "1.5 mm");
-            let stem_ok = stem_v.and_then(|v| cx.positive(v, Dim::Length, "stem"));
-            let stem = stem_ok.unwrap_or(0.5);
-            // Only two good values are compared: a bad one was reported already.
-            if let (Some(v), Some(_), Some(_)) = (stem_v, stem_ok, tip_ok) {
-                if stem >= tip {
-                    cx.err(E::StemThickerThanTip {
-                        span: v.span,
-                        name: name.clone(),
-                        stem: num(stem),
-                        tip: num(tip),
-                    });
-                }
-            }
-            describe_only(cx, &mut p);
-            model.styli.push(Stylus {
+            let stylus = stylus(cx, &mut p, name, span);
+            model.styli.push(stylus);
+        }
+        Kind::Body => {
+            let (diameter, length) = envelope(cx, &mut p);
+            model.bodies.push(Body {
                 name,
-                tip,
+                diameter,
                 length,
-                stem,
                 span,
             });
         }
-        Kind::Body | Kind::Extension => {
-            let diameter = p
-                .req(cx, "diameter", "13.2 mm")
-                .and_then(|v| cx.positive(v, Dim::Length, "diameter"))
-                .unwrap_or(1.0);
-            let length = p
-                .req(cx, "length", "30 mm")
-                .and_then(|v| cx.positive(v, Dim::Length, "length"))
-                .unwrap_or(1.0);
-            describe_only(cx, &mut p);
-            if kind == Kind::Body {
-                model.bodies.push(Body {
-                    name,
-                    diameter,
-                    length,
-                    span,
-                });
-            } else {
-                model.extensions.push(Extension {
-                    name,
-                    diameter,
-                    length,
-                    span,
-                });
-            }
+        Kind::Extension => {
+            let (diameter, length) = envelope(cx, &mut p);
+            model.extensions.push(Extension {
+                name,
+                diameter,
+                length,
+                span,
+            });
         }
         Kind::Probe => {
             let body = p
@@ -156,6 +120,54 @@ pub(super) fn lower(
         Kind::Part | Kind::Hierarchy | Kind::Plan => unreachable!("not a property item"),
     }
     p.finish(cx);
+}
+
+/// A stylus: its `tip`, `length` and `stem`, the stem thinner than the tip.
+fn stylus(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Stylus {
+    let tip_ok = p
+        .req(cx, "tip", "2 mm")
+        .and_then(|v| cx.positive(v, Dim::Length, "tip"));
+    let tip = tip_ok.unwrap_or(1.0);
+    let length = p
+        .req(cx, "length", "20 mm")
+        .and_then(|v| cx.positive(v, Dim::Length, "length"))
+        .unwrap_or(1.0);
+    let stem_v = p.req(cx, "stem", "1.5 mm");
+    let stem_ok = stem_v.and_then(|v| cx.positive(v, Dim::Length, "stem"));
+    let stem = stem_ok.unwrap_or(0.5);
+    // Only two good values are compared: a bad one was reported already.
+    if let (Some(v), Some(_), Some(_)) = (stem_v, stem_ok, tip_ok) {
+        if stem >= tip {
+            cx.err(E::StemThickerThanTip {
+                span: v.span,
+                name: name.clone(),
+                stem: num(stem),
+                tip: num(tip),
+            });
+        }
+    }
+    describe_only(cx, p);
+    Stylus {
+        name,
+        tip,
+        length,
+        stem,
+        span,
+    }
+}
+
+/// A probe body's or an extension's envelope: (diameter, length).
+fn envelope(cx: &mut Cx, p: &mut Props) -> (f64, f64) {
+    let diameter = p
+        .req(cx, "diameter", "13.2 mm")
+        .and_then(|v| cx.positive(v, Dim::Length, "diameter"))
+        .unwrap_or(1.0);
+    let length = p
+        .req(cx, "length", "30 mm")
+        .and_then(|v| cx.positive(v, Dim::Length, "length"))
+        .unwrap_or(1.0);
+    describe_only(cx, p);
+    (diameter, length)
 }
 
 fn head(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Head {
