@@ -55,40 +55,8 @@ pub(super) fn lower(
             });
         }
         Kind::Probe => {
-            let body = p
-                .req(cx, "body", "TP20_SF")
-                .and_then(|v| r.lookup_value(cx, module, v, Kind::Body))
-                .unwrap_or(0);
-            let stylus = p
-                .req(cx, "stylus", "M2_D2_L20")
-                .and_then(|v| r.lookup_value(cx, module, v, Kind::Stylus))
-                .unwrap_or(0);
-            let mut extensions = Vec::new();
-            if let Some(v) = p.get("extensions") {
-                match &v.kind {
-                    ValueKind::List(entries) => {
-                        for e in entries {
-                            if let Some(i) = r.lookup_value(cx, module, &e.value, Kind::Extension) {
-                                extensions.push(ExtensionId(i));
-                            }
-                        }
-                    }
-                    _ => cx.mismatch(v, "a list of extensions", "write `extensions [PEM20]`"),
-                }
-            }
-            let cost = p
-                .get("cost")
-                .and_then(|v| cx.non_negative(v, "cost"))
-                .unwrap_or(1.0);
-            describe_only(cx, &mut p);
-            model.probes.push(Probe {
-                name,
-                body: BodyId(body),
-                extensions,
-                stylus: StylusId(stylus),
-                cost,
-                span,
-            });
+            let probe = probe(r, cx, module, &mut p, name, span);
+            model.probes.push(probe);
         }
         Kind::Fixture => {
             let f = fixture(r, cx, &mut p, name, span);
@@ -103,19 +71,8 @@ pub(super) fn lower(
             model.cmms.push(cmm);
         }
         Kind::Sampling => {
-            let mut per_surface = Vec::new();
-            for s in SurfaceKind::ALL {
-                if let Some(v) = p.get(s.keyword()) {
-                    if let Some(st) = strategy(cx, v, Some(s)) {
-                        per_surface.push((s, st));
-                    }
-                }
-            }
-            model.samplings.push(Sampling {
-                name,
-                per_surface,
-                span,
-            });
+            let sampling = sampling(cx, &mut p, name, span);
+            model.samplings.push(sampling);
         }
         Kind::Part | Kind::Hierarchy | Kind::Plan => unreachable!("not a property item"),
     }
@@ -168,6 +125,68 @@ fn envelope(cx: &mut Cx, p: &mut Props) -> (f64, f64) {
         .unwrap_or(1.0);
     describe_only(cx, p);
     (diameter, length)
+}
+
+/// A probe: its `body`, `extensions` and `stylus` by name, and its `cost`.
+fn probe(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    p: &mut Props,
+    name: String,
+    span: crate::source::Span,
+) -> Probe {
+    let body = p
+        .req(cx, "body", "TP20_SF")
+        .and_then(|v| r.lookup_value(cx, module, v, Kind::Body))
+        .unwrap_or(0);
+    let stylus = p
+        .req(cx, "stylus", "M2_D2_L20")
+        .and_then(|v| r.lookup_value(cx, module, v, Kind::Stylus))
+        .unwrap_or(0);
+    let mut extensions = Vec::new();
+    if let Some(v) = p.get("extensions") {
+        match &v.kind {
+            ValueKind::List(entries) => {
+                for e in entries {
+                    if let Some(i) = r.lookup_value(cx, module, &e.value, Kind::Extension) {
+                        extensions.push(ExtensionId(i));
+                    }
+                }
+            }
+            _ => cx.mismatch(v, "a list of extensions", "write `extensions [PEM20]`"),
+        }
+    }
+    let cost = p
+        .get("cost")
+        .and_then(|v| cx.non_negative(v, "cost"))
+        .unwrap_or(1.0);
+    describe_only(cx, p);
+    Probe {
+        name,
+        body: BodyId(body),
+        extensions,
+        stylus: StylusId(stylus),
+        cost,
+        span,
+    }
+}
+
+/// A sampling: a strategy per surface type it names.
+fn sampling(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Sampling {
+    let mut per_surface = Vec::new();
+    for s in SurfaceKind::ALL {
+        if let Some(v) = p.get(s.keyword()) {
+            if let Some(st) = strategy(cx, v, Some(s)) {
+                per_surface.push((s, st));
+            }
+        }
+    }
+    Sampling {
+        name,
+        per_surface,
+        span,
+    }
 }
 
 fn head(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Head {
