@@ -296,51 +296,10 @@ fn cmm(
     name: String,
     span: crate::source::Span,
 ) -> Cmm {
-    let mut table_z = 0.0;
-    let mut table_size = None;
-    if let Some(v) = p.get("table") {
-        if let ValueKind::Block(props) = &v.kind {
-            let mut t = Props::new(cx, "the table", v.span, props);
-            if let Some(z) = t.get("z").and_then(|z| cx.length(z)) {
-                table_z = z;
-            }
-            if let Some(s) = t.get("size") {
-                if let Some(size) = cx.lengths::<2>(s) {
-                    if size.iter().any(|x| *x <= 0.0) {
-                        cx.err(E::NonPositive {
-                            span: s.span,
-                            what: "the table size".into(),
-                            value: describe(s),
-                            help: "give the table's length and width".into(),
-                        });
-                    } else {
-                        table_size = Some(size);
-                    }
-                }
-            }
-            t.finish(cx);
-        } else {
-            cx.mismatch(v, "a block `{ z 0 mm, size (…) }`", "");
-        }
-    }
-    let (mut ram_radius, mut ram_length) = (1.0, 1.0);
-    if let Some(v) = p.req(cx, "ram", "{ radius 35 mm, length 600 mm }") {
-        match &v.kind {
-            ValueKind::Block(props) => {
-                let mut t = Props::new(cx, "the ram", v.span, props);
-                ram_radius = t
-                    .req(cx, "radius", "35 mm")
-                    .and_then(|x| cx.positive(x, Dim::Length, "radius"))
-                    .unwrap_or(1.0);
-                ram_length = t
-                    .req(cx, "length", "600 mm")
-                    .and_then(|x| cx.positive(x, Dim::Length, "length"))
-                    .unwrap_or(1.0);
-                t.finish(cx);
-            }
-            _ => cx.mismatch(v, "a block `{ radius …, length … }`", ""),
-        }
-    }
+    let (table_z, table_size) = p.get("table").map_or((0.0, None), |v| table(cx, v));
+    let (ram_radius, ram_length) = p
+        .req(cx, "ram", "{ radius 35 mm, length 600 mm }")
+        .map_or((1.0, 1.0), |v| ram(cx, v));
     let head = p
         .req(cx, "head", "PH6")
         .and_then(|v| r.lookup_value(cx, module, v, Kind::Head))
@@ -424,6 +383,59 @@ fn cmm(
         fixture_labels,
         scanner_labels,
         span,
+    }
+}
+
+/// `table { z 0 mm, size (2000 mm, 1200 mm) }`: its height and, when given, its size.
+fn table(cx: &mut Cx, v: &ast::Value) -> (f64, Option<[f64; 2]>) {
+    let mut table_z = 0.0;
+    let mut table_size = None;
+    if let ValueKind::Block(props) = &v.kind {
+        let mut t = Props::new(cx, "the table", v.span, props);
+        if let Some(z) = t.get("z").and_then(|z| cx.length(z)) {
+            table_z = z;
+        }
+        if let Some(s) = t.get("size") {
+            if let Some(size) = cx.lengths::<2>(s) {
+                if size.iter().any(|x| *x <= 0.0) {
+                    cx.err(E::NonPositive {
+                        span: s.span,
+                        what: "the table size".into(),
+                        value: describe(s),
+                        help: "give the table's length and width".into(),
+                    });
+                } else {
+                    table_size = Some(size);
+                }
+            }
+        }
+        t.finish(cx);
+    } else {
+        cx.mismatch(v, "a block `{ z 0 mm, size (…) }`", "");
+    }
+    (table_z, table_size)
+}
+
+/// `ram { radius 35 mm, length 600 mm }`: (radius, length), 1 mm where one is wrong.
+fn ram(cx: &mut Cx, v: &ast::Value) -> (f64, f64) {
+    match &v.kind {
+        ValueKind::Block(props) => {
+            let mut t = Props::new(cx, "the ram", v.span, props);
+            let radius = t
+                .req(cx, "radius", "35 mm")
+                .and_then(|x| cx.positive(x, Dim::Length, "radius"))
+                .unwrap_or(1.0);
+            let length = t
+                .req(cx, "length", "600 mm")
+                .and_then(|x| cx.positive(x, Dim::Length, "length"))
+                .unwrap_or(1.0);
+            t.finish(cx);
+            (radius, length)
+        }
+        _ => {
+            cx.mismatch(v, "a block `{ radius …, length … }`", "");
+            (1.0, 1.0)
+        }
     }
 }
 
