@@ -304,47 +304,14 @@ fn cmm(
         .req(cx, "head", "PH6")
         .and_then(|v| r.lookup_value(cx, module, v, Kind::Head))
         .unwrap_or(0);
-    let mut probes: Vec<(String, ProbeId)> = Vec::new();
-    let mut probe_labels: Vec<crate::source::Span> = Vec::new();
-    if let Some(v) = p.req(cx, "probes", "[p1: TP20_D2_L20]") {
-        match &v.kind {
-            ValueKind::List(entries) if !entries.is_empty() => {
-                for (l, id, at) in
-                    labelled(r, cx, module, entries, Kind::Probe, "probe in the rack")
-                {
-                    probes.push((l, ProbeId(id)));
-                    probe_labels.push(at);
-                }
-            }
-            ValueKind::List(_) => cx.err(E::MissingProperty {
-                span: v.span,
-                key: "probes".into(),
-                item: format!("cmm `{name}`"),
-                help: "a CMM needs at least one probe: `probes [p1: TP20_D2_L20]`".into(),
-            }),
-            _ => cx.mismatch(v, "a list of probes", "write `probes [p1: TP20_D2_L20]`"),
-        }
-    }
-    let mut fixtures: Vec<(String, FixtureId)> = Vec::new();
-    let mut fixture_labels: Vec<crate::source::Span> = Vec::new();
-    if let Some(v) = p.get("fixtures") {
-        match &v.kind {
-            ValueKind::List(entries) => {
-                for (l, id, at) in labelled(
-                    r,
-                    cx,
-                    module,
-                    entries,
-                    Kind::Fixture,
-                    "fixture beside the CMM",
-                ) {
-                    fixtures.push((l, FixtureId(id)));
-                    fixture_labels.push(at);
-                }
-            }
-            _ => cx.mismatch(v, "a list of fixtures", "write `fixtures [vise: VISE_150]`"),
-        }
-    }
+    let (probes, probe_labels) = p
+        .req(cx, "probes", "[p1: TP20_D2_L20]")
+        .map(|v| rack_probes(r, cx, module, v, &name))
+        .unwrap_or_default();
+    let (fixtures, fixture_labels) = p
+        .get("fixtures")
+        .map(|v| cmm_fixtures(r, cx, module, v))
+        .unwrap_or_default();
     let mut scanners: Vec<(String, ScannerId)> = Vec::new();
     let mut scanner_labels: Vec<crate::source::Span> = Vec::new();
     if let Some(v) = p.get("scanners") {
@@ -437,6 +404,63 @@ fn ram(cx: &mut Cx, v: &ast::Value) -> (f64, f64) {
             (1.0, 1.0)
         }
     }
+}
+
+/// Labelled items of a CMM (its probes, fixtures or scanners) and where each label is.
+type Labelled<Id> = (Vec<(String, Id)>, Vec<crate::source::Span>);
+
+/// `probes [p1: TP20_D2_L20, …]`: the rack, at least one probe.
+fn rack_probes(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    v: &ast::Value,
+    cmm: &str,
+) -> Labelled<ProbeId> {
+    let mut out: Labelled<ProbeId> = Default::default();
+    match &v.kind {
+        ValueKind::List(entries) if !entries.is_empty() => {
+            for (l, id, at) in labelled(r, cx, module, entries, Kind::Probe, "probe in the rack") {
+                out.0.push((l, ProbeId(id)));
+                out.1.push(at);
+            }
+        }
+        ValueKind::List(_) => cx.err(E::MissingProperty {
+            span: v.span,
+            key: "probes".into(),
+            item: format!("cmm `{cmm}`"),
+            help: "a CMM needs at least one probe: `probes [p1: TP20_D2_L20]`".into(),
+        }),
+        _ => cx.mismatch(v, "a list of probes", "write `probes [p1: TP20_D2_L20]`"),
+    }
+    out
+}
+
+/// `fixtures [vise: VISE_150, …]`: the fixtures beside the CMM.
+fn cmm_fixtures(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    v: &ast::Value,
+) -> Labelled<FixtureId> {
+    let mut out: Labelled<FixtureId> = Default::default();
+    match &v.kind {
+        ValueKind::List(entries) => {
+            for (l, id, at) in labelled(
+                r,
+                cx,
+                module,
+                entries,
+                Kind::Fixture,
+                "fixture beside the CMM",
+            ) {
+                out.0.push((l, FixtureId(id)));
+                out.1.push(at);
+            }
+        }
+        _ => cx.mismatch(v, "a list of fixtures", "write `fixtures [vise: VISE_150]`"),
+    }
+    out
 }
 
 /// A laser line scanner: its optics (stripe, stand-off, depth of field, triangulation
