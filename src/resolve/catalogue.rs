@@ -312,30 +312,10 @@ fn cmm(
         .get("fixtures")
         .map(|v| cmm_fixtures(r, cx, module, v))
         .unwrap_or_default();
-    let mut scanners: Vec<(String, ScannerId)> = Vec::new();
-    let mut scanner_labels: Vec<crate::source::Span> = Vec::new();
-    if let Some(v) = p.get("scanners") {
-        match &v.kind {
-            ValueKind::List(entries) => {
-                for (l, id, at) in
-                    labelled(r, cx, module, entries, Kind::Scanner, "scanner in the rack")
-                {
-                    if probes.iter().any(|(pl, _)| *pl == l) {
-                        cx.err(E::DuplicateName {
-                            span: at,
-                            first: None,
-                            name: l,
-                            help: "a scanner and a probe of one rack need their own labels".into(),
-                        });
-                        continue;
-                    }
-                    scanners.push((l, ScannerId(id)));
-                    scanner_labels.push(at);
-                }
-            }
-            _ => cx.mismatch(v, "a list of scanners", "write `scanners [l1: LC15Dx]`"),
-        }
-    }
+    let (scanners, scanner_labels) = p
+        .get("scanners")
+        .map(|v| rack_scanners(r, cx, module, v, &probes))
+        .unwrap_or_default();
     Cmm {
         name,
         table_z,
@@ -459,6 +439,38 @@ fn cmm_fixtures(
             }
         }
         _ => cx.mismatch(v, "a list of fixtures", "write `fixtures [vise: VISE_150]`"),
+    }
+    out
+}
+
+/// `scanners [l1: LC15Dx, …]`: scanners in the rack, labelled apart from its probes.
+fn rack_scanners(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    v: &ast::Value,
+    probes: &[(String, ProbeId)],
+) -> Labelled<ScannerId> {
+    let mut out: Labelled<ScannerId> = Default::default();
+    match &v.kind {
+        ValueKind::List(entries) => {
+            for (l, id, at) in
+                labelled(r, cx, module, entries, Kind::Scanner, "scanner in the rack")
+            {
+                if probes.iter().any(|(pl, _)| *pl == l) {
+                    cx.err(E::DuplicateName {
+                        span: at,
+                        first: None,
+                        name: l,
+                        help: "a scanner and a probe of one rack need their own labels".into(),
+                    });
+                    continue;
+                }
+                out.0.push((l, ScannerId(id)));
+                out.1.push(at);
+            }
+        }
+        _ => cx.mismatch(v, "a list of scanners", "write `scanners [l1: LC15Dx]`"),
     }
     out
 }
