@@ -184,6 +184,17 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
             return vec![];
         }
     };
+    role_faces(cx, pc, path, source, rest)
+}
+
+/// The face `rest` names on the stock or an operation: exactly one of its roles.
+fn role_faces(
+    cx: &mut Cx,
+    pc: &PartCx,
+    path: &ast::Path,
+    source: FaceSource,
+    rest: &[PathSeg],
+) -> Vec<FaceRef> {
     let owner = match &source {
         FaceSource::Stock => "the stock".to_string(),
         FaceSource::Op(OpId(i), _) => {
@@ -218,7 +229,7 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
         _ => {
             let roles = known
                 .iter()
-                .map(|r| format!("`{}.{r}`", head.name))
+                .map(|r| format!("`{}.{r}`", path.head().name))
                 .collect::<Vec<_>>()
                 .join(", ");
             cx.err(E::TypeMismatch {
