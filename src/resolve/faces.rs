@@ -106,25 +106,31 @@ fn face_term(cx: &mut Cx, pc: &PartCx, t: &ast::FaceTerm, is_mesh: bool) -> Vec<
     }
 }
 
+/// The faces a path names: a feature's or a datum's, or one role of the stock or of an
+/// operation.
 fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
+    match path_head(cx, pc, path) {
+        PathHead::Faces(faces) => faces,
+        PathHead::Owner(source, rest) => role_faces(cx, pc, path, source, rest),
+    }
+}
+
+/// What the head of a face path stands for.
+enum PathHead<'p> {
+    /// Faces already: a feature's or a datum's, or none after an error.
+    Faces(Vec<FaceRef>),
+    /// The stock or an operation (instance), whose face the rest of the path names.
+    Owner(FaceSource, &'p [PathSeg]),
+}
+
+/// Resolves the first name of a face path (and an operation's `[i]`).
+fn path_head<'p>(cx: &mut Cx, pc: &PartCx, path: &'p ast::Path) -> PathHead<'p> {
     let head = path.head();
     let Some(local) = pc.local(cx, head) else {
-        let candidates: Vec<&str> = pc
-            .names
-            .iter()
-            .filter(|(_, (l, _))| matches!(l, Local::Feature(_) | Local::Op(_) | Local::Stock))
-            .map(|(n, _)| n.as_str())
-            .collect();
-        let help = suggest::help_for_unknown("face or feature", &head.name, candidates);
-        cx.err(E::UnknownName {
-            span: head.span,
-            what: "face or feature".into(),
-            name: head.name.clone(),
-            help,
-        });
-        return vec![];
+        unknown_head(cx, pc, head);
+        return PathHead::Faces(vec![]);
     };
-    let (source, rest) = match (local, &path.segs[1..]) {
+    match (local, &path.segs[1..]) {
         (Local::Feature(i), []) => {
             if i >= pc.lowered_features {
                 cx.err(E::UnknownName {
@@ -136,14 +142,14 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
                         head.name
                     ),
                 });
-                return vec![];
+                return PathHead::Faces(vec![]);
             }
-            return pc.part.features[i].faces.clone();
+            PathHead::Faces(pc.part.features[i].faces.clone())
         }
         (Local::Datum(i), []) if i < pc.part.datums.len() => {
-            return pc.part.features[pc.part.datums[i].feature.0].faces.clone()
+            PathHead::Faces(pc.part.features[pc.part.datums[i].feature.0].faces.clone())
         }
-        (Local::Stock, rest) => (FaceSource::Stock, rest),
+        (Local::Stock, rest) => PathHead::Owner(FaceSource::Stock, rest),
         (Local::Op(i), [PathSeg::Index(n, ispan), rest @ ..]) => {
             let count = pc.part.ops[i].pattern.as_ref().map(Pattern::count);
             match count {
@@ -157,7 +163,7 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
                             head.name
                         ),
                     });
-                    return vec![];
+                    PathHead::Faces(vec![])
                 }
                 Some(c) if *n >= c => {
                     cx.err(E::OutOfRange {
@@ -167,12 +173,12 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
                         range: format!("`{}` has instances 0 to {}", head.name, c - 1),
                         help: "instances are numbered from 0, row by row".into(),
                     });
-                    return vec![];
+                    PathHead::Faces(vec![])
                 }
-                Some(_) => (FaceSource::Op(OpId(i), Some(*n)), rest),
+                Some(_) => PathHead::Owner(FaceSource::Op(OpId(i), Some(*n)), rest),
             }
         }
-        (Local::Op(i), rest) => (FaceSource::Op(OpId(i), None), rest),
+        (Local::Op(i), rest) => PathHead::Owner(FaceSource::Op(OpId(i), None), rest),
         (other, _) => {
             cx.err(E::WrongKind {
                 span: path.span,
@@ -181,10 +187,26 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
                 found: other.word(&pc.part),
                 help: "name faces and features here".into(),
             });
-            return vec![];
+            PathHead::Faces(vec![])
         }
-    };
-    role_faces(cx, pc, path, source, rest)
+    }
+}
+
+/// Says a path's first name is no face, feature, operation or the stock.
+fn unknown_head(cx: &mut Cx, pc: &PartCx, head: &ast::Ident) {
+    let candidates: Vec<&str> = pc
+        .names
+        .iter()
+        .filter(|(_, (l, _))| matches!(l, Local::Feature(_) | Local::Op(_) | Local::Stock))
+        .map(|(n, _)| n.as_str())
+        .collect();
+    let help = suggest::help_for_unknown("face or feature", &head.name, candidates);
+    cx.err(E::UnknownName {
+        span: head.span,
+        what: "face or feature".into(),
+        name: head.name.clone(),
+        help,
+    });
 }
 
 /// The face `rest` names on the stock or an operation: exactly one of its roles.
