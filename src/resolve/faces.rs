@@ -151,31 +151,9 @@ fn path_head<'p>(cx: &mut Cx, pc: &PartCx, path: &'p ast::Path) -> PathHead<'p> 
         }
         (Local::Stock, rest) => PathHead::Owner(FaceSource::Stock, rest),
         (Local::Op(i), [PathSeg::Index(n, ispan), rest @ ..]) => {
-            let count = pc.part.ops[i].pattern.as_ref().map(Pattern::count);
-            match count {
-                None => {
-                    cx.err(E::TypeMismatch {
-                        span: *ispan,
-                        expected: "no index".into(),
-                        found: format!("`[{n}]`"),
-                        help: format!(
-                            "`{}` is not a pattern; only patterned operations have instances",
-                            head.name
-                        ),
-                    });
-                    PathHead::Faces(vec![])
-                }
-                Some(c) if *n >= c => {
-                    cx.err(E::OutOfRange {
-                        span: *ispan,
-                        what: "instance".into(),
-                        value: n.to_string(),
-                        range: format!("`{}` has instances 0 to {}", head.name, c - 1),
-                        help: "instances are numbered from 0, row by row".into(),
-                    });
-                    PathHead::Faces(vec![])
-                }
-                Some(_) => PathHead::Owner(FaceSource::Op(OpId(i), Some(*n)), rest),
+            match instance(cx, pc, head, i, *n, *ispan) {
+                Some(source) => PathHead::Owner(source, rest),
+                None => PathHead::Faces(vec![]),
             }
         }
         (Local::Op(i), rest) => PathHead::Owner(FaceSource::Op(OpId(i), None), rest),
@@ -207,6 +185,43 @@ fn unknown_head(cx: &mut Cx, pc: &PartCx, head: &ast::Ident) {
         name: head.name.clone(),
         help,
     });
+}
+
+/// Instance `[n]` of operation `i`: only a pattern has instances, numbered from 0.
+fn instance(
+    cx: &mut Cx,
+    pc: &PartCx,
+    head: &ast::Ident,
+    i: usize,
+    n: u32,
+    ispan: Span,
+) -> Option<FaceSource> {
+    let count = pc.part.ops[i].pattern.as_ref().map(Pattern::count);
+    match count {
+        None => {
+            cx.err(E::TypeMismatch {
+                span: ispan,
+                expected: "no index".into(),
+                found: format!("`[{n}]`"),
+                help: format!(
+                    "`{}` is not a pattern; only patterned operations have instances",
+                    head.name
+                ),
+            });
+            None
+        }
+        Some(c) if n >= c => {
+            cx.err(E::OutOfRange {
+                span: ispan,
+                what: "instance".into(),
+                value: n.to_string(),
+                range: format!("`{}` has instances 0 to {}", head.name, c - 1),
+                help: "instances are numbered from 0, row by row".into(),
+            });
+            None
+        }
+        Some(_) => Some(FaceSource::Op(OpId(i), Some(n))),
+    }
 }
 
 /// The face `rest` names on the stock or an operation: exactly one of its roles.
