@@ -116,28 +116,7 @@ impl Model {
     pub fn describe(&self, item: ItemRef) -> String {
         let mut o = String::new();
         match item {
-            ItemRef::Head(i) => {
-                let h = &self.heads[i];
-                let kind = match &h.kind {
-                    HeadKind::Fixed => "fixed".to_string(),
-                    HeadKind::Indexable { a, b, step } => format!(
-                        "indexable A {}..{} B {}..{} step {} ({} orientations)",
-                        fmt_num(a[0]),
-                        fmt_num(a[1]),
-                        fmt_num(b[0]),
-                        fmt_num(b[1]),
-                        fmt_num(*step),
-                        h.orientations().len()
-                    ),
-                };
-                let _ = writeln!(
-                    o,
-                    "head {}: {kind}, envelope Ø{} × {}",
-                    h.name,
-                    fmt_num(h.diameter),
-                    fmt_num(h.length)
-                );
-            }
+            ItemRef::Head(i) => head_summary(&mut o, &self.heads[i]),
             ItemRef::Stylus(i) => {
                 let s = &self.styli[i];
                 let _ = writeln!(
@@ -231,26 +210,7 @@ impl Model {
                     o.push_str(&self.describe(ItemRef::Fixture(f.0)));
                 }
             }
-            ItemRef::Scanner(i) => {
-                let s = &self.scanners[i];
-                let _ = writeln!(
-                    o,
-                    "scanner {}: stripe {} at stand-off {} ± {}, triangulation {}°, incidence ≤ {}°, \
-                     spacing {} × {}, accuracy {}, body Ø{} × {}, cost {}",
-                    s.name,
-                    fmt_num(s.stripe_width),
-                    fmt_num(s.standoff),
-                    fmt_num(s.depth_of_field / 2.0),
-                    fmt_num(s.triangulation),
-                    fmt_num(s.max_incidence),
-                    fmt_num(s.spacing[0]),
-                    fmt_num(s.spacing[1]),
-                    fmt_num(s.accuracy),
-                    fmt_num(s.body[0]),
-                    fmt_num(s.body[1]),
-                    fmt_num(s.cost)
-                );
-            }
+            ItemRef::Scanner(i) => scanner_summary(&mut o, &self.scanners[i]),
             ItemRef::Fixture(i) => {
                 let f = &self.fixtures[i];
                 let r = |x: &[f64; 2], unit: &str| {
@@ -412,6 +372,50 @@ impl Model {
         }
         used
     }
+}
+
+/// `head NAME: fixed|indexable …, envelope Ø… × …`
+fn head_summary(o: &mut String, h: &Head) {
+    let kind = match &h.kind {
+        HeadKind::Fixed => "fixed".to_string(),
+        HeadKind::Indexable { a, b, step } => format!(
+            "indexable A {}..{} B {}..{} step {} ({} orientations)",
+            fmt_num(a[0]),
+            fmt_num(a[1]),
+            fmt_num(b[0]),
+            fmt_num(b[1]),
+            fmt_num(*step),
+            h.orientations().len()
+        ),
+    };
+    let _ = writeln!(
+        o,
+        "head {}: {kind}, envelope Ø{} × {}",
+        h.name,
+        fmt_num(h.diameter),
+        fmt_num(h.length)
+    );
+}
+
+/// `scanner NAME: stripe … at stand-off …`, its optics, accuracy, housing and cost.
+fn scanner_summary(o: &mut String, s: &Scanner) {
+    let _ = writeln!(
+        o,
+        "scanner {}: stripe {} at stand-off {} ± {}, triangulation {}°, incidence ≤ {}°, \
+         spacing {} × {}, accuracy {}, body Ø{} × {}, cost {}",
+        s.name,
+        fmt_num(s.stripe_width),
+        fmt_num(s.standoff),
+        fmt_num(s.depth_of_field / 2.0),
+        fmt_num(s.triangulation),
+        fmt_num(s.max_incidence),
+        fmt_num(s.spacing[0]),
+        fmt_num(s.spacing[1]),
+        fmt_num(s.accuracy),
+        fmt_num(s.body[0]),
+        fmt_num(s.body[1]),
+        fmt_num(s.cost)
+    );
 }
 
 fn strategy_text(s: &Strategy) -> String {
