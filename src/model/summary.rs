@@ -148,68 +148,8 @@ impl Model {
                     fmt_num(e.length)
                 );
             }
-            ItemRef::Probe(i) => {
-                let p = &self.probes[i];
-                let ext: Vec<&str> = p
-                    .extensions
-                    .iter()
-                    .map(|e| self.extensions[e.0].name.as_str())
-                    .collect();
-                let _ = writeln!(
-                    o,
-                    "probe {}: body {}, extensions [{}], stylus {}, cost {}",
-                    p.name,
-                    self.bodies[p.body.0].name,
-                    ext.join(", "),
-                    self.styli[p.stylus.0].name,
-                    fmt_num(p.cost)
-                );
-            }
-            ItemRef::Cmm(i) => {
-                let c = &self.cmms[i];
-                let probes: Vec<String> = c
-                    .probes
-                    .iter()
-                    .map(|(l, p)| format!("{l}: {}", self.probes[p.0].name))
-                    .collect();
-                let size = c.table_size.map_or(String::new(), |s| {
-                    format!(" size {} × {}", fmt_num(s[0]), fmt_num(s[1]))
-                });
-                let fixtures: Vec<String> = c
-                    .fixtures
-                    .iter()
-                    .map(|(l, f)| format!("{l}: {}", self.fixtures[f.0].name))
-                    .collect();
-                let fixtures = if fixtures.is_empty() {
-                    String::new()
-                } else {
-                    format!(", fixtures [{}]", fixtures.join(", "))
-                };
-                let scanners: Vec<String> = c
-                    .scanners
-                    .iter()
-                    .map(|(l, s)| format!("{l}: {}", self.scanners[s.0].name))
-                    .collect();
-                let fixtures = if scanners.is_empty() {
-                    fixtures
-                } else {
-                    format!("{fixtures}, scanners [{}]", scanners.join(", "))
-                };
-                let _ = writeln!(
-                    o,
-                    "cmm {}: table z {}{size}, ram r {} l {}, head {}, probes [{}]{fixtures}",
-                    c.name,
-                    fmt_num(c.table_z),
-                    fmt_num(c.ram_radius),
-                    fmt_num(c.ram_length),
-                    self.heads[c.head.0].name,
-                    probes.join(", ")
-                );
-                for (_, f) in &c.fixtures {
-                    o.push_str("  ");
-                    o.push_str(&self.describe(ItemRef::Fixture(f.0)));
-                }
-            }
+            ItemRef::Probe(i) => self.probe_summary(&mut o, &self.probes[i]),
+            ItemRef::Cmm(i) => self.cmm_summary(&mut o, &self.cmms[i]),
             ItemRef::Scanner(i) => scanner_summary(&mut o, &self.scanners[i]),
             ItemRef::Fixture(i) => {
                 let f = &self.fixtures[i];
@@ -274,6 +214,70 @@ impl Model {
             ItemRef::Plan(i) => self.plan_summary(&mut o, &self.plans[i]),
         }
         o
+    }
+
+    /// `probe NAME: body …, extensions […], stylus …, cost …`
+    fn probe_summary(&self, o: &mut String, p: &Probe) {
+        let ext: Vec<&str> = p
+            .extensions
+            .iter()
+            .map(|e| self.extensions[e.0].name.as_str())
+            .collect();
+        let _ = writeln!(
+            o,
+            "probe {}: body {}, extensions [{}], stylus {}, cost {}",
+            p.name,
+            self.bodies[p.body.0].name,
+            ext.join(", "),
+            self.styli[p.stylus.0].name,
+            fmt_num(p.cost)
+        );
+    }
+
+    /// A CMM's line, then each of its fixtures indented.
+    fn cmm_summary(&self, o: &mut String, c: &Cmm) {
+        let probes: Vec<String> = c
+            .probes
+            .iter()
+            .map(|(l, p)| format!("{l}: {}", self.probes[p.0].name))
+            .collect();
+        let size = c.table_size.map_or(String::new(), |s| {
+            format!(" size {} × {}", fmt_num(s[0]), fmt_num(s[1]))
+        });
+        let fixtures: Vec<String> = c
+            .fixtures
+            .iter()
+            .map(|(l, f)| format!("{l}: {}", self.fixtures[f.0].name))
+            .collect();
+        let fixtures = if fixtures.is_empty() {
+            String::new()
+        } else {
+            format!(", fixtures [{}]", fixtures.join(", "))
+        };
+        let scanners: Vec<String> = c
+            .scanners
+            .iter()
+            .map(|(l, s)| format!("{l}: {}", self.scanners[s.0].name))
+            .collect();
+        let fixtures = if scanners.is_empty() {
+            fixtures
+        } else {
+            format!("{fixtures}, scanners [{}]", scanners.join(", "))
+        };
+        let _ = writeln!(
+            o,
+            "cmm {}: table z {}{size}, ram r {} l {}, head {}, probes [{}]{fixtures}",
+            c.name,
+            fmt_num(c.table_z),
+            fmt_num(c.ram_radius),
+            fmt_num(c.ram_length),
+            self.heads[c.head.0].name,
+            probes.join(", ")
+        );
+        for (_, f) in &c.fixtures {
+            o.push_str("  ");
+            o.push_str(&self.describe(ItemRef::Fixture(f.0)));
+        }
     }
 
     fn plan_summary(&self, o: &mut String, p: &Plan) {
