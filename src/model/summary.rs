@@ -151,46 +151,7 @@ impl Model {
             ItemRef::Probe(i) => self.probe_summary(&mut o, &self.probes[i]),
             ItemRef::Cmm(i) => self.cmm_summary(&mut o, &self.cmms[i]),
             ItemRef::Scanner(i) => scanner_summary(&mut o, &self.scanners[i]),
-            ItemRef::Fixture(i) => {
-                let f = &self.fixtures[i];
-                let r = |x: &[f64; 2], unit: &str| {
-                    format!("{} {unit} .. {} {unit}", fmt_num(x[0]), fmt_num(x[1]))
-                };
-                let what = match &f.kind {
-                    FixtureKind::Vise { opening, jaw } => format!(
-                        "opening {} mm, jaw {} × {} mm",
-                        fmt_num(*opening),
-                        fmt_num(jaw[0]),
-                        fmt_num(jaw[1])
-                    ),
-                    FixtureKind::Chuck {
-                        diameter,
-                        jaws,
-                        body,
-                    } => format!(
-                        "diameter {}, jaws {} mm, body {} mm",
-                        r(diameter, "mm"),
-                        fmt_num(*jaws),
-                        fmt_num(*body)
-                    ),
-                    FixtureKind::VBlock { diameter } => format!("diameter {}", r(diameter, "mm")),
-                    FixtureKind::SinePlate { tilt } => format!("tilt {}", r(tilt, "deg")),
-                    FixtureKind::Mesh {
-                        path, unit_mm, up, ..
-                    } => format!(
-                        "file {}, units ×{}, up {}",
-                        path.file_name()
-                            .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
-                        fmt_num(*unit_mm),
-                        v3(up)
-                    ),
-                };
-                let height = match f.kind {
-                    FixtureKind::Mesh { .. } => String::new(),
-                    _ => format!(", height {} mm", fmt_num(f.height)),
-                };
-                let _ = writeln!(o, "fixture {}: {} {what}{height}", f.name, f.kind.word());
-            }
+            ItemRef::Fixture(i) => fixture_summary(&mut o, &self.fixtures[i]),
             ItemRef::Hierarchy(i) => {
                 let h = &self.hierarchies[i];
                 let levels: Vec<String> = h.levels.iter().map(|l| l.text()).collect();
@@ -420,6 +381,46 @@ fn scanner_summary(o: &mut String, s: &Scanner) {
         fmt_num(s.body[1]),
         fmt_num(s.cost)
     );
+}
+
+/// `fixture NAME: kind sizes, height …` (a mesh nest: its file, units and up).
+fn fixture_summary(o: &mut String, f: &Fixture) {
+    let r =
+        |x: &[f64; 2], unit: &str| format!("{} {unit} .. {} {unit}", fmt_num(x[0]), fmt_num(x[1]));
+    let what = match &f.kind {
+        FixtureKind::Vise { opening, jaw } => format!(
+            "opening {} mm, jaw {} × {} mm",
+            fmt_num(*opening),
+            fmt_num(jaw[0]),
+            fmt_num(jaw[1])
+        ),
+        FixtureKind::Chuck {
+            diameter,
+            jaws,
+            body,
+        } => format!(
+            "diameter {}, jaws {} mm, body {} mm",
+            r(diameter, "mm"),
+            fmt_num(*jaws),
+            fmt_num(*body)
+        ),
+        FixtureKind::VBlock { diameter } => format!("diameter {}", r(diameter, "mm")),
+        FixtureKind::SinePlate { tilt } => format!("tilt {}", r(tilt, "deg")),
+        FixtureKind::Mesh {
+            path, unit_mm, up, ..
+        } => format!(
+            "file {}, units ×{}, up {}",
+            path.file_name()
+                .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+            fmt_num(*unit_mm),
+            v3(up)
+        ),
+    };
+    let height = match f.kind {
+        FixtureKind::Mesh { .. } => String::new(),
+        _ => format!(", height {} mm", fmt_num(f.height)),
+    };
+    let _ = writeln!(o, "fixture {}: {} {what}{height}", f.name, f.kind.word());
 }
 
 fn strategy_text(s: &Strategy) -> String {
