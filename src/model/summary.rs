@@ -447,31 +447,7 @@ fn strategy_text(s: &Strategy) -> String {
 }
 
 fn part_summary(o: &mut String, p: &Part) {
-    let geometry = match &p.geometry {
-        Geometry::Stock(Stock::Box { size }) => format!("box {}", v3(size)),
-        Geometry::Stock(Stock::Cylinder { diameter, height }) => {
-            format!("cylinder Ø{} × {}", fmt_num(*diameter), fmt_num(*height))
-        }
-        Geometry::Stock(Stock::Sphere { diameter }) => format!("sphere Ø{}", fmt_num(*diameter)),
-        Geometry::Mesh {
-            path,
-            unit_mm,
-            chord_mm,
-            ..
-        } => {
-            let name = path
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            match CadKind::of_path(path) {
-                Some(_) => format!(
-                    "CAD {name} (in the file's unit, chord {} mm)",
-                    fmt_num(chord_mm.unwrap_or(crate::geometry::step::RESOLUTION.chord_mm))
-                ),
-                None => format!("mesh {name} (× {} mm)", fmt_num(*unit_mm)),
-            }
-        }
-    };
+    let geometry = geometry_text(&p.geometry);
     let _ = writeln!(o, "part {}: {geometry}", p.name);
     for op in &p.ops {
         let verb = op.action.keyword();
@@ -583,6 +559,35 @@ fn part_summary(o: &mut String, p: &Part) {
     }
     for t in &p.tolerances {
         let _ = writeln!(o, "  {}", t.text(p));
+    }
+}
+
+/// A part's geometry source: a stock shape, a CAD file or a mesh.
+fn geometry_text(geometry: &Geometry) -> String {
+    match geometry {
+        Geometry::Stock(Stock::Box { size }) => format!("box {}", v3(size)),
+        Geometry::Stock(Stock::Cylinder { diameter, height }) => {
+            format!("cylinder Ø{} × {}", fmt_num(*diameter), fmt_num(*height))
+        }
+        Geometry::Stock(Stock::Sphere { diameter }) => format!("sphere Ø{}", fmt_num(*diameter)),
+        Geometry::Mesh {
+            path,
+            unit_mm,
+            chord_mm,
+            ..
+        } => {
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            match CadKind::of_path(path) {
+                Some(_) => format!(
+                    "CAD {name} (in the file's unit, chord {} mm)",
+                    fmt_num(chord_mm.unwrap_or(crate::geometry::step::RESOLUTION.chord_mm))
+                ),
+                None => format!("mesh {name} (× {} mm)", fmt_num(*unit_mm)),
+            }
+        }
     }
 }
 
