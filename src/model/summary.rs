@@ -451,101 +451,8 @@ fn part_summary(o: &mut String, p: &Part) {
     let _ = writeln!(o, "part {}: {geometry}", p.name);
     for op in &p.ops {
         let verb = op.action.keyword();
-        let shape = match &op.kind {
-            OpKind::Hole {
-                at,
-                axis,
-                diameter,
-                depth,
-            } => {
-                let at = match at {
-                    Placement::At(p) => format!("at {}", v3(p)),
-                    Placement::Radial(d) => format!("radial {}", v3(d)),
-                };
-                let depth = match depth {
-                    Depth::Through => "through".to_string(),
-                    Depth::Blind(d) => format!("depth {}", fmt_num(*d)),
-                };
-                format!(
-                    "hole {at} axis {} Ø{} {depth}",
-                    v3(axis),
-                    fmt_num(*diameter)
-                )
-            }
-            OpKind::Slot {
-                at,
-                along,
-                into,
-                width,
-                depth,
-                length,
-            } => format!(
-                "slot at {} along {} into {} width {} depth {}{}",
-                v3(at),
-                v3(along),
-                v3(into),
-                fmt_num(*width),
-                fmt_num(*depth),
-                length.map_or(String::new(), |l| format!(" length {}", fmt_num(l)))
-            ),
-            OpKind::Pocket {
-                at,
-                along,
-                into,
-                size,
-                depth,
-                corner_radius,
-            } => format!(
-                "pocket at {} along {} into {} size {} × {} depth {} corner r {}",
-                v3(at),
-                v3(along),
-                v3(into),
-                fmt_num(size[0]),
-                fmt_num(size[1]),
-                fmt_num(*depth),
-                fmt_num(*corner_radius)
-            ),
-            OpKind::Step {
-                at,
-                along,
-                into,
-                width,
-                depth,
-            } => format!(
-                "step at {} along {} into {} width {} depth {}",
-                v3(at),
-                v3(along),
-                v3(into),
-                fmt_num(*width),
-                fmt_num(*depth)
-            ),
-            OpKind::Boss {
-                at,
-                axis,
-                diameter,
-                height,
-            } => format!(
-                "boss at {} axis {} Ø{} height {}",
-                v3(at),
-                v3(axis),
-                fmt_num(*diameter),
-                fmt_num(*height)
-            ),
-        };
-        let pattern = match &op.pattern {
-            None => String::new(),
-            Some(Pattern::Grid { nx, ny, pitch }) => format!(
-                " × grid {nx}×{ny} pitch {} × {}",
-                fmt_num(pitch[0]),
-                fmt_num(pitch[1])
-            ),
-            Some(Pattern::Linear { count, step }) => format!(" × linear {count} step {}", v3(step)),
-            Some(Pattern::Polar {
-                count,
-                axis,
-                center,
-            }) => format!(" × polar {count} about {} through {}", v3(axis), v3(center)),
-        };
+        let shape = op_shape_text(&op.kind);
+        let pattern = pattern_text(op.pattern.as_ref());
         let _ = writeln!(o, "  {verb} {}: {shape}{pattern}", op.name);
     }
     for f in &p.features {
@@ -588,6 +495,109 @@ fn geometry_text(geometry: &Geometry) -> String {
                 None => format!("mesh {name} (× {} mm)", fmt_num(*unit_mm)),
             }
         }
+    }
+}
+
+/// An operation's kind and sizes: `hole at … axis … Ø… depth …`, `slot at …`, ….
+fn op_shape_text(kind: &OpKind) -> String {
+    match kind {
+        OpKind::Hole {
+            at,
+            axis,
+            diameter,
+            depth,
+        } => {
+            let at = match at {
+                Placement::At(p) => format!("at {}", v3(p)),
+                Placement::Radial(d) => format!("radial {}", v3(d)),
+            };
+            let depth = match depth {
+                Depth::Through => "through".to_string(),
+                Depth::Blind(d) => format!("depth {}", fmt_num(*d)),
+            };
+            format!(
+                "hole {at} axis {} Ø{} {depth}",
+                v3(axis),
+                fmt_num(*diameter)
+            )
+        }
+        OpKind::Slot {
+            at,
+            along,
+            into,
+            width,
+            depth,
+            length,
+        } => format!(
+            "slot at {} along {} into {} width {} depth {}{}",
+            v3(at),
+            v3(along),
+            v3(into),
+            fmt_num(*width),
+            fmt_num(*depth),
+            length.map_or(String::new(), |l| format!(" length {}", fmt_num(l)))
+        ),
+        OpKind::Pocket {
+            at,
+            along,
+            into,
+            size,
+            depth,
+            corner_radius,
+        } => format!(
+            "pocket at {} along {} into {} size {} × {} depth {} corner r {}",
+            v3(at),
+            v3(along),
+            v3(into),
+            fmt_num(size[0]),
+            fmt_num(size[1]),
+            fmt_num(*depth),
+            fmt_num(*corner_radius)
+        ),
+        OpKind::Step {
+            at,
+            along,
+            into,
+            width,
+            depth,
+        } => format!(
+            "step at {} along {} into {} width {} depth {}",
+            v3(at),
+            v3(along),
+            v3(into),
+            fmt_num(*width),
+            fmt_num(*depth)
+        ),
+        OpKind::Boss {
+            at,
+            axis,
+            diameter,
+            height,
+        } => format!(
+            "boss at {} axis {} Ø{} height {}",
+            v3(at),
+            v3(axis),
+            fmt_num(*diameter),
+            fmt_num(*height)
+        ),
+    }
+}
+
+/// An operation's pattern after its shape (` × grid 3×2 pitch …`); empty without one.
+fn pattern_text(pattern: Option<&Pattern>) -> String {
+    match pattern {
+        None => String::new(),
+        Some(Pattern::Grid { nx, ny, pitch }) => format!(
+            " × grid {nx}×{ny} pitch {} × {}",
+            fmt_num(pitch[0]),
+            fmt_num(pitch[1])
+        ),
+        Some(Pattern::Linear { count, step }) => format!(" × linear {count} step {}", v3(step)),
+        Some(Pattern::Polar {
+            count,
+            axis,
+            center,
+        }) => format!(" × polar {count} about {} through {}", v3(axis), v3(center)),
     }
 }
 
