@@ -195,43 +195,9 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
         order: Vec::new(),
         used_names: BTreeSet::new(),
     };
-    // Datums: a letter per datum with faces; common datums (A-B) become a two-letter
-    // datum on the union of their features.
-    let mut datum_lines = Vec::new();
-    let mut datum_notes = Vec::new();
-    let mut datum_feature: BTreeMap<String, Vec<usize>> = BTreeMap::new();
-    let mut seen_letters = BTreeSet::new();
-    for d in &p.datums {
-        if !seen_letters.insert(d.letter.clone()) {
-            continue;
-        }
-        if d.faces.is_empty() {
-            left_out(
-                &mut datum_notes,
-                format!("datum {}", d.letter),
-                "the file links it to no face",
-            );
-            continue;
-        }
-        let name = feats.name(&d.faces, Some(format!("datum_{}", d.letter.to_lowercase())));
-        datum_feature.insert(d.letter.clone(), d.faces.clone());
-        if d.located {
-            let targets: Vec<String> = d
-                .targets
-                .iter()
-                .map(|t| format!("{} {}", t.kind, t.label))
-                .collect();
-            datum_lines.push(format!(
-                "    // Datum {} is set up by targets ({}) that the file places on no face; they lie on {}. inspc has no datum targets: the datum is those whole faces. Check it against the drawing.",
-                d.letter,
-                targets.join(", "),
-                faces_text(&d.faces)
-            ));
-        }
-        datum_lines.push(format!("    datum {} = {name}", d.letter));
-    }
+    let datums = datum_lines(p, &mut feats);
     let mut frames = Frames {
-        datum_feature,
+        datum_feature: datums.features,
         common: BTreeMap::new(),
     };
     let mut used_tol_names = BTreeSet::new();
@@ -424,15 +390,8 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
         written_dims += 1;
     }
 
-    // Common datums: their feature and letter, after the plain ones.
-    for (letter, (parts, faces)) in &frames.common {
-        datum_lines.push(format!(
-            "    // Common datum {}: one datum on both features.",
-            parts.join("-")
-        ));
-        let f = feats.name(faces, None);
-        datum_lines.push(format!("    datum {letter} = {f}"));
-    }
+    let mut datum_lines = datums.lines;
+    common_datum_lines(&frames, &mut feats, &mut datum_lines);
 
     let text = render(
         part,
@@ -440,7 +399,7 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
         opts,
         &feats,
         &datum_lines,
-        &datum_notes,
+        &datums.notes,
         &tol_lines,
         &dim_lines,
     );
@@ -448,9 +407,76 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
         // In the layout `inspc fmt` gives, so a formatted repository stays formatted.
         text: crate::fmt::format(&text),
         faces: part.solid_faces(),
-        datums: (seen_letters.len(), frames.datum_feature.len()),
+        datums: (datums.letters, frames.datum_feature.len()),
         tolerances: (p.tolerances.len(), written_tols),
         dimensions: (p.dimensions.len(), written_dims),
+    }
+}
+
+/// The datums of the PMI as the spec writes them.
+struct DatumLines {
+    /// `datum A = datum_a`, with a comment before a datum set up by targets.
+    lines: Vec<String>,
+    /// Comments for the datums left out.
+    notes: Vec<String>,
+    /// The faces of each datum written, by letter.
+    features: BTreeMap<String, Vec<usize>>,
+    /// The distinct letters the PMI has.
+    letters: usize,
+}
+
+/// Datums: a letter per datum with faces, each named as a feature `datum_<letter>`.
+fn datum_lines(p: &pmi::Pmi, feats: &mut Features) -> DatumLines {
+    let mut lines = Vec::new();
+    let mut notes = Vec::new();
+    let mut features: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+    let mut seen_letters = BTreeSet::new();
+    for d in &p.datums {
+        if !seen_letters.insert(d.letter.clone()) {
+            continue;
+        }
+        if d.faces.is_empty() {
+            left_out(
+                &mut notes,
+                format!("datum {}", d.letter),
+                "the file links it to no face",
+            );
+            continue;
+        }
+        let name = feats.name(&d.faces, Some(format!("datum_{}", d.letter.to_lowercase())));
+        features.insert(d.letter.clone(), d.faces.clone());
+        if d.located {
+            let targets: Vec<String> = d
+                .targets
+                .iter()
+                .map(|t| format!("{} {}", t.kind, t.label))
+                .collect();
+            lines.push(format!(
+                "    // Datum {} is set up by targets ({}) that the file places on no face; they lie on {}. inspc has no datum targets: the datum is those whole faces. Check it against the drawing.",
+                d.letter,
+                targets.join(", "),
+                faces_text(&d.faces)
+            ));
+        }
+        lines.push(format!("    datum {} = {name}", d.letter));
+    }
+    DatumLines {
+        lines,
+        notes,
+        features,
+        letters: seen_letters.len(),
+    }
+}
+
+/// Common datums (A-B) the frames made: their feature and letter, after the plain ones.
+fn common_datum_lines(frames: &Frames, feats: &mut Features, lines: &mut Vec<String>) {
+    for (letter, (parts, faces)) in &frames.common {
+        lines.push(format!(
+            "    // Common datum {}: one datum on both features.",
+            parts.join("-")
+        ));
+        let f = feats.name(faces, None);
+        lines.push(format!("    datum {letter} = {f}"));
     }
 }
 
