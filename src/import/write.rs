@@ -201,120 +201,8 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
         common: BTreeMap::new(),
     };
     let mut used_tol_names = BTreeSet::new();
-    let mut tol_lines = Vec::new();
-    let mut written_tols = 0;
-    for t in &p.tolerances {
-        let label = format!("`{}` (#{})", t.name, t.id);
-        let Some(kind) = t.kind else {
-            left_out(&mut tol_lines, label, "the file states no tolerance type");
-            continue;
-        };
-        let Some(rule) = accepts(kind) else {
-            left_out(&mut tol_lines, label, "inspc has no such tolerance type");
-            continue;
-        };
-        if t.faces.is_empty() {
-            left_out(&mut tol_lines, label, "the file links it to no face");
-            continue;
-        }
-        let mut datums = Vec::new();
-        let mut why_not = None;
-        for d in &t.datums {
-            match frames.letter(&d.letters, &mut feats) {
-                Ok(l) => {
-                    let letter = match d.material {
-                        Some(Material::Mmc) => format!("{l}(MMC)"),
-                        Some(Material::Lmc) => format!("{l}(LMC)"),
-                        _ => l.clone(),
-                    };
-                    datums.push((l, letter));
-                }
-                Err(e) => why_not = Some(e),
-            }
-        }
-        let letters: Vec<&String> = datums.iter().map(|(l, _)| l).collect();
-        if letters.iter().collect::<BTreeSet<_>>().len() < letters.len() {
-            why_not = Some("its frame names a datum twice".to_string());
-        }
-        match rule.datums {
-            Datums::Forbidden if !datums.is_empty() => {
-                why_not = Some(format!("{} takes no datums", rule.keyword))
-            }
-            Datums::Required if datums.is_empty() && why_not.is_none() => {
-                why_not = Some(format!(
-                    "{} needs a datum and the frame has none",
-                    rule.keyword
-                ))
-            }
-            _ => {}
-        }
-        if kind == TolKind::Angularity {
-            why_not = Some("its basic angle is not in the PMI".to_string());
-        }
-        // A datum feature is not toleranced relative to its own datum.
-        for (l, _) in &datums {
-            let own = frames
-                .datum_feature
-                .get(l)
-                .or_else(|| frames.common.get(l).map(|(_, f)| f));
-            if own == Some(&t.faces) {
-                why_not = Some(format!(
-                    "it refers to datum {l}, whose feature it tolerances"
-                ));
-            }
-        }
-        if let Some(why) = why_not {
-            left_out(&mut tol_lines, label, &why);
-            continue;
-        }
-        let feature = feats.name(&t.faces, None);
-        let mut args = vec![feature.clone()];
-        let mut lost = Vec::new();
-        if t.diameter && rule.dia {
-            args.push(format!("dia {}", mm(t.value_mm)));
-        } else {
-            if t.diameter {
-                lost.push("Ø zone".to_string());
-            }
-            args.push(mm(t.value_mm));
-        }
-        match (t.material, rule.material) {
-            (Some(Material::Mmc), true) => args.push("MMC".into()),
-            (Some(Material::Lmc), true) => args.push("LMC".into()),
-            (Some(m), false) => lost.push(format!("{m:?}").to_uppercase()),
-            _ => {}
-        }
-        args.extend(datums.iter().map(|(_, s)| s.clone()));
-        lost.extend(t.other.iter().cloned());
-        for d in &t.datums {
-            lost.extend(
-                d.other
-                    .iter()
-                    .map(|o| format!("{o} on datum {}", d.letters.join("-"))),
-            );
-        }
-        if let Some(u) = t.unequal_mm {
-            lost.push(format!(
-                "unequally disposed (U {}): checked as equal bilateral",
-                mm(u)
-            ));
-        }
-        if t.composite_of.is_some() {
-            lost.push("lower segment of a composite frame: checked as its own tolerance".into());
-        }
-        let name = unique(&mut used_tol_names, &format!("{}_{feature}", prefix(kind)));
-        let comment = if lost.is_empty() {
-            String::new()
-        } else {
-            format!("  // {}", lost.join("; "))
-        };
-        tol_lines.push(format!(
-            "    tolerance {name} = {}({}){comment}",
-            rule.keyword,
-            args.join(", ")
-        ));
-        written_tols += 1;
-    }
+    let (tol_lines, written_tols) =
+        tolerance_lines(p, &mut feats, &mut frames, &mut used_tol_names);
 
     let mut dim_lines = Vec::new();
     let mut written_dims = 0;
@@ -478,6 +366,140 @@ fn common_datum_lines(frames: &Frames, feats: &mut Features, lines: &mut Vec<Str
         let f = feats.name(faces, None);
         lines.push(format!("    datum {letter} = {f}"));
     }
+}
+
+/// The geometric tolerances, each written or left out with why, and how many were
+/// written.
+fn tolerance_lines(
+    p: &pmi::Pmi,
+    feats: &mut Features,
+    frames: &mut Frames,
+    used_names: &mut BTreeSet<String>,
+) -> (Vec<String>, usize) {
+    let mut lines = Vec::new();
+    let mut written = 0;
+    for t in &p.tolerances {
+        let label = format!("`{}` (#{})", t.name, t.id);
+        match tolerance_line(t, feats, frames, used_names) {
+            Ok(line) => {
+                lines.push(line);
+                written += 1;
+            }
+            Err(why) => left_out(&mut lines, label, &why),
+        }
+    }
+    (lines, written)
+}
+
+/// One tolerance as `tolerance name = kind(feature, value, datums)`, with a comment on
+/// what it loses; Err with why the language cannot say it. Its frame's common datums
+/// are made even when it is left out.
+fn tolerance_line(
+    t: &pmi::GeoTolerance,
+    feats: &mut Features,
+    frames: &mut Frames,
+    used_names: &mut BTreeSet<String>,
+) -> Result<String, String> {
+    let kind = t.kind.ok_or("the file states no tolerance type")?;
+    let rule = accepts(kind).ok_or("inspc has no such tolerance type")?;
+    if t.faces.is_empty() {
+        return Err("the file links it to no face".into());
+    }
+    let mut datums = Vec::new();
+    let mut why_not = None;
+    for d in &t.datums {
+        match frames.letter(&d.letters, feats) {
+            Ok(l) => {
+                let letter = match d.material {
+                    Some(Material::Mmc) => format!("{l}(MMC)"),
+                    Some(Material::Lmc) => format!("{l}(LMC)"),
+                    _ => l.clone(),
+                };
+                datums.push((l, letter));
+            }
+            Err(e) => why_not = Some(e),
+        }
+    }
+    let letters: Vec<&String> = datums.iter().map(|(l, _)| l).collect();
+    if letters.iter().collect::<BTreeSet<_>>().len() < letters.len() {
+        why_not = Some("its frame names a datum twice".to_string());
+    }
+    match rule.datums {
+        Datums::Forbidden if !datums.is_empty() => {
+            why_not = Some(format!("{} takes no datums", rule.keyword))
+        }
+        Datums::Required if datums.is_empty() && why_not.is_none() => {
+            why_not = Some(format!(
+                "{} needs a datum and the frame has none",
+                rule.keyword
+            ))
+        }
+        _ => {}
+    }
+    if kind == TolKind::Angularity {
+        why_not = Some("its basic angle is not in the PMI".to_string());
+    }
+    // A datum feature is not toleranced relative to its own datum.
+    for (l, _) in &datums {
+        let own = frames
+            .datum_feature
+            .get(l)
+            .or_else(|| frames.common.get(l).map(|(_, f)| f));
+        if own == Some(&t.faces) {
+            why_not = Some(format!(
+                "it refers to datum {l}, whose feature it tolerances"
+            ));
+        }
+    }
+    if let Some(why) = why_not {
+        return Err(why);
+    }
+    let feature = feats.name(&t.faces, None);
+    let mut args = vec![feature.clone()];
+    let mut lost = Vec::new();
+    if t.diameter && rule.dia {
+        args.push(format!("dia {}", mm(t.value_mm)));
+    } else {
+        if t.diameter {
+            lost.push("Ø zone".to_string());
+        }
+        args.push(mm(t.value_mm));
+    }
+    match (t.material, rule.material) {
+        (Some(Material::Mmc), true) => args.push("MMC".into()),
+        (Some(Material::Lmc), true) => args.push("LMC".into()),
+        (Some(m), false) => lost.push(format!("{m:?}").to_uppercase()),
+        _ => {}
+    }
+    args.extend(datums.iter().map(|(_, s)| s.clone()));
+    lost.extend(t.other.iter().cloned());
+    for d in &t.datums {
+        lost.extend(
+            d.other
+                .iter()
+                .map(|o| format!("{o} on datum {}", d.letters.join("-"))),
+        );
+    }
+    if let Some(u) = t.unequal_mm {
+        lost.push(format!(
+            "unequally disposed (U {}): checked as equal bilateral",
+            mm(u)
+        ));
+    }
+    if t.composite_of.is_some() {
+        lost.push("lower segment of a composite frame: checked as its own tolerance".into());
+    }
+    let name = unique(used_names, &format!("{}_{feature}", prefix(kind)));
+    let comment = if lost.is_empty() {
+        String::new()
+    } else {
+        format!("  // {}", lost.join("; "))
+    };
+    Ok(format!(
+        "    tolerance {name} = {}({}){comment}",
+        rule.keyword,
+        args.join(", ")
+    ))
 }
 
 /// The probe rack for a part, as (label, stdlib probe): a general Ø2 tip, a Ø1 tip
