@@ -6,7 +6,7 @@ use super::{ImportOptions, Imported};
 use crate::geometry::step::{pmi, CadPart};
 use crate::geometry::Surface;
 use crate::model::{fmt_num, Material, TolKind};
-use crate::resolve::{accepts, Datums};
+use crate::resolve::{accepts, Accepts, Datums};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write;
 
@@ -420,6 +420,34 @@ fn tolerance_line(
             Err(e) => why_not = Some(e),
         }
     }
+    if let Some(why) = why_not_written(t, kind, rule, &datums, frames, why_not) {
+        return Err(why);
+    }
+    let feature = feats.name(&t.faces, None);
+    let (args, lost) = tolerance_args(t, rule, &feature, &datums);
+    let name = unique(used_names, &format!("{}_{feature}", prefix(kind)));
+    let comment = if lost.is_empty() {
+        String::new()
+    } else {
+        format!("  // {}", lost.join("; "))
+    };
+    Ok(format!(
+        "    tolerance {name} = {}({}){comment}",
+        rule.keyword,
+        args.join(", ")
+    ))
+}
+
+/// Why a tolerance with these datums (letter, as written) cannot be written, if it
+/// cannot; `why_not` is what its frame said, and a later reason replaces an earlier one.
+fn why_not_written(
+    t: &pmi::GeoTolerance,
+    kind: TolKind,
+    rule: Accepts,
+    datums: &[(String, String)],
+    frames: &Frames,
+    mut why_not: Option<String>,
+) -> Option<String> {
     let letters: Vec<&String> = datums.iter().map(|(l, _)| l).collect();
     if letters.iter().collect::<BTreeSet<_>>().len() < letters.len() {
         why_not = Some("its frame names a datum twice".to_string());
@@ -440,7 +468,7 @@ fn tolerance_line(
         why_not = Some("its basic angle is not in the PMI".to_string());
     }
     // A datum feature is not toleranced relative to its own datum.
-    for (l, _) in &datums {
+    for (l, _) in datums {
         let own = frames
             .datum_feature
             .get(l)
@@ -451,11 +479,18 @@ fn tolerance_line(
             ));
         }
     }
-    if let Some(why) = why_not {
-        return Err(why);
-    }
-    let feature = feats.name(&t.faces, None);
-    let mut args = vec![feature.clone()];
+    why_not
+}
+
+/// A tolerance's arguments (feature, zone, modifier, datums) and what the language
+/// cannot carry of it.
+fn tolerance_args(
+    t: &pmi::GeoTolerance,
+    rule: Accepts,
+    feature: &str,
+    datums: &[(String, String)],
+) -> (Vec<String>, Vec<String>) {
+    let mut args = vec![feature.to_string()];
     let mut lost = Vec::new();
     if t.diameter && rule.dia {
         args.push(format!("dia {}", mm(t.value_mm)));
@@ -489,17 +524,7 @@ fn tolerance_line(
     if t.composite_of.is_some() {
         lost.push("lower segment of a composite frame: checked as its own tolerance".into());
     }
-    let name = unique(used_names, &format!("{}_{feature}", prefix(kind)));
-    let comment = if lost.is_empty() {
-        String::new()
-    } else {
-        format!("  // {}", lost.join("; "))
-    };
-    Ok(format!(
-        "    tolerance {name} = {}({}){comment}",
-        rule.keyword,
-        args.join(", ")
-    ))
+    (args, lost)
 }
 
 /// The probe rack for a part, as (label, stdlib probe): a general Ø2 tip, a Ø1 tip
