@@ -203,81 +203,7 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
     let mut used_tol_names = BTreeSet::new();
     let (tol_lines, written_tols) =
         tolerance_lines(p, &mut feats, &mut frames, &mut used_tol_names);
-
-    let mut dim_lines = Vec::new();
-    let mut written_dims = 0;
-    for d in &p.dimensions {
-        let (what, label) = match &d.kind {
-            pmi::DimKind::Size(n) => (n.clone(), format!("size `{n}` (#{})", d.id)),
-            pmi::DimKind::Location(n) => (n.clone(), format!("location `{n}` (#{})", d.id)),
-        };
-        let unit = if d.angular { "deg" } else { "mm" };
-        let (Some(nominal), Some(upper), Some(lower)) = (d.nominal, d.upper, d.lower) else {
-            let why = if let Some(fit) = &d.fit {
-                format!("its limits are a fit ({fit}), which inspc does not read")
-            } else if d.nominal.is_none() {
-                "the file gives it no value".to_string()
-            } else {
-                format!(
-                    "{} has no limits (a basic or reference dimension)",
-                    fmt_num(d.nominal.unwrap_or(0.0))
-                )
-            };
-            left_out(&mut dim_lines, label, &why);
-            continue;
-        };
-        if d.faces.is_empty() {
-            left_out(&mut dim_lines, label, "the file links it to no face");
-            continue;
-        }
-        let call = match &d.kind {
-            pmi::DimKind::Size(_) => {
-                let keyword = match what.as_str() {
-                    "diameter" | "spherical diameter" => "diameter",
-                    "radius" | "spherical radius" => "radius",
-                    "thickness" | "width" | "length" => "width",
-                    _ => {
-                        left_out(&mut dim_lines, label, "inspc has no such size");
-                        continue;
-                    }
-                };
-                let f = feats.name(&d.faces, None);
-                (keyword, vec![f])
-            }
-            pmi::DimKind::Location(_) => {
-                if d.to_faces.is_empty() {
-                    left_out(
-                        &mut dim_lines,
-                        label,
-                        "the file links its second feature to no face",
-                    );
-                    continue;
-                }
-                let a = feats.name(&d.faces, None);
-                let b = feats.name(&d.to_faces, None);
-                (if d.angular { "angle" } else { "distance" }, vec![a, b])
-            }
-        };
-        let (keyword, targets) = call;
-        let name = unique(
-            &mut used_tol_names,
-            &format!(
-                "{}_{}",
-                match keyword {
-                    "diameter" | "radius" | "width" => "size",
-                    k => k,
-                },
-                targets[0]
-            ),
-        );
-        dim_lines.push(format!(
-            "    tolerance {name} = {keyword}({}, {})",
-            targets.join(", "),
-            limits(nominal, upper, lower, unit)
-        ));
-        written_dims += 1;
-    }
-
+    let (dim_lines, written_dims) = dimension_lines(p, &mut feats, &mut used_tol_names);
     let mut datum_lines = datums.lines;
     common_datum_lines(&frames, &mut feats, &mut datum_lines);
 
@@ -525,6 +451,91 @@ fn tolerance_args(
         lost.push("lower segment of a composite frame: checked as its own tolerance".into());
     }
     (args, lost)
+}
+
+/// The dimensions, each written as a size or location tolerance or left out with why,
+/// and how many were written.
+fn dimension_lines(
+    p: &pmi::Pmi,
+    feats: &mut Features,
+    used_names: &mut BTreeSet<String>,
+) -> (Vec<String>, usize) {
+    let mut lines = Vec::new();
+    let mut written = 0;
+    for d in &p.dimensions {
+        let label = match &d.kind {
+            pmi::DimKind::Size(n) => format!("size `{n}` (#{})", d.id),
+            pmi::DimKind::Location(n) => format!("location `{n}` (#{})", d.id),
+        };
+        match dimension_line(d, feats, used_names) {
+            Ok(line) => {
+                lines.push(line);
+                written += 1;
+            }
+            Err(why) => left_out(&mut lines, label, &why),
+        }
+    }
+    (lines, written)
+}
+
+/// One dimension as `tolerance name = diameter|radius|width|distance|angle(…, limits)`;
+/// Err with why the language cannot say it.
+fn dimension_line(
+    d: &pmi::Dimension,
+    feats: &mut Features,
+    used_names: &mut BTreeSet<String>,
+) -> Result<String, String> {
+    let unit = if d.angular { "deg" } else { "mm" };
+    let (Some(nominal), Some(upper), Some(lower)) = (d.nominal, d.upper, d.lower) else {
+        return Err(if let Some(fit) = &d.fit {
+            format!("its limits are a fit ({fit}), which inspc does not read")
+        } else if d.nominal.is_none() {
+            "the file gives it no value".to_string()
+        } else {
+            format!(
+                "{} has no limits (a basic or reference dimension)",
+                fmt_num(d.nominal.unwrap_or(0.0))
+            )
+        });
+    };
+    if d.faces.is_empty() {
+        return Err("the file links it to no face".into());
+    }
+    let (keyword, targets) = match &d.kind {
+        pmi::DimKind::Size(what) => {
+            let keyword = match what.as_str() {
+                "diameter" | "spherical diameter" => "diameter",
+                "radius" | "spherical radius" => "radius",
+                "thickness" | "width" | "length" => "width",
+                _ => return Err("inspc has no such size".into()),
+            };
+            (keyword, vec![feats.name(&d.faces, None)])
+        }
+        pmi::DimKind::Location(_) => {
+            if d.to_faces.is_empty() {
+                return Err("the file links its second feature to no face".into());
+            }
+            let a = feats.name(&d.faces, None);
+            let b = feats.name(&d.to_faces, None);
+            (if d.angular { "angle" } else { "distance" }, vec![a, b])
+        }
+    };
+    let name = unique(
+        used_names,
+        &format!(
+            "{}_{}",
+            match keyword {
+                "diameter" | "radius" | "width" => "size",
+                k => k,
+            },
+            targets[0]
+        ),
+    );
+    Ok(format!(
+        "    tolerance {name} = {keyword}({}, {})",
+        targets.join(", "),
+        limits(nominal, upper, lower, unit)
+    ))
 }
 
 /// The probe rack for a part, as (label, stdlib probe): a general Ø2 tip, a Ø1 tip
