@@ -426,63 +426,71 @@ fn main() -> ExitCode {
             message_format,
             emit,
             front_end_only,
-        } => {
-            let checked = if front_end_only {
-                inspc::check(&FsWorld, &files)
-            } else {
-                inspc::measurement_graphs(&FsWorld, &files).0
-            };
-            let mut stdout = std::io::stdout().lock();
-            let mut stderr = std::io::stderr().lock();
-            let opts = RenderOptions {
-                width: 100,
-                color: std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none(),
-            };
-            for d in &checked.diagnostics {
-                match message_format {
-                    MessageFormat::Json => {
-                        let _ = writeln!(stdout, "{}", to_json(&checked.sources, d));
-                    }
-                    MessageFormat::Human => {
-                        let _ = write!(stderr, "{}", render_human(&checked.sources, d, opts));
-                    }
-                }
+        } => check(&files, message_format, emit, front_end_only),
+    }
+}
+
+/// `inspc check`: every file's diagnostics (as text on stderr or JSON on stdout), the
+/// model when asked and nothing failed, and a count of errors and warnings.
+fn check(
+    files: &[PathBuf],
+    message_format: MessageFormat,
+    emit: Emit,
+    front_end_only: bool,
+) -> ExitCode {
+    let checked = if front_end_only {
+        inspc::check(&FsWorld, files)
+    } else {
+        inspc::measurement_graphs(&FsWorld, files).0
+    };
+    let mut stdout = std::io::stdout().lock();
+    let mut stderr = std::io::stderr().lock();
+    let opts = RenderOptions {
+        width: 100,
+        color: std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none(),
+    };
+    for d in &checked.diagnostics {
+        match message_format {
+            MessageFormat::Json => {
+                let _ = writeln!(stdout, "{}", to_json(&checked.sources, d));
             }
-            if emit == Emit::Model && !checked.has_errors() {
-                let _ = write!(stdout, "{}", checked.summary());
-            }
-            let errors = checked
-                .diagnostics
-                .iter()
-                .filter(|d| d.severity() == miette::Severity::Error)
-                .count();
-            let warnings = checked.diagnostics.len() - errors;
-            if message_format == MessageFormat::Human {
-                let plural =
-                    |n: usize, w: &str| format!("{n} {w}{}", if n == 1 { "" } else { "s" });
-                let _ = if errors > 0 {
-                    writeln!(
-                        stderr,
-                        "inspc: {} and {} in {}",
-                        plural(errors, "error"),
-                        plural(warnings, "warning"),
-                        plural(files.len(), "file")
-                    )
-                } else {
-                    writeln!(
-                        stderr,
-                        "inspc: {} checked, no errors ({})",
-                        plural(files.len(), "file"),
-                        plural(warnings, "warning")
-                    )
-                };
-            }
-            if errors > 0 {
-                ExitCode::from(1)
-            } else {
-                ExitCode::SUCCESS
+            MessageFormat::Human => {
+                let _ = write!(stderr, "{}", render_human(&checked.sources, d, opts));
             }
         }
+    }
+    if emit == Emit::Model && !checked.has_errors() {
+        let _ = write!(stdout, "{}", checked.summary());
+    }
+    let errors = checked
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity() == miette::Severity::Error)
+        .count();
+    let warnings = checked.diagnostics.len() - errors;
+    if message_format == MessageFormat::Human {
+        let plural = |n: usize, w: &str| format!("{n} {w}{}", if n == 1 { "" } else { "s" });
+        let _ = if errors > 0 {
+            writeln!(
+                stderr,
+                "inspc: {} and {} in {}",
+                plural(errors, "error"),
+                plural(warnings, "warning"),
+                plural(files.len(), "file")
+            )
+        } else {
+            writeln!(
+                stderr,
+                "inspc: {} checked, no errors ({})",
+                plural(files.len(), "file"),
+                plural(warnings, "warning")
+            )
+        };
+    }
+    if errors > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
     }
 }
 
