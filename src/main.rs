@@ -382,17 +382,7 @@ fn main() -> ExitCode {
             Some(opts) => view(&file, output, png, &opts),
             None => ExitCode::from(2),
         },
-        Command::Lsp { plan: Some(file) } => {
-            println!("{}", inspc::lsp::plan_file(&file));
-            ExitCode::SUCCESS
-        }
-        Command::Lsp { plan: None } => match inspc::lsp::stdio() {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("inspc lsp: {e}");
-                ExitCode::from(1)
-            }
-        },
+        Command::Lsp { plan } => lsp(plan.as_deref()),
         Command::Import { file, output } => import(&file, output),
         Command::Simulate {
             program,
@@ -427,6 +417,22 @@ fn main() -> ExitCode {
             emit,
             front_end_only,
         } => check(&files, message_format, emit, front_end_only),
+    }
+}
+
+/// `inspc lsp`: the language server on standard input and output, or with `--plan`, one
+/// file planned for it.
+fn lsp(plan: Option<&std::path::Path>) -> ExitCode {
+    if let Some(file) = plan {
+        println!("{}", inspc::lsp::plan_file(file));
+        return ExitCode::SUCCESS;
+    }
+    match inspc::lsp::stdio() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("inspc lsp: {e}");
+            ExitCode::from(1)
+        }
     }
 }
 
