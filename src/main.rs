@@ -382,17 +382,7 @@ fn main() -> ExitCode {
             Some(opts) => view(&file, output, png, &opts),
             None => ExitCode::from(2),
         },
-        Command::Lsp { plan: Some(file) } => {
-            println!("{}", inspc::lsp::plan_file(&file));
-            ExitCode::SUCCESS
-        }
-        Command::Lsp { plan: None } => match inspc::lsp::stdio() {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("inspc lsp: {e}");
-                ExitCode::from(1)
-            }
-        },
+        Command::Lsp { plan } => lsp(plan.as_deref()),
         Command::Import { file, output } => import(&file, output),
         Command::Simulate {
             program,
@@ -426,63 +416,87 @@ fn main() -> ExitCode {
             message_format,
             emit,
             front_end_only,
-        } => {
-            let checked = if front_end_only {
-                inspc::check(&FsWorld, &files)
-            } else {
-                inspc::measurement_graphs(&FsWorld, &files).0
-            };
-            let mut stdout = std::io::stdout().lock();
-            let mut stderr = std::io::stderr().lock();
-            let opts = RenderOptions {
-                width: 100,
-                color: std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none(),
-            };
-            for d in &checked.diagnostics {
-                match message_format {
-                    MessageFormat::Json => {
-                        let _ = writeln!(stdout, "{}", to_json(&checked.sources, d));
-                    }
-                    MessageFormat::Human => {
-                        let _ = write!(stderr, "{}", render_human(&checked.sources, d, opts));
-                    }
-                }
+        } => check(&files, message_format, emit, front_end_only),
+    }
+}
+
+/// `inspc lsp`: the language server on standard input and output, or with `--plan`, one
+/// file planned for it.
+fn lsp(plan: Option<&std::path::Path>) -> ExitCode {
+    if let Some(file) = plan {
+        println!("{}", inspc::lsp::plan_file(file));
+        return ExitCode::SUCCESS;
+    }
+    match inspc::lsp::stdio() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("inspc lsp: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// `inspc check`: every file's diagnostics (as text on stderr or JSON on stdout), the
+/// model when asked and nothing failed, and a count of errors and warnings.
+fn check(
+    files: &[PathBuf],
+    message_format: MessageFormat,
+    emit: Emit,
+    front_end_only: bool,
+) -> ExitCode {
+    let checked = if front_end_only {
+        inspc::check(&FsWorld, files)
+    } else {
+        inspc::measurement_graphs(&FsWorld, files).0
+    };
+    let mut stdout = std::io::stdout().lock();
+    let mut stderr = std::io::stderr().lock();
+    let opts = RenderOptions {
+        width: 100,
+        color: std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none(),
+    };
+    for d in &checked.diagnostics {
+        match message_format {
+            MessageFormat::Json => {
+                let _ = writeln!(stdout, "{}", to_json(&checked.sources, d));
             }
-            if emit == Emit::Model && !checked.has_errors() {
-                let _ = write!(stdout, "{}", checked.summary());
-            }
-            let errors = checked
-                .diagnostics
-                .iter()
-                .filter(|d| d.severity() == miette::Severity::Error)
-                .count();
-            let warnings = checked.diagnostics.len() - errors;
-            if message_format == MessageFormat::Human {
-                let plural =
-                    |n: usize, w: &str| format!("{n} {w}{}", if n == 1 { "" } else { "s" });
-                let _ = if errors > 0 {
-                    writeln!(
-                        stderr,
-                        "inspc: {} and {} in {}",
-                        plural(errors, "error"),
-                        plural(warnings, "warning"),
-                        plural(files.len(), "file")
-                    )
-                } else {
-                    writeln!(
-                        stderr,
-                        "inspc: {} checked, no errors ({})",
-                        plural(files.len(), "file"),
-                        plural(warnings, "warning")
-                    )
-                };
-            }
-            if errors > 0 {
-                ExitCode::from(1)
-            } else {
-                ExitCode::SUCCESS
+            MessageFormat::Human => {
+                let _ = write!(stderr, "{}", render_human(&checked.sources, d, opts));
             }
         }
+    }
+    if emit == Emit::Model && !checked.has_errors() {
+        let _ = write!(stdout, "{}", checked.summary());
+    }
+    let errors = checked
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity() == miette::Severity::Error)
+        .count();
+    let warnings = checked.diagnostics.len() - errors;
+    if message_format == MessageFormat::Human {
+        let plural = |n: usize, w: &str| format!("{n} {w}{}", if n == 1 { "" } else { "s" });
+        let _ = if errors > 0 {
+            writeln!(
+                stderr,
+                "inspc: {} and {} in {}",
+                plural(errors, "error"),
+                plural(warnings, "warning"),
+                plural(files.len(), "file")
+            )
+        } else {
+            writeln!(
+                stderr,
+                "inspc: {} checked, no errors ({})",
+                plural(files.len(), "file"),
+                plural(warnings, "warning")
+            )
+        };
+    }
+    if errors > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
     }
 }
 

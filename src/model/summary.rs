@@ -116,28 +116,7 @@ impl Model {
     pub fn describe(&self, item: ItemRef) -> String {
         let mut o = String::new();
         match item {
-            ItemRef::Head(i) => {
-                let h = &self.heads[i];
-                let kind = match &h.kind {
-                    HeadKind::Fixed => "fixed".to_string(),
-                    HeadKind::Indexable { a, b, step } => format!(
-                        "indexable A {}..{} B {}..{} step {} ({} orientations)",
-                        fmt_num(a[0]),
-                        fmt_num(a[1]),
-                        fmt_num(b[0]),
-                        fmt_num(b[1]),
-                        fmt_num(*step),
-                        h.orientations().len()
-                    ),
-                };
-                let _ = writeln!(
-                    o,
-                    "head {}: {kind}, envelope Ø{} × {}",
-                    h.name,
-                    fmt_num(h.diameter),
-                    fmt_num(h.length)
-                );
-            }
+            ItemRef::Head(i) => head_summary(&mut o, &self.heads[i]),
             ItemRef::Stylus(i) => {
                 let s = &self.styli[i];
                 let _ = writeln!(
@@ -169,128 +148,10 @@ impl Model {
                     fmt_num(e.length)
                 );
             }
-            ItemRef::Probe(i) => {
-                let p = &self.probes[i];
-                let ext: Vec<&str> = p
-                    .extensions
-                    .iter()
-                    .map(|e| self.extensions[e.0].name.as_str())
-                    .collect();
-                let _ = writeln!(
-                    o,
-                    "probe {}: body {}, extensions [{}], stylus {}, cost {}",
-                    p.name,
-                    self.bodies[p.body.0].name,
-                    ext.join(", "),
-                    self.styli[p.stylus.0].name,
-                    fmt_num(p.cost)
-                );
-            }
-            ItemRef::Cmm(i) => {
-                let c = &self.cmms[i];
-                let probes: Vec<String> = c
-                    .probes
-                    .iter()
-                    .map(|(l, p)| format!("{l}: {}", self.probes[p.0].name))
-                    .collect();
-                let size = c.table_size.map_or(String::new(), |s| {
-                    format!(" size {} × {}", fmt_num(s[0]), fmt_num(s[1]))
-                });
-                let fixtures: Vec<String> = c
-                    .fixtures
-                    .iter()
-                    .map(|(l, f)| format!("{l}: {}", self.fixtures[f.0].name))
-                    .collect();
-                let fixtures = if fixtures.is_empty() {
-                    String::new()
-                } else {
-                    format!(", fixtures [{}]", fixtures.join(", "))
-                };
-                let scanners: Vec<String> = c
-                    .scanners
-                    .iter()
-                    .map(|(l, s)| format!("{l}: {}", self.scanners[s.0].name))
-                    .collect();
-                let fixtures = if scanners.is_empty() {
-                    fixtures
-                } else {
-                    format!("{fixtures}, scanners [{}]", scanners.join(", "))
-                };
-                let _ = writeln!(
-                    o,
-                    "cmm {}: table z {}{size}, ram r {} l {}, head {}, probes [{}]{fixtures}",
-                    c.name,
-                    fmt_num(c.table_z),
-                    fmt_num(c.ram_radius),
-                    fmt_num(c.ram_length),
-                    self.heads[c.head.0].name,
-                    probes.join(", ")
-                );
-                for (_, f) in &c.fixtures {
-                    o.push_str("  ");
-                    o.push_str(&self.describe(ItemRef::Fixture(f.0)));
-                }
-            }
-            ItemRef::Scanner(i) => {
-                let s = &self.scanners[i];
-                let _ = writeln!(
-                    o,
-                    "scanner {}: stripe {} at stand-off {} ± {}, triangulation {}°, incidence ≤ {}°, \
-                     spacing {} × {}, accuracy {}, body Ø{} × {}, cost {}",
-                    s.name,
-                    fmt_num(s.stripe_width),
-                    fmt_num(s.standoff),
-                    fmt_num(s.depth_of_field / 2.0),
-                    fmt_num(s.triangulation),
-                    fmt_num(s.max_incidence),
-                    fmt_num(s.spacing[0]),
-                    fmt_num(s.spacing[1]),
-                    fmt_num(s.accuracy),
-                    fmt_num(s.body[0]),
-                    fmt_num(s.body[1]),
-                    fmt_num(s.cost)
-                );
-            }
-            ItemRef::Fixture(i) => {
-                let f = &self.fixtures[i];
-                let r = |x: &[f64; 2], unit: &str| {
-                    format!("{} {unit} .. {} {unit}", fmt_num(x[0]), fmt_num(x[1]))
-                };
-                let what = match &f.kind {
-                    FixtureKind::Vise { opening, jaw } => format!(
-                        "opening {} mm, jaw {} × {} mm",
-                        fmt_num(*opening),
-                        fmt_num(jaw[0]),
-                        fmt_num(jaw[1])
-                    ),
-                    FixtureKind::Chuck {
-                        diameter,
-                        jaws,
-                        body,
-                    } => format!(
-                        "diameter {}, jaws {} mm, body {} mm",
-                        r(diameter, "mm"),
-                        fmt_num(*jaws),
-                        fmt_num(*body)
-                    ),
-                    FixtureKind::VBlock { diameter } => format!("diameter {}", r(diameter, "mm")),
-                    FixtureKind::SinePlate { tilt } => format!("tilt {}", r(tilt, "deg")),
-                    FixtureKind::Mesh {
-                        path, unit_mm, up, ..
-                    } => format!(
-                        "file {}, units ×{}, up {}",
-                        path.file_name()
-                            .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
-                        fmt_num(*unit_mm),
-                        v3(up)
-                    ),
-                };
-                let height = match f.kind {
-                    FixtureKind::Mesh { .. } => String::new(),
-                    _ => format!(", height {} mm", fmt_num(f.height)),
-                };
-                let _ = writeln!(o, "fixture {}: {} {what}{height}", f.name, f.kind.word());
-            }
+            ItemRef::Probe(i) => self.probe_summary(&mut o, &self.probes[i]),
+            ItemRef::Cmm(i) => self.cmm_summary(&mut o, &self.cmms[i]),
+            ItemRef::Scanner(i) => scanner_summary(&mut o, &self.scanners[i]),
+            ItemRef::Fixture(i) => fixture_summary(&mut o, &self.fixtures[i]),
             ItemRef::Hierarchy(i) => {
                 let h = &self.hierarchies[i];
                 let levels: Vec<String> = h.levels.iter().map(|l| l.text()).collect();
@@ -314,6 +175,70 @@ impl Model {
             ItemRef::Plan(i) => self.plan_summary(&mut o, &self.plans[i]),
         }
         o
+    }
+
+    /// `probe NAME: body …, extensions […], stylus …, cost …`
+    fn probe_summary(&self, o: &mut String, p: &Probe) {
+        let ext: Vec<&str> = p
+            .extensions
+            .iter()
+            .map(|e| self.extensions[e.0].name.as_str())
+            .collect();
+        let _ = writeln!(
+            o,
+            "probe {}: body {}, extensions [{}], stylus {}, cost {}",
+            p.name,
+            self.bodies[p.body.0].name,
+            ext.join(", "),
+            self.styli[p.stylus.0].name,
+            fmt_num(p.cost)
+        );
+    }
+
+    /// A CMM's line, then each of its fixtures indented.
+    fn cmm_summary(&self, o: &mut String, c: &Cmm) {
+        let probes: Vec<String> = c
+            .probes
+            .iter()
+            .map(|(l, p)| format!("{l}: {}", self.probes[p.0].name))
+            .collect();
+        let size = c.table_size.map_or(String::new(), |s| {
+            format!(" size {} × {}", fmt_num(s[0]), fmt_num(s[1]))
+        });
+        let fixtures: Vec<String> = c
+            .fixtures
+            .iter()
+            .map(|(l, f)| format!("{l}: {}", self.fixtures[f.0].name))
+            .collect();
+        let fixtures = if fixtures.is_empty() {
+            String::new()
+        } else {
+            format!(", fixtures [{}]", fixtures.join(", "))
+        };
+        let scanners: Vec<String> = c
+            .scanners
+            .iter()
+            .map(|(l, s)| format!("{l}: {}", self.scanners[s.0].name))
+            .collect();
+        let fixtures = if scanners.is_empty() {
+            fixtures
+        } else {
+            format!("{fixtures}, scanners [{}]", scanners.join(", "))
+        };
+        let _ = writeln!(
+            o,
+            "cmm {}: table z {}{size}, ram r {} l {}, head {}, probes [{}]{fixtures}",
+            c.name,
+            fmt_num(c.table_z),
+            fmt_num(c.ram_radius),
+            fmt_num(c.ram_length),
+            self.heads[c.head.0].name,
+            probes.join(", ")
+        );
+        for (_, f) in &c.fixtures {
+            o.push_str("  ");
+            o.push_str(&self.describe(ItemRef::Fixture(f.0)));
+        }
     }
 
     fn plan_summary(&self, o: &mut String, p: &Plan) {
@@ -414,6 +339,90 @@ impl Model {
     }
 }
 
+/// `head NAME: fixed|indexable …, envelope Ø… × …`
+fn head_summary(o: &mut String, h: &Head) {
+    let kind = match &h.kind {
+        HeadKind::Fixed => "fixed".to_string(),
+        HeadKind::Indexable { a, b, step } => format!(
+            "indexable A {}..{} B {}..{} step {} ({} orientations)",
+            fmt_num(a[0]),
+            fmt_num(a[1]),
+            fmt_num(b[0]),
+            fmt_num(b[1]),
+            fmt_num(*step),
+            h.orientations().len()
+        ),
+    };
+    let _ = writeln!(
+        o,
+        "head {}: {kind}, envelope Ø{} × {}",
+        h.name,
+        fmt_num(h.diameter),
+        fmt_num(h.length)
+    );
+}
+
+/// `scanner NAME: stripe … at stand-off …`, its optics, accuracy, housing and cost.
+fn scanner_summary(o: &mut String, s: &Scanner) {
+    let _ = writeln!(
+        o,
+        "scanner {}: stripe {} at stand-off {} ± {}, triangulation {}°, incidence ≤ {}°, \
+         spacing {} × {}, accuracy {}, body Ø{} × {}, cost {}",
+        s.name,
+        fmt_num(s.stripe_width),
+        fmt_num(s.standoff),
+        fmt_num(s.depth_of_field / 2.0),
+        fmt_num(s.triangulation),
+        fmt_num(s.max_incidence),
+        fmt_num(s.spacing[0]),
+        fmt_num(s.spacing[1]),
+        fmt_num(s.accuracy),
+        fmt_num(s.body[0]),
+        fmt_num(s.body[1]),
+        fmt_num(s.cost)
+    );
+}
+
+/// `fixture NAME: kind sizes, height …` (a mesh nest: its file, units and up).
+fn fixture_summary(o: &mut String, f: &Fixture) {
+    let r =
+        |x: &[f64; 2], unit: &str| format!("{} {unit} .. {} {unit}", fmt_num(x[0]), fmt_num(x[1]));
+    let what = match &f.kind {
+        FixtureKind::Vise { opening, jaw } => format!(
+            "opening {} mm, jaw {} × {} mm",
+            fmt_num(*opening),
+            fmt_num(jaw[0]),
+            fmt_num(jaw[1])
+        ),
+        FixtureKind::Chuck {
+            diameter,
+            jaws,
+            body,
+        } => format!(
+            "diameter {}, jaws {} mm, body {} mm",
+            r(diameter, "mm"),
+            fmt_num(*jaws),
+            fmt_num(*body)
+        ),
+        FixtureKind::VBlock { diameter } => format!("diameter {}", r(diameter, "mm")),
+        FixtureKind::SinePlate { tilt } => format!("tilt {}", r(tilt, "deg")),
+        FixtureKind::Mesh {
+            path, unit_mm, up, ..
+        } => format!(
+            "file {}, units ×{}, up {}",
+            path.file_name()
+                .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+            fmt_num(*unit_mm),
+            v3(up)
+        ),
+    };
+    let height = match f.kind {
+        FixtureKind::Mesh { .. } => String::new(),
+        _ => format!(", height {} mm", fmt_num(f.height)),
+    };
+    let _ = writeln!(o, "fixture {}: {} {what}{height}", f.name, f.kind.word());
+}
+
 fn strategy_text(s: &Strategy) -> String {
     let m = match s.method {
         SampleMethod::FanLeu => "fan_leu",
@@ -438,7 +447,31 @@ fn strategy_text(s: &Strategy) -> String {
 }
 
 fn part_summary(o: &mut String, p: &Part) {
-    let geometry = match &p.geometry {
+    let geometry = geometry_text(&p.geometry);
+    let _ = writeln!(o, "part {}: {geometry}", p.name);
+    for op in &p.ops {
+        let verb = op.action.keyword();
+        let shape = op_shape_text(&op.kind);
+        let pattern = pattern_text(op.pattern.as_ref());
+        let _ = writeln!(o, "  {verb} {}: {shape}{pattern}", op.name);
+    }
+    for f in &p.features {
+        let _ = writeln!(o, "  {}", f.text(p));
+    }
+    for d in &p.datums {
+        let _ = writeln!(o, "  datum {} on {}", d.name, p.features[d.feature.0].name);
+    }
+    for f in &p.frames {
+        let _ = writeln!(o, "  frame {} = [{}]", f.name, datum_refs(p, &f.refs));
+    }
+    for t in &p.tolerances {
+        let _ = writeln!(o, "  {}", t.text(p));
+    }
+}
+
+/// A part's geometry source: a stock shape, a CAD file or a mesh.
+fn geometry_text(geometry: &Geometry) -> String {
+    match geometry {
         Geometry::Stock(Stock::Box { size }) => format!("box {}", v3(size)),
         Geometry::Stock(Stock::Cylinder { diameter, height }) => {
             format!("cylinder Ø{} × {}", fmt_num(*diameter), fmt_num(*height))
@@ -462,118 +495,109 @@ fn part_summary(o: &mut String, p: &Part) {
                 None => format!("mesh {name} (× {} mm)", fmt_num(*unit_mm)),
             }
         }
-    };
-    let _ = writeln!(o, "part {}: {geometry}", p.name);
-    for op in &p.ops {
-        let verb = op.action.keyword();
-        let shape = match &op.kind {
-            OpKind::Hole {
-                at,
-                axis,
-                diameter,
-                depth,
-            } => {
-                let at = match at {
-                    Placement::At(p) => format!("at {}", v3(p)),
-                    Placement::Radial(d) => format!("radial {}", v3(d)),
-                };
-                let depth = match depth {
-                    Depth::Through => "through".to_string(),
-                    Depth::Blind(d) => format!("depth {}", fmt_num(*d)),
-                };
-                format!(
-                    "hole {at} axis {} Ø{} {depth}",
-                    v3(axis),
-                    fmt_num(*diameter)
-                )
-            }
-            OpKind::Slot {
-                at,
-                along,
-                into,
-                width,
-                depth,
-                length,
-            } => format!(
-                "slot at {} along {} into {} width {} depth {}{}",
-                v3(at),
-                v3(along),
-                v3(into),
-                fmt_num(*width),
-                fmt_num(*depth),
-                length.map_or(String::new(), |l| format!(" length {}", fmt_num(l)))
-            ),
-            OpKind::Pocket {
-                at,
-                along,
-                into,
-                size,
-                depth,
-                corner_radius,
-            } => format!(
-                "pocket at {} along {} into {} size {} × {} depth {} corner r {}",
-                v3(at),
-                v3(along),
-                v3(into),
-                fmt_num(size[0]),
-                fmt_num(size[1]),
-                fmt_num(*depth),
-                fmt_num(*corner_radius)
-            ),
-            OpKind::Step {
-                at,
-                along,
-                into,
-                width,
-                depth,
-            } => format!(
-                "step at {} along {} into {} width {} depth {}",
-                v3(at),
-                v3(along),
-                v3(into),
-                fmt_num(*width),
-                fmt_num(*depth)
-            ),
-            OpKind::Boss {
-                at,
-                axis,
-                diameter,
-                height,
-            } => format!(
-                "boss at {} axis {} Ø{} height {}",
-                v3(at),
+    }
+}
+
+/// An operation's kind and sizes: `hole at … axis … Ø… depth …`, `slot at …`, ….
+fn op_shape_text(kind: &OpKind) -> String {
+    match kind {
+        OpKind::Hole {
+            at,
+            axis,
+            diameter,
+            depth,
+        } => {
+            let at = match at {
+                Placement::At(p) => format!("at {}", v3(p)),
+                Placement::Radial(d) => format!("radial {}", v3(d)),
+            };
+            let depth = match depth {
+                Depth::Through => "through".to_string(),
+                Depth::Blind(d) => format!("depth {}", fmt_num(*d)),
+            };
+            format!(
+                "hole {at} axis {} Ø{} {depth}",
                 v3(axis),
-                fmt_num(*diameter),
-                fmt_num(*height)
-            ),
-        };
-        let pattern = match &op.pattern {
-            None => String::new(),
-            Some(Pattern::Grid { nx, ny, pitch }) => format!(
-                " × grid {nx}×{ny} pitch {} × {}",
-                fmt_num(pitch[0]),
-                fmt_num(pitch[1])
-            ),
-            Some(Pattern::Linear { count, step }) => format!(" × linear {count} step {}", v3(step)),
-            Some(Pattern::Polar {
-                count,
-                axis,
-                center,
-            }) => format!(" × polar {count} about {} through {}", v3(axis), v3(center)),
-        };
-        let _ = writeln!(o, "  {verb} {}: {shape}{pattern}", op.name);
+                fmt_num(*diameter)
+            )
+        }
+        OpKind::Slot {
+            at,
+            along,
+            into,
+            width,
+            depth,
+            length,
+        } => format!(
+            "slot at {} along {} into {} width {} depth {}{}",
+            v3(at),
+            v3(along),
+            v3(into),
+            fmt_num(*width),
+            fmt_num(*depth),
+            length.map_or(String::new(), |l| format!(" length {}", fmt_num(l)))
+        ),
+        OpKind::Pocket {
+            at,
+            along,
+            into,
+            size,
+            depth,
+            corner_radius,
+        } => format!(
+            "pocket at {} along {} into {} size {} × {} depth {} corner r {}",
+            v3(at),
+            v3(along),
+            v3(into),
+            fmt_num(size[0]),
+            fmt_num(size[1]),
+            fmt_num(*depth),
+            fmt_num(*corner_radius)
+        ),
+        OpKind::Step {
+            at,
+            along,
+            into,
+            width,
+            depth,
+        } => format!(
+            "step at {} along {} into {} width {} depth {}",
+            v3(at),
+            v3(along),
+            v3(into),
+            fmt_num(*width),
+            fmt_num(*depth)
+        ),
+        OpKind::Boss {
+            at,
+            axis,
+            diameter,
+            height,
+        } => format!(
+            "boss at {} axis {} Ø{} height {}",
+            v3(at),
+            v3(axis),
+            fmt_num(*diameter),
+            fmt_num(*height)
+        ),
     }
-    for f in &p.features {
-        let _ = writeln!(o, "  {}", f.text(p));
-    }
-    for d in &p.datums {
-        let _ = writeln!(o, "  datum {} on {}", d.name, p.features[d.feature.0].name);
-    }
-    for f in &p.frames {
-        let _ = writeln!(o, "  frame {} = [{}]", f.name, datum_refs(p, &f.refs));
-    }
-    for t in &p.tolerances {
-        let _ = writeln!(o, "  {}", t.text(p));
+}
+
+/// An operation's pattern after its shape (` × grid 3×2 pitch …`); empty without one.
+fn pattern_text(pattern: Option<&Pattern>) -> String {
+    match pattern {
+        None => String::new(),
+        Some(Pattern::Grid { nx, ny, pitch }) => format!(
+            " × grid {nx}×{ny} pitch {} × {}",
+            fmt_num(pitch[0]),
+            fmt_num(pitch[1])
+        ),
+        Some(Pattern::Linear { count, step }) => format!(" × linear {count} step {}", v3(step)),
+        Some(Pattern::Polar {
+            count,
+            axis,
+            center,
+        }) => format!(" × polar {count} about {} through {}", v3(axis), v3(center)),
     }
 }
 

@@ -1,7 +1,8 @@
 //! Catalogue items: heads, styli, bodies, extensions, probes, CMMs and samplings.
 
 use super::errors::ResolveError as E;
-use super::props::{describe, num, Cx, Dim, Props};
+use super::fixture::fixture;
+use super::props::{describe, describe_only, num, Cx, Dim, Props};
 use super::{Kind, Resolver};
 use crate::diag::suggest;
 use crate::load::ModuleId;
@@ -32,98 +33,30 @@ pub(super) fn lower(
             model.heads.push(head);
         }
         Kind::Stylus => {
-            let tip_ok = p
-                .req(cx, "tip", "2 mm")
-                .and_then(|v| cx.positive(v, Dim::Length, "tip"));
-            let tip = tip_ok.unwrap_or(1.0);
-            let length = p
-                .req(cx, "length", "20 mm")
-                .and_then(|v| cx.positive(v, Dim::Length, "length"))
-                .unwrap_or(1.0);
-            let stem_v = p.req(cx, "stem", "1.5 mm");
-            let stem_ok = stem_v.and_then(|v| cx.positive(v, Dim::Length, "stem"));
-            let stem = stem_ok.unwrap_or(0.5);
-            // Only two good values are compared: a bad one was reported already.
-            if let (Some(v), Some(_), Some(_)) = (stem_v, stem_ok, tip_ok) {
-                if stem >= tip {
-                    cx.err(E::StemThickerThanTip {
-                        span: v.span,
-                        name: name.clone(),
-                        stem: num(stem),
-                        tip: num(tip),
-                    });
-                }
-            }
-            describe_only(cx, &mut p);
-            model.styli.push(Stylus {
+            let stylus = stylus(cx, &mut p, name, span);
+            model.styli.push(stylus);
+        }
+        Kind::Body => {
+            let (diameter, length) = envelope(cx, &mut p);
+            model.bodies.push(Body {
                 name,
-                tip,
+                diameter,
                 length,
-                stem,
                 span,
             });
         }
-        Kind::Body | Kind::Extension => {
-            let diameter = p
-                .req(cx, "diameter", "13.2 mm")
-                .and_then(|v| cx.positive(v, Dim::Length, "diameter"))
-                .unwrap_or(1.0);
-            let length = p
-                .req(cx, "length", "30 mm")
-                .and_then(|v| cx.positive(v, Dim::Length, "length"))
-                .unwrap_or(1.0);
-            describe_only(cx, &mut p);
-            if kind == Kind::Body {
-                model.bodies.push(Body {
-                    name,
-                    diameter,
-                    length,
-                    span,
-                });
-            } else {
-                model.extensions.push(Extension {
-                    name,
-                    diameter,
-                    length,
-                    span,
-                });
-            }
+        Kind::Extension => {
+            let (diameter, length) = envelope(cx, &mut p);
+            model.extensions.push(Extension {
+                name,
+                diameter,
+                length,
+                span,
+            });
         }
         Kind::Probe => {
-            let body = p
-                .req(cx, "body", "TP20_SF")
-                .and_then(|v| r.lookup_value(cx, module, v, Kind::Body))
-                .unwrap_or(0);
-            let stylus = p
-                .req(cx, "stylus", "M2_D2_L20")
-                .and_then(|v| r.lookup_value(cx, module, v, Kind::Stylus))
-                .unwrap_or(0);
-            let mut extensions = Vec::new();
-            if let Some(v) = p.get("extensions") {
-                match &v.kind {
-                    ValueKind::List(entries) => {
-                        for e in entries {
-                            if let Some(i) = r.lookup_value(cx, module, &e.value, Kind::Extension) {
-                                extensions.push(ExtensionId(i));
-                            }
-                        }
-                    }
-                    _ => cx.mismatch(v, "a list of extensions", "write `extensions [PEM20]`"),
-                }
-            }
-            let cost = p
-                .get("cost")
-                .and_then(|v| cx.non_negative(v, "cost"))
-                .unwrap_or(1.0);
-            describe_only(cx, &mut p);
-            model.probes.push(Probe {
-                name,
-                body: BodyId(body),
-                extensions,
-                stylus: StylusId(stylus),
-                cost,
-                span,
-            });
+            let probe = probe(r, cx, module, &mut p, name, span);
+            model.probes.push(probe);
         }
         Kind::Fixture => {
             let f = fixture(r, cx, &mut p, name, span);
@@ -138,31 +71,121 @@ pub(super) fn lower(
             model.cmms.push(cmm);
         }
         Kind::Sampling => {
-            let mut per_surface = Vec::new();
-            for s in SurfaceKind::ALL {
-                if let Some(v) = p.get(s.keyword()) {
-                    if let Some(st) = strategy(cx, v, Some(s)) {
-                        per_surface.push((s, st));
-                    }
-                }
-            }
-            model.samplings.push(Sampling {
-                name,
-                per_surface,
-                span,
-            });
+            let sampling = sampling(cx, &mut p, name, span);
+            model.samplings.push(sampling);
         }
         Kind::Part | Kind::Hierarchy | Kind::Plan => unreachable!("not a property item"),
     }
     p.finish(cx);
 }
 
-/// Catalogue text fields that document an item without affecting planning.
-fn describe_only(cx: &mut Cx, p: &mut Props) {
-    for key in ["part_no", "model"] {
-        if let Some(v) = p.get(key) {
-            cx.string(v);
+/// A stylus: its `tip`, `length` and `stem`, the stem thinner than the tip.
+fn stylus(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Stylus {
+    let tip_ok = p
+        .req(cx, "tip", "2 mm")
+        .and_then(|v| cx.positive(v, Dim::Length, "tip"));
+    let tip = tip_ok.unwrap_or(1.0);
+    let length = p
+        .req(cx, "length", "20 mm")
+        .and_then(|v| cx.positive(v, Dim::Length, "length"))
+        .unwrap_or(1.0);
+    let stem_v = p.req(cx, "stem", "1.5 mm");
+    let stem_ok = stem_v.and_then(|v| cx.positive(v, Dim::Length, "stem"));
+    let stem = stem_ok.unwrap_or(0.5);
+    // Only two good values are compared: a bad one was reported already.
+    if let (Some(v), Some(_), Some(_)) = (stem_v, stem_ok, tip_ok) {
+        if stem >= tip {
+            cx.err(E::StemThickerThanTip {
+                span: v.span,
+                name: name.clone(),
+                stem: num(stem),
+                tip: num(tip),
+            });
         }
+    }
+    describe_only(cx, p);
+    Stylus {
+        name,
+        tip,
+        length,
+        stem,
+        span,
+    }
+}
+
+/// A probe body's or an extension's envelope: (diameter, length).
+fn envelope(cx: &mut Cx, p: &mut Props) -> (f64, f64) {
+    let diameter = p
+        .req(cx, "diameter", "13.2 mm")
+        .and_then(|v| cx.positive(v, Dim::Length, "diameter"))
+        .unwrap_or(1.0);
+    let length = p
+        .req(cx, "length", "30 mm")
+        .and_then(|v| cx.positive(v, Dim::Length, "length"))
+        .unwrap_or(1.0);
+    describe_only(cx, p);
+    (diameter, length)
+}
+
+/// A probe: its `body`, `extensions` and `stylus` by name, and its `cost`.
+fn probe(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    p: &mut Props,
+    name: String,
+    span: crate::source::Span,
+) -> Probe {
+    let body = p
+        .req(cx, "body", "TP20_SF")
+        .and_then(|v| r.lookup_value(cx, module, v, Kind::Body))
+        .unwrap_or(0);
+    let stylus = p
+        .req(cx, "stylus", "M2_D2_L20")
+        .and_then(|v| r.lookup_value(cx, module, v, Kind::Stylus))
+        .unwrap_or(0);
+    let mut extensions = Vec::new();
+    if let Some(v) = p.get("extensions") {
+        match &v.kind {
+            ValueKind::List(entries) => {
+                for e in entries {
+                    if let Some(i) = r.lookup_value(cx, module, &e.value, Kind::Extension) {
+                        extensions.push(ExtensionId(i));
+                    }
+                }
+            }
+            _ => cx.mismatch(v, "a list of extensions", "write `extensions [PEM20]`"),
+        }
+    }
+    let cost = p
+        .get("cost")
+        .and_then(|v| cx.non_negative(v, "cost"))
+        .unwrap_or(1.0);
+    describe_only(cx, p);
+    Probe {
+        name,
+        body: BodyId(body),
+        extensions,
+        stylus: StylusId(stylus),
+        cost,
+        span,
+    }
+}
+
+/// A sampling: a strategy per surface type it names.
+fn sampling(cx: &mut Cx, p: &mut Props, name: String, span: crate::source::Span) -> Sampling {
+    let mut per_surface = Vec::new();
+    for s in SurfaceKind::ALL {
+        if let Some(v) = p.get(s.keyword()) {
+            if let Some(st) = strategy(cx, v, Some(s)) {
+                per_surface.push((s, st));
+            }
+        }
+    }
+    Sampling {
+        name,
+        per_surface,
+        span,
     }
 }
 
@@ -273,120 +296,26 @@ fn cmm(
     name: String,
     span: crate::source::Span,
 ) -> Cmm {
-    let mut table_z = 0.0;
-    let mut table_size = None;
-    if let Some(v) = p.get("table") {
-        if let ValueKind::Block(props) = &v.kind {
-            let mut t = Props::new(cx, "the table", v.span, props);
-            if let Some(z) = t.get("z").and_then(|z| cx.length(z)) {
-                table_z = z;
-            }
-            if let Some(s) = t.get("size") {
-                if let Some(size) = cx.lengths::<2>(s) {
-                    if size.iter().any(|x| *x <= 0.0) {
-                        cx.err(E::NonPositive {
-                            span: s.span,
-                            what: "the table size".into(),
-                            value: describe(s),
-                            help: "give the table's length and width".into(),
-                        });
-                    } else {
-                        table_size = Some(size);
-                    }
-                }
-            }
-            t.finish(cx);
-        } else {
-            cx.mismatch(v, "a block `{ z 0 mm, size (…) }`", "");
-        }
-    }
-    let (mut ram_radius, mut ram_length) = (1.0, 1.0);
-    if let Some(v) = p.req(cx, "ram", "{ radius 35 mm, length 600 mm }") {
-        match &v.kind {
-            ValueKind::Block(props) => {
-                let mut t = Props::new(cx, "the ram", v.span, props);
-                ram_radius = t
-                    .req(cx, "radius", "35 mm")
-                    .and_then(|x| cx.positive(x, Dim::Length, "radius"))
-                    .unwrap_or(1.0);
-                ram_length = t
-                    .req(cx, "length", "600 mm")
-                    .and_then(|x| cx.positive(x, Dim::Length, "length"))
-                    .unwrap_or(1.0);
-                t.finish(cx);
-            }
-            _ => cx.mismatch(v, "a block `{ radius …, length … }`", ""),
-        }
-    }
+    let (table_z, table_size) = p.get("table").map_or((0.0, None), |v| table(cx, v));
+    let (ram_radius, ram_length) = p
+        .req(cx, "ram", "{ radius 35 mm, length 600 mm }")
+        .map_or((1.0, 1.0), |v| ram(cx, v));
     let head = p
         .req(cx, "head", "PH6")
         .and_then(|v| r.lookup_value(cx, module, v, Kind::Head))
         .unwrap_or(0);
-    let mut probes: Vec<(String, ProbeId)> = Vec::new();
-    let mut probe_labels: Vec<crate::source::Span> = Vec::new();
-    if let Some(v) = p.req(cx, "probes", "[p1: TP20_D2_L20]") {
-        match &v.kind {
-            ValueKind::List(entries) if !entries.is_empty() => {
-                for (l, id, at) in
-                    labelled(r, cx, module, entries, Kind::Probe, "probe in the rack")
-                {
-                    probes.push((l, ProbeId(id)));
-                    probe_labels.push(at);
-                }
-            }
-            ValueKind::List(_) => cx.err(E::MissingProperty {
-                span: v.span,
-                key: "probes".into(),
-                item: format!("cmm `{name}`"),
-                help: "a CMM needs at least one probe: `probes [p1: TP20_D2_L20]`".into(),
-            }),
-            _ => cx.mismatch(v, "a list of probes", "write `probes [p1: TP20_D2_L20]`"),
-        }
-    }
-    let mut fixtures: Vec<(String, FixtureId)> = Vec::new();
-    let mut fixture_labels: Vec<crate::source::Span> = Vec::new();
-    if let Some(v) = p.get("fixtures") {
-        match &v.kind {
-            ValueKind::List(entries) => {
-                for (l, id, at) in labelled(
-                    r,
-                    cx,
-                    module,
-                    entries,
-                    Kind::Fixture,
-                    "fixture beside the CMM",
-                ) {
-                    fixtures.push((l, FixtureId(id)));
-                    fixture_labels.push(at);
-                }
-            }
-            _ => cx.mismatch(v, "a list of fixtures", "write `fixtures [vise: VISE_150]`"),
-        }
-    }
-    let mut scanners: Vec<(String, ScannerId)> = Vec::new();
-    let mut scanner_labels: Vec<crate::source::Span> = Vec::new();
-    if let Some(v) = p.get("scanners") {
-        match &v.kind {
-            ValueKind::List(entries) => {
-                for (l, id, at) in
-                    labelled(r, cx, module, entries, Kind::Scanner, "scanner in the rack")
-                {
-                    if probes.iter().any(|(pl, _)| *pl == l) {
-                        cx.err(E::DuplicateName {
-                            span: at,
-                            first: None,
-                            name: l,
-                            help: "a scanner and a probe of one rack need their own labels".into(),
-                        });
-                        continue;
-                    }
-                    scanners.push((l, ScannerId(id)));
-                    scanner_labels.push(at);
-                }
-            }
-            _ => cx.mismatch(v, "a list of scanners", "write `scanners [l1: LC15Dx]`"),
-        }
-    }
+    let (probes, probe_labels) = p
+        .req(cx, "probes", "[p1: TP20_D2_L20]")
+        .map(|v| rack_probes(r, cx, module, v, &name))
+        .unwrap_or_default();
+    let (fixtures, fixture_labels) = p
+        .get("fixtures")
+        .map(|v| cmm_fixtures(r, cx, module, v))
+        .unwrap_or_default();
+    let (scanners, scanner_labels) = p
+        .get("scanners")
+        .map(|v| rack_scanners(r, cx, module, v, &probes))
+        .unwrap_or_default();
     Cmm {
         name,
         table_z,
@@ -402,6 +331,148 @@ fn cmm(
         scanner_labels,
         span,
     }
+}
+
+/// `table { z 0 mm, size (2000 mm, 1200 mm) }`: its height and, when given, its size.
+fn table(cx: &mut Cx, v: &ast::Value) -> (f64, Option<[f64; 2]>) {
+    let mut table_z = 0.0;
+    let mut table_size = None;
+    if let ValueKind::Block(props) = &v.kind {
+        let mut t = Props::new(cx, "the table", v.span, props);
+        if let Some(z) = t.get("z").and_then(|z| cx.length(z)) {
+            table_z = z;
+        }
+        if let Some(s) = t.get("size") {
+            if let Some(size) = cx.lengths::<2>(s) {
+                if size.iter().any(|x| *x <= 0.0) {
+                    cx.err(E::NonPositive {
+                        span: s.span,
+                        what: "the table size".into(),
+                        value: describe(s),
+                        help: "give the table's length and width".into(),
+                    });
+                } else {
+                    table_size = Some(size);
+                }
+            }
+        }
+        t.finish(cx);
+    } else {
+        cx.mismatch(v, "a block `{ z 0 mm, size (…) }`", "");
+    }
+    (table_z, table_size)
+}
+
+/// `ram { radius 35 mm, length 600 mm }`: (radius, length), 1 mm where one is wrong.
+fn ram(cx: &mut Cx, v: &ast::Value) -> (f64, f64) {
+    match &v.kind {
+        ValueKind::Block(props) => {
+            let mut t = Props::new(cx, "the ram", v.span, props);
+            let radius = t
+                .req(cx, "radius", "35 mm")
+                .and_then(|x| cx.positive(x, Dim::Length, "radius"))
+                .unwrap_or(1.0);
+            let length = t
+                .req(cx, "length", "600 mm")
+                .and_then(|x| cx.positive(x, Dim::Length, "length"))
+                .unwrap_or(1.0);
+            t.finish(cx);
+            (radius, length)
+        }
+        _ => {
+            cx.mismatch(v, "a block `{ radius …, length … }`", "");
+            (1.0, 1.0)
+        }
+    }
+}
+
+/// Labelled items of a CMM (its probes, fixtures or scanners) and where each label is.
+type Labelled<Id> = (Vec<(String, Id)>, Vec<crate::source::Span>);
+
+/// `probes [p1: TP20_D2_L20, …]`: the rack, at least one probe.
+fn rack_probes(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    v: &ast::Value,
+    cmm: &str,
+) -> Labelled<ProbeId> {
+    let mut out: Labelled<ProbeId> = Default::default();
+    match &v.kind {
+        ValueKind::List(entries) if !entries.is_empty() => {
+            for (l, id, at) in labelled(r, cx, module, entries, Kind::Probe, "probe in the rack") {
+                out.0.push((l, ProbeId(id)));
+                out.1.push(at);
+            }
+        }
+        ValueKind::List(_) => cx.err(E::MissingProperty {
+            span: v.span,
+            key: "probes".into(),
+            item: format!("cmm `{cmm}`"),
+            help: "a CMM needs at least one probe: `probes [p1: TP20_D2_L20]`".into(),
+        }),
+        _ => cx.mismatch(v, "a list of probes", "write `probes [p1: TP20_D2_L20]`"),
+    }
+    out
+}
+
+/// `fixtures [vise: VISE_150, …]`: the fixtures beside the CMM.
+fn cmm_fixtures(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    v: &ast::Value,
+) -> Labelled<FixtureId> {
+    let mut out: Labelled<FixtureId> = Default::default();
+    match &v.kind {
+        ValueKind::List(entries) => {
+            for (l, id, at) in labelled(
+                r,
+                cx,
+                module,
+                entries,
+                Kind::Fixture,
+                "fixture beside the CMM",
+            ) {
+                out.0.push((l, FixtureId(id)));
+                out.1.push(at);
+            }
+        }
+        _ => cx.mismatch(v, "a list of fixtures", "write `fixtures [vise: VISE_150]`"),
+    }
+    out
+}
+
+/// `scanners [l1: LC15Dx, …]`: scanners in the rack, labelled apart from its probes.
+fn rack_scanners(
+    r: &Resolver,
+    cx: &mut Cx,
+    module: ModuleId,
+    v: &ast::Value,
+    probes: &[(String, ProbeId)],
+) -> Labelled<ScannerId> {
+    let mut out: Labelled<ScannerId> = Default::default();
+    match &v.kind {
+        ValueKind::List(entries) => {
+            for (l, id, at) in
+                labelled(r, cx, module, entries, Kind::Scanner, "scanner in the rack")
+            {
+                if probes.iter().any(|(pl, _)| *pl == l) {
+                    cx.err(E::DuplicateName {
+                        span: at,
+                        first: None,
+                        name: l,
+                        help: "a scanner and a probe of one rack need their own labels".into(),
+                    });
+                    continue;
+                }
+                out.0.push((l, ScannerId(id)));
+                out.1.push(at);
+            }
+        }
+        _ => cx.mismatch(v, "a list of scanners", "write `scanners [l1: LC15Dx]`"),
+    }
+    out
 }
 
 /// A laser line scanner: its optics (stripe, stand-off, depth of field, triangulation
@@ -523,177 +594,6 @@ fn labelled(
         out.push((label, id, lspan));
     }
     out
-}
-
-/// A fixture: `kind vise|chuck|vblock|sine_plate`, its sizes, and `height`, how high it holds
-/// the part above the table.
-fn fixture(
-    r: &Resolver,
-    cx: &mut Cx,
-    p: &mut Props,
-    name: String,
-    span: crate::source::Span,
-) -> Fixture {
-    let kind_v = p.req(cx, "kind", "vise");
-    let word = kind_v
-        .and_then(|v| cx.name(v))
-        .map(|i| (i.name.clone(), i.span));
-    // A mesh fixture's mesh says where it holds the part; the others say how high.
-    let height = if word.as_ref().is_some_and(|(w, _)| w == "mesh") {
-        0.0
-    } else {
-        p.req(cx, "height", "100 mm")
-            .and_then(|v| cx.positive(v, Dim::Length, "height"))
-            .unwrap_or(100.0)
-    };
-    let length = |cx: &mut Cx, p: &mut Props, key: &'static str, example: &str, dflt: f64| {
-        p.req(cx, key, example)
-            .and_then(|v| cx.positive(v, Dim::Length, key))
-            .unwrap_or(dflt)
-    };
-    let kind = match word.as_ref().map(|(w, _)| w.as_str()) {
-        Some("vise") => {
-            let opening = length(cx, p, "opening", "160 mm", 100.0);
-            let jaw = p
-                .req(cx, "jaw", "(150 mm, 40 mm)")
-                .and_then(|v| {
-                    let j = cx.lengths::<2>(v)?;
-                    if j.iter().any(|x| *x <= 0.0) {
-                        cx.err(E::NonPositive {
-                            span: v.span,
-                            what: "the jaw size".into(),
-                            value: describe(v),
-                            help: "give the jaws' width and height".into(),
-                        });
-                        return None;
-                    }
-                    Some(j)
-                })
-                .unwrap_or([100.0, 30.0]);
-            FixtureKind::Vise { opening, jaw }
-        }
-        Some("chuck") => {
-            let diameter = p
-                .req(cx, "diameter", "3 mm .. 200 mm")
-                .and_then(|v| length_range(cx, v, "diameter"))
-                .unwrap_or([1.0, 100.0]);
-            let jaws = length(cx, p, "jaws", "20 mm", 20.0);
-            let body = length(cx, p, "body", "200 mm", 200.0);
-            FixtureKind::Chuck {
-                diameter,
-                jaws,
-                body,
-            }
-        }
-        Some("vblock") => {
-            let diameter = p
-                .req(cx, "diameter", "5 mm .. 100 mm")
-                .and_then(|v| length_range(cx, v, "diameter"))
-                .unwrap_or([1.0, 100.0]);
-            FixtureKind::VBlock { diameter }
-        }
-        Some("sine_plate") => {
-            let tilt = p
-                .req(cx, "tilt", "0 deg .. 60 deg")
-                .and_then(|v| tilt_range(cx, v))
-                .unwrap_or([0.0, 0.0]);
-            FixtureKind::SinePlate { tilt }
-        }
-        Some("mesh") => {
-            let file = p
-                .req(cx, "mesh", "\"nest.stl\"")
-                .and_then(|v| cx.string(v))
-                .cloned();
-            let unit_mm = p
-                .get("units")
-                .and_then(|v| cx.name(v).cloned())
-                .and_then(|u| super::part::length_unit(cx, &u))
-                .unwrap_or(1.0);
-            let up = p
-                .req(cx, "up", "+z")
-                .and_then(|v| cx.direction(v))
-                .unwrap_or([0.0, 0.0, 1.0]);
-            match file.and_then(|f| super::part::mesh_file(r, cx, &f).map(|path| (path, f.span))) {
-                Some((path, span)) => FixtureKind::Mesh {
-                    path,
-                    unit_mm,
-                    up,
-                    span,
-                },
-                None => FixtureKind::SinePlate { tilt: [0.0, 0.0] },
-            }
-        }
-        Some(other) => {
-            if let Some((_, s)) = &word {
-                let help = suggest::help_for_unknown(
-                    "fixture kind",
-                    other,
-                    ["vise", "chuck", "vblock", "sine_plate", "mesh"],
-                );
-                cx.err(E::UnknownName {
-                    span: *s,
-                    what: "fixture kind".into(),
-                    name: other.into(),
-                    help,
-                });
-            }
-            FixtureKind::SinePlate { tilt: [0.0, 0.0] }
-        }
-        None => FixtureKind::SinePlate { tilt: [0.0, 0.0] },
-    };
-    describe_only(cx, p);
-    Fixture {
-        name,
-        kind,
-        height,
-        span,
-    }
-}
-
-/// A range of positive lengths, `3 mm .. 200 mm`.
-fn length_range(cx: &mut Cx, v: &ast::Value, what: &str) -> Option<[f64; 2]> {
-    let ValueKind::Range(lo, hi) = &v.kind else {
-        cx.mismatch(
-            v,
-            "a range of lengths",
-            &format!("write `{what} 3 mm .. 200 mm`"),
-        );
-        return None;
-    };
-    let (lo, hi) = (cx.quantity(lo, Dim::Length), cx.quantity(hi, Dim::Length));
-    let (lo, hi) = (lo?, hi?);
-    if lo <= 0.0 || lo > hi {
-        cx.err(E::OutOfRange {
-            span: v.span,
-            what: format!("`{what}` range"),
-            value: format!("{} mm .. {} mm", num(lo), num(hi)),
-            range: "it must be positive and run upwards".into(),
-            help: "give the smallest and largest size from the data sheet".into(),
-        });
-        return None;
-    }
-    Some([lo, hi])
-}
-
-/// A sine plate's tilt range within 0°..90° (`90 deg .. 90 deg`: an angle plate).
-fn tilt_range(cx: &mut Cx, v: &ast::Value) -> Option<[f64; 2]> {
-    let ValueKind::Range(lo, hi) = &v.kind else {
-        cx.mismatch(v, "an angle range", "write `tilt 0 deg .. 60 deg`");
-        return None;
-    };
-    let (lo, hi) = (cx.quantity(lo, Dim::Angle), cx.quantity(hi, Dim::Angle));
-    let (lo, hi) = (lo?, hi?);
-    if lo < 0.0 || hi > 90.0 || lo > hi {
-        cx.err(E::OutOfRange {
-            span: v.span,
-            what: "`tilt` range".into(),
-            value: format!("{}°..{}°", num(lo), num(hi)),
-            range: "it must run upwards within 0°..90°".into(),
-            help: "a sine plate tilts from flat (0°) to square (90°, an angle plate)".into(),
-        });
-        return None;
-    }
-    Some([lo, hi])
 }
 
 /// A sampling strategy: `fan_leu`, `uniform(points 9, inset 1 mm)`, `hammersley(points 16)`.

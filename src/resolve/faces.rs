@@ -106,25 +106,31 @@ fn face_term(cx: &mut Cx, pc: &PartCx, t: &ast::FaceTerm, is_mesh: bool) -> Vec<
     }
 }
 
+/// The faces a path names: a feature's or a datum's, or one role of the stock or of an
+/// operation.
 fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
+    match path_head(cx, pc, path) {
+        PathHead::Faces(faces) => faces,
+        PathHead::Owner(source, rest) => role_faces(cx, pc, path, source, rest),
+    }
+}
+
+/// What the head of a face path stands for.
+enum PathHead<'p> {
+    /// Faces already: a feature's or a datum's, or none after an error.
+    Faces(Vec<FaceRef>),
+    /// The stock or an operation (instance), whose face the rest of the path names.
+    Owner(FaceSource, &'p [PathSeg]),
+}
+
+/// Resolves the first name of a face path (and an operation's `[i]`).
+fn path_head<'p>(cx: &mut Cx, pc: &PartCx, path: &'p ast::Path) -> PathHead<'p> {
     let head = path.head();
     let Some(local) = pc.local(cx, head) else {
-        let candidates: Vec<&str> = pc
-            .names
-            .iter()
-            .filter(|(_, (l, _))| matches!(l, Local::Feature(_) | Local::Op(_) | Local::Stock))
-            .map(|(n, _)| n.as_str())
-            .collect();
-        let help = suggest::help_for_unknown("face or feature", &head.name, candidates);
-        cx.err(E::UnknownName {
-            span: head.span,
-            what: "face or feature".into(),
-            name: head.name.clone(),
-            help,
-        });
-        return vec![];
+        unknown_head(cx, pc, head);
+        return PathHead::Faces(vec![]);
     };
-    let (source, rest) = match (local, &path.segs[1..]) {
+    match (local, &path.segs[1..]) {
         (Local::Feature(i), []) => {
             if i >= pc.lowered_features {
                 cx.err(E::UnknownName {
@@ -136,43 +142,21 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
                         head.name
                     ),
                 });
-                return vec![];
+                return PathHead::Faces(vec![]);
             }
-            return pc.part.features[i].faces.clone();
+            PathHead::Faces(pc.part.features[i].faces.clone())
         }
         (Local::Datum(i), []) if i < pc.part.datums.len() => {
-            return pc.part.features[pc.part.datums[i].feature.0].faces.clone()
+            PathHead::Faces(pc.part.features[pc.part.datums[i].feature.0].faces.clone())
         }
-        (Local::Stock, rest) => (FaceSource::Stock, rest),
+        (Local::Stock, rest) => PathHead::Owner(FaceSource::Stock, rest),
         (Local::Op(i), [PathSeg::Index(n, ispan), rest @ ..]) => {
-            let count = pc.part.ops[i].pattern.as_ref().map(Pattern::count);
-            match count {
-                None => {
-                    cx.err(E::TypeMismatch {
-                        span: *ispan,
-                        expected: "no index".into(),
-                        found: format!("`[{n}]`"),
-                        help: format!(
-                            "`{}` is not a pattern; only patterned operations have instances",
-                            head.name
-                        ),
-                    });
-                    return vec![];
-                }
-                Some(c) if *n >= c => {
-                    cx.err(E::OutOfRange {
-                        span: *ispan,
-                        what: "instance".into(),
-                        value: n.to_string(),
-                        range: format!("`{}` has instances 0 to {}", head.name, c - 1),
-                        help: "instances are numbered from 0, row by row".into(),
-                    });
-                    return vec![];
-                }
-                Some(_) => (FaceSource::Op(OpId(i), Some(*n)), rest),
+            match instance(cx, pc, head, i, *n, *ispan) {
+                Some(source) => PathHead::Owner(source, rest),
+                None => PathHead::Faces(vec![]),
             }
         }
-        (Local::Op(i), rest) => (FaceSource::Op(OpId(i), None), rest),
+        (Local::Op(i), rest) => PathHead::Owner(FaceSource::Op(OpId(i), None), rest),
         (other, _) => {
             cx.err(E::WrongKind {
                 span: path.span,
@@ -181,9 +165,73 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
                 found: other.word(&pc.part),
                 help: "name faces and features here".into(),
             });
-            return vec![];
+            PathHead::Faces(vec![])
         }
-    };
+    }
+}
+
+/// Says a path's first name is no face, feature, operation or the stock.
+fn unknown_head(cx: &mut Cx, pc: &PartCx, head: &ast::Ident) {
+    let candidates: Vec<&str> = pc
+        .names
+        .iter()
+        .filter(|(_, (l, _))| matches!(l, Local::Feature(_) | Local::Op(_) | Local::Stock))
+        .map(|(n, _)| n.as_str())
+        .collect();
+    let help = suggest::help_for_unknown("face or feature", &head.name, candidates);
+    cx.err(E::UnknownName {
+        span: head.span,
+        what: "face or feature".into(),
+        name: head.name.clone(),
+        help,
+    });
+}
+
+/// Instance `[n]` of operation `i`: only a pattern has instances, numbered from 0.
+fn instance(
+    cx: &mut Cx,
+    pc: &PartCx,
+    head: &ast::Ident,
+    i: usize,
+    n: u32,
+    ispan: Span,
+) -> Option<FaceSource> {
+    let count = pc.part.ops[i].pattern.as_ref().map(Pattern::count);
+    match count {
+        None => {
+            cx.err(E::TypeMismatch {
+                span: ispan,
+                expected: "no index".into(),
+                found: format!("`[{n}]`"),
+                help: format!(
+                    "`{}` is not a pattern; only patterned operations have instances",
+                    head.name
+                ),
+            });
+            None
+        }
+        Some(c) if n >= c => {
+            cx.err(E::OutOfRange {
+                span: ispan,
+                what: "instance".into(),
+                value: n.to_string(),
+                range: format!("`{}` has instances 0 to {}", head.name, c - 1),
+                help: "instances are numbered from 0, row by row".into(),
+            });
+            None
+        }
+        Some(_) => Some(FaceSource::Op(OpId(i), Some(n))),
+    }
+}
+
+/// The face `rest` names on the stock or an operation: exactly one of its roles.
+fn role_faces(
+    cx: &mut Cx,
+    pc: &PartCx,
+    path: &ast::Path,
+    source: FaceSource,
+    rest: &[PathSeg],
+) -> Vec<FaceRef> {
     let owner = match &source {
         FaceSource::Stock => "the stock".to_string(),
         FaceSource::Op(OpId(i), _) => {
@@ -218,7 +266,7 @@ fn path_faces(cx: &mut Cx, pc: &PartCx, path: &ast::Path) -> Vec<FaceRef> {
         _ => {
             let roles = known
                 .iter()
-                .map(|r| format!("`{}.{r}`", head.name))
+                .map(|r| format!("`{}.{r}`", path.head().name))
                 .collect::<Vec<_>>()
                 .join(", ");
             cx.err(E::TypeMismatch {

@@ -3,13 +3,13 @@
 use super::datum::{check_unique_datums, datum, datum_ref};
 use super::errors::ResolveError as E;
 use super::faces::face_expr;
-use super::props::{describe, path_text, Cx, Dim, Props, UNITS};
+use super::props::{call_args, path_text, Cx, Dim, Props, UNITS};
 use super::scope::{Local, PartCx};
-use super::{tolerance, Resolver};
+use super::{ops, tolerance, Resolver};
 use crate::diag::suggest;
 use crate::model::*;
 use crate::source::Span;
-use crate::syntax::ast::{self, NamedKind, PartStmt, ValueKind};
+use crate::syntax::ast::{self, NamedKind, PartStmt};
 use std::collections::BTreeMap;
 
 pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
@@ -25,6 +25,32 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
         span: p.name.span,
     };
     // Units first: they give bare numbers their meaning.
+    if let Some(f) = part_units(cx, p) {
+        part.unit_mm = f;
+    }
+    cx.unit_mm = Some(part.unit_mm);
+    let is_mesh = read_geometry(r, cx, p, &mut part);
+
+    // Declare every local name so references can say what a name is.
+    let mut pc = PartCx {
+        part,
+        names: BTreeMap::new(),
+        lowered_features: 0,
+        stmts: &p.stmts,
+    };
+    declare_locals(cx, &mut pc);
+
+    ops::lower(cx, &mut pc, is_mesh);
+    features_and_datums(cx, &mut pc, is_mesh);
+    frames(cx, &mut pc);
+    tolerances(cx, &mut pc);
+    cx.unit_mm = None;
+    pc.part
+}
+
+/// The part's `units`, said once; None (after saying why) where it is missing or not a
+/// length unit.
+fn part_units(cx: &mut Cx, p: &ast::Part) -> Option<f64> {
     let units: Vec<&ast::Ident> = p
         .stmts
         .iter()
@@ -37,24 +63,32 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
         })
         .collect();
     match units.as_slice() {
-        [] => cx.err(E::MissingProperty {
-            span: p.name.span,
-            key: "units".into(),
-            item: format!("part `{}`", p.name.name),
-            help: "add `units mm` (or cm, m, um, in): bare numbers in the part are read in these units".into(),
-        }),
+        [] => {
+            cx.err(E::MissingProperty {
+                span: p.name.span,
+                key: "units".into(),
+                item: format!("part `{}`", p.name.name),
+                help: "add `units mm` (or cm, m, um, in): bare numbers in the part are read in these units".into(),
+            });
+            None
+        }
         [u, rest @ ..] => {
-            if let Some(f) = length_unit(cx, u) {
-                part.unit_mm = f;
-            }
+            let f = length_unit(cx, u);
             for dup in rest {
-                cx.err(E::DuplicateProperty { span: dup.span, first: u.span, key: "units".into() });
+                cx.err(E::DuplicateProperty {
+                    span: dup.span,
+                    first: u.span,
+                    key: "units".into(),
+                });
             }
+            f
         }
     }
-    cx.unit_mm = Some(part.unit_mm);
+}
 
-    // Geometry source.
+/// The part's one geometry source, a stock or a mesh, into `part.geometry`; whether it
+/// is a mesh (false where there is none).
+fn read_geometry(r: &Resolver, cx: &mut Cx, p: &ast::Part, part: &mut Part) -> bool {
     let mut source_span: Option<Span> = None;
     let mut have_stock = false;
     for s in &p.stmts {
@@ -83,113 +117,71 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
             part: part.name.clone(),
         });
     }
-    let is_mesh = source_span.is_some() && !have_stock;
+    source_span.is_some() && !have_stock
+}
 
-    // Declare every local name so references can say what a name is.
-    let mut pc = PartCx {
-        part,
-        names: BTreeMap::new(),
-        lowered_features: 0,
-        stmts: &p.stmts,
-    };
-    declare_locals(cx, &mut pc);
-
-    let mut instances: u64 = 0;
-    for s in &p.stmts {
-        if let PartStmt::Cut {
-            add,
-            kind,
-            name,
-            props,
-            span,
-        } = s
-        {
-            if is_mesh {
-                cx.err(E::NeedsStock {
-                    span: *span,
-                    what: format!("`{}` {}", if *add { "add" } else { "cut" }, kind.name),
-                });
-            }
-            let mut op = operation(cx, *add, kind, name, props);
-            // The part's operations together stay within the instance limit: every
-            // instance is booleaned, sampled and measured.
-            if let Some(o) = &op {
-                let n = u64::from(o.pattern.as_ref().map_or(1, Pattern::count));
-                if instances + n > u64::from(MAX_INSTANCES) {
-                    cx.err(E::OutOfRange {
-                        span: o.span,
-                        what: format!("`{}`", o.name),
-                        value: format!("brings the part to {} instances", instances + n),
-                        range: format!("a part has at most {MAX_INSTANCES}"),
-                        help: "a CMM program measures each instance; check the pattern counts"
-                            .into(),
-                    });
-                    op = None;
-                } else {
-                    instances += n;
-                }
-            }
-            pc.part.ops.push(op.unwrap_or(Op {
-                name: name.name.clone(),
-                action: if *add { Action::Add } else { Action::Cut },
-                kind: OpKind::Boss {
-                    at: [0.0; 3],
-                    axis: [0.0, 0.0, 1.0],
-                    diameter: 1.0,
-                    height: 1.0,
-                },
-                pattern: None,
-                span: name.span,
-            }));
-        }
-    }
-
-    for s in &p.stmts {
+/// Faces, features and datums in declaration order (a feature may use those above it).
+fn features_and_datums(cx: &mut Cx, pc: &mut PartCx, is_mesh: bool) {
+    for s in pc.stmts {
         match s {
             PartStmt::Named {
                 what: what @ (NamedKind::Face | NamedKind::Feature),
                 name,
                 expr,
                 ..
-            } => {
-                let faces = match expr {
-                    Some(e) => face_expr(cx, &pc, e, is_mesh),
-                    None => vec![],
-                };
-                if faces.is_empty() && expr.is_none() {
-                    cx.err(E::EmptyFeature {
-                        span: name.span,
-                        name: name.name.clone(),
-                    });
-                }
-                pc.part.features.push(Feature {
-                    name: name.name.clone(),
-                    faces,
-                    declared: if *what == NamedKind::Face {
-                        Declared::Face
-                    } else {
-                        Declared::Feature
-                    },
-                    span: name.span,
-                });
-                pc.lowered_features += 1;
-            }
+            } => feature(cx, pc, *what, name, expr.as_ref(), is_mesh),
             PartStmt::Named {
                 what: NamedKind::Datum,
                 name,
                 expr,
                 span,
             } => {
-                datum(cx, &mut pc, name, expr.as_ref(), *span, is_mesh);
+                datum(cx, pc, name, expr.as_ref(), *span, is_mesh);
             }
             _ => {}
         }
     }
-    for s in &p.stmts {
+}
+
+/// `face name = …` or `feature name = …`: its faces, reported empty when it names none.
+fn feature(
+    cx: &mut Cx,
+    pc: &mut PartCx,
+    what: NamedKind,
+    name: &ast::Ident,
+    expr: Option<&ast::FaceExpr>,
+    is_mesh: bool,
+) {
+    let faces = match expr {
+        Some(e) => face_expr(cx, pc, e, is_mesh),
+        None => vec![],
+    };
+    if faces.is_empty() && expr.is_none() {
+        cx.err(E::EmptyFeature {
+            span: name.span,
+            name: name.name.clone(),
+        });
+    }
+    pc.part.features.push(Feature {
+        name: name.name.clone(),
+        faces,
+        declared: if what == NamedKind::Face {
+            Declared::Face
+        } else {
+            Declared::Feature
+        },
+        span: name.span,
+    });
+    pc.lowered_features += 1;
+}
+
+/// Every `frame name = [A, B, C]`, each datum once.
+fn frames(cx: &mut Cx, pc: &mut PartCx) {
+    for s in pc.stmts {
         if let PartStmt::Frame { name, refs, .. } = s {
             let refs = refs
                 .iter()
-                .filter_map(|e| datum_ref(cx, &pc, &e.value))
+                .filter_map(|e| datum_ref(cx, pc, &e.value))
                 .collect::<Vec<_>>();
             check_unique_datums(cx, &pc.part, &refs);
             pc.part.frames.push(Frame {
@@ -199,15 +191,17 @@ pub(super) fn lower(r: &Resolver, cx: &mut Cx, p: &ast::Part) -> Part {
             });
         }
     }
-    for s in &p.stmts {
+}
+
+/// Every `tolerance name = kind(…)` that checks out.
+fn tolerances(cx: &mut Cx, pc: &mut PartCx) {
+    for s in pc.stmts {
         if let PartStmt::Tolerance { name, call, .. } = s {
-            if let Some(t) = tolerance::lower(cx, &pc, name, call) {
+            if let Some(t) = tolerance::lower(cx, pc, name, call) {
                 pc.part.tolerances.push(t);
             }
         }
     }
-    cx.unit_mm = None;
-    pc.part
 }
 
 pub(super) fn length_unit(cx: &mut Cx, u: &ast::Ident) -> Option<f64> {
@@ -289,59 +283,6 @@ fn declare_locals(cx: &mut Cx, pc: &mut PartCx) {
     }
     pc.names
         .insert("stock".into(), (Local::Stock, Span::new(cx.file, 0, 0)));
-}
-
-/// Positional or named arguments of a call, by parameter order.
-fn call_args<'c>(
-    cx: &mut Cx,
-    call: &'c ast::Call,
-    params: &[&'static str],
-    what: &str,
-) -> Vec<Option<&'c ast::Value>> {
-    let mut out: Vec<Option<&ast::Value>> = vec![None; params.len()];
-    let mut next = 0;
-    for a in &call.args {
-        match a {
-            ast::Arg::Positional(v) => {
-                if next < params.len() {
-                    out[next] = Some(v);
-                    next += 1;
-                } else {
-                    cx.err(E::Arity {
-                        span: v.span,
-                        kind: what.into(),
-                        expected: format!("{} arguments ({})", params.len(), params.join(", ")),
-                        found: "one too many".into(),
-                        help: format!("write `{}({})`", path_text(&call.callee), params.join(", ")),
-                    });
-                }
-            }
-            ast::Arg::Named(k, v) => match params.iter().position(|p| *p == k.name) {
-                Some(i) => out[i] = Some(v),
-                None => {
-                    let help =
-                        suggest::help_for_unknown("argument", &k.name, params.iter().copied());
-                    cx.err(E::UnknownProperty {
-                        span: k.span,
-                        key: k.name.clone(),
-                        item: what.into(),
-                        help,
-                    });
-                }
-            },
-        }
-    }
-    for (i, p) in params.iter().enumerate() {
-        if out[i].is_none() {
-            cx.err(E::MissingArgument {
-                span: call.span,
-                kind: what.into(),
-                what: format!("`{p}`"),
-                help: format!("write `{}({})`", path_text(&call.callee), params.join(", ")),
-            });
-        }
-    }
-    out
 }
 
 fn stock(cx: &mut Cx, call: &ast::Call) -> Option<Geometry> {
@@ -475,289 +416,4 @@ pub(super) fn mesh_file(r: &Resolver, cx: &mut Cx, path: &ast::Str) -> Option<st
         });
     }
     Some(full)
-}
-
-fn operation(
-    cx: &mut Cx,
-    add: bool,
-    kind: &ast::Ident,
-    name: &ast::Ident,
-    props: &[ast::Prop],
-) -> Option<Op> {
-    const KINDS: [&str; 5] = ["hole", "slot", "pocket", "step", "boss"];
-    if !KINDS.contains(&kind.name.as_str()) {
-        let help = suggest::help_for_unknown("machining feature", &kind.name, KINDS);
-        cx.err(E::UnknownName {
-            span: kind.span,
-            what: "machining feature".into(),
-            name: kind.name.clone(),
-            help,
-        });
-        return None;
-    }
-    let adds = kind.name == "boss";
-    if add != adds {
-        let (verb, fix) = if add { ("add", "cut") } else { ("cut", "add") };
-        cx.err(E::WrongOperation {
-            span: kind.span,
-            kind: format!("a {}", kind.name),
-            op: if adds {
-                "adds material, it cannot be written".into()
-            } else {
-                "removes material, it cannot be written".into()
-            },
-            verb: verb.into(),
-            fix: format!("{fix} {}", kind.name),
-            help: format!("write `{fix} {} {} {{ … }}`", kind.name, name.name),
-        });
-    }
-    let mut p = Props::new(
-        cx,
-        format!("{} `{}`", kind.name, name.name),
-        name.span,
-        props,
-    );
-    let dir =
-        |cx: &mut Cx, p: &mut Props, key: &'static str, default: Option<Vec3>| match p.get(key) {
-            Some(v) => cx.direction(v),
-            None if default.is_some() => default,
-            None => p.req(cx, key, "+x").and_then(|v| cx.direction(v)),
-        };
-    let point = |cx: &mut Cx, p: &mut Props| {
-        p.req(cx, "at", "(10, 10, 40)")
-            .and_then(|v| cx.lengths::<3>(v))
-    };
-    let positive = |cx: &mut Cx, p: &mut Props, key: &'static str| {
-        p.req(cx, key, "10")
-            .and_then(|v| cx.positive(v, Dim::Length, key))
-    };
-    let op = match kind.name.as_str() {
-        "hole" => {
-            let radial = p.get("radial").and_then(|v| cx.direction(v));
-            let at = match (p.get("at"), radial) {
-                (Some(v), None) => cx.lengths::<3>(v).map(Placement::At),
-                (None, Some(d)) => Some(Placement::Radial(d)),
-                (Some(v), Some(_)) => {
-                    cx.err(E::DuplicateGeometry {
-                        span: v.span,
-                        first: p.get("radial").map_or(v.span, |r| r.span),
-                        part: name.name.clone(),
-                    });
-                    None
-                }
-                (None, None) => p.req(cx, "at", "(10, 10, 40)").and(None),
-            };
-            let axis = match radial {
-                Some(d) => dir(cx, &mut p, "axis", Some([-d[0], -d[1], -d[2]])),
-                None => dir(cx, &mut p, "axis", None),
-            };
-            let diameter = positive(cx, &mut p, "diameter");
-            let depth = match p.req(cx, "depth", "20 mm or `depth through`") {
-                Some(v) if matches!(&v.kind, ValueKind::Path(pp) if pp.as_ident().is_some_and(|i| i.name == "through")) => {
-                    Some(Depth::Through)
-                }
-                Some(v) => cx.positive(v, Dim::Length, "depth").map(Depth::Blind),
-                None => None,
-            };
-            OpKind::Hole {
-                at: at?,
-                axis: axis?,
-                diameter: diameter?,
-                depth: depth?,
-            }
-        }
-        "slot" | "step" => {
-            let at = point(cx, &mut p);
-            let along = dir(cx, &mut p, "along", None);
-            let into = dir(cx, &mut p, "into", Some([0.0, 0.0, -1.0]));
-            let width = positive(cx, &mut p, "width");
-            let depth = positive(cx, &mut p, "depth");
-            perpendicular(cx, &mut p, along, into);
-            if kind.name == "slot" {
-                let length = match p.get("length") {
-                    Some(v) => Some(cx.positive(v, Dim::Length, "length")?),
-                    None => None,
-                };
-                OpKind::Slot {
-                    at: at?,
-                    along: along?,
-                    into: into?,
-                    width: width?,
-                    depth: depth?,
-                    length,
-                }
-            } else {
-                OpKind::Step {
-                    at: at?,
-                    along: along?,
-                    into: into?,
-                    width: width?,
-                    depth: depth?,
-                }
-            }
-        }
-        "pocket" => {
-            let at = point(cx, &mut p);
-            let along = dir(cx, &mut p, "along", Some([1.0, 0.0, 0.0]));
-            let into = dir(cx, &mut p, "into", Some([0.0, 0.0, -1.0]));
-            perpendicular(cx, &mut p, along, into);
-            let size = p.req(cx, "size", "(40, 20)").and_then(|v| {
-                let s = cx.lengths::<2>(v)?;
-                if s.iter().any(|x| *x <= 0.0) {
-                    cx.err(E::NonPositive {
-                        span: v.span,
-                        what: "`size`".into(),
-                        value: describe(v),
-                        help: "a pocket's length and width are positive".into(),
-                    });
-                    return None;
-                }
-                Some(s)
-            });
-            let depth = positive(cx, &mut p, "depth");
-            let corner_radius = match p.get("corner_radius") {
-                Some(v) => cx.length(v).and_then(|x| {
-                    if x < 0.0 {
-                        cx.err(E::OutOfRange {
-                            span: v.span,
-                            what: "`corner_radius`".into(),
-                            value: describe(v),
-                            range: "it cannot be negative".into(),
-                            help: "a corner radius is 0 (sharp) or more".into(),
-                        });
-                        return None;
-                    }
-                    Some(x)
-                }),
-                None => Some(0.0),
-            };
-            OpKind::Pocket {
-                at: at?,
-                along: along?,
-                into: into?,
-                size: size?,
-                depth: depth?,
-                corner_radius: corner_radius?,
-            }
-        }
-        _ => {
-            let at = point(cx, &mut p);
-            let axis = dir(cx, &mut p, "axis", Some([0.0, 0.0, 1.0]));
-            let diameter = positive(cx, &mut p, "diameter");
-            let height = positive(cx, &mut p, "height");
-            OpKind::Boss {
-                at: at?,
-                axis: axis?,
-                diameter: diameter?,
-                height: height?,
-            }
-        }
-    };
-    let pattern = p.get("pattern").and_then(|v| {
-        let pat = pattern(cx, v)?;
-        if pat.count() > MAX_INSTANCES {
-            cx.err(E::OutOfRange {
-                span: v.span,
-                what: "pattern".into(),
-                value: format!("of {} instances", pat.count()),
-                range: format!("at most {MAX_INSTANCES}"),
-                help: "a CMM program measures each instance; split the pattern or check the counts"
-                    .into(),
-            });
-            return None;
-        }
-        Some(pat)
-    });
-    p.finish(cx);
-    Some(Op {
-        name: name.name.clone(),
-        action: if add { Action::Add } else { Action::Cut },
-        kind: op,
-        pattern,
-        span: name.span,
-    })
-}
-
-/// The most instances one pattern, or all of a part's operations together, may have:
-/// the booleans triangulate a face pierced by every instance, which grows faster than
-/// linearly (2,000 holes in one face: about 9 s; 10,000: over two minutes).
-const MAX_INSTANCES: u32 = 2_000;
-
-fn perpendicular(cx: &mut Cx, p: &mut Props, along: Option<Vec3>, into: Option<Vec3>) {
-    if let (Some(a), Some(i)) = (along, into) {
-        let dot = a[0] * i[0] + a[1] * i[1] + a[2] * i[2];
-        if dot.abs() > 1e-6 {
-            let v = p.get("along").or_else(|| p.get("into"));
-            if let Some(v) = v {
-                cx.err(E::OutOfRange {
-                    span: v.span,
-                    what: "`along`".into(),
-                    value: "direction".into(),
-                    range: "it must be perpendicular to `into`".into(),
-                    help: "a slot, pocket or step runs across the material it goes into; e.g. `along +y` with `into -z`".into(),
-                });
-            }
-        }
-    }
-}
-
-fn pattern(cx: &mut Cx, v: &ast::Value) -> Option<Pattern> {
-    let ValueKind::Call(call) = &v.kind else {
-        cx.mismatch(v, "a pattern", "write `grid(nx, ny, pitch_x, pitch_y)`, `linear(count, (dx, dy, dz))` or `polar(count, axis, (cx, cy, cz))`");
-        return None;
-    };
-    let name = call
-        .callee
-        .as_ident()
-        .map(|i| i.name.as_str())
-        .unwrap_or("");
-    match name {
-        "grid" => {
-            let a = call_args(
-                cx,
-                call,
-                &["nx", "ny", "pitch_x", "pitch_y"],
-                "a grid pattern",
-            );
-            let nx = a[0].and_then(|v| cx.count(v, "nx"));
-            let ny = a[1].and_then(|v| cx.count(v, "ny"));
-            let px = a[2].and_then(|v| cx.positive(v, Dim::Length, "pitch_x"));
-            let py = a[3].and_then(|v| cx.positive(v, Dim::Length, "pitch_y"));
-            Some(Pattern::Grid {
-                nx: nx?,
-                ny: ny?,
-                pitch: [px?, py?],
-            })
-        }
-        "linear" => {
-            let a = call_args(cx, call, &["count", "step"], "a linear pattern");
-            let count = a[0].and_then(|v| cx.count(v, "count"));
-            let step = a[1].and_then(|v| cx.lengths::<3>(v));
-            Some(Pattern::Linear {
-                count: count?,
-                step: step?,
-            })
-        }
-        "polar" => {
-            let a = call_args(cx, call, &["count", "axis", "center"], "a polar pattern");
-            let count = a[0].and_then(|v| cx.count(v, "count"));
-            let axis = a[1].and_then(|v| cx.direction(v));
-            let center = a[2].and_then(|v| cx.lengths::<3>(v));
-            Some(Pattern::Polar {
-                count: count?,
-                axis: axis?,
-                center: center?,
-            })
-        }
-        other => {
-            let help = suggest::help_for_unknown("pattern", other, ["grid", "linear", "polar"]);
-            cx.err(E::UnknownName {
-                span: call.callee.span,
-                what: "pattern".into(),
-                name: path_text(&call.callee),
-                help,
-            });
-            None
-        }
-    }
 }

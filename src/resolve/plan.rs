@@ -7,6 +7,7 @@ use super::{Kind, Resolver};
 use crate::diag::suggest;
 use crate::load::ModuleId;
 use crate::model::*;
+use crate::source::Span;
 use crate::syntax::ast::{self, PlanStmt, ValueKind};
 
 pub(super) fn lower(
@@ -16,17 +17,7 @@ pub(super) fn lower(
     p: &ast::Plan,
     model: &Model,
 ) -> Option<Plan> {
-    let props: Vec<ast::Prop> = p
-        .stmts
-        .iter()
-        .filter_map(|s| {
-            if let PlanStmt::Prop(pr) = s {
-                Some(pr.clone())
-            } else {
-                None
-            }
-        })
-        .collect();
+    let props = plan_props(p);
     let mut pp = Props::new(cx, format!("plan `{}`", p.name.name), p.name.span, &props);
     let part = pp
         .req(cx, "part", "f2")
@@ -42,100 +33,24 @@ pub(super) fn lower(
         Some(v) => r.lookup_value(cx, module, v, Kind::Sampling),
         None => r.std_item("std::sampling", "spread", Kind::Sampling),
     };
-    let mut outputs = Outputs::default();
-    if let Some(v) = pp.get("output") {
-        match &v.kind {
-            ValueKind::Block(ops) => {
-                let mut o = Props::new(cx, "`output`", v.span, ops);
-                let mut path = |key: &'static str| {
-                    let s = o.get(key).and_then(|x| cx.string(x))?;
-                    if !stays_inside(&s.value) {
-                        cx.err(E::OutputOutside {
-                            span: s.span,
-                            path: s.value.clone(),
-                        });
-                        return None;
-                    }
-                    Some(s.value.clone())
-                };
-                outputs.dmis = path("dmis");
-                outputs.plan = path("plan");
-                outputs.graph = path("graph");
-                o.finish(cx);
-            }
-            _ => cx.mismatch(v, "a block `{ dmis \"out.dmi\" }`", ""),
-        }
-    }
-    let mut motion = Motion::default();
-    if let Some(v) = pp.get("motion") {
-        match &v.kind {
-            ValueKind::Block(ops) => {
-                let mut o = Props::new(cx, "`motion`", v.span, ops);
-                for (key, slot) in [
-                    ("prehit", &mut motion.prehit),
-                    ("retract", &mut motion.retract),
-                    ("search", &mut motion.search),
-                    ("clearance", &mut motion.clearance),
-                ] {
-                    if let Some(x) = o.get(key).and_then(|x| cx.positive(x, Dim::Length, key)) {
-                        *slot = x;
-                    }
-                }
-                let m = o.get("margin");
-                if let Some((x, v)) = m.and_then(|v| Some((cx.dim(v, Dim::Length)?, v))) {
-                    if x < 0.0 {
-                        cx.err(E::OutOfRange {
-                            span: v.span,
-                            what: "`margin`".into(),
-                            value: format!("{} mm", num(x)),
-                            range: "it must be 0 mm or more".into(),
-                            help: "the least distance moves keep from the part; 0 mm keeps none"
-                                .into(),
-                        });
-                    } else {
-                        motion.margin = x;
-                    }
-                }
-                o.finish(cx);
-            }
-            _ => cx.mismatch(v, "a block `{ prehit 2 mm, retract 2 mm }`", ""),
-        }
-    }
+    let outputs = pp
+        .get("output")
+        .map(|v| output_paths(cx, v))
+        .unwrap_or_default();
+    let motion = pp
+        .get("motion")
+        .map(|v| motion_distances(cx, v))
+        .unwrap_or_default();
     let fixtures_v = pp.get("fixtures");
     let sensors_v = pp.get("sensors");
-    let mut sensor_ratio = 10.0;
-    if let Some(v) = pp.get("sensor_ratio") {
-        if let Some(x) = cx.number(v) {
-            if x <= 0.0 {
-                cx.err(E::OutOfRange {
-                    span: v.span,
-                    what: "`sensor_ratio`".into(),
-                    value: num(x),
-                    range: "it must be more than 0".into(),
-                    help: "tolerance over accuracy: 10 for the usual 1:10 rule, 5 for 1:5".into(),
-                });
-            } else {
-                sensor_ratio = x;
-            }
-        }
-    }
-    let mut scan_coverage = 0.95;
-    if let Some(v) = pp.get("scan_coverage") {
-        if let Some(x) = cx.dim(v, Dim::Ratio) {
-            if x <= 0.0 || x > 1.0 {
-                cx.err(E::OutOfRange {
-                    span: v.span,
-                    what: "`scan_coverage`".into(),
-                    value: format!("{} %", num(x * 100.0)),
-                    range: "a share of the area above 0 % and at most 100 %".into(),
-                    help: "the share of a scanned face's area its passes must see; 95 % is usual"
-                        .into(),
-                });
-            } else {
-                scan_coverage = x;
-            }
-        }
-    }
+    let sensor_ratio = pp
+        .get("sensor_ratio")
+        .and_then(|v| sensor_ratio_value(cx, v))
+        .unwrap_or(10.0);
+    let scan_coverage = pp
+        .get("scan_coverage")
+        .and_then(|v| scan_coverage_value(cx, v))
+        .unwrap_or(0.95);
     pp.finish(cx);
     let (part, cmm, hierarchy, sampling) = (part?, cmm?, hierarchy?, sampling?);
     let the_part = &model.parts[part];
@@ -173,34 +88,7 @@ pub(super) fn lower(
                 feature,
                 strategy: sv,
                 ..
-            } => {
-                let name = path_text(feature);
-                match the_part.features.iter().position(|f| f.name == name) {
-                    Some(i) => {
-                        cx.bind(feature.span, the_part.features[i].span);
-                        if let Some(st) = strategy(cx, sv, None) {
-                            plan.overrides.push((FeatureId(i), st));
-                        }
-                    }
-                    None => {
-                        let help = format!(
-                            "part `{}` has no feature `{name}`; {}",
-                            the_part.name,
-                            suggest::help_for_unknown(
-                                "feature",
-                                &name,
-                                the_part.features.iter().map(|f| f.name.as_str())
-                            )
-                        );
-                        cx.err(E::UnknownName {
-                            span: feature.span,
-                            what: "feature".into(),
-                            name,
-                            help,
-                        });
-                    }
-                }
-            }
+            } => sample_override(cx, &mut plan, the_part, feature, sv),
             PlanStmt::Pref {
                 forbid,
                 kind,
@@ -208,103 +96,261 @@ pub(super) fn lower(
                 opts,
                 span,
             } => {
-                let mut o = Props::new(
-                    cx,
-                    format!(
-                        "`{} {}`",
-                        if *forbid { "forbid" } else { "prefer" },
-                        kind.name
-                    ),
-                    *span,
+                let pref = PrefStmt {
+                    forbid: *forbid,
+                    kind,
+                    value,
                     opts,
-                );
-                match kind.name.as_str() {
-                    "setup" => {
-                        let weight = if *forbid {
-                            None
-                        } else {
-                            o.get("weight").and_then(|v| cx.non_negative(v, "weight"))
-                        };
-                        if let Some(direction) = cx.direction(value) {
-                            plan.setups.push(SetupPref {
-                                direction,
-                                stance: stance(*forbid, weight.unwrap_or(1.0)),
-                                span: *span,
-                            });
-                        }
-                    }
-                    "orientation" => {
-                        let weight = if *forbid {
-                            None
-                        } else {
-                            o.get("weight").and_then(|v| cx.non_negative(v, "weight"))
-                        };
-                        if let Some((a, b)) = orientation(cx, value, head) {
-                            plan.orientations.push(OrientPref {
-                                a,
-                                b,
-                                stance: stance(*forbid, weight.unwrap_or(1.0)),
-                                span: *span,
-                            });
-                        }
-                    }
-                    "probe" => {
-                        let cost = if *forbid {
-                            None
-                        } else {
-                            o.get("cost").and_then(|v| cx.non_negative(v, "cost"))
-                        };
-                        if let Some(label) = cx.name(value) {
-                            if let Some(k) =
-                                the_cmm.probes.iter().position(|(l, _)| *l == label.name)
-                            {
-                                if let Some(&at) = the_cmm.probe_labels.get(k) {
-                                    cx.bind(label.span, at);
-                                }
-                                plan.probes.push(ProbePref {
-                                    label: label.name.clone(),
-                                    stance: stance(*forbid, cost),
-                                    span: *span,
-                                });
-                            } else {
-                                let help = format!(
-                                    "cmm `{}` has no probe `{}`; {}",
-                                    the_cmm.name,
-                                    label.name,
-                                    suggest::help_for_unknown(
-                                        "probe",
-                                        &label.name,
-                                        the_cmm.probes.iter().map(|(l, _)| l.as_str())
-                                    )
-                                );
-                                cx.err(E::UnknownName {
-                                    span: label.span,
-                                    what: "probe".into(),
-                                    name: label.name.clone(),
-                                    help,
-                                });
-                            }
-                        }
-                    }
-                    other => {
-                        let help = suggest::help_for_unknown(
-                            "preference",
-                            other,
-                            ["setup", "orientation", "probe"],
-                        );
-                        cx.err(E::UnknownName {
-                            span: kind.span,
-                            what: "preference".into(),
-                            name: other.into(),
-                            help,
-                        });
-                    }
-                }
-                o.finish(cx);
+                    span: *span,
+                };
+                preference(cx, &mut plan, the_cmm, head, &pref);
             }
         }
     }
     Some(plan)
+}
+
+/// The plan's `key value` properties, without its preferences and overrides.
+fn plan_props(p: &ast::Plan) -> Vec<ast::Prop> {
+    p.stmts
+        .iter()
+        .filter_map(|s| {
+            if let PlanStmt::Prop(pr) = s {
+                Some(pr.clone())
+            } else {
+                None
+            }
+        })
+        .collect()
+}
+
+/// `output { dmis "out.dmi", plan "…", graph "…" }`: paths inside the spec's folder.
+fn output_paths(cx: &mut Cx, v: &ast::Value) -> Outputs {
+    let mut outputs = Outputs::default();
+    match &v.kind {
+        ValueKind::Block(ops) => {
+            let mut o = Props::new(cx, "`output`", v.span, ops);
+            let mut path = |key: &'static str| {
+                let s = o.get(key).and_then(|x| cx.string(x))?;
+                if !stays_inside(&s.value) {
+                    cx.err(E::OutputOutside {
+                        span: s.span,
+                        path: s.value.clone(),
+                    });
+                    return None;
+                }
+                Some(s.value.clone())
+            };
+            outputs.dmis = path("dmis");
+            outputs.plan = path("plan");
+            outputs.graph = path("graph");
+            o.finish(cx);
+        }
+        _ => cx.mismatch(v, "a block `{ dmis \"out.dmi\" }`", ""),
+    }
+    outputs
+}
+
+/// `motion { prehit 2 mm, retract 2 mm, … }`: the defaults where a distance is left out
+/// or wrong.
+fn motion_distances(cx: &mut Cx, v: &ast::Value) -> Motion {
+    let mut motion = Motion::default();
+    match &v.kind {
+        ValueKind::Block(ops) => {
+            let mut o = Props::new(cx, "`motion`", v.span, ops);
+            for (key, slot) in [
+                ("prehit", &mut motion.prehit),
+                ("retract", &mut motion.retract),
+                ("search", &mut motion.search),
+                ("clearance", &mut motion.clearance),
+            ] {
+                if let Some(x) = o.get(key).and_then(|x| cx.positive(x, Dim::Length, key)) {
+                    *slot = x;
+                }
+            }
+            let m = o.get("margin");
+            if let Some((x, v)) = m.and_then(|v| Some((cx.dim(v, Dim::Length)?, v))) {
+                if x < 0.0 {
+                    cx.err(E::OutOfRange {
+                        span: v.span,
+                        what: "`margin`".into(),
+                        value: format!("{} mm", num(x)),
+                        range: "it must be 0 mm or more".into(),
+                        help: "the least distance moves keep from the part; 0 mm keeps none".into(),
+                    });
+                } else {
+                    motion.margin = x;
+                }
+            }
+            o.finish(cx);
+        }
+        _ => cx.mismatch(v, "a block `{ prehit 2 mm, retract 2 mm }`", ""),
+    }
+    motion
+}
+
+/// `sensor_ratio 10`: a number above 0, or None after saying why.
+fn sensor_ratio_value(cx: &mut Cx, v: &ast::Value) -> Option<f64> {
+    let x = cx.number(v)?;
+    if x <= 0.0 {
+        cx.err(E::OutOfRange {
+            span: v.span,
+            what: "`sensor_ratio`".into(),
+            value: num(x),
+            range: "it must be more than 0".into(),
+            help: "tolerance over accuracy: 10 for the usual 1:10 rule, 5 for 1:5".into(),
+        });
+        return None;
+    }
+    Some(x)
+}
+
+/// `scan_coverage 95 %`: a share above 0 and at most 1, or None after saying why.
+fn scan_coverage_value(cx: &mut Cx, v: &ast::Value) -> Option<f64> {
+    let x = cx.dim(v, Dim::Ratio)?;
+    if x <= 0.0 || x > 1.0 {
+        cx.err(E::OutOfRange {
+            span: v.span,
+            what: "`scan_coverage`".into(),
+            value: format!("{} %", num(x * 100.0)),
+            range: "a share of the area above 0 % and at most 100 %".into(),
+            help: "the share of a scanned face's area its passes must see; 95 % is usual".into(),
+        });
+        return None;
+    }
+    Some(x)
+}
+
+/// `sample feature with strategy`: a per-feature override of the plan's sampling.
+fn sample_override(
+    cx: &mut Cx,
+    plan: &mut Plan,
+    part: &Part,
+    feature: &ast::Path,
+    sv: &ast::Value,
+) {
+    let name = path_text(feature);
+    match part.features.iter().position(|f| f.name == name) {
+        Some(i) => {
+            cx.bind(feature.span, part.features[i].span);
+            if let Some(st) = strategy(cx, sv, None) {
+                plan.overrides.push((FeatureId(i), st));
+            }
+        }
+        None => {
+            let help = format!(
+                "part `{}` has no feature `{name}`; {}",
+                part.name,
+                suggest::help_for_unknown(
+                    "feature",
+                    &name,
+                    part.features.iter().map(|f| f.name.as_str())
+                )
+            );
+            cx.err(E::UnknownName {
+                span: feature.span,
+                what: "feature".into(),
+                name,
+                help,
+            });
+        }
+    }
+}
+
+/// One `prefer …` or `forbid …` statement of a plan, as written.
+struct PrefStmt<'a> {
+    forbid: bool,
+    kind: &'a ast::Ident,
+    value: &'a ast::Value,
+    opts: &'a [ast::Prop],
+    span: Span,
+}
+
+/// A setup, orientation or probe preference, added to the plan when it checks out.
+fn preference(cx: &mut Cx, plan: &mut Plan, cmm: &Cmm, head: Option<&Head>, s: &PrefStmt) {
+    let verb = if s.forbid { "forbid" } else { "prefer" };
+    let mut o = Props::new(cx, format!("`{verb} {}`", s.kind.name), s.span, s.opts);
+    match s.kind.name.as_str() {
+        "setup" => {
+            let weight = weight(cx, &mut o, s.forbid, "weight");
+            if let Some(direction) = cx.direction(s.value) {
+                plan.setups.push(SetupPref {
+                    direction,
+                    stance: stance(s.forbid, weight.unwrap_or(1.0)),
+                    span: s.span,
+                });
+            }
+        }
+        "orientation" => {
+            let weight = weight(cx, &mut o, s.forbid, "weight");
+            if let Some((a, b)) = orientation(cx, s.value, head) {
+                plan.orientations.push(OrientPref {
+                    a,
+                    b,
+                    stance: stance(s.forbid, weight.unwrap_or(1.0)),
+                    span: s.span,
+                });
+            }
+        }
+        "probe" => {
+            let cost = weight(cx, &mut o, s.forbid, "cost");
+            if let Some(p) = probe_pref(cx, cmm, s, cost) {
+                plan.probes.push(p);
+            }
+        }
+        other => {
+            let help =
+                suggest::help_for_unknown("preference", other, ["setup", "orientation", "probe"]);
+            cx.err(E::UnknownName {
+                span: s.kind.span,
+                what: "preference".into(),
+                name: other.into(),
+                help,
+            });
+        }
+    }
+    o.finish(cx);
+}
+
+/// A preference's `weight` or `cost` (≥ 0); a ban takes none, so there it is no key.
+fn weight(cx: &mut Cx, o: &mut Props, forbid: bool, key: &'static str) -> Option<f64> {
+    if forbid {
+        None
+    } else {
+        o.get(key).and_then(|v| cx.non_negative(v, key))
+    }
+}
+
+/// `prefer probe p1 cost 2` or `forbid probe p3`: a probe label of the plan's CMM.
+fn probe_pref(cx: &mut Cx, cmm: &Cmm, s: &PrefStmt, cost: Option<f64>) -> Option<ProbePref> {
+    let label = cx.name(s.value)?;
+    let Some(k) = cmm.probes.iter().position(|(l, _)| *l == label.name) else {
+        let help = format!(
+            "cmm `{}` has no probe `{}`; {}",
+            cmm.name,
+            label.name,
+            suggest::help_for_unknown(
+                "probe",
+                &label.name,
+                cmm.probes.iter().map(|(l, _)| l.as_str())
+            )
+        );
+        cx.err(E::UnknownName {
+            span: label.span,
+            what: "probe".into(),
+            name: label.name.clone(),
+            help,
+        });
+        return None;
+    };
+    if let Some(&at) = cmm.probe_labels.get(k) {
+        cx.bind(label.span, at);
+    }
+    Some(ProbePref {
+        label: label.name.clone(),
+        stance: stance(s.forbid, cost),
+        span: s.span,
+    })
 }
 
 /// An `(A, B)` orientation checked against the head's range and grid.

@@ -454,3 +454,65 @@ impl<'a> Props<'a> {
         }
     }
 }
+
+/// Positional or named arguments of a call, by parameter order.
+pub(super) fn call_args<'c>(
+    cx: &mut Cx,
+    call: &'c ast::Call,
+    params: &[&'static str],
+    what: &str,
+) -> Vec<Option<&'c ast::Value>> {
+    let mut out: Vec<Option<&ast::Value>> = vec![None; params.len()];
+    let mut next = 0;
+    for a in &call.args {
+        match a {
+            ast::Arg::Positional(v) => {
+                if next < params.len() {
+                    out[next] = Some(v);
+                    next += 1;
+                } else {
+                    cx.err(E::Arity {
+                        span: v.span,
+                        kind: what.into(),
+                        expected: format!("{} arguments ({})", params.len(), params.join(", ")),
+                        found: "one too many".into(),
+                        help: format!("write `{}({})`", path_text(&call.callee), params.join(", ")),
+                    });
+                }
+            }
+            ast::Arg::Named(k, v) => match params.iter().position(|p| *p == k.name) {
+                Some(i) => out[i] = Some(v),
+                None => {
+                    let help =
+                        suggest::help_for_unknown("argument", &k.name, params.iter().copied());
+                    cx.err(E::UnknownProperty {
+                        span: k.span,
+                        key: k.name.clone(),
+                        item: what.into(),
+                        help,
+                    });
+                }
+            },
+        }
+    }
+    for (i, p) in params.iter().enumerate() {
+        if out[i].is_none() {
+            cx.err(E::MissingArgument {
+                span: call.span,
+                kind: what.into(),
+                what: format!("`{p}`"),
+                help: format!("write `{}({})`", path_text(&call.callee), params.join(", ")),
+            });
+        }
+    }
+    out
+}
+
+/// Catalogue text fields that document an item without affecting planning.
+pub(super) fn describe_only(cx: &mut Cx, p: &mut Props) {
+    for key in ["part_no", "model"] {
+        if let Some(v) = p.get(key) {
+            cx.string(v);
+        }
+    }
+}

@@ -127,6 +127,33 @@ pub(super) fn lower(
     name: &ast::Ident,
     call: &ast::Call,
 ) -> Option<Tolerance> {
+    let rule = rule_of(cx, call)?;
+    let mut args = Args::read(cx, pc, rule, call)?;
+    args.check_arity(cx, rule, call);
+    let Some((value, _)) = args.value.take() else {
+        if args.ok {
+            missing_value(cx, rule, call);
+        }
+        return None;
+    };
+    args.check_datums_allowed(cx, rule, call);
+    args.check_basic_angle(cx, rule, call);
+    check_unique_datums(cx, &pc.part, &args.datums);
+    args.check_self_reference(cx, pc);
+    args.ok.then(|| Tolerance {
+        name: name.name.clone(),
+        kind: rule.kind,
+        targets: args.targets.into_iter().map(|t| t.0).collect(),
+        value,
+        modifier: args.modifier.map(|m| m.0),
+        datums: args.datums.into_iter().map(|d| d.0).collect(),
+        basic_angle: args.basic_angle,
+        span: name.span,
+    })
+}
+
+/// The rule of the tolerance type a call names (`roundness` is `circularity`).
+fn rule_of(cx: &mut Cx, call: &ast::Call) -> Option<&'static Rule> {
     let callee = call.callee.as_ident();
     let callee_name = callee.map_or_else(|| path_text(&call.callee), |i| i.name.clone());
     let lookup = if callee_name == "roundness" {
@@ -145,143 +172,195 @@ pub(super) fn lower(
         });
         return None;
     };
-    let what = rule.name.to_string();
-    let mut targets: Vec<(FeatureId, Span)> = Vec::new();
-    let mut value: Option<(TolValue, Span)> = None;
-    let mut modifier: Option<(Material, Span)> = None;
-    let mut datums: Vec<(DatumRef, Span)> = Vec::new();
-    let mut basic_angle = None;
-    let mut ok = true;
-    // Whether the value has been written (valid or not): targets come before it,
-    // modifiers and datums after.
-    let mut past_value = false;
-    let mut target_failed = false;
+    Some(rule)
+}
 
-    for a in &call.args {
-        match a {
-            ast::Arg::Named(k, v) if k.name == "dia" => {
-                past_value = true;
+/// A tolerance call's arguments as read in one pass, and whether all of them were good.
+struct Args {
+    targets: Vec<(FeatureId, Span)>,
+    value: Option<(TolValue, Span)>,
+    modifier: Option<(Material, Span)>,
+    datums: Vec<(DatumRef, Span)>,
+    basic_angle: Option<f64>,
+    ok: bool,
+    /// Whether the value has been written (valid or not): targets come before it,
+    /// modifiers and datums after.
+    past_value: bool,
+    target_failed: bool,
+}
+
+impl Args {
+    /// Reads every argument in order; None where a material modifier does not read
+    /// (the tolerance is dropped without further checks).
+    fn read(cx: &mut Cx, pc: &PartCx, rule: &Rule, call: &ast::Call) -> Option<Args> {
+        let mut args = Args {
+            targets: Vec::new(),
+            value: None,
+            modifier: None,
+            datums: Vec::new(),
+            basic_angle: None,
+            ok: true,
+            past_value: false,
+            target_failed: false,
+        };
+        for a in &call.args {
+            match a {
+                ast::Arg::Named(k, v) => args.named(cx, rule, k, v),
+                ast::Arg::Positional(v) => args.positional(cx, pc, rule, v)?,
+            }
+        }
+        Some(args)
+    }
+
+    /// `dia 0.1 mm`, `basic 30 deg`, or an unknown name.
+    fn named(&mut self, cx: &mut Cx, rule: &Rule, k: &ast::Ident, v: &ast::Value) {
+        match k.name.as_str() {
+            "dia" => {
+                self.past_value = true;
                 if !rule.dia {
                     cx.err(E::DiameterZone {
                         span: k.span,
-                        kind: what.clone(),
+                        kind: rule.name.into(),
                     });
-                    ok = false;
+                    self.ok = false;
                 }
-                match zone(cx, v, &what) {
+                match zone(cx, v, rule.name) {
                     Some(w) => {
-                        value = Some((
-                            TolValue::Zone {
-                                width: w,
-                                diameter: true,
-                            },
-                            v.span,
-                        ))
+                        let zone = TolValue::Zone {
+                            width: w,
+                            diameter: true,
+                        };
+                        self.value = Some((zone, v.span));
                     }
-                    None => ok = false,
+                    None => self.ok = false,
                 }
             }
-            ast::Arg::Named(k, v) if k.name == "basic" => {
+            "basic" => {
                 if rule.kind != K::Angularity {
                     cx.err(E::UnknownProperty {
                         span: k.span,
                         key: "basic".into(),
-                        item: what.clone(),
+                        item: rule.name.into(),
                         help: "only angularity takes a basic angle".into(),
                     });
                 }
-                basic_angle = cx.angle(v);
+                self.basic_angle = cx.angle(v);
             }
-            ast::Arg::Named(k, _) => {
+            _ => {
                 let help = suggest::help_for_unknown("argument", &k.name, ["dia", "basic"]);
                 cx.err(E::UnknownProperty {
                     span: k.span,
                     key: k.name.clone(),
-                    item: what.clone(),
+                    item: rule.name.into(),
                     help,
                 });
-                ok = false;
+                self.ok = false;
             }
-            ast::Arg::Positional(v) => match &v.kind {
-                ValueKind::Quantity(_) | ValueKind::Limits { .. } | ValueKind::Range(..) => {
-                    past_value = true;
-                    let val = if let Some(dim) = rule.size {
-                        size_limits(cx, v, dim)
-                    } else {
-                        zone(cx, v, &what).map(|w| TolValue::Zone {
-                            width: w,
-                            diameter: false,
-                        })
-                    };
-                    match val {
-                        Some(val) => value = Some((val, v.span)),
-                        None => ok = false,
-                    }
-                }
-                ValueKind::Path(p) if !past_value => match target(cx, pc, p) {
-                    Some(f) => targets.push((f, p.span)),
-                    None => {
-                        ok = false;
-                        target_failed = true;
-                    }
-                },
-                ValueKind::Path(p)
-                    if p.as_ident()
-                        .is_some_and(|i| matches!(i.name.as_str(), "MMC" | "LMC" | "RFS"))
-                        && datums.is_empty() =>
-                {
-                    let m = material(cx, p.as_ident()?)?;
-                    if !rule.material && m != Material::Rfs {
-                        cx.err(E::ModifierNotAllowed {
-                            span: p.span,
-                            kind: what.clone(),
-                            modifier: p.head().name.clone(),
-                            help: format!("{what} applies regardless of feature size; material modifiers belong on features of size under orientation, position or coaxiality"),
-                        });
-                        ok = false;
-                    }
-                    modifier = Some((m, p.span));
-                }
-                ValueKind::Path(p)
-                    if p.segs.len() == 1
-                        && matches!(pc.names.get(&p.head().name), Some((Local::Frame(_), _))) =>
-                {
-                    let Some(Local::Frame(i)) = pc.local(cx, p.head()) else {
-                        unreachable!()
-                    };
-                    match pc.part.frames.get(i) {
-                        Some(f) => datums.extend(f.refs.iter().map(|r| (r.clone(), p.span))),
-                        None => ok = false,
-                    }
-                }
-                ValueKind::Path(_) | ValueKind::Call(_) => match datum_ref(cx, pc, v) {
-                    Some(d) => datums.push(d),
-                    None => ok = false,
-                },
-                _ => {
-                    cx.mismatch(
-                        v,
-                        "a feature, a value, a modifier or a datum",
-                        &format!("write e.g. `{}(feature, 0.05 mm, A)`", rule.name),
-                    );
-                    ok = false;
-                }
-            },
         }
     }
 
-    let (min, max) = rule.targets;
-    if !target_failed && (targets.len() < min || targets.len() > max) {
+    /// A value, a toleranced feature, a material modifier, a frame or a datum, told
+    /// apart by form and by where it stands; None where a modifier does not read.
+    fn positional(&mut self, cx: &mut Cx, pc: &PartCx, rule: &Rule, v: &ast::Value) -> Option<()> {
+        match &v.kind {
+            ValueKind::Quantity(_) | ValueKind::Limits { .. } | ValueKind::Range(..) => {
+                self.value_arg(cx, rule, v);
+            }
+            ValueKind::Path(p) if !self.past_value => match target(cx, pc, p) {
+                Some(f) => self.targets.push((f, p.span)),
+                None => {
+                    self.ok = false;
+                    self.target_failed = true;
+                }
+            },
+            ValueKind::Path(p)
+                if p.as_ident()
+                    .is_some_and(|i| matches!(i.name.as_str(), "MMC" | "LMC" | "RFS"))
+                    && self.datums.is_empty() =>
+            {
+                self.modifier_arg(cx, rule, p)?;
+            }
+            ValueKind::Path(p)
+                if p.segs.len() == 1
+                    && matches!(pc.names.get(&p.head().name), Some((Local::Frame(_), _))) =>
+            {
+                let Some(Local::Frame(i)) = pc.local(cx, p.head()) else {
+                    unreachable!()
+                };
+                match pc.part.frames.get(i) {
+                    Some(f) => self
+                        .datums
+                        .extend(f.refs.iter().map(|r| (r.clone(), p.span))),
+                    None => self.ok = false,
+                }
+            }
+            ValueKind::Path(_) | ValueKind::Call(_) => match datum_ref(cx, pc, v) {
+                Some(d) => self.datums.push(d),
+                None => self.ok = false,
+            },
+            _ => {
+                cx.mismatch(
+                    v,
+                    "a feature, a value, a modifier or a datum",
+                    &format!("write e.g. `{}(feature, 0.05 mm, A)`", rule.name),
+                );
+                self.ok = false;
+            }
+        }
+        Some(())
+    }
+
+    /// The tolerance's value: limits for a size, a zone width for the others.
+    fn value_arg(&mut self, cx: &mut Cx, rule: &Rule, v: &ast::Value) {
+        self.past_value = true;
+        let val = if let Some(dim) = rule.size {
+            size_limits(cx, v, dim)
+        } else {
+            zone(cx, v, rule.name).map(|w| TolValue::Zone {
+                width: w,
+                diameter: false,
+            })
+        };
+        match val {
+            Some(val) => self.value = Some((val, v.span)),
+            None => self.ok = false,
+        }
+    }
+
+    /// `MMC`, `LMC` or `RFS` on the toleranced feature; None where it does not read.
+    fn modifier_arg(&mut self, cx: &mut Cx, rule: &Rule, p: &ast::Path) -> Option<()> {
+        let m = material(cx, p.as_ident()?)?;
+        if !rule.material && m != Material::Rfs {
+            let what = rule.name;
+            cx.err(E::ModifierNotAllowed {
+                span: p.span,
+                kind: what.into(),
+                modifier: p.head().name.clone(),
+                help: format!("{what} applies regardless of feature size; material modifiers belong on features of size under orientation, position or coaxiality"),
+            });
+            self.ok = false;
+        }
+        self.modifier = Some((m, p.span));
+        Some(())
+    }
+
+    /// As many toleranced features as the type takes (unless one already failed).
+    fn check_arity(&mut self, cx: &mut Cx, rule: &Rule, call: &ast::Call) {
+        let (min, max) = rule.targets;
+        let n = self.targets.len();
+        if self.target_failed || (min..=max).contains(&n) {
+            return;
+        }
         let expected = if min == max {
             format!("{min} feature{}", if min == 1 { "" } else { "s" })
         } else {
             format!("{min} or {max} features")
         };
         cx.err(E::Arity {
-            span: targets.get(max).map_or(call.span, |t| t.1),
-            kind: what.clone(),
+            span: self.targets.get(max).map_or(call.span, |t| t.1),
+            kind: rule.name.into(),
             expected,
-            found: format!("{}", targets.len()),
+            found: format!("{n}"),
             help: format!(
                 "the toleranced feature{} come{} first: `{}(…)`",
                 if max > 1 { "s" } else { "" },
@@ -289,86 +368,79 @@ pub(super) fn lower(
                 rule.name
             ),
         });
-        ok = false;
+        self.ok = false;
     }
-    let Some((value, _)) = value else {
-        if ok {
-            let what_value = if rule.size.is_some() {
-                "limits, e.g. `10 mm ± 0.05 mm`"
-            } else {
-                "a tolerance value, e.g. `0.05 mm`"
-            };
+
+    /// Datums where the type forbids them, or none where it requires them.
+    fn check_datums_allowed(&mut self, cx: &mut Cx, rule: &Rule, call: &ast::Call) {
+        let what = rule.name;
+        match rule.datums {
+            Forbidden => {
+                if let Some((_, span)) = self.datums.first() {
+                    let help = if rule.size.is_some() {
+                        "sizes are checked without a datum frame".to_string()
+                    } else {
+                        format!("{what} is a form tolerance: it controls the feature on its own")
+                    };
+                    cx.err(E::DatumsForbidden {
+                        span: *span,
+                        kind: what.into(),
+                        help,
+                    });
+                    self.ok = false;
+                }
+            }
+            // A datum that failed to resolve was reported already: no cascade.
+            Required if self.datums.is_empty() && self.ok => {
+                cx.err(E::DatumsRequired { span: call.span, kind: what.into(), help: format!("{what} is measured relative to a datum: add one, e.g. `{}(feature, 0.05 mm, A)`", rule.name) });
+                self.ok = false;
+            }
+            _ => {}
+        }
+    }
+
+    /// Angularity's basic angle, unless something else failed already.
+    fn check_basic_angle(&mut self, cx: &mut Cx, rule: &Rule, call: &ast::Call) {
+        if rule.kind == K::Angularity && self.basic_angle.is_none() && self.ok {
             cx.err(E::MissingArgument {
                 span: call.span,
-                kind: what.clone(),
-                what: what_value.into(),
-                help: format!(
-                    "write `{}(feature, {})`",
-                    rule.name,
-                    if rule.size.is_some() {
-                        "10 mm ± 0.05 mm"
-                    } else {
-                        "0.05 mm"
-                    }
-                ),
+                kind: rule.name.into(),
+                what: "its basic angle".into(),
+                help: "write `angularity(feature, 0.1 mm, A, basic 30 deg)`".into(),
             });
+            self.ok = false;
         }
-        return None;
-    };
-    match rule.datums {
-        Forbidden => {
-            if let Some((_, span)) = datums.first() {
-                let help = if rule.size.is_some() {
-                    "sizes are checked without a datum frame".to_string()
-                } else {
-                    format!("{what} is a form tolerance: it controls the feature on its own")
-                };
-                cx.err(E::DatumsForbidden {
+    }
+
+    /// No datum whose feature is one the tolerance controls.
+    fn check_self_reference(&mut self, cx: &mut Cx, pc: &PartCx) {
+        for (d, span) in &self.datums {
+            let df = pc.part.datums[d.datum.0].feature;
+            if let Some((f, _)) = self.targets.iter().find(|(f, _)| *f == df) {
+                cx.err(E::DatumSelfReference {
                     span: *span,
-                    kind: what.clone(),
-                    help,
+                    datum: pc.part.datums[d.datum.0].name.clone(),
+                    feature: pc.part.features[f.0].name.clone(),
                 });
-                ok = false;
+                self.ok = false;
             }
         }
-        // A datum that failed to resolve was reported already: no cascade.
-        Required if datums.is_empty() && ok => {
-            cx.err(E::DatumsRequired { span: call.span, kind: what.clone(), help: format!("{what} is measured relative to a datum: add one, e.g. `{}(feature, 0.05 mm, A)`", rule.name) });
-            ok = false;
-        }
-        _ => {}
     }
-    if rule.kind == K::Angularity && basic_angle.is_none() && ok {
-        cx.err(E::MissingArgument {
-            span: call.span,
-            kind: what.clone(),
-            what: "its basic angle".into(),
-            help: "write `angularity(feature, 0.1 mm, A, basic 30 deg)`".into(),
-        });
-        ok = false;
-    }
-    check_unique_datums(cx, &pc.part, &datums);
-    for (d, span) in &datums {
-        let df = pc.part.datums[d.datum.0].feature;
-        if let Some((f, _)) = targets.iter().find(|(f, _)| *f == df) {
-            cx.err(E::DatumSelfReference {
-                span: *span,
-                datum: pc.part.datums[d.datum.0].name.clone(),
-                feature: pc.part.features[f.0].name.clone(),
-            });
-            ok = false;
-        }
-    }
-    ok.then(|| Tolerance {
-        name: name.name.clone(),
-        kind: rule.kind,
-        targets: targets.into_iter().map(|t| t.0).collect(),
-        value,
-        modifier: modifier.map(|m| m.0),
-        datums: datums.into_iter().map(|d| d.0).collect(),
-        basic_angle,
-        span: name.span,
-    })
+}
+
+/// Says a tolerance has no value: limits for a size, a zone for the others.
+fn missing_value(cx: &mut Cx, rule: &Rule, call: &ast::Call) {
+    let (what_value, example) = if rule.size.is_some() {
+        ("limits, e.g. `10 mm ± 0.05 mm`", "10 mm ± 0.05 mm")
+    } else {
+        ("a tolerance value, e.g. `0.05 mm`", "0.05 mm")
+    };
+    cx.err(E::MissingArgument {
+        span: call.span,
+        kind: rule.name.into(),
+        what: what_value.into(),
+        help: format!("write `{}(feature, {example})`", rule.name),
+    });
 }
 
 fn target(cx: &mut Cx, pc: &PartCx, p: &ast::Path) -> Option<FeatureId> {

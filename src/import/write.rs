@@ -1,0 +1,705 @@
+//! The spec `inspc import` writes: features named once per set of faces, datums (common
+//! datums made on demand), tolerances and sizes checked against what the language
+//! accepts, each left out with a comment saying why, and the text around them.
+
+use super::{ImportOptions, Imported};
+use crate::geometry::step::{pmi, CadPart};
+use crate::geometry::Surface;
+use crate::model::{fmt_num, Material, TolKind};
+use crate::resolve::{accepts, Accepts, Datums};
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write;
+
+/// A feature of the spec: a set of faces, named once.
+struct Features {
+    by_faces: BTreeMap<Vec<usize>, String>,
+    order: Vec<Vec<usize>>,
+    used_names: BTreeSet<String>,
+}
+
+impl Features {
+    fn name(&mut self, faces: &[usize], preferred: Option<String>) -> String {
+        if let Some(n) = self.by_faces.get(faces) {
+            return n.clone();
+        }
+        let base = preferred.unwrap_or_else(|| match faces {
+            [one] => format!("f{}", one + 1),
+            [first, .., last] => format!("f{}_{}", first + 1, last + 1),
+            [] => "f".to_string(),
+        });
+        let name = unique(&mut self.used_names, &base);
+        self.by_faces.insert(faces.to_vec(), name.clone());
+        self.order.push(faces.to_vec());
+        name
+    }
+}
+
+fn unique(used: &mut BTreeSet<String>, base: &str) -> String {
+    let mut name = base.to_string();
+    let mut k = 2;
+    while used.contains(&name) {
+        name = format!("{base}_{k}");
+        k += 1;
+    }
+    used.insert(name.clone());
+    name
+}
+
+/// The letters a frame may name: datums with faces, and common datums (A-B) made on
+/// demand as a two-letter datum on the union of their features.
+struct Frames {
+    datum_feature: BTreeMap<String, Vec<usize>>,
+    common: BTreeMap<String, (Vec<String>, Vec<usize>)>,
+}
+
+impl Frames {
+    fn letter(&mut self, letters: &[String], feats: &mut Features) -> Result<String, String> {
+        for l in letters {
+            if !self.datum_feature.contains_key(l) {
+                return Err(format!("datum {l} has no faces"));
+            }
+        }
+        if letters.len() == 1 {
+            return Ok(letters[0].clone());
+        }
+        let joined: String = letters.concat();
+        if joined.len() > 2 {
+            return Err(format!(
+                "the common datum {} has more letters than a datum name holds",
+                letters.join("-")
+            ));
+        }
+        if self.datum_feature.contains_key(&joined) {
+            return Err(format!(
+                "common datum {} clashes with datum {joined}",
+                letters.join("-")
+            ));
+        }
+        let mut faces: Vec<usize> = letters
+            .iter()
+            .flat_map(|l| self.datum_feature[l].clone())
+            .collect();
+        faces.sort_unstable();
+        faces.dedup();
+        if !self.common.contains_key(&joined) {
+            feats.name(&faces, Some(format!("datum_{}", joined.to_lowercase())));
+            self.common
+                .insert(joined.clone(), (letters.to_vec(), faces));
+        }
+        Ok(joined)
+    }
+}
+
+/// Short keyword prefixes for tolerance names.
+fn prefix(kind: TolKind) -> &'static str {
+    match kind {
+        TolKind::Flatness => "flat",
+        TolKind::Straightness => "straight",
+        TolKind::Circularity => "round",
+        TolKind::Cylindricity => "cyl",
+        TolKind::ProfileLine => "lprof",
+        TolKind::ProfileSurface => "prof",
+        TolKind::Perpendicularity => "perp",
+        TolKind::Parallelism => "par",
+        TolKind::Angularity => "ang",
+        TolKind::Position => "pos",
+        TolKind::Concentricity => "conc",
+        TolKind::Coaxiality => "coax",
+        TolKind::Symmetry => "sym",
+        TolKind::CircularRunout => "runout",
+        TolKind::TotalRunout => "trunout",
+        _ => "tol",
+    }
+}
+
+fn mm(x: f64) -> String {
+    format!("{} mm", fmt_num(x))
+}
+
+fn faces_text(faces: &[usize]) -> String {
+    let v: Vec<String> = faces.iter().map(|f| (f + 1).to_string()).collect();
+    format!(
+        "face{} {}",
+        if faces.len() == 1 { "" } else { "s" },
+        v.join(", ")
+    )
+}
+
+/// One line of a spec that could not be written, as a comment.
+fn left_out(out: &mut Vec<String>, what: String, why: &str) {
+    out.push(format!("    // not written: {what}: {why}"));
+}
+
+/// Limits as the language writes them: `± 0.15 mm`, `+0 mm -0.2 mm`.
+fn limits(nominal: f64, upper: f64, lower: f64, unit: &str) -> String {
+    let q = |x: f64| format!("{} {unit}", fmt_num(x));
+    if (upper + lower).abs() < 1e-12 && upper > 0.0 {
+        return format!("{} ± {}", q(nominal), q(upper));
+    }
+    // A zero deviation takes the sign of its side: `+0` above, `-0` below.
+    let signed = |x: f64, minus: bool| {
+        if minus {
+            format!("-{}", q(-x))
+        } else {
+            format!("+{}", q(x))
+        }
+    };
+    format!(
+        "{} {} {}",
+        q(nominal),
+        signed(upper, upper < 0.0),
+        signed(lower, lower <= 0.0)
+    )
+}
+
+/// The PMI without the faces of sheet bodies: an open surface the file carries beside
+/// its solid (construction geometry) is no material a probe can touch, and the part's
+/// mesh leaves it out. What loses faces says so in the notes.
+fn solid_pmi(part: &CadPart) -> pmi::Pmi {
+    let mut p = part.pmi.clone();
+    let solid = part.solid_faces();
+    let mut notes = Vec::new();
+    let mut keep = |faces: &mut Vec<usize>, what: String| {
+        let before = faces.len();
+        faces.retain(|f| *f < solid);
+        if faces.len() < before {
+            notes.push(format!(
+                "{what}: its sheet (construction) face{} left out",
+                if before - faces.len() == 1 {
+                    " is"
+                } else {
+                    "s are"
+                }
+            ));
+        }
+    };
+    for d in &mut p.datums {
+        keep(&mut d.faces, format!("datum {}", d.letter));
+    }
+    for t in &mut p.tolerances {
+        keep(&mut t.faces, format!("`{}`", t.name));
+    }
+    for d in &mut p.dimensions {
+        keep(&mut d.faces, format!("dimension #{}", d.id));
+        keep(&mut d.to_faces, format!("dimension #{}", d.id));
+    }
+    p.notes.extend(notes);
+    p
+}
+
+pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
+    let solid = solid_pmi(part);
+    let p = &solid;
+    let mut feats = Features {
+        by_faces: BTreeMap::new(),
+        order: Vec::new(),
+        used_names: BTreeSet::new(),
+    };
+    let datums = datum_lines(p, &mut feats);
+    let mut frames = Frames {
+        datum_feature: datums.features,
+        common: BTreeMap::new(),
+    };
+    let mut used_tol_names = BTreeSet::new();
+    let (tol_lines, written_tols) =
+        tolerance_lines(p, &mut feats, &mut frames, &mut used_tol_names);
+    let (dim_lines, written_dims) = dimension_lines(p, &mut feats, &mut used_tol_names);
+    let mut datum_lines = datums.lines;
+    common_datum_lines(&frames, &mut feats, &mut datum_lines);
+
+    let text = render(
+        part,
+        &p.notes,
+        opts,
+        &feats,
+        &datum_lines,
+        &datums.notes,
+        &tol_lines,
+        &dim_lines,
+    );
+    Imported {
+        // In the layout `inspc fmt` gives, so a formatted repository stays formatted.
+        text: crate::fmt::format(&text),
+        faces: part.solid_faces(),
+        datums: (datums.letters, frames.datum_feature.len()),
+        tolerances: (p.tolerances.len(), written_tols),
+        dimensions: (p.dimensions.len(), written_dims),
+    }
+}
+
+/// The datums of the PMI as the spec writes them.
+struct DatumLines {
+    /// `datum A = datum_a`, with a comment before a datum set up by targets.
+    lines: Vec<String>,
+    /// Comments for the datums left out.
+    notes: Vec<String>,
+    /// The faces of each datum written, by letter.
+    features: BTreeMap<String, Vec<usize>>,
+    /// The distinct letters the PMI has.
+    letters: usize,
+}
+
+/// Datums: a letter per datum with faces, each named as a feature `datum_<letter>`.
+fn datum_lines(p: &pmi::Pmi, feats: &mut Features) -> DatumLines {
+    let mut lines = Vec::new();
+    let mut notes = Vec::new();
+    let mut features: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+    let mut seen_letters = BTreeSet::new();
+    for d in &p.datums {
+        if !seen_letters.insert(d.letter.clone()) {
+            continue;
+        }
+        if d.faces.is_empty() {
+            left_out(
+                &mut notes,
+                format!("datum {}", d.letter),
+                "the file links it to no face",
+            );
+            continue;
+        }
+        let name = feats.name(&d.faces, Some(format!("datum_{}", d.letter.to_lowercase())));
+        features.insert(d.letter.clone(), d.faces.clone());
+        if d.located {
+            let targets: Vec<String> = d
+                .targets
+                .iter()
+                .map(|t| format!("{} {}", t.kind, t.label))
+                .collect();
+            lines.push(format!(
+                "    // Datum {} is set up by targets ({}) that the file places on no face; they lie on {}. inspc has no datum targets: the datum is those whole faces. Check it against the drawing.",
+                d.letter,
+                targets.join(", "),
+                faces_text(&d.faces)
+            ));
+        }
+        lines.push(format!("    datum {} = {name}", d.letter));
+    }
+    DatumLines {
+        lines,
+        notes,
+        features,
+        letters: seen_letters.len(),
+    }
+}
+
+/// Common datums (A-B) the frames made: their feature and letter, after the plain ones.
+fn common_datum_lines(frames: &Frames, feats: &mut Features, lines: &mut Vec<String>) {
+    for (letter, (parts, faces)) in &frames.common {
+        lines.push(format!(
+            "    // Common datum {}: one datum on both features.",
+            parts.join("-")
+        ));
+        let f = feats.name(faces, None);
+        lines.push(format!("    datum {letter} = {f}"));
+    }
+}
+
+/// The geometric tolerances, each written or left out with why, and how many were
+/// written.
+fn tolerance_lines(
+    p: &pmi::Pmi,
+    feats: &mut Features,
+    frames: &mut Frames,
+    used_names: &mut BTreeSet<String>,
+) -> (Vec<String>, usize) {
+    let mut lines = Vec::new();
+    let mut written = 0;
+    for t in &p.tolerances {
+        let label = format!("`{}` (#{})", t.name, t.id);
+        match tolerance_line(t, feats, frames, used_names) {
+            Ok(line) => {
+                lines.push(line);
+                written += 1;
+            }
+            Err(why) => left_out(&mut lines, label, &why),
+        }
+    }
+    (lines, written)
+}
+
+/// One tolerance as `tolerance name = kind(feature, value, datums)`, with a comment on
+/// what it loses; Err with why the language cannot say it. Its frame's common datums
+/// are made even when it is left out.
+fn tolerance_line(
+    t: &pmi::GeoTolerance,
+    feats: &mut Features,
+    frames: &mut Frames,
+    used_names: &mut BTreeSet<String>,
+) -> Result<String, String> {
+    let kind = t.kind.ok_or("the file states no tolerance type")?;
+    let rule = accepts(kind).ok_or("inspc has no such tolerance type")?;
+    if t.faces.is_empty() {
+        return Err("the file links it to no face".into());
+    }
+    let mut datums = Vec::new();
+    let mut why_not = None;
+    for d in &t.datums {
+        match frames.letter(&d.letters, feats) {
+            Ok(l) => {
+                let letter = match d.material {
+                    Some(Material::Mmc) => format!("{l}(MMC)"),
+                    Some(Material::Lmc) => format!("{l}(LMC)"),
+                    _ => l.clone(),
+                };
+                datums.push((l, letter));
+            }
+            Err(e) => why_not = Some(e),
+        }
+    }
+    if let Some(why) = why_not_written(t, kind, rule, &datums, frames, why_not) {
+        return Err(why);
+    }
+    let feature = feats.name(&t.faces, None);
+    let (args, lost) = tolerance_args(t, rule, &feature, &datums);
+    let name = unique(used_names, &format!("{}_{feature}", prefix(kind)));
+    let comment = if lost.is_empty() {
+        String::new()
+    } else {
+        format!("  // {}", lost.join("; "))
+    };
+    Ok(format!(
+        "    tolerance {name} = {}({}){comment}",
+        rule.keyword,
+        args.join(", ")
+    ))
+}
+
+/// Why a tolerance with these datums (letter, as written) cannot be written, if it
+/// cannot; `why_not` is what its frame said, and a later reason replaces an earlier one.
+fn why_not_written(
+    t: &pmi::GeoTolerance,
+    kind: TolKind,
+    rule: Accepts,
+    datums: &[(String, String)],
+    frames: &Frames,
+    mut why_not: Option<String>,
+) -> Option<String> {
+    let letters: Vec<&String> = datums.iter().map(|(l, _)| l).collect();
+    if letters.iter().collect::<BTreeSet<_>>().len() < letters.len() {
+        why_not = Some("its frame names a datum twice".to_string());
+    }
+    match rule.datums {
+        Datums::Forbidden if !datums.is_empty() => {
+            why_not = Some(format!("{} takes no datums", rule.keyword))
+        }
+        Datums::Required if datums.is_empty() && why_not.is_none() => {
+            why_not = Some(format!(
+                "{} needs a datum and the frame has none",
+                rule.keyword
+            ))
+        }
+        _ => {}
+    }
+    if kind == TolKind::Angularity {
+        why_not = Some("its basic angle is not in the PMI".to_string());
+    }
+    // A datum feature is not toleranced relative to its own datum.
+    for (l, _) in datums {
+        let own = frames
+            .datum_feature
+            .get(l)
+            .or_else(|| frames.common.get(l).map(|(_, f)| f));
+        if own == Some(&t.faces) {
+            why_not = Some(format!(
+                "it refers to datum {l}, whose feature it tolerances"
+            ));
+        }
+    }
+    why_not
+}
+
+/// A tolerance's arguments (feature, zone, modifier, datums) and what the language
+/// cannot carry of it.
+fn tolerance_args(
+    t: &pmi::GeoTolerance,
+    rule: Accepts,
+    feature: &str,
+    datums: &[(String, String)],
+) -> (Vec<String>, Vec<String>) {
+    let mut args = vec![feature.to_string()];
+    let mut lost = Vec::new();
+    if t.diameter && rule.dia {
+        args.push(format!("dia {}", mm(t.value_mm)));
+    } else {
+        if t.diameter {
+            lost.push("Ø zone".to_string());
+        }
+        args.push(mm(t.value_mm));
+    }
+    match (t.material, rule.material) {
+        (Some(Material::Mmc), true) => args.push("MMC".into()),
+        (Some(Material::Lmc), true) => args.push("LMC".into()),
+        (Some(m), false) => lost.push(format!("{m:?}").to_uppercase()),
+        _ => {}
+    }
+    args.extend(datums.iter().map(|(_, s)| s.clone()));
+    lost.extend(t.other.iter().cloned());
+    for d in &t.datums {
+        lost.extend(
+            d.other
+                .iter()
+                .map(|o| format!("{o} on datum {}", d.letters.join("-"))),
+        );
+    }
+    if let Some(u) = t.unequal_mm {
+        lost.push(format!(
+            "unequally disposed (U {}): checked as equal bilateral",
+            mm(u)
+        ));
+    }
+    if t.composite_of.is_some() {
+        lost.push("lower segment of a composite frame: checked as its own tolerance".into());
+    }
+    (args, lost)
+}
+
+/// The dimensions, each written as a size or location tolerance or left out with why,
+/// and how many were written.
+fn dimension_lines(
+    p: &pmi::Pmi,
+    feats: &mut Features,
+    used_names: &mut BTreeSet<String>,
+) -> (Vec<String>, usize) {
+    let mut lines = Vec::new();
+    let mut written = 0;
+    for d in &p.dimensions {
+        let label = match &d.kind {
+            pmi::DimKind::Size(n) => format!("size `{n}` (#{})", d.id),
+            pmi::DimKind::Location(n) => format!("location `{n}` (#{})", d.id),
+        };
+        match dimension_line(d, feats, used_names) {
+            Ok(line) => {
+                lines.push(line);
+                written += 1;
+            }
+            Err(why) => left_out(&mut lines, label, &why),
+        }
+    }
+    (lines, written)
+}
+
+/// One dimension as `tolerance name = diameter|radius|width|distance|angle(…, limits)`;
+/// Err with why the language cannot say it.
+fn dimension_line(
+    d: &pmi::Dimension,
+    feats: &mut Features,
+    used_names: &mut BTreeSet<String>,
+) -> Result<String, String> {
+    let unit = if d.angular { "deg" } else { "mm" };
+    let (Some(nominal), Some(upper), Some(lower)) = (d.nominal, d.upper, d.lower) else {
+        return Err(if let Some(fit) = &d.fit {
+            format!("its limits are a fit ({fit}), which inspc does not read")
+        } else if d.nominal.is_none() {
+            "the file gives it no value".to_string()
+        } else {
+            format!(
+                "{} has no limits (a basic or reference dimension)",
+                fmt_num(d.nominal.unwrap_or(0.0))
+            )
+        });
+    };
+    if d.faces.is_empty() {
+        return Err("the file links it to no face".into());
+    }
+    let (keyword, targets) = match &d.kind {
+        pmi::DimKind::Size(what) => {
+            let keyword = match what.as_str() {
+                "diameter" | "spherical diameter" => "diameter",
+                "radius" | "spherical radius" => "radius",
+                "thickness" | "width" | "length" => "width",
+                _ => return Err("inspc has no such size".into()),
+            };
+            (keyword, vec![feats.name(&d.faces, None)])
+        }
+        pmi::DimKind::Location(_) => {
+            if d.to_faces.is_empty() {
+                return Err("the file links its second feature to no face".into());
+            }
+            let a = feats.name(&d.faces, None);
+            let b = feats.name(&d.to_faces, None);
+            (if d.angular { "angle" } else { "distance" }, vec![a, b])
+        }
+    };
+    let name = unique(
+        used_names,
+        &format!(
+            "{}_{}",
+            match keyword {
+                "diameter" | "radius" | "width" => "size",
+                k => k,
+            },
+            targets[0]
+        ),
+    );
+    Ok(format!(
+        "    tolerance {name} = {keyword}({}, {})",
+        targets.join(", "),
+        limits(nominal, upper, lower, unit)
+    ))
+}
+
+/// The probe rack for a part, as (label, stdlib probe): a general Ø2 tip, a Ø1 tip
+/// for narrow slots and small holes (the shorter one when the part's smallest hole is
+/// under 6 mm, where a long thin stylus bends and collides), a long Ø3 stylus for
+/// reach, and an extension when the part is taller than that stylus reaches.
+fn rack(part: &CadPart, size: [f64; 3]) -> Vec<(&'static str, &'static str)> {
+    let smallest_hole = part
+        .mesh
+        .exact
+        .iter()
+        .filter_map(|s| match s {
+            Surface::Cylinder {
+                radius,
+                convex: false,
+                ..
+            } => Some(2.0 * radius),
+            _ => None,
+        })
+        .fold(f64::INFINITY, f64::min);
+    let extent = size.into_iter().fold(0.0, f64::max);
+    let small = if smallest_hole < 6.0 {
+        "TP20_D1_L10"
+    } else {
+        "TP20_D1_L20"
+    };
+    let mut rack = vec![("p1", "TP20_D2_L20"), ("p2", small), ("p3", "TP20_D3_L50")];
+    if extent > 150.0 {
+        rack.push(("p4", "TP20_D2_L20_X30"));
+    }
+    rack
+}
+
+/// The part's extent along x, y and z (mm).
+fn size(part: &CadPart) -> [f64; 3] {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for v in &part.mesh.vertices {
+        for i in 0..3 {
+            lo[i] = lo[i].min(v[i]);
+            hi[i] = hi[i].max(v[i]);
+        }
+    }
+    [0, 1, 2].map(|i| hi[i] - lo[i])
+}
+
+#[allow(clippy::too_many_arguments)]
+fn render(
+    part: &CadPart,
+    notes: &[String],
+    opts: &ImportOptions,
+    feats: &Features,
+    datum_lines: &[String],
+    datum_notes: &[String],
+    tol_lines: &[String],
+    dim_lines: &[String],
+) -> String {
+    let mut s = String::new();
+    let extent = size(part);
+    let size = extent.map(|x| fmt_num(x.round()));
+    let _ = writeln!(s, "// Written by `inspc import` from {}.", opts.cad_path);
+    let _ = writeln!(
+        s,
+        "// {} faces (`face_<n>` in the file's shell order), {} × {} × {} mm; the file's unit is {}.",
+        part.solid_faces(),
+        size[0],
+        size[1],
+        size[2],
+        part.unit.0
+    );
+    if part.sheet_faces > 0 {
+        let _ = writeln!(
+            s,
+            "// The file's {} sheet (construction) face{} beside the solid {} no material and left out.",
+            part.sheet_faces,
+            if part.sheet_faces == 1 { "" } else { "s" },
+            if part.sheet_faces == 1 { "is" } else { "are" },
+        );
+    }
+    let _ = writeln!(
+        s,
+        "// The datums, tolerances and sizes are the file's semantic PMI; what the language cannot say is a comment."
+    );
+    if !notes.is_empty() {
+        let _ = writeln!(s, "//\n// The PMI as read:");
+        for n in notes {
+            let _ = writeln!(s, "//   - {n}");
+        }
+    }
+    let rack = rack(part, extent);
+    let _ = writeln!(s, "\nuse std::heads::PH10MQ");
+    let probes: Vec<&str> = rack.iter().map(|(_, p)| *p).collect();
+    let _ = writeln!(s, "use std::probes::{{{}}}", probes.join(", "));
+    let _ = writeln!(s, "use std::hierarchies::efficient_accuracy");
+    let _ = writeln!(s, "use std::fixtures::{{ANGLE_PLATE, SINE_PLATE_60}}");
+
+    let _ = writeln!(s, "\npart {} {{", opts.part_name);
+    let _ = writeln!(
+        s,
+        "    // Quantities below are in mm; the file's own unit applies to its geometry."
+    );
+    let _ = writeln!(s, "    units mm");
+    let _ = writeln!(s, "    mesh \"{}\"", opts.cad_path);
+    if !feats.order.is_empty() {
+        s.push('\n');
+    }
+    for faces in &feats.order {
+        let name = &feats.by_faces[faces];
+        let terms: Vec<String> = faces
+            .iter()
+            .map(|f| format!("group \"face_{}\"", f + 1))
+            .collect();
+        let head = format!("    feature {name} = ");
+        let mut line = head.clone();
+        let indent = " ".repeat(head.len() - 2);
+        for (i, t) in terms.iter().enumerate() {
+            if i > 0 {
+                if i % 4 == 0 {
+                    let _ = writeln!(s, "{line}");
+                    line = format!("{indent}+ {t}");
+                    continue;
+                }
+                line.push_str(" + ");
+            }
+            line.push_str(t);
+        }
+        let _ = writeln!(s, "{line}");
+    }
+    for block in [datum_notes, datum_lines, tol_lines, dim_lines] {
+        if !block.is_empty() {
+            s.push('\n');
+            for l in block {
+                let _ = writeln!(s, "{l}");
+            }
+        }
+    }
+    let _ = writeln!(s, "}}");
+
+    let table = |i: usize, min: f64| fmt_num(min.max((extent[i] * 2.5 / 100.0).ceil() * 100.0));
+    let _ = writeln!(
+        s,
+        "\n// A bridge CMM whose table holds the part in any pose, an indexable head and a rack\n// sized to the part's smallest holes and its height."
+    );
+    let _ = writeln!(s, "cmm lab {{");
+    let _ = writeln!(
+        s,
+        "    table {{ z 0 mm, size ({} mm, {} mm) }}",
+        table(0, 2000.0),
+        table(1, 1200.0)
+    );
+    let _ = writeln!(s, "    ram {{ radius 40 mm, length 800 mm }}");
+    let _ = writeln!(s, "    head PH10MQ");
+    let rack_text: Vec<String> = rack.iter().map(|(l, p)| format!("{l}: {p}")).collect();
+    let _ = writeln!(s, "    probes [{}]", rack_text.join(", "));
+    let _ = writeln!(s, "    fixtures [angle: ANGLE_PLATE, sine: SINE_PLATE_60]");
+    let _ = writeln!(s, "}}");
+    let _ = writeln!(s, "\nplan {}_plan {{", opts.part_name);
+    let _ = writeln!(s, "    part {}", opts.part_name);
+    let _ = writeln!(s, "    cmm lab");
+    let _ = writeln!(s, "    hierarchy efficient_accuracy");
+    let _ = writeln!(s, "    prefer setup +z weight 1.0");
+    let _ = writeln!(s, "    // Plates for faces the table alone cannot present.");
+    let _ = writeln!(s, "    fixtures [angle, sine]");
+    let _ = writeln!(s, "    output {{ dmis \"{}.dmi\" }}", opts.part_name);
+    let _ = writeln!(s, "}}");
+    s
+}
