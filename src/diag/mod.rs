@@ -54,7 +54,7 @@ impl Located for crate::source::io::IoError {
 }
 
 /// The file of a primary span (for [`located!`]).
-pub fn primary_file(span: &Span) -> FileId {
+pub(crate) fn primary_file(span: &Span) -> FileId {
     span.file
 }
 

@@ -121,7 +121,7 @@ pub fn to_json(map: &SourceMap, d: &Diagnostic) -> serde_json::Value {
 }
 
 /// The most bytes of one source line a report quotes.
-pub const QUOTE_WIDTH: usize = 240;
+pub(crate) const QUOTE_WIDTH: usize = 240;
 
 /// Lines quoted before the first label's line and after the last's.
 const CONTEXT_LINES: usize = 2;

@@ -10,10 +10,10 @@
 use std::collections::BTreeSet;
 
 /// The longest line (characters).
-pub const LINE_MAX: usize = 80;
+pub(crate) const LINE_MAX: usize = 80;
 
 /// The longest label.
-pub const LABEL_MAX: usize = 16;
+pub(crate) const LABEL_MAX: usize = 16;
 
 /// The one number formatter: at most 4 decimals (0.1 µm), no trailing zeros, no `-0`.
 pub fn num(x: f64) -> String {
@@ -42,7 +42,7 @@ pub fn real(x: f64) -> String {
 }
 
 /// Whether `s` is a legal label: `[A-Z][A-Z0-9_]{0,15}`.
-pub fn is_label(s: &str) -> bool {
+pub(crate) fn is_label(s: &str) -> bool {
     let b = s.as_bytes();
     !b.is_empty()
         && b.len() <= LABEL_MAX
@@ -126,7 +126,7 @@ impl Labels {
 }
 
 /// Splits a statement's text at commas outside quotes.
-pub fn split_params(s: &str) -> Vec<&str> {
+pub(crate) fn split_params(s: &str) -> Vec<&str> {
     let mut out = Vec::new();
     let mut quoted = false;
     let mut start = 0;

@@ -57,7 +57,7 @@ impl Program {
 
 /// A problem found while loading.
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
-pub enum LoadError {
+pub(crate) enum LoadError {
     /// A file could not be read.
     #[error("cannot read `{path}`: {reason}")]
     #[diagnostic(

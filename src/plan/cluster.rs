@@ -228,7 +228,10 @@ pub fn valid_clustering<S: Set>(w: &[&S], order: &[usize]) -> Vec<Cluster<S>> {
 /// The item-buffer clustering (ch. 3.6.1): count, per element, the sets left that hold
 /// it; take the element of best size × weight (then size, then lowest index) and make
 /// every set holding it a cluster; repeat.
-pub fn weighted_clustering<S: Set>(w: &[&S], weight: &dyn Fn(usize) -> f64) -> Vec<Cluster<S>> {
+pub(crate) fn weighted_clustering<S: Set>(
+    w: &[&S],
+    weight: &dyn Fn(usize) -> f64,
+) -> Vec<Cluster<S>> {
     let mut left: Vec<usize> = (0..w.len()).collect();
     let mut out = Vec::new();
     let bits = w.first().map_or(0, |s| s.words().len() * 64);

@@ -43,7 +43,7 @@ impl Fallback {
     /// The plan: the branches less their failed touches, each failed touch moved to the
     /// first configuration that validates, the rest left out and reported. `None` when
     /// nothing of the plan is left.
-    pub fn settle(
+    pub(crate) fn settle(
         self,
         input: &Input,
         k: &mut Knowledge,

@@ -57,7 +57,7 @@ const SAME_PLANE_DEG: f64 = 0.5;
 
 /// A way the part can rest on the table.
 #[derive(Debug, Clone)]
-pub struct RestPose {
+pub(crate) struct RestPose {
     /// The part frame's up direction in this pose (minus the resting facet's normal).
     pub up: V3,
     /// The planar faces that lie on the table.
@@ -78,7 +78,7 @@ pub struct RestPose {
 impl RestPose {
     /// The four directions, square to `up`, a plate clamping this face may tilt it
     /// towards: along its longest edge or square to it, either way.
-    pub fn azimuths(&self) -> [V3; 8] {
+    pub(crate) fn azimuths(&self) -> [V3; 8] {
         let w = self.up.cross(&self.edge).normalize();
         let (a, b) = ((self.edge + w).normalize(), (self.edge - w).normalize());
         [self.edge, -self.edge, w, -w, a, -a, b, -b]
@@ -90,7 +90,7 @@ impl RestPose {
     }
 
     /// Why it is not stable, in words; `None` when it is.
-    pub fn excluded(&self) -> Option<String> {
+    pub(crate) fn excluded(&self) -> Option<String> {
         if !self.flat {
             Some("it would rest on a curved face's line or point and roll".into())
         } else if self.tip_deg < 0.0 {
@@ -891,7 +891,7 @@ fn clamp_pairs(g: &PartGeometry, hull: &[P3]) -> Vec<(V3, FaceId, FaceId, f64)> 
 /// The centre of mass of the solid (uniform density), from the signed volumes of the
 /// tetrahedra from the origin to each triangle; the area centroid for a mesh without
 /// volume.
-pub fn centre_of_mass(g: &PartGeometry) -> P3 {
+pub(crate) fn centre_of_mass(g: &PartGeometry) -> P3 {
     let (mut vol, mut m) = (0.0, V3::zeros());
     let (mut area, mut a) = (0.0, V3::zeros());
     for t in &g.triangles {

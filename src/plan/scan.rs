@@ -47,7 +47,7 @@ use crate::graph::Node;
 use crate::model::{FeatureId, SensorChoice, SlotId, ToleranceId};
 
 /// The overlap of neighbouring passes, as a share of the stripe's width.
-pub const OVERLAP: f64 = 0.2;
+pub(crate) const OVERLAP: f64 = 0.2;
 
 /// A feature the sensor selection gave a scanner.
 #[derive(Debug, Clone, PartialEq)]

@@ -105,7 +105,7 @@ impl Cx<'_> {
         self.index.names.push(crate::model::NameUse { used, decl });
     }
 
-    pub fn mismatch(&mut self, v: &Value, expected: &str, help: &str) {
+    pub(crate) fn mismatch(&mut self, v: &Value, expected: &str, help: &str) {
         let help = if !help.is_empty() {
             help.to_string()
         } else {
@@ -265,7 +265,7 @@ impl Cx<'_> {
     }
 
     /// A plain number ≥ 0.
-    pub fn non_negative(&mut self, v: &Value, what: &str) -> Option<f64> {
+    pub(crate) fn non_negative(&mut self, v: &Value, what: &str) -> Option<f64> {
         let x = self.number(v)?;
         if x < 0.0 {
             self.err(E::OutOfRange {
@@ -333,7 +333,7 @@ impl Cx<'_> {
     }
 
     /// A tuple of `N` lengths.
-    pub fn lengths<const N: usize>(&mut self, v: &Value) -> Option<[f64; N]> {
+    pub(crate) fn lengths<const N: usize>(&mut self, v: &Value) -> Option<[f64; N]> {
         match &v.kind {
             ValueKind::Tuple(items) if items.len() == N => {
                 let mut out = [0.0; N];

@@ -189,14 +189,14 @@ impl Chart {
     }
 
     /// The face's extent along u and v (mm).
-    pub fn extent_mm(&self) -> (f64, f64) {
+    pub(crate) fn extent_mm(&self) -> (f64, f64) {
         let (su, sv) = self.scale();
         ((self.u.1 - self.u.0) * su, (self.v.1 - self.v.0) * sv)
     }
 
     /// Maps t ∈ [0, 1] to v so that equal steps of t cover equal areas (cones and
     /// spheres grow with v); linear otherwise.
-    pub fn v_by_area(&self, t: f64) -> f64 {
+    pub(crate) fn v_by_area(&self, t: f64) -> f64 {
         let (a, b) = self.v;
         match self.shape {
             Shape::Cone { .. } if a >= 0.0 => (a * a + t * (b * b - a * a)).sqrt(),
@@ -211,7 +211,7 @@ impl Chart {
     /// The largest distance from the surface to the face's triangles worth accepting as
     /// "on the face" (mm): generous for chordal error, below anything that could reach
     /// the other side of a curved surface.
-    pub fn cover_tolerance(&self) -> f64 {
+    pub(crate) fn cover_tolerance(&self) -> f64 {
         match self.shape {
             Shape::Plane { .. } => 1.0,
             Shape::Cylinder { radius, .. } | Shape::Sphere { radius, .. } => {

@@ -214,19 +214,19 @@ impl<'a> Sampler<'a> {
 
 /// How far beyond the tip's radius `spread` keeps its outer points from a plane's
 /// edges (mm): a chamfer or burr stays clear of the ball.
-pub const EDGE_CLEARANCE: f64 = 0.5;
+pub(crate) const EDGE_CLEARANCE: f64 = 0.5;
 
 /// How far beyond the tip's radius `spread` keeps a cylinder's or cone's end circles
 /// from its ends (mm): the default `motion { margin }` and half a millimetre more, so
 /// that a ball at a blind bore's last circle keeps more than the plan's margin from its
 /// floor.
-pub const END_CLEARANCE: f64 = 1.5;
+pub(crate) const END_CLEARANCE: f64 = 1.5;
 
 /// `spread`'s distance between rows (mm).
-pub const SPREAD_SPACING: f64 = 25.0;
+pub(crate) const SPREAD_SPACING: f64 = 25.0;
 
 /// `spread`'s most rows along one side.
-pub const SPREAD_MAX_ROWS: usize = 7;
+pub(crate) const SPREAD_MAX_ROWS: usize = 7;
 
 /// Rows of a `spread` grid over a usable `a` × `b` mm: one every [`SPREAD_SPACING`], at
 /// least 3 each way (2 on a strip under 4 mm: points in one row fix no plane), denser
@@ -256,7 +256,7 @@ fn spread_rows(a: f64, b: f64, want: Option<usize>) -> (usize, usize) {
 }
 
 /// The least margin a face is sampled with (mm), however narrow it is.
-pub const MIN_MARGIN_MM: f64 = 0.1;
+pub(crate) const MIN_MARGIN_MM: f64 = 0.1;
 
 /// The most of a face's width the margin may take on each side: a face narrower than
 /// twice the margin keeps its points in the middle tenth.
@@ -610,7 +610,7 @@ fn pick_evenly(points: Vec<Fpoint>, n: usize) -> Vec<Fpoint> {
 
 /// The van der Corput radical inverse of `i` in `base`: its digits mirrored after the
 /// point, a low-discrepancy sequence in [0, 1).
-pub fn radical_inverse(mut i: u32, base: u32) -> f64 {
+pub(crate) fn radical_inverse(mut i: u32, base: u32) -> f64 {
     let (mut inv, mut f) = (0.0, 1.0 / base as f64);
     while i > 0 {
         inv += (i % base) as f64 * f;

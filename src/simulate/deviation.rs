@@ -37,7 +37,7 @@ pub struct FaceChange {
 
 /// A planar face bowed: a paraboloid over the plane, in the nominal part frame.
 #[derive(Debug, Clone, Copy)]
-pub struct Bow {
+pub(crate) struct Bow {
     /// Height at the centre (mm).
     pub height: f64,
     /// The face's centroid.
@@ -95,7 +95,7 @@ impl Deviations {
     }
 
     /// The placement of setup `k` (from 1).
-    pub fn placement_of(&self, k: usize) -> Placement {
+    pub(crate) fn placement_of(&self, k: usize) -> Placement {
         let mut p = self.placement;
         for (s, q) in &self.setups {
             if *s == k {
@@ -108,7 +108,7 @@ impl Deviations {
     }
 
     /// A planar face's bow, moved with it; `None` when it has none.
-    pub fn bow_of(&self, g: &PartGeometry, f: FaceId) -> Option<Bow> {
+    pub(crate) fn bow_of(&self, g: &PartGeometry, f: FaceId) -> Option<Bow> {
         let c = self.faces.get(f.0)?;
         if c.bow == 0.0 {
             return None;

@@ -159,11 +159,6 @@ impl TolDef {
         }
         Some(def)
     }
-
-    /// Whether the tolerance has limits on a value rather than a zone.
-    pub fn is_size(&self) -> bool {
-        self.limits.is_some()
-    }
 }
 
 /// The result of one tolerance on its features.

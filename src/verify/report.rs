@@ -108,7 +108,7 @@ impl VariantResult {
     /// The factor of the zone from which the program reads this deviation out, by
     /// linear interpolation between the two readings; infinite when the reading does
     /// not grow.
-    pub fn detects_from(&self) -> f64 {
+    pub(crate) fn detects_from(&self) -> f64 {
         let (Some(a), Some(b)) = (Self::read(&self.at_in), Self::read(&self.at_out)) else {
             return f64::INFINITY;
         };
@@ -161,7 +161,7 @@ impl TolResult {
     }
 
     /// What this tolerance read in a run.
-    pub fn reading(&self, tried: &Tried) -> Option<Reading> {
+    pub(crate) fn reading(&self, tried: &Tried) -> Option<Reading> {
         let rows: Vec<_> = tried.rows().filter(|r| r.tolerance == self.label).collect();
         if rows.is_empty() {
             return None;
@@ -191,7 +191,7 @@ impl TolResult {
     }
 
     /// Drops the trials the virtual part could not take.
-    pub fn drop_rejected(&mut self) {
+    pub(crate) fn drop_rejected(&mut self) {
         let rejected = |t: &Option<(Vec<String>, Tried, Option<Reading>)>| {
             t.as_ref().is_some_and(|x| x.1.rejected.is_some())
         };

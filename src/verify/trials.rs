@@ -28,7 +28,7 @@ use crate::model::{Part, TolKind, TolValue, Tolerance};
 
 /// One way of breaking a tolerance, at a factor of its zone.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Variant {
+pub(crate) struct Variant {
     /// In words: `bow on stock.top`, `tilt about (1, 0, 0)`, `upper limit`.
     pub what: String,
     /// The deviations file at factor `k`.
@@ -41,7 +41,7 @@ pub struct Variant {
 /// The variants of tolerance `t` at factor `k` of `zone` (a zone's width, or for a size
 /// the deviation that `k` multiplies: the variant's own limit). Empty: no deviation the
 /// virtual part can model breaks it.
-pub fn forbidden(
+pub(crate) fn forbidden(
     part: &Part,
     g: &PartGeometry,
     feature_faces: &[Vec<FaceId>],
@@ -321,7 +321,7 @@ impl Frame {
 
 /// The size changes that take a size to its limits: `("upper limit", +0.1)`,
 /// `("lower limit", -0.1)`; a side without room is left out.
-pub fn size_sides(v: &TolValue) -> Vec<(&'static str, f64)> {
+pub(crate) fn size_sides(v: &TolValue) -> Vec<(&'static str, f64)> {
     let TolValue::Size {
         nominal,
         lower,

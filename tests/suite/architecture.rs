@@ -385,8 +385,8 @@ fn strip_literals(line: &str) -> String {
             '\'' => {
                 // A char literal ('{', '\n'), not a lifetime ('a).
                 let rest: String = chars.clone().take(3).collect();
-                if rest.starts_with('\\') {
-                    let close = rest[1..].find('\'').map(|k| k + 2);
+                if let Some(escaped) = rest.strip_prefix('\\') {
+                    let close = escaped.find('\'').map(|k| k + 2);
                     for _ in 0..close.unwrap_or(0) {
                         chars.next();
                     }
