@@ -131,133 +131,49 @@ pub(crate) fn plan_scans(
     }
     let (model, plan, g) = (input.model, input.plan, input.geometry);
     let cmm = &model.cmms[plan.cmm.0];
-    let shapes = ScannerShape::of_cmm(model, cmm);
-    let scene = Scene::of_part(g);
     let machine = super::machine::Machine::new(model, plan);
-    // The orientations the plan allows (one (0, 0) on a fixed head).
-    let grid: Vec<(f64, f64)> = machine
-        .grid_allowed
-        .ones()
-        .map(|k| machine.grid[k])
-        .collect();
-    let cone_opts = ConeOptions {
-        n: opts.n.min(32),
-        backend: opts.backend,
-        ..Default::default()
+    let scanning = Scanning {
+        g,
+        shapes: ScannerShape::of_cmm(model, cmm),
+        scene: Scene::of_part(g),
+        // The orientations the plan allows (one (0, 0) on a fixed head).
+        grid: machine
+            .grid_allowed
+            .ones()
+            .map(|k| machine.grid[k])
+            .collect(),
+        cone_opts: ConeOptions {
+            n: opts.n.min(32),
+            backend: opts.backend,
+            ..Default::default()
+        },
+        backend: opts.backend.get(),
+        target: plan.scan_coverage,
+        margin: plan.motion.margin,
+        setups: Setups::new(model, plan, g, input.fixtures),
     };
-    let backend = opts.backend.get();
-    let target = plan.scan_coverage;
-    let setups = Setups::new(model, plan, g, input.fixtures);
     // The setups a face may go to: the plan's, then the part's others that can be held.
     let mut ups: Vec<V3> = hlip.setups.iter().map(|s| s.up).collect();
-    let others: Vec<V3> = setups
+    let others: Vec<V3> = scanning
+        .setups
         .exact_dirs()
         .into_iter()
-        .filter(|u| setups.holder(u).is_some())
+        .filter(|u| scanning.setups.holder(u).is_some())
         .filter(|u| !ups.iter().any(|v| (u - v).norm() < 1e-6))
         .collect();
-    // The table's height under the part in a setup and the fixture's solids, as the
-    // setup holds it.
-    let held_at = |up: &V3| match setups.holder(up) {
-        Some(h) => {
-            let solids = setups.solids(&h, up);
-            (setups.table(&h, up, &solids), solids)
-        }
-        None => (crate::access::pose::table_height(&scene, up), vec![]),
-    };
-    let margin = plan.motion.margin;
     let mut placed: Vec<Placed> = Vec::new();
     let mut uncovered = Vec::new();
     for (li, l) in lasers.iter().enumerate() {
-        let shape = &shapes[l.scanner];
         for &face in &l.faces {
-            let normal = mean_normal(g, face);
-            let cones = || FaceCones::new(backend, &scene, g, face.0, shape, &cone_opts);
-            let cover = |cones: &FaceCones, up: &V3| {
-                let (table, solids) = held_at(up);
-                let views = Views {
-                    grid: &grid,
-                    overlap: OVERLAP,
-                    up: *up,
-                    table: (table, margin),
-                    fixture: &solids,
-                };
-                let mut c = cones.coverage(&scene, shape, &views);
-                // The passes as the path stage will run them: a view whose housing does
-                // not clear the part, table and fixture by the margin along every pass
-                // is not the plan's.
-                c.views.retain(|v| {
-                    let pose = Pose::new(&scene, &shape.probe, v.dir, *up, table)
-                        .with_fixture(&solids)
-                        .with_margin(margin);
-                    let ok = v
-                        .lines
-                        .iter()
-                        .all(|l| pose.segment(&l.start, &l.end).is_ok());
-                    if !ok {
-                        c.covered -= v.share;
-                    }
-                    ok
-                });
-                c
-            };
-            // The plan's setups, the one the face looks up in most first.
-            let mut order: Vec<usize> = (0..ups.len()).collect();
-            order.sort_by(|&a, &b| {
-                normal
-                    .dot(&ups[b])
-                    .total_cmp(&normal.dot(&ups[a]))
-                    .then(a.cmp(&b))
-            });
-            let mut best: Option<(usize, FaceCoverage)> = None;
-            for s in order {
-                let c = memo.get((l.scanner, face), &ups[s], &cones, &cover);
-                let better = best
-                    .as_ref()
-                    .is_none_or(|b| c.covered > b.1.covered + 1e-12);
-                if better {
-                    best = Some((s, c));
+            match scanning.place(l, face, &mut ups, &others, memo) {
+                Some((s, c)) if s != usize::MAX && c.covered >= scanning.target => {
+                    placed.push(Placed {
+                        laser: li,
+                        face,
+                        setup: s,
+                        coverage: c,
+                    })
                 }
-                if best.as_ref().is_some_and(|b| b.1.covered >= target) {
-                    break;
-                }
-            }
-            if l.asked && best.as_ref().is_none_or(|b| b.1.covered < target) {
-                // A setup the plan does not have yet, for a feature the plan asked the
-                // scanner for: the best of the others. (One the rule chose goes back to
-                // the touch probe instead: a setup costs more than touching it.)
-                let mut fresh: Option<(usize, FaceCoverage)> = None;
-                for (k, up) in others.iter().enumerate() {
-                    if ups.iter().any(|v| (up - v).norm() < 1e-6) {
-                        continue;
-                    }
-                    let c = memo.get((l.scanner, face), up, &cones, &cover);
-                    if fresh
-                        .as_ref()
-                        .is_none_or(|f| c.covered > f.1.covered + 1e-12)
-                    {
-                        fresh = Some((k, c));
-                    }
-                }
-                if let Some((k, c)) = fresh {
-                    let gain = best
-                        .as_ref()
-                        .is_none_or(|b| c.covered > b.1.covered + 1e-12);
-                    if c.covered >= target && gain {
-                        ups.push(others[k]);
-                        best = Some((ups.len() - 1, c));
-                    } else if gain && best.as_ref().is_none_or(|b| b.1.covered < c.covered) {
-                        best = Some((usize::MAX, c));
-                    }
-                }
-            }
-            match best {
-                Some((s, c)) if s != usize::MAX && c.covered >= target => placed.push(Placed {
-                    laser: li,
-                    face,
-                    setup: s,
-                    coverage: c,
-                }),
                 b => uncovered.push(Uncovered {
                     feature: l.feature,
                     face,
@@ -272,13 +188,162 @@ pub(crate) fn plan_scans(
             .iter()
             .any(|u| u.feature == lasers[p.laser].feature)
     });
-    // New setups join the plan, held as the part's setups say.
-    for up in ups
-        .iter()
-        .skip(hlip.setups.len())
-        .copied()
-        .collect::<Vec<_>>()
-    {
+    add_setups(hlip, &ups, &placed, &scanning.setups);
+    let setup_of = |p: &Placed| {
+        hlip.setups
+            .iter()
+            .position(|s| (s.up - ups[p.setup]).norm() < 1e-5)
+            .unwrap_or(0)
+    };
+    let placed: Vec<(usize, Placed)> = placed.into_iter().map(|p| (setup_of(&p), p)).collect();
+    let part = &model.parts[plan.part.0];
+    for (s, p) in &placed {
+        record_scan(hlip, *s, p, &lasers[p.laser], part, cmm.probes.len());
+    }
+    hlip.scans.sort_by_key(|s| (s.feature, s.face));
+    recount(hlip, machine.head);
+    uncovered
+}
+
+/// What placing the scanners' faces in setups shares.
+struct Scanning<'a> {
+    g: &'a crate::geometry::PartGeometry,
+    shapes: Vec<ScannerShape>,
+    scene: Scene,
+    grid: Vec<(f64, f64)>,
+    cone_opts: ConeOptions,
+    backend: &'static dyn crate::access::Backend,
+    /// The plan's `scan_coverage`.
+    target: f64,
+    margin: f64,
+    setups: Setups<'a>,
+}
+
+impl Scanning<'_> {
+    /// The table's height under the part in a setup and the fixture's solids, as the
+    /// setup holds it.
+    fn held_at(&self, up: &V3) -> (f64, Vec<crate::access::pose::Solid>) {
+        match self.setups.holder(up) {
+            Some(h) => {
+                let solids = self.setups.solids(&h, up);
+                (self.setups.table(&h, up, &solids), solids)
+            }
+            None => (crate::access::pose::table_height(&self.scene, up), vec![]),
+        }
+    }
+
+    /// The coverage of a face by `shape` in setup `up`, on the face's `cones`: the
+    /// passes as the path stage will run them, so a view whose housing does not clear
+    /// the part, table and fixture by the margin along every pass is not the plan's.
+    fn cover(&self, cones: &FaceCones, shape: &ScannerShape, up: &V3) -> FaceCoverage {
+        let (table, solids) = self.held_at(up);
+        let views = Views {
+            grid: &self.grid,
+            overlap: OVERLAP,
+            up: *up,
+            table: (table, self.margin),
+            fixture: &solids,
+        };
+        let mut c = cones.coverage(&self.scene, shape, &views);
+        c.views.retain(|v| {
+            let pose = Pose::new(&self.scene, &shape.probe, v.dir, *up, table)
+                .with_fixture(&solids)
+                .with_margin(self.margin);
+            let ok = v
+                .lines
+                .iter()
+                .all(|l| pose.segment(&l.start, &l.end).is_ok());
+            if !ok {
+                c.covered -= v.share;
+            }
+            ok
+        });
+        c
+    }
+
+    /// The setup (index into `ups`) that covers `face` best, and its coverage: the
+    /// plan's setups, the one the face looks up in most first; for a feature the plan
+    /// asked the scanner for, a setup the plan does not have yet (pushed onto `ups`), or
+    /// `usize::MAX` for one that covers more without reaching the target.
+    fn place(
+        &self,
+        l: &Laser,
+        face: FaceId,
+        ups: &mut Vec<V3>,
+        others: &[V3],
+        memo: &mut ScanMemo,
+    ) -> Option<(usize, FaceCoverage)> {
+        let shape = &self.shapes[l.scanner];
+        let normal = mean_normal(self.g, face);
+        let cones = || {
+            FaceCones::new(
+                self.backend,
+                &self.scene,
+                self.g,
+                face.0,
+                shape,
+                &self.cone_opts,
+            )
+        };
+        let cover = |cones: &FaceCones, up: &V3| self.cover(cones, shape, up);
+        let mut order: Vec<usize> = (0..ups.len()).collect();
+        order.sort_by(|&a, &b| {
+            normal
+                .dot(&ups[b])
+                .total_cmp(&normal.dot(&ups[a]))
+                .then(a.cmp(&b))
+        });
+        let mut best: Option<(usize, FaceCoverage)> = None;
+        for s in order {
+            let c = memo.get((l.scanner, face), &ups[s], &cones, &cover);
+            let better = best
+                .as_ref()
+                .is_none_or(|b| c.covered > b.1.covered + 1e-12);
+            if better {
+                best = Some((s, c));
+            }
+            if best.as_ref().is_some_and(|b| b.1.covered >= self.target) {
+                break;
+            }
+        }
+        if !l.asked || best.as_ref().is_some_and(|b| b.1.covered >= self.target) {
+            return best;
+        }
+        // A setup the plan does not have yet, for a feature the plan asked the scanner
+        // for: the best of the others. (One the rule chose goes back to the touch probe
+        // instead: a setup costs more than touching it.)
+        let mut fresh: Option<(usize, FaceCoverage)> = None;
+        for (k, up) in others.iter().enumerate() {
+            if ups.iter().any(|v| (up - v).norm() < 1e-6) {
+                continue;
+            }
+            let c = memo.get((l.scanner, face), up, &cones, &cover);
+            if fresh
+                .as_ref()
+                .is_none_or(|f| c.covered > f.1.covered + 1e-12)
+            {
+                fresh = Some((k, c));
+            }
+        }
+        if let Some((k, c)) = fresh {
+            let gain = best
+                .as_ref()
+                .is_none_or(|b| c.covered > b.1.covered + 1e-12);
+            if c.covered >= self.target && gain {
+                ups.push(others[k]);
+                best = Some((ups.len() - 1, c));
+            } else if gain && best.as_ref().is_none_or(|b| b.1.covered < c.covered) {
+                best = Some((usize::MAX, c));
+            }
+        }
+        best
+    }
+}
+
+/// The setups `ups` added beyond the plan's that a placed face uses join the plan, held
+/// as the part's setups say.
+fn add_setups(hlip: &mut Hlip, ups: &[V3], placed: &[Placed], setups: &Setups) {
+    for &up in ups.iter().skip(hlip.setups.len()) {
         if !placed.iter().any(|p| (ups[p.setup] - up).norm() < 1e-6) {
             continue;
         }
@@ -299,102 +364,104 @@ pub(crate) fn plan_scans(
             square_within: None,
         });
     }
-    let setup_of = |p: &Placed| {
-        hlip.setups
-            .iter()
-            .position(|s| (s.up - ups[p.setup]).norm() < 1e-5)
-            .unwrap_or(0)
+}
+
+/// A placed face's views into setup `s`'s scanner node (the scanner's slot after the
+/// rack's probes), one orientation per view, and its line in `hlip.scans`.
+fn record_scan(
+    hlip: &mut Hlip,
+    s: usize,
+    p: &Placed,
+    l: &Laser,
+    part: &crate::model::Part,
+    probes: usize,
+) {
+    let slot = SlotId(probes + l.scanner);
+    let node = &mut hlip.setups[s];
+    let pi = match node.probes.iter().position(|n| n.probe == slot) {
+        Some(k) => k,
+        None => {
+            node.probes.push(ProbeNode {
+                probe: slot,
+                orients: vec![],
+            });
+            node.probes.len() - 1
+        }
     };
-    let placed: Vec<(usize, Placed)> = placed.into_iter().map(|p| (setup_of(&p), p)).collect();
-    let part = &model.parts[plan.part.0];
-    let probes = cmm.probes.len();
-    for (s, p) in &placed {
-        let l = &lasers[p.laser];
-        let slot = SlotId(probes + l.scanner);
-        let node = &mut hlip.setups[*s];
-        let pi = match node.probes.iter().position(|n| n.probe == slot) {
+    let last_view = p.coverage.views.len().saturating_sub(1);
+    for (vi, v) in p.coverage.views.iter().enumerate() {
+        let orients = &mut node.probes[pi].orients;
+        let oi = match orients
+            .iter()
+            .position(|o| o.a.to_bits() == v.a.to_bits() && o.b.to_bits() == v.b.to_bits())
+        {
             Some(k) => k,
             None => {
-                node.probes.push(ProbeNode {
-                    probe: slot,
-                    orients: vec![],
+                orients.push(OrientNode {
+                    a: v.a,
+                    b: v.b,
+                    direction: quantise(&v.dir),
+                    inspections: vec![],
                 });
-                node.probes.len() - 1
+                orients.len() - 1
             }
         };
-        let last_view = p.coverage.views.len().saturating_sub(1);
-        for (vi, v) in p.coverage.views.iter().enumerate() {
-            let orients = &mut node.probes[pi].orients;
-            let oi = match orients
-                .iter()
-                .position(|o| o.a.to_bits() == v.a.to_bits() && o.b.to_bits() == v.b.to_bits())
-            {
-                Some(k) => k,
-                None => {
-                    orients.push(OrientNode {
-                        a: v.a,
-                        b: v.b,
-                        direction: quantise(&v.dir),
-                        inspections: vec![],
-                    });
-                    orients.len() - 1
+        let passes: Vec<ScanPass> = v
+            .lines
+            .iter()
+            .map(|x| ScanPass {
+                start: P3::from(quantise(&x.start.coords)),
+                end: P3::from(quantise(&x.end.coords)),
+            })
+            .collect();
+        let visit = FaceVisit {
+            face: p.face,
+            contact: Contact::Part,
+            points: vec![],
+            passes,
+        };
+        // The tolerances reading the feature are recorded with its last view.
+        let records: Vec<ToleranceId> = if vi == last_view {
+            records_of(part, l.feature)
+        } else {
+            vec![]
+        };
+        add_visit(&mut orients[oi], l.feature, visit, records);
+    }
+    hlip.scans.push(ScannedFace {
+        feature: l.feature,
+        face: p.face,
+        scanner: slot,
+        setup: s,
+        coverage: p.coverage.covered,
+        views: p.coverage.views.len(),
+        passes: p.coverage.views.iter().map(|v| v.passes).sum(),
+        why: l.why.clone(),
+    });
+}
+
+/// A face's visit joins its feature's inspection in an orientation (made if new), with
+/// the tolerances it records.
+fn add_visit(o: &mut OrientNode, feature: FeatureId, visit: FaceVisit, records: Vec<ToleranceId>) {
+    match o
+        .inspections
+        .iter_mut()
+        .find(|i| i.feature == Some(feature))
+    {
+        Some(i) => {
+            i.faces.push(visit);
+            for r in records {
+                if !i.records.contains(&r) {
+                    i.records.push(r);
                 }
-            };
-            let o = &mut orients[oi];
-            let passes: Vec<ScanPass> = v
-                .lines
-                .iter()
-                .map(|x| ScanPass {
-                    start: P3::from(quantise(&x.start.coords)),
-                    end: P3::from(quantise(&x.end.coords)),
-                })
-                .collect();
-            let visit = FaceVisit {
-                face: p.face,
-                contact: Contact::Part,
-                points: vec![],
-                passes,
-            };
-            // The tolerances reading the feature are recorded with its last view.
-            let records: Vec<ToleranceId> = if vi == last_view {
-                records_of(part, l.feature)
-            } else {
-                vec![]
-            };
-            match o
-                .inspections
-                .iter_mut()
-                .find(|i| i.feature == Some(l.feature))
-            {
-                Some(i) => {
-                    i.faces.push(visit);
-                    for r in records {
-                        if !i.records.contains(&r) {
-                            i.records.push(r);
-                        }
-                    }
-                }
-                None => o.inspections.push(Inspection {
-                    feature: Some(l.feature),
-                    faces: vec![visit],
-                    records,
-                }),
             }
         }
-        hlip.scans.push(ScannedFace {
-            feature: l.feature,
-            face: p.face,
-            scanner: slot,
-            setup: *s,
-            coverage: p.coverage.covered,
-            views: p.coverage.views.len(),
-            passes: p.coverage.views.iter().map(|v| v.passes).sum(),
-            why: l.why.clone(),
-        });
+        None => o.inspections.push(Inspection {
+            feature: Some(feature),
+            faces: vec![visit],
+            records,
+        }),
     }
-    hlip.scans.sort_by_key(|s| (s.feature, s.face));
-    recount(hlip, machine.head);
-    uncovered
 }
 
 /// The tolerances that read a feature: as a target or through a datum it carries.
