@@ -24,6 +24,7 @@ mod errors;
 mod linearise;
 mod render;
 mod roadmap;
+mod touch_group;
 pub mod tour;
 
 pub use align::{AlignStep, Alignment, ExtraFace};
@@ -38,7 +39,7 @@ use crate::model::{DatumId, FeatureId, Motion, SlotId, TolKind, ToleranceId};
 use crate::plan::{Ban, Hlip, Input, Names};
 use linearise::{linearise, GroupIn};
 use rayon::prelude::*;
-use roadmap::Roadmap;
+use touch_group::{first_clear, lift, plan_group, GroupOut};
 
 /// The low-level inspection plan: every move of the program.
 #[derive(Debug, Clone, PartialEq)]
@@ -156,15 +157,6 @@ pub struct PathSummary {
     pub checks: usize,
     /// Faces whose stand-offs keep less than the plan's margin, with the least kept.
     pub tight: Vec<(crate::geometry::FaceId, f64)>,
-}
-
-/// A group's planned moves, before the moves between groups are joined.
-struct GroupOut {
-    entry: Vec<P3>,
-    blocks: Vec<BlockPath>,
-    exit: Vec<P3>,
-    added: usize,
-    checks: usize,
 }
 
 /// Plans every move of `hlip` around `scene` (the part, [`Scene::of_part`]). `None`
@@ -467,9 +459,6 @@ fn and_list(items: &[String]) -> String {
     }
 }
 
-/// The shares of the plan's margin a stand-off tries, largest first.
-const MARGIN_STEPS: [f64; 5] = [1.0, 0.5, 0.25, 0.125, 0.0];
-
 /// The length of a polyline.
 fn polyline(pts: &[P3]) -> f64 {
     pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
@@ -513,235 +502,6 @@ fn no_path(input: &Input, b: &BlockPath, g: &GroupIn, why: &str, points: Vec<usi
         why: why.to_string(),
     });
     Unreached { error, bans }
-}
-
-/// Plans one group: roadmap, tour, entry and exit.
-fn plan_group(
-    input: &Input,
-    hlip: &Hlip,
-    scene: &Scene,
-    g: &GroupIn,
-    standoff: f64,
-) -> Result<GroupOut, Unreached> {
-    let full = input.plan.motion.margin;
-    let mut pose = Pose::new(scene, g.probe, g.dir, g.up, g.table)
-        .with_fixture(g.fixture)
-        .with_margin(full);
-    let r = g.probe.tip_radius;
-    // Goals: every touch's stand-off, block by block.
-    let mut goals = Vec::new();
-    let mut owner = Vec::new();
-    for (bi, b) in g.blocks.iter().enumerate() {
-        for (ti, t) in b.touches.iter().enumerate() {
-            let p = &hlip.points[t.point];
-            goals.push(p.position + p.normal * (r + b.standoff));
-            owner.push((bi, ti));
-        }
-    }
-    // Each stand-off keeps the largest of the margin, a half, a quarter, an eighth or
-    // none that its feature leaves room for; moves to and from it keep that much.
-    let margins: Vec<f64> = goals
-        .par_iter()
-        .map(|x| {
-            MARGIN_STEPS
-                .iter()
-                .map(|f| full * f)
-                .find(|&m| pose.segment_with(x, x, m).is_ok())
-                .unwrap_or(0.0)
-        })
-        .collect();
-    for (x, &m) in goals.iter().zip(&margins) {
-        if m < full {
-            pose.set_tight(x, m);
-        }
-    }
-    let pose = pose;
-    let geometry = input.geometry;
-    let face_points = |goal: usize| -> Vec<P3> {
-        let (bi, ti) = owner[goal];
-        let b = &g.blocks[bi];
-        if b.contact == Contact::Table {
-            return vec![];
-        }
-        let face = hlip.points[b.touches[ti].point].face;
-        let tris = &geometry.faces[face.0].triangles;
-        let stride = tris.len().div_ceil(24).max(1);
-        tris.iter()
-            .step_by(stride)
-            .filter_map(|&t| {
-                let [a, b2, c] =
-                    geometry.triangles[t as usize].map(|i| geometry.vertices[i as usize]);
-                let n = (b2 - a).cross(&(c - a));
-                (n.norm() > 1e-12).then(|| {
-                    P3::from((a.coords + b2.coords + c.coords) / 3.0)
-                        + n.normalize() * (r + standoff)
-                })
-            })
-            .collect()
-    };
-    let mut map = Roadmap::new(
-        &pose,
-        goals.clone(),
-        g.dir,
-        &input.geometry.vertices,
-        g.height,
-    );
-    // Every goal left out is banned at once, so the planner's next try does not walk
-    // the face's unreachable points one by one.
-    let added = map.build(face_points).map_err(|d| {
-        let (bi, _) = owner[d.goal];
-        let point = |k: usize| {
-            let (bi, ti) = owner[k];
-            g.blocks[bi].touches[ti].point
-        };
-        let why = d.blocker.map_or_else(
-            || "every route the roadmap tried around the part is blocked".to_string(),
-            |b| format!("{b} hits the part on the way"),
-        );
-        no_path(
-            input,
-            &g.blocks[bi],
-            g,
-            &why,
-            d.stray.iter().map(|&k| point(k)).collect(),
-        )
-    })?;
-    let paths = map.shortest_paths();
-    // The way up from each goal to the clearance plane.
-    let (lifts, lift_checks): (Vec<Option<Vec<P3>>>, Vec<usize>) =
-        goals.par_iter().map(|x| lift(&pose, x, g)).unzip();
-    let checks = map.checks + lift_checks.iter().sum::<usize>();
-    let lift_len = |k: usize| {
-        lifts[k].as_ref().map_or(f64::INFINITY, |w| {
-            let mut pts = vec![goals[k]];
-            pts.extend(w.iter().copied());
-            polyline(&pts)
-        })
-    };
-    // Goals of each block.
-    let mut of_block: Vec<Vec<usize>> = vec![vec![]; g.blocks.len()];
-    for (k, &(bi, _)) in owner.iter().enumerate() {
-        of_block[bi].push(k);
-    }
-    // Block order: datum blocks first (in datum order), then a tour over the rest.
-    let rank = |bi: usize| g.blocks[bi].datum.map(|d| d.0);
-    let mut datum_blocks: Vec<usize> = (0..g.blocks.len()).filter(|&b| rank(b).is_some()).collect();
-    datum_blocks.sort_by_key(|&b| (rank(b), b));
-    let rest: Vec<usize> = (0..g.blocks.len()).filter(|&b| rank(b).is_none()).collect();
-    let dist_from = |cur: Option<usize>, k: usize| match cur {
-        None => lift_len(k),
-        Some(c) => paths.d(c, k),
-    };
-    let mut order: Vec<(usize, Vec<usize>)> = Vec::new();
-    let mut cur: Option<usize> = None;
-    let visit = |bi: usize, cur: &mut Option<usize>, order: &mut Vec<(usize, Vec<usize>)>| {
-        let ks = &of_block[bi];
-        let m = tour::Matrix::new(
-            ks.len(),
-            |i, j| paths.d(ks[i], ks[j]),
-            ks.iter().map(|&k| dist_from(*cur, k)).collect(),
-        );
-        let seq: Vec<usize> = tour::solve(&m).into_iter().map(|i| ks[i]).collect();
-        *cur = seq.last().copied().or(*cur);
-        order.push((bi, seq));
-    };
-    for &bi in &datum_blocks {
-        visit(bi, &mut cur, &mut order);
-    }
-    if !rest.is_empty() {
-        let near = |a: usize, b: usize| {
-            of_block[a]
-                .iter()
-                .flat_map(|&x| of_block[b].iter().map(move |&y| (x, y)))
-                .map(|(x, y)| paths.d(x, y))
-                .fold(f64::INFINITY, f64::min)
-        };
-        let m = tour::Matrix::new(
-            rest.len(),
-            |i, j| near(rest[i], rest[j]),
-            rest.iter()
-                .map(|&b| {
-                    of_block[b]
-                        .iter()
-                        .map(|&k| dist_from(cur, k))
-                        .fold(f64::INFINITY, f64::min)
-                })
-                .collect(),
-        );
-        for i in tour::solve(&m) {
-            visit(rest[i], &mut cur, &mut order);
-        }
-    }
-    // Unreachable distances mean the goals are not all connected (cannot happen after
-    // a successful build) or no lift exists at all.
-    let first = order
-        .first()
-        .and_then(|(_, s)| s.first())
-        .copied()
-        .unwrap_or(0);
-    let Some(entry_up) = lifts[first].clone() else {
-        let (bi, ti) = owner[first];
-        let b = &g.blocks[bi];
-        let points = vec![b.touches[ti].point];
-        return Err(no_path(
-            input,
-            b,
-            g,
-            "the way up to the clearance plane",
-            points,
-        ));
-    };
-    let mut entry: Vec<P3> = entry_up.into_iter().rev().collect();
-    if entry.is_empty() {
-        entry.push(goals[first]);
-    }
-    let last = cur.unwrap_or(first);
-    let exit_goal = (0..goals.len())
-        .filter(|&k| lifts[k].is_some())
-        .min_by(|&a, &b| {
-            (paths.d(last, a) + lift_len(a))
-                .total_cmp(&(paths.d(last, b) + lift_len(b)))
-                .then(a.cmp(&b))
-        })
-        .unwrap_or(first);
-    let mut exit = paths.path(&map, last, exit_goal);
-    exit.extend(lifts[exit_goal].clone().unwrap_or_default());
-    // The blocks in tour order with their moves.
-    let mut blocks = Vec::new();
-    let mut prev: Option<usize> = None;
-    for (bi, seq) in order {
-        let mut b = g.blocks[bi].clone();
-        b.touches = seq
-            .iter()
-            .map(|&k| {
-                let (_, ti) = owner[k];
-                let mut via: Vec<[f64; 3]> = match prev {
-                    Some(p) => paths
-                        .path(&map, p, k)
-                        .iter()
-                        .map(|x| x.coords.into())
-                        .collect(),
-                    None => vec![],
-                };
-                via.pop();
-                prev = Some(k);
-                Touch {
-                    point: g.blocks[bi].touches[ti].point,
-                    via,
-                    standoff: goals[k].coords.into(),
-                    margin: margins[k],
-                }
-            })
-            .collect();
-        blocks.push(b);
-    }
-    Ok(GroupOut {
-        entry,
-        blocks,
-        exit,
-        added,
-        checks,
-    })
 }
 
 /// Plans one scanner group: its blocks' passes in order, each pass run the way that
@@ -841,35 +601,6 @@ fn scan_move(pose: &Pose, x: &P3, y: &P3, g: &GroupIn) -> (Option<Vec<P3>>, usiz
         }),
         checks,
     )
-}
-
-/// The first of `tries` (waypoints after `x`) along which `pose` moves clear, and how
-/// many segments were checked to find it.
-fn first_clear(pose: &Pose, x: &P3, tries: Vec<Vec<P3>>) -> (Option<Vec<P3>>, usize) {
-    let mut checks = 0;
-    let found = tries.into_iter().find(|w| {
-        let mut from = *x;
-        w.iter().all(|p| {
-            checks += 1;
-            let ok = pose.segment(&from, p).is_ok();
-            from = *p;
-            ok
-        })
-    });
-    (found, checks)
-}
-
-/// The way from stand-off `x` up to the clearance plane: straight up the ram axis, or
-/// first up the probe axis; the waypoints after `x`, or `None` when every way is blocked.
-/// Also returns how many segments it checked.
-fn lift(pose: &Pose, x: &P3, g: &GroupIn) -> (Option<Vec<P3>>, usize) {
-    let raise = |y: &P3| y + g.up * (g.height - y.coords.dot(&g.up)).max(0.0);
-    let mut tries: Vec<Vec<P3>> = vec![vec![raise(x)]];
-    for h in [5.0, 20.0, 60.0] {
-        let y = x + g.dir * h;
-        tries.push(vec![y, raise(&y)]);
-    }
-    first_clear(pose, x, tries)
 }
 
 /// Warns of each tolerance read against a setup's frame that one of its own features
