@@ -7,7 +7,7 @@ use crate::access::pose::{Contact, Pose};
 use crate::access::{ProbeShape, Scene};
 use crate::geometry::V3;
 use crate::model::{DatumId, FeatureId, SlotId, TolKind, ToleranceId};
-use crate::plan::{Hlip, Input};
+use crate::plan::{FaceVisit, Hlip, Input, Inspection, OrientNode, SetupNode};
 
 /// Everything a group needs while it is planned.
 pub(super) struct GroupIn<'a> {
@@ -35,134 +35,187 @@ pub(super) fn linearise<'a>(
     probes: &'a [ProbeShape],
     scene: &Scene,
 ) -> Vec<GroupIn<'a>> {
-    let motion = input.plan.motion;
+    let datum_of = datum_of_features(input);
+    let mut groups: Vec<GroupIn> = Vec::new();
+    for (si, s) in hlip.setups.iter().enumerate() {
+        let setup_groups = setup_groups(input, hlip, probes, scene, (si, s), &datum_of);
+        groups.extend(datum_groups_first(setup_groups));
+    }
+    groups
+}
+
+/// Per feature, the datum it carries (the last declared, when several).
+fn datum_of_features(input: &Input) -> Vec<Option<DatumId>> {
     let part = &input.model.parts[input.plan.part.0];
-    let vertices = &input.geometry.vertices;
-    // Per feature, the datum it carries (the last declared, when several).
     let mut datum_of: Vec<Option<DatumId>> = vec![None; part.features.len()];
     for (k, d) in part.datums.iter().enumerate() {
         datum_of[d.feature.0] = Some(DatumId(k));
     }
+    datum_of
+}
+
+/// One setup's groups in HLIP order, one per probe and orientation, each with its
+/// blocks and the height it keeps on the clearance plane.
+fn setup_groups<'a>(
+    input: &Input,
+    hlip: &Hlip,
+    probes: &'a [ProbeShape],
+    scene: &Scene,
+    (si, s): (usize, &'a SetupNode),
+    datum_of: &[Option<DatumId>],
+) -> Vec<GroupIn<'a>> {
+    let motion = input.plan.motion;
     let standoff = motion.prehit.max(motion.retract);
-    let mut groups: Vec<GroupIn> = Vec::new();
-    for (si, s) in hlip.setups.iter().enumerate() {
-        let up = s.up;
-        let table = s.table;
-        let top = vertices
-            .iter()
-            .map(|v| v.coords.dot(&up))
-            .fold(f64::NEG_INFINITY, f64::max);
-        let mut setup_groups = Vec::new();
-        let reach_max = s
-            .probes
-            .iter()
-            .map(|p| probes[p.probe.0].reach())
-            .fold(0.0, f64::max);
-        for p in &s.probes {
-            let probe = &probes[p.probe.0];
-            for o in &p.orients {
-                let dir = o.direction;
-                // Every group of a setup keeps the head at one height on the clearance
-                // plane, where the longest probe in any orientation swings clear.
-                let lift = reach_max - probe.reach() * dir.dot(&up);
-                let mut blocks = Vec::new();
-                let mut records = Vec::new();
-                for i in &o.inspections {
-                    for f in &i.faces {
-                        // The faces of a feature that lie on one surface (a bore in two
-                        // halves) are one block: one feature, one `MEAS`.
-                        let one = blocks.iter_mut().find(|b: &&mut BlockPath| {
-                            f.passes.is_empty()
-                                && b.passes.is_empty()
-                                && b.feature == i.feature
-                                && b.contact == Contact::Part
-                                && f.contact == Contact::Part
-                                && input.geometry.one_surface(b.face, f.face)
-                        });
-                        if let Some(b) = one {
-                            let own = block_standoff(scene, hlip, &f.points, standoff, probe);
-                            b.standoff = b.standoff.min(own);
-                            for &k in &f.points {
-                                if !b.touches.iter().any(|t| t.point == k) {
-                                    b.touches.push(Touch {
-                                        point: k,
-                                        via: vec![],
-                                        standoff: [0.0; 3],
-                                        margin: 0.0,
-                                    });
-                                }
-                            }
-                            continue;
-                        }
-                        blocks.push(BlockPath {
-                            passes: f
-                                .passes
-                                .iter()
-                                .map(|x| PassPath {
-                                    via: vec![],
-                                    start: x.start.coords.into(),
-                                    end: x.end.coords.into(),
-                                })
-                                .collect(),
-                            feature: i.feature,
-                            face: f.face,
-                            contact: f.contact,
-                            datum: i.feature.and_then(|x| datum_of[x.0]),
-                            standoff: block_standoff(scene, hlip, &f.points, standoff, probe),
-                            touches: f
-                                .points
-                                .iter()
-                                .map(|&k| Touch {
-                                    point: k,
-                                    via: vec![],
-                                    standoff: [0.0; 3],
-                                    margin: 0.0,
-                                })
-                                .collect(),
+    let up = s.up;
+    let table = s.table;
+    let top = input
+        .geometry
+        .vertices
+        .iter()
+        .map(|v| v.coords.dot(&up))
+        .fold(f64::NEG_INFINITY, f64::max);
+    let mut setup_groups = Vec::new();
+    let reach_max = s
+        .probes
+        .iter()
+        .map(|p| probes[p.probe.0].reach())
+        .fold(0.0, f64::max);
+    for p in &s.probes {
+        let probe = &probes[p.probe.0];
+        for o in &p.orients {
+            let dir = o.direction;
+            // Every group of a setup keeps the head at one height on the clearance
+            // plane, where the longest probe in any orientation swings clear.
+            let lift = reach_max - probe.reach() * dir.dot(&up);
+            let (mut blocks, records) = orient_blocks(input, hlip, scene, probe, o, datum_of);
+            let pose = Pose::new(scene, probe, dir, up, table).with_fixture(&s.fixture);
+            for b in &mut blocks {
+                outlast(input, hlip, (scene, probe, &pose), b, standoff);
+            }
+            let has_datum = blocks.iter().any(|b| b.datum.is_some());
+            setup_groups.push(GroupIn {
+                setup: si,
+                probe,
+                slot: p.probe,
+                a: o.a,
+                b: o.b,
+                dir,
+                up,
+                table,
+                fixture: &s.fixture,
+                height: top + motion.clearance + lift,
+                blocks,
+                records,
+                has_datum,
+            });
+        }
+    }
+    setup_groups
+}
+
+/// The blocks of one orientation's inspections, one per feature face, and the
+/// tolerances they complete (each once, in HLIP order).
+fn orient_blocks(
+    input: &Input,
+    hlip: &Hlip,
+    scene: &Scene,
+    probe: &ProbeShape,
+    o: &OrientNode,
+    datum_of: &[Option<DatumId>],
+) -> (Vec<BlockPath>, Vec<ToleranceId>) {
+    let motion = input.plan.motion;
+    let standoff = motion.prehit.max(motion.retract);
+    let mut blocks = Vec::new();
+    let mut records = Vec::new();
+    for i in &o.inspections {
+        for f in &i.faces {
+            // The faces of a feature that lie on one surface (a bore in two
+            // halves) are one block: one feature, one `MEAS`.
+            let one = blocks.iter_mut().find(|b: &&mut BlockPath| {
+                f.passes.is_empty()
+                    && b.passes.is_empty()
+                    && b.feature == i.feature
+                    && b.contact == Contact::Part
+                    && f.contact == Contact::Part
+                    && input.geometry.one_surface(b.face, f.face)
+            });
+            if let Some(b) = one {
+                let own = block_standoff(scene, hlip, &f.points, standoff, probe);
+                b.standoff = b.standoff.min(own);
+                for &k in &f.points {
+                    if !b.touches.iter().any(|t| t.point == k) {
+                        b.touches.push(Touch {
+                            point: k,
+                            via: vec![],
+                            standoff: [0.0; 3],
+                            margin: 0.0,
                         });
                     }
-                    for r in &i.records {
-                        if !records.contains(r) {
-                            records.push(*r);
-                        }
-                    }
                 }
-                let pose = Pose::new(scene, probe, dir, up, table).with_fixture(&s.fixture);
-                for b in &mut blocks {
-                    outlast(input, hlip, (scene, probe, &pose), b, standoff);
-                }
-                let has_datum = blocks.iter().any(|b| b.datum.is_some());
-                setup_groups.push(GroupIn {
-                    setup: si,
-                    probe,
-                    slot: p.probe,
-                    a: o.a,
-                    b: o.b,
-                    dir,
-                    up,
-                    table,
-                    fixture: &s.fixture,
-                    height: top + motion.clearance + lift,
-                    blocks,
-                    records,
-                    has_datum,
-                });
+                continue;
+            }
+            let own = block_standoff(scene, hlip, &f.points, standoff, probe);
+            blocks.push(new_block(i, f, datum_of, own));
+        }
+        for r in &i.records {
+            if !records.contains(r) {
+                records.push(*r);
             }
         }
-        // Datum groups first, keeping each probe's orientations together.
-        let probe_has_datum =
-            |slot: SlotId, gs: &[GroupIn]| gs.iter().any(|g| g.slot == slot && g.has_datum);
-        let keys: Vec<(bool, bool)> = setup_groups
+    }
+    (blocks, records)
+}
+
+/// The block of face visit `f` of inspection `i`, its touches not yet planned.
+fn new_block(
+    i: &Inspection,
+    f: &FaceVisit,
+    datum_of: &[Option<DatumId>],
+    standoff: f64,
+) -> BlockPath {
+    BlockPath {
+        passes: f
+            .passes
             .iter()
-            .map(|g| (!probe_has_datum(g.slot, &setup_groups), !g.has_datum))
-            .collect();
-        let mut idx: Vec<usize> = (0..setup_groups.len()).collect();
-        idx.sort_by_key(|&k| keys[k]);
-        let mut taken: Vec<Option<GroupIn>> = setup_groups.into_iter().map(Some).collect();
-        for k in idx {
-            if let Some(g) = taken[k].take() {
-                groups.push(g);
-            }
+            .map(|x| PassPath {
+                via: vec![],
+                start: x.start.coords.into(),
+                end: x.end.coords.into(),
+            })
+            .collect(),
+        feature: i.feature,
+        face: f.face,
+        contact: f.contact,
+        datum: i.feature.and_then(|x| datum_of[x.0]),
+        standoff,
+        touches: f
+            .points
+            .iter()
+            .map(|&k| Touch {
+                point: k,
+                via: vec![],
+                standoff: [0.0; 3],
+                margin: 0.0,
+            })
+            .collect(),
+    }
+}
+
+/// A setup's groups with datum groups first, keeping each probe's orientations together.
+fn datum_groups_first(setup_groups: Vec<GroupIn>) -> Vec<GroupIn> {
+    let probe_has_datum =
+        |slot: SlotId, gs: &[GroupIn]| gs.iter().any(|g| g.slot == slot && g.has_datum);
+    let keys: Vec<(bool, bool)> = setup_groups
+        .iter()
+        .map(|g| (!probe_has_datum(g.slot, &setup_groups), !g.has_datum))
+        .collect();
+    let mut idx: Vec<usize> = (0..setup_groups.len()).collect();
+    idx.sort_by_key(|&k| keys[k]);
+    let mut taken: Vec<Option<GroupIn>> = setup_groups.into_iter().map(Some).collect();
+    let mut groups = Vec::new();
+    for k in idx {
+        if let Some(g) = taken[k].take() {
+            groups.push(g);
         }
     }
     groups
