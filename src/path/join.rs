@@ -4,12 +4,14 @@
 use super::linearise::GroupIn;
 use super::touch_group::GroupOut;
 use super::{
-    align, no_path, polyline, Alignment, GroupPath, Llip, PathSummary, SetupPath, Unreached,
+    align, no_path, polyline, Alignment, BlockPath, GroupPath, Llip, PathSummary, SetupPath,
+    Unreached,
 };
 use crate::access::pose::{Contact, Pose};
 use crate::access::Scene;
-use crate::geometry::{P3, V3};
+use crate::geometry::{FaceId, P3, V3};
 use crate::plan::{Hlip, Input};
+use std::collections::BTreeMap;
 
 /// Joins the planned groups: moves between groups of a setup run on the clearance
 /// plane, each setup gets its alignment, and the counts are summed.
@@ -24,64 +26,24 @@ pub(super) fn join(
     let total = groups.len();
     let mut setups: Vec<SetupPath> = Vec::new();
     let (mut added, mut checks, mut length, mut touches) = (0, 0, 0.0, 0);
-    let mut tight: std::collections::BTreeMap<crate::geometry::FaceId, f64> =
-        std::collections::BTreeMap::new();
     // The previous group: its setup and where its head ends.
     let mut prev: Option<(usize, P3)> = None;
     for (g, o) in groups.iter().zip(outs) {
         added += o.added;
         checks += o.checks;
         let mut entry = o.entry;
-        let arm = |g: &GroupIn| g.probe.reach();
         if let Some((s, head)) = prev {
             if s == g.setup {
-                // After the sensor change the tip hangs from the same head position;
-                // from there, up or down to this group's height, then across.
-                let from = head - g.dir * arm(g);
-                let across = from + g.up * (g.height - from.coords.dot(&g.up));
-                let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table).with_fixture(g.fixture);
                 checks += 2;
-                let moves = pose
-                    .segment(&from, &across)
-                    .and_then(|_| pose.segment(&across, &entry[0]));
-                if let Err(blocker) = moves {
-                    let b = &o.blocks[0];
-                    let points = b.touches.iter().map(|t| t.point).collect();
-                    let why = format!("{blocker} hits the part on the way");
-                    return Err(no_path(input, b, g, &why, points));
-                }
+                let across = sensor_change(input, scene, g, &o.blocks, head, &entry[0])?;
                 entry.insert(0, across);
             }
         }
         let exit_end = o.exit.last().copied().unwrap_or(entry[0]);
-        prev = Some((g.setup, exit_end + g.dir * arm(g)));
-        let mut glen = polyline(&entry) + polyline(&o.exit);
-        let mut at = entry.last().copied().unwrap_or_else(P3::origin);
-        let mut first = true;
-        for b in &o.blocks {
-            for t in &b.touches {
-                let s = P3::from(t.standoff);
-                let mut pts = vec![at];
-                if !first {
-                    pts.extend(t.via.iter().map(|&v| P3::from(v)));
-                }
-                pts.push(s);
-                glen += polyline(&pts);
-                first = false;
-                glen += 2.0 * b.standoff;
-                at = s;
-                touches += 1;
-            }
-            for p in &b.passes {
-                let mut pts = vec![at];
-                pts.extend(p.via.iter().map(|&v| P3::from(v)));
-                pts.push(P3::from(p.start));
-                pts.push(P3::from(p.end));
-                glen += polyline(&pts);
-                at = P3::from(p.end);
-            }
-        }
+        prev = Some((g.setup, exit_end + g.dir * g.probe.reach()));
+        let (glen, group_touches) = travel(&entry, &o.blocks, &o.exit);
         length += glen;
+        touches += group_touches;
         let gp = GroupPath {
             probe: g.slot,
             a: g.a,
@@ -103,58 +65,9 @@ pub(super) fn join(
         }
     }
     for sp in &mut setups {
-        // By hand, the operator holds the probe as one of the setup's groups does, or
-        // indexes the head to an orientation taken only to align.
-        let standoff = motion.prehit.max(motion.retract);
-        let own: Vec<&GroupIn> = groups.iter().filter(|g| g.setup == sp.setup).collect();
-        let held: Vec<HandHeld> = own
-            .iter()
-            .enumerate()
-            .map(|(gi, g)| (gi, None, g.dir))
-            .chain(
-                align_orients(input, &own)
-                    .into_iter()
-                    .map(|(gi, a, b, dir)| (gi, Some((a, b)), dir)),
-            )
-            .map(|(gi, orient, dir)| {
-                let g = own[gi];
-                HandHeld {
-                    pose: Pose::new(scene, g.probe, dir, g.up, g.table).with_fixture(g.fixture),
-                    group: gi,
-                    orient,
-                    dir,
-                }
-            })
-            .collect();
-        let clears: Vec<_> = held
-            .iter()
-            .map(|h| move |c: &P3, n: &V3| h.pose.approach(c, n, standoff, Contact::Part).is_ok())
-            .collect();
-        let touch: Vec<align::Touchable> = held
-            .iter()
-            .zip(&clears)
-            .map(|(h, clear)| align::Touchable {
-                group: h.group,
-                orient: h.orient,
-                probe: own[h.group].slot.0,
-                dir: h.dir,
-                tip: own[h.group].probe.tip_radius,
-                clear,
-            })
-            .collect();
-        sp.alignment = align::align(input, hlip, sp, &touch);
-        for g in &sp.groups {
-            for b in &g.blocks {
-                for t in &b.touches {
-                    if t.margin < motion.margin {
-                        let m = tight.entry(b.face).or_insert(t.margin);
-                        *m = m.min(t.margin);
-                    }
-                }
-            }
-        }
+        sp.alignment = hand_alignment(input, hlip, scene, groups, sp);
     }
-    let tight: Vec<(crate::geometry::FaceId, f64)> = tight.into_iter().collect();
+    let tight = tight_faces(&setups, motion.margin);
     Ok(Llip {
         motion,
         summary: PathSummary {
@@ -167,6 +80,134 @@ pub(super) fn join(
         },
         setups,
     })
+}
+
+/// The turn of the move from group to group of one setup after the sensor change, where
+/// the head stays at `head`: the tip hangs from there, goes up or down to group `g`'s
+/// height, then across to its `entry`. `blocks` are the group's, for the diagnostic when
+/// something is in the way.
+fn sensor_change(
+    input: &Input,
+    scene: &Scene,
+    g: &GroupIn,
+    blocks: &[BlockPath],
+    head: P3,
+    entry: &P3,
+) -> Result<P3, Unreached> {
+    let from = head - g.dir * g.probe.reach();
+    let across = from + g.up * (g.height - from.coords.dot(&g.up));
+    let pose = Pose::new(scene, g.probe, g.dir, g.up, g.table).with_fixture(g.fixture);
+    let moves = pose
+        .segment(&from, &across)
+        .and_then(|_| pose.segment(&across, entry));
+    if let Err(blocker) = moves {
+        let b = &blocks[0];
+        let points = b.touches.iter().map(|t| t.point).collect();
+        let why = format!("{blocker} hits the part on the way");
+        return Err(no_path(input, b, g, &why, points));
+    }
+    Ok(across)
+}
+
+/// A group's travel (mm) from its entry through every block's touches (in and out of
+/// each stand-off) and passes to its exit, and how many touches it makes.
+fn travel(entry: &[P3], blocks: &[BlockPath], exit: &[P3]) -> (f64, usize) {
+    let mut glen = polyline(entry) + polyline(exit);
+    let mut touches = 0;
+    let mut at = entry.last().copied().unwrap_or_else(P3::origin);
+    let mut first = true;
+    for b in blocks {
+        for t in &b.touches {
+            let s = P3::from(t.standoff);
+            let mut pts = vec![at];
+            if !first {
+                pts.extend(t.via.iter().map(|&v| P3::from(v)));
+            }
+            pts.push(s);
+            glen += polyline(&pts);
+            first = false;
+            glen += 2.0 * b.standoff;
+            at = s;
+            touches += 1;
+        }
+        for p in &b.passes {
+            let mut pts = vec![at];
+            pts.extend(p.via.iter().map(|&v| P3::from(v)));
+            pts.push(P3::from(p.start));
+            pts.push(P3::from(p.end));
+            glen += polyline(&pts);
+            at = P3::from(p.end);
+        }
+    }
+    (glen, touches)
+}
+
+/// A setup's hand alignment: by hand, the operator holds the probe as one of the
+/// setup's groups does, or indexes the head to an orientation taken only to align.
+fn hand_alignment(
+    input: &Input,
+    hlip: &Hlip,
+    scene: &Scene,
+    groups: &[GroupIn],
+    sp: &SetupPath,
+) -> Alignment {
+    let motion = input.plan.motion;
+    let standoff = motion.prehit.max(motion.retract);
+    let own: Vec<&GroupIn> = groups.iter().filter(|g| g.setup == sp.setup).collect();
+    let held: Vec<HandHeld> = own
+        .iter()
+        .enumerate()
+        .map(|(gi, g)| (gi, None, g.dir))
+        .chain(
+            align_orients(input, &own)
+                .into_iter()
+                .map(|(gi, a, b, dir)| (gi, Some((a, b)), dir)),
+        )
+        .map(|(gi, orient, dir)| {
+            let g = own[gi];
+            HandHeld {
+                pose: Pose::new(scene, g.probe, dir, g.up, g.table).with_fixture(g.fixture),
+                group: gi,
+                orient,
+                dir,
+            }
+        })
+        .collect();
+    let clears: Vec<_> = held
+        .iter()
+        .map(|h| move |c: &P3, n: &V3| h.pose.approach(c, n, standoff, Contact::Part).is_ok())
+        .collect();
+    let touch: Vec<align::Touchable> = held
+        .iter()
+        .zip(&clears)
+        .map(|(h, clear)| align::Touchable {
+            group: h.group,
+            orient: h.orient,
+            probe: own[h.group].slot.0,
+            dir: h.dir,
+            tip: own[h.group].probe.tip_radius,
+            clear,
+        })
+        .collect();
+    align::align(input, hlip, sp, &touch)
+}
+
+/// The faces whose stand-offs keep less than `margin`, with the least kept.
+fn tight_faces(setups: &[SetupPath], margin: f64) -> Vec<(FaceId, f64)> {
+    let mut tight: BTreeMap<FaceId, f64> = BTreeMap::new();
+    for sp in setups {
+        for g in &sp.groups {
+            for b in &g.blocks {
+                for t in &b.touches {
+                    if t.margin < margin {
+                        let m = tight.entry(b.face).or_insert(t.margin);
+                        *m = m.min(t.margin);
+                    }
+                }
+            }
+        }
+    }
+    tight.into_iter().collect()
 }
 
 /// Head orientations the operator may index to for the hand alignment beyond the
