@@ -2,11 +2,11 @@
 //! tour order (datum blocks first), and its way down from and up to the clearance plane.
 
 use super::linearise::GroupIn;
-use super::roadmap::Roadmap;
+use super::roadmap::{Disconnected, Paths, Roadmap};
 use super::{no_path, polyline, tour, BlockPath, Touch, Unreached};
 use crate::access::pose::{Contact, Pose};
 use crate::access::Scene;
-use crate::geometry::P3;
+use crate::geometry::{PartGeometry, P3};
 use crate::plan::{Hlip, Input};
 use rayon::prelude::*;
 
@@ -34,58 +34,15 @@ pub(super) fn plan_group(
     let mut pose = Pose::new(scene, g.probe, g.dir, g.up, g.table)
         .with_fixture(g.fixture)
         .with_margin(full);
-    let r = g.probe.tip_radius;
-    // Goals: every touch's stand-off, block by block.
-    let mut goals = Vec::new();
-    let mut owner = Vec::new();
-    for (bi, b) in g.blocks.iter().enumerate() {
-        for (ti, t) in b.touches.iter().enumerate() {
-            let p = &hlip.points[t.point];
-            goals.push(p.position + p.normal * (r + b.standoff));
-            owner.push((bi, ti));
-        }
-    }
-    // Each stand-off keeps the largest of the margin, a half, a quarter, an eighth or
-    // none that its feature leaves room for; moves to and from it keep that much.
-    let margins: Vec<f64> = goals
-        .par_iter()
-        .map(|x| {
-            MARGIN_STEPS
-                .iter()
-                .map(|f| full * f)
-                .find(|&m| pose.segment_with(x, x, m).is_ok())
-                .unwrap_or(0.0)
-        })
-        .collect();
+    let (goals, owner) = standoffs(hlip, g);
+    let margins = standoff_margins(&pose, &goals, full);
     for (x, &m) in goals.iter().zip(&margins) {
         if m < full {
             pose.set_tight(x, m);
         }
     }
     let pose = pose;
-    let geometry = input.geometry;
-    let face_points = |goal: usize| -> Vec<P3> {
-        let (bi, ti) = owner[goal];
-        let b = &g.blocks[bi];
-        if b.contact == Contact::Table {
-            return vec![];
-        }
-        let face = hlip.points[b.touches[ti].point].face;
-        let tris = &geometry.faces[face.0].triangles;
-        let stride = tris.len().div_ceil(24).max(1);
-        tris.iter()
-            .step_by(stride)
-            .filter_map(|&t| {
-                let [a, b2, c] =
-                    geometry.triangles[t as usize].map(|i| geometry.vertices[i as usize]);
-                let n = (b2 - a).cross(&(c - a));
-                (n.norm() > 1e-12).then(|| {
-                    P3::from((a.coords + b2.coords + c.coords) / 3.0)
-                        + n.normalize() * (r + standoff)
-                })
-            })
-            .collect()
-    };
+    let face_points = |goal: usize| face_samples(input.geometry, hlip, g, owner[goal], standoff);
     let mut map = Roadmap::new(
         &pose,
         goals.clone(),
@@ -93,26 +50,9 @@ pub(super) fn plan_group(
         &input.geometry.vertices,
         g.height,
     );
-    // Every goal left out is banned at once, so the planner's next try does not walk
-    // the face's unreachable points one by one.
-    let added = map.build(face_points).map_err(|d| {
-        let (bi, _) = owner[d.goal];
-        let point = |k: usize| {
-            let (bi, ti) = owner[k];
-            g.blocks[bi].touches[ti].point
-        };
-        let why = d.blocker.map_or_else(
-            || "every route the roadmap tried around the part is blocked".to_string(),
-            |b| format!("{b} hits the part on the way"),
-        );
-        no_path(
-            input,
-            &g.blocks[bi],
-            g,
-            &why,
-            d.stray.iter().map(|&k| point(k)).collect(),
-        )
-    })?;
+    let added = map
+        .build(face_points)
+        .map_err(|d| disconnected(input, g, &owner, d))?;
     let paths = map.shortest_paths();
     // The way up from each goal to the clearance plane.
     let (lifts, lift_checks): (Vec<Option<Vec<P3>>>, Vec<usize>) =
@@ -125,12 +65,128 @@ pub(super) fn plan_group(
             polyline(&pts)
         })
     };
+    let (order, cur) = block_order(g, &owner, &paths, &lift_len);
+    let first = order
+        .first()
+        .and_then(|(_, s)| s.first())
+        .copied()
+        .unwrap_or(0);
+    let entry = way_down(input, g, &owner, &goals, &lifts, first)?;
+    let last = cur.unwrap_or(first);
+    let exit = way_up((&map, &paths), &lifts, &lift_len, last, first);
+    let blocks = blocks_in_order(g, order, &owner, (&map, &paths), &goals, &margins);
+    Ok(GroupOut {
+        entry,
+        blocks,
+        exit,
+        added,
+        checks,
+    })
+}
+
+/// A group's goals, every touch's stand-off (tip centre) block by block, and the
+/// (block, touch) each belongs to.
+fn standoffs(hlip: &Hlip, g: &GroupIn) -> (Vec<P3>, Vec<(usize, usize)>) {
+    let r = g.probe.tip_radius;
+    let mut goals = Vec::new();
+    let mut owner = Vec::new();
+    for (bi, b) in g.blocks.iter().enumerate() {
+        for (ti, t) in b.touches.iter().enumerate() {
+            let p = &hlip.points[t.point];
+            goals.push(p.position + p.normal * (r + b.standoff));
+            owner.push((bi, ti));
+        }
+    }
+    (goals, owner)
+}
+
+/// The margin each stand-off keeps: the largest of the plan's margin (`full`), a half, a
+/// quarter, an eighth or none that its feature leaves room for; moves to and from it
+/// keep that much.
+fn standoff_margins(pose: &Pose, goals: &[P3], full: f64) -> Vec<f64> {
+    goals
+        .par_iter()
+        .map(|x| {
+            MARGIN_STEPS
+                .iter()
+                .map(|f| full * f)
+                .find(|&m| pose.segment_with(x, x, m).is_ok())
+                .unwrap_or(0.0)
+        })
+        .collect()
+}
+
+/// Points in front of the face of touch `(bi, ti)` of group `g`, `standoff` out from
+/// the tip's surface: up to about 24 triangle centroids, which the roadmap tries as
+/// nodes around a goal it cannot reach. None for a touch on the table.
+fn face_samples(
+    geometry: &PartGeometry,
+    hlip: &Hlip,
+    g: &GroupIn,
+    (bi, ti): (usize, usize),
+    standoff: f64,
+) -> Vec<P3> {
+    let r = g.probe.tip_radius;
+    let b = &g.blocks[bi];
+    if b.contact == Contact::Table {
+        return vec![];
+    }
+    let face = hlip.points[b.touches[ti].point].face;
+    let tris = &geometry.faces[face.0].triangles;
+    let stride = tris.len().div_ceil(24).max(1);
+    tris.iter()
+        .step_by(stride)
+        .filter_map(|&t| {
+            let [a, b2, c] = geometry.triangles[t as usize].map(|i| geometry.vertices[i as usize]);
+            let n = (b2 - a).cross(&(c - a));
+            (n.norm() > 1e-12).then(|| {
+                P3::from((a.coords + b2.coords + c.coords) / 3.0) + n.normalize() * (r + standoff)
+            })
+        })
+        .collect()
+}
+
+/// The diagnostic for goals the roadmap could not connect. Every goal left out is
+/// banned at once, so the planner's next try does not walk the face's unreachable
+/// points one by one.
+fn disconnected(
+    input: &Input,
+    g: &GroupIn,
+    owner: &[(usize, usize)],
+    d: Disconnected,
+) -> Unreached {
+    let (bi, _) = owner[d.goal];
+    let point = |k: usize| {
+        let (bi, ti) = owner[k];
+        g.blocks[bi].touches[ti].point
+    };
+    let why = d.blocker.map_or_else(
+        || "every route the roadmap tried around the part is blocked".to_string(),
+        |b| format!("{b} hits the part on the way"),
+    );
+    no_path(
+        input,
+        &g.blocks[bi],
+        g,
+        &why,
+        d.stray.iter().map(|&k| point(k)).collect(),
+    )
+}
+
+/// The order of a group's blocks, each with its goals in tour order: datum blocks first
+/// (in datum order), then a tour over the rest, the first block from the clearance
+/// plane (`lift_len`: the way up from a goal); also the last goal visited.
+fn block_order(
+    g: &GroupIn,
+    owner: &[(usize, usize)],
+    paths: &Paths,
+    lift_len: &dyn Fn(usize) -> f64,
+) -> (Vec<(usize, Vec<usize>)>, Option<usize>) {
     // Goals of each block.
     let mut of_block: Vec<Vec<usize>> = vec![vec![]; g.blocks.len()];
     for (k, &(bi, _)) in owner.iter().enumerate() {
         of_block[bi].push(k);
     }
-    // Block order: datum blocks first (in datum order), then a tour over the rest.
     let rank = |bi: usize| g.blocks[bi].datum.map(|d| d.0);
     let mut datum_blocks: Vec<usize> = (0..g.blocks.len()).filter(|&b| rank(b).is_some()).collect();
     datum_blocks.sort_by_key(|&b| (rank(b), b));
@@ -179,13 +235,20 @@ pub(super) fn plan_group(
             visit(rest[i], &mut cur, &mut order);
         }
     }
+    (order, cur)
+}
+
+/// The way down from the clearance plane to goal `first`: its way up, reversed.
+fn way_down(
+    input: &Input,
+    g: &GroupIn,
+    owner: &[(usize, usize)],
+    goals: &[P3],
+    lifts: &[Option<Vec<P3>>],
+    first: usize,
+) -> Result<Vec<P3>, Unreached> {
     // Unreachable distances mean the goals are not all connected (cannot happen after
     // a successful build) or no lift exists at all.
-    let first = order
-        .first()
-        .and_then(|(_, s)| s.first())
-        .copied()
-        .unwrap_or(0);
     let Some(entry_up) = lifts[first].clone() else {
         let (bi, ti) = owner[first];
         let b = &g.blocks[bi];
@@ -202,8 +265,19 @@ pub(super) fn plan_group(
     if entry.is_empty() {
         entry.push(goals[first]);
     }
-    let last = cur.unwrap_or(first);
-    let exit_goal = (0..goals.len())
+    Ok(entry)
+}
+
+/// The way from goal `last` up to the clearance plane: over the roadmap to the goal
+/// whose way there and up is shortest (`first` when none has a way up), then up.
+fn way_up(
+    (map, paths): (&Roadmap, &Paths),
+    lifts: &[Option<Vec<P3>>],
+    lift_len: &dyn Fn(usize) -> f64,
+    last: usize,
+    first: usize,
+) -> Vec<P3> {
+    let exit_goal = (0..lifts.len())
         .filter(|&k| lifts[k].is_some())
         .min_by(|&a, &b| {
             (paths.d(last, a) + lift_len(a))
@@ -211,9 +285,21 @@ pub(super) fn plan_group(
                 .then(a.cmp(&b))
         })
         .unwrap_or(first);
-    let mut exit = paths.path(&map, last, exit_goal);
+    let mut exit = paths.path(map, last, exit_goal);
     exit.extend(lifts[exit_goal].clone().unwrap_or_default());
-    // The blocks in tour order with their moves.
+    exit
+}
+
+/// The blocks in tour order, each touch with its way from the one before over the
+/// roadmap, its stand-off and the margin it keeps.
+fn blocks_in_order(
+    g: &GroupIn,
+    order: Vec<(usize, Vec<usize>)>,
+    owner: &[(usize, usize)],
+    (map, paths): (&Roadmap, &Paths),
+    goals: &[P3],
+    margins: &[f64],
+) -> Vec<BlockPath> {
     let mut blocks = Vec::new();
     let mut prev: Option<usize> = None;
     for (bi, seq) in order {
@@ -224,7 +310,7 @@ pub(super) fn plan_group(
                 let (_, ti) = owner[k];
                 let mut via: Vec<[f64; 3]> = match prev {
                     Some(p) => paths
-                        .path(&map, p, k)
+                        .path(map, p, k)
                         .iter()
                         .map(|x| x.coords.into())
                         .collect(),
@@ -242,13 +328,7 @@ pub(super) fn plan_group(
             .collect();
         blocks.push(b);
     }
-    Ok(GroupOut {
-        entry,
-        blocks,
-        exit,
-        added,
-        checks,
-    })
+    blocks
 }
 
 /// The way from stand-off `x` up to the clearance plane: straight up the ram axis, or
