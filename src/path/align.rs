@@ -17,12 +17,13 @@
 //! for that touch alone ([`Touchable::orient`]). Whatever stays free is named in
 //! [`Alignment::missing`] and becomes an operator instruction.
 
-use super::{Hlip, SetupPath};
+use super::{BlockPath, Hlip, SetupPath};
 use crate::access::Contact;
 use crate::geometry::{FaceId, Surface, P3, V3};
 use crate::graph::Node;
 use crate::model::FeatureId;
 use crate::plan::Input;
+use std::collections::BTreeSet;
 
 /// A setup's alignment.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -182,6 +183,67 @@ fn align_on(
     touch: &[Touchable],
     on_referenced: bool,
 ) -> Alignment {
+    let cands = candidates(input, hlip, sp, on_referenced);
+    let mut out = Alignment::default();
+    let mut dirs: Vec<usize> = Vec::new();
+    let mut origins = [false; 3];
+    let mut free = Free {
+        dirs: &mut dirs,
+        origins: &mut origins,
+    };
+    steps_on_blocks(hlip, &cands, &mut out, &mut free);
+    // A primary cylinder or a lone sphere when no plane qualifies.
+    if out.steps.is_empty() {
+        step_on_round(hlip, &cands, &mut out, &mut free);
+    }
+    let used_faces: Vec<FaceId> = out
+        .steps
+        .iter()
+        .filter_map(|st| {
+            let b = sp.groups.get(st.group)?.blocks.get(st.block?)?;
+            (b.contact == Contact::Part).then_some(b.face)
+        })
+        .collect();
+    let group = out.steps.first().map_or(0, |st| st.group);
+    let up = hlip.setups[sp.setup].up;
+    complete(input, up, group, &used_faces, touch, &mut out, &mut free);
+    if dirs.is_empty() {
+        out.missing.push("the part's orientation".into());
+    } else if dirs.len() == 1 {
+        out.missing
+            .push(format!("the rotation about {}", AXES[dirs[0]]));
+    }
+    for k in 0..3 {
+        if !origins[k] {
+            out.missing.push(format!("the {} origin", AXES[k]));
+        }
+    }
+    out
+}
+
+/// A block of the setup the alignment may stand on.
+struct Candidate {
+    /// (class, datum, stands in for it): datum features first in datum order (the datum
+    /// itself before a plane parallel to the one it rests on), then features no
+    /// tolerance reads against datums, then the rest.
+    rank: (u8, usize, u8),
+    /// The face's area, negated: the largest first.
+    neg_area: f64,
+    /// The group (index into [`SetupPath::groups`]).
+    group: usize,
+    /// The block in that group.
+    block: usize,
+    /// Its surface as the alignment sees it.
+    shape: Shape,
+    /// Its points, in tour order.
+    points: Vec<usize>,
+}
+
+/// The setup's blocks the alignment may stand on, best first: by rank, then area, then
+/// in block order. Without `on_referenced`, the blocks of features a tolerance reads
+/// against datums are left out, and so are faces this setup measures only part of and
+/// faces a frame this setup does not build would carry over.
+fn candidates(input: &Input, hlip: &Hlip, sp: &SetupPath, on_referenced: bool) -> Vec<Candidate> {
     let geometry = input.geometry;
     // Features whose tolerances refer to datums: aligned on, such a feature sets the
     // frame its own tolerance is read in (moved, it would read perfect).
@@ -199,33 +261,8 @@ fn align_on(
     let setup = &hlip.setups[sp.setup];
     let resting = resting_datum(input, setup.up, setup.table);
     let vertical = axis_of(&setup.up).map(|(k, _)| k);
-    // Faces of features a tolerance reads against datums this setup does not measure
-    // (a datum bore that is also one of a toleranced pattern's holes): the frame would
-    // carry those datums over as drawn and move with the face.
-    let here_features = sp.features();
-    let carried: Vec<FaceId> = part
-        .tolerances
-        .iter()
-        .filter(|t| {
-            !t.datums.is_empty()
-                && !t
-                    .datums
-                    .iter()
-                    .all(|d| here_features.contains(&part.datums[d.datum.0].feature))
-        })
-        .flat_map(|t| t.targets.iter())
-        .flat_map(|f| faces_in_graph(input, *f))
-        .collect();
-    let elsewhere = points_elsewhere(hlip, sp.setup);
-    let here: std::collections::BTreeSet<usize> = sp
-        .groups
-        .iter()
-        .flat_map(|g| &g.blocks)
-        .flat_map(|b| b.touches.iter().map(|t| t.point))
-        .collect();
-    // Candidates: (rank, -area, group, block, shape, points in tour order); the rank is
-    // datum features first in datum order, then features no tolerance reads against
-    // datums, then the rest.
+    let carried = carried_faces(input, sp);
+    let split = split_faces(hlip, sp);
     let mut cands = Vec::new();
     for (gi, g) in sp.groups.iter().enumerate() {
         for (bi, b) in g.blocks.iter().enumerate() {
@@ -233,44 +270,14 @@ fn align_on(
             let Some(&first) = points.first() else {
                 continue;
             };
-            let split = elsewhere
-                .get(&b.face)
-                .is_some_and(|pts| pts.iter().any(|p| !here.contains(p)));
+            let split = split.contains(&b.face);
             if (split || carried.contains(&b.face)) && !on_referenced && b.contact == Contact::Part
             {
                 continue;
             }
-            let f = geometry.faces.get(b.face.0);
-            let shape = if b.contact == Contact::Table {
-                let p = &hlip.points[first];
-                axis_of(&p.normal).map(|(axis, positive)| Shape::Plane {
-                    axis,
-                    positive,
-                    at: p.position[axis],
-                })
-            } else {
-                match f.map(|f| &f.surface) {
-                    Some(Surface::Plane { origin, normal }) => {
-                        axis_of(normal).map(|(axis, positive)| Shape::Plane {
-                            axis,
-                            positive,
-                            at: origin[axis],
-                        })
-                    }
-                    Some(Surface::Cylinder { origin, axis, .. }) => {
-                        axis_of(axis).map(|(k, positive)| Shape::Cylinder {
-                            axis: k,
-                            positive,
-                            at: *origin,
-                        })
-                    }
-                    Some(Surface::Sphere { center, .. }) => Some(Shape::Sphere { at: *center }),
-                    _ => None,
-                }
+            let Some(shape) = block_shape(input, hlip, b, first) else {
+                continue;
             };
-            let Some(shape) = shape else { continue };
-            // (class, datum, stands in for it): the datum itself before a plane parallel
-            // to the one it rests on.
             let mut rank = match (b.datum, b.feature) {
                 (Some(d), _) => (0, d.0, 0),
                 (None, Some(f)) if referenced.contains(&f) => {
@@ -286,77 +293,118 @@ fn align_on(
                     rank = rank.min((0, r, 1));
                 }
             }
-            let area = f.map_or(0.0, |f| f.area);
-            cands.push((rank, -area, gi, bi, shape, points));
+            let area = geometry.faces.get(b.face.0).map_or(0.0, |f| f.area);
+            cands.push(Candidate {
+                rank,
+                neg_area: -area,
+                group: gi,
+                block: bi,
+                shape,
+                points,
+            });
         }
     }
     // Datum rank first, then area, then order.
     cands.sort_by(|a, b| {
-        a.0.cmp(&b.0)
-            .then(a.1.total_cmp(&b.1))
-            .then((a.2, a.3).cmp(&(b.2, b.3)))
+        a.rank
+            .cmp(&b.rank)
+            .then(a.neg_area.total_cmp(&b.neg_area))
+            .then((a.group, a.block).cmp(&(b.group, b.block)))
     });
+    cands
+}
 
-    let mut out = Alignment::default();
-    let mut dirs: Vec<usize> = Vec::new();
-    let mut origins = [false; 3];
+/// Faces of features a tolerance reads against datums this setup does not measure
+/// (a datum bore that is also one of a toleranced pattern's holes): the frame would
+/// carry those datums over as drawn and move with the face.
+fn carried_faces(input: &Input, sp: &SetupPath) -> Vec<FaceId> {
+    let part = &input.model.parts[input.plan.part.0];
+    let here_features = sp.features();
+    part.tolerances
+        .iter()
+        .filter(|t| {
+            !t.datums.is_empty()
+                && !t
+                    .datums
+                    .iter()
+                    .all(|d| here_features.contains(&part.datums[d.datum.0].feature))
+        })
+        .flat_map(|t| t.targets.iter())
+        .flat_map(|f| faces_in_graph(input, *f))
+        .collect()
+}
+
+/// The faces this setup measures only part of: other setups take points on them that
+/// this one does not.
+fn split_faces(hlip: &Hlip, sp: &SetupPath) -> BTreeSet<FaceId> {
+    let here: BTreeSet<usize> = sp
+        .groups
+        .iter()
+        .flat_map(|g| &g.blocks)
+        .flat_map(|b| b.touches.iter().map(|t| t.point))
+        .collect();
+    points_elsewhere(hlip, sp.setup)
+        .into_iter()
+        .filter(|(_, pts)| pts.iter().any(|p| !here.contains(p)))
+        .map(|(face, _)| face)
+        .collect()
+}
+
+/// The surface the alignment sees in block `b` (its first point `first`): the table's
+/// plane there, or the block's face where its normal or axis is a part axis (any
+/// sphere); `None` for anything else.
+fn block_shape(input: &Input, hlip: &Hlip, b: &BlockPath, first: usize) -> Option<Shape> {
+    if b.contact == Contact::Table {
+        let p = &hlip.points[first];
+        return axis_of(&p.normal).map(|(axis, positive)| Shape::Plane {
+            axis,
+            positive,
+            at: p.position[axis],
+        });
+    }
+    match input.geometry.faces.get(b.face.0).map(|f| &f.surface) {
+        Some(Surface::Plane { origin, normal }) => {
+            axis_of(normal).map(|(axis, positive)| Shape::Plane {
+                axis,
+                positive,
+                at: origin[axis],
+            })
+        }
+        Some(Surface::Cylinder { origin, axis, .. }) => {
+            axis_of(axis).map(|(k, positive)| Shape::Cylinder {
+                axis: k,
+                positive,
+                at: *origin,
+            })
+        }
+        Some(Surface::Sphere { center, .. }) => Some(Shape::Sphere { at: *center }),
+        _ => None,
+    }
+}
+
+/// What a step fixes.
+struct Fix {
+    /// Its keywords: `ZDIR`, `XORIG`, ….
+    keywords: Vec<String>,
+    /// How many points it touches.
+    points: usize,
+    /// The origins it fixes (part axes).
+    origins: Vec<usize>,
+    /// The direction it fixes.
+    dir: Option<usize>,
+}
+
+/// The steps the setup's own blocks give, stage by stage — a primary (0), a secondary
+/// (1), tertiaries (2) — each the first candidate in order that fixes something still
+/// free and whose points can show it.
+fn steps_on_blocks(hlip: &Hlip, cands: &[Candidate], out: &mut Alignment, free: &mut Free) {
     let mut used = vec![false; cands.len()];
-    // `n` of `pts`, each as far as it can be from those chosen before (positions seen
-    // through `view`: a bore's points are spread by their angle about its axis).
-    let spread_by = |pts: &[usize], n: usize, view: &dyn Fn(&P3) -> P3| -> Option<Vec<usize>> {
-        if pts.len() < n {
-            return None;
-        }
-        let pos = |k: usize| view(&hlip.points[k].position);
-        let mut chosen = vec![pts[0]];
-        while chosen.len() < n {
-            let next = pts
-                .iter()
-                .filter(|k| !chosen.contains(k))
-                .max_by(|&&a, &&b| {
-                    let d = |x: usize| {
-                        chosen
-                            .iter()
-                            .map(|&c| (pos(x) - pos(c)).norm())
-                            .fold(f64::INFINITY, f64::min)
-                    };
-                    d(a).total_cmp(&d(b)).then(b.cmp(&a))
-                })?;
-            chosen.push(*next);
-        }
-        Some(chosen)
-    };
-    let spread = |pts: &[usize], n: usize| spread_by(pts, n, &|p: &P3| *p);
-    // A bore touched by hand: circles of `per_level` points at `levels` heights along
-    // its axis (most-touched heights first), each circle's points spread round it; the
-    // points of one height alone say nothing of the centre across them.
-    let round = |pts: &[usize], axis: usize, levels: usize, per_level: usize| {
-        let mut by_level: Vec<(i64, Vec<usize>)> = Vec::new();
-        for &k in pts {
-            let h = (hlip.points[k].position[axis] * 1e3).round() as i64;
-            match by_level.iter_mut().find(|(x, _)| *x == h) {
-                Some((_, v)) => v.push(k),
-                None => by_level.push((h, vec![k])),
-            }
-        }
-        by_level.sort_by(|a, b| b.1.len().cmp(&a.1.len()).then(a.0.cmp(&b.0)));
-        let flat = |p: &P3| {
-            let mut q = *p;
-            q[axis] = 0.0;
-            q
-        };
-        let mut out = Vec::new();
-        for (_, at) in by_level.iter().take(levels) {
-            out.extend(spread_by(at, per_level.min(at.len()).max(3), &flat)?);
-        }
-        (by_level.len() >= levels).then_some(out)
-    };
-    let is_datum = |ci: usize| cands[ci].0 .0 == 0;
+    let is_datum = |ci: usize| cands[ci].rank.0 == 0;
     let datum_bore = |primary: usize| {
         cands.iter().any(|c| {
-            c.0 .0 == 0
-                && c.5.len() >= 4
-                && matches!(c.4, Shape::Cylinder { axis, .. } if axis == primary)
+            c.rank.0 == 0
+                && c.points.len() >= 4
+                && matches!(c.shape, Shape::Cylinder { axis, .. } if axis == primary)
         })
     };
     // A secondary plane fixes the turn about the primary that a bore cannot: planes are
@@ -365,199 +413,263 @@ fn align_on(
     for stage in 0..3 {
         let order = (0..passes(stage)).flat_map(|pass| {
             cands.iter().enumerate().filter(move |(_, c)| {
-                passes(stage) == 1 || (pass == 0) == matches!(c.4, Shape::Plane { .. })
+                passes(stage) == 1 || (pass == 0) == matches!(c.shape, Shape::Plane { .. })
             })
         });
-        for (ci, (_, _, gi, bi, shape, pts)) in order {
+        for (ci, c) in order {
             if used[ci] {
                 continue;
             }
-            let free = |skip: Option<usize>| -> Vec<usize> {
-                (0..3).filter(|&k| Some(k) != skip && !origins[k]).collect()
+            let Some(fix) = stage_fix(stage, &c.shape, free, is_datum(ci), &datum_bore) else {
+                continue;
             };
-            // (keywords, points needed, origins fixed, direction fixed)
-            let (keywords, n, fixed, dir): (Vec<String>, usize, Vec<usize>, Option<usize>) =
-                match (stage, shape) {
-                    (0, Shape::Plane { axis, positive, .. }) => (
-                        vec![dir_word(*axis, *positive), orig_word(*axis)],
-                        3,
-                        vec![*axis],
-                        Some(*axis),
-                    ),
-                    // A plane that is no datum gives only its direction where a datum
-                    // bore along the primary will place the origins across it.
-                    (1, Shape::Plane { axis, positive, .. })
-                        if !dirs.contains(axis)
-                            && dirs.len() == 1
-                            && !is_datum(ci)
-                            && datum_bore(dirs[0]) =>
-                    {
-                        (vec![dir_word(*axis, *positive)], 2, vec![], Some(*axis))
-                    }
-                    (1, Shape::Plane { axis, positive, .. })
-                        if !dirs.contains(axis) && dirs.len() == 1 =>
-                    {
-                        (
-                            vec![dir_word(*axis, *positive), orig_word(*axis)],
-                            2,
-                            vec![*axis],
-                            Some(*axis),
-                        )
-                    }
-                    (2, Shape::Plane { axis, .. }) if !origins[*axis] && dirs.len() == 2 => {
-                        (vec![orig_word(*axis)], 1, vec![*axis], None)
-                    }
-                    (1, Shape::Cylinder { axis, .. }) if dirs == [*axis] => {
-                        let o = free(Some(*axis));
-                        (o.iter().map(|&k| orig_word(k)).collect(), 4, o, None)
-                    }
-                    // A bore along one of the directions places the origins left free
-                    // across it (a plane and its edge, then a hole for the last one).
-                    (2, Shape::Cylinder { axis, .. }) if dirs.contains(axis) => {
-                        let o = free(Some(*axis));
-                        (o.iter().map(|&k| orig_word(k)).collect(), 4, o, None)
-                    }
-                    (2, Shape::Sphere { .. }) => {
-                        let o = free(None);
-                        (o.iter().map(|&k| orig_word(k)).collect(), 4, o, None)
-                    }
-                    _ => continue,
-                };
-            if keywords.is_empty() {
+            if fix.keywords.is_empty() {
                 continue;
             }
-            // The secondary's two points lie along it, across the primary direction:
-            // two points one above the other say nothing of the turn about it.
-            let points = match (stage, shape, dirs.first()) {
-                (1, Shape::Plane { axis, .. }, Some(&p)) => {
-                    let along = V3::ith(p, 1.0).cross(&V3::ith(*axis, 1.0));
-                    let pos = |k: usize| hlip.points[k].position;
-                    let mut best: Option<(f64, [usize; 2])> = None;
-                    for (i, &a) in pts.iter().enumerate() {
-                        for &b in &pts[i + 1..] {
-                            let d = (pos(b) - pos(a)).dot(&along).abs();
-                            if best.is_none_or(|(x, _)| d > x + 1e-9) {
-                                best = Some((d, [a, b]));
-                            }
-                        }
-                    }
-                    match best {
-                        Some((d, pair)) if d > 1e-3 => Some(pair.to_vec()),
-                        _ => None,
-                    }
-                }
-                (_, Shape::Cylinder { axis, .. }, _) => round(pts, *axis, 1, n),
-                // A primary plane: the widest triangle of its points (the farthest ones
-                // may lie on one line, which fixes no plane).
-                (0, Shape::Plane { .. }, _) => {
-                    let pos: Vec<P3> = pts.iter().map(|&k| hlip.points[k].position).collect();
-                    widest_triangle(&pos).map(|t| t.iter().map(|&i| pts[i]).collect())
-                }
-                _ => spread(pts, n),
-            };
-            let Some(points) = points else {
+            let primary = free.dirs.first().copied();
+            let Some(points) = stage_points(hlip, stage, &c.shape, &c.points, fix.points, primary)
+            else {
                 continue;
             };
             used[ci] = true;
-            dirs.extend(dir);
-            for k in fixed {
-                origins[k] = true;
-                out.trans.push((AXES[k], shape.at(k)));
+            free.dirs.extend(fix.dir);
+            for k in fix.origins {
+                free.origins[k] = true;
+                out.trans.push((AXES[k], c.shape.at(k)));
             }
             out.steps.push(AlignStep {
-                group: *gi,
+                group: c.group,
                 orient: None,
-                block: Some(*bi),
+                block: Some(c.block),
                 points,
                 extra: None,
-                keywords,
+                keywords: fix.keywords,
             });
             break;
         }
     }
-    // A primary cylinder or a lone sphere when no plane qualifies.
-    if out.steps.is_empty() {
-        for (gi, bi, shape, pts) in cands.iter().map(|c| (c.2, c.3, &c.4, &c.5)) {
-            let (keywords, fixed): (Vec<String>, Vec<usize>) = match shape {
-                Shape::Cylinder { axis, positive, .. } => {
-                    let o: Vec<usize> = (0..3).filter(|k| k != axis).collect();
-                    let mut w = vec![dir_word(*axis, *positive)];
-                    w.extend(o.iter().map(|&k| orig_word(k)));
-                    (w, o)
-                }
-                Shape::Sphere { .. } => ((0..3).map(orig_word).collect(), (0..3).collect()),
-                Shape::Plane { .. } => continue,
-            };
-            // A circle takes 3 touches, a sphere 4: a block of fewer (one of a
-            // surface's split touches) aligns nothing.
-            let need = if matches!(shape, Shape::Sphere { .. }) {
-                4
-            } else {
-                3
-            };
-            if pts.len() < need {
-                continue;
-            }
-            let points = match shape {
-                // Its direction needs two circles.
-                Shape::Cylinder { axis, .. } => round(pts, *axis, 2, 3),
-                _ => spread(pts, 4.min(pts.len())),
-            };
-            let Some(points) = points else {
-                continue;
-            };
-            if let Shape::Cylinder { axis, .. } = shape {
-                dirs.push(*axis);
-            }
-            for k in fixed {
-                origins[k] = true;
-                out.trans.push((AXES[k], shape.at(k)));
-            }
-            out.steps.push(AlignStep {
-                group: gi,
-                orient: None,
-                block: Some(bi),
-                points,
-                extra: None,
-                keywords,
-            });
-            break;
-        }
-    }
-    let used_faces: Vec<FaceId> = out
-        .steps
-        .iter()
-        .filter_map(|st| {
-            let b = sp.groups.get(st.group)?.blocks.get(st.block?)?;
-            (b.contact == Contact::Part).then_some(b.face)
-        })
-        .collect();
-    let group = out.steps.first().map_or(0, |st| st.group);
-    let mut free = Free {
-        dirs: &mut dirs,
-        origins: &mut origins,
+}
+
+/// What a candidate of surface `shape` fixes at `stage`, given what `free` says is
+/// fixed; `None` where it fixes nothing there. `is_datum`: whether it is a datum
+/// feature's; `datum_bore(axis)`: whether a datum bore runs along part axis `axis`.
+fn stage_fix(
+    stage: usize,
+    shape: &Shape,
+    free: &Free,
+    is_datum: bool,
+    datum_bore: &dyn Fn(usize) -> bool,
+) -> Option<Fix> {
+    let dirs: &Vec<usize> = free.dirs;
+    let origins: &[bool; 3] = free.origins;
+    let free_origins = |skip: Option<usize>| -> Vec<usize> {
+        (0..3).filter(|&k| Some(k) != skip && !origins[k]).collect()
     };
-    complete(
-        input,
-        setup.up,
-        group,
-        &used_faces,
-        touch,
-        &mut out,
-        &mut free,
-    );
-    if dirs.is_empty() {
-        out.missing.push("the part's orientation".into());
-    } else if dirs.len() == 1 {
-        out.missing
-            .push(format!("the rotation about {}", AXES[dirs[0]]));
+    let plane = |axis: usize, positive: bool, points: usize| Fix {
+        keywords: vec![dir_word(axis, positive), orig_word(axis)],
+        points,
+        origins: vec![axis],
+        dir: Some(axis),
+    };
+    let centre = |o: Vec<usize>| Fix {
+        keywords: o.iter().map(|&k| orig_word(k)).collect(),
+        points: 4,
+        origins: o,
+        dir: None,
+    };
+    Some(match (stage, shape) {
+        (0, Shape::Plane { axis, positive, .. }) => plane(*axis, *positive, 3),
+        // A plane that is no datum gives only its direction where a datum
+        // bore along the primary will place the origins across it.
+        (1, Shape::Plane { axis, positive, .. })
+            if !dirs.contains(axis) && dirs.len() == 1 && !is_datum && datum_bore(dirs[0]) =>
+        {
+            Fix {
+                keywords: vec![dir_word(*axis, *positive)],
+                points: 2,
+                origins: vec![],
+                dir: Some(*axis),
+            }
+        }
+        (1, Shape::Plane { axis, positive, .. }) if !dirs.contains(axis) && dirs.len() == 1 => {
+            plane(*axis, *positive, 2)
+        }
+        (2, Shape::Plane { axis, .. }) if !origins[*axis] && dirs.len() == 2 => Fix {
+            keywords: vec![orig_word(*axis)],
+            points: 1,
+            origins: vec![*axis],
+            dir: None,
+        },
+        (1, Shape::Cylinder { axis, .. }) if *dirs == [*axis] => centre(free_origins(Some(*axis))),
+        // A bore along one of the directions places the origins left free
+        // across it (a plane and its edge, then a hole for the last one).
+        (2, Shape::Cylinder { axis, .. }) if dirs.contains(axis) => {
+            centre(free_origins(Some(*axis)))
+        }
+        (2, Shape::Sphere { .. }) => centre(free_origins(None)),
+        _ => return None,
+    })
+}
+
+/// The `n` points of `pts` a step at `stage` touches on a candidate of surface `shape`;
+/// `primary` is the direction fixed first. `None` when its points cannot show what it
+/// fixes.
+fn stage_points(
+    hlip: &Hlip,
+    stage: usize,
+    shape: &Shape,
+    pts: &[usize],
+    n: usize,
+    primary: Option<usize>,
+) -> Option<Vec<usize>> {
+    match (stage, shape, primary) {
+        (1, Shape::Plane { axis, .. }, Some(p)) => secondary_pair(hlip, pts, p, *axis),
+        (_, Shape::Cylinder { axis, .. }, _) => round(hlip, pts, *axis, 1, n),
+        // A primary plane: the widest triangle of its points (the farthest ones
+        // may lie on one line, which fixes no plane).
+        (0, Shape::Plane { .. }, _) => {
+            let pos: Vec<P3> = pts.iter().map(|&k| hlip.points[k].position).collect();
+            widest_triangle(&pos).map(|t| t.iter().map(|&i| pts[i]).collect())
+        }
+        _ => spread(hlip, pts, n),
     }
-    for k in 0..3 {
-        if !origins[k] {
-            out.missing.push(format!("the {} origin", AXES[k]));
+}
+
+/// A secondary plane's two points (of `pts`, square to part axis `axis`): the pair
+/// farthest apart along it, across the primary direction `primary` — two points one
+/// above the other say nothing of the turn about it. `None` when no pair is 1 µm apart
+/// that way.
+fn secondary_pair(hlip: &Hlip, pts: &[usize], primary: usize, axis: usize) -> Option<Vec<usize>> {
+    let along = V3::ith(primary, 1.0).cross(&V3::ith(axis, 1.0));
+    let pos = |k: usize| hlip.points[k].position;
+    let mut best: Option<(f64, [usize; 2])> = None;
+    for (i, &a) in pts.iter().enumerate() {
+        for &b in &pts[i + 1..] {
+            let d = (pos(b) - pos(a)).dot(&along).abs();
+            if best.is_none_or(|(x, _)| d > x + 1e-9) {
+                best = Some((d, [a, b]));
+            }
         }
     }
-    out
+    match best {
+        Some((d, pair)) if d > 1e-3 => Some(pair.to_vec()),
+        _ => None,
+    }
+}
+
+/// The step on a primary cylinder (its direction, from two circles, and the origins
+/// across it) or a lone sphere (the three origins) of the setup's blocks, for a setup
+/// where no plane qualifies.
+fn step_on_round(hlip: &Hlip, cands: &[Candidate], out: &mut Alignment, free: &mut Free) {
+    for c in cands {
+        let (shape, pts) = (&c.shape, &c.points);
+        let (keywords, fixed): (Vec<String>, Vec<usize>) = match shape {
+            Shape::Cylinder { axis, positive, .. } => {
+                let o: Vec<usize> = (0..3).filter(|k| k != axis).collect();
+                let mut w = vec![dir_word(*axis, *positive)];
+                w.extend(o.iter().map(|&k| orig_word(k)));
+                (w, o)
+            }
+            Shape::Sphere { .. } => ((0..3).map(orig_word).collect(), (0..3).collect()),
+            Shape::Plane { .. } => continue,
+        };
+        // A circle takes 3 touches, a sphere 4: a block of fewer (one of a
+        // surface's split touches) aligns nothing.
+        let need = if matches!(shape, Shape::Sphere { .. }) {
+            4
+        } else {
+            3
+        };
+        if pts.len() < need {
+            continue;
+        }
+        let points = match shape {
+            // Its direction needs two circles.
+            Shape::Cylinder { axis, .. } => round(hlip, pts, *axis, 2, 3),
+            _ => spread(hlip, pts, 4.min(pts.len())),
+        };
+        let Some(points) = points else {
+            continue;
+        };
+        if let Shape::Cylinder { axis, .. } = shape {
+            free.dirs.push(*axis);
+        }
+        for k in fixed {
+            free.origins[k] = true;
+            out.trans.push((AXES[k], shape.at(k)));
+        }
+        out.steps.push(AlignStep {
+            group: c.group,
+            orient: None,
+            block: Some(c.block),
+            points,
+            extra: None,
+            keywords,
+        });
+        break;
+    }
+}
+
+/// `n` of `pts`, each as far as it can be from those chosen before (positions seen
+/// through `view`: a bore's points are spread by their angle about its axis).
+fn spread_by(hlip: &Hlip, pts: &[usize], n: usize, view: &dyn Fn(&P3) -> P3) -> Option<Vec<usize>> {
+    if pts.len() < n {
+        return None;
+    }
+    let pos = |k: usize| view(&hlip.points[k].position);
+    let mut chosen = vec![pts[0]];
+    while chosen.len() < n {
+        let next = pts
+            .iter()
+            .filter(|k| !chosen.contains(k))
+            .max_by(|&&a, &&b| {
+                let d = |x: usize| {
+                    chosen
+                        .iter()
+                        .map(|&c| (pos(x) - pos(c)).norm())
+                        .fold(f64::INFINITY, f64::min)
+                };
+                d(a).total_cmp(&d(b)).then(b.cmp(&a))
+            })?;
+        chosen.push(*next);
+    }
+    Some(chosen)
+}
+
+/// `n` of `pts`, each as far as it can be from those chosen before.
+fn spread(hlip: &Hlip, pts: &[usize], n: usize) -> Option<Vec<usize>> {
+    spread_by(hlip, pts, n, &|p: &P3| *p)
+}
+
+/// A bore touched by hand: circles of `per_level` points at `levels` heights along
+/// its axis (most-touched heights first), each circle's points spread round it; the
+/// points of one height alone say nothing of the centre across them.
+fn round(
+    hlip: &Hlip,
+    pts: &[usize],
+    axis: usize,
+    levels: usize,
+    per_level: usize,
+) -> Option<Vec<usize>> {
+    let mut by_level: Vec<(i64, Vec<usize>)> = Vec::new();
+    for &k in pts {
+        let h = (hlip.points[k].position[axis] * 1e3).round() as i64;
+        match by_level.iter_mut().find(|(x, _)| *x == h) {
+            Some((_, v)) => v.push(k),
+            None => by_level.push((h, vec![k])),
+        }
+    }
+    by_level.sort_by(|a, b| b.1.len().cmp(&a.1.len()).then(a.0.cmp(&b.0)));
+    let flat = |p: &P3| {
+        let mut q = *p;
+        q[axis] = 0.0;
+        q
+    };
+    let mut out = Vec::new();
+    for (_, at) in by_level.iter().take(levels) {
+        out.extend(spread_by(hlip, at, per_level.min(at.len()).max(3), &flat)?);
+    }
+    (by_level.len() >= levels).then_some(out)
 }
 
 /// Per face, the points other setups than `setup` take on it.
