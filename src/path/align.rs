@@ -19,11 +19,13 @@
 
 use super::{BlockPath, Hlip, SetupPath};
 use crate::access::Contact;
-use crate::geometry::{FaceId, Surface, P3, V3};
+use crate::geometry::{FaceId, PartGeometry, Surface, P3, V3};
 use crate::graph::Node;
-use crate::model::FeatureId;
+use crate::model::{FeatureId, SampleMethod, Strategy};
 use crate::plan::Input;
-use std::collections::BTreeSet;
+use crate::sample::{Fpoint, Sampler};
+use std::cell::RefCell;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// A setup's alignment.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -719,81 +721,138 @@ fn complete(
     out: &mut Alignment,
     free: &mut Free,
 ) {
-    let g = input.geometry;
-    let part = &input.model.parts[input.plan.part.0];
-    let datum_features: Vec<FeatureId> = part.datums.iter().map(|d| d.feature).collect();
-    let left_free = LeftFree::of(input);
-    // Candidate planes: along a part axis, not facing the table, by area.
-    let mut planes: Vec<(FaceId, usize, bool, f64)> = g
-        .faces
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| !used.contains(&FaceId(*i)))
-        .filter_map(|(i, f)| match &f.surface {
-            Surface::Plane { normal, origin } if normal.dot(&up) > -1e-6 => {
-                axis_of(normal).map(|(k, pos)| (FaceId(i), k, pos, origin[k]))
-            }
-            _ => None,
-        })
-        .collect();
-    // Datum faces first, then faces no tolerance reads (a deviation of a toleranced
-    // face would move the frame the others are read in), each the largest first.
-    let datum_faces: Vec<FaceId> = datum_features
-        .iter()
-        .flat_map(|f| faces_in_graph(input, *f))
-        .collect();
-    let toleranced: Vec<FaceId> = part
-        .tolerances
-        .iter()
-        .flat_map(|t| t.targets.iter())
-        .flat_map(|f| faces_in_graph(input, *f))
-        .collect();
-    let rank = |f: FaceId| {
-        if datum_faces.contains(&f) {
-            0
-        } else if toleranced.contains(&f) {
-            2
-        } else {
-            1
-        }
-    };
-    planes.sort_by(|a, b| {
-        rank(a.0)
-            .cmp(&rank(b.0))
-            .then(g.faces[b.0 .0].area.total_cmp(&g.faces[a.0 .0].area))
-            .then(a.0.cmp(&b.0))
-    });
-    let largest_tip = touch.iter().map(|t| t.tip).fold(0.0, f64::max);
-    let sampler = crate::sample::Sampler::new(g, largest_tip + 1.0);
-    // The groups whose probe the operator may touch with: the first step's, then the
-    // setup's others in order (the writer selects each step's sensor).
-    let mut order: Vec<usize> = Vec::new();
-    for gi in std::iter::once(group).chain(0..touch.len()) {
-        let same = |o: &usize| {
-            touch[*o].probe == touch[gi].probe && (touch[*o].dir - touch[gi].dir).norm() < 1e-6
-        };
-        if gi < touch.len() && !order.iter().any(same) {
-            order.push(gi);
+    let hand = HandTouch::new(input, up, group, used, touch);
+    let mut taken: Vec<FaceId> = Vec::new();
+    if free.dirs.is_empty() {
+        hand_primary(&hand, up, out, free, &mut taken);
+    }
+    hand_secondary(&hand, out, free, &mut taken);
+    // Tertiaries: one touch for each origin still free, once the frame's directions
+    // are fixed.
+    if free.dirs.len() >= 2 {
+        hand_tertiaries(&hand, out, free, &mut taken);
+    }
+    for &gi in &hand.order {
+        if let Some((f, pts, keywords, trans)) =
+            sphere_origins(hand.g, &|f| hand.reachable(f, gi), free)
+        {
+            hand.push(out, gi, f, pts, keywords);
+            out.trans.extend(trans);
+            break;
         }
     }
-    let strategy = crate::model::Strategy {
-        method: crate::model::SampleMethod::Uniform,
-        points: Some(25),
-        inset: None,
-    };
-    // The points of a face group `gi`'s probe can touch: the face's samples (once a
-    // face), those the stylus does not stand behind, then those whose approach is clear
-    // — kept [`HAND_EDGE`] in from the face's edges where three such remain, since a
-    // joystick touch lands a few millimetres from where the controller shows it.
-    let inside = crate::sample::Sampler::new(g, largest_tip + HAND_EDGE);
-    let samples = std::cell::RefCell::new(std::collections::BTreeMap::new());
-    let reachable = |f: FaceId, gi: usize| -> Vec<(P3, V3)> {
-        let t = &touch[gi];
-        let mut samples = samples.borrow_mut();
-        let (near_middle, all) = samples
-            .entry(f)
-            .or_insert_with(|| (inside.sample(f, &strategy), sampler.sample(f, &strategy)));
-        let touchable = |pts: &[crate::sample::Fpoint]| -> Vec<(P3, V3)> {
+}
+
+/// What the operator can touch by hand on faces the setup does not measure: the
+/// candidate planes, the groups whose probes may touch them, and the points each
+/// probe reaches on a face.
+struct HandTouch<'a> {
+    g: &'a PartGeometry,
+    touch: &'a [Touchable<'a>],
+    left_free: LeftFree,
+    /// Planes along a part axis, not facing the table — (face, axis, facing along it,
+    /// its coordinate there) — datum faces first, then faces no tolerance reads, then
+    /// toleranced faces, each the largest first.
+    planes: Vec<(FaceId, usize, bool, f64)>,
+    datum_faces: Vec<FaceId>,
+    toleranced: Vec<FaceId>,
+    /// The groups whose probe the operator may touch with: the first step's, then the
+    /// setup's others in order (the writer selects each step's sensor).
+    order: Vec<usize>,
+    sampler: Sampler<'a>,
+    /// A sampler keeping [`HAND_EDGE`] in from the faces' edges.
+    inside: Sampler<'a>,
+    strategy: Strategy,
+    /// The samples of each face sampled so far.
+    samples: RefCell<BTreeMap<FaceId, FaceSamples>>,
+}
+
+/// A face's samples for hand touches: those in from its edges, and all of them.
+type FaceSamples = (Vec<Fpoint>, Vec<Fpoint>);
+
+impl<'a> HandTouch<'a> {
+    fn new(
+        input: &Input<'a>,
+        up: V3,
+        group: usize,
+        used: &[FaceId],
+        touch: &'a [Touchable<'a>],
+    ) -> HandTouch<'a> {
+        let g = input.geometry;
+        let part = &input.model.parts[input.plan.part.0];
+        let datum_features: Vec<FeatureId> = part.datums.iter().map(|d| d.feature).collect();
+        let left_free = LeftFree::of(input);
+        // Candidate planes: along a part axis, not facing the table, by area.
+        let mut planes: Vec<(FaceId, usize, bool, f64)> = g
+            .faces
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !used.contains(&FaceId(*i)))
+            .filter_map(|(i, f)| match &f.surface {
+                Surface::Plane { normal, origin } if normal.dot(&up) > -1e-6 => {
+                    axis_of(normal).map(|(k, pos)| (FaceId(i), k, pos, origin[k]))
+                }
+                _ => None,
+            })
+            .collect();
+        // Datum faces first, then faces no tolerance reads (a deviation of a toleranced
+        // face would move the frame the others are read in), each the largest first.
+        let datum_faces: Vec<FaceId> = datum_features
+            .iter()
+            .flat_map(|f| faces_in_graph(input, *f))
+            .collect();
+        let toleranced: Vec<FaceId> = part
+            .tolerances
+            .iter()
+            .flat_map(|t| t.targets.iter())
+            .flat_map(|f| faces_in_graph(input, *f))
+            .collect();
+        let rank = |f: FaceId| face_rank(&datum_faces, &toleranced, f);
+        planes.sort_by(|a, b| {
+            rank(a.0)
+                .cmp(&rank(b.0))
+                .then(g.faces[b.0 .0].area.total_cmp(&g.faces[a.0 .0].area))
+                .then(a.0.cmp(&b.0))
+        });
+        let largest_tip = touch.iter().map(|t| t.tip).fold(0.0, f64::max);
+        HandTouch {
+            g,
+            touch,
+            left_free,
+            planes,
+            datum_faces,
+            toleranced,
+            order: touch_order(touch, group),
+            sampler: Sampler::new(g, largest_tip + 1.0),
+            inside: Sampler::new(g, largest_tip + HAND_EDGE),
+            strategy: Strategy {
+                method: SampleMethod::Uniform,
+                points: Some(25),
+                inset: None,
+            },
+            samples: RefCell::new(BTreeMap::new()),
+        }
+    }
+
+    /// 0 for a datum face, 1 for a face no tolerance reads, 2 for a toleranced face.
+    fn rank(&self, f: FaceId) -> u8 {
+        face_rank(&self.datum_faces, &self.toleranced, f)
+    }
+
+    /// The points of face `f` group `gi`'s probe can touch: the face's samples (once a
+    /// face), those the stylus does not stand behind, then those whose approach is clear
+    /// — kept [`HAND_EDGE`] in from the face's edges where three such remain, since a
+    /// joystick touch lands a few millimetres from where the controller shows it.
+    fn reachable(&self, f: FaceId, gi: usize) -> Vec<(P3, V3)> {
+        let t = &self.touch[gi];
+        let mut samples = self.samples.borrow_mut();
+        let (near_middle, all) = samples.entry(f).or_insert_with(|| {
+            (
+                self.inside.sample(f, &self.strategy),
+                self.sampler.sample(f, &self.strategy),
+            )
+        });
+        let touchable = |pts: &[Fpoint]| -> Vec<(P3, V3)> {
             pts.iter()
                 .filter(|p| p.normal.dot(&t.dir) > BEHIND)
                 .filter(|p| (t.clear)(&p.tip_centre(t.tip), &p.normal))
@@ -806,88 +865,121 @@ fn complete(
         } else {
             touchable(all)
         }
-    };
-    let push = |out: &mut Alignment,
-                gi: usize,
-                face: FaceId,
-                touches: Vec<(P3, V3)>,
-                keywords: Vec<String>| {
+    }
+
+    /// Adds the step of touches `touches` on `face` with group `gi`'s probe.
+    fn push(
+        &self,
+        out: &mut Alignment,
+        gi: usize,
+        face: FaceId,
+        touches: Vec<(P3, V3)>,
+        keywords: Vec<String>,
+    ) {
         out.steps.push(AlignStep {
-            group: touch[gi].group,
-            orient: touch[gi].orient,
+            group: self.touch[gi].group,
+            orient: self.touch[gi].orient,
             block: None,
             points: Vec::new(),
             extra: Some(ExtraFace { face, touches }),
             keywords,
         });
-    };
-    let mut taken: Vec<FaceId> = Vec::new();
-    // A primary: the plane facing most nearly up (a setup on a sine plate has no face
-    // straight up), the largest first among equals.
-    if free.dirs.is_empty() {
-        let facing = |k: usize, pos: bool| if pos { up[k] } else { -up[k] };
-        let mut primaries: Vec<_> = planes.clone();
-        primaries.sort_by(|a, b| {
-            let (fa, fb) = (facing(a.1, a.2), facing(b.1, b.2));
-            (fb * 1e3).round().total_cmp(&(fa * 1e3).round())
-        });
-        'primary: for &gi in &order {
-            for &(f, k, pos, at) in &primaries {
-                if !left_free.may_fix(f, &Fixes::primary(k)) {
-                    continue;
-                }
-                let pts = reachable(f, gi);
-                let Some(chosen) = farthest(&pts, 3) else {
-                    continue;
-                };
-                if !spans_plane(&chosen) {
-                    continue;
-                }
-                push(out, gi, f, chosen, vec![dir_word(k, pos), orig_word(k)]);
-                free.dirs.push(k);
-                free.origins[k] = true;
-                out.trans.push((AXES[k], at));
-                taken.push(f);
-                break 'primary;
-            }
+    }
+}
+
+/// A face's rank among faces touched by hand: 0 for a datum face, 1 for a face no
+/// tolerance reads, 2 for a toleranced face.
+fn face_rank(datum_faces: &[FaceId], toleranced: &[FaceId], f: FaceId) -> u8 {
+    if datum_faces.contains(&f) {
+        0
+    } else if toleranced.contains(&f) {
+        2
+    } else {
+        1
+    }
+}
+
+/// The touchables (indices into `touch`) the operator may touch with, one per probe and
+/// direction: group `group`'s first, then the others in order.
+fn touch_order(touch: &[Touchable], group: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = Vec::new();
+    for gi in std::iter::once(group).chain(0..touch.len()) {
+        let same = |o: &usize| {
+            touch[*o].probe == touch[gi].probe && (touch[*o].dir - touch[gi].dir).norm() < 1e-6
+        };
+        if gi < touch.len() && !order.iter().any(same) {
+            order.push(gi);
         }
     }
-    // A secondary: a plane across the primary, two touches along it — first only
-    // lines long enough for the part (`long_line`) on faces no tolerance reads (a
-    // toleranced face moved within its zone would carry the frame and its moves with
-    // it), then any of 5 mm or more in the usual order.
-    let long = long_line(g);
+    order
+}
+
+/// A primary touched by hand: the plane facing most nearly up (a setup on a sine plate
+/// has no face straight up), the largest first among equals, 3 touches spanning it.
+fn hand_primary(
+    hand: &HandTouch,
+    up: V3,
+    out: &mut Alignment,
+    free: &mut Free,
+    taken: &mut Vec<FaceId>,
+) {
+    let facing = |k: usize, pos: bool| if pos { up[k] } else { -up[k] };
+    let mut primaries: Vec<_> = hand.planes.clone();
+    primaries.sort_by(|a, b| {
+        let (fa, fb) = (facing(a.1, a.2), facing(b.1, b.2));
+        (fb * 1e3).round().total_cmp(&(fa * 1e3).round())
+    });
+    for &gi in &hand.order {
+        for &(f, k, pos, at) in &primaries {
+            if !hand.left_free.may_fix(f, &Fixes::primary(k)) {
+                continue;
+            }
+            let pts = hand.reachable(f, gi);
+            let Some(chosen) = farthest(&pts, 3) else {
+                continue;
+            };
+            if !spans_plane(&chosen) {
+                continue;
+            }
+            hand.push(out, gi, f, chosen, vec![dir_word(k, pos), orig_word(k)]);
+            free.dirs.push(k);
+            free.origins[k] = true;
+            out.trans.push((AXES[k], at));
+            taken.push(f);
+            return;
+        }
+    }
+}
+
+/// A secondary touched by hand: a plane across the primary, two touches along it —
+/// first only lines long enough for the part ([`long_line`]) on faces no tolerance
+/// reads (a toleranced face moved within its zone would carry the frame and its moves
+/// with it), then any of [`SHORTEST_LINE`] or more in the usual order.
+fn hand_secondary(hand: &HandTouch, out: &mut Alignment, free: &mut Free, taken: &mut Vec<FaceId>) {
+    let long = long_line(hand.g);
     for (least, toleranced) in [(long, false), (SHORTEST_LINE, true)] {
         if free.dirs.len() != 1 {
             break;
         }
         let p = free.dirs[0];
-        let tries = order
+        let tries = hand
+            .order
             .iter()
-            .flat_map(|&gi| planes.iter().map(move |pl| (gi, pl)));
+            .flat_map(|&gi| hand.planes.iter().map(move |pl| (gi, pl)));
         for (gi, &(f, k, pos, at)) in tries {
-            if k == p || taken.contains(&f) || (!toleranced && rank(f) == 2) {
+            if k == p || taken.contains(&f) || (!toleranced && hand.rank(f) == 2) {
                 continue;
             }
             let fixes = Fixes {
                 turns: vec![p],
                 moves: if free.origins[k] { vec![] } else { vec![k] },
             };
-            if !left_free.may_fix(f, &fixes) {
+            if !hand.left_free.may_fix(f, &fixes) {
                 continue;
             }
             let along = V3::ith(p, 1.0).cross(&V3::ith(k, 1.0));
-            let pts = reachable(f, gi);
-            let mut best: Option<(f64, [usize; 2])> = None;
-            for i in 0..pts.len() {
-                for j in i + 1..pts.len() {
-                    let d = (pts[j].0 - pts[i].0).dot(&along).abs();
-                    if best.is_none_or(|(x, _)| d > x + 1e-9) {
-                        best = Some((d, [i, j]));
-                    }
-                }
-            }
-            let Some((_, [i, j])) = best.filter(|b| b.0 >= least) else {
+            let pts = hand.reachable(f, gi);
+            let Some((_, [i, j])) = longest_pair(&pts, &along).filter(|b| b.0 >= least) else {
                 continue;
             };
             let mut keywords = vec![dir_word(k, pos)];
@@ -896,50 +988,64 @@ fn complete(
                 free.origins[k] = true;
                 out.trans.push((AXES[k], at));
             }
-            push(out, gi, f, vec![pts[i], pts[j]], keywords);
+            hand.push(out, gi, f, vec![pts[i], pts[j]], keywords);
             free.dirs.push(k);
             taken.push(f);
             break;
         }
     }
-    // Tertiaries: one touch for each origin still free, once the frame's directions
-    // are fixed.
-    if free.dirs.len() >= 2 {
-        for (k, axis) in AXES.iter().enumerate() {
-            if free.origins[k] {
-                continue;
-            }
-            let tries = order
-                .iter()
-                .flat_map(|&gi| planes.iter().map(move |pl| (gi, pl)));
-            for (gi, &(f, kk, _, at)) in tries {
-                let fixes = Fixes {
-                    turns: vec![],
-                    moves: vec![k],
-                };
-                if kk != k || taken.contains(&f) || !left_free.may_fix(f, &fixes) {
-                    continue;
-                }
-                let pts = reachable(f, gi);
-                let c = g.faces[f.0].centroid;
-                let Some(&p) = pts
-                    .iter()
-                    .min_by(|a, b| (a.0 - c).norm().total_cmp(&(b.0 - c).norm()))
-                else {
-                    continue;
-                };
-                push(out, gi, f, vec![p], vec![orig_word(k)]);
-                free.origins[k] = true;
-                out.trans.push((*axis, at));
-                taken.push(f);
-                break;
+}
+
+/// The two of `pts` (indices) farthest apart along `along`, and how far.
+fn longest_pair(pts: &[(P3, V3)], along: &V3) -> Option<(f64, [usize; 2])> {
+    let mut best: Option<(f64, [usize; 2])> = None;
+    for i in 0..pts.len() {
+        for j in i + 1..pts.len() {
+            let d = (pts[j].0 - pts[i].0).dot(along).abs();
+            if best.is_none_or(|(x, _)| d > x + 1e-9) {
+                best = Some((d, [i, j]));
             }
         }
     }
-    for &gi in &order {
-        if let Some((f, pts, keywords, trans)) = sphere_origins(g, &|f| reachable(f, gi), free) {
-            push(out, gi, f, pts, keywords);
-            out.trans.extend(trans);
+    best
+}
+
+/// Tertiaries touched by hand: for each origin still free, one touch near the middle of
+/// a plane square to it.
+fn hand_tertiaries(
+    hand: &HandTouch,
+    out: &mut Alignment,
+    free: &mut Free,
+    taken: &mut Vec<FaceId>,
+) {
+    for (k, axis) in AXES.iter().enumerate() {
+        if free.origins[k] {
+            continue;
+        }
+        let tries = hand
+            .order
+            .iter()
+            .flat_map(|&gi| hand.planes.iter().map(move |pl| (gi, pl)));
+        for (gi, &(f, kk, _, at)) in tries {
+            let fixes = Fixes {
+                turns: vec![],
+                moves: vec![k],
+            };
+            if kk != k || taken.contains(&f) || !hand.left_free.may_fix(f, &fixes) {
+                continue;
+            }
+            let pts = hand.reachable(f, gi);
+            let c = hand.g.faces[f.0].centroid;
+            let Some(&p) = pts
+                .iter()
+                .min_by(|a, b| (a.0 - c).norm().total_cmp(&(b.0 - c).norm()))
+            else {
+                continue;
+            };
+            hand.push(out, gi, f, vec![p], vec![orig_word(k)]);
+            free.origins[k] = true;
+            out.trans.push((*axis, at));
+            taken.push(f);
             break;
         }
     }
