@@ -20,6 +20,7 @@
 //! enhancement nodes come from a fixed seed, and ties go to the lower index.
 
 pub mod align;
+mod align_extra;
 mod errors;
 mod join;
 mod linearise;
