@@ -336,23 +336,56 @@ fn face_mesh(face: &Face, edges: &[Vec<P3>], res: Resolution) -> Result<Vec<[P3;
     }
     let sense = if face.same_sense { 1.0 } else { -1.0 };
     let polygons = close_loops(s, loops, periods, sense, res)?;
-
-    // One scale for the whole face, taken at the mean of its bound points. Along a
-    // ruled surface's straight lines (a cylinder's or cone's v) a triangle may be longer:
-    // the plane is squeezed along v so that Delaunay triangles come out long and thin.
-    let m = mean(&polygons.concat());
-    let (su, mut sv) = s.scale(m[0], m[1]);
-    if matches!(s, Surf::Cylinder(..) | Surf::Cone(..)) {
-        sv /= RULED_STRETCH;
+    let scale = ParamScale::of(s, &polygons);
+    let mut cdt = bounds_triangulation(&polygons, &scale)?;
+    if !matches!(s, Surf::Plane(_)) {
+        refine(&mut cdt, s, &scale, res)?;
     }
-    let scaled = |uv: [f64; 2]| [uv[0] * su, uv[1] * sv];
-    let unscale = |q: [f64; 2]| [q[0] / su, q[1] / sv];
+    inside_triangles(&cdt, sense)
+}
 
-    let mut cdt: ConstrainedDelaunayTriangulation<Vert> = ConstrainedDelaunayTriangulation::new();
-    for poly in &polygons {
+/// The triangulation of a face's parameter plane.
+type Cdt = ConstrainedDelaunayTriangulation<Vert>;
+
+/// One scale from a face's parameters to the plane it is triangulated in, taken at the
+/// mean of its bound points. Along a ruled surface's straight lines (a cylinder's or
+/// cone's v) a triangle may be longer: the plane is squeezed along v so that Delaunay
+/// triangles come out long and thin.
+struct ParamScale {
+    su: f64,
+    sv: f64,
+}
+
+impl ParamScale {
+    fn of(s: &Surf, polygons: &[Vec<Pt>]) -> ParamScale {
+        let m = mean(&polygons.concat());
+        let (su, mut sv) = s.scale(m[0], m[1]);
+        if matches!(s, Surf::Cylinder(..) | Surf::Cone(..)) {
+            sv /= RULED_STRETCH;
+        }
+        ParamScale { su, sv }
+    }
+
+    /// Parameters to the plane.
+    fn scaled(&self, uv: [f64; 2]) -> [f64; 2] {
+        [uv[0] * self.su, uv[1] * self.sv]
+    }
+
+    /// The plane to parameters.
+    fn unscale(&self, q: [f64; 2]) -> [f64; 2] {
+        [q[0] / self.su, q[1] / self.sv]
+    }
+}
+
+/// The constrained Delaunay triangulation of a face's bounds (`polygons`) in its
+/// scaled parameter plane, every bound segment a constraint; an error when a point
+/// cannot be inserted or bounds cross.
+fn bounds_triangulation(polygons: &[Vec<Pt>], scale: &ParamScale) -> Result<Cdt, String> {
+    let mut cdt: Cdt = ConstrainedDelaunayTriangulation::new();
+    for poly in polygons {
         let mut handles = Vec::new();
         for p in poly {
-            let q = scaled(p.uv);
+            let q = scale.scaled(p.uv);
             let h = cdt
                 .insert(Vert {
                     pos: Point2::new(q[0], q[1]),
@@ -377,118 +410,148 @@ fn face_mesh(face: &Face, edges: &[Vec<P3>], res: Resolution) -> Result<Vec<[P3;
             }
         }
     }
+    Ok(cdt)
+}
 
-    let eval = |q: [f64; 2]| {
-        let uv = unscale(q);
-        s.eval(uv[0], uv[1])
-    };
+/// Refines a curved face: round by round, adds a point in every triangle that strays
+/// from the surface or turns too much ([`refinement_points`]), until none does, after
+/// 24 rounds, or with an error past 200,000 points.
+fn refine(cdt: &mut Cdt, s: &Surf, scale: &ParamScale, res: Resolution) -> Result<(), String> {
+    let mut budget = 200_000usize;
+    // Triangles (by their corners) already found close enough: a later round
+    // leaves most of them as they are.
+    let mut good: std::collections::HashSet<[usize; 3]> = std::collections::HashSet::new();
+    for _round in 0..24 {
+        let add = refinement_points(cdt, s, scale, res, &mut good);
+        if add.is_empty() {
+            break;
+        }
+        if add.len() > budget {
+            return Err(format!(
+                "it needs more than {} points inside to meet the chord tolerance",
+                200_000
+            ));
+        }
+        budget -= add.len();
+        for c in add {
+            let uv = scale.unscale(c);
+            let xyz = s.eval(uv[0], uv[1]);
+            cdt.insert(Vert {
+                pos: Point2::new(c[0], c[1]),
+                xyz,
+            })
+            .map_err(|e| format!("an inner point cannot be triangulated ({e:?})"))?;
+        }
+    }
+    Ok(())
+}
 
-    // Refine curved faces: add the centroid of every triangle that strays from the
-    // surface or turns too much.
-    if !matches!(s, Surf::Plane(_)) {
-        let mut budget = 200_000usize;
-        // Triangles (by their corners) already found close enough: a later round
-        // leaves most of them as they are.
-        let mut good: std::collections::HashSet<[usize; 3]> = std::collections::HashSet::new();
-        for _round in 0..24 {
-            let mut add = Vec::new();
-            let inside = inside_faces(&cdt);
-            for f in cdt.inner_faces() {
-                if !inside[f.fix().index()] {
-                    continue;
+/// One round's points to add: in each triangle inside the bounds, not yet found `good`,
+/// that strays ([`strays`]), the middle of its longest edge where that is not a bound
+/// (a Delaunay refinement keeps triangles well shaped), else its centroid. Triangles
+/// close enough join `good`.
+fn refinement_points(
+    cdt: &Cdt,
+    s: &Surf,
+    scale: &ParamScale,
+    res: Resolution,
+    good: &mut std::collections::HashSet<[usize; 3]>,
+) -> Vec<[f64; 2]> {
+    let mut add = Vec::new();
+    let inside = inside_faces(cdt);
+    for f in cdt.inner_faces() {
+        if !inside[f.fix().index()] {
+            continue;
+        }
+        let mut key = f.vertices().map(|v| v.fix().index());
+        key.sort_unstable();
+        if good.contains(&key) {
+            continue;
+        }
+        let vs = f.vertices();
+        let q = vs.map(|v| [v.position().x, v.position().y]);
+        let c = [
+            (q[0][0] + q[1][0] + q[2][0]) / 3.0,
+            (q[0][1] + q[1][1] + q[2][1]) / 3.0,
+        ];
+        let x = vs.map(|v| v.data().xyz);
+        if (x[1] - x[0]).cross(&(x[2] - x[0])).norm() < 1e-12 {
+            // Two corners on one pole: nothing to refine.
+            continue;
+        }
+        if !strays(s, scale, res, (q, c), x) {
+            good.insert(key);
+        } else {
+            let es = f.adjacent_edges();
+            let longest = es
+                .iter()
+                .max_by(|a, b| a.length_2().total_cmp(&b.length_2()))
+                .filter(|e| !e.is_constraint_edge());
+            match longest {
+                Some(e) => {
+                    let [a, b] = e.positions();
+                    add.push([(a.x + b.x) / 2.0, (a.y + b.y) / 2.0]);
                 }
-                let mut key = f.vertices().map(|v| v.fix().index());
-                key.sort_unstable();
-                if good.contains(&key) {
-                    continue;
-                }
-                let vs = f.vertices();
-                let q = vs.map(|v| [v.position().x, v.position().y]);
-                let c = [
-                    (q[0][0] + q[1][0] + q[2][0]) / 3.0,
-                    (q[0][1] + q[1][1] + q[2][1]) / 3.0,
-                ];
-                let x = vs.map(|v| v.data().xyz);
-                if (x[1] - x[0]).cross(&(x[2] - x[0])).norm() < 1e-12 {
-                    // Two corners on one pole: nothing to refine.
-                    continue;
-                }
-                // The chord error: how far the flat triangle's centroid and edge
-                // midpoints lie from the surface.
-                let off = |flat: P3, at: [f64; 2]| {
-                    let uv = unscale(at);
-                    s.distance(&flat, (uv[0], uv[1]))
-                };
-                let flat = P3::from((x[0].coords + x[1].coords + x[2].coords) / 3.0);
-                let mut far = off(flat, c) > res.chord_mm;
-                if !far {
-                    for k in 0..3 {
-                        let m = [
-                            (q[k][0] + q[(k + 1) % 3][0]) / 2.0,
-                            (q[k][1] + q[(k + 1) % 3][1]) / 2.0,
-                        ];
-                        let mid = P3::from((x[k].coords + x[(k + 1) % 3].coords) / 2.0);
-                        if off(mid, m) > res.chord_mm {
-                            far = true;
-                            break;
-                        }
-                    }
-                }
-                if !far {
-                    let n: Vec<Option<V3>> = (0..3)
-                        .map(|k| {
-                            let uv = unscale(q[k]);
-                            s.normal(&x[k], uv[0], uv[1])
-                        })
-                        .collect();
-                    if let (Some(a), Some(b), Some(c2)) = (n[0], n[1], n[2]) {
-                        far = a.angle(&b) > res.angle_rad
-                            || b.angle(&c2) > res.angle_rad
-                            || a.angle(&c2) > res.angle_rad;
-                    }
-                }
-                if !far {
-                    good.insert(key);
-                } else {
-                    // Split the longest edge where it is not a bound (a Delaunay
-                    // refinement keeps triangles well shaped); else add the centroid.
-                    let es = f.adjacent_edges();
-                    let longest = es
-                        .iter()
-                        .max_by(|a, b| a.length_2().total_cmp(&b.length_2()))
-                        .filter(|e| !e.is_constraint_edge());
-                    match longest {
-                        Some(e) => {
-                            let [a, b] = e.positions();
-                            add.push([(a.x + b.x) / 2.0, (a.y + b.y) / 2.0]);
-                        }
-                        None => add.push(c),
-                    }
-                }
-            }
-            if add.is_empty() {
-                break;
-            }
-            if add.len() > budget {
-                return Err(format!(
-                    "it needs more than {} points inside to meet the chord tolerance",
-                    200_000
-                ));
-            }
-            budget -= add.len();
-            for c in add {
-                let xyz = eval(c);
-                cdt.insert(Vert {
-                    pos: Point2::new(c[0], c[1]),
-                    xyz,
-                })
-                .map_err(|e| format!("an inner point cannot be triangulated ({e:?})"))?;
+                None => add.push(c),
             }
         }
     }
+    add
+}
 
+/// Whether a triangle (corners `q` in the scaled plane, centroid `c` there, points `x`)
+/// strays from the surface: its centroid or an edge's midpoint farther from it than the
+/// chord tolerance, or the surface's normal turning across it by more than the angle
+/// limit.
+fn strays(
+    s: &Surf,
+    scale: &ParamScale,
+    res: Resolution,
+    (q, c): ([[f64; 2]; 3], [f64; 2]),
+    x: [P3; 3],
+) -> bool {
+    // The chord error: how far the flat triangle's centroid and edge
+    // midpoints lie from the surface.
+    let off = |flat: P3, at: [f64; 2]| {
+        let uv = scale.unscale(at);
+        s.distance(&flat, (uv[0], uv[1]))
+    };
+    let flat = P3::from((x[0].coords + x[1].coords + x[2].coords) / 3.0);
+    let mut far = off(flat, c) > res.chord_mm;
+    if !far {
+        for k in 0..3 {
+            let m = [
+                (q[k][0] + q[(k + 1) % 3][0]) / 2.0,
+                (q[k][1] + q[(k + 1) % 3][1]) / 2.0,
+            ];
+            let mid = P3::from((x[k].coords + x[(k + 1) % 3].coords) / 2.0);
+            if off(mid, m) > res.chord_mm {
+                far = true;
+                break;
+            }
+        }
+    }
+    if !far {
+        let n: Vec<Option<V3>> = (0..3)
+            .map(|k| {
+                let uv = scale.unscale(q[k]);
+                s.normal(&x[k], uv[0], uv[1])
+            })
+            .collect();
+        if let (Some(a), Some(b), Some(c2)) = (n[0], n[1], n[2]) {
+            far = a.angle(&b) > res.angle_rad
+                || b.angle(&c2) > res.angle_rad
+                || a.angle(&c2) > res.angle_rad;
+        }
+    }
+    far
+}
+
+/// The triangles inside the bounds, counter-clockwise from outside: along the natural
+/// normal where `sense` is positive; an error when none lies inside.
+fn inside_triangles(cdt: &Cdt, sense: f64) -> Result<Vec<[P3; 3]>, String> {
     let mut out = Vec::new();
-    let inside = inside_faces(&cdt);
+    let inside = inside_faces(cdt);
     for f in cdt.inner_faces() {
         if !inside[f.fix().index()] {
             continue;
