@@ -802,120 +802,8 @@ fn close_loops(
     let mut polygons: Vec<Vec<Pt>> = Vec::new();
     match round.len() {
         0 => {}
-        1 => {
-            let l = &round[0];
-            if l.wraps[1] != 0 || l.wraps[0].abs() != 1 {
-                return Err("a bound goes round the surface in a way inspc cannot close".into());
-            }
-            let dir = l.wraps[0] as f64;
-            // The face lies left of its bounds seen from its normal: toward +v when the
-            // loop runs toward +u along the natural normal.
-            let toward = dir * sense;
-            let pole = s
-                .poles()
-                .into_iter()
-                .filter(|p| (p - l.pts[0].uv[1]) * toward > 0.0)
-                .min_by(|a, b| {
-                    (a - l.pts[0].uv[1])
-                        .abs()
-                        .total_cmp(&(b - l.pts[0].uv[1]).abs())
-                })
-                .ok_or(
-                    "a single bound goes round the surface and there is no pole to close it at",
-                )?;
-            let mut poly = l.pts.clone();
-            let first = poly[0];
-            let per = periods[0].unwrap_or(TAU);
-            let end_u = first.uv[0] + dir * per;
-            let xyz_pole = s.eval(first.uv[0], pole);
-            poly.push(Pt {
-                uv: [end_u, first.uv[1]],
-                xyz: first.xyz,
-            });
-            poly.push(Pt {
-                uv: [end_u, pole],
-                xyz: xyz_pole,
-            });
-            along_pole(&mut poly, end_u, first.uv[0], pole, xyz_pole);
-            poly.push(Pt {
-                uv: [first.uv[0], pole],
-                xyz: xyz_pole,
-            });
-            polygons.push(poly);
-        }
-        2 => {
-            let k = if round[0].wraps[0] != 0 { 0 } else { 1 };
-            let per = periods[k].unwrap_or(TAU);
-            if round
-                .iter()
-                .any(|l| l.wraps[k].abs() != 1 || l.wraps[1 - k] != 0)
-            {
-                return Err("two bounds go round the surface in different ways".into());
-            }
-            // Both loops made to run toward +k; the band is A forward, then B backward.
-            let forward = |l: &Loop| {
-                let mut p = l.pts.clone();
-                if l.wraps[k] < 0 {
-                    p.reverse();
-                }
-                p
-            };
-            let a = forward(&round[0]);
-            let mut b = forward(&round[1]);
-            // B starts where it is nearest A's start, shifted into A's period.
-            let a0 = a[0].uv[k];
-            let (start, _) = b
-                .iter()
-                .enumerate()
-                .map(|(i, p)| {
-                    let d = unwrap_near(p.uv[k], a0, per) - a0;
-                    (i, d.abs())
-                })
-                .min_by(|x, y| x.1.total_cmp(&y.1))
-                .unwrap_or((0, 0.0));
-            b.rotate_left(start);
-            let mut b2 = Vec::with_capacity(b.len());
-            let mut prev = a0;
-            for p in &b {
-                let mut q = *p;
-                q.uv[k] = unwrap_near(q.uv[k], prev, per);
-                prev = q.uv[k];
-                b2.push(q);
-            }
-            // A: a[0] .. a[n-1], then a[0] again one period on; B likewise, walked back.
-            // The cut from A's start to B's start is a curve on the surface (a
-            // meridian of a torus, a profile of a revolved B-spline): it is cut into
-            // segments like an edge, the same on both of its sides.
-            let (from, to) = (a[0], b2[0]);
-            let mut ts = vec![0.0];
-            let at = |t: f64| {
-                s.eval(
-                    from.uv[0] + (to.uv[0] - from.uv[0]) * t,
-                    from.uv[1] + (to.uv[1] - from.uv[1]) * t,
-                )
-            };
-            refine_curve(&at, 0.0, 1.0, res, 0, &mut ts);
-            let cut = |shift: f64, t: f64| {
-                let mut uv = [
-                    from.uv[0] + (to.uv[0] - from.uv[0]) * t,
-                    from.uv[1] + (to.uv[1] - from.uv[1]) * t,
-                ];
-                uv[k] += shift;
-                Pt { uv, xyz: at(t) }
-            };
-            let inner = &ts[1..ts.len() - 1];
-            let mut poly = a.clone();
-            let mut a_end = a[0];
-            a_end.uv[k] += per;
-            poly.push(a_end);
-            poly.extend(inner.iter().map(|&t| cut(per, t)));
-            let mut b_end = b2[0];
-            b_end.uv[k] += per;
-            poly.push(b_end);
-            poly.extend(b2.iter().rev().copied());
-            poly.extend(inner.iter().rev().map(|&t| cut(0.0, t)));
-            polygons.push(poly);
-        }
+        1 => polygons.push(closed_at_pole(s, &round[0], periods, sense)?),
+        2 => polygons.push(band(s, &round, periods, res)?),
         _ => return Err(format!("{} bounds go round the surface", round.len())),
     }
     // Ordinary loops: shift each next to the first polygon (or the first of them).
@@ -943,6 +831,135 @@ fn close_loops(
         );
     }
     Ok(polygons)
+}
+
+/// The polygon of a face bounded by one loop `l` that goes once round in u (a
+/// spherical cap, a cone to its apex): the loop, then along the pole on the face's side
+/// back to its start.
+fn closed_at_pole(
+    s: &Surf,
+    l: &Loop,
+    periods: [Option<f64>; 2],
+    sense: f64,
+) -> Result<Vec<Pt>, String> {
+    if l.wraps[1] != 0 || l.wraps[0].abs() != 1 {
+        return Err("a bound goes round the surface in a way inspc cannot close".into());
+    }
+    let dir = l.wraps[0] as f64;
+    // The face lies left of its bounds seen from its normal: toward +v when the
+    // loop runs toward +u along the natural normal.
+    let toward = dir * sense;
+    let pole = s
+        .poles()
+        .into_iter()
+        .filter(|p| (p - l.pts[0].uv[1]) * toward > 0.0)
+        .min_by(|a, b| {
+            (a - l.pts[0].uv[1])
+                .abs()
+                .total_cmp(&(b - l.pts[0].uv[1]).abs())
+        })
+        .ok_or("a single bound goes round the surface and there is no pole to close it at")?;
+    let mut poly = l.pts.clone();
+    let first = poly[0];
+    let per = periods[0].unwrap_or(TAU);
+    let end_u = first.uv[0] + dir * per;
+    let xyz_pole = s.eval(first.uv[0], pole);
+    poly.push(Pt {
+        uv: [end_u, first.uv[1]],
+        xyz: first.xyz,
+    });
+    poly.push(Pt {
+        uv: [end_u, pole],
+        xyz: xyz_pole,
+    });
+    along_pole(&mut poly, end_u, first.uv[0], pole, xyz_pole);
+    poly.push(Pt {
+        uv: [first.uv[0], pole],
+        xyz: xyz_pole,
+    });
+    Ok(poly)
+}
+
+/// The polygon of a band bounded by two loops (`round`) that each go once round (a
+/// band of a bore with no seam edge): cut open along a curve between them, one loop
+/// forward, the cut, the other loop backward, the cut back.
+fn band(
+    s: &Surf,
+    round: &[Loop],
+    periods: [Option<f64>; 2],
+    res: Resolution,
+) -> Result<Vec<Pt>, String> {
+    let k = if round[0].wraps[0] != 0 { 0 } else { 1 };
+    let per = periods[k].unwrap_or(TAU);
+    if round
+        .iter()
+        .any(|l| l.wraps[k].abs() != 1 || l.wraps[1 - k] != 0)
+    {
+        return Err("two bounds go round the surface in different ways".into());
+    }
+    // Both loops made to run toward +k; the band is A forward, then B backward.
+    let forward = |l: &Loop| {
+        let mut p = l.pts.clone();
+        if l.wraps[k] < 0 {
+            p.reverse();
+        }
+        p
+    };
+    let a = forward(&round[0]);
+    let mut b = forward(&round[1]);
+    // B starts where it is nearest A's start, shifted into A's period.
+    let a0 = a[0].uv[k];
+    let (start, _) = b
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let d = unwrap_near(p.uv[k], a0, per) - a0;
+            (i, d.abs())
+        })
+        .min_by(|x, y| x.1.total_cmp(&y.1))
+        .unwrap_or((0, 0.0));
+    b.rotate_left(start);
+    let mut b2 = Vec::with_capacity(b.len());
+    let mut prev = a0;
+    for p in &b {
+        let mut q = *p;
+        q.uv[k] = unwrap_near(q.uv[k], prev, per);
+        prev = q.uv[k];
+        b2.push(q);
+    }
+    // A: a[0] .. a[n-1], then a[0] again one period on; B likewise, walked back.
+    // The cut from A's start to B's start is a curve on the surface (a
+    // meridian of a torus, a profile of a revolved B-spline): it is cut into
+    // segments like an edge, the same on both of its sides.
+    let (from, to) = (a[0], b2[0]);
+    let mut ts = vec![0.0];
+    let at = |t: f64| {
+        s.eval(
+            from.uv[0] + (to.uv[0] - from.uv[0]) * t,
+            from.uv[1] + (to.uv[1] - from.uv[1]) * t,
+        )
+    };
+    refine_curve(&at, 0.0, 1.0, res, 0, &mut ts);
+    let cut = |shift: f64, t: f64| {
+        let mut uv = [
+            from.uv[0] + (to.uv[0] - from.uv[0]) * t,
+            from.uv[1] + (to.uv[1] - from.uv[1]) * t,
+        ];
+        uv[k] += shift;
+        Pt { uv, xyz: at(t) }
+    };
+    let inner = &ts[1..ts.len() - 1];
+    let mut poly = a.clone();
+    let mut a_end = a[0];
+    a_end.uv[k] += per;
+    poly.push(a_end);
+    poly.extend(inner.iter().map(|&t| cut(per, t)));
+    let mut b_end = b2[0];
+    b_end.uv[k] += per;
+    poly.push(b_end);
+    poly.extend(b2.iter().rev().copied());
+    poly.extend(inner.iter().rev().map(|&t| cut(0.0, t)));
+    Ok(poly)
 }
 
 fn mean(pts: &[Pt]) -> [f64; 2] {
