@@ -57,23 +57,7 @@ pub fn cone_report(
     diags: &mut Diagnostics,
 ) -> Option<ConeReport> {
     let (model, part, g) = (input.model, input.part, input.geometry);
-    let chosen: Vec<&Fpoint> = match &req.face {
-        Some(name) => {
-            let Some(face) = g.faces.iter().position(|f| &f.name == name) else {
-                let mut known: Vec<&str> = g.faces.iter().map(|f| f.name.as_str()).collect();
-                known.truncate(12);
-                diags.push(AccessError::UnknownFace {
-                    span: part.span,
-                    face: name.clone(),
-                    part: part.name.clone(),
-                    known: known.join(", "),
-                });
-                return None;
-            };
-            input.fpoints.iter().filter(|f| f.face.0 == face).collect()
-        }
-        None => input.fpoints.iter().collect(),
-    };
+    let chosen = chosen_fpoints(input, req, diags)?;
     let Some(f) = chosen.get(req.point) else {
         diags.push(AccessError::NoPoint {
             span: part.span,
@@ -91,7 +75,74 @@ pub fn cone_report(
             return Some(scanner_report(input, req, f, chosen.len(), &shape));
         }
     }
-    let probe = match plan {
+    let probe = requested_probe(input, req, diags)?;
+    let scene = Scene::of_part(g);
+    let n = req.n;
+    let prefs = axes();
+    let mut text = fpoint_line(g, req, f, chosen.len());
+    let _ = writeln!(
+        text,
+        "part {}: {} triangles, {}",
+        part.name,
+        scene.tris.len(),
+        if scene.closed {
+            "closed"
+        } else {
+            "open (no back-face culling)"
+        }
+    );
+    text.push_str(&cells_line(n, &prefs));
+    let r = probe.as_ref().map_or(1.0, |p| p.tip_radius);
+    let c = f.tip_centre(r);
+    let half = gac_halfline(&scene, &c, n, &prefs);
+    let _ = writeln!(text, "  half-line at the tip centre      {}", share(&half));
+    let drawn = match &probe {
+        None => half,
+        Some(probe) => probe_cones(input, (&scene, n, &prefs), f, probe, &mut text),
+    };
+    Some(ConeReport {
+        text,
+        pgm: pgm(&drawn),
+    })
+}
+
+/// The fpoints a request chooses among: the named face's, or the part's; `None`, with a
+/// diagnostic, for a face the part does not have.
+fn chosen_fpoints<'a>(
+    input: &ConeInput<'a>,
+    req: &ConeRequest,
+    diags: &mut Diagnostics,
+) -> Option<Vec<&'a Fpoint>> {
+    let (part, g) = (input.part, input.geometry);
+    Some(match &req.face {
+        Some(name) => {
+            let Some(face) = g.faces.iter().position(|f| &f.name == name) else {
+                let mut known: Vec<&str> = g.faces.iter().map(|f| f.name.as_str()).collect();
+                known.truncate(12);
+                diags.push(AccessError::UnknownFace {
+                    span: part.span,
+                    face: name.clone(),
+                    part: part.name.clone(),
+                    known: known.join(", "),
+                });
+                return None;
+            };
+            input.fpoints.iter().filter(|f| f.face.0 == face).collect()
+        }
+        None => input.fpoints.iter().collect(),
+    })
+}
+
+/// The touch probe a request names (the plan machine's first without a label), or
+/// `Some(None)` without a plan; `None`, with a diagnostic, for a label the machine does
+/// not carry or a probe asked for without a machine.
+fn requested_probe(
+    input: &ConeInput,
+    req: &ConeRequest,
+    diags: &mut Diagnostics,
+) -> Option<Option<ProbeShape>> {
+    let model = input.model;
+    Some(match input.plan {
         Some(plan) => {
             let cmm = &model.cmms[plan.cmm.0];
             let shapes = ProbeShape::of_cmm(model, cmm);
@@ -118,108 +169,94 @@ pub fn cone_report(
         }
         None if req.probe.is_some() => {
             diags.push(AccessError::NoMachine {
-                span: part.span,
-                part: part.name.clone(),
+                span: input.part.span,
+                part: input.part.name.clone(),
             });
             return None;
         }
         None => None,
+    })
+}
+
+/// The report's lines for a touch probe at fpoint `f` — its shape, whether its tip
+/// fits, each leading component's cone, the approach cone (D1) and the axes and head
+/// orientations in it — written to `text`, in `scene` at cube-map resolution `n` with
+/// preferred directions `prefs`. Returns the approach cone, the one drawn.
+fn probe_cones(
+    input: &ConeInput,
+    (scene, n, prefs): (&Scene, u32, &[V3]),
+    f: &Fpoint,
+    probe: &ProbeShape,
+    text: &mut String,
+) -> CubeMap {
+    let model = input.model;
+    let c = f.tip_centre(probe.tip_radius);
+    let head = match probe.head {
+        Head::Indexable => "indexable head",
+        Head::Fixed => "fixed head",
     };
-    let scene = Scene::of_part(g);
-    let n = req.n;
-    let prefs = axes();
-    let mut text = fpoint_line(g, req, f, chosen.len());
     let _ = writeln!(
         text,
-        "part {}: {} triangles, {}",
-        part.name,
-        scene.tris.len(),
-        if scene.closed {
-            "closed"
+        "probe {}: tip radius {} mm, reach {} mm, {head}",
+        probe.name,
+        fmt_num(probe.tip_radius),
+        fmt_num(probe.reach())
+    );
+    if !tip_fits(scene, &c, probe.tip_radius) {
+        let _ = writeln!(
+            text,
+            "  the tip does not fit: the part is {} mm from its centre",
+            fmt_num(scene.distance(&c))
+        );
+    }
+    for comp in &probe.leading() {
+        let cone = gac(&Cpu, scene, &c, std::slice::from_ref(comp), n, prefs);
+        let _ = writeln!(
+            text,
+            "  {:<32} {}",
+            format!("{} (r {} mm)", comp.name, fmt_num(comp.radius)),
+            share(&cone)
+        );
+    }
+    let opts = ConeOptions {
+        n,
+        preferred: prefs.to_vec(),
+        ..ConeOptions::default()
+    };
+    let cones = point_cones(&Cpu, scene, f, probe, &opts);
+    let what = match probe.head {
+        Head::Indexable => "D1, approach and retract",
+        Head::Fixed => "probe, approach and retract",
+    };
+    let _ = writeln!(text, "  {what:<32} {}", share(&cones.approach));
+    let axes_free: Vec<&str> = ["+x", "-x", "+y", "-y", "+z", "-z"]
+        .into_iter()
+        .enumerate()
+        .filter(|(k, _)| cones.approach.get(Cell::Preferred(*k)))
+        .map(|(_, s)| s)
+        .collect();
+    let _ = writeln!(
+        text,
+        "  axes in the cone: {}",
+        if axes_free.is_empty() {
+            "none".to_string()
         } else {
-            "open (no back-face culling)"
+            axes_free.join(" ")
         }
     );
-    text.push_str(&cells_line(n, &prefs));
-    let r = probe.as_ref().map_or(1.0, |p| p.tip_radius);
-    let c = f.tip_centre(r);
-    let half = gac_halfline(&scene, &c, n, &prefs);
-    let _ = writeln!(text, "  half-line at the tip centre      {}", share(&half));
-    let drawn = match &probe {
-        None => half,
-        Some(probe) => {
-            let head = match probe.head {
-                Head::Indexable => "indexable head",
-                Head::Fixed => "fixed head",
-            };
-            let _ = writeln!(
-                text,
-                "probe {}: tip radius {} mm, reach {} mm, {head}",
-                probe.name,
-                fmt_num(probe.tip_radius),
-                fmt_num(probe.reach())
-            );
-            if !tip_fits(&scene, &c, probe.tip_radius) {
-                let _ = writeln!(
-                    text,
-                    "  the tip does not fit: the part is {} mm from its centre",
-                    fmt_num(scene.distance(&c))
-                );
-            }
-            for comp in &probe.leading() {
-                let cone = gac(&Cpu, &scene, &c, std::slice::from_ref(comp), n, &prefs);
-                let _ = writeln!(
-                    text,
-                    "  {:<32} {}",
-                    format!("{} (r {} mm)", comp.name, fmt_num(comp.radius)),
-                    share(&cone)
-                );
-            }
-            let opts = ConeOptions {
-                n,
-                preferred: prefs.clone(),
-                ..ConeOptions::default()
-            };
-            let cones = point_cones(&Cpu, &scene, f, probe, &opts);
-            let what = match probe.head {
-                Head::Indexable => "D1, approach and retract",
-                Head::Fixed => "probe, approach and retract",
-            };
-            let _ = writeln!(text, "  {what:<32} {}", share(&cones.approach));
-            let axes_free: Vec<&str> = ["+x", "-x", "+y", "-y", "+z", "-z"]
-                .into_iter()
-                .enumerate()
-                .filter(|(k, _)| cones.approach.get(Cell::Preferred(*k)))
-                .map(|(_, s)| s)
-                .collect();
-            let _ = writeln!(
-                text,
-                "  axes in the cone: {}",
-                if axes_free.is_empty() {
-                    "none".to_string()
-                } else {
-                    axes_free.join(" ")
-                }
-            );
-            if let Some(d2) = &cones.d2 {
-                let _ = writeln!(text, "  D2 (setup directions)           {}", share(d2));
-                let cmm = &model.cmms[plan.map(|p| p.cmm.0).unwrap_or(0)];
-                let grid = model.heads[cmm.head.0].orientations();
-                let inside = orientations_in(&cones.approach, &grid);
-                let _ = writeln!(
-                    text,
-                    "  head orientations in D1: {} of {}",
-                    inside.len(),
-                    grid.len()
-                );
-            }
-            cones.approach
-        }
-    };
-    Some(ConeReport {
-        text,
-        pgm: pgm(&drawn),
-    })
+    if let Some(d2) = &cones.d2 {
+        let _ = writeln!(text, "  D2 (setup directions)           {}", share(d2));
+        let cmm = &model.cmms[input.plan.map(|p| p.cmm.0).unwrap_or(0)];
+        let grid = model.heads[cmm.head.0].orientations();
+        let inside = orientations_in(&cones.approach, &grid);
+        let _ = writeln!(
+            text,
+            "  head orientations in D1: {} of {}",
+            inside.len(),
+            grid.len()
+        );
+    }
+    cones.approach
 }
 
 /// The report of a scanner's cones at one point: the share of directions each condition

@@ -48,8 +48,18 @@ pub(super) fn build(
     stock: &Stock,
     diags: &mut Diagnostics,
 ) -> Option<PartGeometry> {
-    let mut specs: Vec<Spec> = Vec::new();
-    let (stock_prim, stock_roles): (Prim, Vec<Role>) = match stock {
+    let (stock_prim, stock_roles) = stock_primitive(stock);
+    let size = StockSize::of(&stock_prim);
+    let mut specs = stock_specs(&stock_prim, &stock_roles, size.grow);
+    let material = material_bounds(part, stock, &size);
+    let tools = place_tools(part, stock, &size, material, &mut specs, diags);
+    let current = apply_tools(part, &stock_prim, &tools, diags)?;
+    Some(classified(&current, specs, size.diag))
+}
+
+/// The stock as a primitive, with the role of each of its faces in order.
+fn stock_primitive(stock: &Stock) -> (Prim, Vec<Role>) {
+    match stock {
         Stock::Box { size } => {
             let f = Frame {
                 o: P3::origin(),
@@ -82,12 +92,45 @@ pub(super) fn build(
             )
         }
         Stock::Sphere { diameter } => (sphere(P3::origin(), diameter / 2.0), vec![Role::Surface]),
-    };
-    let (slo, shi) = stock_prim.bounds();
-    let diag = (shi - slo).norm();
-    let ext = 1.0 + 0.01 * diag;
-    let big = 2.0 * diag + 10.0;
-    let grow = 2.0 * CHORD_MM + 1e-6 * diag.max(1.0);
+    }
+}
+
+/// The lengths a build takes from the stock's bounds.
+struct StockSize {
+    /// The stock's bounds.
+    lo: P3,
+    hi: P3,
+    /// Their middle.
+    center: P3,
+    /// Their diagonal (mm).
+    diag: f64,
+    /// How far a cutter reaches back behind its entry (mm).
+    ext: f64,
+    /// A length past anything of the part (mm): a through cut's, an open slot's.
+    big: f64,
+    /// How far a face's bounds are grown to hold its triangles (mm).
+    grow: f64,
+}
+
+impl StockSize {
+    fn of(stock_prim: &Prim) -> StockSize {
+        let (lo, hi) = stock_prim.bounds();
+        let diag = (hi - lo).norm();
+        StockSize {
+            lo,
+            hi,
+            center: P3::from((lo.coords + hi.coords) / 2.0),
+            diag,
+            ext: 1.0 + 0.01 * diag,
+            big: 2.0 * diag + 10.0,
+            grow: 2.0 * CHORD_MM + 1e-6 * diag.max(1.0),
+        }
+    }
+}
+
+/// The specs of the stock's faces, `stock.<role>`, their bounds grown by `grow`.
+fn stock_specs(stock_prim: &Prim, stock_roles: &[Role], grow: f64) -> Vec<Spec> {
+    let mut specs = Vec::new();
     for (k, role) in stock_roles.iter().enumerate() {
         let (lo, hi) = stock_prim.bounds_of_part(k as u32);
         specs.push(Spec {
@@ -99,12 +142,14 @@ pub(super) fn build(
             hi: hi + V3::repeat(grow),
         });
     }
+    specs
+}
 
-    let center = P3::from((slo.coords + shi.coords) / 2.0);
-    // Where material may be: the stock and every added instance, as boxes.
-    let (mut mlo, mut mhi) = (slo, shi);
+/// Where material may be: the bounds of the stock and of every added instance.
+fn material_bounds(part: &model::Part, stock: &Stock, size: &StockSize) -> (P3, P3) {
+    let (mut mlo, mut mhi) = (size.lo, size.hi);
     for op in part.ops.iter().filter(|o| o.action == Action::Add) {
-        let Some((prim, _)) = cutter(op, stock, center, ext, big) else {
+        let Some((prim, _)) = cutter(op, stock, size.center, size.ext, size.big) else {
             continue;
         };
         for m in op
@@ -119,9 +164,24 @@ pub(super) fn build(
             mhi = mhi.sup(&hi);
         }
     }
+    (mlo, mhi)
+}
+
+/// Every operation's instances as tools, in order, with the specs of their faces added
+/// to `specs`; an instance that misses the part (outside the stock, or cutting from
+/// outside the material `(mlo, mhi)`) is left out, with one error per operation.
+fn place_tools(
+    part: &model::Part,
+    stock: &Stock,
+    size: &StockSize,
+    (mlo, mhi): (P3, P3),
+    specs: &mut Vec<Spec>,
+    diags: &mut Diagnostics,
+) -> Vec<Tool> {
+    let (slo, shi, center) = (size.lo, size.hi, size.center);
     let mut tools: Vec<Tool> = Vec::new();
     for (oi, op) in part.ops.iter().enumerate() {
-        let Some((prim, roles)) = cutter(op, stock, center, ext, big) else {
+        let Some((prim, roles)) = cutter(op, stock, center, size.ext, size.big) else {
             continue;
         };
         let instances: Vec<(Option<u32>, Isometry3<f64>)> = match &op.pattern {
@@ -149,26 +209,7 @@ pub(super) fn build(
                 missed.push(inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name)));
                 continue;
             }
-            for (k, rs) in roles.iter().enumerate() {
-                if rs.is_empty() {
-                    continue;
-                }
-                let (lo, hi) = prim.bounds_of_part(k as u32);
-                let mut surface = prim.surfaces[k].clone();
-                if op.action == Action::Cut {
-                    surface = flip(surface);
-                }
-                let base = inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name));
-                let role_name = rs[0];
-                specs.push(Spec {
-                    name: format!("{base}.{role_name}"),
-                    surface,
-                    source: FaceSource::Op(OpId(oi), inst),
-                    roles: rs.clone(),
-                    lo: lo - V3::repeat(grow),
-                    hi: hi + V3::repeat(grow),
-                });
-            }
+            specs.extend(instance_specs(op, (oi, inst), &prim, &roles, size.grow));
             tools.push(Tool {
                 bounds: (lo, hi),
                 prim,
@@ -190,9 +231,52 @@ pub(super) fn build(
             });
         }
     }
+    tools
+}
 
-    // Booleans, with consecutive disjoint tools of the same kind batched into one.
-    let mut current = to_manifold(&[&stock_prim]).ok()?;
+/// The specs of the faces of instance `inst` of operation `op` (index `oi`), placed as
+/// `prim`: one per face with roles, `<op>[<inst>].<role>`, a cut's facing out of the
+/// material.
+fn instance_specs(
+    op: &model::Op,
+    (oi, inst): (usize, Option<u32>),
+    prim: &Prim,
+    roles: &[Vec<Role>],
+    grow: f64,
+) -> Vec<Spec> {
+    let mut specs = Vec::new();
+    for (k, rs) in roles.iter().enumerate() {
+        if rs.is_empty() {
+            continue;
+        }
+        let (lo, hi) = prim.bounds_of_part(k as u32);
+        let mut surface = prim.surfaces[k].clone();
+        if op.action == Action::Cut {
+            surface = flip(surface);
+        }
+        let base = inst.map_or(op.name.clone(), |i| format!("{}[{i}]", op.name));
+        let role_name = rs[0];
+        specs.push(Spec {
+            name: format!("{base}.{role_name}"),
+            surface,
+            source: FaceSource::Op(OpId(oi), inst),
+            roles: rs.clone(),
+            lo: lo - V3::repeat(grow),
+            hi: hi + V3::repeat(grow),
+        });
+    }
+    specs
+}
+
+/// The stock with every tool added or cut in order, consecutive disjoint tools of the
+/// same kind batched into one boolean. `None`, with a diagnostic, when a boolean fails.
+fn apply_tools(
+    part: &model::Part,
+    stock_prim: &Prim,
+    tools: &[Tool],
+    diags: &mut Diagnostics,
+) -> Option<Manifold> {
+    let mut current = to_manifold(&[stock_prim]).ok()?;
     let mut i = 0;
     while i < tools.len() {
         let mut batch = vec![i];
@@ -227,7 +311,12 @@ pub(super) fn build(
         }
         i = j;
     }
+    Some(current)
+}
 
+/// The geometry of the result: its triangles, each on the face of the spec it is
+/// classified onto (tolerances scaled by the stock's diagonal `diag`).
+fn classified(current: &Manifold, specs: Vec<Spec>, diag: f64) -> PartGeometry {
     let vertices: Vec<P3> = current.ps.iter().map(|p| P3::new(p.x, p.y, p.z)).collect();
     let triangles: Vec<[u32; 3]> = current
         .hs
@@ -259,7 +348,7 @@ pub(super) fn build(
     );
     let mut geometry = geometry;
     geometry.roles = specs.into_iter().map(|s| (s.source, s.roles)).collect();
-    Some(geometry)
+    geometry
 }
 
 /// The spec a triangle belongs to: every corner on its surface (within the tessellation

@@ -8,7 +8,7 @@
 //! it. The planner offers that one pose (`plan::poses`).
 
 use super::errors::{self, GeometryError};
-use super::{FaceId, PartGeometry, P3};
+use super::{FaceId, PartGeometry, RawMesh, P3};
 use crate::diag::Diagnostics;
 use crate::model::{Fixture, FixtureId, FixtureKind};
 use crate::source::World;
@@ -74,26 +74,7 @@ pub fn place_fixture(
     let Ok(part_mesh) = TriMesh::new(g.vertices.clone(), g.triangles.clone()) else {
         return None;
     };
-    // How deep each mesh's vertices lie inside the other solid (0 outside).
-    let depth = |points: &[P3], mesh: &TriMesh, inside: &(dyn Fn(&P3) -> bool + Sync)| {
-        points
-            .par_iter()
-            .map(|p| {
-                if inside(p) {
-                    mesh.distance_to_local_point(p, false)
-                } else {
-                    0.0
-                }
-            })
-            .reduce(|| 0.0, f64::max)
-    };
-    let in_fixture = |p: &P3| super::query::winding_number(&raw.vertices, &raw.triangles, p) > 0.5;
-    let in_part = |p: &P3| g.winding_number(p) > 0.5;
-    let sunk = depth(&g.vertices, &fixture_mesh, &in_fixture).max(depth(
-        &raw.vertices,
-        &part_mesh,
-        &in_part,
-    ));
+    let sunk = sunk_depth(g, &raw, &fixture_mesh, &part_mesh);
     if sunk > OVERLAP_MM {
         diags.push(GeometryError::FixtureOverlapsPart {
             span: *span,
@@ -103,54 +84,7 @@ pub fn place_fixture(
         });
         return None;
     }
-    // Locating faces: those with at least MIN_CONTACT_MM2 of their area within
-    // CONTACT_MM of the fixture, each triangle cut into pieces of about SAMPLE_MM.
-    let (flo, fhi) = bounds(&raw.vertices);
-    let near_box =
-        |p: &P3| (0..3).all(|i| p[i] >= flo[i] - CONTACT_MM && p[i] <= fhi[i] + CONTACT_MM);
-    let contact = |t: u32| -> f64 {
-        let [a, b, c] = g.triangles[t as usize].map(|i| g.vertices[i as usize]);
-        let (tlo, thi) = bounds(&[a, b, c]);
-        if (0..3).any(|i| thi[i] < flo[i] - CONTACT_MM || tlo[i] > fhi[i] + CONTACT_MM) {
-            return 0.0;
-        }
-        let longest = [(b - a).norm(), (c - b).norm(), (a - c).norm()]
-            .into_iter()
-            .fold(0.0, f64::max);
-        let n = ((longest / SAMPLE_MM).ceil() as usize).clamp(1, 64);
-        let area = (b - a).cross(&(c - a)).norm() / 2.0 / (n * n) as f64;
-        let (u, v) = ((b - a) / n as f64, (c - a) / n as f64);
-        let mut touching = 0;
-        for i in 0..n {
-            for j in 0..n - i {
-                // The centres of the piece (i, j) and, inside the strip, its mirror.
-                let corner = a + u * i as f64 + v * j as f64;
-                let mut centres = vec![corner + (u + v) / 3.0];
-                if i + j + 1 < n {
-                    centres.push(corner + (u + v) * (2.0 / 3.0));
-                }
-                touching += centres
-                    .iter()
-                    .filter(|p| {
-                        near_box(p) && fixture_mesh.distance_to_local_point(p, false) <= CONTACT_MM
-                    })
-                    .count();
-            }
-        }
-        touching as f64 * area
-    };
-    let locating: Vec<FaceId> = (0..g.faces.len())
-        .into_par_iter()
-        .filter(|&k| {
-            g.faces[k]
-                .triangles
-                .iter()
-                .map(|&t| contact(t))
-                .sum::<f64>()
-                >= MIN_CONTACT_MM2
-        })
-        .map(FaceId)
-        .collect();
+    let locating = locating_faces(g, &raw.vertices, &fixture_mesh);
     if locating.is_empty() {
         let gap = g
             .vertices
@@ -171,6 +105,86 @@ pub fn place_fixture(
         triangles: raw.triangles,
         locating,
     })
+}
+
+/// How deep the part and the fixture sink into each other: the deepest vertex of
+/// either inside the other solid (0 when none is).
+fn sunk_depth(g: &PartGeometry, raw: &RawMesh, fixture_mesh: &TriMesh, part_mesh: &TriMesh) -> f64 {
+    // How deep each mesh's vertices lie inside the other solid (0 outside).
+    let depth = |points: &[P3], mesh: &TriMesh, inside: &(dyn Fn(&P3) -> bool + Sync)| {
+        points
+            .par_iter()
+            .map(|p| {
+                if inside(p) {
+                    mesh.distance_to_local_point(p, false)
+                } else {
+                    0.0
+                }
+            })
+            .reduce(|| 0.0, f64::max)
+    };
+    let in_fixture = |p: &P3| super::query::winding_number(&raw.vertices, &raw.triangles, p) > 0.5;
+    let in_part = |p: &P3| g.winding_number(p) > 0.5;
+    depth(&g.vertices, fixture_mesh, &in_fixture).max(depth(&raw.vertices, part_mesh, &in_part))
+}
+
+/// The locating faces: those with at least [`MIN_CONTACT_MM2`] of their area within
+/// [`CONTACT_MM`] of the fixture (`fixture_vertices`, `fixture_mesh`).
+fn locating_faces(
+    g: &PartGeometry,
+    fixture_vertices: &[P3],
+    fixture_mesh: &TriMesh,
+) -> Vec<FaceId> {
+    let near = bounds(fixture_vertices);
+    (0..g.faces.len())
+        .into_par_iter()
+        .filter(|&k| {
+            g.faces[k]
+                .triangles
+                .iter()
+                .map(|&t| contact_area(g, t, fixture_mesh, near))
+                .sum::<f64>()
+                >= MIN_CONTACT_MM2
+        })
+        .map(FaceId)
+        .collect()
+}
+
+/// The area of triangle `t` within [`CONTACT_MM`] of the fixture (`fixture_mesh`,
+/// bounded by `(flo, fhi)`): the triangle cut into pieces of about [`SAMPLE_MM`], each
+/// piece counted by its centre.
+fn contact_area(g: &PartGeometry, t: u32, fixture_mesh: &TriMesh, (flo, fhi): (P3, P3)) -> f64 {
+    let near_box =
+        |p: &P3| (0..3).all(|i| p[i] >= flo[i] - CONTACT_MM && p[i] <= fhi[i] + CONTACT_MM);
+    let [a, b, c] = g.triangles[t as usize].map(|i| g.vertices[i as usize]);
+    let (tlo, thi) = bounds(&[a, b, c]);
+    if (0..3).any(|i| thi[i] < flo[i] - CONTACT_MM || tlo[i] > fhi[i] + CONTACT_MM) {
+        return 0.0;
+    }
+    let longest = [(b - a).norm(), (c - b).norm(), (a - c).norm()]
+        .into_iter()
+        .fold(0.0, f64::max);
+    let n = ((longest / SAMPLE_MM).ceil() as usize).clamp(1, 64);
+    let area = (b - a).cross(&(c - a)).norm() / 2.0 / (n * n) as f64;
+    let (u, v) = ((b - a) / n as f64, (c - a) / n as f64);
+    let mut touching = 0;
+    for i in 0..n {
+        for j in 0..n - i {
+            // The centres of the piece (i, j) and, inside the strip, its mirror.
+            let corner = a + u * i as f64 + v * j as f64;
+            let mut centres = vec![corner + (u + v) / 3.0];
+            if i + j + 1 < n {
+                centres.push(corner + (u + v) * (2.0 / 3.0));
+            }
+            touching += centres
+                .iter()
+                .filter(|p| {
+                    near_box(p) && fixture_mesh.distance_to_local_point(p, false) <= CONTACT_MM
+                })
+                .count();
+        }
+    }
+    touching as f64 * area
 }
 
 /// The bounding box of points.

@@ -111,10 +111,49 @@ pub fn from_groups(m: &RawMesh) -> PartGeometry {
 pub fn segment(m: &RawMesh) -> PartGeometry {
     let nt = m.triangles.len();
     let normals: Vec<_> = (0..nt).map(|t| tri_normal(m, t)).collect();
+    let adj = Adjacency {
+        normals: &normals,
+        nbrs: neighbours(m),
+    };
+    // 1. Flat patches.
+    let patches = flat_patches(&adj);
+    // 2. Facets: patches bordered mostly by gentle creases.
+    let facet = facets(&adj, &patches);
+    // 3. Curved regions: facets joined across gentle creases.
+    let regions = curved_regions(&adj, &patches, &facet);
+    // 4. Fit.
+    let mut faces = fitted_faces(m, &adj, &patches, regions);
+    faces.sort_by_key(|f| f[0]);
+    let names = (1..=faces.len()).map(|k| format!("segment_{k}")).collect();
+    assemble(m, faces, names, &normals)
+}
+
+/// The triangles of a mesh as segmentation walks them: their normals (with area and
+/// centroid) and, per triangle, its neighbours across manifold edges with the edge's
+/// length.
+struct Adjacency<'a> {
+    normals: &'a [(V3, f64, P3)],
+    nbrs: Vec<Vec<(u32, f64)>>,
+}
+
+impl Adjacency<'_> {
+    /// The angle between two triangles' normals (degrees).
+    fn angle(&self, a: u32, b: u32) -> f64 {
+        self.normals[a as usize]
+            .0
+            .dot(&self.normals[b as usize].0)
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees()
+    }
+}
+
+/// Per triangle, its neighbours across manifold edges, with the edge length, in the
+/// order of the edges' vertex pairs.
+fn neighbours(m: &RawMesh) -> Vec<Vec<(u32, f64)>> {
     // Edge → triangles.
     let edge_tris = super::query::edge_triangles(&m.triangles);
-    // Neighbours of each triangle across manifold edges, with the edge length.
-    let mut nbrs: Vec<Vec<(u32, f64)>> = vec![Vec::new(); nt];
+    let mut nbrs: Vec<Vec<(u32, f64)>> = vec![Vec::new(); m.triangles.len()];
     let mut keys: Vec<&(u32, u32)> = edge_tris.keys().collect();
     keys.sort_unstable();
     for key in keys {
@@ -125,16 +164,20 @@ pub fn segment(m: &RawMesh) -> PartGeometry {
             nbrs[ts[1] as usize].push((ts[0], len));
         }
     }
-    let angle = |a: u32, b: u32| {
-        normals[a as usize]
-            .0
-            .dot(&normals[b as usize].0)
-            .clamp(-1.0, 1.0)
-            .acos()
-            .to_degrees()
-    };
+    nbrs
+}
 
-    // 1. Flat patches.
+/// The flat patches of a mesh: per triangle its patch, and per patch its triangles
+/// (sorted), numbered in the order of their first triangle.
+struct Patches {
+    flat: Vec<u32>,
+    patches: Vec<Vec<u32>>,
+}
+
+/// Grows flat patches from each triangle not yet in one: neighbours whose normals
+/// agree with the seed's within [`FLAT_DEG`] join it.
+fn flat_patches(adj: &Adjacency) -> Patches {
+    let nt = adj.nbrs.len();
     let mut flat = vec![u32::MAX; nt];
     let mut patches: Vec<Vec<u32>> = Vec::new();
     for seed in 0..nt as u32 {
@@ -147,8 +190,8 @@ pub fn segment(m: &RawMesh) -> PartGeometry {
         let mut members = Vec::new();
         while let Some(t) = stack.pop() {
             members.push(t);
-            for &(n, _) in &nbrs[t as usize] {
-                if flat[n as usize] == u32::MAX && angle(seed, n) < FLAT_DEG {
+            for &(n, _) in &adj.nbrs[t as usize] {
+                if flat[n as usize] == u32::MAX && adj.angle(seed, n) < FLAT_DEG {
                     flat[n as usize] = id;
                     stack.push(n);
                 }
@@ -157,43 +200,65 @@ pub fn segment(m: &RawMesh) -> PartGeometry {
         members.sort_unstable();
         patches.push(members);
     }
-    // 2. Facets: patches bordered mostly by gentle creases.
-    let np = patches.len();
+    Patches { flat, patches }
+}
+
+/// Per patch, whether it is a facet of a curved face: more than half its border runs
+/// along creases gentler than [`SMOOTH_DEG`].
+fn facets(adj: &Adjacency, p: &Patches) -> Vec<bool> {
+    let np = p.patches.len();
     let mut gentle = vec![0.0; np];
     let mut border = vec![0.0; np];
-    for (t, ns) in nbrs.iter().enumerate() {
+    for (t, ns) in adj.nbrs.iter().enumerate() {
         for &(n, len) in ns {
-            let (pa, pb) = (flat[t], flat[n as usize]);
+            let (pa, pb) = (p.flat[t], p.flat[n as usize]);
             if pa != pb {
                 border[pa as usize] += len;
-                if angle(t as u32, n) < SMOOTH_DEG {
+                if adj.angle(t as u32, n) < SMOOTH_DEG {
                     gentle[pa as usize] += len;
                 }
             }
         }
     }
-    let facet: Vec<bool> = (0..np)
-        .map(|p| border[p] > 0.0 && gentle[p] > 0.5 * border[p])
-        .collect();
-    // 3. Curved regions: facets joined across gentle creases.
+    (0..np)
+        .map(|q| border[q] > 0.0 && gentle[q] > 0.5 * border[q])
+        .collect()
+}
+
+/// Regions of patches: a facet with the facets it reaches across gentle creases, any
+/// other patch alone.
+struct Regions {
+    /// Per patch, its region.
+    region: Vec<u32>,
+    /// Per region, its triangles.
+    tris: Vec<Vec<u32>>,
+    /// The patches in the order of their first triangle.
+    order: Vec<usize>,
+}
+
+/// Joins facets across gentle creases into curved regions, in the order of their
+/// patches' first triangles.
+fn curved_regions(adj: &Adjacency, p: &Patches, facet: &[bool]) -> Regions {
+    let (flat, patches) = (&p.flat, &p.patches);
+    let np = patches.len();
     let mut region = vec![u32::MAX; np];
     let mut regions: Vec<Vec<u32>> = Vec::new();
     let mut order: Vec<usize> = (0..np).collect();
-    order.sort_by_key(|&p| patches[p][0]);
-    for &p in &order {
-        if region[p] != u32::MAX {
+    order.sort_by_key(|&q| patches[q][0]);
+    for &q0 in &order {
+        if region[q0] != u32::MAX {
             continue;
         }
         let id = regions.len() as u32;
-        region[p] = id;
-        let mut group = vec![p];
-        if facet[p] {
-            let mut stack = vec![p];
+        region[q0] = id;
+        let mut group = vec![q0];
+        if facet[q0] {
+            let mut stack = vec![q0];
             while let Some(q) = stack.pop() {
                 for &t in &patches[q] {
-                    for &(n, _) in &nbrs[t as usize] {
+                    for &(n, _) in &adj.nbrs[t as usize] {
                         let r = flat[n as usize] as usize;
-                        if region[r] == u32::MAX && facet[r] && angle(t, n) < SMOOTH_DEG {
+                        if region[r] == u32::MAX && facet[r] && adj.angle(t, n) < SMOOTH_DEG {
                             region[r] = id;
                             group.push(r);
                             stack.push(r);
@@ -209,21 +274,39 @@ pub fn segment(m: &RawMesh) -> PartGeometry {
                 .collect(),
         );
     }
-    // 4. Fit. A curved region no single surface fits (two tangent fillets, say) is split
-    // by growing sub-regions facet by facet while one surface still fits them.
+    Regions {
+        region,
+        tris: regions,
+        order,
+    }
+}
+
+/// The faces of the regions, each fitted: a curved region no single surface fits (two
+/// tangent fillets, say) is split by growing sub-regions facet by facet while one
+/// surface still fits them ([`grow_by_fit`]).
+fn fitted_faces(m: &RawMesh, adj: &Adjacency, p: &Patches, regions: Regions) -> Vec<Vec<u32>> {
     let tol = fit_tolerance(m);
-    let mut members_of: Vec<Vec<usize>> = vec![Vec::new(); regions.len()];
-    for &p in &order {
-        members_of[region[p] as usize].push(p);
+    let mut members_of: Vec<Vec<usize>> = vec![Vec::new(); regions.tris.len()];
+    for &q in &regions.order {
+        members_of[regions.region[q] as usize].push(q);
     }
     let mut faces: Vec<Vec<u32>> = Vec::new();
-    for (id, tris) in regions.into_iter().enumerate() {
+    for (id, tris) in regions.tris.into_iter().enumerate() {
         let members = &members_of[id];
         if members.len() > 1
-            && matches!(fit_face(m, &tris, &normals, tol).surface, Surface::Freeform)
+            && matches!(
+                fit_face(m, &tris, adj.normals, tol).surface,
+                Surface::Freeform
+            )
         {
             faces.extend(grow_by_fit(
-                m, members, &patches, &flat, &nbrs, &normals, tol,
+                m,
+                members,
+                &p.patches,
+                &p.flat,
+                &adj.nbrs,
+                adj.normals,
+                tol,
             ));
         } else {
             let mut t = tris;
@@ -231,9 +314,7 @@ pub fn segment(m: &RawMesh) -> PartGeometry {
             faces.push(t);
         }
     }
-    faces.sort_by_key(|f| f[0]);
-    let names = (1..=faces.len()).map(|k| format!("segment_{k}")).collect();
-    assemble(m, faces, names, &normals)
+    faces
 }
 
 /// Splits a region into sub-regions that each fit one analytic surface: from the first

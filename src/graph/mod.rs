@@ -187,6 +187,29 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
     for d in &part.datums {
         datums_of.entry(d.feature).or_default().push(d.name.clone());
     }
+    let feature_nodes = add_features(part, &mut graph, root, &datums_of);
+    let (face_nodes, owners_of) = add_faces(input, &mut graph, &feature_nodes, &datums_of);
+    let fpoints = add_points(input, &mut graph, &face_nodes, owners_of, diags);
+    MeasurementGraph {
+        plan: input.plan.map(str::to_owned),
+        sampling: input.sampling.name.clone(),
+        graph,
+        root,
+        fpoints,
+        margin: input.margin,
+        sensors: Vec::new(),
+    }
+}
+
+/// Adds the tolerances under `root`, each with the features it tolerances and the
+/// features of its datums, then the features no tolerance names (face aliases aside);
+/// returns every feature node in node order.
+fn add_features(
+    part: &Part,
+    graph: &mut DiGraph<Node, Edge>,
+    root: NodeIndex,
+    datums_of: &HashMap<FeatureId, Vec<String>>,
+) -> Vec<(FeatureId, NodeIndex)> {
     // Per feature, its node once made (lookups stay linear in the part's size).
     let mut node_of: Vec<Option<NodeIndex>> = vec![None; part.features.len()];
     let mut feature_node = |graph: &mut DiGraph<Node, Edge>, f: FeatureId| -> NodeIndex {
@@ -204,12 +227,12 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
         let tn = graph.add_node(Node::Tolerance(k));
         graph.add_edge(root, tn, Edge::Tolerance);
         for &f in &t.targets {
-            let fnode = feature_node(&mut graph, f);
+            let fnode = feature_node(graph, f);
             graph.update_edge(tn, fnode, Edge::Target);
         }
         for r in &t.datums {
             let f = part.datums[r.datum.0].feature;
-            let fnode = feature_node(&mut graph, f);
+            let fnode = feature_node(graph, f);
             if graph.find_edge(tn, fnode).is_none() {
                 graph.add_edge(tn, fnode, Edge::Datum);
             }
@@ -227,24 +250,34 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
         // Face aliases (`face top = …`) only name a face for use in features.
         let alias_only = f.declared == Declared::Face && !datums_of.contains_key(&id);
         if !named && !alias_only {
-            let fnode = feature_node(&mut graph, id);
+            let fnode = feature_node(graph, id);
             graph.add_edge(root, fnode, Edge::Target);
         }
     }
-    let feature_nodes: Vec<(FeatureId, NodeIndex)> = graph
+    graph
         .node_indices()
         .filter_map(|i| match &graph[i] {
             Node::Feature { feature, .. } => Some((*feature, i)),
             _ => None,
         })
-        .collect();
+        .collect()
+}
 
+/// Adds each feature's faces under it, a face two features share once, marked
+/// `on_table` when a datum feature lists it and it can rest on the table. Returns the
+/// face nodes in order with the first feature that lists each, and per face the
+/// features that list it, in declaration order (for its strategy).
+fn add_faces(
+    input: &Input,
+    graph: &mut DiGraph<Node, Edge>,
+    feature_nodes: &[(FeatureId, NodeIndex)],
+    datums_of: &HashMap<FeatureId, Vec<String>>,
+) -> FacesAdded {
     let g = input.geometry;
     let mut face_nodes: Vec<(FaceId, NodeIndex, FeatureId)> = Vec::new();
     let mut face_node_of: HashMap<FaceId, NodeIndex> = HashMap::new();
-    // Per face, the features that list it, in declaration order (for its strategy).
     let mut owners_of: HashMap<FaceId, Vec<FeatureId>> = HashMap::new();
-    for &(f, fnode) in &feature_nodes {
+    for &(f, fnode) in feature_nodes {
         let datum = datums_of.contains_key(&f);
         for &face in &input.feature_faces[f.0] {
             // Each feature comes once and lists each face once.
@@ -272,10 +305,30 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
             graph.update_edge(fnode, node, Edge::Face);
         }
     }
+    (face_nodes, owners_of)
+}
 
+/// What [`add_faces`] gives: the face nodes (face, node, first feature) and each face's
+/// features.
+type FacesAdded = (
+    Vec<(FaceId, NodeIndex, FeatureId)>,
+    HashMap<FaceId, Vec<FeatureId>>,
+);
+
+/// Samples each face and adds its fpoints under it, up to [`MAX_POINTS`] in all;
+/// reports a face that gets none, and stops with an error past the limit.
+fn add_points(
+    input: &Input,
+    graph: &mut DiGraph<Node, Edge>,
+    face_nodes: &[(FaceId, NodeIndex, FeatureId)],
+    mut owners_of: HashMap<FaceId, Vec<FeatureId>>,
+    diags: &mut Diagnostics,
+) -> Vec<Fpoint> {
+    let part = input.part;
+    let g = input.geometry;
     let sampler = Sampler::new(g, input.margin);
     let mut fpoints = Vec::new();
-    for &(face, fnode, first_feature) in &face_nodes {
+    for &(face, fnode, first_feature) in face_nodes {
         let mut owners = owners_of.remove(&face).unwrap_or_default();
         owners.sort();
         let strategy = strategy_for(input, face, &owners);
@@ -306,15 +359,7 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
             fpoints.push(p);
         }
     }
-    MeasurementGraph {
-        plan: input.plan.map(str::to_owned),
-        sampling: input.sampling.name.clone(),
-        graph,
-        root,
-        fpoints,
-        margin: input.margin,
-        sensors: Vec::new(),
-    }
+    fpoints
 }
 
 /// The strategy for a face: the override of the first feature (in declaration order)

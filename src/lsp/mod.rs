@@ -575,149 +575,153 @@ impl Server {
         let _ = self.sender.send(Message::Response(response));
     }
 
-    fn answer(
-        &mut self,
-        req: Request,
-    ) -> Result<serde_json::Value, (lsp_server::ErrorCode, String)> {
+    fn answer(&mut self, req: Request) -> Result<serde_json::Value, Failure> {
         use lt::request::*;
-        let bad = |e: String| (lsp_server::ErrorCode::InvalidParams, e);
-        let json = |v: Result<serde_json::Value, serde_json::Error>| {
-            v.map_err(|e| (lsp_server::ErrorCode::InternalError, e.to_string()))
-        };
         match req.method.as_str() {
-            HoverRequest::METHOD => {
-                let p: lt::HoverParams = extract(req)?;
-                let at = &p.text_document_position_params;
-                let hover =
-                    self.at(&at.text_document.uri, at.position)
-                        .and_then(|(a, file, offset)| {
-                            let (span, md) = hover::hover(a, file, offset)?;
-                            Some(lt::Hover {
-                                contents: lt::HoverContents::Markup(lt::MarkupContent {
-                                    kind: lt::MarkupKind::Markdown,
-                                    value: md,
-                                }),
-                                range: Some(self.range(&a.front, span)?.range),
-                            })
-                        });
-                json(serde_json::to_value(hover))
-            }
+            HoverRequest::METHOD => json(serde_json::to_value(self.on_hover(extract(req)?))),
             GotoDefinition::METHOD => {
-                let p: lt::GotoDefinitionParams = extract(req)?;
-                let at = &p.text_document_position_params;
-                let loc =
-                    self.at(&at.text_document.uri, at.position)
-                        .and_then(|(a, file, offset)| {
-                            let (_, decl) = symbols::target(&a.front, file, offset)?;
-                            self.range(&a.front, decl)
-                        });
+                let loc = self.on_definition(extract(req)?);
                 json(serde_json::to_value(
                     loc.map(lt::GotoDefinitionResponse::Scalar),
                 ))
             }
-            References::METHOD => {
-                let p: lt::ReferenceParams = extract(req)?;
-                let at = &p.text_document_position;
-                let include = p.context.include_declaration;
-                let locs = self
-                    .at(&at.text_document.uri, at.position)
-                    .map(|(a, file, offset)| {
-                        let Some((_, decl)) = symbols::target(&a.front, file, offset) else {
-                            return Vec::new();
-                        };
-                        symbols::references(&a.front, decl)
-                            .into_iter()
-                            .filter(|s| include || *s != decl)
-                            .filter_map(|s| self.range(&a.front, s))
-                            .collect::<Vec<_>>()
-                    });
-                json(serde_json::to_value(locs))
-            }
-            DocumentSymbolRequest::METHOD => {
-                let p: lt::DocumentSymbolParams = extract(req)?;
-                let symbols =
-                    self.at(&p.text_document.uri, lt::Position::default())
-                        .map(|(a, file, _)| {
-                            lt::DocumentSymbolResponse::Nested(document_symbols(a, file))
-                        });
-                json(serde_json::to_value(symbols))
-            }
-            Completion::METHOD => {
-                let p: lt::CompletionParams = extract(req)?;
-                let at = &p.text_document_position;
-                let Some(path) = canonical(&at.text_document.uri) else {
-                    return Ok(serde_json::Value::Null);
-                };
-                let (Some(doc), Some(a)) = (self.docs.get(&path), self.analyses.get(&path)) else {
-                    return Ok(serde_json::Value::Null);
-                };
-                let offset = text::offset(&doc.text, at.position);
-                let checked = a.parsed.as_deref().unwrap_or(&a.front);
-                let file = checked
-                    .sources
-                    .find_path(&path)
-                    .unwrap_or(crate::source::FileId(u32::MAX));
-                let items = complete::complete(checked, file, &doc.text, offset);
-                json(serde_json::to_value(lt::CompletionResponse::Array(items)))
-            }
-            Rename::METHOD => {
-                let p: lt::RenameParams = extract(req)?;
-                let at = &p.text_document_position;
-                let new_name = p.new_name;
-                if !symbols::is_name(&new_name) {
-                    return Err(bad(format!(
-                        "`{new_name}` is not a name: a letter or `_`, then letters, digits and `_`, and not a keyword"
-                    )));
-                }
-                let Some((a, file, offset)) = self.at(&at.text_document.uri, at.position) else {
-                    return Ok(serde_json::Value::Null);
-                };
-                let Some((_, decl)) = symbols::target(&a.front, file, offset) else {
-                    return Err(bad("no name here to rename".into()));
-                };
-                if a.front.sources.get(decl.file).path.is_none() {
-                    return Err(bad("a standard-library name cannot be renamed".into()));
-                }
-                // `WorkspaceEdit` keys its edits by `Uri`, which clippy thinks mutable.
-                #[allow(clippy::mutable_key_type)]
-                let mut changes: std::collections::HashMap<
-                    lt::Uri,
-                    Vec<lt::TextEdit>,
-                > = std::collections::HashMap::new();
-                for s in symbols::references(&a.front, decl) {
-                    if let Some(loc) = self.range(&a.front, s) {
-                        changes.entry(loc.uri).or_default().push(lt::TextEdit {
-                            range: loc.range,
-                            new_text: new_name.clone(),
-                        });
-                    }
-                }
-                json(serde_json::to_value(lt::WorkspaceEdit {
-                    changes: Some(changes),
-                    ..Default::default()
-                }))
-            }
-            Formatting::METHOD => {
-                let p: lt::DocumentFormattingParams = extract(req)?;
-                let Some(doc) = canonical(&p.text_document.uri).and_then(|p| self.docs.get(&p))
-                else {
-                    return Ok(serde_json::Value::Null);
-                };
-                // Only a layout change that keeps the parse tree (as `inspc fmt`).
-                let edits = match crate::fmt::format_checked(&doc.text) {
-                    Some(formatted) if formatted != doc.text => vec![lt::TextEdit {
-                        range: text::range(&doc.text, 0..doc.text.len()),
-                        new_text: formatted,
-                    }],
-                    _ => Vec::new(),
-                };
-                json(serde_json::to_value(edits))
-            }
+            References::METHOD => json(serde_json::to_value(self.on_references(extract(req)?))),
+            DocumentSymbolRequest::METHOD => json(serde_json::to_value(
+                self.on_document_symbols(extract(req)?),
+            )),
+            Completion::METHOD => self.on_completion(extract(req)?),
+            Rename::METHOD => self.on_rename(extract(req)?),
+            Formatting::METHOD => self.on_formatting(extract(req)?),
             _ => Err((
                 lsp_server::ErrorCode::MethodNotFound,
                 format!("inspc lsp does not answer {}", req.method),
             )),
         }
+    }
+
+    /// The hover at a position: what the name there is, in Markdown.
+    fn on_hover(&self, p: lt::HoverParams) -> Option<lt::Hover> {
+        let at = &p.text_document_position_params;
+        self.at(&at.text_document.uri, at.position)
+            .and_then(|(a, file, offset)| {
+                let (span, md) = hover::hover(a, file, offset)?;
+                Some(lt::Hover {
+                    contents: lt::HoverContents::Markup(lt::MarkupContent {
+                        kind: lt::MarkupKind::Markdown,
+                        value: md,
+                    }),
+                    range: Some(self.range(&a.front, span)?.range),
+                })
+            })
+    }
+
+    /// Where the name at a position is declared.
+    fn on_definition(&self, p: lt::GotoDefinitionParams) -> Option<lt::Location> {
+        let at = &p.text_document_position_params;
+        self.at(&at.text_document.uri, at.position)
+            .and_then(|(a, file, offset)| {
+                let (_, decl) = symbols::target(&a.front, file, offset)?;
+                self.range(&a.front, decl)
+            })
+    }
+
+    /// Every use of the name at a position, its declaration too when asked.
+    fn on_references(&self, p: lt::ReferenceParams) -> Option<Vec<lt::Location>> {
+        let at = &p.text_document_position;
+        let include = p.context.include_declaration;
+        self.at(&at.text_document.uri, at.position)
+            .map(|(a, file, offset)| {
+                let Some((_, decl)) = symbols::target(&a.front, file, offset) else {
+                    return Vec::new();
+                };
+                symbols::references(&a.front, decl)
+                    .into_iter()
+                    .filter(|s| include || *s != decl)
+                    .filter_map(|s| self.range(&a.front, s))
+                    .collect::<Vec<_>>()
+            })
+    }
+
+    /// A document's outline.
+    fn on_document_symbols(
+        &self,
+        p: lt::DocumentSymbolParams,
+    ) -> Option<lt::DocumentSymbolResponse> {
+        self.at(&p.text_document.uri, lt::Position::default())
+            .map(|(a, file, _)| lt::DocumentSymbolResponse::Nested(document_symbols(a, file)))
+    }
+
+    /// The completions at a position, from the document's last parsed analysis.
+    fn on_completion(&self, p: lt::CompletionParams) -> Result<serde_json::Value, Failure> {
+        let at = &p.text_document_position;
+        let Some(path) = canonical(&at.text_document.uri) else {
+            return Ok(serde_json::Value::Null);
+        };
+        let (Some(doc), Some(a)) = (self.docs.get(&path), self.analyses.get(&path)) else {
+            return Ok(serde_json::Value::Null);
+        };
+        let offset = text::offset(&doc.text, at.position);
+        let checked = a.parsed.as_deref().unwrap_or(&a.front);
+        let file = checked
+            .sources
+            .find_path(&path)
+            .unwrap_or(crate::source::FileId(u32::MAX));
+        let items = complete::complete(checked, file, &doc.text, offset);
+        json(serde_json::to_value(lt::CompletionResponse::Array(items)))
+    }
+
+    /// The edits that rename the name at a position, wherever it is used; an error for a
+    /// new name that is not one, no name there, or a standard-library name.
+    fn on_rename(&self, p: lt::RenameParams) -> Result<serde_json::Value, Failure> {
+        let bad = |e: String| (lsp_server::ErrorCode::InvalidParams, e);
+        let at = &p.text_document_position;
+        let new_name = p.new_name;
+        if !symbols::is_name(&new_name) {
+            return Err(bad(format!(
+                "`{new_name}` is not a name: a letter or `_`, then letters, digits and `_`, and not a keyword"
+            )));
+        }
+        let Some((a, file, offset)) = self.at(&at.text_document.uri, at.position) else {
+            return Ok(serde_json::Value::Null);
+        };
+        let Some((_, decl)) = symbols::target(&a.front, file, offset) else {
+            return Err(bad("no name here to rename".into()));
+        };
+        if a.front.sources.get(decl.file).path.is_none() {
+            return Err(bad("a standard-library name cannot be renamed".into()));
+        }
+        // `WorkspaceEdit` keys its edits by `Uri`, which clippy thinks mutable.
+        #[allow(clippy::mutable_key_type)]
+        let mut changes: std::collections::HashMap<lt::Uri, Vec<lt::TextEdit>> =
+            std::collections::HashMap::new();
+        for s in symbols::references(&a.front, decl) {
+            if let Some(loc) = self.range(&a.front, s) {
+                changes.entry(loc.uri).or_default().push(lt::TextEdit {
+                    range: loc.range,
+                    new_text: new_name.clone(),
+                });
+            }
+        }
+        json(serde_json::to_value(lt::WorkspaceEdit {
+            changes: Some(changes),
+            ..Default::default()
+        }))
+    }
+
+    /// The edit that formats a document, when formatting changes its layout only.
+    fn on_formatting(&self, p: lt::DocumentFormattingParams) -> Result<serde_json::Value, Failure> {
+        let Some(doc) = canonical(&p.text_document.uri).and_then(|p| self.docs.get(&p)) else {
+            return Ok(serde_json::Value::Null);
+        };
+        // Only a layout change that keeps the parse tree (as `inspc fmt`).
+        let edits = match crate::fmt::format_checked(&doc.text) {
+            Some(formatted) if formatted != doc.text => vec![lt::TextEdit {
+                range: text::range(&doc.text, 0..doc.text.len()),
+                new_text: formatted,
+            }],
+            _ => Vec::new(),
+        };
+        json(serde_json::to_value(edits))
     }
 
     /// The analysis of an open document, its file id there and the byte offset of a
@@ -754,6 +758,14 @@ fn extract<P: serde::de::DeserializeOwned>(
 ) -> Result<P, (lsp_server::ErrorCode, String)> {
     serde_json::from_value(req.params)
         .map_err(|e| (lsp_server::ErrorCode::InvalidParams, e.to_string()))
+}
+
+/// What a request fails with: an LSP error code and a message.
+type Failure = (lsp_server::ErrorCode, String);
+
+/// A result as JSON, or an internal error where it cannot be written.
+fn json(v: Result<serde_json::Value, serde_json::Error>) -> Result<serde_json::Value, Failure> {
+    v.map_err(|e| (lsp_server::ErrorCode::InternalError, e.to_string()))
 }
 
 fn canonical(uri: &lt::Uri) -> Option<PathBuf> {

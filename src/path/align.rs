@@ -61,12 +61,14 @@
 //! it (one circle; two for a primary axis), not the four points farthest apart in
 //! space, which can lie on one line and leave the centre across them unknown.
 
-use super::{Hlip, SetupPath};
+use super::align_extra::complete;
+use super::{BlockPath, Hlip, SetupPath};
 use crate::access::Contact;
 use crate::geometry::{FaceId, Surface, P3, V3};
 use crate::graph::Node;
 use crate::model::FeatureId;
 use crate::plan::Input;
+use std::collections::BTreeSet;
 
 /// A setup's alignment.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -108,20 +110,20 @@ pub struct ExtraFace {
     pub touches: Vec<(P3, V3)>,
 }
 
-const AXES: [char; 3] = ['X', 'Y', 'Z'];
+pub(super) const AXES: [char; 3] = ['X', 'Y', 'Z'];
 
 /// The part axis a unit vector lies along, and its sign.
-fn axis_of(v: &V3) -> Option<(usize, bool)> {
+pub(super) fn axis_of(v: &V3) -> Option<(usize, bool)> {
     (0..3)
         .find(|&k| v[k].abs() > 1.0 - 1e-9)
         .map(|k| (k, v[k] > 0.0))
 }
 
-fn dir_word(k: usize, positive: bool) -> String {
+pub(super) fn dir_word(k: usize, positive: bool) -> String {
     format!("{}{}DIR", if positive { "" } else { "-" }, AXES[k])
 }
 
-fn orig_word(k: usize) -> String {
+pub(super) fn orig_word(k: usize) -> String {
     format!("{}ORIG", AXES[k])
 }
 
@@ -226,6 +228,67 @@ fn align_on(
     touch: &[Touchable],
     on_referenced: bool,
 ) -> Alignment {
+    let cands = candidates(input, hlip, sp, on_referenced);
+    let mut out = Alignment::default();
+    let mut dirs: Vec<usize> = Vec::new();
+    let mut origins = [false; 3];
+    let mut free = Free {
+        dirs: &mut dirs,
+        origins: &mut origins,
+    };
+    steps_on_blocks(hlip, &cands, &mut out, &mut free);
+    // A primary cylinder or a lone sphere when no plane qualifies.
+    if out.steps.is_empty() {
+        step_on_round(hlip, &cands, &mut out, &mut free);
+    }
+    let used_faces: Vec<FaceId> = out
+        .steps
+        .iter()
+        .filter_map(|st| {
+            let b = sp.groups.get(st.group)?.blocks.get(st.block?)?;
+            (b.contact == Contact::Part).then_some(b.face)
+        })
+        .collect();
+    let group = out.steps.first().map_or(0, |st| st.group);
+    let up = hlip.setups[sp.setup].up;
+    complete(input, up, group, &used_faces, touch, &mut out, &mut free);
+    if dirs.is_empty() {
+        out.missing.push("the part's orientation".into());
+    } else if dirs.len() == 1 {
+        out.missing
+            .push(format!("the rotation about {}", AXES[dirs[0]]));
+    }
+    for k in 0..3 {
+        if !origins[k] {
+            out.missing.push(format!("the {} origin", AXES[k]));
+        }
+    }
+    out
+}
+
+/// A block of the setup the alignment may stand on.
+struct Candidate {
+    /// (class, datum, stands in for it): datum features first in datum order (the datum
+    /// itself before a plane parallel to the one it rests on), then features no
+    /// tolerance reads against datums, then the rest.
+    rank: (u8, usize, u8),
+    /// The face's area, negated: the largest first.
+    neg_area: f64,
+    /// The group (index into [`SetupPath::groups`]).
+    group: usize,
+    /// The block in that group.
+    block: usize,
+    /// Its surface as the alignment sees it.
+    shape: Shape,
+    /// Its points, in tour order.
+    points: Vec<usize>,
+}
+
+/// The setup's blocks the alignment may stand on, best first: by rank, then area, then
+/// in block order. Without `on_referenced`, the blocks of features a tolerance reads
+/// against datums are left out, and so are faces this setup measures only part of and
+/// faces a frame this setup does not build would carry over.
+fn candidates(input: &Input, hlip: &Hlip, sp: &SetupPath, on_referenced: bool) -> Vec<Candidate> {
     let geometry = input.geometry;
     // Features whose tolerances refer to datums: aligned on, such a feature sets the
     // frame its own tolerance is read in (moved, it would read perfect).
@@ -243,33 +306,8 @@ fn align_on(
     let setup = &hlip.setups[sp.setup];
     let resting = resting_datum(input, setup.up, setup.table);
     let vertical = axis_of(&setup.up).map(|(k, _)| k);
-    // Faces of features a tolerance reads against datums this setup does not measure
-    // (a datum bore that is also one of a toleranced pattern's holes): the frame would
-    // carry those datums over as drawn and move with the face.
-    let here_features = sp.features();
-    let carried: Vec<FaceId> = part
-        .tolerances
-        .iter()
-        .filter(|t| {
-            !t.datums.is_empty()
-                && !t
-                    .datums
-                    .iter()
-                    .all(|d| here_features.contains(&part.datums[d.datum.0].feature))
-        })
-        .flat_map(|t| t.targets.iter())
-        .flat_map(|f| faces_in_graph(input, *f))
-        .collect();
-    let elsewhere = points_elsewhere(hlip, sp.setup);
-    let here: std::collections::BTreeSet<usize> = sp
-        .groups
-        .iter()
-        .flat_map(|g| &g.blocks)
-        .flat_map(|b| b.touches.iter().map(|t| t.point))
-        .collect();
-    // Candidates: (rank, -area, group, block, shape, points in tour order); the rank is
-    // datum features first in datum order, then features no tolerance reads against
-    // datums, then the rest.
+    let carried = carried_faces(input, sp);
+    let split = split_faces(hlip, sp);
     let mut cands = Vec::new();
     for (gi, g) in sp.groups.iter().enumerate() {
         for (bi, b) in g.blocks.iter().enumerate() {
@@ -277,44 +315,14 @@ fn align_on(
             let Some(&first) = points.first() else {
                 continue;
             };
-            let split = elsewhere
-                .get(&b.face)
-                .is_some_and(|pts| pts.iter().any(|p| !here.contains(p)));
+            let split = split.contains(&b.face);
             if (split || carried.contains(&b.face)) && !on_referenced && b.contact == Contact::Part
             {
                 continue;
             }
-            let f = geometry.faces.get(b.face.0);
-            let shape = if b.contact == Contact::Table {
-                let p = &hlip.points[first];
-                axis_of(&p.normal).map(|(axis, positive)| Shape::Plane {
-                    axis,
-                    positive,
-                    at: p.position[axis],
-                })
-            } else {
-                match f.map(|f| &f.surface) {
-                    Some(Surface::Plane { origin, normal }) => {
-                        axis_of(normal).map(|(axis, positive)| Shape::Plane {
-                            axis,
-                            positive,
-                            at: origin[axis],
-                        })
-                    }
-                    Some(Surface::Cylinder { origin, axis, .. }) => {
-                        axis_of(axis).map(|(k, positive)| Shape::Cylinder {
-                            axis: k,
-                            positive,
-                            at: *origin,
-                        })
-                    }
-                    Some(Surface::Sphere { center, .. }) => Some(Shape::Sphere { at: *center }),
-                    _ => None,
-                }
+            let Some(shape) = block_shape(input, hlip, b, first) else {
+                continue;
             };
-            let Some(shape) = shape else { continue };
-            // (class, datum, stands in for it): the datum itself before a plane parallel
-            // to the one it rests on.
             let mut rank = match (b.datum, b.feature) {
                 (Some(d), _) => (0, d.0, 0),
                 (None, Some(f)) if referenced.contains(&f) => {
@@ -330,77 +338,118 @@ fn align_on(
                     rank = rank.min((0, r, 1));
                 }
             }
-            let area = f.map_or(0.0, |f| f.area);
-            cands.push((rank, -area, gi, bi, shape, points));
+            let area = geometry.faces.get(b.face.0).map_or(0.0, |f| f.area);
+            cands.push(Candidate {
+                rank,
+                neg_area: -area,
+                group: gi,
+                block: bi,
+                shape,
+                points,
+            });
         }
     }
     // Datum rank first, then area, then order.
     cands.sort_by(|a, b| {
-        a.0.cmp(&b.0)
-            .then(a.1.total_cmp(&b.1))
-            .then((a.2, a.3).cmp(&(b.2, b.3)))
+        a.rank
+            .cmp(&b.rank)
+            .then(a.neg_area.total_cmp(&b.neg_area))
+            .then((a.group, a.block).cmp(&(b.group, b.block)))
     });
+    cands
+}
 
-    let mut out = Alignment::default();
-    let mut dirs: Vec<usize> = Vec::new();
-    let mut origins = [false; 3];
+/// Faces of features a tolerance reads against datums this setup does not measure
+/// (a datum bore that is also one of a toleranced pattern's holes): the frame would
+/// carry those datums over as drawn and move with the face.
+fn carried_faces(input: &Input, sp: &SetupPath) -> Vec<FaceId> {
+    let part = &input.model.parts[input.plan.part.0];
+    let here_features = sp.features();
+    part.tolerances
+        .iter()
+        .filter(|t| {
+            !t.datums.is_empty()
+                && !t
+                    .datums
+                    .iter()
+                    .all(|d| here_features.contains(&part.datums[d.datum.0].feature))
+        })
+        .flat_map(|t| t.targets.iter())
+        .flat_map(|f| faces_in_graph(input, *f))
+        .collect()
+}
+
+/// The faces this setup measures only part of: other setups take points on them that
+/// this one does not.
+fn split_faces(hlip: &Hlip, sp: &SetupPath) -> BTreeSet<FaceId> {
+    let here: BTreeSet<usize> = sp
+        .groups
+        .iter()
+        .flat_map(|g| &g.blocks)
+        .flat_map(|b| b.touches.iter().map(|t| t.point))
+        .collect();
+    points_elsewhere(hlip, sp.setup)
+        .into_iter()
+        .filter(|(_, pts)| pts.iter().any(|p| !here.contains(p)))
+        .map(|(face, _)| face)
+        .collect()
+}
+
+/// The surface the alignment sees in block `b` (its first point `first`): the table's
+/// plane there, or the block's face where its normal or axis is a part axis (any
+/// sphere); `None` for anything else.
+fn block_shape(input: &Input, hlip: &Hlip, b: &BlockPath, first: usize) -> Option<Shape> {
+    if b.contact == Contact::Table {
+        let p = &hlip.points[first];
+        return axis_of(&p.normal).map(|(axis, positive)| Shape::Plane {
+            axis,
+            positive,
+            at: p.position[axis],
+        });
+    }
+    match input.geometry.faces.get(b.face.0).map(|f| &f.surface) {
+        Some(Surface::Plane { origin, normal }) => {
+            axis_of(normal).map(|(axis, positive)| Shape::Plane {
+                axis,
+                positive,
+                at: origin[axis],
+            })
+        }
+        Some(Surface::Cylinder { origin, axis, .. }) => {
+            axis_of(axis).map(|(k, positive)| Shape::Cylinder {
+                axis: k,
+                positive,
+                at: *origin,
+            })
+        }
+        Some(Surface::Sphere { center, .. }) => Some(Shape::Sphere { at: *center }),
+        _ => None,
+    }
+}
+
+/// What a step fixes.
+struct Fix {
+    /// Its keywords: `ZDIR`, `XORIG`, ….
+    keywords: Vec<String>,
+    /// How many points it touches.
+    points: usize,
+    /// The origins it fixes (part axes).
+    origins: Vec<usize>,
+    /// The direction it fixes.
+    dir: Option<usize>,
+}
+
+/// The steps the setup's own blocks give, stage by stage — a primary (0), a secondary
+/// (1), tertiaries (2) — each the first candidate in order that fixes something still
+/// free and whose points can show it.
+fn steps_on_blocks(hlip: &Hlip, cands: &[Candidate], out: &mut Alignment, free: &mut Free) {
     let mut used = vec![false; cands.len()];
-    // `n` of `pts`, each as far as it can be from those chosen before (positions seen
-    // through `view`: a bore's points are spread by their angle about its axis).
-    let spread_by = |pts: &[usize], n: usize, view: &dyn Fn(&P3) -> P3| -> Option<Vec<usize>> {
-        if pts.len() < n {
-            return None;
-        }
-        let pos = |k: usize| view(&hlip.points[k].position);
-        let mut chosen = vec![pts[0]];
-        while chosen.len() < n {
-            let next = pts
-                .iter()
-                .filter(|k| !chosen.contains(k))
-                .max_by(|&&a, &&b| {
-                    let d = |x: usize| {
-                        chosen
-                            .iter()
-                            .map(|&c| (pos(x) - pos(c)).norm())
-                            .fold(f64::INFINITY, f64::min)
-                    };
-                    d(a).total_cmp(&d(b)).then(b.cmp(&a))
-                })?;
-            chosen.push(*next);
-        }
-        Some(chosen)
-    };
-    let spread = |pts: &[usize], n: usize| spread_by(pts, n, &|p: &P3| *p);
-    // A bore touched by hand: circles of `per_level` points at `levels` heights along
-    // its axis (most-touched heights first), each circle's points spread round it; the
-    // points of one height alone say nothing of the centre across them.
-    let round = |pts: &[usize], axis: usize, levels: usize, per_level: usize| {
-        let mut by_level: Vec<(i64, Vec<usize>)> = Vec::new();
-        for &k in pts {
-            let h = (hlip.points[k].position[axis] * 1e3).round() as i64;
-            match by_level.iter_mut().find(|(x, _)| *x == h) {
-                Some((_, v)) => v.push(k),
-                None => by_level.push((h, vec![k])),
-            }
-        }
-        by_level.sort_by(|a, b| b.1.len().cmp(&a.1.len()).then(a.0.cmp(&b.0)));
-        let flat = |p: &P3| {
-            let mut q = *p;
-            q[axis] = 0.0;
-            q
-        };
-        let mut out = Vec::new();
-        for (_, at) in by_level.iter().take(levels) {
-            out.extend(spread_by(at, per_level.min(at.len()).max(3), &flat)?);
-        }
-        (by_level.len() >= levels).then_some(out)
-    };
-    let is_datum = |ci: usize| cands[ci].0 .0 == 0;
+    let is_datum = |ci: usize| cands[ci].rank.0 == 0;
     let datum_bore = |primary: usize| {
         cands.iter().any(|c| {
-            c.0 .0 == 0
-                && c.5.len() >= 4
-                && matches!(c.4, Shape::Cylinder { axis, .. } if axis == primary)
+            c.rank.0 == 0
+                && c.points.len() >= 4
+                && matches!(c.shape, Shape::Cylinder { axis, .. } if axis == primary)
         })
     };
     // A secondary plane fixes the turn about the primary that a bore cannot: planes are
@@ -409,199 +458,263 @@ fn align_on(
     for stage in 0..3 {
         let order = (0..passes(stage)).flat_map(|pass| {
             cands.iter().enumerate().filter(move |(_, c)| {
-                passes(stage) == 1 || (pass == 0) == matches!(c.4, Shape::Plane { .. })
+                passes(stage) == 1 || (pass == 0) == matches!(c.shape, Shape::Plane { .. })
             })
         });
-        for (ci, (_, _, gi, bi, shape, pts)) in order {
+        for (ci, c) in order {
             if used[ci] {
                 continue;
             }
-            let free = |skip: Option<usize>| -> Vec<usize> {
-                (0..3).filter(|&k| Some(k) != skip && !origins[k]).collect()
+            let Some(fix) = stage_fix(stage, &c.shape, free, is_datum(ci), &datum_bore) else {
+                continue;
             };
-            // (keywords, points needed, origins fixed, direction fixed)
-            let (keywords, n, fixed, dir): (Vec<String>, usize, Vec<usize>, Option<usize>) =
-                match (stage, shape) {
-                    (0, Shape::Plane { axis, positive, .. }) => (
-                        vec![dir_word(*axis, *positive), orig_word(*axis)],
-                        3,
-                        vec![*axis],
-                        Some(*axis),
-                    ),
-                    // A plane that is no datum gives only its direction where a datum
-                    // bore along the primary will place the origins across it.
-                    (1, Shape::Plane { axis, positive, .. })
-                        if !dirs.contains(axis)
-                            && dirs.len() == 1
-                            && !is_datum(ci)
-                            && datum_bore(dirs[0]) =>
-                    {
-                        (vec![dir_word(*axis, *positive)], 2, vec![], Some(*axis))
-                    }
-                    (1, Shape::Plane { axis, positive, .. })
-                        if !dirs.contains(axis) && dirs.len() == 1 =>
-                    {
-                        (
-                            vec![dir_word(*axis, *positive), orig_word(*axis)],
-                            2,
-                            vec![*axis],
-                            Some(*axis),
-                        )
-                    }
-                    (2, Shape::Plane { axis, .. }) if !origins[*axis] && dirs.len() == 2 => {
-                        (vec![orig_word(*axis)], 1, vec![*axis], None)
-                    }
-                    (1, Shape::Cylinder { axis, .. }) if dirs == [*axis] => {
-                        let o = free(Some(*axis));
-                        (o.iter().map(|&k| orig_word(k)).collect(), 4, o, None)
-                    }
-                    // A bore along one of the directions places the origins left free
-                    // across it (a plane and its edge, then a hole for the last one).
-                    (2, Shape::Cylinder { axis, .. }) if dirs.contains(axis) => {
-                        let o = free(Some(*axis));
-                        (o.iter().map(|&k| orig_word(k)).collect(), 4, o, None)
-                    }
-                    (2, Shape::Sphere { .. }) => {
-                        let o = free(None);
-                        (o.iter().map(|&k| orig_word(k)).collect(), 4, o, None)
-                    }
-                    _ => continue,
-                };
-            if keywords.is_empty() {
+            if fix.keywords.is_empty() {
                 continue;
             }
-            // The secondary's two points lie along it, across the primary direction:
-            // two points one above the other say nothing of the turn about it.
-            let points = match (stage, shape, dirs.first()) {
-                (1, Shape::Plane { axis, .. }, Some(&p)) => {
-                    let along = V3::ith(p, 1.0).cross(&V3::ith(*axis, 1.0));
-                    let pos = |k: usize| hlip.points[k].position;
-                    let mut best: Option<(f64, [usize; 2])> = None;
-                    for (i, &a) in pts.iter().enumerate() {
-                        for &b in &pts[i + 1..] {
-                            let d = (pos(b) - pos(a)).dot(&along).abs();
-                            if best.is_none_or(|(x, _)| d > x + 1e-9) {
-                                best = Some((d, [a, b]));
-                            }
-                        }
-                    }
-                    match best {
-                        Some((d, pair)) if d > 1e-3 => Some(pair.to_vec()),
-                        _ => None,
-                    }
-                }
-                (_, Shape::Cylinder { axis, .. }, _) => round(pts, *axis, 1, n),
-                // A primary plane: the widest triangle of its points (the farthest ones
-                // may lie on one line, which fixes no plane).
-                (0, Shape::Plane { .. }, _) => {
-                    let pos: Vec<P3> = pts.iter().map(|&k| hlip.points[k].position).collect();
-                    widest_triangle(&pos).map(|t| t.iter().map(|&i| pts[i]).collect())
-                }
-                _ => spread(pts, n),
-            };
-            let Some(points) = points else {
+            let primary = free.dirs.first().copied();
+            let Some(points) = stage_points(hlip, stage, &c.shape, &c.points, fix.points, primary)
+            else {
                 continue;
             };
             used[ci] = true;
-            dirs.extend(dir);
-            for k in fixed {
-                origins[k] = true;
-                out.trans.push((AXES[k], shape.at(k)));
+            free.dirs.extend(fix.dir);
+            for k in fix.origins {
+                free.origins[k] = true;
+                out.trans.push((AXES[k], c.shape.at(k)));
             }
             out.steps.push(AlignStep {
-                group: *gi,
+                group: c.group,
                 orient: None,
-                block: Some(*bi),
+                block: Some(c.block),
                 points,
                 extra: None,
-                keywords,
+                keywords: fix.keywords,
             });
             break;
         }
     }
-    // A primary cylinder or a lone sphere when no plane qualifies.
-    if out.steps.is_empty() {
-        for (gi, bi, shape, pts) in cands.iter().map(|c| (c.2, c.3, &c.4, &c.5)) {
-            let (keywords, fixed): (Vec<String>, Vec<usize>) = match shape {
-                Shape::Cylinder { axis, positive, .. } => {
-                    let o: Vec<usize> = (0..3).filter(|k| k != axis).collect();
-                    let mut w = vec![dir_word(*axis, *positive)];
-                    w.extend(o.iter().map(|&k| orig_word(k)));
-                    (w, o)
-                }
-                Shape::Sphere { .. } => ((0..3).map(orig_word).collect(), (0..3).collect()),
-                Shape::Plane { .. } => continue,
-            };
-            // A circle takes 3 touches, a sphere 4: a block of fewer (one of a
-            // surface's split touches) aligns nothing.
-            let need = if matches!(shape, Shape::Sphere { .. }) {
-                4
-            } else {
-                3
-            };
-            if pts.len() < need {
-                continue;
-            }
-            let points = match shape {
-                // Its direction needs two circles.
-                Shape::Cylinder { axis, .. } => round(pts, *axis, 2, 3),
-                _ => spread(pts, 4.min(pts.len())),
-            };
-            let Some(points) = points else {
-                continue;
-            };
-            if let Shape::Cylinder { axis, .. } = shape {
-                dirs.push(*axis);
-            }
-            for k in fixed {
-                origins[k] = true;
-                out.trans.push((AXES[k], shape.at(k)));
-            }
-            out.steps.push(AlignStep {
-                group: gi,
-                orient: None,
-                block: Some(bi),
-                points,
-                extra: None,
-                keywords,
-            });
-            break;
-        }
-    }
-    let used_faces: Vec<FaceId> = out
-        .steps
-        .iter()
-        .filter_map(|st| {
-            let b = sp.groups.get(st.group)?.blocks.get(st.block?)?;
-            (b.contact == Contact::Part).then_some(b.face)
-        })
-        .collect();
-    let group = out.steps.first().map_or(0, |st| st.group);
-    let mut free = Free {
-        dirs: &mut dirs,
-        origins: &mut origins,
+}
+
+/// What a candidate of surface `shape` fixes at `stage`, given what `free` says is
+/// fixed; `None` where it fixes nothing there. `is_datum`: whether it is a datum
+/// feature's; `datum_bore(axis)`: whether a datum bore runs along part axis `axis`.
+fn stage_fix(
+    stage: usize,
+    shape: &Shape,
+    free: &Free,
+    is_datum: bool,
+    datum_bore: &dyn Fn(usize) -> bool,
+) -> Option<Fix> {
+    let dirs: &Vec<usize> = free.dirs;
+    let origins: &[bool; 3] = free.origins;
+    let free_origins = |skip: Option<usize>| -> Vec<usize> {
+        (0..3).filter(|&k| Some(k) != skip && !origins[k]).collect()
     };
-    complete(
-        input,
-        setup.up,
-        group,
-        &used_faces,
-        touch,
-        &mut out,
-        &mut free,
-    );
-    if dirs.is_empty() {
-        out.missing.push("the part's orientation".into());
-    } else if dirs.len() == 1 {
-        out.missing
-            .push(format!("the rotation about {}", AXES[dirs[0]]));
+    let plane = |axis: usize, positive: bool, points: usize| Fix {
+        keywords: vec![dir_word(axis, positive), orig_word(axis)],
+        points,
+        origins: vec![axis],
+        dir: Some(axis),
+    };
+    let centre = |o: Vec<usize>| Fix {
+        keywords: o.iter().map(|&k| orig_word(k)).collect(),
+        points: 4,
+        origins: o,
+        dir: None,
+    };
+    Some(match (stage, shape) {
+        (0, Shape::Plane { axis, positive, .. }) => plane(*axis, *positive, 3),
+        // A plane that is no datum gives only its direction where a datum
+        // bore along the primary will place the origins across it.
+        (1, Shape::Plane { axis, positive, .. })
+            if !dirs.contains(axis) && dirs.len() == 1 && !is_datum && datum_bore(dirs[0]) =>
+        {
+            Fix {
+                keywords: vec![dir_word(*axis, *positive)],
+                points: 2,
+                origins: vec![],
+                dir: Some(*axis),
+            }
+        }
+        (1, Shape::Plane { axis, positive, .. }) if !dirs.contains(axis) && dirs.len() == 1 => {
+            plane(*axis, *positive, 2)
+        }
+        (2, Shape::Plane { axis, .. }) if !origins[*axis] && dirs.len() == 2 => Fix {
+            keywords: vec![orig_word(*axis)],
+            points: 1,
+            origins: vec![*axis],
+            dir: None,
+        },
+        (1, Shape::Cylinder { axis, .. }) if *dirs == [*axis] => centre(free_origins(Some(*axis))),
+        // A bore along one of the directions places the origins left free
+        // across it (a plane and its edge, then a hole for the last one).
+        (2, Shape::Cylinder { axis, .. }) if dirs.contains(axis) => {
+            centre(free_origins(Some(*axis)))
+        }
+        (2, Shape::Sphere { .. }) => centre(free_origins(None)),
+        _ => return None,
+    })
+}
+
+/// The `n` points of `pts` a step at `stage` touches on a candidate of surface `shape`;
+/// `primary` is the direction fixed first. `None` when its points cannot show what it
+/// fixes.
+fn stage_points(
+    hlip: &Hlip,
+    stage: usize,
+    shape: &Shape,
+    pts: &[usize],
+    n: usize,
+    primary: Option<usize>,
+) -> Option<Vec<usize>> {
+    match (stage, shape, primary) {
+        (1, Shape::Plane { axis, .. }, Some(p)) => secondary_pair(hlip, pts, p, *axis),
+        (_, Shape::Cylinder { axis, .. }, _) => round(hlip, pts, *axis, 1, n),
+        // A primary plane: the widest triangle of its points (the farthest ones
+        // may lie on one line, which fixes no plane).
+        (0, Shape::Plane { .. }, _) => {
+            let pos: Vec<P3> = pts.iter().map(|&k| hlip.points[k].position).collect();
+            widest_triangle(&pos).map(|t| t.iter().map(|&i| pts[i]).collect())
+        }
+        _ => spread(hlip, pts, n),
     }
-    for k in 0..3 {
-        if !origins[k] {
-            out.missing.push(format!("the {} origin", AXES[k]));
+}
+
+/// A secondary plane's two points (of `pts`, square to part axis `axis`): the pair
+/// farthest apart along it, across the primary direction `primary` — two points one
+/// above the other say nothing of the turn about it. `None` when no pair is 1 µm apart
+/// that way.
+fn secondary_pair(hlip: &Hlip, pts: &[usize], primary: usize, axis: usize) -> Option<Vec<usize>> {
+    let along = V3::ith(primary, 1.0).cross(&V3::ith(axis, 1.0));
+    let pos = |k: usize| hlip.points[k].position;
+    let mut best: Option<(f64, [usize; 2])> = None;
+    for (i, &a) in pts.iter().enumerate() {
+        for &b in &pts[i + 1..] {
+            let d = (pos(b) - pos(a)).dot(&along).abs();
+            if best.is_none_or(|(x, _)| d > x + 1e-9) {
+                best = Some((d, [a, b]));
+            }
         }
     }
-    out
+    match best {
+        Some((d, pair)) if d > 1e-3 => Some(pair.to_vec()),
+        _ => None,
+    }
+}
+
+/// The step on a primary cylinder (its direction, from two circles, and the origins
+/// across it) or a lone sphere (the three origins) of the setup's blocks, for a setup
+/// where no plane qualifies.
+fn step_on_round(hlip: &Hlip, cands: &[Candidate], out: &mut Alignment, free: &mut Free) {
+    for c in cands {
+        let (shape, pts) = (&c.shape, &c.points);
+        let (keywords, fixed): (Vec<String>, Vec<usize>) = match shape {
+            Shape::Cylinder { axis, positive, .. } => {
+                let o: Vec<usize> = (0..3).filter(|k| k != axis).collect();
+                let mut w = vec![dir_word(*axis, *positive)];
+                w.extend(o.iter().map(|&k| orig_word(k)));
+                (w, o)
+            }
+            Shape::Sphere { .. } => ((0..3).map(orig_word).collect(), (0..3).collect()),
+            Shape::Plane { .. } => continue,
+        };
+        // A circle takes 3 touches, a sphere 4: a block of fewer (one of a
+        // surface's split touches) aligns nothing.
+        let need = if matches!(shape, Shape::Sphere { .. }) {
+            4
+        } else {
+            3
+        };
+        if pts.len() < need {
+            continue;
+        }
+        let points = match shape {
+            // Its direction needs two circles.
+            Shape::Cylinder { axis, .. } => round(hlip, pts, *axis, 2, 3),
+            _ => spread(hlip, pts, 4.min(pts.len())),
+        };
+        let Some(points) = points else {
+            continue;
+        };
+        if let Shape::Cylinder { axis, .. } = shape {
+            free.dirs.push(*axis);
+        }
+        for k in fixed {
+            free.origins[k] = true;
+            out.trans.push((AXES[k], shape.at(k)));
+        }
+        out.steps.push(AlignStep {
+            group: c.group,
+            orient: None,
+            block: Some(c.block),
+            points,
+            extra: None,
+            keywords,
+        });
+        break;
+    }
+}
+
+/// `n` of `pts`, each as far as it can be from those chosen before (positions seen
+/// through `view`: a bore's points are spread by their angle about its axis).
+fn spread_by(hlip: &Hlip, pts: &[usize], n: usize, view: &dyn Fn(&P3) -> P3) -> Option<Vec<usize>> {
+    if pts.len() < n {
+        return None;
+    }
+    let pos = |k: usize| view(&hlip.points[k].position);
+    let mut chosen = vec![pts[0]];
+    while chosen.len() < n {
+        let next = pts
+            .iter()
+            .filter(|k| !chosen.contains(k))
+            .max_by(|&&a, &&b| {
+                let d = |x: usize| {
+                    chosen
+                        .iter()
+                        .map(|&c| (pos(x) - pos(c)).norm())
+                        .fold(f64::INFINITY, f64::min)
+                };
+                d(a).total_cmp(&d(b)).then(b.cmp(&a))
+            })?;
+        chosen.push(*next);
+    }
+    Some(chosen)
+}
+
+/// `n` of `pts`, each as far as it can be from those chosen before.
+fn spread(hlip: &Hlip, pts: &[usize], n: usize) -> Option<Vec<usize>> {
+    spread_by(hlip, pts, n, &|p: &P3| *p)
+}
+
+/// A bore touched by hand: circles of `per_level` points at `levels` heights along
+/// its axis (most-touched heights first), each circle's points spread round it; the
+/// points of one height alone say nothing of the centre across them.
+fn round(
+    hlip: &Hlip,
+    pts: &[usize],
+    axis: usize,
+    levels: usize,
+    per_level: usize,
+) -> Option<Vec<usize>> {
+    let mut by_level: Vec<(i64, Vec<usize>)> = Vec::new();
+    for &k in pts {
+        let h = (hlip.points[k].position[axis] * 1e3).round() as i64;
+        match by_level.iter_mut().find(|(x, _)| *x == h) {
+            Some((_, v)) => v.push(k),
+            None => by_level.push((h, vec![k])),
+        }
+    }
+    by_level.sort_by(|a, b| b.1.len().cmp(&a.1.len()).then(a.0.cmp(&b.0)));
+    let flat = |p: &P3| {
+        let mut q = *p;
+        q[axis] = 0.0;
+        q
+    };
+    let mut out = Vec::new();
+    for (_, at) in by_level.iter().take(levels) {
+        out.extend(spread_by(hlip, at, per_level.min(at.len()).max(3), &flat)?);
+    }
+    (by_level.len() >= levels).then_some(out)
 }
 
 /// Per face, the points other setups than `setup` take on it.
@@ -626,394 +739,13 @@ fn points_elsewhere(hlip: &Hlip, setup: usize) -> std::collections::BTreeMap<Fac
 }
 
 /// What an alignment has fixed so far: directions (part axes) and origins.
-struct Free<'a> {
-    dirs: &'a mut Vec<usize>,
-    origins: &'a mut [bool; 3],
-}
-
-/// Completes an alignment from faces the setup does not measure: the plane that fixes
-/// what is free (datum faces first, then faces no tolerance reads, then toleranced
-/// faces for what their frames fix ([`LeftFree`]), the largest first in each), touched
-/// where the operator can reach it with one of the setup's probe orientations (the
-/// first step's first) — 3 touches on a primary, 2 along a secondary (across the
-/// primary direction, as far apart as the face allows), 1 near the middle of a
-/// tertiary. Nothing then depends on the operator
-/// squaring the part or placing it at a nominal position: the 3-2-1 alignment of
-/// coordinate metrology (Hocken & Pereira, *Coordinate Measuring Machines and
-/// Systems*, 2nd ed., §13.3: a part coordinate system takes all six degrees of
-/// freedom from features of the part).
-fn complete(
-    input: &Input,
-    up: V3,
-    group: usize,
-    used: &[FaceId],
-    touch: &[Touchable],
-    out: &mut Alignment,
-    free: &mut Free,
-) {
-    let g = input.geometry;
-    let part = &input.model.parts[input.plan.part.0];
-    let datum_features: Vec<FeatureId> = part.datums.iter().map(|d| d.feature).collect();
-    let left_free = LeftFree::of(input);
-    // Candidate planes: along a part axis, not facing the table, by area.
-    let mut planes: Vec<(FaceId, usize, bool, f64)> = g
-        .faces
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| !used.contains(&FaceId(*i)))
-        .filter_map(|(i, f)| match &f.surface {
-            Surface::Plane { normal, origin } if normal.dot(&up) > -1e-6 => {
-                axis_of(normal).map(|(k, pos)| (FaceId(i), k, pos, origin[k]))
-            }
-            _ => None,
-        })
-        .collect();
-    // Datum faces first, then faces no tolerance reads (a deviation of a toleranced
-    // face would move the frame the others are read in), each the largest first.
-    let datum_faces: Vec<FaceId> = datum_features
-        .iter()
-        .flat_map(|f| faces_in_graph(input, *f))
-        .collect();
-    let toleranced: Vec<FaceId> = part
-        .tolerances
-        .iter()
-        .flat_map(|t| t.targets.iter())
-        .flat_map(|f| faces_in_graph(input, *f))
-        .collect();
-    let rank = |f: FaceId| {
-        if datum_faces.contains(&f) {
-            0
-        } else if toleranced.contains(&f) {
-            2
-        } else {
-            1
-        }
-    };
-    planes.sort_by(|a, b| {
-        rank(a.0)
-            .cmp(&rank(b.0))
-            .then(g.faces[b.0 .0].area.total_cmp(&g.faces[a.0 .0].area))
-            .then(a.0.cmp(&b.0))
-    });
-    let largest_tip = touch.iter().map(|t| t.tip).fold(0.0, f64::max);
-    let sampler = crate::sample::Sampler::new(g, largest_tip + 1.0);
-    // The groups whose probe the operator may touch with: the first step's, then the
-    // setup's others in order (the writer selects each step's sensor).
-    let mut order: Vec<usize> = Vec::new();
-    for gi in std::iter::once(group).chain(0..touch.len()) {
-        let same = |o: &usize| {
-            touch[*o].probe == touch[gi].probe && (touch[*o].dir - touch[gi].dir).norm() < 1e-6
-        };
-        if gi < touch.len() && !order.iter().any(same) {
-            order.push(gi);
-        }
-    }
-    let strategy = crate::model::Strategy {
-        method: crate::model::SampleMethod::Uniform,
-        points: Some(25),
-        inset: None,
-    };
-    // The points of a face group `gi`'s probe can touch: the face's samples (once a
-    // face), those the stylus does not stand behind, then those whose approach is clear
-    // — kept [`HAND_EDGE`] in from the face's edges where three such remain, since a
-    // joystick touch lands a few millimetres from where the controller shows it.
-    let inside = crate::sample::Sampler::new(g, largest_tip + HAND_EDGE);
-    let samples = std::cell::RefCell::new(std::collections::BTreeMap::new());
-    let reachable = |f: FaceId, gi: usize| -> Vec<(P3, V3)> {
-        let t = &touch[gi];
-        let mut samples = samples.borrow_mut();
-        let (near_middle, all) = samples
-            .entry(f)
-            .or_insert_with(|| (inside.sample(f, &strategy), sampler.sample(f, &strategy)));
-        let touchable = |pts: &[crate::sample::Fpoint]| -> Vec<(P3, V3)> {
-            pts.iter()
-                .filter(|p| p.normal.dot(&t.dir) > BEHIND)
-                .filter(|p| (t.clear)(&p.tip_centre(t.tip), &p.normal))
-                .map(|p| (p.position, p.normal))
-                .collect()
-        };
-        let inner = touchable(near_middle);
-        if inner.len() >= 3 {
-            inner
-        } else {
-            touchable(all)
-        }
-    };
-    let push = |out: &mut Alignment,
-                gi: usize,
-                face: FaceId,
-                touches: Vec<(P3, V3)>,
-                keywords: Vec<String>| {
-        out.steps.push(AlignStep {
-            group: touch[gi].group,
-            orient: touch[gi].orient,
-            block: None,
-            points: Vec::new(),
-            extra: Some(ExtraFace { face, touches }),
-            keywords,
-        });
-    };
-    let mut taken: Vec<FaceId> = Vec::new();
-    // A primary: the plane facing most nearly up (a setup on a sine plate has no face
-    // straight up), the largest first among equals.
-    if free.dirs.is_empty() {
-        let facing = |k: usize, pos: bool| if pos { up[k] } else { -up[k] };
-        let mut primaries: Vec<_> = planes.clone();
-        primaries.sort_by(|a, b| {
-            let (fa, fb) = (facing(a.1, a.2), facing(b.1, b.2));
-            (fb * 1e3).round().total_cmp(&(fa * 1e3).round())
-        });
-        'primary: for &gi in &order {
-            for &(f, k, pos, at) in &primaries {
-                if !left_free.may_fix(f, &Fixes::primary(k)) {
-                    continue;
-                }
-                let pts = reachable(f, gi);
-                let Some(chosen) = farthest(&pts, 3) else {
-                    continue;
-                };
-                if !spans_plane(&chosen) {
-                    continue;
-                }
-                push(out, gi, f, chosen, vec![dir_word(k, pos), orig_word(k)]);
-                free.dirs.push(k);
-                free.origins[k] = true;
-                out.trans.push((AXES[k], at));
-                taken.push(f);
-                break 'primary;
-            }
-        }
-    }
-    // A secondary: a plane across the primary, two touches along it — first only
-    // lines long enough for the part (`long_line`) on faces no tolerance reads (a
-    // toleranced face moved within its zone would carry the frame and its moves with
-    // it), then any of 5 mm or more in the usual order.
-    let long = long_line(g);
-    for (least, toleranced) in [(long, false), (SHORTEST_LINE, true)] {
-        if free.dirs.len() != 1 {
-            break;
-        }
-        let p = free.dirs[0];
-        let tries = order
-            .iter()
-            .flat_map(|&gi| planes.iter().map(move |pl| (gi, pl)));
-        for (gi, &(f, k, pos, at)) in tries {
-            if k == p || taken.contains(&f) || (!toleranced && rank(f) == 2) {
-                continue;
-            }
-            let fixes = Fixes {
-                turns: vec![p],
-                moves: if free.origins[k] { vec![] } else { vec![k] },
-            };
-            if !left_free.may_fix(f, &fixes) {
-                continue;
-            }
-            let along = V3::ith(p, 1.0).cross(&V3::ith(k, 1.0));
-            let pts = reachable(f, gi);
-            let mut best: Option<(f64, [usize; 2])> = None;
-            for i in 0..pts.len() {
-                for j in i + 1..pts.len() {
-                    let d = (pts[j].0 - pts[i].0).dot(&along).abs();
-                    if best.is_none_or(|(x, _)| d > x + 1e-9) {
-                        best = Some((d, [i, j]));
-                    }
-                }
-            }
-            let Some((_, [i, j])) = best.filter(|b| b.0 >= least) else {
-                continue;
-            };
-            let mut keywords = vec![dir_word(k, pos)];
-            if !free.origins[k] {
-                keywords.push(orig_word(k));
-                free.origins[k] = true;
-                out.trans.push((AXES[k], at));
-            }
-            push(out, gi, f, vec![pts[i], pts[j]], keywords);
-            free.dirs.push(k);
-            taken.push(f);
-            break;
-        }
-    }
-    // Tertiaries: one touch for each origin still free, once the frame's directions
-    // are fixed.
-    if free.dirs.len() >= 2 {
-        for (k, axis) in AXES.iter().enumerate() {
-            if free.origins[k] {
-                continue;
-            }
-            let tries = order
-                .iter()
-                .flat_map(|&gi| planes.iter().map(move |pl| (gi, pl)));
-            for (gi, &(f, kk, _, at)) in tries {
-                let fixes = Fixes {
-                    turns: vec![],
-                    moves: vec![k],
-                };
-                if kk != k || taken.contains(&f) || !left_free.may_fix(f, &fixes) {
-                    continue;
-                }
-                let pts = reachable(f, gi);
-                let c = g.faces[f.0].centroid;
-                let Some(&p) = pts
-                    .iter()
-                    .min_by(|a, b| (a.0 - c).norm().total_cmp(&(b.0 - c).norm()))
-                else {
-                    continue;
-                };
-                push(out, gi, f, vec![p], vec![orig_word(k)]);
-                free.origins[k] = true;
-                out.trans.push((*axis, at));
-                taken.push(f);
-                break;
-            }
-        }
-    }
-    for &gi in &order {
-        if let Some((f, pts, keywords, trans)) = sphere_origins(g, &|f| reachable(f, gi), free) {
-            push(out, gi, f, pts, keywords);
-            out.trans.extend(trans);
-            break;
-        }
-    }
-}
-
-/// The least cosine between a face's outward normal and the probe's direction (tip to
-/// head) at which the probe may touch it: below, the stylus stands behind the face (a
-/// face under an overhang for a vertical stylus), and no pose need be checked.
-const BEHIND: f64 = -0.3;
-
-/// The degrees of freedom a face touched by hand fixes: turns about part axes and
-/// moves along them.
-struct Fixes {
-    turns: Vec<usize>,
-    moves: Vec<usize>,
-}
-
-impl Fixes {
-    /// A primary plane square to axis `k`: the turns about the other two, the move
-    /// along `k`.
-    fn primary(k: usize) -> Fixes {
-        Fixes {
-            turns: (0..3).filter(|&j| j != k).collect(),
-            moves: vec![k],
-        }
-    }
-}
-
-/// Per face, what the datum reference frames of its location and profile tolerances
-/// leave free: (moves, turns). A frame fixes only the degrees of freedom its datum
-/// features constrain (ASME Y14.5-2018, ch. 7: a primary plane alone leaves the moves
-/// along it and the turn about its normal free); the evaluation reads what is left in
-/// the program's alignment ([`crate::geometry::drf`]), so a face aligned on in a
-/// degree of freedom its own frame leaves free would read in place in it. Form and
-/// orientation tolerances do not depend on the alignment, nor do those of datum
-/// features (the frame is built on them).
-struct LeftFree {
-    faces: Vec<(FaceId, Vec<V3>, Vec<V3>)>,
-}
-
-impl LeftFree {
-    fn of(input: &Input) -> LeftFree {
-        use crate::geometry::cmm_fit::Shape as Fitted;
-        use crate::model::TolKind;
-        let part = &input.model.parts[input.plan.part.0];
-        let datum_features: Vec<FeatureId> = part.datums.iter().map(|d| d.feature).collect();
-        let nominal = |f: FeatureId| -> Option<Fitted> {
-            let face = *faces_in_graph(input, f).first()?;
-            Fitted::of_surface(&input.geometry.faces.get(face.0)?.surface).map(|x| x.0)
-        };
-        let mut faces = Vec::new();
-        for t in &part.tolerances {
-            let located = matches!(
-                t.kind,
-                TolKind::Position
-                    | TolKind::Concentricity
-                    | TolKind::Coaxiality
-                    | TolKind::Symmetry
-                    | TolKind::ProfileLine
-                    | TolKind::ProfileSurface
-            );
-            if t.datums.is_empty() || !located {
-                continue;
-            }
-            let shapes: Vec<(Fitted, Fitted)> = t
-                .datums
-                .iter()
-                .filter_map(|d| nominal(part.datums[d.datum.0].feature))
-                .map(|s| (s.clone(), s))
-                .collect();
-            let drf = crate::geometry::drf::drf(&shapes);
-            for f in t.targets.iter().filter(|f| !datum_features.contains(f)) {
-                for face in faces_in_graph(input, *f) {
-                    faces.push((face, drf.free_t.clone(), drf.free_r.clone()));
-                }
-            }
-        }
-        LeftFree { faces }
-    }
-
-    /// Whether `face` may fix `fixes`: no frame of its tolerances leaves one of them
-    /// free.
-    fn may_fix(&self, face: FaceId, fixes: &Fixes) -> bool {
-        self.faces
-            .iter()
-            .filter(|x| x.0 == face)
-            .all(|(_, moves, turns)| {
-                let moved = |k: usize| moves.iter().any(|m| m[k].abs() > 1e-3);
-                let turned = |k: usize| turns.iter().any(|t| t[k].abs() > 0.999);
-                !fixes.moves.iter().any(|&k| moved(k)) && !fixes.turns.iter().any(|&k| turned(k))
-            })
-    }
-}
-
-/// A sphere touched for the origins: its face, touches, keywords and origin shifts.
-type SphereStep = (FaceId, Vec<(P3, V3)>, Vec<String>, Vec<(char, f64)>);
-
-/// The origins a sphere of the part gives, where planes left some free: its centre,
-/// from 4 touches spread over the part of it the probe reaches.
-fn sphere_origins(
-    g: &crate::geometry::PartGeometry,
-    reachable: &dyn Fn(FaceId) -> Vec<(P3, V3)>,
-    free: &mut Free,
-) -> Option<SphereStep> {
-    if free.origins.iter().all(|o| *o) {
-        return None;
-    }
-    let mut spheres: Vec<(FaceId, P3)> = g
-        .faces
-        .iter()
-        .enumerate()
-        .filter_map(|(i, f)| match f.surface {
-            Surface::Sphere { center, .. } => Some((FaceId(i), center)),
-            _ => None,
-        })
-        .collect();
-    spheres.sort_by(|a, b| {
-        g.faces[b.0 .0]
-            .area
-            .total_cmp(&g.faces[a.0 .0].area)
-            .then(a.0.cmp(&b.0))
-    });
-    for (f, centre) in spheres {
-        let Some(pts) = farthest(&reachable(f), 4) else {
-            continue;
-        };
-        let free_k: Vec<usize> = (0..3).filter(|&k| !free.origins[k]).collect();
-        for &k in &free_k {
-            free.origins[k] = true;
-        }
-        return Some((
-            f,
-            pts,
-            free_k.iter().map(|&k| orig_word(k)).collect(),
-            free_k.iter().map(|&k| (AXES[k], centre[k])).collect(),
-        ));
-    }
-    None
+pub(super) struct Free<'a> {
+    pub(super) dirs: &'a mut Vec<usize>,
+    pub(super) origins: &'a mut [bool; 3],
 }
 
 /// The faces the measurement graph gives feature `f`.
-fn faces_in_graph(input: &Input, f: FeatureId) -> Vec<FaceId> {
+pub(super) fn faces_in_graph(input: &Input, f: FeatureId) -> Vec<FaceId> {
     let graph = input.graph;
     graph
         .nodes()
@@ -1024,29 +756,6 @@ fn faces_in_graph(input: &Input, f: FeatureId) -> Vec<FaceId> {
             _ => None,
         })
         .collect()
-}
-
-/// How far beyond the largest tip's radius (mm) a face's edges keep the touches the
-/// operator makes by hand where the face leaves room: a joystick touch lands a few
-/// millimetres from the point shown, and one 2 mm from an edge with a Ø3 ball (as an
-/// independent review found on CTC 02) slips off it.
-const HAND_EDGE: f64 = 5.0;
-
-/// The shortest hand-touched line that says anything of a turn (mm).
-const SHORTEST_LINE: f64 = 5.0;
-
-/// The length a hand-touched secondary line is first asked for: a tenth of the part's
-/// largest extent, between [`SHORTEST_LINE`] and 50 mm. A touch's error over the line's
-/// length turns the frame, and the far end of the part moves by it times the part's
-/// length over the line's: on CTC 02 (800 mm) a 6.4 mm line beside a bore turned the
-/// frame 0.45° for a 0.05 mm difference between its touches.
-fn long_line(g: &crate::geometry::PartGeometry) -> f64 {
-    let (lo, hi) = g.vertices.iter().fold(
-        (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY)),
-        |(lo, hi), v| (lo.inf(&v.coords), hi.sup(&v.coords)),
-    );
-    let extent = (hi - lo).max();
-    (0.1 * extent).clamp(SHORTEST_LINE, 50.0)
 }
 
 /// Three of `p` (indices) spanning a wide triangle: the farthest from the first, the
@@ -1078,30 +787,4 @@ fn widest_triangle(p: &[P3]) -> Option<[usize; 3]> {
     let c = third(a, b);
     let a = third(b, c);
     (area(a, b, c) > 25.0 && a != b && b != c && a != c).then_some([a, b, c])
-}
-
-/// `n` of `pts`, the first then each farthest from those chosen.
-fn farthest(pts: &[(P3, V3)], n: usize) -> Option<Vec<(P3, V3)>> {
-    if pts.len() < n {
-        return None;
-    }
-    let mut chosen = vec![pts[0]];
-    while chosen.len() < n {
-        let next = pts.iter().filter(|p| !chosen.contains(p)).max_by(|a, b| {
-            let d = |x: &(P3, V3)| {
-                chosen
-                    .iter()
-                    .map(|c| (x.0 - c.0).norm())
-                    .fold(f64::INFINITY, f64::min)
-            };
-            d(a).total_cmp(&d(b))
-        })?;
-        chosen.push(*next);
-    }
-    Some(chosen)
-}
-
-/// Three points far enough from a line to fix a plane (a triangle of some area).
-fn spans_plane(p: &[(P3, V3)]) -> bool {
-    p.len() >= 3 && (p[1].0 - p[0].0).cross(&(p[2].0 - p[0].0)).norm() > 25.0
 }

@@ -166,12 +166,7 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
     let plan = &model.plans[built.plan];
     let part = &model.parts[plan.part.0];
     let g: &PartGeometry = &data.geometry;
-    let mut face_feature: Vec<Option<usize>> = vec![None; g.faces.len()];
-    for (k, faces) in data.feature_faces.iter().enumerate() {
-        for f in faces {
-            face_feature[f.0].get_or_insert(k);
-        }
-    }
+    let face_feature = face_features(data, g);
     let features = part
         .features
         .iter()
@@ -183,20 +178,7 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
         .collect();
     let cmm = &model.cmms[plan.cmm.0];
     let shapes = access::scan::sensor_shapes(model, cmm);
-    let probes = shapes
-        .iter()
-        .enumerate()
-        .map(|(k, s)| ProbeInfo {
-            name: s.name.clone(),
-            color: PROBE_COLORS[k % PROBE_COLORS.len()].to_string(),
-            tip: s.tip_radius as f32,
-            components: s
-                .first
-                .iter()
-                .map(|c| [c.a as f32, c.b as f32, c.radius as f32])
-                .collect(),
-        })
-        .collect();
+    let probes = probe_infos(&shapes);
     let points: Vec<PointInfo> = hlip
         .points
         .iter()
@@ -208,74 +190,24 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
         .collect();
     let sphere = fibonacci_sphere(SPHERE);
     let scene3 = access::Scene::of_part(g);
-    let opts = access::ConeOptions {
-        n: CONE_N,
-        preferred: access::axes(),
-        ..access::ConeOptions::default()
+    let cones = Cones {
+        scene: &scene3,
+        opts: access::ConeOptions {
+            n: CONE_N,
+            preferred: access::axes(),
+            ..access::ConeOptions::default()
+        },
+        sphere: &sphere,
     };
     let names = crate::plan::Names::new(model, g, crate::model::PlanId(built.plan));
     let mut setups = Vec::new();
     for sp in &built.llip.setups {
         let s = &hlip.setups[sp.setup];
-        let mut groups = Vec::new();
-        for gp in &sp.groups {
-            let mut path: Vec<[f32; 3]> = gp.entry.iter().map(f3).collect();
-            let mut touches = Vec::new();
-            let shape = &shapes[gp.probe.0];
-            for b in &gp.blocks {
-                for t in &b.touches {
-                    path.extend(t.via.iter().map(f3));
-                    path.push(f3(&t.standoff));
-                    let p = &hlip.points[t.point];
-                    let c = p.position + p.normal * shape.tip_radius;
-                    path.push(f3(&c.coords.into()));
-                    path.push(f3(&t.standoff));
-                    touches.push(t.point);
-                }
-                // A scanner's passes: the focus moves along each.
-                for p in &b.passes {
-                    path.extend(p.via.iter().map(f3));
-                    path.push(f3(&p.start));
-                    path.push(f3(&p.end));
-                }
-            }
-            path.extend(gp.exit.iter().map(f3));
-            let cones: Vec<(usize, String)> = {
-                use rayon::prelude::*;
-                touches
-                    .par_iter()
-                    .map(|&k| {
-                        let p = &hlip.points[k];
-                        let f = crate::sample::Fpoint {
-                            face: p.face,
-                            position: p.position,
-                            normal: p.normal,
-                        };
-                        let cone = access::approach_cone(&Cpu, &scene3, &f, shape, &opts);
-                        let bits: String = sphere
-                            .iter()
-                            .map(|d| {
-                                let v =
-                                    crate::geometry::V3::new(d[0] as f64, d[1] as f64, d[2] as f64);
-                                match &cone {
-                                    Some(c) if c.contains(&v) => '1',
-                                    _ => '0',
-                                }
-                            })
-                            .collect();
-                        (k, bits)
-                    })
-                    .collect()
-            };
-            groups.push(GroupInfo {
-                probe: gp.probe.0,
-                a: gp.a as f32,
-                b: gp.b as f32,
-                direction: f3(&gp.direction),
-                path,
-                touches: cones,
-            });
-        }
+        let groups = sp
+            .groups
+            .iter()
+            .map(|gp| group_info(hlip, gp, &shapes[gp.probe.0], &cones))
+            .collect();
         setups.push(SetupInfo {
             held_by: names.holder(&s.holder, &s.up),
             rotation: s
@@ -311,6 +243,116 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
         scene.setups[k].yaw = raster::best_yaw(&scene, k);
     }
     scene
+}
+
+/// Per face, the first feature (in the part's order) that names it.
+fn face_features(data: &PartData, g: &PartGeometry) -> Vec<Option<usize>> {
+    let mut face_feature: Vec<Option<usize>> = vec![None; g.faces.len()];
+    for (k, faces) in data.feature_faces.iter().enumerate() {
+        for f in faces {
+            face_feature[f.0].get_or_insert(k);
+        }
+    }
+    face_feature
+}
+
+/// The probes of the rack with their colours and components.
+fn probe_infos(shapes: &[access::ProbeShape]) -> Vec<ProbeInfo> {
+    shapes
+        .iter()
+        .enumerate()
+        .map(|(k, s)| ProbeInfo {
+            name: s.name.clone(),
+            color: PROBE_COLORS[k % PROBE_COLORS.len()].to_string(),
+            tip: s.tip_radius as f32,
+            components: s
+                .first
+                .iter()
+                .map(|c| [c.a as f32, c.b as f32, c.radius as f32])
+                .collect(),
+        })
+        .collect()
+}
+
+/// What the cones of the touches are computed in and shown at: the part's scene, the
+/// options, and the directions sampled.
+struct Cones<'a> {
+    scene: &'a access::Scene,
+    opts: access::ConeOptions,
+    sphere: &'a [[f32; 3]],
+}
+
+/// One group as the page shows it: its tip centre's path and the cone of each touch of
+/// probe `shape`.
+fn group_info(
+    hlip: &Hlip,
+    gp: &crate::path::GroupPath,
+    shape: &access::ProbeShape,
+    cones: &Cones,
+) -> GroupInfo {
+    let mut path: Vec<[f32; 3]> = gp.entry.iter().map(f3).collect();
+    let mut touches = Vec::new();
+    for b in &gp.blocks {
+        for t in &b.touches {
+            path.extend(t.via.iter().map(f3));
+            path.push(f3(&t.standoff));
+            let p = &hlip.points[t.point];
+            let c = p.position + p.normal * shape.tip_radius;
+            path.push(f3(&c.coords.into()));
+            path.push(f3(&t.standoff));
+            touches.push(t.point);
+        }
+        // A scanner's passes: the focus moves along each.
+        for p in &b.passes {
+            path.extend(p.via.iter().map(f3));
+            path.push(f3(&p.start));
+            path.push(f3(&p.end));
+        }
+    }
+    path.extend(gp.exit.iter().map(f3));
+    GroupInfo {
+        probe: gp.probe.0,
+        a: gp.a as f32,
+        b: gp.b as f32,
+        direction: f3(&gp.direction),
+        path,
+        touches: touch_cones(hlip, &touches, shape, cones),
+    }
+}
+
+/// Per touch (a point index), its cone over the sampled directions: `1` where the
+/// probe `shape` is free, `0` where it is blocked.
+fn touch_cones(
+    hlip: &Hlip,
+    touches: &[usize],
+    shape: &access::ProbeShape,
+    cones: &Cones,
+) -> Vec<(usize, String)> {
+    use rayon::prelude::*;
+    touches
+        .par_iter()
+        .map(|&k| {
+            let p = &hlip.points[k];
+            let f = crate::sample::Fpoint {
+                face: p.face,
+                position: p.position,
+                normal: p.normal,
+            };
+            let cone = access::approach_cone(&Cpu, cones.scene, &f, shape, &cones.opts);
+            let bits: String = cones
+                .sphere
+                .iter()
+                .map(|d| {
+                    let v = crate::geometry::V3::new(d[0] as f64, d[1] as f64, d[2] as f64);
+                    match &cone {
+                        Some(c) if c.contains(&v) => '1',
+                        _ => '0',
+                    }
+                })
+                .collect();
+            (k, bits)
+        })
+        .collect()
 }
 
 /// `n` directions spread evenly over the sphere (a Fibonacci lattice).

@@ -76,54 +76,7 @@ pub fn read(d: &Doc, root: &Node, faces: &[u64], edge_faces: &HashMap<u64, Vec<u
         notes: Vec::new(),
     };
     let mut pmi = Pmi::default();
-    let mut letters: HashMap<u64, String> = HashMap::new();
-    let targets: HashMap<u64, &Node> = root
-        .child("DatumTargetDefinitions")
-        .map(|t| {
-            t.children
-                .iter()
-                .filter_map(|n| Some((n.id()?, n)))
-                .collect()
-        })
-        .unwrap_or_default();
-    for dd in root
-        .child("DatumDefinitions")
-        .into_iter()
-        .flat_map(|n| n.all("DatumDefinition"))
-    {
-        let letter = dd.text_at(&["DatumLabel"]).unwrap_or("").trim().to_string();
-        let id = dd.id().unwrap_or(0);
-        letters.insert(id, letter.clone());
-        let mut faces = BTreeSet::new();
-        for f in Doc::id_list(dd, "FeatureNominalIds") {
-            faces.extend(r.feature_faces(f, &format!("datum {letter}")));
-        }
-        let mut tlist = Vec::new();
-        for t in Doc::id_list(dd, "DatumTargetIds") {
-            let Some(tn) = targets.get(&t) else {
-                r.notes
-                    .push(format!("datum {letter}: target {t} is not in the file"));
-                continue;
-            };
-            if let Some(f) = tn
-                .text_at(&["FeatureNominalId"])
-                .and_then(|x| x.trim().parse().ok())
-            {
-                faces.extend(r.feature_faces(f, &format!("datum {letter}")));
-            }
-            tlist.push(r.target(tn));
-        }
-        if faces.is_empty() {
-            r.notes.push(format!("datum {letter} is linked to no face"));
-        }
-        pmi.datums.push(Datum {
-            id,
-            letter,
-            faces: faces.into_iter().collect(),
-            targets: tlist,
-            located: false,
-        });
-    }
+    let letters = r.datums(root, &mut pmi.datums);
     let frames: HashMap<u64, Vec<DatumRef>> = root
         .child("DatumReferenceFrames")
         .into_iter()
@@ -145,8 +98,90 @@ pub fn read(d: &Doc, root: &Node, faces: &[u64], edge_faces: &HashMap<u64, Vec<u
         .map(|n| n.children.as_slice())
         .unwrap_or_default();
     for nom in nominals {
+        r.characteristic(nom, &defs, &frames, &mut pmi);
+    }
+    pmi.notes = r.notes;
+    pmi
+}
+
+/// A characteristic nominal being read: its id, name, node, definition and the feature
+/// nominals it names.
+struct Nominal<'n> {
+    id: u64,
+    name: String,
+    node: &'n Node,
+    def: &'n Node,
+    feats: Vec<u64>,
+}
+
+impl Reader<'_> {
+    /// Reads the datum definitions into `datums`, each linked to the faces of its
+    /// feature nominals and targets; returns each definition's letter by its id.
+    fn datums(&mut self, root: &Node, datums: &mut Vec<Datum>) -> HashMap<u64, String> {
+        let mut letters: HashMap<u64, String> = HashMap::new();
+        let targets: HashMap<u64, &Node> = root
+            .child("DatumTargetDefinitions")
+            .map(|t| {
+                t.children
+                    .iter()
+                    .filter_map(|n| Some((n.id()?, n)))
+                    .collect()
+            })
+            .unwrap_or_default();
+        for dd in root
+            .child("DatumDefinitions")
+            .into_iter()
+            .flat_map(|n| n.all("DatumDefinition"))
+        {
+            let letter = dd.text_at(&["DatumLabel"]).unwrap_or("").trim().to_string();
+            let id = dd.id().unwrap_or(0);
+            letters.insert(id, letter.clone());
+            let mut faces = BTreeSet::new();
+            for f in Doc::id_list(dd, "FeatureNominalIds") {
+                faces.extend(self.feature_faces(f, &format!("datum {letter}")));
+            }
+            let mut tlist = Vec::new();
+            for t in Doc::id_list(dd, "DatumTargetIds") {
+                let Some(tn) = targets.get(&t) else {
+                    self.notes
+                        .push(format!("datum {letter}: target {t} is not in the file"));
+                    continue;
+                };
+                if let Some(f) = tn
+                    .text_at(&["FeatureNominalId"])
+                    .and_then(|x| x.trim().parse().ok())
+                {
+                    faces.extend(self.feature_faces(f, &format!("datum {letter}")));
+                }
+                tlist.push(self.target(tn));
+            }
+            if faces.is_empty() {
+                self.notes
+                    .push(format!("datum {letter} is linked to no face"));
+            }
+            datums.push(Datum {
+                id,
+                letter,
+                faces: faces.into_iter().collect(),
+                targets: tlist,
+                located: false,
+            });
+        }
+        letters
+    }
+
+    /// Reads one characteristic nominal into `pmi`: a geometric tolerance, a size or a
+    /// location by its element's name; a note for one whose definition is not in the
+    /// file or whose kind inspc does not read.
+    fn characteristic(
+        &mut self,
+        nom: &Node,
+        defs: &HashMap<u64, &Node>,
+        frames: &HashMap<u64, Vec<DatumRef>>,
+        pmi: &mut Pmi,
+    ) {
         let Some(kind) = nom.name.strip_suffix("CharacteristicNominal") else {
-            continue;
+            return;
         };
         let name = nom.text_at(&["Name"]).unwrap_or(kind).trim().to_string();
         let id = nom.id().unwrap_or(0);
@@ -155,68 +190,97 @@ pub fn read(d: &Doc, root: &Node, faces: &[u64], edge_faces: &HashMap<u64, Vec<u
             .and_then(|t| t.trim().parse().ok())
             .and_then(|i| defs.get(&i))
         else {
-            r.notes
+            self.notes
                 .push(format!("{name}: its definition is not in the file"));
-            continue;
+            return;
         };
-        let feats = Doc::id_list(nom, "FeatureNominalIds");
+        let n = Nominal {
+            id,
+            name,
+            node: nom,
+            def,
+            feats: Doc::id_list(nom, "FeatureNominalIds"),
+        };
         if let Some((_, tk)) = KINDS.iter().find(|(k, _)| *k == kind) {
-            let faces = r.features_faces(&feats, &name);
-            let upper = r.tolerance(id, &name, *tk, def, &frames, faces.clone());
-            pmi.tolerances.push(upper);
-            if let Some(lower) = def
-                .children
-                .iter()
-                .find(|c| c.name.starts_with("SecondCompositeSegment"))
-            {
-                let mut t = r.tolerance(
-                    id,
-                    &format!("{name} (lower segment)"),
-                    *tk,
-                    lower,
-                    &frames,
-                    faces,
-                );
-                t.composite_of = Some(id);
-                pmi.tolerances.push(t);
-            }
+            pmi.tolerances.extend(self.geometric(&n, *tk, frames));
         } else if let Some((_, label, angular)) = SIZES.iter().find(|(k, _, _)| *k == kind) {
-            let faces = r.features_faces(&feats, &name);
-            // The angle of a feature of two planes (a V) is the angle between them, as
-            // STEP files state it.
-            let (kind, from, to) = match (*label, faces.as_slice()) {
-                ("angle", [a, rest @ ..]) if !rest.is_empty() => (
-                    DimKind::Location("angle".to_string()),
-                    vec![*a],
-                    rest.to_vec(),
-                ),
-                _ => (DimKind::Size(label.to_string()), faces, Vec::new()),
-            };
-            pmi.dimensions
-                .push(r.dimension(id, kind, *angular, nom, def, from, to));
+            pmi.dimensions.push(self.size(&n, label, *angular));
         } else if let Some((_, label, angular)) = LOCATIONS.iter().find(|(k, _, _)| *k == kind) {
-            let (from, to) = match feats.as_slice() {
-                [a, b, ..] => (r.feature_faces(*a, &name), r.feature_faces(*b, &name)),
-                [a] => (r.feature_faces(*a, &name), BTreeSet::new()),
-                [] => (BTreeSet::new(), BTreeSet::new()),
-            };
-            pmi.dimensions.push(r.dimension(
-                id,
-                DimKind::Location(label.to_string()),
-                *angular,
-                nom,
-                def,
-                from.into_iter().collect(),
-                to.into_iter().collect(),
-            ));
+            pmi.dimensions.push(self.location(&n, label, *angular));
         } else {
-            r.notes.push(format!(
-                "{name}: a {kind} characteristic, which inspc does not read"
+            self.notes.push(format!(
+                "{}: a {kind} characteristic, which inspc does not read",
+                n.name
             ));
         }
     }
-    pmi.notes = r.notes;
-    pmi
+
+    /// A geometric tolerance of kind `tk`, and the lower segment of a composite one.
+    fn geometric(
+        &mut self,
+        n: &Nominal,
+        tk: TolKind,
+        frames: &HashMap<u64, Vec<DatumRef>>,
+    ) -> Vec<GeoTolerance> {
+        let faces = self.features_faces(&n.feats, &n.name);
+        let upper = self.tolerance(n.id, &n.name, tk, n.def, frames, faces.clone());
+        let mut out = vec![upper];
+        if let Some(lower) = n
+            .def
+            .children
+            .iter()
+            .find(|c| c.name.starts_with("SecondCompositeSegment"))
+        {
+            let mut t = self.tolerance(
+                n.id,
+                &format!("{} (lower segment)", n.name),
+                tk,
+                lower,
+                frames,
+                faces,
+            );
+            t.composite_of = Some(n.id);
+            out.push(t);
+        }
+        out
+    }
+
+    /// A size named `label` (angular or not).
+    fn size(&mut self, n: &Nominal, label: &str, angular: bool) -> Dimension {
+        let faces = self.features_faces(&n.feats, &n.name);
+        // The angle of a feature of two planes (a V) is the angle between them, as
+        // STEP files state it.
+        let (kind, from, to) = match (label, faces.as_slice()) {
+            ("angle", [a, rest @ ..]) if !rest.is_empty() => (
+                DimKind::Location("angle".to_string()),
+                vec![*a],
+                rest.to_vec(),
+            ),
+            _ => (DimKind::Size(label.to_string()), faces, Vec::new()),
+        };
+        self.dimension(n.id, kind, angular, n.node, n.def, from, to)
+    }
+
+    /// A location named `label` (angular or not) from the first feature to the second.
+    fn location(&mut self, n: &Nominal, label: &str, angular: bool) -> Dimension {
+        let (from, to) = match n.feats.as_slice() {
+            [a, b, ..] => (
+                self.feature_faces(*a, &n.name),
+                self.feature_faces(*b, &n.name),
+            ),
+            [a] => (self.feature_faces(*a, &n.name), BTreeSet::new()),
+            [] => (BTreeSet::new(), BTreeSet::new()),
+        };
+        self.dimension(
+            n.id,
+            DimKind::Location(label.to_string()),
+            angular,
+            n.node,
+            n.def,
+            from.into_iter().collect(),
+            to.into_iter().collect(),
+        )
+    }
 }
 
 /// The length units the document names, in millimetres.

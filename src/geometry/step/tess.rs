@@ -349,23 +349,56 @@ fn face_mesh(face: &Face, edges: &[Vec<P3>], res: Resolution) -> Result<Vec<[P3;
     }
     let sense = if face.same_sense { 1.0 } else { -1.0 };
     let polygons = close_loops(s, loops, periods, sense, res)?;
-
-    // One scale for the whole face, taken at the mean of its bound points. Along a
-    // ruled surface's straight lines (a cylinder's or cone's v) a triangle may be longer:
-    // the plane is squeezed along v so that Delaunay triangles come out long and thin.
-    let m = mean(&polygons.concat());
-    let (su, mut sv) = s.scale(m[0], m[1]);
-    if matches!(s, Surf::Cylinder(..) | Surf::Cone(..)) {
-        sv /= RULED_STRETCH;
+    let scale = ParamScale::of(s, &polygons);
+    let mut cdt = bounds_triangulation(&polygons, &scale)?;
+    if !matches!(s, Surf::Plane(_)) {
+        refine(&mut cdt, s, &scale, res)?;
     }
-    let scaled = |uv: [f64; 2]| [uv[0] * su, uv[1] * sv];
-    let unscale = |q: [f64; 2]| [q[0] / su, q[1] / sv];
+    inside_triangles(&cdt, sense)
+}
 
-    let mut cdt: ConstrainedDelaunayTriangulation<Vert> = ConstrainedDelaunayTriangulation::new();
-    for poly in &polygons {
+/// The triangulation of a face's parameter plane.
+type Cdt = ConstrainedDelaunayTriangulation<Vert>;
+
+/// One scale from a face's parameters to the plane it is triangulated in, taken at the
+/// mean of its bound points. Along a ruled surface's straight lines (a cylinder's or
+/// cone's v) a triangle may be longer: the plane is squeezed along v so that Delaunay
+/// triangles come out long and thin.
+struct ParamScale {
+    su: f64,
+    sv: f64,
+}
+
+impl ParamScale {
+    fn of(s: &Surf, polygons: &[Vec<Pt>]) -> ParamScale {
+        let m = mean(&polygons.concat());
+        let (su, mut sv) = s.scale(m[0], m[1]);
+        if matches!(s, Surf::Cylinder(..) | Surf::Cone(..)) {
+            sv /= RULED_STRETCH;
+        }
+        ParamScale { su, sv }
+    }
+
+    /// Parameters to the plane.
+    fn scaled(&self, uv: [f64; 2]) -> [f64; 2] {
+        [uv[0] * self.su, uv[1] * self.sv]
+    }
+
+    /// The plane to parameters.
+    fn unscale(&self, q: [f64; 2]) -> [f64; 2] {
+        [q[0] / self.su, q[1] / self.sv]
+    }
+}
+
+/// The constrained Delaunay triangulation of a face's bounds (`polygons`) in its
+/// scaled parameter plane, every bound segment a constraint; an error when a point
+/// cannot be inserted or bounds cross.
+fn bounds_triangulation(polygons: &[Vec<Pt>], scale: &ParamScale) -> Result<Cdt, String> {
+    let mut cdt: Cdt = ConstrainedDelaunayTriangulation::new();
+    for poly in polygons {
         let mut handles = Vec::new();
         for p in poly {
-            let q = scaled(p.uv);
+            let q = scale.scaled(p.uv);
             let h = cdt
                 .insert(Vert {
                     pos: Point2::new(q[0], q[1]),
@@ -390,118 +423,148 @@ fn face_mesh(face: &Face, edges: &[Vec<P3>], res: Resolution) -> Result<Vec<[P3;
             }
         }
     }
+    Ok(cdt)
+}
 
-    let eval = |q: [f64; 2]| {
-        let uv = unscale(q);
-        s.eval(uv[0], uv[1])
-    };
+/// Refines a curved face: round by round, adds a point in every triangle that strays
+/// from the surface or turns too much ([`refinement_points`]), until none does, after
+/// 24 rounds, or with an error past 200,000 points.
+fn refine(cdt: &mut Cdt, s: &Surf, scale: &ParamScale, res: Resolution) -> Result<(), String> {
+    let mut budget = 200_000usize;
+    // Triangles (by their corners) already found close enough: a later round
+    // leaves most of them as they are.
+    let mut good: std::collections::HashSet<[usize; 3]> = std::collections::HashSet::new();
+    for _round in 0..24 {
+        let add = refinement_points(cdt, s, scale, res, &mut good);
+        if add.is_empty() {
+            break;
+        }
+        if add.len() > budget {
+            return Err(format!(
+                "it needs more than {} points inside to meet the chord tolerance",
+                200_000
+            ));
+        }
+        budget -= add.len();
+        for c in add {
+            let uv = scale.unscale(c);
+            let xyz = s.eval(uv[0], uv[1]);
+            cdt.insert(Vert {
+                pos: Point2::new(c[0], c[1]),
+                xyz,
+            })
+            .map_err(|e| format!("an inner point cannot be triangulated ({e:?})"))?;
+        }
+    }
+    Ok(())
+}
 
-    // Refine curved faces: add the centroid of every triangle that strays from the
-    // surface or turns too much.
-    if !matches!(s, Surf::Plane(_)) {
-        let mut budget = 200_000usize;
-        // Triangles (by their corners) already found close enough: a later round
-        // leaves most of them as they are.
-        let mut good: std::collections::HashSet<[usize; 3]> = std::collections::HashSet::new();
-        for _round in 0..24 {
-            let mut add = Vec::new();
-            let inside = inside_faces(&cdt);
-            for f in cdt.inner_faces() {
-                if !inside[f.fix().index()] {
-                    continue;
+/// One round's points to add: in each triangle inside the bounds, not yet found `good`,
+/// that strays ([`strays`]), the middle of its longest edge where that is not a bound
+/// (a Delaunay refinement keeps triangles well shaped), else its centroid. Triangles
+/// close enough join `good`.
+fn refinement_points(
+    cdt: &Cdt,
+    s: &Surf,
+    scale: &ParamScale,
+    res: Resolution,
+    good: &mut std::collections::HashSet<[usize; 3]>,
+) -> Vec<[f64; 2]> {
+    let mut add = Vec::new();
+    let inside = inside_faces(cdt);
+    for f in cdt.inner_faces() {
+        if !inside[f.fix().index()] {
+            continue;
+        }
+        let mut key = f.vertices().map(|v| v.fix().index());
+        key.sort_unstable();
+        if good.contains(&key) {
+            continue;
+        }
+        let vs = f.vertices();
+        let q = vs.map(|v| [v.position().x, v.position().y]);
+        let c = [
+            (q[0][0] + q[1][0] + q[2][0]) / 3.0,
+            (q[0][1] + q[1][1] + q[2][1]) / 3.0,
+        ];
+        let x = vs.map(|v| v.data().xyz);
+        if (x[1] - x[0]).cross(&(x[2] - x[0])).norm() < 1e-12 {
+            // Two corners on one pole: nothing to refine.
+            continue;
+        }
+        if !strays(s, scale, res, (q, c), x) {
+            good.insert(key);
+        } else {
+            let es = f.adjacent_edges();
+            let longest = es
+                .iter()
+                .max_by(|a, b| a.length_2().total_cmp(&b.length_2()))
+                .filter(|e| !e.is_constraint_edge());
+            match longest {
+                Some(e) => {
+                    let [a, b] = e.positions();
+                    add.push([(a.x + b.x) / 2.0, (a.y + b.y) / 2.0]);
                 }
-                let mut key = f.vertices().map(|v| v.fix().index());
-                key.sort_unstable();
-                if good.contains(&key) {
-                    continue;
-                }
-                let vs = f.vertices();
-                let q = vs.map(|v| [v.position().x, v.position().y]);
-                let c = [
-                    (q[0][0] + q[1][0] + q[2][0]) / 3.0,
-                    (q[0][1] + q[1][1] + q[2][1]) / 3.0,
-                ];
-                let x = vs.map(|v| v.data().xyz);
-                if (x[1] - x[0]).cross(&(x[2] - x[0])).norm() < 1e-12 {
-                    // Two corners on one pole: nothing to refine.
-                    continue;
-                }
-                // The chord error: how far the flat triangle's centroid and edge
-                // midpoints lie from the surface.
-                let off = |flat: P3, at: [f64; 2]| {
-                    let uv = unscale(at);
-                    s.distance(&flat, (uv[0], uv[1]))
-                };
-                let flat = P3::from((x[0].coords + x[1].coords + x[2].coords) / 3.0);
-                let mut far = off(flat, c) > res.chord_mm;
-                if !far {
-                    for k in 0..3 {
-                        let m = [
-                            (q[k][0] + q[(k + 1) % 3][0]) / 2.0,
-                            (q[k][1] + q[(k + 1) % 3][1]) / 2.0,
-                        ];
-                        let mid = P3::from((x[k].coords + x[(k + 1) % 3].coords) / 2.0);
-                        if off(mid, m) > res.chord_mm {
-                            far = true;
-                            break;
-                        }
-                    }
-                }
-                if !far {
-                    let n: Vec<Option<V3>> = (0..3)
-                        .map(|k| {
-                            let uv = unscale(q[k]);
-                            s.normal(&x[k], uv[0], uv[1])
-                        })
-                        .collect();
-                    if let (Some(a), Some(b), Some(c2)) = (n[0], n[1], n[2]) {
-                        far = a.angle(&b) > res.angle_rad
-                            || b.angle(&c2) > res.angle_rad
-                            || a.angle(&c2) > res.angle_rad;
-                    }
-                }
-                if !far {
-                    good.insert(key);
-                } else {
-                    // Split the longest edge where it is not a bound (a Delaunay
-                    // refinement keeps triangles well shaped); else add the centroid.
-                    let es = f.adjacent_edges();
-                    let longest = es
-                        .iter()
-                        .max_by(|a, b| a.length_2().total_cmp(&b.length_2()))
-                        .filter(|e| !e.is_constraint_edge());
-                    match longest {
-                        Some(e) => {
-                            let [a, b] = e.positions();
-                            add.push([(a.x + b.x) / 2.0, (a.y + b.y) / 2.0]);
-                        }
-                        None => add.push(c),
-                    }
-                }
-            }
-            if add.is_empty() {
-                break;
-            }
-            if add.len() > budget {
-                return Err(format!(
-                    "it needs more than {} points inside to meet the chord tolerance",
-                    200_000
-                ));
-            }
-            budget -= add.len();
-            for c in add {
-                let xyz = eval(c);
-                cdt.insert(Vert {
-                    pos: Point2::new(c[0], c[1]),
-                    xyz,
-                })
-                .map_err(|e| format!("an inner point cannot be triangulated ({e:?})"))?;
+                None => add.push(c),
             }
         }
     }
+    add
+}
 
+/// Whether a triangle (corners `q` in the scaled plane, centroid `c` there, points `x`)
+/// strays from the surface: its centroid or an edge's midpoint farther from it than the
+/// chord tolerance, or the surface's normal turning across it by more than the angle
+/// limit.
+fn strays(
+    s: &Surf,
+    scale: &ParamScale,
+    res: Resolution,
+    (q, c): ([[f64; 2]; 3], [f64; 2]),
+    x: [P3; 3],
+) -> bool {
+    // The chord error: how far the flat triangle's centroid and edge
+    // midpoints lie from the surface.
+    let off = |flat: P3, at: [f64; 2]| {
+        let uv = scale.unscale(at);
+        s.distance(&flat, (uv[0], uv[1]))
+    };
+    let flat = P3::from((x[0].coords + x[1].coords + x[2].coords) / 3.0);
+    let mut far = off(flat, c) > res.chord_mm;
+    if !far {
+        for k in 0..3 {
+            let m = [
+                (q[k][0] + q[(k + 1) % 3][0]) / 2.0,
+                (q[k][1] + q[(k + 1) % 3][1]) / 2.0,
+            ];
+            let mid = P3::from((x[k].coords + x[(k + 1) % 3].coords) / 2.0);
+            if off(mid, m) > res.chord_mm {
+                far = true;
+                break;
+            }
+        }
+    }
+    if !far {
+        let n: Vec<Option<V3>> = (0..3)
+            .map(|k| {
+                let uv = scale.unscale(q[k]);
+                s.normal(&x[k], uv[0], uv[1])
+            })
+            .collect();
+        if let (Some(a), Some(b), Some(c2)) = (n[0], n[1], n[2]) {
+            far = a.angle(&b) > res.angle_rad
+                || b.angle(&c2) > res.angle_rad
+                || a.angle(&c2) > res.angle_rad;
+        }
+    }
+    far
+}
+
+/// The triangles inside the bounds, counter-clockwise from outside: along the natural
+/// normal where `sense` is positive; an error when none lies inside.
+fn inside_triangles(cdt: &Cdt, sense: f64) -> Result<Vec<[P3; 3]>, String> {
     let mut out = Vec::new();
-    let inside = inside_faces(&cdt);
+    let inside = inside_faces(cdt);
     for f in cdt.inner_faces() {
         if !inside[f.fix().index()] {
             continue;
@@ -752,120 +815,8 @@ fn close_loops(
     let mut polygons: Vec<Vec<Pt>> = Vec::new();
     match round.len() {
         0 => {}
-        1 => {
-            let l = &round[0];
-            if l.wraps[1] != 0 || l.wraps[0].abs() != 1 {
-                return Err("a bound goes round the surface in a way inspc cannot close".into());
-            }
-            let dir = l.wraps[0] as f64;
-            // The face lies left of its bounds seen from its normal: toward +v when the
-            // loop runs toward +u along the natural normal.
-            let toward = dir * sense;
-            let pole = s
-                .poles()
-                .into_iter()
-                .filter(|p| (p - l.pts[0].uv[1]) * toward > 0.0)
-                .min_by(|a, b| {
-                    (a - l.pts[0].uv[1])
-                        .abs()
-                        .total_cmp(&(b - l.pts[0].uv[1]).abs())
-                })
-                .ok_or(
-                    "a single bound goes round the surface and there is no pole to close it at",
-                )?;
-            let mut poly = l.pts.clone();
-            let first = poly[0];
-            let per = periods[0].unwrap_or(TAU);
-            let end_u = first.uv[0] + dir * per;
-            let xyz_pole = s.eval(first.uv[0], pole);
-            poly.push(Pt {
-                uv: [end_u, first.uv[1]],
-                xyz: first.xyz,
-            });
-            poly.push(Pt {
-                uv: [end_u, pole],
-                xyz: xyz_pole,
-            });
-            along_pole(&mut poly, end_u, first.uv[0], pole, xyz_pole);
-            poly.push(Pt {
-                uv: [first.uv[0], pole],
-                xyz: xyz_pole,
-            });
-            polygons.push(poly);
-        }
-        2 => {
-            let k = if round[0].wraps[0] != 0 { 0 } else { 1 };
-            let per = periods[k].unwrap_or(TAU);
-            if round
-                .iter()
-                .any(|l| l.wraps[k].abs() != 1 || l.wraps[1 - k] != 0)
-            {
-                return Err("two bounds go round the surface in different ways".into());
-            }
-            // Both loops made to run toward +k; the band is A forward, then B backward.
-            let forward = |l: &Loop| {
-                let mut p = l.pts.clone();
-                if l.wraps[k] < 0 {
-                    p.reverse();
-                }
-                p
-            };
-            let a = forward(&round[0]);
-            let mut b = forward(&round[1]);
-            // B starts where it is nearest A's start, shifted into A's period.
-            let a0 = a[0].uv[k];
-            let (start, _) = b
-                .iter()
-                .enumerate()
-                .map(|(i, p)| {
-                    let d = unwrap_near(p.uv[k], a0, per) - a0;
-                    (i, d.abs())
-                })
-                .min_by(|x, y| x.1.total_cmp(&y.1))
-                .unwrap_or((0, 0.0));
-            b.rotate_left(start);
-            let mut b2 = Vec::with_capacity(b.len());
-            let mut prev = a0;
-            for p in &b {
-                let mut q = *p;
-                q.uv[k] = unwrap_near(q.uv[k], prev, per);
-                prev = q.uv[k];
-                b2.push(q);
-            }
-            // A: a[0] .. a[n-1], then a[0] again one period on; B likewise, walked back.
-            // The cut from A's start to B's start is a curve on the surface (a
-            // meridian of a torus, a profile of a revolved B-spline): it is cut into
-            // segments like an edge, the same on both of its sides.
-            let (from, to) = (a[0], b2[0]);
-            let mut ts = vec![0.0];
-            let at = |t: f64| {
-                s.eval(
-                    from.uv[0] + (to.uv[0] - from.uv[0]) * t,
-                    from.uv[1] + (to.uv[1] - from.uv[1]) * t,
-                )
-            };
-            refine_curve(&at, 0.0, 1.0, res, 0, &mut ts);
-            let cut = |shift: f64, t: f64| {
-                let mut uv = [
-                    from.uv[0] + (to.uv[0] - from.uv[0]) * t,
-                    from.uv[1] + (to.uv[1] - from.uv[1]) * t,
-                ];
-                uv[k] += shift;
-                Pt { uv, xyz: at(t) }
-            };
-            let inner = &ts[1..ts.len() - 1];
-            let mut poly = a.clone();
-            let mut a_end = a[0];
-            a_end.uv[k] += per;
-            poly.push(a_end);
-            poly.extend(inner.iter().map(|&t| cut(per, t)));
-            let mut b_end = b2[0];
-            b_end.uv[k] += per;
-            poly.push(b_end);
-            poly.extend(b2.iter().rev().copied());
-            poly.extend(inner.iter().rev().map(|&t| cut(0.0, t)));
-            polygons.push(poly);
-        }
+        1 => polygons.push(closed_at_pole(s, &round[0], periods, sense)?),
+        2 => polygons.push(band(s, &round, periods, res)?),
         _ => return Err(format!("{} bounds go round the surface", round.len())),
     }
     // Ordinary loops: shift each next to the first polygon (or the first of them).
@@ -893,6 +844,135 @@ fn close_loops(
         );
     }
     Ok(polygons)
+}
+
+/// The polygon of a face bounded by one loop `l` that goes once round in u (a
+/// spherical cap, a cone to its apex): the loop, then along the pole on the face's side
+/// back to its start.
+fn closed_at_pole(
+    s: &Surf,
+    l: &Loop,
+    periods: [Option<f64>; 2],
+    sense: f64,
+) -> Result<Vec<Pt>, String> {
+    if l.wraps[1] != 0 || l.wraps[0].abs() != 1 {
+        return Err("a bound goes round the surface in a way inspc cannot close".into());
+    }
+    let dir = l.wraps[0] as f64;
+    // The face lies left of its bounds seen from its normal: toward +v when the
+    // loop runs toward +u along the natural normal.
+    let toward = dir * sense;
+    let pole = s
+        .poles()
+        .into_iter()
+        .filter(|p| (p - l.pts[0].uv[1]) * toward > 0.0)
+        .min_by(|a, b| {
+            (a - l.pts[0].uv[1])
+                .abs()
+                .total_cmp(&(b - l.pts[0].uv[1]).abs())
+        })
+        .ok_or("a single bound goes round the surface and there is no pole to close it at")?;
+    let mut poly = l.pts.clone();
+    let first = poly[0];
+    let per = periods[0].unwrap_or(TAU);
+    let end_u = first.uv[0] + dir * per;
+    let xyz_pole = s.eval(first.uv[0], pole);
+    poly.push(Pt {
+        uv: [end_u, first.uv[1]],
+        xyz: first.xyz,
+    });
+    poly.push(Pt {
+        uv: [end_u, pole],
+        xyz: xyz_pole,
+    });
+    along_pole(&mut poly, end_u, first.uv[0], pole, xyz_pole);
+    poly.push(Pt {
+        uv: [first.uv[0], pole],
+        xyz: xyz_pole,
+    });
+    Ok(poly)
+}
+
+/// The polygon of a band bounded by two loops (`round`) that each go once round (a
+/// band of a bore with no seam edge): cut open along a curve between them, one loop
+/// forward, the cut, the other loop backward, the cut back.
+fn band(
+    s: &Surf,
+    round: &[Loop],
+    periods: [Option<f64>; 2],
+    res: Resolution,
+) -> Result<Vec<Pt>, String> {
+    let k = if round[0].wraps[0] != 0 { 0 } else { 1 };
+    let per = periods[k].unwrap_or(TAU);
+    if round
+        .iter()
+        .any(|l| l.wraps[k].abs() != 1 || l.wraps[1 - k] != 0)
+    {
+        return Err("two bounds go round the surface in different ways".into());
+    }
+    // Both loops made to run toward +k; the band is A forward, then B backward.
+    let forward = |l: &Loop| {
+        let mut p = l.pts.clone();
+        if l.wraps[k] < 0 {
+            p.reverse();
+        }
+        p
+    };
+    let a = forward(&round[0]);
+    let mut b = forward(&round[1]);
+    // B starts where it is nearest A's start, shifted into A's period.
+    let a0 = a[0].uv[k];
+    let (start, _) = b
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let d = unwrap_near(p.uv[k], a0, per) - a0;
+            (i, d.abs())
+        })
+        .min_by(|x, y| x.1.total_cmp(&y.1))
+        .unwrap_or((0, 0.0));
+    b.rotate_left(start);
+    let mut b2 = Vec::with_capacity(b.len());
+    let mut prev = a0;
+    for p in &b {
+        let mut q = *p;
+        q.uv[k] = unwrap_near(q.uv[k], prev, per);
+        prev = q.uv[k];
+        b2.push(q);
+    }
+    // A: a[0] .. a[n-1], then a[0] again one period on; B likewise, walked back.
+    // The cut from A's start to B's start is a curve on the surface (a
+    // meridian of a torus, a profile of a revolved B-spline): it is cut into
+    // segments like an edge, the same on both of its sides.
+    let (from, to) = (a[0], b2[0]);
+    let mut ts = vec![0.0];
+    let at = |t: f64| {
+        s.eval(
+            from.uv[0] + (to.uv[0] - from.uv[0]) * t,
+            from.uv[1] + (to.uv[1] - from.uv[1]) * t,
+        )
+    };
+    refine_curve(&at, 0.0, 1.0, res, 0, &mut ts);
+    let cut = |shift: f64, t: f64| {
+        let mut uv = [
+            from.uv[0] + (to.uv[0] - from.uv[0]) * t,
+            from.uv[1] + (to.uv[1] - from.uv[1]) * t,
+        ];
+        uv[k] += shift;
+        Pt { uv, xyz: at(t) }
+    };
+    let inner = &ts[1..ts.len() - 1];
+    let mut poly = a.clone();
+    let mut a_end = a[0];
+    a_end.uv[k] += per;
+    poly.push(a_end);
+    poly.extend(inner.iter().map(|&t| cut(per, t)));
+    let mut b_end = b2[0];
+    b_end.uv[k] += per;
+    poly.push(b_end);
+    poly.extend(b2.iter().rev().copied());
+    poly.extend(inner.iter().rev().map(|&t| cut(0.0, t)));
+    Ok(poly)
 }
 
 fn mean(pts: &[Pt]) -> [f64; 2] {
