@@ -20,21 +20,6 @@
 //! **Architecture Invariant:** for components of non-zero radius a direction the
 //! obstacle blocks is never reported accessible; the bare half-line is exact at pixel
 //! centres.
-//!
-//! **Decision: D2 and D1′ err on the blocked side.** D2 samples
-//! `ConeOptions::d2_samples` points of dD1 (16 by default, the seed's; the planner asks
-//! 6), evenly by cell index, at half the cones' resolution from N = 32 up; it is a
-//! lower bound, as in the seed. With `d2_wanted` it stops once it holds every wanted
-//! setup, and a sample stops drawing once the cells still needed are blocked. D1′ reads
-//! a 96 × 96 depth map ([`SecondMap`]) dilated by the largest second-component radius,
-//! so it is pessimistic.
-//!
-//! `gac_with` is a union of components, each after the first drawn only where those
-//! before leave the probe free (the retract point only where the contact does);
-//! `point_cones` is the cone at the contact ∩ the cone at the retract point (D1 for
-//! bent probes) plus D2; `cones` and the batched `gac_halfline_many` and
-//! `point_cones_many` keep input order, so a batching backend gets every query of many
-//! points in one call.
 
 mod backend;
 mod batch;

@@ -1,6 +1,15 @@
 //! The HLIP linearised (seed ch. 5): one group per (setup, probe, orientation), each with
 //! its blocks of touches — one per feature face — and their stand-offs, datum groups
 //! first within a setup.
+//!
+//! **Decision: stand-offs follow the feature** (`outlast`). In front of a narrow bore a
+//! block's stand-off shrinks to half the free space (the bore's axis). Where a
+//! feature's tolerances let its surface stand proud by more than the stand-off leaves —
+//! twice the largest excursion they allow (half a profile zone, a position zone's
+//! radius, a form or orientation zone, a size's farther limit) plus the motion margin —
+//! the block's stand-off grows to that, when the longer approach validates and the
+//! space in front allows: a part out by as much again as its tolerance reads OUT
+//! instead of stopping the run (CTC 02's 2.5 mm profiles).
 
 use super::{BlockPath, PassPath, Touch};
 use crate::access::pose::{Contact, Pose};

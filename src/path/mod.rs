@@ -28,26 +28,11 @@
 //! order, each from its nearer end, joined straight, over the passes lifted along the
 //! scanner's direction, or by the clearance plane.
 //!
-//! **Decision: stand-offs follow the feature** (`outlast`). In front of a narrow bore a
-//! block's stand-off shrinks to half the free space (the bore's axis). Where a
-//! feature's tolerances let its surface stand proud by more than the stand-off leaves —
-//! twice the largest excursion they allow (half a profile zone, a position zone's
-//! radius, a form or orientation zone, a size's farther limit) plus the motion margin —
-//! the block's stand-off grows to that, when the longer approach validates and the
-//! space in front allows: a part out by as much again as its tolerance reads OUT
-//! instead of stopping the run (CTC 02's 2.5 mm profiles).
-//!
-//! **Decision: tours respect `MEAS` blocks** (`plan_group`). DMIS measures a feature's
-//! points in one block, so a group's tour orders blocks (datum features first, in datum
-//! order, for the alignment) and then points within each; on swiss_block and CTC 01
-//! that costs about 30 % over an unconstrained tour of the same stand-offs.
-//!
 //! **Decision: an unreachable touch is one more failed test.** A touch the roadmap
 //! cannot reach is returned, not given up on: the driver bans its configuration and
 //! plans again (`paths_of` in `lib.rs`).
 
 pub mod align;
-mod align_extra;
 mod errors;
 mod join;
 mod linearise;

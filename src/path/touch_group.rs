@@ -1,5 +1,10 @@
 //! One touch group planned (seed ch. 5.4): a roadmap over its stand-offs, the blocks in
 //! tour order (datum blocks first), and its way down from and up to the clearance plane.
+//!
+//! **Decision: tours respect `MEAS` blocks** (`plan_group`). DMIS measures a feature's
+//! points in one block, so a group's tour orders blocks (datum features first, in datum
+//! order, for the alignment) and then points within each; on swiss_block and CTC 01
+//! that costs about 30 % over an unconstrained tour of the same stand-offs.
 
 use super::linearise::GroupIn;
 use super::roadmap::{Disconnected, Paths, Roadmap};

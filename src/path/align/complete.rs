@@ -3,7 +3,7 @@
 //! other planes of the part by hand — a primary, a secondary, tertiaries — or a sphere,
 //! with one of the setup's probes held as a group holds it or indexed for the touch.
 
-use super::align::{
+use super::{
     axis_of, dir_word, faces_in_graph, orig_word, AlignStep, Alignment, ExtraFace, Free, Touchable,
     AXES,
 };

@@ -61,13 +61,15 @@
 //! it (one circle; two for a primary axis), not the four points farthest apart in
 //! space, which can lie on one line and leave the centre across them unknown.
 
-use super::align_extra::complete;
+mod complete;
+
 use super::{BlockPath, Hlip, SetupPath};
 use crate::access::Contact;
 use crate::geometry::{FaceId, Surface, P3, V3};
 use crate::graph::Node;
 use crate::model::FeatureId;
 use crate::plan::Input;
+use complete::complete;
 use std::collections::BTreeSet;
 
 /// A setup's alignment.
