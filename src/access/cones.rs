@@ -22,16 +22,8 @@ use super::{
     heightmap, pose, refine, Backend, Cell, Component, ConeOptions, Cpu, CubeMap, D2Wanted,
     ProbeShape, Scene,
 };
-use crate::geometry::{PartGeometry, P3, V3};
+use crate::geometry::{P3, V3};
 use crate::sample::Fpoint;
-
-/// The part's triangles as corner points.
-pub fn triangles_of(g: &PartGeometry) -> Vec<[P3; 3]> {
-    g.triangles
-        .iter()
-        .map(|t| t.map(|i| g.vertices[i as usize]))
-        .collect()
-}
 
 /// The global accessibility cone of a half-line at `p`: the directions d for which the
 /// ray p + t·d, t > 0, misses every triangle (seed ch. 2.3), sampled at pixel centres.
@@ -56,7 +48,7 @@ pub fn gac(
 
 /// [`gac`], optionally with each component's cone [`refine`]d by exact tests at its
 /// boundary.
-pub fn gac_with(
+pub(crate) fn gac_with(
     backend: &dyn Backend,
     scene: &Scene,
     from: &P3,

@@ -72,7 +72,7 @@ const MAX_SPLIT: u32 = 4;
 const MIN_STEP: f64 = 0.408 * 2.0;
 
 /// How many whole-pixel growths cover a dilation by `alpha` rad at resolution `n`.
-pub fn pixels_for(alpha: f64, n: u32) -> u32 {
+pub(crate) fn pixels_for(alpha: f64, n: u32) -> u32 {
     (alpha * n as f64 / MIN_STEP * 1.02).ceil().max(1.0) as u32
 }
 

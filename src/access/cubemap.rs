@@ -66,7 +66,7 @@ fn key(d: &V3) -> [u64; 3] {
 }
 
 /// The major axis and sign of a direction, and its (u, v) on that cube face.
-pub fn face_uv(d: &V3) -> (u8, f64, f64) {
+pub(crate) fn face_uv(d: &V3) -> (u8, f64, f64) {
     let a = d.iamax();
     let s = d[a];
     let face = (2 * a + usize::from(s < 0.0)) as u8;
@@ -75,7 +75,7 @@ pub fn face_uv(d: &V3) -> (u8, f64, f64) {
 }
 
 /// The direction through (u, v) of a cube face (not normalised).
-pub fn face_dir(face: u8, u: f64, v: f64) -> V3 {
+pub(crate) fn face_dir(face: u8, u: f64, v: f64) -> V3 {
     let a = (face / 2) as usize;
     let s = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
     let mut d = V3::zeros();
@@ -202,7 +202,7 @@ impl CubeMap {
     }
 
     /// The pixel a direction falls in.
-    pub fn pixel_of(&self, d: &V3) -> Pixel {
+    pub(crate) fn pixel_of(&self, d: &V3) -> Pixel {
         let (face, u, v) = face_uv(d);
         let at =
             |x: f64| floor_i((x + 1.0) / 2.0 * self.n as f64).clamp(0, self.n as i64 - 1) as u32;
@@ -341,7 +341,7 @@ impl CubeMap {
     }
 
     /// Whether every direction is in the cone.
-    pub fn is_full(&self) -> bool {
+    pub(crate) fn is_full(&self) -> bool {
         self.count() == self.len()
     }
 
@@ -583,7 +583,7 @@ impl CubeMap {
 
     /// A map shaped like this one whose pixels are the bits of `words` (32 to a word, in
     /// pixel order: see [`CubeMap::words`]) and whose preferred directions are clear.
-    pub fn with_pixel_words(&self, words: &[u32]) -> CubeMap {
+    pub(crate) fn with_pixel_words(&self, words: &[u32]) -> CubeMap {
         let mut out = self.empty_like();
         let pixels = 6 * (self.n as usize) * (self.n as usize);
         for (k, w) in out.bits.iter_mut().enumerate() {
@@ -603,7 +603,7 @@ impl CubeMap {
     }
 
     /// Adds pixels i0..=i1 of row `j` of a face.
-    pub fn set_span(&mut self, face: u8, j: u32, i0: u32, i1: u32) {
+    pub(crate) fn set_span(&mut self, face: u8, j: u32, i0: u32, i1: u32) {
         if i0 > i1 {
             return;
         }
@@ -629,7 +629,7 @@ impl CubeMap {
 
     /// Whether pixels i0..=i1 of rows j0..=j1 of a face are all in the map (true for an
     /// empty range).
-    pub fn spans_set(&self, face: u8, j0: u32, j1: u32, i0: u32, i1: u32) -> bool {
+    pub(crate) fn spans_set(&self, face: u8, j0: u32, j1: u32, i0: u32, i1: u32) -> bool {
         if i0 > i1 {
             return true;
         }
@@ -838,7 +838,7 @@ impl CubeMap {
     }
 
     /// Adds every preferred direction.
-    pub fn fill_preferred(&mut self) {
+    pub(crate) fn fill_preferred(&mut self) {
         for k in 0..self.extra.len() {
             self.set(Cell::Preferred(k), true);
         }
@@ -880,7 +880,7 @@ impl CubeMap {
     }
 
     /// Adds every pixel.
-    pub fn fill_pixels(&mut self) {
+    pub(crate) fn fill_pixels(&mut self) {
         for f in 0..6 {
             for j in 0..self.n {
                 self.set_span(f, j, 0, self.n - 1);

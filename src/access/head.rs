@@ -14,7 +14,7 @@ pub fn head_direction(a_deg: f64, b_deg: f64) -> V3 {
 }
 
 /// The orientations of a head's grid whose direction is in the cone, in grid order.
-pub fn orientations_in(cone: &CubeMap, orientations: &[(f64, f64)]) -> Vec<(f64, f64)> {
+pub(crate) fn orientations_in(cone: &CubeMap, orientations: &[(f64, f64)]) -> Vec<(f64, f64)> {
     orientations
         .iter()
         .copied()
@@ -22,8 +22,9 @@ pub fn orientations_in(cone: &CubeMap, orientations: &[(f64, f64)]) -> Vec<(f64,
         .collect()
 }
 
+#[cfg(test)]
 /// The cone of a set of orientations: the cells their directions fall in.
-pub fn orientation_cone(orientations: &[(f64, f64)], n: u32, preferred: &[V3]) -> CubeMap {
+pub(crate) fn orientation_cone(orientations: &[(f64, f64)], n: u32, preferred: &[V3]) -> CubeMap {
     let mut c = CubeMap::empty(n, preferred);
     for &(a, b) in orientations {
         let cell = c.cell_of(&head_direction(a, b));

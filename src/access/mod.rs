@@ -43,19 +43,20 @@ mod swept;
 pub use backend::{auto_backend, gpu, Backend, BackendKind, Cpu, Query};
 pub use batch::{cones, gac_halfline_many, point_cones_many};
 pub use cones::{
-    approach_cone, axes, d1, d1_prime, d2, feature_cone, gac, gac_halfline, gac_with, point_cones,
-    tip_fits, triangles_of, PointCones, SecondMap,
+    approach_cone, axes, d1, d1_prime, d2, feature_cone, gac, gac_halfline, point_cones, tip_fits,
+    PointCones, SecondMap,
 };
-pub use cpu::{blocked_plain, pixels_for};
-pub use cubemap::{face_dir, face_uv, ones, Cell, CubeMap, Pixel, PreferredIndex};
+pub use cpu::blocked_plain;
+pub use cubemap::{ones, Cell, CubeMap, Pixel, PreferredIndex};
 pub use errors::AccessError;
 pub use exact::{component_hits, refine};
 pub use gpu::Gpu;
-pub use head::{head_direction, orientation_cone, orientations_in};
+pub use head::head_direction;
+pub(crate) use head::orientations_in;
 pub use options::{ConeOptions, D2Wanted};
 pub use pose::{Blocker, Contact, Head, Pose};
 pub use probe::{Component, End, ProbeShape};
-pub use raster::{shadow_polygon, Coverage};
+pub use raster::Coverage;
 pub use report::{cone_report, pgm, ConeInput, ConeReport, ConeRequest};
 pub use scan::{scan_cones, ScanCones, ScannerShape};
-pub use scene::{point_triangle_distance, Scene, Tri};
+pub use scene::{Scene, Tri};

@@ -40,7 +40,7 @@ use parry3d_f64::shape::{Capsule, Cuboid, Cylinder, RoundShape, Shape, TriMesh, 
 /// The share of the tip radius the mesh may come closer than the radius at a contact:
 /// fpoints lie on the exact surface and a concave face's facets are up to the
 /// tessellation's chord error nearer (a tenth of the radius at most).
-pub const TIP_CLEARANCE: f64 = 0.9;
+pub(crate) const TIP_CLEARANCE: f64 = 0.9;
 
 /// The table may come no closer to the probe than this during a move (mm).
 pub const TABLE_MARGIN: f64 = 0.1;
@@ -323,7 +323,7 @@ impl Solid {
     }
 
     /// A sphere around it (part frame): centre and radius.
-    pub fn bounding_sphere(&self) -> (P3, f64) {
+    pub(crate) fn bounding_sphere(&self) -> (P3, f64) {
         match &self.shape {
             SolidShape::Box(h) => (P3::from(self.at.translation.vector), h.norm()),
             SolidShape::Cylinder {
@@ -463,7 +463,7 @@ impl<'a> Pose<'a> {
     }
 
     /// The margin a move from or to `x` keeps.
-    pub fn margin_at(&self, x: &P3) -> f64 {
+    pub(crate) fn margin_at(&self, x: &P3) -> f64 {
         if self.tight.is_empty() {
             return self.margin;
         }
@@ -550,7 +550,7 @@ impl<'a> Pose<'a> {
 
     /// Whether the probe standing with its tip centre at `p`, grown by the margin there,
     /// clears the fixture (the part and the table not asked).
-    pub fn clear_of_fixture(&self, p: &P3) -> bool {
+    pub(crate) fn clear_of_fixture(&self, p: &P3) -> bool {
         self.sweep_fixture(p, p, self.margin_at(p)).is_ok()
     }
 

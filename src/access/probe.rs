@@ -72,7 +72,7 @@ impl Component {
 /// The head a machine's probes hang from, and its second components — head and ram —
 /// for a first component reaching `reach` from the tip: from the articulation point of
 /// an indexable head (a bent probe), or continuing the first on a fixed head.
-pub fn second_components(model: &Model, cmm: &Cmm, reach: f64) -> (Head, Vec<Component>) {
+pub(crate) fn second_components(model: &Model, cmm: &Cmm, reach: f64) -> (Head, Vec<Component>) {
     let head = &model.heads[cmm.head.0];
     let kind = match head.kind {
         HeadKind::Fixed => Head::Fixed,

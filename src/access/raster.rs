@@ -102,14 +102,15 @@ fn in_frame(face: u8, x: &V3) -> [f64; 3] {
 }
 
 /// Marks in `out` the shadow, seen from the origin, of the convex planar polygon with
-/// corners `q` (relative to the viewpoint, at most 12).
-pub fn shadow_polygon(out: &mut CubeMap, q: &[V3], cov: Coverage) {
-    shadow_polygon_where(out, q, cov, None);
-}
-
-/// [`shadow_polygon`], drawn only if it could mark a pixel of `matter` (when given):
-/// a shadow whose rectangle on every face misses those pixels is passed over.
-pub fn shadow_polygon_where(out: &mut CubeMap, q: &[V3], cov: Coverage, matter: Option<&CubeMap>) {
+/// corners `q` (relative to the viewpoint, at most 12), drawn only if it could mark a
+/// pixel of `matter` (when given): a shadow whose rectangle on every face misses those
+/// pixels is passed over.
+pub(crate) fn shadow_polygon_where(
+    out: &mut CubeMap,
+    q: &[V3],
+    cov: Coverage,
+    matter: Option<&CubeMap>,
+) {
     debug_assert!(q.len() >= 3 && q.len() <= 12);
     // Fast path: every corner strictly inside one face's pyramid.
     let f0 = face_of(&q[0]);
@@ -172,7 +173,7 @@ pub fn shadow_polygon_where(out: &mut CubeMap, q: &[V3], cov: Coverage, matter: 
 /// corners lie in the convex hull of `corners` (relative to the viewpoint; a box, a
 /// triangle): a face and the rows j0..=j1 and columns i0..=i1 of a rectangle on it, as
 /// (face, j0, j1, i0, i1). None unless the hull lies strictly inside one face's
-/// pyramid: then every such polygon takes [`shadow_polygon`]'s fast path on that face,
+/// pyramid: then every such polygon takes [`shadow_polygon_where`]'s fast path on that face,
 /// and its projection lies in the hull's (central projection keeps it convex), so the
 /// rectangle holds every span [`raster_convex`] would set.
 pub fn footprint(corners: &[V3], cov: Coverage, n: u32) -> Option<(u8, u32, u32, u32, u32)> {

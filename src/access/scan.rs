@@ -116,7 +116,7 @@ pub fn sensor_shapes(model: &Model, cmm: &Cmm) -> Vec<ProbeShape> {
 /// The camera's line of sight to a point seen along `d` (unit, towards the scanner) on a
 /// surface with outward normal `n`: `d` turned by `angle` towards `n` (see the module's
 /// decision).
-pub fn camera_dir(d: &V3, n: &V3, angle: f64) -> V3 {
+pub(crate) fn camera_dir(d: &V3, n: &V3, angle: f64) -> V3 {
     let mut axis = d.cross(n);
     if axis.norm() < 1e-9 {
         let e = if d.x.abs() < 0.9 { V3::x() } else { V3::y() };

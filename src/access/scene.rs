@@ -138,7 +138,7 @@ impl Scene {
     /// lies wholly under the floor, with a margin for rounding, so that [`Scene::skips`]
     /// leaves out each of them.
     #[inline]
-    pub fn skips_ball(&self, centre: &P3, radius: f64) -> bool {
+    pub(crate) fn skips_ball(&self, centre: &P3, radius: f64) -> bool {
         self.floor.as_ref().is_some_and(|(at, n, h)| {
             let c = (centre - at).dot(n);
             c + radius < h - 1e-9 * (1.0 + h.abs() + c.abs() + radius)
@@ -147,7 +147,7 @@ impl Scene {
 
     /// Whether drawing leaves `t` out: wholly under the floor (see [`Scene::above`]).
     #[inline]
-    pub fn skips(&self, t: &Tri) -> bool {
+    pub(crate) fn skips(&self, t: &Tri) -> bool {
         self.floor.as_ref().is_some_and(|(at, n, h)| {
             // The bounding sphere first: most triangles are decided by it.
             let c = (t.centre - at).dot(n);
@@ -202,7 +202,7 @@ impl Scene {
     /// its axis; a cylinder misses a triangle wholly past either end's plane and meets
     /// one with a corner inside it (each by the margin). The others are tested as
     /// [`Scene::meets`] tests them.
-    pub fn meets_axis(
+    pub(crate) fn meets_axis(
         &self,
         (shape, pos): (&dyn Shape, &Isometry<f64>),
         a: &P3,
@@ -475,7 +475,7 @@ fn segment_segment_distance(p1: &P3, q1: &P3, p2: &P3, q2: &P3) -> f64 {
 /// The distance between the segment a–b and the triangle `t`: nought where the segment
 /// pierces it, else the least of its ends' distances to the triangle and its distances
 /// to the triangle's edges.
-pub fn segment_triangle_distance(a: &P3, b: &P3, t: &[P3; 3]) -> f64 {
+pub(crate) fn segment_triangle_distance(a: &P3, b: &P3, t: &[P3; 3]) -> f64 {
     let d = b - a;
     if d.norm_squared() > 0.0 {
         if let Some(s) = crate::geometry::line_triangle(a, &d, &t[0], &t[1], &t[2]) {
@@ -491,7 +491,7 @@ pub fn segment_triangle_distance(a: &P3, b: &P3, t: &[P3; 3]) -> f64 {
 }
 
 /// Distance from `p` to the triangle (Ericson, Real-Time Collision Detection 5.1.5).
-pub fn point_triangle_distance(p: &P3, t: &[P3; 3]) -> f64 {
+pub(crate) fn point_triangle_distance(p: &P3, t: &[P3; 3]) -> f64 {
     let [a, b, c] = t;
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));

@@ -20,7 +20,7 @@ use parry3d_f64::shape::{ConvexPolyhedron, FeatureId, Shape, ShapeType, SupportM
 /// The convex hull of a point set and that set moved by `v`: the points' support plus
 /// the move's.
 #[derive(Debug, Clone)]
-pub struct SweptHull {
+pub(crate) struct SweptHull {
     /// The shape at the start of the move (its vertices; interior points do no harm).
     pub points: Vec<P3>,
     /// The move.

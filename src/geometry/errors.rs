@@ -456,7 +456,7 @@ impl MeshError {
 
 /// How a mesh path appears in a message: its file name, so that messages read the same on
 /// every machine (the label points at the path as the spec wrote it).
-pub fn shown_path(path: &std::path::Path) -> String {
+pub(crate) fn shown_path(path: &std::path::Path) -> String {
     path.file_name()
         .unwrap_or(path.as_os_str())
         .to_string_lossy()

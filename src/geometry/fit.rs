@@ -76,7 +76,7 @@ pub fn plane(p: &Patch) -> Fit {
 
 /// The best cylinder or cone (whichever the radius along the axis says), or `None` when
 /// the normals do not determine an axis.
-pub fn cylinder_or_cone(p: &Patch) -> Option<Fit> {
+pub(crate) fn cylinder_or_cone(p: &Patch) -> Option<Fit> {
     let wsum: f64 = p.normals.iter().map(|(_, a, _)| a).sum();
     if wsum <= 0.0 {
         return None;
@@ -245,7 +245,7 @@ fn normals_agree(p: &Patch, s: &Surface, max_deg: f64) -> bool {
 }
 
 /// How far a planar face's facet normals may turn from the plane's (degrees).
-pub const PLANE_NORMAL_DEG: f64 = 10.0;
+pub(crate) const PLANE_NORMAL_DEG: f64 = 10.0;
 
 /// The best analytic surface for a patch, or free-form when none is within `tol` (mm).
 /// The simplest surface that fits wins: plane, then cylinder or cone, then sphere (a

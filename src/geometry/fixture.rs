@@ -17,17 +17,17 @@ use parry3d_f64::shape::TriMesh;
 use rayon::prelude::*;
 
 /// How near a part face must come to the fixture to rest on it (mm).
-pub const CONTACT_MM: f64 = 0.05;
+pub(crate) const CONTACT_MM: f64 = 0.05;
 
 /// The least area of a face touching the fixture for it to be a locating face (mm²).
-pub const MIN_CONTACT_MM2: f64 = 1.0;
+pub(crate) const MIN_CONTACT_MM2: f64 = 1.0;
 
 /// The size of the pieces a face's triangles are cut into to find its contact (mm).
 const SAMPLE_MM: f64 = 2.0;
 
 /// How deep the part may sink into the fixture, or the fixture into the part, before
 /// they overlap (mm): meshes exported from one assembly meet to about this.
-pub const OVERLAP_MM: f64 = 0.05;
+pub(crate) const OVERLAP_MM: f64 = 0.05;
 
 /// A mesh fixture placed with its part.
 #[derive(Debug, Clone)]

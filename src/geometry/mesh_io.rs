@@ -12,7 +12,7 @@ use crate::source::{FileKind, World};
 use std::path::Path;
 
 /// The most triangles a mesh may have.
-pub const MAX_TRIANGLES: usize = 2_000_000;
+pub(crate) const MAX_TRIANGLES: usize = 2_000_000;
 
 /// Reads a mesh file through the world, scaling by `unit_mm`; a STEP or QIF part is
 /// meshed at the default resolution.
@@ -21,7 +21,7 @@ pub fn read_mesh(world: &dyn World, path: &Path, unit_mm: f64) -> Result<RawMesh
 }
 
 /// [`read_mesh`], meshing a STEP or QIF part at `res`.
-pub fn read_mesh_at(
+pub(crate) fn read_mesh_at(
     world: &dyn World,
     path: &Path,
     unit_mm: f64,

@@ -29,9 +29,9 @@ pub mod step;
 mod weld;
 
 pub use errors::{GeometryError, MeshError};
-pub use fixture::{place_fixture, FixtureMesh, CONTACT_MM};
+pub use fixture::{place_fixture, FixtureMesh};
 pub use mesh_io::read_mesh;
-pub use query::{edge_triangles, line_triangle, segment_distance, FaceIndex};
+pub use query::{edge_triangles, line_triangle, FaceIndex};
 pub use report::{describe, faces_json, faces_table};
 pub use select::resolve_faces;
 pub use weld::RawMesh;
@@ -45,9 +45,6 @@ use nalgebra::{Point3, Vector3};
 pub type P3 = Point3<f64>;
 /// A vector in the part frame.
 pub type V3 = Vector3<f64>;
-
-/// Geometric tolerance for "lies on a surface" (mm).
-pub const ON_SURFACE_MM: f64 = 1e-6;
 
 /// The analytic surface a face lies on.
 #[derive(Debug, Clone, PartialEq)]
@@ -147,7 +144,7 @@ impl Surface {
     /// Whether two faces' surfaces are one surface (the halves of a bore, the pieces of
     /// a plane the CAD split): same type, sense and shape, an axis either way for a
     /// cylinder. Free-form faces are never one surface.
-    pub fn same_as(&self, other: &Surface) -> bool {
+    pub(crate) fn same_as(&self, other: &Surface) -> bool {
         let cos = SAME_SURFACE_DEG.to_radians().cos();
         let tol = SAME_SURFACE_MM;
         // The distance from `p` to the line through `o` along unit `a`.

@@ -40,7 +40,7 @@ impl Frame {
     }
 
     /// A frame from `u` and `w` (made orthogonal).
-    pub fn from_uw(o: P3, u: V3, w: V3) -> Frame {
+    pub(crate) fn from_uw(o: P3, u: V3, w: V3) -> Frame {
         let w = w.normalize();
         let u = (u - w * u.dot(&w)).normalize();
         Frame {
@@ -141,7 +141,7 @@ pub(crate) struct Prim {
 }
 
 impl Prim {
-    pub fn bounds_of_part(&self, part: u32) -> (P3, P3) {
+    pub(crate) fn bounds_of_part(&self, part: u32) -> (P3, P3) {
         let mut lo = P3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
         let mut hi = -lo;
         for (t, tri) in self.tris.iter().enumerate() {
@@ -166,7 +166,7 @@ impl Prim {
     }
 
     /// Applies a rigid motion to vertices and surfaces.
-    pub fn transform(&mut self, m: &nalgebra::Isometry3<f64>) {
+    pub(crate) fn transform(&mut self, m: &nalgebra::Isometry3<f64>) {
         for v in &mut self.verts {
             *v = m * *v;
         }

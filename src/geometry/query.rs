@@ -56,7 +56,7 @@ pub fn edge_triangles(triangles: &[[u32; 3]]) -> HashMap<(u32, u32), Vec<u32>> {
 }
 
 /// Distance from a point to a segment.
-pub fn segment_distance(p: &P3, a: &P3, b: &P3) -> f64 {
+pub(crate) fn segment_distance(p: &P3, a: &P3, b: &P3) -> f64 {
     let ab = b - a;
     let len2 = ab.norm_squared();
     let t = if len2 > 0.0 {

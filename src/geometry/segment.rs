@@ -12,9 +12,9 @@ use super::fit::{self, Patch};
 use super::{PartGeometry, RawMesh, Surface, P3, V3};
 
 /// Normals within this angle are one flat patch (degrees).
-pub const FLAT_DEG: f64 = 0.5;
+pub(crate) const FLAT_DEG: f64 = 0.5;
 /// Creases gentler than this join facets of one curved face (degrees).
-pub const SMOOTH_DEG: f64 = 30.0;
+pub(crate) const SMOOTH_DEG: f64 = 30.0;
 
 fn tri_normal(m: &RawMesh, t: usize) -> (V3, f64, P3) {
     let [a, b, c] = m.triangles[t].map(|i| m.vertices[i as usize]);

@@ -114,7 +114,7 @@ pub struct MeasurementGraph {
 /// The most measuring points one graph may hold. The path stage keeps a shortest-path
 /// tree per point of a group (points × roadmap nodes), so this bounds its memory to a
 /// few hundred megabytes and a build to seconds; real parts use far fewer (FTC 08: 737).
-pub const MAX_POINTS: usize = 5_000;
+pub(crate) const MAX_POINTS: usize = 5_000;
 
 impl MeasurementGraph {
     /// The fpoints of a face, by index.
@@ -437,11 +437,11 @@ fn spread_for(input: &Input, kind: SurfaceKind, owners: &[FeatureId], base: Stra
 }
 
 /// A zone under this (mm) doubles `spread`'s points on the face.
-pub const TIGHT_ZONE: f64 = 0.05;
+pub(crate) const TIGHT_ZONE: f64 = 0.05;
 
 /// The fewest points a plane whose flatness is toleranced gets unless the spec says
 /// otherwise for its feature: a 3 × 3 grid, the least that sees a face bow or twist.
-pub const FORM_POINTS: u32 = 9;
+pub(crate) const FORM_POINTS: u32 = 9;
 
 /// The surface types a tolerance kind applies to; `None` for kinds that apply to any.
 fn surfaces_for(kind: TolKind) -> Option<&'static [SurfaceKind]> {

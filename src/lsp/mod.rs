@@ -43,7 +43,7 @@ pub fn stdio() -> Result<(), String> {
 }
 
 /// Serves the protocol over a connection until the client says `exit`.
-pub fn serve(connection: &Connection) -> Result<(), String> {
+pub(crate) fn serve(connection: &Connection) -> Result<(), String> {
     let caps = capabilities();
     let caps = serde_json::to_value(caps).map_err(|e| e.to_string())?;
     connection.initialize(caps).map_err(|e| e.to_string())?;
@@ -123,7 +123,7 @@ struct Doc {
 }
 
 /// What the server knows of one open spec.
-pub struct Analysis {
+pub(crate) struct Analysis {
     /// The front end of the current text.
     pub front: Arc<Checked>,
     /// The last front end whose root parsed: names and keys for completion while the
@@ -136,7 +136,7 @@ pub struct Analysis {
 }
 
 /// The geometry stage and measurement graphs of one version of a spec.
-pub struct Deep {
+pub(crate) struct Deep {
     /// The version analysed.
     pub version: i32,
     /// Every diagnostic up to the measurement graph.
@@ -148,7 +148,7 @@ pub struct Deep {
 }
 
 /// What a plan run (`inspc lsp --plan`) reported.
-pub struct PlanResult {
+pub(crate) struct PlanResult {
     /// The text it planned (diagnostics show only while the document still reads so).
     pub text: String,
     /// Per file, its diagnostics.

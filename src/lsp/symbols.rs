@@ -7,7 +7,7 @@ use crate::Checked;
 
 /// What a declaration declares.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum DeclKind {
+pub(crate) enum DeclKind {
     /// `cmm`, `probe`, `head`, … items.
     Block(ast::BlockKind),
     /// `part name { … }`
@@ -66,7 +66,7 @@ pub struct Decl<'a> {
 
 impl Decl<'_> {
     /// Whether it is a top-level item (not a name inside a part, not a rack label).
-    pub fn is_item(&self) -> bool {
+    pub(crate) fn is_item(&self) -> bool {
         self.part.is_none() && self.kind != DeclKind::Label
     }
 }
@@ -203,7 +203,7 @@ pub fn references(checked: &Checked, decl: Span) -> Vec<Span> {
 
 /// Whether `name` can be written as a name: a letter or `_`, then letters, digits and `_`,
 /// and not a word the language reserves.
-pub fn is_name(name: &str) -> bool {
+pub(crate) fn is_name(name: &str) -> bool {
     let mut chars = name.chars();
     let first_ok = chars
         .next()
@@ -213,7 +213,7 @@ pub fn is_name(name: &str) -> bool {
 
 /// The grammar's keywords (`grammar/insp.pest`, the `kw_` rules and `block_kw`): a name
 /// spelt like one would read as the keyword where the keyword may stand.
-pub const RESERVED: &[&str] = &[
+pub(crate) const RESERVED: &[&str] = &[
     "use",
     "part",
     "plan",

@@ -53,7 +53,7 @@ pub fn range(text: &str, r: std::ops::Range<usize>) -> Range {
 }
 
 /// The path a `file://` URI names; `None` for any other scheme.
-pub fn path_of(uri: &Uri) -> Option<PathBuf> {
+pub(crate) fn path_of(uri: &Uri) -> Option<PathBuf> {
     let s = uri.as_str();
     let rest = s.strip_prefix("file://")?;
     // `file:///a/b` has an empty authority; `file://localhost/a/b` names this machine.
@@ -80,7 +80,7 @@ pub fn path_of(uri: &Uri) -> Option<PathBuf> {
 }
 
 /// The `file://` URI of an absolute path, percent-encoding what a URI path may not hold.
-pub fn uri_of(path: &Path) -> Option<Uri> {
+pub(crate) fn uri_of(path: &Path) -> Option<Uri> {
     let mut s = String::from("file://");
     for b in path.to_str()?.bytes() {
         match b {

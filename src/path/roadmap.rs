@@ -25,7 +25,7 @@ const BRIDGES: usize = 16;
 
 /// How a local path between two nodes runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Route {
+pub(crate) enum Route {
     /// The straight segment.
     Straight,
     /// Up the probe axis by `h`, across, down.
@@ -43,7 +43,7 @@ struct Edge {
 }
 
 /// The roadmap of one group.
-pub struct Roadmap<'a> {
+pub(crate) struct Roadmap<'a> {
     pose: &'a Pose<'a>,
     /// Node positions (tip centre, part frame); the first `goals` are the goals.
     pub nodes: Vec<P3>,
@@ -61,7 +61,7 @@ pub struct Roadmap<'a> {
 
 /// Why goals could not be connected: the goals left out and what blocked the first.
 #[derive(Debug, Clone)]
-pub struct Disconnected {
+pub(crate) struct Disconnected {
     /// The first goal left out.
     pub goal: usize,
     /// Every goal left out, `goal` first.
@@ -100,7 +100,7 @@ impl<'a> Roadmap<'a> {
     }
 
     /// The waypoints of a route from `p` to `q`, without `p`, with `q`.
-    pub fn waypoints(&self, p: &P3, q: &P3, route: Route) -> Vec<P3> {
+    pub(crate) fn waypoints(&self, p: &P3, q: &P3, route: Route) -> Vec<P3> {
         match route {
             Route::Straight => vec![*q],
             Route::Probe(h) => vec![p + self.dir * h, q + self.dir * h, *q],
@@ -458,7 +458,7 @@ impl<'a> Roadmap<'a> {
 
     /// Shortest paths from every goal: distances between goals and the trees to
     /// extract the paths.
-    pub fn shortest_paths(&self) -> Paths {
+    pub(crate) fn shortest_paths(&self) -> Paths {
         let trees: Vec<_> = (0..self.goals)
             .into_par_iter()
             .map(|g| self.dijkstra(g))
@@ -479,7 +479,7 @@ struct Tree {
 }
 
 /// Shortest paths from each goal.
-pub struct Paths {
+pub(crate) struct Paths {
     trees: Vec<Tree>,
 }
 

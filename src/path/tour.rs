@@ -6,7 +6,7 @@
 //! improves. [`nearest_neighbour`] is the baseline the bench compares against.
 
 /// The most points [`solve`] orders exactly.
-pub const EXACT_MAX: usize = 12;
+pub(crate) const EXACT_MAX: usize = 12;
 
 /// Improvements smaller than this are noise (mm).
 const EPS: f64 = 1e-9;

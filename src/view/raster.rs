@@ -6,7 +6,7 @@ use super::Scene;
 
 /// The camera: turned about the vertical by the setup's yaw ([`best_yaw`]), looking
 /// 30° down.
-pub const PITCH_DEG: f32 = 30.0;
+pub(crate) const PITCH_DEG: f32 = 30.0;
 
 /// The yaws tried for each setup (degrees): from the front-left, and round the part.
 const YAWS: [f32; 4] = [-35.0, 55.0, 145.0, -125.0];
@@ -135,7 +135,7 @@ pub fn png(scene: &Scene, setup: usize, width: u32, height: u32) -> Option<Vec<u
 
 /// The yaw (degrees) from which most of the part shows in setup `setup`: a fixture
 /// beside the part (an angle plate) hides it from one side.
-pub fn best_yaw(scene: &Scene, setup: usize) -> f32 {
+pub(crate) fn best_yaw(scene: &Scene, setup: usize) -> f32 {
     let mut best = (0, YAWS[0]);
     for yaw in YAWS {
         let shown =

@@ -120,7 +120,7 @@ impl Gpu {
     }
 
     /// Whether the adapter runs on the CPU (Mesa's lavapipe, say).
-    pub fn is_software(&self) -> bool {
+    pub(crate) fn is_software(&self) -> bool {
         self.software
     }
 

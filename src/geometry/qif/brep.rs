@@ -34,14 +34,14 @@ impl<'a> Doc<'a> {
     }
 
     /// The id in `<name><Id>…</Id></name>` under `n`.
-    pub fn ref_id(&self, n: &Node, name: &str) -> Result<u64, QifError> {
+    pub(crate) fn ref_id(&self, n: &Node, name: &str) -> Result<u64, QifError> {
         n.at(&[name, "Id"])
             .and_then(|i| i.text.trim().parse().ok())
             .ok_or_else(|| malformed(n, &format!("it has no <{name}><Id>")))
     }
 
     /// The ids listed under `n`'s child `name` (`<FaceIds><Id>…`).
-    pub fn id_list(n: &Node, name: &str) -> Vec<u64> {
+    pub(crate) fn id_list(n: &Node, name: &str) -> Vec<u64> {
         n.child(name)
             .map(|l| {
                 l.all("Id")
@@ -53,7 +53,7 @@ impl<'a> Doc<'a> {
 }
 
 /// The error for an element whose content does not fit its type.
-pub fn malformed(n: &Node, message: &str) -> QifError {
+pub(crate) fn malformed(n: &Node, message: &str) -> QifError {
     QifError::Malformed {
         id: n.id(),
         element: n.name.clone(),

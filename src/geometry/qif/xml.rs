@@ -23,7 +23,7 @@ pub struct Node {
 
 impl Node {
     /// An attribute's value.
-    pub fn attr(&self, name: &str) -> Option<&str> {
+    pub(crate) fn attr(&self, name: &str) -> Option<&str> {
         self.attrs
             .iter()
             .find(|(k, _)| k == name)
@@ -46,7 +46,7 @@ impl Node {
     }
 
     /// The text of the child at `path`.
-    pub fn text_at(&self, path: &[&str]) -> Option<&str> {
+    pub(crate) fn text_at(&self, path: &[&str]) -> Option<&str> {
         self.at(path).map(|n| n.text.as_str())
     }
 
@@ -74,7 +74,7 @@ impl Node {
 
 /// Why a document could not be read as XML.
 #[derive(Debug, Clone, PartialEq)]
-pub struct XmlError {
+pub(crate) struct XmlError {
     /// 1-based line.
     pub line: usize,
     /// What is wrong.

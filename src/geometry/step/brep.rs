@@ -27,7 +27,7 @@ pub struct Edge {
 /// A face bound: a loop of edges, each used forward or backward, or a single vertex
 /// (a cone's apex, a sphere's pole).
 #[derive(Debug, Clone)]
-pub enum Bound {
+pub(crate) enum Bound {
     /// Edges (index into [`Brep::edges`], forward?).
     Edges(Vec<(usize, bool)>),
     /// A vertex loop.
@@ -49,7 +49,7 @@ pub struct Face {
 
 /// A file's B-rep.
 #[derive(Debug, Clone)]
-pub struct Brep {
+pub(crate) struct Brep {
     /// Faces in shell order: solids first, then sheet bodies, in file order.
     pub faces: Vec<Face>,
     /// Edges.

@@ -48,12 +48,12 @@ impl Frame {
 }
 
 /// The highest B-spline degree read (CAD systems write up to 9 or so).
-pub const MAX_DEGREE: usize = 15;
+pub(crate) const MAX_DEGREE: usize = 15;
 
 /// A non-uniform rational B-spline in any number of parameters' worth of control points:
 /// one knot vector and degree per direction (used for curves and surfaces).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Knots {
+pub(crate) struct Knots {
     /// Degree.
     pub degree: usize,
     /// The full knot vector (multiplicities expanded).
@@ -105,7 +105,7 @@ impl Knots {
     }
 
     /// The distinct knots inside the range, with the ends.
-    pub fn breaks(&self) -> Vec<f64> {
+    pub(crate) fn breaks(&self) -> Vec<f64> {
         let (a, b) = self.range();
         let mut out: Vec<f64> = self
             .knots
@@ -147,7 +147,7 @@ impl Knots {
 
 /// A B-spline curve.
 #[derive(Debug, Clone, PartialEq)]
-pub struct BSplineCurve {
+pub(crate) struct BSplineCurve {
     /// Knots and degree.
     pub knots: Knots,
     /// Control points.
@@ -173,7 +173,7 @@ impl BSplineCurve {
 
 /// A B-spline surface.
 #[derive(Debug, Clone, PartialEq)]
-pub struct BSplineSurface {
+pub(crate) struct BSplineSurface {
     /// Knots along u (the first index of `points`).
     pub u: Knots,
     /// Knots along v.
@@ -215,7 +215,7 @@ impl BSplineSurface {
 
 /// An edge's curve.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Curve {
+pub(crate) enum Curve {
     /// A straight line (the edge runs between its vertices).
     Line,
     /// A circle in the frame's xy plane, parametrised by angle from x.
@@ -258,7 +258,7 @@ impl Curve {
 
 /// The parameter in `range` whose point is nearest `p`: a dense scan, then golden-section
 /// refinement around the best sample.
-pub fn nearest_param(f: impl Fn(f64) -> P3, (a, b): (f64, f64), p: &P3) -> f64 {
+pub(crate) fn nearest_param(f: impl Fn(f64) -> P3, (a, b): (f64, f64), p: &P3) -> f64 {
     const N: usize = 64;
     let d = |t: f64| (f(t) - p).norm_squared();
     let step = (b - a) / N as f64;
@@ -376,7 +376,7 @@ impl Surf {
     }
 
     /// The period of u (an angle), if it has one.
-    pub fn u_period(&self) -> Option<f64> {
+    pub(crate) fn u_period(&self) -> Option<f64> {
         match self {
             Surf::Plane(_) => None,
             Surf::BSpline(s) => s.closed[0].then(|| s.u.range().1 - s.u.range().0),
@@ -385,7 +385,7 @@ impl Surf {
     }
 
     /// The period of v: a torus's tube angle.
-    pub fn v_period(&self) -> Option<f64> {
+    pub(crate) fn v_period(&self) -> Option<f64> {
         match self {
             Surf::Torus(..) => Some(TAU),
             Surf::BSpline(s) => s.closed[1].then(|| s.v.range().1 - s.v.range().0),
@@ -394,7 +394,7 @@ impl Surf {
     }
 
     /// The values of v where u is undefined: a sphere's poles, a cone's apex.
-    pub fn poles(&self) -> Vec<f64> {
+    pub(crate) fn poles(&self) -> Vec<f64> {
         match self {
             Surf::Sphere(..) => vec![-FRAC_PI_2, FRAC_PI_2],
             Surf::Cone(_, r, a) => vec![-r / a.tan()],
@@ -403,7 +403,7 @@ impl Surf {
     }
 
     /// Whether `v` is at a pole (where u is undefined).
-    pub fn at_pole(&self, p: &P3, v: f64) -> bool {
+    pub(crate) fn at_pole(&self, p: &P3, v: f64) -> bool {
         match self {
             Surf::Sphere(_, r) => (FRAC_PI_2 - v.abs()) * r < 1e-7,
             Surf::Cone(f, ..) => {
@@ -519,7 +519,7 @@ fn bspline_param(s: &BSplineSurface, p: &P3, hint: Option<(f64, f64)>) -> (f64, 
 }
 
 /// `a` shifted by whole periods to lie within half a period of `near`.
-pub fn unwrap_near(a: f64, near: f64, period: f64) -> f64 {
+pub(crate) fn unwrap_near(a: f64, near: f64, period: f64) -> f64 {
     a + ((near - a) / period).round() * period
 }
 

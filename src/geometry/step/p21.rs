@@ -60,7 +60,7 @@ impl Param {
     }
 
     /// A boolean or logical: `.T.` is true, `.F.` false.
-    pub fn boolean(&self) -> Option<bool> {
+    pub(crate) fn boolean(&self) -> Option<bool> {
         match self {
             Param::Enum(e) if e == "T" => Some(true),
             Param::Enum(e) if e == "F" => Some(false),
@@ -69,7 +69,7 @@ impl Param {
     }
 
     /// The enumeration's value.
-    pub fn enumeration(&self) -> Option<&str> {
+    pub(crate) fn enumeration(&self) -> Option<&str> {
         match self {
             Param::Enum(e) => Some(e),
             _ => None,
@@ -115,7 +115,7 @@ impl Instance {
     }
 
     /// The first record's type (for messages).
-    pub fn type_name(&self) -> String {
+    pub(crate) fn type_name(&self) -> String {
         if self.records.len() == 1 {
             self.records[0].name.clone()
         } else {

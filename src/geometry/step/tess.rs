@@ -47,7 +47,7 @@ const RULED_STRETCH: f64 = 8.0;
 
 /// The mesh of a B-rep: triangle corners per face, not yet welded.
 #[derive(Debug, Default)]
-pub struct Soup {
+pub(crate) struct Soup {
     /// Corner positions (mm).
     pub positions: Vec<[f64; 3]>,
     /// Triangles into `positions`, counter-clockwise from outside.
@@ -58,7 +58,7 @@ pub struct Soup {
 
 /// A face that could not be tessellated.
 #[derive(Debug, Clone)]
-pub struct FaceFailure {
+pub(crate) struct FaceFailure {
     /// Index of the face (0-based, shell order).
     pub index: usize,
     /// Its instance number.
@@ -68,7 +68,7 @@ pub struct FaceFailure {
 }
 
 /// Tessellates every face; the failures are every face that could not be meshed.
-pub fn tessellate(b: &Brep, res: Resolution) -> (Soup, Vec<FaceFailure>) {
+pub(crate) fn tessellate(b: &Brep, res: Resolution) -> (Soup, Vec<FaceFailure>) {
     let edges = edge_polylines(b, res);
     let mut soup = Soup::default();
     let mut failures = Vec::new();
@@ -300,7 +300,7 @@ fn face_loops(face: &Face, edges: &[Vec<P3>]) -> Vec<Loop> {
 }
 
 /// Edges cut into polylines as [`tessellate`] cuts them.
-pub fn edge_polylines(b: &Brep, res: Resolution) -> Vec<Vec<P3>> {
+pub(crate) fn edge_polylines(b: &Brep, res: Resolution) -> Vec<Vec<P3>> {
     b.edges.par_iter().map(|e| edge_points(e, res)).collect()
 }
 
@@ -308,7 +308,7 @@ pub fn edge_polylines(b: &Brep, res: Resolution) -> Vec<Vec<P3>> {
 /// under the B-rep rule that a face lies left of its bounds seen from outside: the
 /// bounds enclose a positive area of the parameter plane. `None` when the bounds cannot
 /// tell (one loop going round a sphere: either cap is left of it for one of the senses).
-pub fn bound_sense(face: &Face, edges: &[Vec<P3>]) -> Option<bool> {
+pub(crate) fn bound_sense(face: &Face, edges: &[Vec<P3>]) -> Option<bool> {
     let s = &face.surface;
     let periods = [s.u_period(), s.v_period()];
     let loops = face_loops(face, edges);
