@@ -53,6 +53,58 @@ impl Located for crate::source::io::IoError {
     }
 }
 
+/// A diagnostic at another severity than its type's ([`Diagnostics::push_at`]): all
+/// else — code, message, labels, help — is the inner one's.
+struct AtSeverity {
+    inner: Box<dyn miette::Diagnostic + Send + Sync + 'static>,
+    severity: Severity,
+}
+
+impl std::fmt::Debug for AtSeverity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Debug::fmt(&self.inner, f)
+    }
+}
+
+impl std::fmt::Display for AtSeverity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Display::fmt(&self.inner, f)
+    }
+}
+
+impl std::error::Error for AtSeverity {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.inner.source()
+    }
+}
+
+impl miette::Diagnostic for AtSeverity {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        self.inner.code()
+    }
+    fn severity(&self) -> Option<Severity> {
+        Some(self.severity)
+    }
+    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        self.inner.help()
+    }
+    fn url<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        self.inner.url()
+    }
+    fn source_code(&self) -> Option<&dyn miette::SourceCode> {
+        self.inner.source_code()
+    }
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
+        self.inner.labels()
+    }
+    fn related<'a>(&'a self) -> Option<Box<dyn Iterator<Item = &'a dyn miette::Diagnostic> + 'a>> {
+        self.inner.related()
+    }
+    fn diagnostic_source(&self) -> Option<&dyn miette::Diagnostic> {
+        self.inner.diagnostic_source()
+    }
+}
+
 /// The file of a primary span (for [`located!`]).
 pub(crate) fn primary_file(span: &Span) -> FileId {
     span.file
@@ -121,6 +173,23 @@ impl Diagnostics {
         self.items.push(Diagnostic {
             file: err.file(),
             inner: Box::new(err),
+        });
+    }
+
+    /// Files `err` at `severity` instead of its type's: one problem, one code, an error
+    /// by default and a warning where the user allowed it (`--allow-unmeasured`), as
+    /// rustc's lints keep their name at any level.
+    pub fn push_at(
+        &mut self,
+        severity: Severity,
+        err: impl miette::Diagnostic + Located + Send + Sync + 'static,
+    ) {
+        self.items.push(Diagnostic {
+            file: err.file(),
+            inner: Box::new(AtSeverity {
+                inner: Box::new(err),
+                severity,
+            }),
         });
     }
 

@@ -6,7 +6,8 @@
 //! face of every feature and datum feature of each tolerance must be touched; one that
 //! is not fails the build (`insp::plan::unmeasured`) unless `--allow-unmeasured`, which
 //! also plans around a face no probe inspects
-//! (`insp::plan::uninspectable_face_allowed`) instead of stopping.
+//! (`insp::plan::uninspectable_face`, then a warning) instead of stopping: one code per
+//! problem, at the severity the flag gives it (`Diagnostics::push_at`).
 
 use super::filter::min_points;
 use super::{axes, scan, Hlip, Input, PlanError, PlanOptions};
@@ -14,6 +15,7 @@ use crate::diag::Diagnostics;
 use crate::geometry::FaceId;
 use crate::graph::{MeasurementGraph, Node};
 use crate::model::FeatureId;
+use miette::Severity;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Counts the tolerances the plan measures — every face of their features and datum
@@ -70,25 +72,26 @@ pub(super) fn account(
             part.features[f.0].name.clone(),
             input.geometry.faces[face.0].name.clone(),
         );
-        if opts.allow_unmeasured {
-            diags.push(PlanError::UnmeasuredAllowed {
-                span: t.span,
-                tolerance,
-                feature,
-                face,
-                why,
-                help,
-            });
+        // One problem, one code: an error, or a warning under `--allow-unmeasured`.
+        let (severity, remedy) = if opts.allow_unmeasured {
+            (Severity::Warning, "the program leaves it out")
         } else {
-            diags.push(PlanError::Unmeasured {
+            (
+                Severity::Error,
+                "`inspc build --allow-unmeasured` writes the program without it",
+            )
+        };
+        diags.push_at(
+            severity,
+            PlanError::Unmeasured {
                 span: t.span,
                 tolerance,
                 feature,
                 face,
                 why,
-                help,
-            });
-        }
+                help: format!("{help}; {remedy}"),
+            },
+        );
     }
     hlip.summary.tolerances = (measured, part.tolerances.len());
     axes::short_axes(input, &touches, &faces_of, diags);

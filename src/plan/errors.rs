@@ -16,20 +16,6 @@ pub enum PlanError {
         why: String,
         help: String,
     },
-    #[error("face `{face}` of feature `{feature}` cannot be inspected (allowed): {why}")]
-    #[diagnostic(
-        code(insp::plan::uninspectable_face_allowed),
-        severity(Warning),
-        help("{help}; the program leaves it out")
-    )]
-    UninspectableFaceAllowed {
-        #[label("`{face}` is part of this feature")]
-        span: Span,
-        face: String,
-        feature: String,
-        why: String,
-        help: String,
-    },
     #[error("planning `{plan}` did not settle after {iterations} rounds of generate-and-test")]
     #[diagnostic(
         code(insp::plan::no_convergence),
@@ -127,26 +113,8 @@ pub enum PlanError {
         ram: String,
     },
     #[error("tolerance `{tolerance}` is not measured: face `{face}` of feature `{feature}` {why}")]
-    #[diagnostic(
-        code(insp::plan::unmeasured),
-        help("{help}; `inspc build --allow-unmeasured` writes the program without it")
-    )]
+    #[diagnostic(code(insp::plan::unmeasured), help("{help}"))]
     Unmeasured {
-        #[label("this tolerance")]
-        span: Span,
-        tolerance: String,
-        feature: String,
-        face: String,
-        why: String,
-        help: String,
-    },
-    #[error("tolerance `{tolerance}` is not measured (allowed): face `{face}` of feature `{feature}` {why}")]
-    #[diagnostic(
-        code(insp::plan::unmeasured_allowed),
-        severity(Warning),
-        help("{help}; the program leaves it out")
-    )]
-    UnmeasuredAllowed {
         #[label("this tolerance")]
         span: Span,
         tolerance: String,
@@ -169,9 +137,7 @@ pub enum PlanError {
 
 crate::diag::located!(PlanError {
     Unmeasured,
-    UnmeasuredAllowed,
     UninspectableFace,
-    UninspectableFaceAllowed,
     NoConvergence,
     PointsLeftOut,
     ShortAxis,

@@ -125,23 +125,26 @@ pub(super) fn report_face(
         feature.map_or(part.span, |f| f.span),
         feature.map_or_else(|| part.name.clone(), |f| f.name.clone()),
     );
-    diags.push(if allowed {
-        PlanError::UninspectableFaceAllowed {
-            span,
-            face: name,
-            feature,
-            why,
-            help,
-        }
+    // One problem, one code: an error, or a warning where `--allow-unmeasured` plans on
+    // without the face.
+    let (severity, help) = if allowed {
+        (
+            miette::Severity::Warning,
+            format!("{help}; the program leaves it out"),
+        )
     } else {
+        (miette::Severity::Error, help)
+    };
+    diags.push_at(
+        severity,
         PlanError::UninspectableFace {
             span,
             face: name,
             feature,
             why,
             help,
-        }
-    });
+        },
+    );
 }
 
 /// What blocks probe `p` at point `f`: the components' cones from the tip up; the first

@@ -21,8 +21,6 @@ const NO_SPEC_EXAMPLE: &[(&str, &str)] = &[
     ("insp::access::no_point", "a command-line request; tests/suite/cli.rs"),
     ("insp::access::unknown_probe", "a command-line request; tests/suite/cli.rs"),
     ("insp::access::no_machine", "a command-line request; tests/suite/cli.rs"),
-    ("insp::plan::unmeasured_allowed", "needs `--allow-unmeasured` on the command line: tests/suite/cli.rs"),
-    ("insp::plan::uninspectable_face_allowed", "needs `--allow-unmeasured` on the command line: tests/suite/cli.rs"),
     ("insp::plan::no_convergence", "a guard: generate-and-test removes a configuration every round, and every example and NIST part settles well inside the limit"),
     ("insp::plan::points_left_out", "needs `--rounds` cut short: the golden case fallback_best_plan_found"),
     ("insp::path::self_aligned", "arises only where no other face completes a setup's frame: the golden cases real_nist_ftc_08 and import_nist_ctc_01"),
