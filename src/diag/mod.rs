@@ -13,7 +13,7 @@
 mod render;
 pub mod suggest;
 
-pub use render::{render_human, terminal_safe, to_json, RenderOptions};
+pub use render::{render_human, to_json, RenderOptions};
 
 use crate::source::{FileId, Span};
 use miette::Severity;

@@ -11,7 +11,7 @@ use std::fmt;
 /// newline, a carriage return or a tab become `?`, and bidirectional controls (which can
 /// reorder what a reader sees, U+202A–U+202E, U+2066–U+2069) become U+FFFD. Both keep
 /// their UTF-8 length, so spans into the text still point at the same characters.
-pub fn terminal_safe(s: &str) -> Cow<'_, str> {
+pub(crate) fn terminal_safe(s: &str) -> Cow<'_, str> {
     let bad = |c: char| {
         (c.is_control() && !matches!(c, '\n' | '\r' | '\t'))
             || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}')

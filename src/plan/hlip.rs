@@ -29,7 +29,7 @@ use std::collections::BTreeSet;
 
 /// The resolution of the plan's coordinates and directions: steps per millimetre (or
 /// per unit of a direction's components), a nanometre.
-pub const STEPS_PER_MM: f64 = 1e6;
+pub(crate) const STEPS_PER_MM: f64 = 1e6;
 
 /// A high-level inspection plan.
 #[derive(Debug, Clone, PartialEq)]

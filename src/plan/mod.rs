@@ -50,9 +50,9 @@ mod validate;
 
 pub use errors::PlanError;
 pub use explain::explain_setups;
+pub(crate) use hlip::STEPS_PER_MM;
 pub use hlip::{
     FaceVisit, Hlip, Inspection, OrientNode, PlanPoint, PointRef, ProbeNode, SetupNode, Summary,
-    STEPS_PER_MM,
 };
 pub use input::{Ban, Input, PlanOptions};
 pub use machine::check_machine;
