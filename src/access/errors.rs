@@ -5,7 +5,7 @@ use crate::source::Span;
 /// A cone request that names nothing the spec has.
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
 #[allow(missing_docs)]
-pub enum AccessError {
+pub(crate) enum AccessError {
     #[error("part `{part}` has no face `{face}`")]
     #[diagnostic(
         code(insp::access::unknown_face),

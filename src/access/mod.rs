@@ -48,7 +48,6 @@ pub use cones::{
 };
 pub use cpu::blocked_plain;
 pub use cubemap::{ones, Cell, CubeMap, Pixel, PreferredIndex};
-pub use errors::AccessError;
 pub use exact::{component_hits, refine};
 pub use gpu::Gpu;
 pub use head::head_direction;

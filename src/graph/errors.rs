@@ -5,7 +5,7 @@ use crate::source::Span;
 /// A problem building the measurement graph.
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
 #[allow(missing_docs)]
-pub enum GraphError {
+pub(crate) enum GraphError {
     #[error("face `{face}` of feature `{feature}` gets no measuring point")]
     #[diagnostic(
         code(insp::graph::no_points),

@@ -41,7 +41,7 @@ mod errors;
 mod render;
 pub mod sensors;
 
-pub use errors::GraphError;
+pub(crate) use errors::GraphError;
 pub use render::{dot, json, mermaid};
 
 use crate::diag::Diagnostics;

@@ -7,7 +7,7 @@ use thiserror::Error;
 /// What can stop the path planner.
 #[derive(Debug, Error, Diagnostic)]
 #[allow(missing_docs)]
-pub enum PathError {
+pub(crate) enum PathError {
     #[error("no collision-free move reaches face `{face}` of feature `{feature}` with probe `{probe}`{orient}: {why}")]
     #[diagnostic(
         code(insp::path::no_path),

@@ -43,7 +43,7 @@ mod touch_group;
 pub mod tour;
 
 pub use align::{AlignStep, Alignment, ExtraFace};
-pub use errors::PathError;
+pub(crate) use errors::PathError;
 pub use render::json;
 
 use crate::access::pose::{Contact, Head};

@@ -5,7 +5,7 @@ use crate::source::Span;
 /// A name, unit, value or structure problem in a spec.
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
 #[allow(missing_docs)]
-pub enum ResolveError {
+pub(crate) enum ResolveError {
     #[error("unknown {what} `{name}`")]
     #[diagnostic(code(insp::resolve::unknown_name))]
     UnknownName {

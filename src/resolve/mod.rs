@@ -26,7 +26,6 @@ mod props;
 mod scope;
 mod tolerance;
 
-pub use errors::ResolveError;
 pub use props::{length_unit_mm, units};
 pub use tolerance::{accepts, keywords as tolerance_keywords, Accepts, Datums};
 
