@@ -8,7 +8,7 @@
 //! root files declare or their plans name), the margin each plan samples with
 //! ([`sampling_margin`]), the surface checks after geometry ([`graph::check_surfaces`]:
 //! a flatness on a cylinder is an error before any sampling), one measurement graph per
-//! plan and per root part no plan names (sampled with `std::sampling::fan_leu`), and
+//! plan and per root part no plan names (sampled with `std::sampling::spread`), and
 //! that such a part is `insp::plan::no_plan` when a build is asked for. Each stage runs
 //! only when the stages before it left no error. `run(…, Until)` keeps every stage's
 //! result, so the golden tests snapshot every stage from one run.

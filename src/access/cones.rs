@@ -14,9 +14,7 @@
 //! `gac_with` is a union of components, each after the first drawn only where those
 //! before leave the probe free (the retract point only where the contact does);
 //! `point_cones` is the cone at the contact ∩ the cone at the retract point (D1 for
-//! bent probes) plus D2; `cones` and the batched `gac_halfline_many` and
-//! `point_cones_many` keep input order, so a batching backend gets every query of many
-//! points in one call.
+//! bent probes) plus D2; the batched forms of many points are in `batch.rs`.
 
 use super::{
     heightmap, pose, refine, Backend, Cell, Component, ConeOptions, Cpu, CubeMap, D2Wanted,

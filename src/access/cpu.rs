@@ -1,5 +1,5 @@
-//! The CPU backend: the blocked directions of one probe component, by projecting the
-//! obstacle onto the cube in software.
+//! The software rasterizer behind the `Cpu` backend (`backend.rs`): the blocked
+//! directions of one probe component, by projecting the obstacle onto the cube.
 //!
 //! Per triangle, cheapest test first:
 //! - **distance**: a triangle entirely nearer than the component's nearest point or

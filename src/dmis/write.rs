@@ -36,7 +36,7 @@
 //! directly; the reader and the virtual CMM also take `FA()` there. A `DATSET`
 //! direction is the `FEAT`'s: its sign turns where a split bore's touched half runs
 //! against the feature's first face. A head orientation indexed for a hand touch alone
-//! (`path::align_orients`) gets its own sensor, selected for that step, and faces
+//! (`path::join::align_orients`) gets its own sensor, selected for that step, and faces
 //! touched by hand only to align are declared where the alignment measures them.
 //!
 //! **Decision: coordinates are the part frame.** After each setup's `DATSET` (axes and
@@ -80,7 +80,7 @@
 //! the rack is not modelled.
 //!
 //! **Decision: stand-offs.** A block whose stand-off differs from the program's
-//! (`path::outlast`: a narrow bore, a feature whose tolerances let it stand proud) gets
+//! (`path::linearise::outlast`: a narrow bore, a feature whose tolerances let it stand proud) gets
 //! its own `SNSET/APPRCH` and `RETRCT`; consecutive blocks of one stand-off share one
 //! `SNSET`, and the default comes back before the next block that approaches by it, or
 //! at the group's end (`group`).

@@ -1,10 +1,6 @@
-//! Reading STL (binary and ASCII) and OBJ meshes (and STEP and QIF parts, through `step` and `qif`), welding coincident vertices and
-//! checking that the result is a (nearly) closed solid.
-//!
-//! **Decision: imperfect meshes are read.** Real exports are nearly closed (NIST CTC
-//! 01's mesh has 4 non-manifold edges, FTC 08's 24 open and 20 non-manifold); up to a
-//! tenth of the edges defective is a warning (`insp::geometry::mesh_defects`), more is
-//! an error.
+//! Reading STL (binary and ASCII) and OBJ meshes, and STEP and QIF parts through `step`
+//! and `qif`: each file parsed and its triangles handed to [`weld`](super::weld), which
+//! merges vertices and checks for a (nearly) closed solid.
 
 use super::errors::MeshError;
 use super::weld::{weld, RawMesh};

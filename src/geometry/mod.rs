@@ -5,12 +5,18 @@
 //! Manifold) on primitives whose faces carry exact surfaces; since boolmesh does not
 //! report which input face an output triangle came from, each output triangle is
 //! classified against the exact surfaces of the inputs (`csg.rs`). Mesh parts are read
-//! from STL or OBJ (`mesh_io.rs`); their faces come from OBJ groups or from segmentation
-//! (`segment.rs`), with surfaces fitted by least squares (`fit.rs`).
+//! from STL or OBJ (`mesh_io.rs`) and welded (`weld.rs`); their faces come from OBJ
+//! groups or from segmentation (`segment.rs`), with surfaces fitted by least squares
+//! (`fit.rs`). CAD parts are read from STEP (`step/`) or QIF (`qif/`) with each face's
+//! exact surface. Mesh fixtures are placed by `fixture.rs`; `query.rs` answers point
+//! questions. `cmm_fit.rs` fits measured points as a CMM's software does and `drf.rs`
+//! builds a datum reference frame from them: the simulator evaluates with both, and the
+//! path stage asks what a frame leaves free.
 //!
 //! **Architecture Invariant:** face numbering is deterministic: stock faces, then each
 //! operation's faces in declaration order, pattern instances in order; for meshes, the
-//! file's group order or the segmentation's seed order.
+//! file's group order or the segmentation's seed order; for STEP and QIF, `face_<n>` in
+//! shell order.
 
 pub mod cmm_fit;
 mod csg;

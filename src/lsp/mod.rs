@@ -1,7 +1,8 @@
-//! `inspc lsp`: the language server. Entry point: [`serve`] (over stdio: [`stdio`]).
+//! `inspc lsp`: the language server. Entry point: [`stdio`] (`serve` over any
+//! connection).
 //!
 //! One thread reads the client's messages and answers each from what it knows of the
-//! open specs ([`Analysis`]). The front end (parse, load, resolve) runs on that thread
+//! open specs (`Analysis`). The front end (parse, load, resolve) runs on that thread
 //! at every change — milliseconds, so a typo's diagnostic comes back at once. The
 //! geometry and measurement graph (up to half a second on a real part) run on one
 //! background thread that always takes the newest version of each spec, and their

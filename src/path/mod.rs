@@ -14,7 +14,9 @@
 //!   groups run along it, high enough for the head to index.
 //!
 //! Each setup also gets its manual 3-2-1 alignment ([`align`], ch. 5.6). The entry point
-//! is [`plan`]; a move that cannot be made collision-free is `insp::path::no_path`.
+//! is [`plan`]; a move that cannot be made collision-free is `insp::path::no_path`. The
+//! files: `linearise.rs` cuts the HLIP into groups and blocks, `touch_group.rs` and
+//! `scan_group.rs` plan a group, `join.rs` joins the groups into the LLIP.
 //!
 //! **Architecture Invariant:** the result is a function of the input alone: the roadmap
 //! links nodes in index order and collects parallel checks in input order, random

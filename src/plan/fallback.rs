@@ -1,6 +1,6 @@
-//! What generate-and-test ends with when no round settles (issue 14, "always an
-//! answer"): the round whose plan had the fewest touches that failed validation, each of
-//! those touches moved to another configuration that validates (a setup the plan already
+//! What generate-and-test ends with when no round settles ("always an answer"): the
+//! round whose plan had the fewest touches that failed validation, each of those touches
+//! moved to another configuration that validates (a setup the plan already
 //! has, any probe, any orientation), and the few that none takes left out with a warning
 //! naming the face, the probe and what it hit. Every touch of the result validated.
 //!

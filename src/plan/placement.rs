@@ -1,6 +1,6 @@
 //! How square the operator must set the part: the touches of a plan validated at the
 //! nominal pose only (a point whose configurations collided turned, or every touch of
-//! [`super::plan_placed`]'s second try) that collide with the part turned
+//! `search::plan_placed`'s second try) that collide with the part turned
 //! [`PLACEMENT_TURN`] about the vertical, and the turn each setup tolerates.
 
 use super::explain::face_name;

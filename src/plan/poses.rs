@@ -1,4 +1,4 @@
-//! Setups an operator can realise (issue 14): the part resting on the table in a stable
+//! Setups an operator can realise: the part resting on the table in a stable
 //! pose. Spitz treats a setup as any direction and assumes a fixture exists; a CMM user
 //! has a table and gravity, so the planner chooses among these poses only (and those of
 //! the fixtures a plan names, see [`Setups`]).

@@ -1,4 +1,5 @@
-//! Parts: units, geometry source, machining operations, faces, features, datums, frames.
+//! Parts: units, geometry source, faces, features, datums, frames (machining operations
+//! and patterns: `ops.rs`).
 
 use super::datum::{check_unique_datums, datum, datum_ref};
 use super::errors::ResolveError as E;

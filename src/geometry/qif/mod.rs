@@ -3,7 +3,8 @@
 //! reference frames, characteristics, sizes) linked to the faces.
 //!
 //! `xml.rs` reads the document into an element tree, `brep.rs` the faces, edges and
-//! surfaces, `pmi.rs` the features and characteristics. [`read`] is the entry point:
+//! surfaces, `pmi.rs` the features and characteristics, `error.rs` why a document could
+//! not be read. [`read`] is the entry point:
 //! bytes in, a [`CadPart`] out whose groups are the faces (`face_<n>`, numbered from 1 in
 //! the body's shell order).
 //!

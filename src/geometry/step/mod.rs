@@ -2,8 +2,9 @@
 //! exact surface, tessellated to a stated chord tolerance.
 //!
 //! `p21.rs` reads the exchange file's instances, `brep.rs` the faces, edges and units,
-//! `geom.rs` evaluates the curves and surfaces, `tess.rs` meshes them. [`read`] is the
-//! entry point: bytes in, a [`RawMesh`] out whose groups are the faces (`face_<n>`,
+//! `geom.rs` evaluates the curves and surfaces, `tess.rs` meshes them, `pmi.rs` reads the
+//! semantic PMI, `error.rs` says why a file could not be read. [`read`] is the entry
+//! point: bytes in, a [`CadPart`] out whose mesh's groups are the faces (`face_<n>`,
 //! numbered from 1 in shell order, as the reference meshes of `../shared/parts/` name
 //! them) with their exact surfaces beside.
 //!

@@ -5,8 +5,8 @@
 //! datum features first in datum order, then features no tolerance reads against a datum
 //! (a feature the frame is built on reads perfect in it), then the rest, the largest
 //! faces first in each — the rest, and faces the setup measures only part of, only
-//! where the others and the part's untouched faces leave something free ([`align`]); a plane parallel to the table ranks with the datum the part
-//! rests on; a plane qualifies when its normal is a part axis, a cylinder
+//! where the others and the part's untouched faces leave something free ([`align`]); a
+//! plane parallel to the table ranks with the datum the part rests on; a plane qualifies when its normal is a part axis, a cylinder
 //! when its axis is, so that every feature maps onto `XDIR`/`YDIR`/`ZDIR` and
 //! `XORIG`/`YORIG`/`ZORIG`. A secondary plane comes before a bore (it fixes the turn);
 //! a cylinder along a fixed direction (a bore in the primary face) can stand in for the
@@ -25,7 +25,7 @@
 //! for degrees of freedom every frame of its location and profile tolerances fixes
 //! (`LeftFree`: a frame fixes only what its datum features constrain, ASME Y14.5-2018
 //! ch. 7; the evaluation reads what it leaves free in the alignment,
-//! `simulate::evaluate::drf`, so a face aligned on in such a degree of freedom would
+//! `geometry::drf`, so a face aligned on in such a degree of freedom would
 //! read in place in it). The steps: the plane facing most nearly up, a plane across it
 //! touched twice along it, one touch per free origin, a sphere's centre; each touch
 //! checked with `Pose::approach`, points from the `spread` grid; each step carries its
@@ -33,7 +33,7 @@
 //! realignment keeps their manual features (measuring them under DCC would need paths
 //! the planner never planned). On an indexable head the operator may also index the
 //! head for such a touch: per probe of the setup, the grid orientation nearest each
-//! part axis that no group takes (`path::align_orients`, within 20°), offered after the
+//! part axis that no group takes (`path::join::align_orients`, within 20°), offered after the
 //! setup's own orientations — a setup that measures one face from above otherwise has
 //! nothing to fix its turn.
 //!
