@@ -105,7 +105,24 @@ pub(crate) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
     // Token-level attempts see literals (`=`, `)`, `,`) that rule positives miss, and
     // the farthest position the parser reached.
     let mut pos = pos;
-    if let Some(att) = e.parse_attempts() {
+    // Where an item was expected, "an item" says it. At the file's start pest names the
+    // `file` rule; after a comment it names each item keyword, and its attempts run into
+    // a misspelt keyword's prefix (`probe` of `probee`): either way, an item.
+    let item_expected = match &e.variant {
+        pest::error::ErrorVariant::ParsingError { positives, .. } => {
+            positives
+                .iter()
+                .any(|r| matches!(r, Rule::item | Rule::file))
+                || [Rule::kw_use, Rule::kw_part, Rule::kw_plan]
+                    .iter()
+                    .all(|k| positives.contains(k))
+        }
+        pest::error::ErrorVariant::CustomError { .. } => false,
+    };
+    if item_expected {
+        expected = vec![word(Rule::item).unwrap_or("an item").to_string()];
+    }
+    if let Some(att) = e.parse_attempts().filter(|_| !item_expected) {
         if att.max_position >= pos {
             let mut words: Vec<String> = Vec::new();
             // pest 2.9 does not re-export `ParseAttempt` and `ParsingToken`; their
