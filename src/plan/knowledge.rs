@@ -210,46 +210,8 @@ impl<'a> Knowledge<'a> {
     ) -> Knowledge<'a> {
         let realisable = setups.exact_dirs();
         let scene = memo.scene(geometry);
-        // Preferred directions: the axes, the plan's setups, the table setups, then
-        // feature axes and plane normals — a probe often fits a hole only along its
-        // axis (at most MAX_FACE_DIRECTIONS of those).
-        let mut pref = opts.preferred.clone();
-        fn add(pref: &mut Vec<V3>, d: V3) -> bool {
-            let d = d.normalize();
-            let new = !pref.iter().any(|p| (p - d).norm() < 1e-9);
-            if new {
-                pref.push(d);
-            }
-            new
-        }
-        for s in &plan.setups {
-            add(&mut pref, V3::from(s.direction));
-        }
-        for d in &realisable {
-            add(&mut pref, *d);
-        }
-        let mut table_dirs = Vec::new();
-        for &f in table_faces {
-            if let Surface::Plane { normal, .. } = geometry.faces[f.0].surface {
-                add(&mut pref, -normal);
-                table_dirs.push((f, -normal));
-            }
-        }
-        let mut face_dirs = 0;
-        let mut seen: BTreeSet<usize> = BTreeSet::new();
-        for f in fpoints {
-            if face_dirs >= MAX_FACE_DIRECTIONS || !seen.insert(f.face.0) {
-                continue;
-            }
-            let dirs = match geometry.faces[f.face.0].surface {
-                Surface::Plane { normal, .. } => vec![normal],
-                Surface::Cylinder { axis, .. } | Surface::Cone { axis, .. } => vec![axis, -axis],
-                _ => vec![],
-            };
-            for d in dirs {
-                face_dirs += usize::from(add(&mut pref, d));
-            }
-        }
+        let (pref, table_dirs) =
+            preferred_directions(plan, geometry, fpoints, table_faces, &realisable, &opts);
         let opts = ConeOptions {
             preferred: pref.clone(),
             ..opts
@@ -290,90 +252,20 @@ impl<'a> Knowledge<'a> {
             ..opts
         };
         let mut points = fpoints.to_vec();
-        let mut tables = Vec::new();
-        for (face, up) in table_dirs {
-            let pts = table_points(&scene, geometry, face, &up, machine);
-            let first = points.len();
-            points.extend(pts.iter().map(|&position| Fpoint {
-                face,
-                position,
-                normal: up,
-            }));
-            // A datum face can rest on the table only in a pose that stands.
-            let cell = empty.cell_of(&up);
-            tables.push(TableAlt {
-                face,
-                cell: empty.index(cell),
-                points: (first..points.len()).collect(),
-                alive: real.get(cell),
-            });
-        }
+        let tables = table_alternatives(
+            &scene,
+            geometry,
+            machine,
+            &table_dirs,
+            &empty,
+            &real,
+            &mut points,
+        );
         let graph_points = fpoints.len();
         let dom: Vec<Vec<Dom>> = match &memo.initial {
             Some(dom) => dom.clone(),
             None => {
-                // The initial knowledge depends on a probe only through its tip's
-                // radius: probes sharing a tip size share it.
-                let same_tip: Vec<Option<usize>> = machine
-                    .probes
-                    .iter()
-                    .enumerate()
-                    .map(|(p, probe)| {
-                        machine.probes[..p]
-                            .iter()
-                            .position(|q| q.tip_radius == probe.tip_radius)
-                    })
-                    .collect();
-                // The pairs whose knowledge is computed: each point with the first
-                // probe of each tip size. Their half-line cones go to the backend in
-                // one call.
-                let own: Vec<(usize, usize)> = (0..fpoints.len())
-                    .flat_map(|f| {
-                        (0..machine.probes.len())
-                            .filter(|&p| same_tip[p].is_none())
-                            .map(move |p| (f, p))
-                    })
-                    .collect();
-                let fits: Vec<bool> = own
-                    .par_iter()
-                    .map(|&(f, p)| tip_ok(&scene, &fpoints[f], &machine.probes[p], &opts))
-                    .collect();
-                let centres: Vec<P3> = own
-                    .iter()
-                    .zip(&fits)
-                    .filter(|(_, &ok)| ok)
-                    .map(|(&(f, p), _)| fpoints[f].tip_centre(machine.probes[p].tip_radius))
-                    .collect();
-                let mut halves = access::gac_halfline_many(
-                    opts.backend.get(),
-                    &scene,
-                    &centres,
-                    opts.n,
-                    &opts.preferred,
-                )
-                .into_iter();
-                let halves: Vec<Option<CubeMap>> = fits
-                    .iter()
-                    .map(|&ok| if ok { halves.next() } else { None })
-                    .collect();
-                let mut own_dom = halves
-                    .into_par_iter()
-                    .map(|half| initial(half, machine, &opts))
-                    .collect::<Vec<Dom>>()
-                    .into_iter();
-                let dom: Vec<Vec<Dom>> = (0..fpoints.len())
-                    .map(|_| {
-                        let mut out: Vec<Dom> = Vec::with_capacity(machine.probes.len());
-                        for q in same_tip.iter() {
-                            let d = match q {
-                                Some(q) => out[*q].clone(),
-                                None => own_dom.next().expect("one dom per own pair"),
-                            };
-                            out.push(d);
-                        }
-                        out
-                    })
-                    .collect();
+                let dom = initial_domains(&scene, fpoints, machine, &opts);
                 memo.initial = Some(dom.clone());
                 dom
             }
@@ -952,6 +844,159 @@ impl<'a> Knowledge<'a> {
         }
         self.d1p.retain(|&(f, p, _), _| !done.contains(&(f, p)));
     }
+}
+
+/// Preferred directions: the axes, the plan's setups, the realisable setups, the table
+/// setups, then feature axes and plane normals — a probe often fits a hole only along
+/// its axis (at most [`MAX_FACE_DIRECTIONS`] of those). Also each table face with the
+/// direction up when it rests on the table.
+fn preferred_directions(
+    plan: &Plan,
+    geometry: &crate::geometry::PartGeometry,
+    fpoints: &[Fpoint],
+    table_faces: &[FaceId],
+    realisable: &[V3],
+    opts: &ConeOptions,
+) -> (Vec<V3>, Vec<(FaceId, V3)>) {
+    let mut pref = opts.preferred.clone();
+    fn add(pref: &mut Vec<V3>, d: V3) -> bool {
+        let d = d.normalize();
+        let new = !pref.iter().any(|p| (p - d).norm() < 1e-9);
+        if new {
+            pref.push(d);
+        }
+        new
+    }
+    for s in &plan.setups {
+        add(&mut pref, V3::from(s.direction));
+    }
+    for d in realisable {
+        add(&mut pref, *d);
+    }
+    let mut table_dirs = Vec::new();
+    for &f in table_faces {
+        if let Surface::Plane { normal, .. } = geometry.faces[f.0].surface {
+            add(&mut pref, -normal);
+            table_dirs.push((f, -normal));
+        }
+    }
+    let mut face_dirs = 0;
+    let mut seen: BTreeSet<usize> = BTreeSet::new();
+    for f in fpoints {
+        if face_dirs >= MAX_FACE_DIRECTIONS || !seen.insert(f.face.0) {
+            continue;
+        }
+        let dirs = match geometry.faces[f.face.0].surface {
+            Surface::Plane { normal, .. } => vec![normal],
+            Surface::Cylinder { axis, .. } | Surface::Cone { axis, .. } => vec![axis, -axis],
+            _ => vec![],
+        };
+        for d in dirs {
+            face_dirs += usize::from(add(&mut pref, d));
+        }
+    }
+    (pref, table_dirs)
+}
+
+/// The table alternatives of datum faces that can rest on the table (ch. 3.6.2): each
+/// face's table points join `points`, and the alternative is alive only where the pose
+/// stands (`real`).
+fn table_alternatives(
+    scene: &Scene,
+    geometry: &crate::geometry::PartGeometry,
+    machine: &Machine,
+    table_dirs: &[(FaceId, V3)],
+    empty: &CubeMap,
+    real: &CubeMap,
+    points: &mut Vec<Fpoint>,
+) -> Vec<TableAlt> {
+    let mut tables = Vec::new();
+    for &(face, up) in table_dirs {
+        let pts = table_points(scene, geometry, face, &up, machine);
+        let first = points.len();
+        points.extend(pts.iter().map(|&position| Fpoint {
+            face,
+            position,
+            normal: up,
+        }));
+        // A datum face can rest on the table only in a pose that stands.
+        let cell = empty.cell_of(&up);
+        tables.push(TableAlt {
+            face,
+            cell: empty.index(cell),
+            points: (first..points.len()).collect(),
+            alive: real.get(cell),
+        });
+    }
+    tables
+}
+
+/// The initial knowledge of every (graph point, probe): the tip's fit and the bare
+/// half-line cone, computed once per tip size and shared by the probes of that size.
+fn initial_domains(
+    scene: &Scene,
+    fpoints: &[Fpoint],
+    machine: &Machine,
+    opts: &ConeOptions,
+) -> Vec<Vec<Dom>> {
+    // The initial knowledge depends on a probe only through its tip's
+    // radius: probes sharing a tip size share it.
+    let same_tip: Vec<Option<usize>> = machine
+        .probes
+        .iter()
+        .enumerate()
+        .map(|(p, probe)| {
+            machine.probes[..p]
+                .iter()
+                .position(|q| q.tip_radius == probe.tip_radius)
+        })
+        .collect();
+    // The pairs whose knowledge is computed: each point with the first
+    // probe of each tip size. Their half-line cones go to the backend in
+    // one call.
+    let own: Vec<(usize, usize)> = (0..fpoints.len())
+        .flat_map(|f| {
+            (0..machine.probes.len())
+                .filter(|&p| same_tip[p].is_none())
+                .map(move |p| (f, p))
+        })
+        .collect();
+    let fits: Vec<bool> = own
+        .par_iter()
+        .map(|&(f, p)| tip_ok(scene, &fpoints[f], &machine.probes[p], opts))
+        .collect();
+    let centres: Vec<P3> = own
+        .iter()
+        .zip(&fits)
+        .filter(|(_, &ok)| ok)
+        .map(|(&(f, p), _)| fpoints[f].tip_centre(machine.probes[p].tip_radius))
+        .collect();
+    let mut halves =
+        access::gac_halfline_many(opts.backend.get(), scene, &centres, opts.n, &opts.preferred)
+            .into_iter();
+    let halves: Vec<Option<CubeMap>> = fits
+        .iter()
+        .map(|&ok| if ok { halves.next() } else { None })
+        .collect();
+    let mut own_dom = halves
+        .into_par_iter()
+        .map(|half| initial(half, machine, opts))
+        .collect::<Vec<Dom>>()
+        .into_iter();
+    let dom: Vec<Vec<Dom>> = (0..fpoints.len())
+        .map(|_| {
+            let mut out: Vec<Dom> = Vec::with_capacity(machine.probes.len());
+            for q in same_tip.iter() {
+                let d = match q {
+                    Some(q) => out[*q].clone(),
+                    None => own_dom.next().expect("one dom per own pair"),
+                };
+                out.push(d);
+            }
+            out
+        })
+        .collect();
+    dom
 }
 
 /// The most face axes and normals added as exact directions.

@@ -132,12 +132,7 @@ pub(crate) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
                 let rule = deepest
                     .strip_prefix("Rule(")
                     .and_then(|n| n.strip_suffix(')'))
-                    .and_then(|n| {
-                        Rule::all_rules()
-                            .iter()
-                            .find(|r| format!("{r:?}") == n)
-                            .copied()
-                    });
+                    .and_then(rule_named);
                 if let Some(w) = rule.and_then(|r| word(r).or_else(|| stack.parent.and_then(word)))
                 {
                     words.push(w.to_string());
@@ -148,29 +143,7 @@ pub(crate) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
                     continue;
                 }
                 let token = t.to_string();
-                // Whitespace, comments, optional suffixes of numbers and paths, and keywords
-                // (which the rule words already name) would only bury the real expectation.
-                let noise = matches!(
-                    token.as_str(),
-                    "\r" | " "
-                        | "\t"
-                        | "\u{feff}"
-                        | "//"
-                        | "/*"
-                        | "*/"
-                        | "%"
-                        | "+-"
-                        | "±"
-                        | "+"
-                        | "-"
-                        | ".."
-                        | "."
-                        | "::"
-                        | "["
-                        | "e"
-                        | "E"
-                ) || token.chars().all(|c| c.is_ascii_alphabetic() || c == '_');
-                if noise {
+                if is_noise(&token) {
                     continue;
                 }
                 words.push(if token == "\n" {
@@ -221,6 +194,39 @@ pub(crate) fn syntax_error(file: FileId, text: &str, e: pest::error::Error<Rule>
         found,
         help,
     }
+}
+
+/// The grammar rule of a name, as pest's `Debug` writes it.
+fn rule_named(name: &str) -> Option<Rule> {
+    Rule::all_rules()
+        .iter()
+        .find(|r| format!("{r:?}") == name)
+        .copied()
+}
+
+/// Whitespace, comments, optional suffixes of numbers and paths, and keywords (which the
+/// rule words already name): tokens that would only bury the real expectation.
+fn is_noise(token: &str) -> bool {
+    matches!(
+        token,
+        "\r" | " "
+            | "\t"
+            | "\u{feff}"
+            | "//"
+            | "/*"
+            | "*/"
+            | "%"
+            | "+-"
+            | "±"
+            | "+"
+            | "-"
+            | ".."
+            | "."
+            | "::"
+            | "["
+            | "e"
+            | "E"
+    ) || token.chars().all(|c| c.is_ascii_alphabetic() || c == '_')
 }
 
 /// What sits at `pos`, in words, and its length in bytes.
