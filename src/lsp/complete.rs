@@ -46,10 +46,7 @@ const PLAN_KEYWORDS: &[&str] = &["prefer", "forbid", "sample"];
 pub fn complete(checked: &Checked, file: FileId, text: &str, offset: usize) -> Vec<CompletionItem> {
     let before = &text[..offset.min(text.len())];
     let line = &before[before.rfind('\n').map_or(0, |i| i + 1)..];
-    let word_start = line
-        .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
-        .map_or(0, |i| i + 1);
-    let head = &line[..word_start];
+    let head = &line[..word_start(line)];
     let trimmed = head.trim_start();
 
     // `use std::…`
@@ -143,6 +140,15 @@ fn name_item(d: &Decl) -> CompletionItem {
         CompletionItemKind::REFERENCE,
         d.kind.keyword(),
     )
+}
+
+/// Where the word being typed at the end of `line` starts (a byte offset): after the last
+/// character that cannot be part of a name, whatever its length in bytes (`±`, `°`).
+fn word_start(line: &str) -> usize {
+    line.char_indices()
+        .rev()
+        .find(|&(_, c)| !(c.is_ascii_alphanumeric() || c == '_'))
+        .map_or(0, |(i, c)| i + c.len_utf8())
 }
 
 fn keywords(words: &[&str]) -> Vec<CompletionItem> {
@@ -348,4 +354,17 @@ fn visible<'a>(checked: &'a Checked, all: &[Decl<'a>], file: FileId) -> Vec<Decl
         );
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::word_start;
+
+    #[test]
+    fn a_word_starts_after_any_character_that_is_no_part_of_a_name() {
+        assert_eq!(word_start("  probe p1"), 8);
+        assert_eq!(word_start("x ±1"), "x ±".len());
+        assert_eq!(word_start("angle 90°"), "angle 90°".len());
+        assert_eq!(word_start("tip"), 0);
+    }
 }
