@@ -417,6 +417,11 @@ fn param(params: &[String], k: usize) -> &str {
     params.get(k).map(String::as_str).unwrap_or("")
 }
 
+/// Whether a parameter reads as a number that is not finite (`inf`, `NaN`, `1e999`).
+fn non_finite(p: &str) -> bool {
+    p.parse::<f64>().is_ok_and(|x| !x.is_finite())
+}
+
 fn nums(params: &[String]) -> Vec<f64> {
     params
         .iter()
@@ -447,6 +452,16 @@ impl Machine<'_> {
         if crate::dmis::word(major) != crate::dmis::Word::Runs {
             // The reader warned on it: DMIS the virtual CMM does not run, or not DMIS.
             return Ok(());
+        }
+        // Every number a statement gives is finite, checked here for all statements: a
+        // `TOL/PERP,inf` read as a zone wider than any part, or a `ROTATE` by NaN, would
+        // pass silently.
+        if let Some(p) = params.iter().find(|p| non_finite(p)) {
+            return Err(self.bad(
+                at,
+                &format!("{major} with `{p}`, which is not a finite number"),
+                "write a finite number (DMIS numbers are decimals: no `inf`, `nan` or out-of-range exponent)",
+            ));
         }
         match major {
             // What a real controller needs and a virtual one has no use for: names, feed

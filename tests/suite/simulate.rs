@@ -442,6 +442,20 @@ plan f2_again {{
         "MODE/PROG,MAN\nCALL/EXTERN,DME,'X'\n",
     );
     assert!(run(spec, &p, None, Options::default()).is_ok());
+    // A number that is not finite, in any statement, stops the run: a zone of `inf`
+    // would judge every part in.
+    for (name, from, to) in [
+        ("inf.dmi", "TOL/PERP,0.05,", "TOL/PERP,inf,"),
+        ("nan.dmi", "TOL/PERP,0.05,", "TOL/PERP,NaN,"),
+        ("huge.dmi", "TOL/PERP,0.05,", "TOL/PERP,1e999,"),
+    ] {
+        let p = edited(name, from, to);
+        assert_eq!(
+            code(spec, &p, None),
+            vec!["insp::simulate::bad_statement"],
+            "{name}"
+        );
+    }
     let p = edited("inch.dmi", "UNITS/MM,ANGDEC\n", "UNITS/INCH,ANGDEC\n");
     assert_eq!(code(spec, &p, None), vec!["insp::simulate::unsupported"]);
     let p = edited("tilted.dmi", "PAUSE\n", "D(TILT)=ROTATE/XAXIS,45\nPAUSE\n");
