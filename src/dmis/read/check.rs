@@ -158,6 +158,17 @@ fn first_and_last(commands: &[Cmd], span: &dyn Fn(usize) -> Span, errors: &mut V
             "start with `DMISMN/'name',05.3` and end with `ENDFIL`",
         )),
     }
+    // ENDFIL ends the input file (ANSI/DMIS 105.2, ENDFIL): statements after an early one
+    // are no part of the program, and a controller that ran them would run another one.
+    let early = commands.iter().rev().skip(1).rfind(|c| c.1 == "ENDFIL");
+    if let Some((_, _, _, at)) = early {
+        errors.push(structure(
+            span,
+            *at,
+            "statements follow ENDFIL",
+            "ENDFIL ends the program: remove it, or the statements after it",
+        ));
+    }
     if let Some((_, m, _, at)) = commands.last() {
         if *m != "ENDFIL" {
             errors.push(structure(

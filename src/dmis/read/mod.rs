@@ -331,6 +331,14 @@ mod tests {
     }
 
     #[test]
+    fn statements_after_an_early_endfil_are_an_error() {
+        assert_eq!(
+            codes("DMISMN/'X',05.3\nENDFIL\nTEXT/OPER,'after the end'\nENDFIL\n"),
+            ["insp::dmis::structure"]
+        );
+    }
+
+    #[test]
     fn each_problem_has_its_code() {
         let long = format!("DMISMN/'X',05.3\nTEXT/OPER,'{}'\nENDFIL\n", "A".repeat(80));
         assert_eq!(codes(&long), ["insp::dmis::long_line"]);
