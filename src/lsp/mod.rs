@@ -59,6 +59,10 @@ pub(crate) fn serve(connection: &Connection) -> Result<(), String> {
         planning: BTreeMap::new(),
         plan_runs: 0,
     };
+    // The protocol's `exit` without `shutdown` before it ends the server with code 1
+    // (LSP 3.17, "Exit Notification"); `handle_shutdown` answers `shutdown` and waits for
+    // the `exit` after it.
+    let mut outcome = Ok(());
     loop {
         select! {
             recv(connection.receiver) -> msg => {
@@ -69,6 +73,10 @@ pub(crate) fn serve(connection: &Connection) -> Result<(), String> {
                             break;
                         }
                         server.request(req);
+                    }
+                    Message::Notification(n) if n.method == "exit" => {
+                        outcome = Err("the client sent `exit` without `shutdown`".to_string());
+                        break;
                     }
                     Message::Notification(n) => server.notification(n),
                     Message::Response(_) => {}
@@ -85,7 +93,7 @@ pub(crate) fn serve(connection: &Connection) -> Result<(), String> {
         let _ = run.child.kill();
         let _ = run.child.wait();
     }
-    Ok(())
+    outcome
 }
 
 fn capabilities() -> lt::ServerCapabilities {

@@ -178,6 +178,17 @@ fn example(name: &str) -> PathBuf {
         .join(name)
 }
 
+/// LSP 3.17, "Exit Notification": the server exits with 0 after `shutdown`, with 1 when
+/// `exit` comes without it.
+#[test]
+fn exit_without_shutdown_ends_the_server_with_code_1() {
+    let mut c = Client::start();
+    c.notify("exit", Value::Null);
+    let status = c.child.wait().unwrap();
+    assert_eq!(status.code(), Some(1), "inspc lsp exited with {status}");
+    Client::start().shutdown();
+}
+
 #[test]
 fn ctc_01_hover_definition_completion_and_a_typo() {
     let path = real("nist_ctc_01.insp");
