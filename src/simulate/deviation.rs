@@ -703,7 +703,14 @@ fn tilt_change(
     } else {
         None
     };
-    let Some(axis) = axis.and_then(|v| Unit::try_new(V3::new(v[0], v[1], v[2]), 1e-12)) else {
+    // Scaled by its largest component before it is normalised: the length of
+    // (1e300, 1e300, 0) overflows, which would leave no direction at all.
+    let direction = |v: Vec<f64>| {
+        let v = V3::new(v[0], v[1], v[2]);
+        let m = v.amax();
+        (m > 0.0).then(|| Unit::try_new(v / m, 1e-12)).flatten()
+    };
+    let Some(axis) = axis.and_then(direction) else {
         return Err(bad(
             s,
             e,

@@ -166,6 +166,15 @@ fn a_deviation_fails_exactly_the_tolerance_it_targets() {
     )
     .expect("runs");
     assert_eq!(failing(&r), vec!["T1".to_string()], "{}", r.text());
+    // An axis whose length overflows is still the direction it names.
+    let huge = run(
+        spec,
+        program,
+        Some("feature large_slot tilt 0.4 about (0, 1e300, 0)"),
+        Options::default(),
+    )
+    .expect("runs");
+    assert_eq!(huge.text(), r.text());
 }
 
 /// Scanned features are judged from their clouds: on the mixed example a bowed front
