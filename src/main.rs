@@ -826,9 +826,17 @@ fn view(
             }
         }
     }
-    if let Some(d) = &png {
-        if let Err(e) = std::fs::create_dir_all(d) {
-            eprintln!("inspc: cannot create {}: {e}", d.display());
+    // The images' folder is made only when an image goes into it, and a path that
+    // cannot be one is a diagnostic like any output's.
+    if let Some(d) = png
+        .as_ref()
+        .filter(|d| writes.iter().any(|w| w.path.starts_with(d)))
+    {
+        let mut sources = inspc::source::SourceMap::new();
+        if let Err(e) = cli::outputs::folder(d, &mut sources) {
+            let mut diags = inspc::diag::Diagnostics::new();
+            diags.push(e);
+            print_diagnostics(&sources, &diags.sorted());
             return ExitCode::from(1);
         }
     }

@@ -70,6 +70,18 @@ fn filed(
     make(file, shown)
 }
 
+/// Creates the folder `dir` (and its parents) that outputs will be written into: a
+/// path that cannot be a folder (a file stands there) is `insp::io::unwritable`.
+pub fn folder(dir: &Path, sources: &mut SourceMap) -> Result<(), IoError> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        filed(sources, dir, |file, path| IoError::Unwritable {
+            file,
+            path,
+            reason: format!("cannot create the folder: {e}"),
+        })
+    })
+}
+
 /// Checks every target, then writes every output or none. `inputs` are the files the
 /// run read.
 pub fn commit(

@@ -823,3 +823,37 @@ fn densely_sampled_bores_get_a_path() {
     assert_eq!(code, 0, "{stderr}");
     assert!(stdout.contains("100 in, 0 out"), "{stdout}");
 }
+
+/// `inspc view --png DIR`: a file where the folder should be is `insp::io::unwritable`,
+/// and nothing is written; a run that writes nothing makes no folder.
+#[test]
+fn view_images_into_a_path_that_cannot_be_a_folder() {
+    let dir = std::env::temp_dir().join(format!("inspc-view-png-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let page = dir.join("f2.html");
+    let blocker = dir.join("images");
+    std::fs::write(&blocker, "a file, not a folder").unwrap();
+    let (code, _, stderr) = inspc(&[
+        "view",
+        "examples/f2.insp",
+        "-o",
+        page.to_str().unwrap(),
+        "--png",
+        blocker.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("insp::io::unwritable"), "{stderr}");
+    assert!(!page.exists(), "nothing is written");
+    // A spec that fails writes nothing and makes no folder.
+    let bad = dir.join("bad.insp");
+    std::fs::write(&bad, "part p {\n").unwrap();
+    let images = dir.join("never");
+    let (code, _, _) = inspc(&[
+        "view",
+        bad.to_str().unwrap(),
+        "--png",
+        images.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(!images.exists(), "no folder for a run that writes nothing");
+}
