@@ -169,7 +169,7 @@ fn plan_touch(
 ) -> Option<Hlip> {
     let (model, plan) = (input.model, input.plan);
     let machine = Machine::new(model, plan);
-    let mut k = knowledge(input, opts, &machine, memo);
+    let mut k = initial_knowledge(input, opts, &machine, memo);
     let mut search = Search {
         input,
         opts,
@@ -193,7 +193,7 @@ fn plan_touch(
 
 /// The knowledge base the search starts from: the plan's setups, the datum faces that
 /// can rest on the table, and the cones' options.
-fn knowledge<'a>(
+fn initial_knowledge<'a>(
     input: &'a Input,
     opts: &PlanOptions,
     machine: &Machine,
