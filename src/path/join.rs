@@ -4,7 +4,7 @@
 use super::linearise::GroupIn;
 use super::touch_group::GroupOut;
 use super::{
-    align, no_path, polyline, Alignment, BlockPath, GroupPath, Llip, PathSummary, SetupPath,
+    align, no_path, polyline, Alignment, BlockPath, GroupPath, Llip, NoWay, PathSummary, SetupPath,
     Unreached,
 };
 use crate::access::pose::{Contact, Pose};
@@ -103,8 +103,7 @@ fn sensor_change(
     if let Err(blocker) = moves {
         let b = &blocks[0];
         let points = b.touches.iter().map(|t| t.point).collect();
-        let why = format!("{blocker} hits the part on the way");
-        return Err(no_path(input, b, g, &why, points));
+        return Err(no_path(input, b, g, NoWay::OnTheWay(blocker), points));
     }
     Ok(across)
 }

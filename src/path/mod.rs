@@ -45,7 +45,7 @@ mod touch_group;
 pub mod tour;
 
 pub use align::{AlignStep, Alignment, ExtraFace};
-pub(crate) use errors::PathError;
+pub(crate) use errors::{NoWay, PathError};
 pub use render::json;
 
 use crate::access::pose::{Contact, Head};
@@ -269,9 +269,9 @@ pub(crate) struct Unreached {
     bans: Vec<Ban>,
 }
 
-/// The diagnostic for a block no move reaches; `why` says what hits, `points` which
-/// touches of the group (indices into [`Hlip::points`]) cannot be reached.
-fn no_path(input: &Input, b: &BlockPath, g: &GroupIn, why: &str, points: Vec<usize>) -> Unreached {
+/// The diagnostic for a block no move reaches; `why` says which move and what hits,
+/// `points` which touches of the group (indices into [`Hlip::points`]) cannot be reached.
+fn no_path(input: &Input, b: &BlockPath, g: &GroupIn, why: NoWay, points: Vec<usize>) -> Unreached {
     let names = Names::new(input.model, input.geometry, input.plan_id());
     let part = names.part();
     let feature = b.feature.map(|f| &part.features[f.0]);
@@ -290,14 +290,10 @@ fn no_path(input: &Input, b: &BlockPath, g: &GroupIn, why: &str, points: Vec<usi
         feature: names.feature(b.feature).to_string(),
         probe: names.probe(g.slot).to_string(),
         orient: match g.probe.head {
-            Head::Indexable => format!(
-                " at A{} B{}",
-                crate::model::fmt_num(g.a),
-                crate::model::fmt_num(g.b)
-            ),
-            Head::Fixed => String::new(),
+            Head::Indexable => Some((g.a, g.b)),
+            Head::Fixed => None,
         },
-        why: why.to_string(),
+        why,
     });
     Unreached { error, bans }
 }

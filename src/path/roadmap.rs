@@ -68,7 +68,7 @@ pub(crate) struct Disconnected {
     pub stray: Vec<usize>,
     /// What hit on `goal`'s straight move towards the nearest connected goal; `None`
     /// when that move is clear but every route the roadmap tried is not.
-    pub blocker: Option<String>,
+    pub blocker: Option<crate::access::Blocker>,
 }
 
 impl<'a> Roadmap<'a> {
@@ -407,9 +407,8 @@ impl<'a> Roadmap<'a> {
                         d(a).total_cmp(&d(b))
                     })
                     .copied();
-                let blocker = near
-                    .and_then(|m| self.pose.segment(&self.nodes[goal], &self.nodes[m]).err())
-                    .map(|b| b.to_string());
+                let blocker =
+                    near.and_then(|m| self.pose.segment(&self.nodes[goal], &self.nodes[m]).err());
                 Err(Disconnected {
                     goal,
                     stray,
@@ -593,8 +592,8 @@ mod tests {
                 assert_eq!(goal, 0);
                 assert_eq!(stray, [0]);
                 assert_eq!(
-                    blocker.as_deref(),
-                    Some("the tip"),
+                    blocker,
+                    Some(crate::access::Blocker::Tip),
                     "the straight move out crosses the wall"
                 );
             }

@@ -2,7 +2,7 @@
 
 use super::linearise::GroupIn;
 use super::touch_group::{first_clear, lift, GroupOut};
-use super::{no_path, Unreached};
+use super::{no_path, NoWay, Unreached};
 use crate::access::pose::Pose;
 use crate::access::Scene;
 use crate::geometry::P3;
@@ -34,15 +34,14 @@ pub(super) fn plan_scan_group(
             }
             checks += 1;
             if let Err(blocker) = pose.segment(&s, &e) {
-                let why = format!("{blocker} hits the part along a pass");
-                return Err(no_path(input, b, g, &why, vec![]));
+                return Err(no_path(input, b, g, NoWay::AlongPass(blocker), vec![]));
             }
             let via = match at {
                 None => {
                     let (up, n) = lift(&pose, &s, g);
                     checks += n;
                     let Some(up) = up else {
-                        return Err(no_path(input, b, g, "the way down to a pass", vec![]));
+                        return Err(no_path(input, b, g, NoWay::DownToPass, vec![]));
                     };
                     entry = up.into_iter().rev().collect();
                     vec![]
@@ -53,7 +52,7 @@ pub(super) fn plan_scan_group(
                         w
                     }
                     (None, _) => {
-                        return Err(no_path(input, b, g, "the move between passes", vec![]));
+                        return Err(no_path(input, b, g, NoWay::BetweenPasses, vec![]));
                     }
                 },
             };
@@ -69,13 +68,7 @@ pub(super) fn plan_scan_group(
     checks += n;
     let Some(exit) = exit else {
         let b = &g.blocks[g.blocks.len() - 1];
-        return Err(no_path(
-            input,
-            b,
-            g,
-            "the way up from the last pass",
-            vec![],
-        ));
+        return Err(no_path(input, b, g, NoWay::UpFromLastPass, vec![]));
     };
     if entry.is_empty() {
         entry.push(last);

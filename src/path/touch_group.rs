@@ -8,7 +8,7 @@
 
 use super::linearise::GroupIn;
 use super::roadmap::{Disconnected, Paths, Roadmap};
-use super::{no_path, polyline, tour, BlockPath, Touch, Unreached};
+use super::{no_path, polyline, tour, BlockPath, NoWay, Touch, Unreached};
 use crate::access::pose::{Contact, Pose};
 use crate::access::Scene;
 use crate::geometry::{PartGeometry, P3};
@@ -165,15 +165,12 @@ fn disconnected(
         let (bi, ti) = owner[k];
         g.blocks[bi].touches[ti].point
     };
-    let why = d.blocker.map_or_else(
-        || "every route the roadmap tried around the part is blocked".to_string(),
-        |b| format!("{b} hits the part on the way"),
-    );
+    let why = d.blocker.map_or(NoWay::RoadmapBlocked, NoWay::OnTheWay);
     no_path(
         input,
         &g.blocks[bi],
         g,
-        &why,
+        why,
         d.stray.iter().map(|&k| point(k)).collect(),
     )
 }
@@ -258,13 +255,7 @@ fn way_down(
         let (bi, ti) = owner[first];
         let b = &g.blocks[bi];
         let points = vec![b.touches[ti].point];
-        return Err(no_path(
-            input,
-            b,
-            g,
-            "the way up to the clearance plane",
-            points,
-        ));
+        return Err(no_path(input, b, g, NoWay::UpToClearance, points));
     };
     let mut entry: Vec<P3> = entry_up.into_iter().rev().collect();
     if entry.is_empty() {

@@ -9,6 +9,7 @@
 //! (`insp::plan::uninspectable_face`, then a warning) instead of stopping: one code per
 //! problem, at the severity the flag gives it (`Diagnostics::push_at`).
 
+use super::errors::Shortfall;
 use super::filter::min_points;
 use super::{axes, scan, Hlip, Input, PlanError, PlanOptions};
 use crate::diag::Diagnostics;
@@ -66,20 +67,18 @@ pub(super) fn account(
             measured += 1;
             continue;
         };
-        let (why, help) = unmeasured_reason(input, &touches, &sampled, uncovered, f, face);
+        let why = shortfall(input, &touches, &sampled, uncovered, f, face);
         let (tolerance, feature, face) = (
             t.name.clone(),
             part.features[f.0].name.clone(),
             input.geometry.faces[face.0].name.clone(),
         );
         // One problem, one code: an error, or a warning under `--allow-unmeasured`.
-        let (severity, remedy) = if opts.allow_unmeasured {
-            (Severity::Warning, "the program leaves it out")
+        let allowed = opts.allow_unmeasured;
+        let severity = if allowed {
+            Severity::Warning
         } else {
-            (
-                Severity::Error,
-                "`inspc build --allow-unmeasured` writes the program without it",
-            )
+            Severity::Error
         };
         diags.push_at(
             severity,
@@ -89,7 +88,7 @@ pub(super) fn account(
                 feature,
                 face,
                 why,
-                help: format!("{help}; {remedy}"),
+                allowed,
             },
         );
     }
@@ -137,51 +136,27 @@ fn faces_of(g: &MeasurementGraph) -> (BTreeMap<FeatureId, Vec<FaceId>>, BTreeSet
     (faces_of, sampled)
 }
 
-/// Why feature `f`'s `face` is not measured, and what would measure it: the scanner
-/// covers too little of it, too few or no touches are left on it, or sampling gave it no
-/// point.
-fn unmeasured_reason(
+/// Why face `face` of feature `f` is not measured by the plan.
+fn shortfall(
     input: &Input,
     touches: &BTreeMap<FaceId, BTreeSet<usize>>,
     sampled: &BTreeSet<FaceId>,
     uncovered: &[scan::Uncovered],
     f: FeatureId,
     face: FaceId,
-) -> (String, String) {
+) -> Shortfall {
     let few = touches.get(&face).map_or(0, |p| p.len());
-    let short = uncovered.iter().find(|u| u.feature == f);
-    if let Some(u) = short {
-        (
-            format!(
-                "is asked of the laser scanner, which sees {} % of {} at best (the plan asks {} %)",
-                crate::model::fmt_num((u.best * 1000.0).round() / 10.0),
-                if u.face == face {
-                    "it".to_string()
-                } else {
-                    format!("face {}", input.geometry.faces[u.face.0].name)
-                },
-                crate::model::fmt_num((input.plan.scan_coverage * 1000.0).round() / 10.0)
-            ),
-            "touch it instead (`sensors { … touch }`), hold the part so the scanner sees more of it (a fixture), or lower `scan_coverage`".to_string(),
-        )
+    if let Some(u) = uncovered.iter().find(|u| u.feature == f) {
+        Shortfall::Scanner {
+            best: u.best,
+            other_face: (u.face != face).then(|| input.geometry.faces[u.face.0].name.clone()),
+            asked: input.plan.scan_coverage,
+        }
     } else if few > 0 {
-        (
-            format!(
-                "gets {few} {} in the plan, fewer than its surface's fit needs",
-                if few == 1 { "touch" } else { "touches" }
-            ),
-            "its other points were left out as hard to reach; a probe that reaches more of them, or more points (`sample`), keeps it".to_string(),
-        )
+        Shortfall::FewTouches(few)
     } else if sampled.contains(&face) {
-        (
-            "gets no touch in the plan".to_string(),
-            "its points were dropped as hard to reach; a probe that reaches more of them, or more points (`sample`), keeps it".to_string(),
-        )
+        Shortfall::NoTouch
     } else {
-        (
-            "gets no measuring point".to_string(),
-            "no point of it keeps the sampling margin from its edges; lower the sampling inset"
-                .to_string(),
-        )
+        Shortfall::NoPoint
     }
 }

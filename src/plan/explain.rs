@@ -1,6 +1,7 @@
 //! Explaining a failed plan: for a face no configuration inspects, which probe came
 //! closest, from where, and what stopped it.
 
+use super::errors::{Stop, Unreachable};
 use super::filter::min_points;
 use super::knowledge::Knowledge;
 use super::machine::Machine;
@@ -9,7 +10,6 @@ use crate::diag::Diagnostics;
 use crate::geometry::PartGeometry;
 use crate::geometry::{FaceId, V3};
 use crate::graph::Node;
-use crate::model::fmt_num;
 use crate::model::{Model, Plan};
 
 /// The face a point lies on, in words ("the table under ..." for a table point).
@@ -53,7 +53,7 @@ pub(super) fn report_face(
     let need = min_points(input.geometry.faces[face.0].surface.kind()).min(pts.len());
     // Per probe: how many points it reaches in a setup the part can be put in, how
     // many in any direction, and the first blocking component.
-    let mut best: Option<(usize, usize, usize, String, String, usize)> = None;
+    let mut best: Option<(usize, usize, usize, Stop, usize)> = None;
     let usable = k.realisable.and(&k.forbidden.not());
     for (p, probe) in m.probes.iter().enumerate() {
         if !m.allowed[p] {
@@ -67,59 +67,47 @@ pub(super) fn report_face(
             .iter()
             .filter(|&&f| k.dom[f][p].tip && !k.dom[f][p].setup.and(&usable).is_empty())
             .count();
-        let tips = pts.iter().filter(|&&f| k.dom[f][p].tip).count();
-        let (depth, why) = if tips == 0 {
-            (
+        let (depth, stop) = match pts.iter().copied().find(|&f| k.dom[f][p].tip) {
+            None => (
                 0,
-                format!(
-                    "probe {}'s Ø{} mm tip does not fit at any of its {} points with {} mm to back off the surface",
-                    probe.name,
-                    fmt_num(2.0 * probe.tip_radius),
-                    pts.len(),
-                    fmt_num(crate::access::pose::MIN_TRAVEL)
-                ),
-            )
-        } else {
-            let f = pts
-                .iter()
-                .copied()
-                .find(|&f| k.dom[f][p].tip)
-                .unwrap_or(pts[0]);
-            blocking(k, m, p, f)
+                Stop::TipDoesNotFit {
+                    probe: probe.name.clone(),
+                    diameter: 2.0 * probe.tip_radius,
+                    points: pts.len(),
+                    travel: crate::access::pose::MIN_TRAVEL,
+                },
+            ),
+            Some(f) => blocking(k, m, p, f),
         };
-        let cand = (real, reach, depth, why, probe.name.clone(), p);
         if best
             .as_ref()
-            .is_none_or(|b| (cand.0, cand.1, cand.2) > (b.0, b.1, b.2))
+            .is_none_or(|b| (real, reach, depth) > (b.0, b.1, b.2))
         {
-            best = Some(cand);
+            best = Some((real, reach, depth, stop, p));
         }
     }
-    let (real, reach, _, why, probe, p) =
-        best.unwrap_or((0, 0, 0, "no probe is allowed".into(), String::new(), 0));
-    let mut help = "use a smaller tip, a longer or thinner stylus, an extension, or an indexable head; `inspc cones --face` shows the cones".to_string();
-    let why = if probe.is_empty() {
-        why
-    } else if real < need && reach >= need {
-        // The probe gets there, but only with the part in a pose it cannot take.
-        let mut any = k.empty_cone();
-        for &f in &pts {
-            any.or_assign(&k.dom[f][p].setup);
+    let why = match best {
+        None => Unreachable::NoProbeAllowed,
+        Some((real, reach, _, _, p)) if real < need && reach >= need => {
+            // The probe gets there, but only with the part in a pose it cannot take.
+            let mut any = k.empty_cone();
+            for &f in &pts {
+                any.or_assign(&k.dom[f][p].setup);
+            }
+            Unreachable::OnlyInPose {
+                probe: m.probes[p].name.clone(),
+                reach,
+                points: pts.len(),
+                up: deepest(&any.and(&k.forbidden.not())),
+            }
         }
-        let d = deepest(&any.and(&k.forbidden.not()));
-        help = "name a fixture that holds the part so (`fixtures [vise: VISE_150]` on the CMM, `fixtures [vise]` in the plan: a vise, a chuck, a sine or angle plate from `std::fixtures`); `inspc plan --explain-setups` lists the poses the part can take".into();
-        format!(
-            "probe {probe} reaches {reach} of its {} points only with the part turned so that ({}, {}, {}) points up, a pose in which it does not stand on the table and no fixture of the plan holds it",
-            pts.len(),
-            fmt_num((d.x * 1e3).round() / 1e3),
-            fmt_num((d.y * 1e3).round() / 1e3),
-            fmt_num((d.z * 1e3).round() / 1e3)
-        )
-    } else {
-        format!(
-            "probe {probe} reaches {reach} of its {} points (it needs {need}); {why}",
-            pts.len()
-        )
+        Some((_, reach, _, stop, p)) => Unreachable::TooFew {
+            probe: m.probes[p].name.clone(),
+            reach,
+            points: pts.len(),
+            need,
+            stop,
+        },
     };
     let (span, feature) = (
         feature.map_or(part.span, |f| f.span),
@@ -127,13 +115,10 @@ pub(super) fn report_face(
     );
     // One problem, one code: an error, or a warning where `--allow-unmeasured` plans on
     // without the face.
-    let (severity, help) = if allowed {
-        (
-            miette::Severity::Warning,
-            format!("{help}; the program leaves it out"),
-        )
+    let severity = if allowed {
+        miette::Severity::Warning
     } else {
-        (miette::Severity::Error, help)
+        miette::Severity::Error
     };
     diags.push_at(
         severity,
@@ -142,23 +127,20 @@ pub(super) fn report_face(
             face: name,
             feature,
             why,
-            help,
+            allowed,
         },
     );
 }
 
 /// What blocks probe `p` at point `f`: the components' cones from the tip up; the first
 /// that leaves no direction is named, with the last direction still open.
-fn blocking(k: &Knowledge, m: &Machine, p: usize, f: usize) -> (usize, String) {
+fn blocking(k: &Knowledge, m: &Machine, p: usize, f: usize) -> (usize, Stop) {
     let probe = &m.probes[p];
     let c = k.points[f].tip_centre(probe.tip_radius);
     let (n, pref) = (k.opts.n, &k.opts.preferred[..]);
     let mut open = crate::access::gac_halfline(&k.scene, &c, n, pref);
     if open.is_empty() {
-        return (
-            1,
-            "no straight line leaves the tip centre without meeting the part".into(),
-        );
+        return (1, Stop::NoLine);
     }
     let comps = probe.leading();
     for (depth, comp) in comps.iter().enumerate() {
@@ -172,31 +154,17 @@ fn blocking(k: &Knowledge, m: &Machine, p: usize, f: usize) -> (usize, String) {
         );
         let next = open.and(&cone);
         if next.is_empty() {
-            let d = deepest(&open);
-            return (
-                2 + depth,
-                format!(
-                    "its {} (Ø{} mm) meets the part from every direction the parts below it leave open; closest along ({}, {}, {})",
-                    comp.name,
-                    fmt_num(2.0 * comp.radius),
-                    fmt_num((d.x * 1e3).round() / 1e3),
-                    fmt_num((d.y * 1e3).round() / 1e3),
-                    fmt_num((d.z * 1e3).round() / 1e3)
-                ),
-            );
+            let stop = Stop::Component {
+                name: comp.name.clone(),
+                diameter: 2.0 * comp.radius,
+                closest: deepest(&open),
+            };
+            return (2 + depth, stop);
         }
         open = next;
     }
-    let d = deepest(&open);
-    (
-        2 + comps.len(),
-        format!(
-            "every component clears the part at the contact along ({}, {}, {}), but not on the way to the retract point, or the head cannot tilt that far",
-            fmt_num((d.x * 1e3).round() / 1e3),
-            fmt_num((d.y * 1e3).round() / 1e3),
-            fmt_num((d.z * 1e3).round() / 1e3)
-        ),
-    )
+    let closest = deepest(&open);
+    (2 + comps.len(), Stop::OnTheWay { closest })
 }
 
 /// The direction deepest inside a cone (+z when it is empty).
@@ -215,45 +183,16 @@ pub(super) fn report_left_out(
     (probe, blocker): (&str, &crate::access::pose::Blocker),
     diags: &mut Diagnostics,
 ) {
-    use crate::access::pose::Blocker;
     let part = &input.model.parts[input.plan.part.0];
     let feature = owner(input, face).map(|f| &part.features[f.0]);
-    let total = input.graph.face_points(face).len();
-    let help = match blocker {
-        Blocker::Tip => "the tip meets the part on its way in or out: shorten `motion { retract }` and `prehit`, or use a smaller tip",
-        Blocker::TipOnTable | Blocker::ComponentOnTable(_) => {
-            "the probe comes down to the table here: a setup or fixture that lifts this face off the table (`fixtures [..]`), or a probe with a longer stylus"
-        }
-        Blocker::Component(_) => {
-            "a longer or thinner stylus, an extension, or another setup (`prefer setup`) gives the probe room"
-        }
-        Blocker::Fixture(_) => {
-            "another fixture, or a setup on the table, leaves this face free; `inspc plan --explain-setups` lists them"
-        }
-        Blocker::Path => {
-            "a longer stylus, another orientation or a larger `motion { clearance }` may open a way to it"
-        }
-    };
     diags.push(PlanError::PointsLeftOut {
         span: feature.map_or(part.span, |f| f.span),
         face: input.geometry.faces[face.0].name.clone(),
         left,
-        total,
-        verb: if left == 1 { "is" } else { "are" },
+        total: input.graph.face_points(face).len(),
         iterations,
-        why: match blocker {
-            Blocker::Tip => {
-                format!("the tip of probe {probe} meets the part coming in or backing off")
-            }
-            Blocker::TipOnTable => format!("the tip of probe {probe} comes too near the table"),
-            Blocker::Component(c) => format!("the {c} of probe {probe} meets the part"),
-            Blocker::ComponentOnTable(c) => {
-                format!("the {c} of probe {probe} comes too near the table")
-            }
-            Blocker::Fixture(c) => format!("the {c} of probe {probe} meets the fixture"),
-            Blocker::Path => format!("no collision-free move brings probe {probe} to it"),
-        },
-        help: help.into(),
+        probe: probe.to_string(),
+        blocker: blocker.clone(),
     });
 }
 

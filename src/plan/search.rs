@@ -33,6 +33,7 @@
 
 use super::account::account;
 use super::cluster::{self, Strategy};
+use super::errors::LastRound;
 use super::explain::{face_name, report_face};
 use super::fallback::Fallback;
 use super::filter::filter;
@@ -178,7 +179,7 @@ fn plan_touch(
         turn,
         validated: BTreeSet::new(),
         turned_fails: BTreeMap::new(),
-        last: String::from("no round was run"),
+        last: LastRound::NotRun,
         fallback: None,
         skipped: skip.clone(),
         read_axes: axes::axis_faces(input.graph, &model.parts[plan.part.0]),
@@ -261,7 +262,7 @@ struct Search<'a> {
     /// FRAGILE_AFTER of them the point takes one clear at the nominal pose alone.
     turned_fails: BTreeMap<usize, usize>,
     /// Why the last round failed, for the diagnostic when none settles.
-    last: String,
+    last: LastRound,
     /// The round whose plan had the fewest touches that failed validation: what the plan
     /// falls back on, less those touches, if no round settles.
     fallback: Option<Fallback>,
@@ -278,8 +279,9 @@ struct Failures {
     invalid: Vec<(usize, usize, usize, Option<usize>)>,
     /// The touches that failed.
     left: BTreeSet<Pip>,
-    /// Per face name, the touches that failed and the first cause, for the diagnostic.
-    failed: BTreeMap<String, (usize, String)>,
+    /// Per face name, the touches that failed and the first cause (probe, what it hit),
+    /// for the diagnostic.
+    failed: BTreeMap<String, (usize, usize, crate::access::pose::Blocker)>,
     /// Per face, the touches that failed, the probe and the first blocker.
     causes: BTreeMap<FaceId, (usize, usize, crate::access::pose::Blocker)>,
 }
@@ -319,7 +321,7 @@ impl Search<'_> {
             return ControlFlow::Break(Some(hlip));
         }
         if !failures.failed.is_empty() {
-            self.last = last_failures(&failures.failed);
+            self.last = LastRound::Failed(last_failures(&failures.failed, self.machine));
         }
         if self
             .fallback
@@ -409,7 +411,7 @@ impl Search<'_> {
             }
         }
         if results.is_empty() {
-            self.last = format!("{} points found no probe orientation", failures.len());
+            self.last = LastRound::NoOrientation(failures.len());
             learn(
                 k,
                 machine,
@@ -498,12 +500,7 @@ impl Search<'_> {
                     let e = failures
                         .failed
                         .entry(face_name(input, k, p.point))
-                        .or_insert_with(|| {
-                            (
-                                0,
-                                format!("probe {} hits {w}", machine.probes[p.probe].name),
-                            )
-                        });
+                        .or_insert_with(|| (0, p.probe, w.clone()));
                     e.0 += 1;
                     failures.invalid.push((
                         p.point,
@@ -582,23 +579,19 @@ impl Search<'_> {
     }
 }
 
-/// The faces whose touches failed in the last round, four at most, for the diagnostic.
-fn last_failures(failed: &BTreeMap<String, (usize, String)>) -> String {
-    let faces: Vec<String> = failed
+/// The faces whose touches failed in the last round, for the diagnostic: per face name,
+/// how many and the first cause in words.
+fn last_failures(
+    failed: &BTreeMap<String, (usize, usize, crate::access::pose::Blocker)>,
+    machine: &Machine,
+) -> Vec<(String, usize, String, crate::access::pose::Blocker)> {
+    failed
         .iter()
-        .take(4)
-        .map(|(face, (n, why))| format!("{face} ({n} touches; {why})"))
-        .collect();
-    let more = failed.len().saturating_sub(4);
-    format!(
-        "in the last round touches failed on {}{}",
-        faces.join(", "),
-        if more > 0 {
-            format!(" and {more} more faces")
-        } else {
-            String::new()
-        }
-    )
+        .map(|(face, (n, probe, hit))| {
+            let probe = machine.probes[*probe].name.clone();
+            (face.clone(), *n, probe, hit.clone())
+        })
+        .collect()
 }
 
 /// The configurations of a plan that lie outside their point's domain (there should be
