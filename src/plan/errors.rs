@@ -415,7 +415,7 @@ mod tests {
 
     #[test]
     fn causes_read_as_sentences() {
-        let up = V3::new(0.0, 0.70710678, -0.70710678);
+        let up = V3::new(0.0, 0.6, -0.8);
         let pose = Unreachable::OnlyInPose {
             probe: "P1".into(),
             reach: 4,
@@ -424,7 +424,7 @@ mod tests {
         };
         assert!(pose
             .to_string()
-            .contains("so that (0, 0.707, -0.707) points up"));
+            .contains("so that (0, 0.6, -0.8) points up"));
         assert!(pose.remedy().starts_with("name a fixture"));
         let few = Unreachable::TooFew {
             probe: "P1".into(),
