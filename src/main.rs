@@ -18,6 +18,21 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// How every command prints its diagnostics: graphical on stderr, or one JSON object
+    /// per diagnostic per line on stdout (the command's summary lines then go to stderr).
+    #[arg(long, global = true, value_enum, default_value_t = MessageFormat::Human)]
+    message_format: MessageFormat,
+}
+
+/// The `--message-format` of this run, set once in `main` before any command runs.
+static MESSAGE_FORMAT: std::sync::OnceLock<MessageFormat> = std::sync::OnceLock::new();
+
+/// The `--message-format` of this run.
+fn message_format() -> MessageFormat {
+    MESSAGE_FORMAT
+        .get()
+        .copied()
+        .unwrap_or(MessageFormat::Human)
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -66,69 +81,17 @@ enum GraphFormat {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Prints the measurement graph (part → tolerance → feature → face → fpoint) of every
-    /// plan in the spec, or of its parts when it has no plan.
-    Graph {
-        /// The `.insp` spec.
-        file: PathBuf,
-        /// Output format.
-        #[arg(long, value_enum, default_value_t = GraphFormat::Dot)]
-        format: GraphFormat,
-        /// Draw every fpoint as a node (DOT and Mermaid); otherwise faces show counts.
+    /// Checks specs: parses, resolves names and units, checks values. Exits 1 on error.
+    Check {
+        /// The `.insp` files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Stop after the front end: skip geometry and sampling.
         #[arg(long)]
-        points: bool,
-    },
-    /// Lists the faces of a mesh (STL, OBJ) or of every part of a spec: id, surface type,
-    /// area, centroid, normal or axis and radius.
-    Faces {
-        /// A mesh file or an `.insp` spec.
-        file: PathBuf,
-        /// Segment the mesh even when it has groups.
-        #[arg(long)]
-        segment: bool,
-        /// The unit the mesh file is in.
-        #[arg(long, default_value = "mm")]
-        units: String,
-        /// Output format.
-        #[arg(long, value_enum, default_value_t = TableFormat::Text)]
-        format: TableFormat,
-    },
-    /// Computes the accessibility cones of one fpoint under one probe: prints how much of
-    /// the sphere each probe component leaves free and draws the probe's cone as an
-    /// unfolded cube map (binary PGM).
-    Cones {
-        /// The `.insp` spec.
-        file: PathBuf,
-        /// A face, by the name `inspc faces` gives it; all fpoints when absent.
-        #[arg(long)]
-        face: Option<String>,
-        /// Which fpoint of the face (or of the part), from 0.
-        #[arg(long, default_value_t = 0)]
-        point: usize,
-        /// A probe label of the plan's machine; its first probe when absent.
-        #[arg(long)]
-        probe: Option<String>,
-        /// Cube-map resolution (pixels per cube-face side).
-        #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(2..=256))]
-        resolution: u32,
-        /// Where to write the image.
-        #[arg(short, long, default_value = "cone.pgm")]
-        output: PathBuf,
-    },
-    /// Plans every plan of a spec: setups, probes, orientations and what each inspects
-    /// (the high-level inspection plan).
-    Plan {
-        /// The `.insp` spec.
-        file: PathBuf,
-        /// Output format.
-        #[arg(long, value_enum, default_value_t = TableFormat::Text)]
-        format: TableFormat,
-        #[command(flatten)]
-        search: Search,
-        /// First list the setups each plan may use: the poses the part stands in on the
-        /// table, those excluded and why, and what its fixtures can hold.
-        #[arg(long)]
-        explain_setups: bool,
+        front_end_only: bool,
+        /// What to print besides diagnostics.
+        #[arg(long, value_enum, default_value_t = Emit::Nothing)]
+        emit: Emit,
     },
     /// Builds a spec into a DMIS program: plans, paths, program. Writes nothing unless
     /// every plan succeeds.
@@ -148,6 +111,21 @@ enum Command {
         /// listed as a warning), instead of failing.
         #[arg(long)]
         allow_unmeasured: bool,
+    },
+    /// Plans every plan of a spec: setups, probes, orientations and what each inspects
+    /// (the high-level inspection plan).
+    Plan {
+        /// The `.insp` spec.
+        file: PathBuf,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = TableFormat::Text)]
+        format: TableFormat,
+        #[command(flatten)]
+        search: Search,
+        /// First list the setups each plan may use: the poses the part stands in on the
+        /// table, those excluded and why, and what its fixtures can hold.
+        #[arg(long)]
+        explain_setups: bool,
     },
     /// Runs a DMIS program on a virtual CMM against the part of its spec: moves swept
     /// with the real probe, touches searched on the actual surfaces, features fitted,
@@ -198,16 +176,6 @@ enum Command {
         #[command(flatten)]
         search: Search,
     },
-    /// Formats specs in place in the one canonical layout (indentation, spacing, blank
-    /// lines; comments and line breaks kept). A file that does not parse is left alone.
-    Fmt {
-        /// The `.insp` files.
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// Write nothing; exit 1 and name the files that are not formatted.
-        #[arg(long)]
-        check: bool,
-    },
     /// Builds a spec and draws the plan as one self-contained HTML page: the part in 3D
     /// with faces coloured by feature, each setup's pose on the table with its fixture,
     /// points, paths, the probe at a touch and that touch's accessibility cone.
@@ -223,19 +191,15 @@ enum Command {
         #[command(flatten)]
         search: Search,
     },
-    /// The language server, over standard input and output: diagnostics as you type,
-    /// hover, go to definition, references, symbols, completion, rename, formatting.
-    Lsp {
-        /// Plan FILE and print the result for the server (what the server runs on save,
-        /// in a child process it can stop).
-        #[arg(long, hide = true)]
-        plan: Option<PathBuf>,
-    },
-    /// Reads a DMIS program and checks it as a controller would: line lengths, labels,
-    /// names defined before use, MEAS blocks.
-    Dmis {
-        /// The `.dmi` file.
-        file: PathBuf,
+    /// Formats specs in place in the one canonical layout (indentation, spacing, blank
+    /// lines; comments and line breaks kept). A file that does not parse is left alone.
+    Fmt {
+        /// The `.insp` files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Write nothing; exit 1 and name the files that are not formatted.
+        #[arg(long)]
+        check: bool,
     },
     /// Writes a starter spec from a STEP or QIF file: the part read from its B-rep, a feature per
     /// PMI feature, every datum, tolerance and size the language can express (a comment
@@ -247,20 +211,68 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
-    /// Checks specs: parses, resolves names and units, checks values. Exits 1 on error.
-    Check {
-        /// The `.insp` files.
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// How to print diagnostics.
-        #[arg(long, value_enum, default_value_t = MessageFormat::Human)]
-        message_format: MessageFormat,
-        /// Stop after the front end: skip geometry and sampling.
+    /// Reads a DMIS program and checks it as a controller would: line lengths, labels,
+    /// names defined before use, MEAS blocks.
+    Dmis {
+        /// The `.dmi` file.
+        file: PathBuf,
+    },
+    /// Lists the faces of a mesh (STL, OBJ) or of every part of a spec: id, surface type,
+    /// area, centroid, normal or axis and radius.
+    Faces {
+        /// A mesh file or an `.insp` spec.
+        file: PathBuf,
+        /// Segment the mesh even when it has groups.
         #[arg(long)]
-        front_end_only: bool,
-        /// What to print besides diagnostics.
-        #[arg(long, value_enum, default_value_t = Emit::Nothing)]
-        emit: Emit,
+        segment: bool,
+        /// The unit the mesh file is in.
+        #[arg(long, default_value = "mm")]
+        units: String,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = TableFormat::Text)]
+        format: TableFormat,
+    },
+    /// Prints the measurement graph (part → tolerance → feature → face → fpoint) of every
+    /// plan in the spec, or of its parts when it has no plan.
+    Graph {
+        /// The `.insp` spec.
+        file: PathBuf,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = GraphFormat::Dot)]
+        format: GraphFormat,
+        /// Draw every fpoint as a node (DOT and Mermaid); otherwise faces show counts.
+        #[arg(long)]
+        points: bool,
+    },
+    /// Computes the accessibility cones of one fpoint under one probe: prints how much of
+    /// the sphere each probe component leaves free and draws the probe's cone as an
+    /// unfolded cube map (binary PGM).
+    Cones {
+        /// The `.insp` spec.
+        file: PathBuf,
+        /// A face, by the name `inspc faces` gives it; all fpoints when absent.
+        #[arg(long)]
+        face: Option<String>,
+        /// Which fpoint of the face (or of the part), from 0.
+        #[arg(long, default_value_t = 0)]
+        point: usize,
+        /// A probe label of the plan's machine; its first probe when absent.
+        #[arg(long)]
+        probe: Option<String>,
+        /// Cube-map resolution (pixels per cube-face side).
+        #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(2..=256))]
+        resolution: u32,
+        /// Where to write the image.
+        #[arg(short, long, default_value = "cone.pgm")]
+        output: PathBuf,
+    },
+    /// The language server, over standard input and output: diagnostics as you type,
+    /// hover, go to definition, references, symbols, completion, rename, formatting.
+    Lsp {
+        /// Plan FILE and print the result for the server (what the server runs on save,
+        /// in a child process it can stop).
+        #[arg(long, hide = true)]
+        plan: Option<PathBuf>,
     },
 }
 
@@ -324,6 +336,7 @@ impl Search {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let _ = MESSAGE_FORMAT.set(cli.message_format);
     match cli.command {
         Command::Faces {
             file,
@@ -413,10 +426,9 @@ fn main() -> ExitCode {
         }
         Command::Check {
             files,
-            message_format,
             emit,
             front_end_only,
-        } => check(&files, message_format, emit, front_end_only),
+        } => check(&files, emit, front_end_only),
     }
 }
 
@@ -438,12 +450,8 @@ fn lsp(plan: Option<&std::path::Path>) -> ExitCode {
 
 /// `inspc check`: every file's diagnostics (as text on stderr or JSON on stdout), the
 /// model when asked and nothing failed, and a count of errors and warnings.
-fn check(
-    files: &[PathBuf],
-    message_format: MessageFormat,
-    emit: Emit,
-    front_end_only: bool,
-) -> ExitCode {
+fn check(files: &[PathBuf], emit: Emit, front_end_only: bool) -> ExitCode {
+    let message_format = message_format();
     let checked = if front_end_only {
         inspc::check(&FsWorld, files)
     } else {
@@ -500,14 +508,29 @@ fn check(
     }
 }
 
+/// Prints diagnostics in the run's `--message-format`.
 fn print_diagnostics(sources: &inspc::source::SourceMap, diags: &[inspc::diag::Diagnostic]) {
     let opts = RenderOptions {
         width: 100,
         color: std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none(),
     };
     for d in diags {
-        eprint!("{}", render_human(sources, d, opts));
+        match message_format() {
+            MessageFormat::Human => eprint!("{}", render_human(sources, d, opts)),
+            MessageFormat::Json => println!("{}", to_json(sources, d)),
+        }
     }
+}
+
+/// Prints a command's summary line: on stdout, or on stderr where stdout carries JSON
+/// diagnostics.
+macro_rules! say {
+    ($($arg:tt)*) => {
+        match message_format() {
+            MessageFormat::Human => println!($($arg)*),
+            MessageFormat::Json => eprintln!($($arg)*),
+        }
+    };
 }
 
 fn cones(
@@ -675,7 +698,7 @@ fn build(
             let es = if w.ends_with("ch") { "es" } else { "s" };
             format!("{k} {w}{}", if k == 1 { "" } else { es })
         };
-        println!(
+        say!(
             "plan {}: tolerances measured {} of {}, {}, {}, {}, {}, {}",
             checked.model.plans[b.plan].name,
             s.tolerances.0,
@@ -686,7 +709,7 @@ fn build(
             n(s.features, "feature"),
             n(l.summary.touches, "touch")
         );
-        println!(
+        say!(
             "  path {:.2} m in {} ({} roadmap nodes added, {} moves checked)",
             l.summary.length / 1000.0,
             n(l.summary.groups, "group"),
@@ -696,7 +719,7 @@ fn build(
         let m = l.motion.margin;
         let fmt = inspc::model::fmt_num;
         if l.summary.tight.is_empty() {
-            println!("  moves keep {} mm from part, fixtures and table", fmt(m));
+            say!("  moves keep {} mm from part, fixtures and table", fmt(m));
         } else {
             let faces: Vec<String> = b
                 .tight
@@ -705,7 +728,7 @@ fn build(
                 .map(|(face, x)| format!("{face} {} mm", fmt(*x)))
                 .collect();
             let more = b.tight.len().saturating_sub(6);
-            println!(
+            say!(
                 "  moves keep {} mm from part, fixtures and table; less at stand-offs on {}{}",
                 fmt(m),
                 faces.join(", "),
@@ -722,9 +745,9 @@ fn build(
         .iter()
         .map(|(s, t)| format!("{s} {t:.2} s"))
         .collect();
-    println!("  time: {}", stages.join(", "));
+    say!("  time: {}", stages.join(", "));
     for w in &writes {
-        println!("wrote {} ({} bytes)", w.path.display(), w.bytes.len());
+        say!("wrote {} ({} bytes)", w.path.display(), w.bytes.len());
     }
     eprintln!("inspc: built in {:.2} s", start.elapsed().as_secs_f64());
     ExitCode::SUCCESS
@@ -970,11 +993,13 @@ fn read_source(
 }
 
 /// `inspc fmt`: formats every file that parses; with `--check`, only says which are not
-/// formatted. Nothing is written when a file does not parse.
+/// formatted. A file that does not parse (or cannot be read) is named, left as it is,
+/// and fails the run.
 fn fmt(files: &[PathBuf], check: bool) -> ExitCode {
     let mut sources = inspc::source::SourceMap::new();
     let mut diags = inspc::diag::Diagnostics::new();
     let mut writes: Vec<cli::outputs::Output> = Vec::new();
+    let mut parsed = 0;
     for file in files {
         let Some(id) = read_source(
             &mut sources,
@@ -989,6 +1014,7 @@ fn fmt(files: &[PathBuf], check: bool) -> ExitCode {
             diags.push(e);
             continue;
         }
+        parsed += 1;
         // It parses, so `None` means the layout would change what the spec says.
         let Some(formatted) = inspc::fmt::format_checked(text) else {
             eprintln!(
@@ -1006,30 +1032,47 @@ fn fmt(files: &[PathBuf], check: bool) -> ExitCode {
             what: "the formatted spec",
         });
     }
+    // Like rustfmt and gofmt: every file that parses is formatted, each one that does not
+    // is named and left as it is, and the run fails.
     let failed = diags.has_errors();
     print_diagnostics(&sources, &diags.sorted());
-    if failed {
-        eprintln!("inspc: nothing formatted");
-        return ExitCode::from(1);
-    }
+    let unparsed = files.len() - parsed;
     if check {
         for w in &writes {
             let f = w.path.display();
-            println!("{f}: not formatted (run `inspc fmt {f}`)");
+            say!("{f}: not formatted (run `inspc fmt {f}`)");
         }
-        if !writes.is_empty() {
-            return ExitCode::from(1);
+    } else {
+        if let Err(code) = commit(&writes, &[]) {
+            return code;
         }
-        eprintln!("inspc: {} files formatted", files.len());
-        return ExitCode::SUCCESS;
+        for w in &writes {
+            say!("formatted {}", w.path.display());
+        }
     }
-    if let Err(code) = commit(&writes, &[]) {
-        return code;
+    let plural = |n: usize| if n == 1 { "file" } else { "files" };
+    let already = parsed - writes.len();
+    let mut tally = vec![];
+    if !writes.is_empty() {
+        let done = if check { "to format" } else { "formatted" };
+        tally.push(format!("{} {} {done}", writes.len(), plural(writes.len())));
     }
-    for w in &writes {
-        println!("formatted {}", w.path.display());
+    if already > 0 {
+        tally.push(format!("{already} {} already formatted", plural(already)));
     }
-    ExitCode::SUCCESS
+    if unparsed > 0 {
+        tally.push(format!(
+            "{unparsed} {} with errors left as {}",
+            plural(unparsed),
+            if unparsed == 1 { "it was" } else { "they were" }
+        ));
+    }
+    eprintln!("inspc: {}", tally.join(", "));
+    if failed || (check && !writes.is_empty()) {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
 }
 
 fn read_dmis(file: &std::path::Path) -> ExitCode {
@@ -1052,7 +1095,7 @@ fn read_dmis(file: &std::path::Path) -> ExitCode {
             }
             print_diagnostics(&sources, &warnings.sorted());
             let count = |m: &str| p.commands(m).count();
-            println!(
+            say!(
                 "{}: {} statements, {} sensors, {} features, {} tolerances, {} MEAS blocks, {} touches, {} moves",
                 file.display(),
                 p.statements.len(),

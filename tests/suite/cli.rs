@@ -190,6 +190,41 @@ fn json_diagnostics_are_one_object_per_line() {
 }
 
 #[test]
+fn every_command_prints_json_diagnostics_and_keeps_stdout_for_them() {
+    // F3 with a fixed head plans with a warning (a datum measured in another setup): the
+    // plan's diagnostics reach JSON like the front end's; the summary moves to stderr.
+    let out = std::env::temp_dir().join(format!("inspc-json-{}.dmi", std::process::id()));
+    let out = out.to_string_lossy().into_owned();
+    let args = [
+        "build",
+        "--message-format",
+        "json",
+        "examples/f3_fixed.insp",
+        "-o",
+        &out,
+    ];
+    let (code, stdout, stderr) = inspc(&args);
+    let _ = std::fs::remove_file(&out);
+    assert_eq!(code, 0, "{stderr}");
+    let lines: Vec<serde_json::Value> = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|_| panic!("not JSON: {l}")))
+        .collect();
+    assert!(
+        lines
+            .iter()
+            .any(|v| v["code"] == "insp::plan::datum_in_other_setup" && v["severity"] == "warning"),
+        "{stdout}"
+    );
+    assert!(stderr.contains("wrote "), "{stderr}");
+    // The flag also stands before the command.
+    let (code, stdout, _) = inspc(&["--message-format", "json", "dmis", "no/such/program.dmi"]);
+    assert_eq!(code, 1);
+    let v: serde_json::Value = serde_json::from_str(stdout.lines().next().unwrap()).unwrap();
+    assert_eq!(v["code"], "insp::io::unreadable");
+}
+
+#[test]
 fn missing_file_is_a_diagnostic() {
     let (code, stdout, _) = inspc(&["check", "--message-format", "json", "no/such/spec.insp"]);
     assert_eq!(code, 1);

@@ -67,7 +67,7 @@ fn a_spec_laid_out_by_hand_gets_the_canonical_layout() {
 }
 
 #[test]
-fn fmt_check_names_unformatted_files_and_refuses_broken_ones() {
+fn fmt_formats_what_parses_names_what_does_not_and_tells_the_truth() {
     let dir = std::env::temp_dir().join(format!("inspc-fmt-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let messy = dir.join("messy.insp");
@@ -89,20 +89,34 @@ fn fmt_check_names_unformatted_files_and_refuses_broken_ones() {
         std::fs::read_to_string(&messy).unwrap(),
         "part p {\n  units mm\n}\n"
     );
-    // A file that does not parse: its diagnostic, and nothing written, not even the other.
+    // A file that does not parse: its diagnostic, it is left as it is, the run fails,
+    // and the one that parses is formatted all the same (as rustfmt and gofmt do).
     let o = run(&[&messy, &broken]);
     assert_eq!(o.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("insp::syntax::"));
-    assert_eq!(
-        std::fs::read_to_string(&messy).unwrap(),
-        "part p {\n  units mm\n}\n"
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("insp::syntax::"), "{err}");
+    assert!(
+        err.contains("1 file formatted, 1 file with errors left as it was"),
+        "{err}"
     );
-    let o = run(&[&messy]);
-    assert_eq!(o.status.code(), Some(0));
+    assert_eq!(
+        std::fs::read_to_string(&broken).unwrap(),
+        "part p {\n  units mm\n"
+    );
     assert_eq!(
         std::fs::read_to_string(&messy).unwrap(),
         "part p {\n    units mm\n}\n"
     );
-    let o = run(&[Path::new("--check"), &messy]);
-    assert_eq!(o.status.code(), Some(0));
+    // Nothing to change: said so, not "formatted".
+    for args in [&[Path::new("--check"), &messy][..], &[messy.as_path()][..]] {
+        let o = run(args);
+        assert_eq!(o.status.code(), Some(0));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("inspc: 1 file already formatted"), "{err}");
+        assert!(
+            o.stdout.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&o.stdout)
+        );
+    }
 }

@@ -101,9 +101,14 @@ fn quantities_limits_ranges_and_directions() {
         } => assert_eq!((nominal.value, plus.value, minus.value), (10.0, 0.1, -0.1)),
         v => panic!("{v:?}"),
     }
-    match first_prop_value("head h { a 10 mm +- 0.1 mm }") {
-        ValueKind::Limits { plus, minus, .. } => assert_eq!((plus.value, minus.value), (0.1, -0.1)),
-        v => panic!("{v:?}"),
+    // ASCII spellings of ±: `+-`, and `+/-` as drawings and DMIS programs write it.
+    for pm in ["+-", "+/-"] {
+        match first_prop_value(&format!("head h {{ a 10 mm {pm} 0.1 mm }}")) {
+            ValueKind::Limits { plus, minus, .. } => {
+                assert_eq!((plus.value, minus.value), (0.1, -0.1))
+            }
+            v => panic!("{pm}: {v:?}"),
+        }
     }
     match first_prop_value("head h { a 35 mm -0.2 mm +0 mm }") {
         ValueKind::Limits { plus, minus, .. } => assert_eq!((plus.value, minus.value), (0.0, -0.2)),
