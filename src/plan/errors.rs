@@ -40,7 +40,7 @@ pub enum PlanError {
         iterations: usize,
         last: LastRound,
     },
-    #[error("{left} of the {total} points of face `{face}` {} left out: generate-and-test did not settle after {iterations} rounds, and in the best plan found {}", if *.left == 1 { "is" } else { "are" }, blocked(.probe, .blocker))]
+    #[error("{left} of the {total} points {} `{face}` {} left out: generate-and-test did not settle after {iterations} rounds, and in the best plan found {}", if *.on_table { "on the table under face" } else { "of face" }, if *.left == 1 { "is" } else { "are" }, blocked(.probe, .blocker))]
     #[diagnostic(
         code(insp::plan::points_left_out),
         severity(Warning),
@@ -50,6 +50,9 @@ pub enum PlanError {
         #[label("`{face}` is part of this feature")]
         span: Span,
         face: String,
+        /// Whether the points are on the table under the face (a datum face's stand-in).
+        on_table: bool,
+        /// Distinct points left out, of `total`.
         left: usize,
         total: usize,
         iterations: usize,
@@ -470,5 +473,21 @@ mod tests {
             blocked("P2", &Blocker::Path),
             "no collision-free move brings probe P2 to it"
         );
+    }
+
+    #[test]
+    fn points_left_out_on_the_table_say_so() {
+        let e = PlanError::PointsLeftOut {
+            span: Span::new(crate::source::FileId(0), 0, 0),
+            face: "A".into(),
+            on_table: true,
+            left: 1,
+            total: 4,
+            iterations: 40,
+            probe: "p1".into(),
+            blocker: Blocker::TipOnTable,
+        };
+        let text = e.to_string();
+        assert!(text.starts_with("1 of the 4 points on the table under face `A` is left out"));
     }
 }

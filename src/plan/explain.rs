@@ -173,12 +173,13 @@ fn deepest(c: &crate::access::CubeMap) -> V3 {
 }
 
 /// One warning for a face some of whose touches never validated when generate-and-test
-/// ran out of rounds: how many points the plan leaves out, which probe was tried last and
-/// what it hit, and the fix for that cause.
+/// ran out of rounds: how many of its points (distinct points, of the face or of the
+/// table under it) the plan leaves out, which probe was tried last and what it hit, and
+/// the fix for that cause.
 pub(super) fn report_left_out(
     input: &Input,
-    face: FaceId,
-    left: usize,
+    (face, on_table): (FaceId, bool),
+    (left, total): (usize, usize),
     iterations: usize,
     (probe, blocker): (&str, &crate::access::pose::Blocker),
     diags: &mut Diagnostics,
@@ -188,8 +189,9 @@ pub(super) fn report_left_out(
     diags.push(PlanError::PointsLeftOut {
         span: feature.map_or(part.span, |f| f.span),
         face: input.geometry.faces[face.0].name.clone(),
+        on_table,
         left,
-        total: input.graph.face_points(face).len(),
+        total,
         iterations,
         probe: probe.to_string(),
         blocker: blocker.clone(),

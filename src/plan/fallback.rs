@@ -75,7 +75,11 @@ impl Fallback {
         let setups: BTreeSet<usize> = self.branches.iter().map(|b| b.setup).collect();
         // Moved touches, grouped by the branch they came from and where they went.
         let mut moved: BTreeMap<(usize, usize, usize, usize), Vec<usize>> = BTreeMap::new();
-        let mut still: BTreeMap<FaceId, (usize, usize, Blocker)> = BTreeMap::new();
+        // Per face (and whether on the table under it): the distinct points left out,
+        // and the probe and blocker to name; `left` counts the touches.
+        let mut still: BTreeMap<(FaceId, bool), (BTreeSet<usize>, usize, Blocker)> =
+            BTreeMap::new();
+        let mut left = 0;
         for (pip, from) in origin {
             match relocate(k, m, &pip, &setups, &used, &opts.bans) {
                 Some((s, p, o)) => moved.entry((from, s, p, o)).or_default().push(pip.point),
@@ -83,7 +87,13 @@ impl Fallback {
                     let face = k.points[pip.point].face;
                     let cause = self.causes.get(&face).map(|c| (c.1, c.2.clone()));
                     let (probe, blocker) = cause.unwrap_or((pip.probe, Blocker::Tip));
-                    still.entry(face).or_insert((0, probe, blocker)).0 += 1;
+                    let on_table = pip.point >= k.graph_points;
+                    let entry = still.entry((face, on_table));
+                    entry
+                        .or_insert((BTreeSet::new(), probe, blocker))
+                        .0
+                        .insert(pip.point);
+                    left += 1;
                 }
             }
         }
@@ -103,17 +113,22 @@ impl Fallback {
         if branches.is_empty() {
             return None;
         }
-        for (face, (n, probe, blocker)) in &still {
+        for (&(face, on_table), (points, probe, blocker)) in &still {
+            let total = if on_table {
+                let alts = k.tables.iter().filter(|t| t.face == face);
+                alts.map(|t| t.points.len()).sum()
+            } else {
+                input.graph.face_points(face).len()
+            };
             explain::report_left_out(
                 input,
-                *face,
-                *n,
+                (face, on_table),
+                (points.len(), total),
                 opts.max_iterations,
                 (&m.probes[*probe].name, blocker),
                 diags,
             );
         }
-        let left: usize = still.values().map(|c| c.0).sum();
         let moved_touches = self.left.len() - left;
         let round = Round {
             branches: &branches,
