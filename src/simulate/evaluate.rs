@@ -170,13 +170,19 @@ impl TolDef {
     pub(crate) fn empty_zone(&self) -> Option<(String, &'static str)> {
         if let Some(z) = self.zone.filter(|z| *z <= 0.0) {
             return Some((
-                format!("TOL/{} with a zone of {z} mm, which holds nothing", self.word),
+                format!(
+                    "TOL/{} with a zone of {z} mm, which holds nothing",
+                    self.word
+                ),
                 "a tolerance zone has a positive width: write it as `TOL/FLAT,0.05`",
             ));
         }
         if let Some((lo, hi)) = self.limits.filter(|(lo, hi)| lo >= hi) {
             return Some((
-                format!("TOL/{} with limits {lo} to {hi}, which leave no size", self.word),
+                format!(
+                    "TOL/{} with limits {lo} to {hi}, which leave no size",
+                    self.word
+                ),
                 "the lower deviation comes first and lies below the upper: `TOL/DIAM,-0.1,0.1`",
             ));
         }

@@ -455,11 +455,7 @@ impl Machine<'_> {
         // `number`): what reads them later sees only usable numbers.
         for p in params {
             if let Err(why) = number::number(p) {
-                return Err(self.bad(
-                    at,
-                    &format!("{major} with {}", why.what(p)),
-                    &why.help(),
-                ));
+                return Err(self.bad(at, &format!("{major} with {}", why.what(p)), &why.help()));
             }
         }
         match major {
@@ -742,12 +738,9 @@ impl Machine<'_> {
                 "ZORIG" => 2,
                 _ => return Err(self.unsupported(at, &format!("TRANS/{}", params.join(",")))),
             };
-            let v = pair
-                .get(1)
-                .and_then(|p| number::value(p))
-                .ok_or_else(|| {
-                    self.bad(at, "TRANS without a value", "write `TRANS/XORIG,value`")
-                })?;
+            let v = pair.get(1).and_then(|p| number::value(p)).ok_or_else(|| {
+                self.bad(at, "TRANS without a value", "write `TRANS/XORIG,value`")
+            })?;
             o += self.frame.rotation * (V3::ith(k, 1.0) * v);
         }
         self.frame = Isometry3::from_parts(Translation3::from(o), self.frame.rotation);

@@ -664,7 +664,11 @@ fn a_deviation_for_a_setup_the_program_lacks_is_an_error() {
         &Options::default(),
     );
     let d = &r.checked.diagnostics[0];
-    let label = d.inner.labels().and_then(|mut l| l.next()).expect("a label");
+    let label = d
+        .inner
+        .labels()
+        .and_then(|mut l| l.next())
+        .expect("a label");
     let text = &r.checked.sources.get(d.file).text;
     assert_eq!(
         &text[label.offset()..label.offset() + label.len()],
