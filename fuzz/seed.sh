@@ -2,7 +2,7 @@
 # Seeds the fuzz corpora from the repository's own inputs (run from fuzz/).
 set -euo pipefail
 cd "$(dirname "$0")"
-mkdir -p corpus/spec corpus/check corpus/mesh corpus/dmis
+mkdir -p corpus/spec corpus/check corpus/mesh corpus/dmis corpus/simulate
 for f in ../examples/*.insp ../examples/parts/*.insp ../tests/cases/*/main.insp ../stdlib/*.insp; do
     n=$(echo "$f" | tr '/.' '__')
     cp "$f" "corpus/spec/$n"
@@ -23,4 +23,15 @@ fi
 for f in ../tests/cases/*/program.dmi; do
     n=$(echo "$f" | tr '/.' '__')
     cp "$f" "corpus/dmis/$n"
+done
+# The virtual CMM: F2's program, then a deviations file after 64 blank lines; the first
+# byte (the share of 255 the program takes of the rest, rounded up) splits within them.
+prog=../tests/cases/example_f2/program.dmi
+for dev in "" "feature large_slot move (0.3, 0, 0)" "face stock.top bow 0.05" "part move (1, 0)
+part turn 2" "setup 1 move (0.5, 0)"; do
+    n=$(printf '%s' "$dev" | cksum | cut -d' ' -f1)
+    size=$(wc -c < "$prog")
+    total=$(( size + 64 + ${#dev} ))
+    split=$(( (size * 255 + total - 1) / total ))
+    { printf "\\$(printf '%03o' "$split")"; cat "$prog"; for _ in $(seq 64); do echo; done; printf '\n%s\n' "$dev"; } > "corpus/simulate/f2_$n"
 done

@@ -1187,6 +1187,23 @@ fn mesh_error(file: &std::path::Path, e: inspc::geometry::MeshError) {
     print_diagnostics(&sources, &diags.sorted());
 }
 
+/// Prints the items an import left out, labelled on the file's path as the command line
+/// named it.
+fn import_warnings(file: &std::path::Path, warnings: &[inspc::import::LeftOut]) {
+    if warnings.is_empty() {
+        return;
+    }
+    let mut sources = inspc::source::SourceMap::new();
+    let shown = file.to_string_lossy().into_owned();
+    let id = sources.add(shown.clone(), None, shown.clone());
+    let span = inspc::source::Span::new(id, 0, shown.len());
+    let mut diags = inspc::diag::Diagnostics::new();
+    for w in warnings {
+        diags.push(w.at(span));
+    }
+    print_diagnostics(&sources, &diags.sorted());
+}
+
 /// `inspc import`: a spec from a STEP or QIF file, on stdout or written atomically.
 fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
     use inspc::source::{FileKind, World};
@@ -1216,6 +1233,7 @@ fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
         datums: (d, dw),
         tolerances: (t, tw),
         dimensions: (s, sw),
+        warnings,
     } = match inspc::import::import(&bytes, &opts) {
         Ok(i) => i,
         Err(e) => {
@@ -1223,6 +1241,7 @@ fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
             return ExitCode::from(1);
         }
     };
+    import_warnings(file, &warnings);
     match &output {
         Some(path) => {
             let out = cli::outputs::Output {

@@ -11,11 +11,20 @@
 //! tolerance is checked against `resolve::accepts` (datums, modifiers, Ø zones) and the
 //! reference rules resolve enforces (a datum feature never referenced by its own
 //! tolerance, a datum once per frame) before it is written; what fails is a comment.
+//! Nothing the file says reaches the text but through `text::source` (identifiers,
+//! string literals, comments; datum letters through its `DatumLetters`) and
+//! `values::written` (numbers): a name, label or path cannot end a string or a comment
+//! or open an item, and an item whose value the spec cannot hold is left out with a
+//! comment and a warning ([`LeftOut`]).
 
+mod errors;
+mod text;
+mod values;
 mod write;
 
 use crate::geometry::step;
 use crate::geometry::MeshError;
+pub use errors::{ImportError, LeftOut};
 use write::write_spec;
 
 /// What to write where the spec refers outside itself.
@@ -41,9 +50,13 @@ pub struct Imported {
     pub tolerances: (usize, usize),
     /// Dimensions read, and written as size or location tolerances.
     pub dimensions: (usize, usize),
+    /// The items left out for a value the spec cannot hold, each also a comment in
+    /// the spec: warnings for the caller to place on the file's path.
+    pub warnings: Vec<LeftOut>,
 }
 
-/// A file stem as an identifier: letters, digits and `_`, not starting with a digit.
+/// A file stem as an identifier: letters, digits and `_`, lower case, starting with a
+/// letter, and no keyword (`part.stp` gives `part_`).
 pub fn identifier(stem: &str) -> String {
     let mut id: String = stem
         .chars()
@@ -58,7 +71,7 @@ pub fn identifier(stem: &str) -> String {
     if !id.starts_with(|c: char| c.is_ascii_alphabetic()) {
         id.insert_str(0, "part_");
     }
-    id
+    text::source(&id, text::Place::Identifier)
 }
 
 /// Reads a STEP or QIF file (by `opts.cad_path`'s extension) and writes a spec for it.

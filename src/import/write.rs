@@ -2,6 +2,9 @@
 //! datums made on demand), tolerances and sizes checked against what the language
 //! accepts, each left out with a comment saying why, and the text around them.
 
+use super::errors::LeftOut;
+use super::text::{source, DatumLetters, Place};
+use super::values::{written, Sign};
 use super::{ImportOptions, Imported};
 use crate::geometry::step::{pmi, CadPart};
 use crate::geometry::Surface;
@@ -27,7 +30,7 @@ impl Features {
             [first, .., last] => format!("f{}_{}", first + 1, last + 1),
             [] => "f".to_string(),
         });
-        let name = unique(&mut self.used_names, &base);
+        let name = unique(&mut self.used_names, &source(&base, Place::Identifier));
         self.by_faces.insert(faces.to_vec(), name.clone());
         self.order.push(faces.to_vec());
         name
@@ -127,7 +130,12 @@ fn faces_text(faces: &[usize]) -> String {
 
 /// One line of a spec that could not be written, as a comment.
 fn left_out(out: &mut Vec<String>, what: String, why: &str) {
-    out.push(format!("    // not written: {what}: {why}"));
+    out.push(comment(&format!("not written: {what}: {why}")));
+}
+
+/// A comment line of the part's body, its text from the file.
+fn comment(text: &str) -> String {
+    format!("    // {}", source(text, Place::Comment))
 }
 
 /// Limits as the language writes them: `± 0.15 mm`, `+0 mm -0.2 mm`.
@@ -187,9 +195,44 @@ fn solid_pmi(part: &CadPart) -> pmi::Pmi {
     p
 }
 
+/// The PMI with every datum letter as the spec writes it ([`DatumLetters`]): the
+/// datums' and those of every frame, a note for each one renamed.
+fn with_datum_letters(mut p: pmi::Pmi) -> pmi::Pmi {
+    let file_letters: Vec<String> = p
+        .datums
+        .iter()
+        .map(|d| d.letter.clone())
+        .chain(
+            p.tolerances
+                .iter()
+                .flat_map(|t| t.datums.iter().flat_map(|d| d.letters.clone())),
+        )
+        .collect();
+    let letters = DatumLetters::new(file_letters.iter().map(String::as_str));
+    for d in &mut p.datums {
+        d.letter = letters.of(&d.letter);
+    }
+    for t in &mut p.tolerances {
+        for d in &mut t.datums {
+            for l in &mut d.letters {
+                *l = letters.of(l);
+            }
+        }
+    }
+    let renamed: Vec<String> = letters
+        .renamed()
+        .map(|(file, spec)| {
+            format!("datum `{file}` is written as datum {spec}: datum letters are capitals other than I, O and Q (ASME Y14.5)")
+        })
+        .collect();
+    p.notes.extend(renamed);
+    p
+}
+
 pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
-    let solid = solid_pmi(part);
+    let solid = with_datum_letters(solid_pmi(part));
     let p = &solid;
+    let mut warnings = Vec::new();
     let mut feats = Features {
         by_faces: BTreeMap::new(),
         order: Vec::new(),
@@ -201,9 +244,15 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
         common: BTreeMap::new(),
     };
     let mut used_tol_names = BTreeSet::new();
-    let (tol_lines, written_tols) =
-        tolerance_lines(p, &mut feats, &mut frames, &mut used_tol_names);
-    let (dim_lines, written_dims) = dimension_lines(p, &mut feats, &mut used_tol_names);
+    let (tol_lines, written_tols) = tolerance_lines(
+        p,
+        &mut feats,
+        &mut frames,
+        &mut used_tol_names,
+        &mut warnings,
+    );
+    let (dim_lines, written_dims) =
+        dimension_lines(p, &mut feats, &mut used_tol_names, &mut warnings);
     let mut datum_lines = datums.lines;
     common_datum_lines(&frames, &mut feats, &mut datum_lines);
 
@@ -224,6 +273,7 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
         datums: (datums.letters, frames.datum_feature.len()),
         tolerances: (p.tolerances.len(), written_tols),
         dimensions: (p.dimensions.len(), written_dims),
+        warnings,
     }
 }
 
@@ -265,12 +315,12 @@ fn datum_lines(p: &pmi::Pmi, feats: &mut Features) -> DatumLines {
                 .iter()
                 .map(|t| format!("{} {}", t.kind, t.label))
                 .collect();
-            lines.push(format!(
-                "    // Datum {} is set up by targets ({}) that the file places on no face; they lie on {}. inspc has no datum targets: the datum is those whole faces. Check it against the drawing.",
+            lines.push(comment(&format!(
+                "Datum {} is set up by targets ({}) that the file places on no face; they lie on {}. inspc has no datum targets: the datum is those whole faces. Check it against the drawing.",
                 d.letter,
                 targets.join(", "),
                 faces_text(&d.faces)
-            ));
+            )));
         }
         lines.push(format!("    datum {} = {name}", d.letter));
     }
@@ -301,20 +351,29 @@ fn tolerance_lines(
     feats: &mut Features,
     frames: &mut Frames,
     used_names: &mut BTreeSet<String>,
+    warnings: &mut Vec<LeftOut>,
 ) -> (Vec<String>, usize) {
     let mut lines = Vec::new();
-    let mut written = 0;
+    let mut count = 0;
     for t in &p.tolerances {
         let label = format!("`{}` (#{})", t.name, t.id);
+        if let Err(why) = written(t.value_mm, Sign::Positive, "a zone", "mm") {
+            warnings.push(LeftOut {
+                item: source(&format!("tolerance {label}"), Place::Comment),
+                value: why.clone(),
+            });
+            left_out(&mut lines, label, &why);
+            continue;
+        }
         match tolerance_line(t, feats, frames, used_names) {
             Ok(line) => {
                 lines.push(line);
-                written += 1;
+                count += 1;
             }
             Err(why) => left_out(&mut lines, label, &why),
         }
     }
-    (lines, written)
+    (lines, count)
 }
 
 /// One tolerance as `tolerance name = kind(feature, value, datums)`, with a comment on
@@ -355,7 +414,7 @@ fn tolerance_line(
     let comment = if lost.is_empty() {
         String::new()
     } else {
-        format!("  // {}", lost.join("; "))
+        format!("  // {}", source(&lost.join("; "), Place::Comment))
     };
     Ok(format!(
         "    tolerance {name} = {}({}){comment}",
@@ -442,9 +501,12 @@ fn tolerance_args(
         );
     }
     if let Some(u) = t.unequal_mm {
+        let u = match written(u, Sign::Any, "U", "mm") {
+            Ok((text, _)) => format!("U {text} mm"),
+            Err(why) => why,
+        };
         lost.push(format!(
-            "unequally disposed (U {}): checked as equal bilateral",
-            mm(u)
+            "unequally disposed ({u}): checked as equal bilateral"
         ));
     }
     if t.composite_of.is_some() {
@@ -459,23 +521,61 @@ fn dimension_lines(
     p: &pmi::Pmi,
     feats: &mut Features,
     used_names: &mut BTreeSet<String>,
+    warnings: &mut Vec<LeftOut>,
 ) -> (Vec<String>, usize) {
     let mut lines = Vec::new();
-    let mut written = 0;
+    let mut count = 0;
     for d in &p.dimensions {
         let label = match &d.kind {
             pmi::DimKind::Size(n) => format!("size `{n}` (#{})", d.id),
             pmi::DimKind::Location(n) => format!("location `{n}` (#{})", d.id),
         };
+        if let Err(why) = dimension_values(d) {
+            warnings.push(LeftOut {
+                item: source(&label, Place::Comment),
+                value: why.clone(),
+            });
+            left_out(&mut lines, label, &why);
+            continue;
+        }
         match dimension_line(d, feats, used_names) {
             Ok(line) => {
                 lines.push(line);
-                written += 1;
+                count += 1;
             }
             Err(why) => left_out(&mut lines, label, &why),
         }
     }
-    (lines, written)
+    (lines, count)
+}
+
+/// Whether a dimension's values can be written as the limits `resolve` takes: each
+/// finite and in range, a length's nominal above 0, the lower limit below the upper as
+/// written. A value the file does not give is `dimension_line`'s to explain.
+fn dimension_values(d: &pmi::Dimension) -> Result<(), String> {
+    let (unit, nominal_sign) = if d.angular {
+        ("deg", Sign::Any)
+    } else {
+        ("mm", Sign::Positive)
+    };
+    if let Some(n) = d.nominal {
+        written(n, nominal_sign, "a nominal", unit)?;
+    }
+    let upper = d
+        .upper
+        .map(|u| written(u, Sign::Any, "an upper deviation", unit));
+    let lower = d
+        .lower
+        .map(|l| written(l, Sign::Any, "a lower deviation", unit));
+    if let (Some(upper), Some(lower)) = (upper.transpose()?, lower.transpose()?) {
+        if lower.1 >= upper.1 {
+            return Err(format!(
+                "limits of `{} {unit}` to `{} {unit}`, the lower not below the upper",
+                lower.0, upper.0
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// One dimension as `tolerance name = diameter|radius|width|distance|angle(…, limits)`;
@@ -582,6 +682,30 @@ fn size(part: &CadPart) -> [f64; 3] {
     [0, 1, 2].map(|i| hi[i] - lo[i])
 }
 
+/// The names the spec declares or imports beside the part's.
+const SPEC_NAMES: &[&str] = &[
+    "lab",
+    "efficient_accuracy",
+    "PH10MQ",
+    "ANGLE_PLATE",
+    "SINE_PLATE_60",
+    "TP20_D2_L20",
+    "TP20_D1_L10",
+    "TP20_D1_L20",
+    "TP20_D3_L50",
+    "TP20_D2_L20_X30",
+];
+
+/// The part's name as an identifier that no other item of the spec has.
+fn part_name(asked: &str) -> String {
+    let name = source(asked, Place::Identifier);
+    if SPEC_NAMES.contains(&name.as_str()) {
+        format!("{name}_part")
+    } else {
+        name
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn render(
     part: &CadPart,
@@ -595,8 +719,14 @@ fn render(
 ) -> String {
     let mut s = String::new();
     let extent = size(part);
-    let size = extent.map(|x| fmt_num(x.round()));
-    let _ = writeln!(s, "// Written by `inspc import` from {}.", opts.cad_path);
+    let size = extent.map(|x| {
+        written(x.round(), Sign::Any, "a size", "mm").map_or_else(|_| "?".to_string(), |w| w.0)
+    });
+    let _ = writeln!(
+        s,
+        "// Written by `inspc import` from {}.",
+        source(&opts.cad_path, Place::Comment)
+    );
     let _ = writeln!(
         s,
         "// {} faces (`face_<n>` in the file's shell order), {} × {} × {} mm; the file's unit is {}.",
@@ -604,7 +734,7 @@ fn render(
         size[0],
         size[1],
         size[2],
-        part.unit.0
+        source(&part.unit.0, Place::Comment)
     );
     if part.sheet_faces > 0 {
         let _ = writeln!(
@@ -622,7 +752,7 @@ fn render(
     if !notes.is_empty() {
         let _ = writeln!(s, "//\n// The PMI as read:");
         for n in notes {
-            let _ = writeln!(s, "//   - {n}");
+            let _ = writeln!(s, "//   - {}", source(n, Place::Comment));
         }
     }
     let rack = rack(part, extent);
@@ -632,13 +762,14 @@ fn render(
     let _ = writeln!(s, "use std::hierarchies::efficient_accuracy");
     let _ = writeln!(s, "use std::fixtures::{{ANGLE_PLATE, SINE_PLATE_60}}");
 
-    let _ = writeln!(s, "\npart {} {{", opts.part_name);
+    let name = part_name(&opts.part_name);
+    let _ = writeln!(s, "\npart {name} {{");
     let _ = writeln!(
         s,
         "    // Quantities below are in mm; the file's own unit applies to its geometry."
     );
     let _ = writeln!(s, "    units mm");
-    let _ = writeln!(s, "    mesh \"{}\"", opts.cad_path);
+    let _ = writeln!(s, "    mesh \"{}\"", source(&opts.cad_path, Place::Literal));
     if !feats.order.is_empty() {
         s.push('\n');
     }
@@ -674,7 +805,12 @@ fn render(
     }
     let _ = writeln!(s, "}}");
 
-    let table = |i: usize, min: f64| fmt_num(min.max((extent[i] * 2.5 / 100.0).ceil() * 100.0));
+    // A part too large to write gets the smallest table; its size says `?` above.
+    let table = |i: usize, min: f64| {
+        let want = (extent[i] * 2.5 / 100.0).ceil() * 100.0;
+        written(want, Sign::Positive, "a table", "mm")
+            .map_or(fmt_num(min), |w| fmt_num(min.max(w.1)))
+    };
     let _ = writeln!(
         s,
         "\n// A bridge CMM whose table holds the part in any pose, an indexable head and a rack\n// sized to the part's smallest holes and its height."
@@ -692,14 +828,14 @@ fn render(
     let _ = writeln!(s, "    probes [{}]", rack_text.join(", "));
     let _ = writeln!(s, "    fixtures [angle: ANGLE_PLATE, sine: SINE_PLATE_60]");
     let _ = writeln!(s, "}}");
-    let _ = writeln!(s, "\nplan {}_plan {{", opts.part_name);
-    let _ = writeln!(s, "    part {}", opts.part_name);
+    let _ = writeln!(s, "\nplan {name}_plan {{");
+    let _ = writeln!(s, "    part {name}");
     let _ = writeln!(s, "    cmm lab");
     let _ = writeln!(s, "    hierarchy efficient_accuracy");
     let _ = writeln!(s, "    prefer setup +z weight 1.0");
     let _ = writeln!(s, "    // Plates for faces the table alone cannot present.");
     let _ = writeln!(s, "    fixtures [angle, sine]");
-    let _ = writeln!(s, "    output {{ dmis \"{}.dmi\" }}", opts.part_name);
+    let _ = writeln!(s, "    output {{ dmis \"{name}.dmi\" }}");
     let _ = writeln!(s, "}}");
     s
 }

@@ -18,6 +18,7 @@
 //! faces about the feature's centroid, so a moved bore stays one cylinder.
 
 use super::errors::SimError;
+use super::number::number;
 use crate::geometry::{FaceId, PartGeometry, Surface, P3, V3};
 use crate::model::Part;
 use crate::source::{FileId, Span};
@@ -74,6 +75,17 @@ pub struct Placement {
     pub turn: f64,
 }
 
+/// A placement of one setup only, on top of every setup's.
+#[derive(Debug, Clone, Copy)]
+pub struct SetupPlacement {
+    /// The setup, from 1.
+    pub setup: usize,
+    /// How it lies off.
+    pub placement: Placement,
+    /// The setup's number in the deviations file.
+    pub span: Span,
+}
+
 /// Everything a deviations file says.
 #[derive(Debug, Clone, Default)]
 pub struct Deviations {
@@ -81,8 +93,8 @@ pub struct Deviations {
     pub faces: Vec<FaceChange>,
     /// For every setup.
     pub placement: Placement,
-    /// Per setup (from 1), on top of [`Deviations::placement`].
-    pub setups: Vec<(usize, Placement)>,
+    /// Per setup, on top of [`Deviations::placement`].
+    pub setups: Vec<SetupPlacement>,
 }
 
 impl Deviations {
@@ -97,14 +109,34 @@ impl Deviations {
     /// The placement of setup `k` (from 1).
     pub(crate) fn placement_of(&self, k: usize) -> Placement {
         let mut p = self.placement;
-        for (s, q) in &self.setups {
-            if *s == k {
-                p.shift[0] += q.shift[0];
-                p.shift[1] += q.shift[1];
-                p.turn += q.turn;
-            }
+        for s in self.setups.iter().filter(|s| s.setup == k) {
+            p.shift[0] += s.placement.shift[0];
+            p.shift[1] += s.placement.shift[1];
+            p.turn += s.placement.turn;
         }
         p
+    }
+
+    /// An error for each placement of a setup the program does not have (it ran
+    /// `setups` of them): a deviation that applies to nothing is a mistake in the file,
+    /// and the run it was meant for never happened.
+    pub(crate) fn missing_setups(&self, setups: usize) -> Vec<SimError> {
+        self.setups
+            .iter()
+            .filter(|s| s.setup > setups)
+            .map(|s| SimError::BadDeviation {
+                span: s.span,
+                what: format!(
+                    "the program has {setups} setup{}: there is no setup {}",
+                    if setups == 1 { "" } else { "s" },
+                    s.setup
+                ),
+                label: "no such setup".into(),
+                help: format!(
+                    "number the setups from 1 to {setups}, as the program's `PAUSE`s place the part; `part move|turn` places it in every setup"
+                ),
+            })
+            .collect()
     }
 
     /// A planar face's bow, moved with it; `None` when it has none.
@@ -190,8 +222,17 @@ enum Tok {
     Comma,
 }
 
-/// Tokens with their byte ranges, or the range of a character that is none.
-type Tokens = Result<Vec<(Tok, usize, usize)>, (usize, usize)>;
+/// Why a stretch of a line is no token: its byte range, and what to say.
+struct NoToken {
+    start: usize,
+    end: usize,
+    what: String,
+    label: &'static str,
+    help: String,
+}
+
+/// Tokens with their byte ranges, or what is none.
+type Tokens = Result<Vec<(Tok, usize, usize)>, NoToken>;
 
 fn tokens(line: &str, base: usize) -> Tokens {
     let b = line.as_bytes();
@@ -222,10 +263,22 @@ fn tokens(line: &str, base: usize) -> Tokens {
                 {
                     i += 1;
                 }
-                match line[start..i].parse::<f64>() {
-                    Ok(x) if x.is_finite() => Tok::Num(x),
-                    _ => return Err((base + start, base + i)),
-                }
+                let text = &line[start..i];
+                let (what, help) = match number(text) {
+                    Ok(Some(x)) => {
+                        out.push((Tok::Num(x), base + start, base + i));
+                        continue;
+                    }
+                    Ok(None) => (format!("`{text}` is not a number"), USAGE.to_string()),
+                    Err(why) => (format!("a deviation with {}", why.what(text)), why.help()),
+                };
+                return Err(NoToken {
+                    start: base + start,
+                    end: base + i,
+                    what,
+                    label: "not a usable number",
+                    help,
+                });
             }
             _ if c.is_ascii_alphabetic() || c == '_' => {
                 while i < b.len()
@@ -236,7 +289,17 @@ fn tokens(line: &str, base: usize) -> Tokens {
                 }
                 Tok::Word(line[start..i].to_string())
             }
-            _ => return Err((base + start, base + start + c.len_utf8())),
+            _ => {
+                // The whole character, though the loop reads bytes.
+                let c = line[start..].chars().next().unwrap_or(' ');
+                return Err(NoToken {
+                    start: base + start,
+                    end: base + start + c.len_utf8(),
+                    what: "a deviation line holds a character it cannot read".into(),
+                    label: "not a word, number, parenthesis or comma",
+                    help: "write one change per line: `feature NAME move (x, y, z)`".into(),
+                });
+            }
         };
         out.push((tok, base + start, base + i));
     }
@@ -271,18 +334,17 @@ pub fn parse(
             };
         let toks = match tokens(line, base) {
             Ok(t) => t,
-            Err((s, e)) => {
-                errors.push(bad(
-                    s,
-                    e,
-                    "a deviation line holds a character it cannot read",
-                    "not a word, number, parenthesis or comma",
-                    "write one change per line: `feature NAME move (x, y, z)`",
-                ));
+            Err(no) => {
+                errors.push(bad(no.start, no.end, &no.what, no.label, &no.help));
                 continue;
             }
         };
-        if let Err(e) = one_line(&toks, &mut dev, part, g, feature_faces, &bad) {
+        let mut c = Cur {
+            toks: &toks,
+            k: 0,
+            file,
+        };
+        if let Err(e) = one_line(&mut c, &mut dev, part, g, feature_faces, &bad) {
             errors.push(e);
         }
     }
@@ -301,6 +363,8 @@ const USAGE: &str = "lines read `feature NAME move (x, y, z)`, `… tilt DEG abo
 struct Cur<'t> {
     toks: &'t [(Tok, usize, usize)],
     k: usize,
+    /// The deviations file, for spans the parse keeps.
+    file: FileId,
 }
 
 impl Cur<'_> {
@@ -372,14 +436,13 @@ impl Cur<'_> {
 /// One line of the file: what it changes (`part`, `setup`, `feature`, `face`), read
 /// into `dev`.
 fn one_line(
-    toks: &[(Tok, usize, usize)],
+    c: &mut Cur,
     dev: &mut Deviations,
     part: &Part,
     g: &PartGeometry,
     feature_faces: &[Vec<FaceId>],
     bad: &Bad,
 ) -> Result<(), SimError> {
-    let mut c = Cur { toks, k: 0 };
     let (s0, e0) = c.span();
     let Some(kind) = c.word() else {
         return Err(bad(
@@ -391,8 +454,8 @@ fn one_line(
         ));
     };
     match kind.as_str() {
-        "part" | "setup" => placement_line(&mut c, &kind, dev, bad)?,
-        "feature" | "face" => face_line(&mut c, &kind, dev, part, g, feature_faces, bad)?,
+        "part" | "setup" => placement_line(c, &kind, dev, bad)?,
+        "feature" | "face" => face_line(c, &kind, dev, part, g, feature_faces, bad)?,
         _ => {
             return Err(bad(
                 s0,
@@ -403,7 +466,7 @@ fn one_line(
             ))
         }
     }
-    if c.k < toks.len() {
+    if c.k < c.toks.len() {
         let (s, e) = c.span();
         return Err(bad(
             s,
@@ -425,13 +488,18 @@ fn placement_line(
     bad: &Bad,
 ) -> Result<(), SimError> {
     let setup = if kind == "setup" {
-        Some(setup_number(c, bad)?)
+        let (s, e) = c.span();
+        Some((setup_number(c, bad)?, Span::new(c.file, s, e)))
     } else {
         None
     };
     let p = placement(c, bad)?;
     match setup {
-        Some(k) => dev.setups.push((k, p)),
+        Some((setup, span)) => dev.setups.push(SetupPlacement {
+            setup,
+            placement: p,
+            span,
+        }),
         None => {
             dev.placement.shift[0] += p.shift[0];
             dev.placement.shift[1] += p.shift[1];

@@ -108,7 +108,7 @@ impl TolDef {
             material: None,
             datums: Vec::new(),
         };
-        let num = |s: &String| s.parse::<f64>().ok();
+        let num = |s: &String| super::number::value(s);
         if SIZE_WORDS.contains(&word.as_str()) {
             if rest.peek().map(|s| s.as_str()) == Some("NOMINL") {
                 rest.next();
@@ -158,6 +158,35 @@ impl TolDef {
             }
         }
         Some(def)
+    }
+
+    /// What leaves this tolerance nothing to hold a part in, if anything: a zone of
+    /// width 0 or less, or size limits whose lower is not below their upper. DMIS 5.3
+    /// (ANSI/DMIS 105.2 part 1) gives a zone tolerance (`TOL/FLAT,tolzon`,
+    /// `TOL/POS,2D,tolzon,…`) by its width and a size (`TOL/DIAM,lotol,uptol`) by its
+    /// lower and upper deviation; ASME Y14.5-2018 and ISO 1101 define a zone by a
+    /// positive width `t`. Judging a part against an empty zone would fail every part
+    /// for the program's sake, not the part's.
+    pub(crate) fn empty_zone(&self) -> Option<(String, &'static str)> {
+        if let Some(z) = self.zone.filter(|z| *z <= 0.0) {
+            return Some((
+                format!(
+                    "TOL/{} with a zone of {z} mm, which holds nothing",
+                    self.word
+                ),
+                "a tolerance zone has a positive width: write it as `TOL/FLAT,0.05`",
+            ));
+        }
+        if let Some((lo, hi)) = self.limits.filter(|(lo, hi)| lo >= hi) {
+            return Some((
+                format!(
+                    "TOL/{} with limits {lo} to {hi}, which leave no size",
+                    self.word
+                ),
+                "the lower deviation comes first and lies below the upper: `TOL/DIAM,-0.1,0.1`",
+            ));
+        }
+        None
     }
 }
 

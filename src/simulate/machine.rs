@@ -39,6 +39,7 @@ use super::deviation::Deviations;
 use super::errors::SimError;
 use super::evaluate::{self, Measured, TolDef};
 use super::fit::{self, Shape};
+use super::number;
 use super::report::{FeatureRow, Report, Row};
 use super::{Input, Options};
 use crate::access::pose::{Blocker, Contact, Pose, Solid};
@@ -371,6 +372,10 @@ pub fn simulate(input: &Input, opts: &Options) -> Result<Report, Vec<SimError>> 
         m.statement(label.as_ref(), major, params, *at)
             .map_err(|e| vec![e])?;
     }
+    let missing = input.deviations.missing_setups(m.aligns.len());
+    if !missing.is_empty() {
+        return Err(missing);
+    }
     let program = input
         .program
         .commands("DMISMN")
@@ -417,16 +422,9 @@ fn param(params: &[String], k: usize) -> &str {
     params.get(k).map(String::as_str).unwrap_or("")
 }
 
-/// Whether a parameter reads as a number that is not finite (`inf`, `NaN`, `1e999`).
-fn non_finite(p: &str) -> bool {
-    p.parse::<f64>().is_ok_and(|x| !x.is_finite())
-}
-
+/// The numbers among a statement's parameters, in order (its words left out).
 fn nums(params: &[String]) -> Vec<f64> {
-    params
-        .iter()
-        .filter_map(|p| p.parse::<f64>().ok())
-        .collect()
+    params.iter().filter_map(|p| number::value(p)).collect()
 }
 
 impl Machine<'_> {
@@ -453,15 +451,12 @@ impl Machine<'_> {
             // The reader warned on it: DMIS the virtual CMM does not run, or not DMIS.
             return Ok(());
         }
-        // Every number a statement gives is finite, checked here for all statements: a
-        // `TOL/PERP,inf` read as a zone wider than any part, or a `ROTATE` by NaN, would
-        // pass silently.
-        if let Some(p) = params.iter().find(|p| non_finite(p)) {
-            return Err(self.bad(
-                at,
-                &format!("{major} with `{p}`, which is not a finite number"),
-                "write a finite number (DMIS numbers are decimals: no `inf`, `nan` or out-of-range exponent)",
-            ));
+        // Every number a statement gives is read here, once, for all statements (see
+        // `number`): what reads them later sees only usable numbers.
+        for p in params {
+            if let Err(why) = number::number(p) {
+                return Err(self.bad(at, &format!("{major} with {}", why.what(p)), &why.help()));
+            }
         }
         match major {
             // What a real controller needs and a virtual one has no use for: names, feed
@@ -607,6 +602,13 @@ impl Machine<'_> {
         } else {
             let n = nominal(params)
                 .ok_or_else(|| self.unsupported(at, &format!("FEAT/{}", param(params, 0))))?;
+            if let Some(what) = sizeless(&n.shape) {
+                return Err(self.bad(
+                    at,
+                    &format!("FEAT/{} with {what}", n.word),
+                    "a nominal feature's size is positive (a cone's angle under 180°)",
+                ));
+            }
             self.nominals.insert(l.clone(), n);
         }
         Ok(())
@@ -659,6 +661,9 @@ impl Machine<'_> {
         };
         let def = TolDef::parse(params)
             .ok_or_else(|| self.unsupported(at, &format!("TOL/{}", params.join(","))))?;
+        if let Some((what, help)) = def.empty_zone() {
+            return Err(self.bad(at, &what, help));
+        }
         self.tols.insert(l.clone(), def);
         let words = params[1..]
             .iter()
@@ -709,7 +714,7 @@ impl Machine<'_> {
             "ZAXIS" => V3::z(),
             _ => return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(",")))),
         };
-        let Some(angle) = params.get(1).and_then(|p| p.parse::<f64>().ok()) else {
+        let Some(angle) = params.get(1).and_then(|p| number::value(p)) else {
             return Err(self.unsupported(at, &format!("ROTATE/{}", params.join(","))));
         };
         let q = UnitQuaternion::from_axis_angle(&Unit::new_normalize(axis), angle.to_radians());
@@ -733,12 +738,9 @@ impl Machine<'_> {
                 "ZORIG" => 2,
                 _ => return Err(self.unsupported(at, &format!("TRANS/{}", params.join(",")))),
             };
-            let v = pair
-                .get(1)
-                .and_then(|p| p.parse::<f64>().ok())
-                .ok_or_else(|| {
-                    self.bad(at, "TRANS without a value", "write `TRANS/XORIG,value`")
-                })?;
+            let v = pair.get(1).and_then(|p| number::value(p)).ok_or_else(|| {
+                self.bad(at, "TRANS without a value", "write `TRANS/XORIG,value`")
+            })?;
             o += self.frame.rotation * (V3::ith(k, 1.0) * v);
         }
         self.frame = Isometry3::from_parts(Translation3::from(o), self.frame.rotation);
@@ -2234,6 +2236,21 @@ fn fixed_length(v: &[f64]) -> Option<f64> {
     let dir = V3::new(*v.get(3)?, *v.get(4)?, *v.get(5)?).try_normalize(1e-9)?;
     let len = off.norm();
     (off.cross(&dir).norm() <= 1e-6 * len.max(1.0)).then_some(len)
+}
+
+/// What a nominal shape lacks to be a feature, if anything: a diameter, width or cone
+/// angle of 0 or less (or a cone angle of 180° or more), which no part has.
+fn sizeless(shape: &Shape) -> Option<String> {
+    match *shape {
+        Shape::Cylinder { r, .. } | Shape::Sphere { r, .. } if r <= 0.0 => {
+            Some(format!("a diameter of {}", 2.0 * r))
+        }
+        Shape::Parpln { width, .. } if width <= 0.0 => Some(format!("a width of {width}")),
+        Shape::Cone { half, .. } if half <= 0.0 || half >= std::f64::consts::FRAC_PI_2 => {
+            Some(format!("a cone angle of {}°", 2.0 * half.to_degrees()))
+        }
+        _ => None,
+    }
 }
 
 /// A nominal from `FEAT` parameters.

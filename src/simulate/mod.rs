@@ -22,6 +22,7 @@ pub mod deviation;
 mod errors;
 pub mod evaluate;
 mod machine;
+mod number;
 mod qif;
 mod report;
 

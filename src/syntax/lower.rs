@@ -15,6 +15,17 @@ struct L {
     file: FileId,
 }
 
+/// The character of a `\u{…}` escape (1 to 6 hex digits, a Unicode scalar value) at
+/// the start of `after` (what follows `\u`), and the escape's length there.
+fn unicode_escape(after: &str) -> Option<(char, usize)> {
+    let digits = after.strip_prefix('{')?.split_once('}')?.0;
+    if digits.is_empty() || digits.len() > 6 || !digits.bytes().all(|b| b.is_ascii_hexdigit()) {
+        return None;
+    }
+    let c = char::from_u32(u32::from_str_radix(digits, 16).ok()?)?;
+    Some((c, digits.len() + 2))
+}
+
 impl L {
     /// A pair's span without the blanks pest's implicit whitespace leaves at its end (a
     /// bare number's optional unit consumes the space after it), so that labels
@@ -43,20 +54,32 @@ impl L {
                 value.push(c);
                 continue;
             }
-            match chars.next() {
-                Some((_, '\\')) => value.push('\\'),
-                Some((_, '"')) => value.push('"'),
-                Some((_, 'n')) => value.push('\n'),
-                Some((_, 't')) => value.push('\t'),
-                Some((j, other)) => {
+            let escape = match chars.next() {
+                Some((_, '\\')) => Some('\\'),
+                Some((_, '"')) => Some('"'),
+                Some((_, 'n')) => Some('\n'),
+                Some((_, 't')) => Some('\t'),
+                Some((j, 'u')) => unicode_escape(&raw[j + 1..]).map(|(c, len)| {
+                    // Past `{`, the digits and `}`, all ASCII.
+                    for _ in 0..len {
+                        chars.next();
+                    }
+                    c
+                }),
+                Some(_) => None,
+                None => Some('\\'),
+            };
+            match escape {
+                Some(c) => value.push(c),
+                None => {
+                    let other = raw[i + 1..].chars().next().unwrap_or('\\');
                     let start = inner.as_span().start() + i;
-                    let end = inner.as_span().start() + j + other.len_utf8();
+                    let end = start + 1 + other.len_utf8();
                     return Err(SyntaxError::InvalidEscape {
                         span: Span::new(self.file, start, end),
                         text: format!("\\{other}"),
                     });
                 }
-                None => value.push('\\'),
             }
         }
         Ok(Str { value, span })

@@ -69,7 +69,7 @@ pub enum SyntaxError {
     #[error("unknown escape `{text}` in a string")]
     #[diagnostic(
         code(insp::syntax::invalid_escape),
-        help("strings know `\\\\`, `\\\"`, `\\n` and `\\t`")
+        help("strings know `\\\\`, `\\\"`, `\\n`, `\\t` and `\\u{{…}}` (1 to 6 hex digits)")
     )]
     InvalidEscape {
         /// Where.

@@ -381,21 +381,65 @@ fn fixture_mesh(s: &crate::plan::SetupNode) -> Mesh {
     m
 }
 
-/// The page: `viewer.html` with the scene inlined.
+/// The page: `viewer.html` with the scene inlined: the title as HTML text, the scene
+/// as JSON in the page's `<script>`, each through its one escaping function. The
+/// template is cut at its two places once, so nothing a name holds is read as a place.
 pub fn page(scene: &Scene) -> String {
     let data = serde_json::to_string(scene).unwrap_or_else(|_| "null".into());
-    // `</` would end the script element early.
-    let data = data.replace("</", "<\\/");
-    TEMPLATE
-        .replace("{{TITLE}}", &html_escape(&scene.title))
-        .replace("/*{{SCENE}}*/null", &data)
+    let (head, rest) = TEMPLATE
+        .split_once("{{TITLE}}")
+        .expect("viewer.html has a title place");
+    let (middle, tail) = rest
+        .split_once("/*{{SCENE}}*/null")
+        .expect("viewer.html has a scene place");
+    let mut out = String::with_capacity(TEMPLATE.len() + data.len());
+    out.push_str(head);
+    out.push_str(&html_text(&scene.title));
+    out.push_str(middle);
+    out.push_str(&script_json(&data));
+    out.push_str(tail);
+    out
 }
 
 const TEMPLATE: &str = include_str!("viewer.html");
 
-fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
+/// Text in HTML (element content or a quoted attribute): the five characters the HTML
+/// spec gives meaning there as character references.
+fn html_text(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// JSON made safe inside a `<script>` element. In the HTML tokenizer's script-data states
+/// `</script` ends the element, and `<!--` followed by `<script` switches to the "double
+/// escaped" state, where the page's own `</script>` no longer closes it and the page
+/// stays blank (WHATWG HTML, "Restrictions for contents of script elements"): with no
+/// `<` in the text neither can happen. `>` and `&`
+/// go too (`-->` and character references in XHTML), and U+2028/U+2029, which end a
+/// line in JavaScript before ES2019. Each becomes its `\uXXXX` escape, which is only
+/// legal inside a JSON string: JSON's punctuation never holds them, so the data reads
+/// back the same.
+fn script_json(json: &str) -> String {
+    let mut out = String::with_capacity(json.len());
+    for c in json.chars() {
+        match c {
+            '<' => out.push_str("\\u003c"),
+            '>' => out.push_str("\\u003e"),
+            '&' => out.push_str("\\u0026"),
+            '\u{2028}' => out.push_str("\\u2028"),
+            '\u{2029}' => out.push_str("\\u2029"),
+            c => out.push(c),
+        }
+    }
+    out
 }

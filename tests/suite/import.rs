@@ -234,3 +234,193 @@ fn imported_specs_match_their_goldens_and_import_twice_the_same() {
         crate::common::check_imported_golden(&text, &golden);
     }
 }
+
+/// Names a hostile file may hold: quotes, backslashes, newlines, a smuggled item, a
+/// comment closer, unicode (a bidirectional override among it), nothing, keywords.
+const HOSTILE_NAMES: &[&str] = &[
+    "a\"b",
+    "back\\slash\\",
+    "two\nlines",
+    "}\npart evil {\n  units mm\n}\n//",
+    "*/ /* \r\u{2028}",
+    "Ø 5 ±0.1 \u{202e}txet",
+    "",
+    "part",
+    "use",
+    "A",
+    "a",
+];
+
+/// Where the imported spec and its STEP or QIF file are written: a folder of its own
+/// and a file name with a quote, a backslash and a space, which the spec must name.
+fn hostile_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("inspc-hostile-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Imports `bytes` as `name` (beside the spec), writes the spec and checks it: it parses,
+/// resolves with no error and no warning about a name, and holds one part with exactly
+/// the datums and tolerances the import says it wrote, one CMM and one plan — nothing
+/// the file smuggled in.
+fn import_checks_clean(dir: &std::path::Path, name: &str, bytes: &[u8]) -> inspc::import::Imported {
+    std::fs::write(dir.join(name), bytes).unwrap();
+    let opts = ImportOptions {
+        cad_path: name.to_string(),
+        part_name: identifier(name),
+    };
+    let imported = import(bytes, &opts).unwrap();
+    let spec = dir.join("spec.insp");
+    std::fs::write(&spec, &imported.text).unwrap();
+    let checked = inspc::check(&inspc::source::FsWorld, std::slice::from_ref(&spec));
+    let errors: Vec<String> = checked
+        .diagnostics
+        .iter()
+        .filter(|d| {
+            d.severity() == miette::Severity::Error || d.code() == "insp::resolve::datum_letter"
+        })
+        .map(|d| format!("{}: {}", d.code(), d.message()))
+        .collect();
+    assert!(errors.is_empty(), "{errors:?}\n{}", imported.text);
+    let own = |span: &inspc::source::Span| checked.roots.contains(&span.file);
+    let parts: Vec<_> = checked
+        .model
+        .parts
+        .iter()
+        .filter(|p| own(&p.span))
+        .collect();
+    assert_eq!(parts.len(), 1, "{}", imported.text);
+    let part = parts[0];
+    assert_eq!(part.datums.len(), imported.datums.1, "{}", imported.text);
+    assert_eq!(
+        part.tolerances.len(),
+        imported.tolerances.1 + imported.dimensions.1,
+        "{}",
+        imported.text
+    );
+    assert_eq!(checked.model.plans.len(), 1);
+    assert!(
+        !imported
+            .text
+            .lines()
+            .any(|l| l.trim_start().starts_with("part evil")),
+        "{}",
+        imported.text
+    );
+    imported
+}
+
+/// `s` as a STEP string's inside: a quote doubled.
+fn p21(s: &str) -> String {
+    s.replace('\'', "''")
+}
+
+/// The class of hostile STEP files: every datum letter and tolerance name replaced by
+/// one of [`HOSTILE_NAMES`] in turn (three rotations), and tolerance values that are
+/// huge, zero, negative or below what six decimals write; the file's own name holds
+/// a quote and a backslash. Each import writes a spec that checks clean and holds what
+/// the file has, and each value left out is a warning and a comment.
+#[test]
+fn hostile_step_names_and_values_write_a_spec_that_checks_clean() {
+    require_shared_parts();
+    let text = std::fs::read_to_string(file("ctc_01", "stp")).unwrap();
+    // (A STEP real past `f64` is a syntax error of the file.)
+    let bad_values = ["1.E300", "0.", "-0.05", "1.E-9"];
+    for turn in 0..3 {
+        let mut k = turn;
+        let mut next = || {
+            k += 1;
+            p21(HOSTILE_NAMES[k % HOSTILE_NAMES.len()])
+        };
+        let mut out = String::new();
+        let mut values = 0;
+        for line in text.split_inclusive('\n') {
+            let line = if let Some(rest) = line.split_once("=DATUM('',$,").map(|x| x.1) {
+                // `#37=DATUM('',$,#4269,.F.,'A');`
+                let (head, _) = rest.rsplit_once(",'").unwrap();
+                format!(
+                    "{}=DATUM('',$,{head},'{}');\n",
+                    line.split('=').next().unwrap(),
+                    next()
+                )
+            } else if let Some((head, rest)) = line.split_once("TOLERANCE('") {
+                let (_, tail) = rest.split_once('\'').unwrap();
+                format!("{head}TOLERANCE('{}'{tail}", next())
+            } else if line.starts_with("MEASURE_WITH_UNIT(LENGTH_MEASURE(0.") && values < 8 {
+                values += 1;
+                let v = bad_values[(values + turn) % bad_values.len()];
+                let (_, tail) = line.split_once("),").unwrap();
+                format!("MEASURE_WITH_UNIT(LENGTH_MEASURE({v}),{tail}")
+            } else {
+                line.to_string()
+            };
+            out.push_str(&line);
+        }
+        let dir = hostile_dir(&format!("step{turn}"));
+        let imported = import_checks_clean(&dir, "we\"ird \\name.stp", out.as_bytes());
+        assert!(!imported.warnings.is_empty(), "values left out warn");
+        for w in &imported.warnings {
+            assert!(
+                imported.text.contains("not written"),
+                "{w:?} has no comment"
+            );
+        }
+        assert!(
+            imported.text.contains("mesh \"we\\\"ird \\\\name.stp\""),
+            "{}",
+            imported.text
+        );
+    }
+}
+
+/// XML text: the markup characters as entities.
+fn xml(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// The class of hostile QIF files: datum labels, characteristic names and tolerance
+/// values patched as for STEP; the spec checks clean and holds what the file has.
+#[test]
+fn hostile_qif_labels_and_values_write_a_spec_that_checks_clean() {
+    require_shared_parts();
+    let text = std::fs::read_to_string("../shared/parts/nist_ctc_01_asme1_ap242.qif").unwrap();
+    let bad_values = ["INF", "0", "-0.5", "NaN", "1e-9", "1e400"];
+    for turn in 0..3 {
+        let mut k = turn;
+        let mut next = || {
+            k += 1;
+            xml(HOSTILE_NAMES[k % HOSTILE_NAMES.len()])
+        };
+        let mut values = turn;
+        let mut out = String::new();
+        for line in text.split_inclusive('\n') {
+            let patched = |tag: &str, with: String| -> Option<String> {
+                let open = format!("<{tag}");
+                let start = line.find(&open)?;
+                let inner = start + line[start..].find('>')? + 1;
+                let end = line.find(&format!("</{tag}>"))?;
+                Some(format!("{}{with}{}", &line[..inner], &line[end..]))
+            };
+            let line = if let Some(l) = patched("DatumLabel", next()) {
+                l
+            } else if line.contains("<Name>Nominal") {
+                patched("Name", next()).unwrap()
+            } else if line.contains("<ToleranceValue") && values < turn + 6 {
+                values += 1;
+                patched(
+                    "ToleranceValue",
+                    bad_values[values % bad_values.len()].into(),
+                )
+                .unwrap()
+            } else {
+                line.to_string()
+            };
+            out.push_str(&line);
+        }
+        let dir = hostile_dir(&format!("qif{turn}"));
+        import_checks_clean(&dir, "odd\\\"name.qif", out.as_bytes());
+    }
+}

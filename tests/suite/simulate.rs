@@ -501,3 +501,186 @@ plan f2_again {{
         vec!["insp::simulate::bad_statement"]
     );
 }
+
+/// Replaces the `k`th parameter of the first statement of `text` whose major word is
+/// `major` (after its label, if any) with `to`.
+fn with_param(text: &str, major: &str, k: usize, to: &str) -> String {
+    let mut out = String::new();
+    let mut done = false;
+    for line in text.split_inclusive('\n') {
+        let body = line.split_once('=').map_or(line, |(_, b)| b);
+        if done || !body.starts_with(&format!("{major}/")) {
+            out.push_str(line);
+            continue;
+        }
+        let head = &line[..line.len() - body.len()];
+        let (word, params) = body.trim_end().split_once('/').expect("a statement");
+        let mut params: Vec<&str> = params.split(',').collect();
+        params[k] = to;
+        out.push_str(&format!("{head}{word}/{}\n", params.join(",")));
+        done = true;
+    }
+    assert!(done, "no {major} statement");
+    out
+}
+
+/// The class of numbers a run reads: in every kind of statement that gives one, a
+/// number that is not finite stops the run with
+/// `bad_statement`; so does a tolerance zone of 0 or less, size limits the wrong way
+/// round and a nominal size of 0; and in a deviations file, such a number is a
+/// `bad_deviation` on its line.
+#[test]
+fn every_number_a_run_reads_is_checked_where_it_is_read() {
+    let (spec, program) = F2;
+    let text = std::fs::read_to_string(program).expect("program");
+    // One ROTATE, which F2's program has none of, before its first setup.
+    let text = text.replacen("PAUSE\n", "D(TURN)=ROTATE/ZAXIS,0.0\nPAUSE\n", 1);
+    let dir = std::env::temp_dir().join(format!("inspc-sim-num-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let code = |name: &str, program: &str| -> Vec<String> {
+        let p = dir.join(name);
+        std::fs::write(&p, program).expect("write");
+        run(spec, p.to_str().unwrap(), None, Options::default())
+            .err()
+            .unwrap_or_default()
+    };
+    assert!(code("base.dmi", &text).is_empty(), "the edited base runs");
+    let hostile = ["inf", "NaN", "1e999", "-inf", "nan", "-1e400", "infinity"];
+    // (statement, index of a number among its parameters)
+    let places = [
+        ("SNSET", 1),
+        ("SNSDEF", 3),
+        ("FEAT", 3),
+        ("TOL", 1),
+        ("TRANS", 1),
+        ("ROTATE", 1),
+        ("GOTO", 0),
+        ("PTMEAS", 1),
+    ];
+    for (i, (major, k)) in places.iter().enumerate() {
+        for (j, bad) in hostile.iter().enumerate() {
+            // Every value on the tolerance's zone; one, in turn, elsewhere.
+            if *major != "TOL" && j != i % hostile.len() {
+                continue;
+            }
+            let edited = with_param(&text, major, *k, bad);
+            // A move's and a touch's coordinates are plain decimals, which the DMIS
+            // reader checks first.
+            let expected = if matches!(*major, "GOTO" | "PTMEAS") {
+                "insp::dmis::structure"
+            } else {
+                "insp::simulate::bad_statement"
+            };
+            assert_eq!(
+                code(&format!("{major}_{j}.dmi"), &edited),
+                vec![expected],
+                "{major} with {bad}"
+            );
+        }
+    }
+    // Zones that hold nothing, limits the wrong way round, a size of nothing.
+    for (name, edited) in [
+        ("zero", with_param(&text, "TOL", 1, "0.0")),
+        ("negative", with_param(&text, "TOL", 1, "-0.05")),
+        ("tiny_negative", with_param(&text, "TOL", 1, "-1e-9")),
+        (
+            "limits",
+            text.replacen(
+                "T(T1)=TOL/PERP,0.05,RFS,DAT(A)",
+                "T(T1)=TOL/DIAM,0.1,-0.1",
+                1,
+            ),
+        ),
+        ("width", {
+            let line = text
+                .lines()
+                .find(|l| l.contains("=FEAT/PARPLN"))
+                .expect("a slot");
+            let mut params: Vec<&str> = line.split(',').collect();
+            params[9] = "0.0";
+            text.replacen(line, &params.join(","), 1)
+        }),
+    ] {
+        assert_eq!(
+            code(&format!("{name}.dmi"), &edited),
+            vec!["insp::simulate::bad_statement"],
+            "{name}"
+        );
+    }
+    // The deviations file: each number of each kind of line.
+    for line in [
+        "feature large_slot move (inf, 0, 0)",
+        "feature large_slot move (0, 1e999, 0)",
+        "feature large_slot move (0, 0, -1e999)",
+        "feature large_slot tilt 1e999 about (0, 1, 0)",
+        "feature large_slot tilt 0.1 about (0, 1e999, 0)",
+        "feature large_slot grow -1e400",
+        "face stock.top bow 2e999",
+        "face stock.top shift NaN",
+        "part move (1e999, 0)",
+        "part turn -1e300000",
+        "setup 1e999 move (1, 0)",
+        "setup 1 turn inf",
+    ] {
+        assert_eq!(
+            run(spec, program, Some(line), Options::default())
+                .err()
+                .unwrap_or_default(),
+            vec!["insp::simulate::bad_deviation"],
+            "{line}"
+        );
+    }
+}
+
+/// The class of deviations that apply to nothing: a setup the program does not have
+/// (any number past its last), like a face or feature the part does not have, is a
+/// `bad_deviation`; the program's own setups take theirs.
+#[test]
+fn a_deviation_for_a_setup_the_program_lacks_is_an_error() {
+    let (spec, program) = F2;
+    let setups = nominal(spec, program).setups;
+    for k in 1..=setups {
+        let line = format!("setup {k} move (0.5, 0)");
+        assert!(
+            run(spec, program, Some(&line), Options::default()).is_ok(),
+            "{line}"
+        );
+    }
+    for k in [setups + 1, setups + 2, 99, 1_000_000] {
+        let line = format!("part move (0.5, 0)\nsetup {k} turn 1");
+        assert_eq!(
+            run(spec, program, Some(&line), Options::default())
+                .err()
+                .unwrap_or_default(),
+            vec!["insp::simulate::bad_deviation"],
+            "{line}"
+        );
+    }
+    let r = inspc::simulate(
+        &FsWorld,
+        Path::new(spec),
+        Path::new(program),
+        Some(&write_dev("setup 99 move (1, 0)\n")),
+        &Options::default(),
+    );
+    let d = &r.checked.diagnostics[0];
+    let label = d
+        .inner
+        .labels()
+        .and_then(|mut l| l.next())
+        .expect("a label");
+    let text = &r.checked.sources.get(d.file).text;
+    assert_eq!(
+        &text[label.offset()..label.offset() + label.len()],
+        "99",
+        "labelled on the setup's number in the deviations file"
+    );
+}
+
+fn write_dev(text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("inspc-sim-dev-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let p = dir.join("setup99.dev");
+    std::fs::write(&p, text).expect("write");
+    p
+}

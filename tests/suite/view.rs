@@ -209,3 +209,78 @@ fn every_example_and_real_part_views_in_a_headless_browser() {
     let _ = std::fs::remove_dir_all(&dir);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// The class of strings that reach the page: face, feature, probe, holder and plan names
+/// holding `</script>`, `<!--<script>`, quotes, ampersands and U+2028. The scene inlined
+/// in the page's script holds no `<` (nor `>`, `&`, U+2028/2029) and reads back as the
+/// scene; the title holds none of `<>"'&` raw; the rest of the page is the template's.
+#[test]
+fn hostile_names_cannot_leave_the_pages_script() {
+    use inspc::view::{page, FaceInfo, GroupInfo, Mesh, Named, ProbeInfo, Scene, SetupInfo};
+    const NAMES: &[&str] = &[
+        "</script><script>alert(1)</script>",
+        "<!--<script>",
+        "a\"b'c&amp;d",
+        "x\u{2028}y\u{2029}z",
+        "/*{{SCENE}}*/null {{TITLE}}",
+        "]]><![CDATA[",
+    ];
+    let named = |k: usize| NAMES[k % NAMES.len()].to_string();
+    let scene = Scene {
+        title: format!("plan {}: part {}", named(0), named(1)),
+        vertices: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        triangles: vec![[0, 1, 2]],
+        tri_face: vec![0],
+        faces: (0..NAMES.len())
+            .map(|k| FaceInfo {
+                name: named(k),
+                feature: Some(k),
+            })
+            .collect(),
+        features: (0..NAMES.len())
+            .map(|k| Named {
+                name: named(k + 1),
+                color: named(k + 2),
+            })
+            .collect(),
+        probes: vec![ProbeInfo {
+            name: named(3),
+            color: named(4),
+            tip: 1.0,
+            components: vec![],
+        }],
+        points: vec![],
+        setups: vec![SetupInfo {
+            held_by: named(4),
+            rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            table: 0.0,
+            fixture: Mesh::default(),
+            groups: vec![GroupInfo {
+                probe: 0,
+                a: 0.0,
+                b: 0.0,
+                direction: [0.0, 0.0, 1.0],
+                path: vec![],
+                touches: vec![(0, named(5))],
+            }],
+            yaw: 0.0,
+        }],
+        sphere: vec![],
+    };
+    let html = page(&scene);
+    let template = include_str!("../../src/view/viewer.html");
+    let (head, rest) = template.split_once("{{TITLE}}").unwrap();
+    let (middle, tail) = rest.split_once("/*{{SCENE}}*/null").unwrap();
+    assert!(
+        html.starts_with(head) && html.ends_with(tail),
+        "the template kept"
+    );
+    let title = &html[head.len()..html.find(middle).expect("the template's middle")];
+    assert!(!title.contains(['<', '>', '"', '\'']), "{title}");
+    let json = &html[head.len() + title.len() + middle.len()..html.len() - tail.len()];
+    for c in ['<', '>', '&', '\u{2028}', '\u{2029}'] {
+        assert!(!json.contains(c), "{c:?} raw in the script: {json}");
+    }
+    let back: serde_json::Value = serde_json::from_str(json).expect("the scene's JSON");
+    assert_eq!(back, serde_json::to_value(&scene).unwrap());
+}
