@@ -136,8 +136,9 @@ enum Command {
         program: PathBuf,
         /// The `.insp` spec it was built from.
         spec: PathBuf,
-        /// How the part and its placement differ from nominal (see README).
-        #[arg(long)]
+        /// How the part and its placement differ from nominal: a file (`--help` shows
+        /// its format).
+        #[arg(long, long_help = DEVIATIONS_FORMAT)]
         deviations: Option<PathBuf>,
         /// Measurement noise: standard deviation along each touch's vector (mm).
         #[arg(long, default_value_t = 0.0)]
@@ -275,6 +276,25 @@ enum Command {
         plan: Option<PathBuf>,
     },
 }
+
+/// The deviations file's format, for `simulate --help` (`simulate/deviation.rs` reads it).
+const DEVIATIONS_FORMAT: &str = "\
+How the part and its placement differ from nominal: a file of one change per line, \
+`#` to the end of a line a comment, lengths in mm and angles in degrees (a trailing \
+`mm` or `deg` may say so):
+
+  feature NAME move (x, y, z)            its faces translate (part frame)
+  feature NAME tilt DEG about (x, y, z)  turn about an axis through its centroid
+  feature NAME grow MM                   its size grows: a diameter, a slot's width
+  face NAME shift MM                     a plane moves along its outward normal
+  face NAME bow MM                       a plane's centre stands out (flatness)
+  part move (x, y)                       the part lies off on the table (machine x, y)
+  part turn DEG                          ... and turned about the vertical
+  setup N move (x, y) | setup N turn DEG the same, in setup N only
+
+A feature is named as in the spec; a face as `inspc faces SPEC` lists it (stock.top, \
+face_12) or by the name of a feature whose faces it changes. Changes to one face \
+compose in file order.";
 
 /// How hard the planner searches.
 #[derive(clap::Args)]

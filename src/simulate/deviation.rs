@@ -7,7 +7,8 @@
 //! feature bore_1 move (0.3, 0, 0)        # the feature's faces translate (part frame)
 //! feature top tilt 0.2 about (0, 1, 0)   # turn about an axis through its centroid
 //! feature bore_1 grow 0.05               # its size grows: a diameter, a slot's width
-//! face stock.top bow 0.1                 # a plane's centre stands out (flatness)
+//! face stock.top bow 0.1                 # a plane's centre stands out (flatness); a
+//!                                        # face by its geometry name or a feature's name
 //! face stock.top shift 0.1               # a plane moves along its outward normal
 //! part move (5, 0)                       # the part lies off on the table (machine x, y)
 //! part turn 3                            # … and turned about the vertical (degrees)
@@ -594,7 +595,7 @@ fn face_line(
     let faces = if kind == "feature" {
         feature_faces_named(&name, (ns, ne), part, feature_faces, bad)?
     } else {
-        face_named(&name, (ns, ne), part, g, bad)?
+        face_named(&name, (ns, ne), part, g, feature_faces, bad)?
     };
     if faces.is_empty() {
         return Err(bad(
@@ -643,21 +644,26 @@ fn feature_faces_named(
     }
 }
 
-/// The part's face `name`, written at `ns..ne`, alone.
+/// The part's face `name`, written at `ns..ne`: a face of the geometry by its name
+/// (`stock.top`, `face_12`, as `inspc faces` lists them), else the faces of the feature
+/// the spec names so (`face top bow 0.1` where the spec says `feature top = …`).
 fn face_named(
     name: &str,
     (ns, ne): (usize, usize),
     part: &Part,
     g: &PartGeometry,
+    feature_faces: &[Vec<FaceId>],
     bad: &Bad,
 ) -> Result<Vec<FaceId>, SimError> {
-    match g.faces.iter().position(|f| f.name == name) {
-        Some(k) => Ok(vec![FaceId(k)]),
+    if let Some(k) = g.faces.iter().position(|f| f.name == name) {
+        return Ok(vec![FaceId(k)]);
+    }
+    match part.features.iter().position(|f| f.name == name) {
+        Some(k) => Ok(feature_faces.get(k).cloned().unwrap_or_default()),
         None => {
-            let help = match crate::diag::suggest::did_you_mean(
-                name,
-                g.faces.iter().map(|f| f.name.as_str()),
-            ) {
+            let faces = g.faces.iter().map(|f| f.name.as_str());
+            let features = part.features.iter().map(|f| f.name.as_str());
+            let help = match crate::diag::suggest::did_you_mean(name, faces.chain(features)) {
                 Some(s) => format!("did you mean `{s}`?"),
                 None => "`inspc faces SPEC` lists the part's faces".into(),
             };

@@ -677,6 +677,52 @@ fn a_deviation_for_a_setup_the_program_lacks_is_an_error() {
     );
 }
 
+/// `face NAME` takes a face as `inspc faces` names it or a feature as the spec does: on
+/// CTC 01 (a STEP part, faces `face_N`) the datum face `top` bowed by either name fails
+/// its flatness alike.
+#[test]
+fn a_face_is_named_as_the_spec_names_its_feature() {
+    let (spec, program) = CTC01;
+    let by_feature = run(spec, program, Some("face top bow 0.5"), Options::default())
+        .expect("a feature's name is a face's name");
+    assert!(
+        failing(&by_feature).contains(&"FLAT_A".to_string()),
+        "{}",
+        by_feature.text()
+    );
+    let both = run(
+        spec,
+        program,
+        Some("feature top bow 0.5"),
+        Options::default(),
+    )
+    .expect("runs");
+    assert_eq!(by_feature.text(), both.text());
+    assert_eq!(
+        run(spec, program, Some("face tpo bow 0.5"), Options::default()).err(),
+        Some(vec!["insp::simulate::bad_deviation".to_string()])
+    );
+}
+
+/// `simulate --help` spells out the deviations file's format.
+#[test]
+fn the_deviations_format_is_in_the_help() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_inspc"))
+        .args(["simulate", "--help"])
+        .output()
+        .expect("inspc runs");
+    let help = String::from_utf8_lossy(&out.stdout);
+    for line in [
+        "feature NAME move (x, y, z)",
+        "face NAME bow MM",
+        "part turn DEG",
+        "setup N",
+    ] {
+        assert!(help.contains(line), "{line} missing from:\n{help}");
+    }
+    assert!(!help.contains("see README"), "{help}");
+}
+
 fn write_dev(text: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("inspc-sim-dev-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
