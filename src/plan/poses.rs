@@ -979,6 +979,7 @@ fn rest_poses(g: &PartGeometry, hv: &[P3], hi_tris: &[[u32; 3]]) -> Vec<RestPose
             }
         }
     }
+    let edges = face_edges(g);
     let mut out = Vec::new();
     for p in &planes {
         let (e1, e2) = perpendicular_basis(&p.n);
@@ -1041,6 +1042,11 @@ fn rest_poses(g: &PartGeometry, hv: &[P3], hi_tris: &[[u32; 3]]) -> Vec<RestPose
                 contact.push(flat2(x));
             }
         }
+        for edge in &edges {
+            if edge.iter().all(|&v| in_plane(&g.vertices[v])) {
+                contact.extend(edge.iter().map(|&v| flat2(&g.vertices[v])));
+            }
+        }
         faces.sort();
         let poly = convex_hull(contact);
         let flat = poly.len() >= 3 && polygon_area(&poly) > tol * size;
@@ -1061,6 +1067,71 @@ fn rest_poses(g: &PartGeometry, hv: &[P3], hi_tris: &[[u32; 3]]) -> Vec<RestPose
             .then(a.up.x.total_cmp(&b.up.x))
     });
     out
+}
+
+/// The edges where two faces meet, each the vertices of one connected chain of mesh
+/// edges between the same two faces (a circle where a chamfer meets a side, the line
+/// where two planes meet). An edge lying wholly in a resting plane is a contact even
+/// between curved faces — a disc on the rim where its side meets a conical recess stands
+/// on that ring — while the end circle of a cylinder lying on its side touches the
+/// plane of a tessellation facet at two vertices only, its arc between them dipping
+/// below: no contact, and the cylinder rolls.
+fn face_edges(g: &PartGeometry) -> Vec<Vec<usize>> {
+    use std::collections::BTreeMap;
+    // Per mesh edge, the faces of its triangles.
+    let mut sides: BTreeMap<(u32, u32), Vec<u32>> = BTreeMap::new();
+    for (t, tri) in g.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            sides
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push(g.tri_face[t]);
+        }
+    }
+    // Mesh edges between two different faces, grouped by the pair, then by connection.
+    let mut by_pair: BTreeMap<(u32, u32), Vec<(u32, u32)>> = BTreeMap::new();
+    for (e, f) in sides {
+        if let [f1, f2] = f[..] {
+            if f1 != f2 {
+                by_pair.entry((f1.min(f2), f1.max(f2))).or_default().push(e);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for segs in by_pair.values() {
+        out.extend(chains(segs));
+    }
+    out
+}
+
+/// The vertex sets of the connected chains of `segs` (union–find over their vertices).
+fn chains(segs: &[(u32, u32)]) -> Vec<Vec<usize>> {
+    use std::collections::BTreeMap;
+    let mut parent: BTreeMap<u32, u32> = BTreeMap::new();
+    fn root(parent: &mut BTreeMap<u32, u32>, v: u32) -> u32 {
+        let mut r = v;
+        while let Some(&p) = parent.get(&r).filter(|&&p| p != r) {
+            r = p;
+        }
+        parent.insert(v, r);
+        r
+    }
+    for &(a, b) in segs {
+        parent.entry(a).or_insert(a);
+        parent.entry(b).or_insert(b);
+        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+        if ra != rb {
+            parent.insert(ra.max(rb), ra.min(rb));
+        }
+    }
+    let vertices: Vec<u32> = parent.keys().copied().collect();
+    let mut groups: BTreeMap<u32, Vec<usize>> = BTreeMap::new();
+    for v in vertices {
+        let r = root(&mut parent, v);
+        groups.entry(r).or_default().push(v as usize);
+    }
+    groups.into_values().collect()
 }
 
 /// A sine plate's tilts (degrees): its limits and the multiples of [`PLATE_STEP_DEG`]
@@ -1160,5 +1231,126 @@ mod tests {
         let sq = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)];
         assert!((tip(&sq, (1.0, 1.0), 1.0) - 45.0).abs() < 1e-9);
         assert!(tip(&sq, (3.0, 1.0), 1.0) < 0.0);
+    }
+
+    /// A disc of radius `r` and height `h` whose underside is a conical recess from the
+    /// rim up to `apex` at the centre (`apex` 0: a flat underside, as a plane), and
+    /// whose side is `n` facets: faces top (plane), side (cylinder), underside.
+    fn recessed_disc(r: f64, h: f64, apex: f64, n: usize) -> PartGeometry {
+        use crate::geometry::Face;
+        let ring = |z: f64| -> Vec<P3> {
+            (0..n)
+                .map(|k| {
+                    let a = k as f64 / n as f64 * std::f64::consts::TAU;
+                    P3::new(r * a.cos(), r * a.sin(), z)
+                })
+                .collect()
+        };
+        let mut vertices = ring(h);
+        vertices.extend(ring(0.0));
+        vertices.push(P3::new(0.0, 0.0, h));
+        vertices.push(P3::new(0.0, 0.0, apex));
+        let (top_c, bot_c) = (2 * n as u32, 2 * n as u32 + 1);
+        let mut triangles = Vec::new();
+        let mut tri_face = Vec::new();
+        for k in 0..n as u32 {
+            let j = (k + 1) % n as u32;
+            let (t0, t1, b0, b1) = (k, j, n as u32 + k, n as u32 + j);
+            triangles.push([top_c, t0, t1]);
+            tri_face.push(0);
+            triangles.extend([[b0, b1, t1], [b0, t1, t0]]);
+            tri_face.extend([1, 1]);
+            triangles.push([bot_c, b1, b0]);
+            tri_face.push(2);
+        }
+        let under = if apex > 0.0 {
+            Surface::Cone {
+                apex: P3::new(0.0, 0.0, apex),
+                axis: -V3::z(),
+                half_angle: (r / apex).atan(),
+                convex: false,
+            }
+        } else {
+            Surface::Plane {
+                origin: P3::origin(),
+                normal: -V3::z(),
+            }
+        };
+        let surfaces = [
+            Surface::Plane {
+                origin: P3::new(0.0, 0.0, h),
+                normal: V3::z(),
+            },
+            Surface::Cylinder {
+                origin: P3::origin(),
+                axis: V3::z(),
+                radius: r,
+                convex: true,
+            },
+            under,
+        ];
+        let faces = surfaces
+            .into_iter()
+            .enumerate()
+            .map(|(f, surface)| Face {
+                name: format!("face_{f}"),
+                surface,
+                triangles: (0..triangles.len() as u32)
+                    .filter(|&t| tri_face[t as usize] == f as u32)
+                    .collect(),
+                area: 1.0,
+                centroid: P3::origin(),
+                fit_rms: 0.0,
+            })
+            .collect();
+        PartGeometry {
+            vertices,
+            triangles,
+            tri_face,
+            faces,
+            roles: vec![],
+            cad: None,
+        }
+    }
+
+    fn poses(g: &PartGeometry) -> Vec<RestPose> {
+        let (v, tris) = parry3d_f64::transformation::try_convex_hull(&g.vertices).unwrap();
+        rest_poses(g, &v, &tris)
+    }
+
+    /// The pose with `up` (within a degree).
+    fn pose(rests: &[RestPose], up: V3) -> &RestPose {
+        let found = rests.iter().find(|r| r.up.dot(&up) > 0.9998);
+        found.unwrap_or_else(|| panic!("no pose with up {up:?}: {rests:?}"))
+    }
+
+    #[test]
+    fn a_disc_stands_on_the_ring_of_its_recess_and_not_on_its_side() {
+        // Ø35.2 × 6 with a conical recess 3 deep: upside up it rests on the ring where
+        // its side meets the recess, whatever the faces there are.
+        let g = recessed_disc(17.6, 6.0, 3.0, 48);
+        let rests = poses(&g);
+        let ring = pose(&rests, V3::z());
+        assert!(ring.stable(), "{:?}", ring.excluded());
+        assert!(
+            ring.area > 0.95 * std::f64::consts::PI * 17.6 * 17.6,
+            "{}",
+            ring.area
+        );
+        // Turned over it lies on its flat top, as before; on its rim it cannot stand.
+        assert!(pose(&rests, -V3::z()).stable());
+        assert!(rests.iter().all(|r| r.up.z.abs() > 0.1 || !r.stable()));
+    }
+
+    #[test]
+    fn a_coarse_cylinder_on_its_side_rolls() {
+        // 12 facets: a facet's corners on the end circles would make a 0.52 r wide
+        // support that tips at 15°, but the end circles' arcs dip below it.
+        let g = recessed_disc(20.0, 60.0, 0.0, 12);
+        let rests = poses(&g);
+        for r in rests.iter().filter(|r| r.up.z.abs() < 0.1) {
+            assert!(!r.stable(), "{r:?}");
+        }
+        assert!(pose(&rests, V3::z()).stable());
     }
 }
