@@ -56,7 +56,7 @@ impl<'a> Doc<'a> {
 pub(crate) fn malformed(n: &Node, message: &str) -> QifError {
     QifError::Malformed {
         id: n.id(),
-        element: n.name.clone(),
+        element: n.name.to_string(),
         line: n.line,
         message: message.to_string(),
     }
@@ -291,23 +291,18 @@ fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Option<P3>), Qi
                     })?,
                 None => vec![1.0; points.len()],
             };
-            let degree = order as usize;
-            if order.fract() != 0.0
-                || degree < 2
-                || degree - 1 > crate::geometry::step::geom::MAX_DEGREE
-                || knots.len() != points.len() + degree
-                || knots.windows(2).any(|w| w[1] < w[0])
-            {
-                return Err(malformed(
-                    c,
-                    "its order, knots and control points do not fit together",
-                ));
-            }
+            // The order is checked before it sizes anything: a whole number no
+            // higher than the highest degree read, plus one.
+            let max_order = (crate::geometry::step::geom::MAX_DEGREE + 1) as f64;
+            let fits = order.fract() == 0.0 && (2.0..=max_order).contains(&order);
+            let knots = Some(knots)
+                .filter(|k| fits && k.len() == points.len() + order as usize)
+                .and_then(|k| Knots::checked(order as usize - 1, k))
+                .ok_or_else(|| {
+                    malformed(c, "its order, knots and control points do not fit together")
+                })?;
             let curve = BSplineCurve {
-                knots: Knots {
-                    degree: degree - 1,
-                    knots,
-                },
+                knots,
                 points,
                 weights,
             };

@@ -95,7 +95,7 @@ pub fn read(d: &Doc, root: &Node, faces: &[u64], edge_faces: &HashMap<u64, Vec<u
         .unwrap_or_default();
     let nominals = root
         .at(&["Characteristics", "CharacteristicNominals"])
-        .map(|n| n.children.as_slice())
+        .map(|n| &n.children[..])
         .unwrap_or_default();
     for nom in nominals {
         r.characteristic(nom, &defs, &frames, &mut pmi);

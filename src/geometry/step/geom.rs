@@ -63,18 +63,43 @@ pub(crate) struct Knots {
 impl Knots {
     /// The knot vector from STEP's distinct knots and multiplicities; `None` when it
     /// does not fit `n` control points of this degree.
+    ///
+    /// The multiplicities are summed and checked against the `n + degree + 1` knots
+    /// the control points already read call for before anything is allocated from
+    /// them: a file's counts never size memory by themselves (a multiplicity of 10¹²
+    /// is refused, not expanded).
     pub fn new(degree: usize, mults: &[i64], values: &[f64], n: usize) -> Option<Knots> {
         if mults.len() != values.len() || degree == 0 || degree > MAX_DEGREE {
             return None;
         }
-        let mut knots = Vec::new();
+        let want = n.checked_add(degree + 1)?;
+        let mut total = 0usize;
+        for m in mults {
+            let m = usize::try_from(*m).ok().filter(|m| *m >= 1)?;
+            total = total.checked_add(m).filter(|t| *t <= want)?;
+        }
+        if total != want {
+            return None;
+        }
+        let mut knots = Vec::with_capacity(want);
         for (m, v) in mults.iter().zip(values) {
-            if *m < 1 {
-                return None;
-            }
             knots.extend(std::iter::repeat_n(*v, *m as usize));
         }
-        if knots.len() != n + degree + 1 || knots.windows(2).any(|w| w[1] < w[0]) {
+        if knots.windows(2).any(|w| w[1] < w[0] || w[0].is_nan()) {
+            return None;
+        }
+        Knots::checked(degree, knots)
+    }
+
+    /// A knot vector given in full (QIF writes it so): `None` unless it is
+    /// non-decreasing (no NaN), of a degree inspc evaluates, and long enough for the
+    /// `degree + 1` control points the degree needs at least (the caller checks it
+    /// against its own points).
+    pub fn checked(degree: usize, knots: Vec<f64>) -> Option<Knots> {
+        if degree == 0 || degree > MAX_DEGREE || knots.len() < 2 * (degree + 1) {
+            return None;
+        }
+        if knots.windows(2).any(|w| !(w[0] <= w[1])) {
             return None;
         }
         Some(Knots { degree, knots })

@@ -39,6 +39,7 @@ pub mod pmi;
 pub(super) mod tess;
 
 pub use error::StepError;
+pub(crate) use p21::Name;
 pub use tess::Resolution;
 
 use super::weld::{weld, RawMesh};

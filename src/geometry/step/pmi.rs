@@ -309,7 +309,8 @@ pub fn read(f: &P21, faces: &[u64], edge_faces: &HashMap<u64, Vec<usize>>, unit_
 fn collect_refs(p: &Param, out: &mut Vec<u64>) {
     match p {
         Param::Ref(r) => out.push(*r),
-        Param::List(v) | Param::Typed(_, v) => v.iter().for_each(|q| collect_refs(q, out)),
+        Param::List(v) => v.iter().for_each(|q| collect_refs(q, out)),
+        Param::Typed(t) => t.params.iter().for_each(|q| collect_refs(q, out)),
         _ => {}
     }
 }
@@ -810,7 +811,7 @@ impl Links<'_> {
         })?;
         let value = r.params[0].real()?;
         let kind = match &r.params[0] {
-            Param::Typed(k, _) => k.as_str(),
+            Param::Typed(t) => t.name.as_str(),
             _ => "",
         };
         let unit = r.params[1]
@@ -844,8 +845,9 @@ fn sort_modifiers(modifiers: &[String], material: &mut Option<Material>, other: 
 /// The enumerations in a modifier list (`SIMPLE_DATUM_REFERENCE_MODIFIER(.X.)`).
 fn collect_enums(p: &Param, out: &mut Vec<String>) {
     match p {
-        Param::Enum(e) => out.push(e.clone()),
-        Param::List(v) | Param::Typed(_, v) => v.iter().for_each(|q| collect_enums(q, out)),
+        Param::Enum(e) => out.push(e.to_string()),
+        Param::List(v) => v.iter().for_each(|q| collect_enums(q, out)),
+        Param::Typed(t) => t.params.iter().for_each(|q| collect_enums(q, out)),
         _ => {}
     }
 }
