@@ -64,6 +64,18 @@ pub enum QifError {
         /// What is wrong.
         message: String,
     },
+    /// Elements that name each other round a circle.
+    #[error("{}", cycle(ids, *line))]
+    #[diagnostic(
+        code(insp::geometry::qif_cycle),
+        help("a feature cannot be made of itself: the file is corrupt or was edited by hand; re-export it")
+    )]
+    Cycle {
+        /// The ids of the circle, the first named again by the last.
+        ids: Vec<u64>,
+        /// The first one's line.
+        line: usize,
+    },
     /// A curve or surface type inspc does not evaluate.
     #[error("{}", unsupported(*id, *line, what))]
     #[diagnostic(
@@ -128,6 +140,15 @@ fn unsupported(id: Option<u64>, line: usize, what: &str) -> String {
         }
         None => format!("line {line} holds a {what}, which inspc does not evaluate"),
     }
+}
+
+fn cycle(ids: &[u64], line: usize) -> String {
+    let mut path: Vec<String> = ids.iter().map(u64::to_string).collect();
+    path.extend(ids.first().map(u64::to_string));
+    format!(
+        "elements name each other round a circle: ids {} (line {line})",
+        path.join(" → ")
+    )
 }
 
 fn faces(list: &[(usize, u64, String)]) -> String {

@@ -51,6 +51,18 @@ pub enum StepError {
         /// What is wrong.
         message: String,
     },
+    /// Instances that refer to each other round a circle.
+    #[error("{}", cycle(ids, *line))]
+    #[diagnostic(
+        code(insp::geometry::step_cycle),
+        help("an instance cannot be made of itself: the file is corrupt or was edited by hand; re-export it")
+    )]
+    Cycle {
+        /// The instances of the circle, the first referred to again by the last.
+        ids: Vec<u64>,
+        /// The first one's line.
+        line: usize,
+    },
     /// A curve or surface type inspc does not evaluate.
     #[error("#{id} (line {line}) is a {what}, which inspc does not evaluate")]
     #[diagnostic(
@@ -100,6 +112,15 @@ fn missing(id: u64, from: Option<u64>) -> String {
         Some(from) => format!("#{from} refers to #{id}, which the file does not define"),
         None => format!("#{id} is referred to but not defined"),
     }
+}
+
+fn cycle(ids: &[u64], line: usize) -> String {
+    let mut path: Vec<String> = ids.iter().map(|i| format!("#{i}")).collect();
+    path.extend(ids.first().map(|i| format!("#{i}")));
+    format!(
+        "instances refer to each other round a circle: {} (line {line})",
+        path.join(" → ")
+    )
 }
 
 fn faces(list: &[(usize, u64, String)]) -> String {

@@ -7,6 +7,7 @@
 
 use crate::geometry::{P3, V3};
 use std::f64::consts::{FRAC_PI_2, TAU};
+use std::sync::Arc;
 
 /// A right-handed orthonormal frame (STEP's `AXIS2_PLACEMENT_3D`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -247,10 +248,10 @@ pub(crate) enum Curve {
     Circle(Frame, f64),
     /// An ellipse: semi-axes along x and y.
     Ellipse(Frame, f64, f64),
-    /// A B-spline curve.
-    BSpline(BSplineCurve),
-    /// A polyline through these points.
-    Polyline(Vec<P3>),
+    /// A B-spline curve (shared: every edge on it holds the one read).
+    BSpline(Arc<BSplineCurve>),
+    /// A polyline through these points (shared likewise).
+    Polyline(Arc<[P3]>),
 }
 
 impl Curve {
@@ -323,8 +324,8 @@ pub enum Surf {
     Sphere(Frame, f64),
     /// A torus about z: major and minor radius.
     Torus(Frame, f64, f64),
-    /// A B-spline surface.
-    BSpline(Box<BSplineSurface>),
+    /// A B-spline surface (shared: every face on it holds the one read).
+    BSpline(Arc<BSplineSurface>),
 }
 
 impl Surf {
@@ -598,7 +599,7 @@ mod tests {
             let p = c.eval(i as f64 / 10.0);
             assert!((p.coords.norm() - 2.0).abs() < 1e-12);
         }
-        let t = Curve::BSpline(c.clone()).param(&c.eval(0.37));
+        let t = Curve::BSpline(Arc::new(c.clone())).param(&c.eval(0.37));
         assert!((t - 0.37).abs() < 1e-7);
     }
 }

@@ -36,6 +36,7 @@ pub(in crate::geometry) mod error;
 pub(super) mod geom;
 mod p21;
 pub mod pmi;
+mod refs;
 pub(super) mod tess;
 
 pub use error::StepError;
@@ -97,12 +98,14 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
     } else {
         0
     };
+    // The PMI links faces and edges, not the mesh: it is read (and a circle of its
+    // references found) before the faces are meshed.
+    let mut pmi = pmi::read(&file, &face_ids, &pmi_edges, b.unit_mm).map_err(MeshError::Step)?;
     b.faces.truncate(b.faces.len() - sheet_faces);
     let mesh = mesh_brep(&b, res, crate::model::CadKind::Step).map_err(|e| match e {
         MeshFailure::Faces(list) => MeshError::Step(StepError::Faces(list)),
         MeshFailure::Mesh(e) => e,
     })?;
-    let mut pmi = pmi::read(&file, &face_ids, &pmi_edges, b.unit_mm);
     locate_targets(&mut pmi, &mesh);
     Ok(CadPart {
         pmi,
@@ -128,7 +131,8 @@ pub(super) fn mesh_brep(
     res: Resolution,
     kind: crate::model::CadKind,
 ) -> Result<RawMesh, MeshFailure> {
-    let (soup, failures) = tess::tessellate(b, res);
+    let (soup, failures) =
+        tess::tessellate(b, res).map_err(|e| MeshFailure::Mesh(MeshError::TooLarge(e)))?;
     if !failures.is_empty() {
         return Err(MeshFailure::Faces(
             failures
