@@ -2,7 +2,7 @@
 # Seeds the fuzz corpora from the repository's own inputs (run from fuzz/).
 set -euo pipefail
 cd "$(dirname "$0")"
-mkdir -p corpus/spec corpus/check corpus/mesh corpus/dmis
+mkdir -p corpus/spec corpus/check corpus/mesh corpus/dmis corpus/step corpus/qif
 for f in ../examples/*.insp ../examples/parts/*.insp ../tests/cases/*/main.insp ../stdlib/*.insp; do
     n=$(echo "$f" | tr '/.' '__')
     cp "$f" "corpus/spec/$n"
@@ -23,4 +23,12 @@ fi
 for f in ../tests/cases/*/program.dmi; do
     n=$(echo "$f" | tr '/.' '__')
     cp "$f" "corpus/dmis/$n"
+done
+# CAD parts: the suite's STEP and QIF files and the NIST parts beside the repository.
+for f in $(find ../tests ../examples -name '*.stp' -o -name '*.step') \
+    $(ls ../../shared/parts/*.stp ../../shared/parts/*/*.stp ../../shared/parts/*/*.step 2>/dev/null); do
+    cp "$f" "corpus/step/$(echo "$f" | tr '/.' '__')"
+done
+for f in $(find ../tests ../examples -name '*.qif') $(ls ../../shared/parts/*.qif 2>/dev/null); do
+    cp "$f" "corpus/qif/$(echo "$f" | tr '/.' '__')"
 done

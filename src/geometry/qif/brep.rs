@@ -378,7 +378,8 @@ fn sample(curve: &Curve, c: &Node, d: &Doc) -> Result<Vec<P3>, QifError> {
         Curve::Polyline(p) => p.len(),
         Curve::Circle(..) | Curve::Ellipse(..) => {
             let (a, b) = domain(c).ok_or_else(|| malformed(c, "it has no domain"))?;
-            if !((b - a).abs() <= TAU + 1e-9) {
+            let sweep = (b - a).abs();
+            if sweep.is_nan() || sweep > TAU + 1e-9 {
                 return Err(malformed(c, "its domain spans more than a full turn"));
             }
             ((b - a).abs() / 0.02).ceil().max(1.0) as usize + 1

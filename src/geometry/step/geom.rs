@@ -86,9 +86,6 @@ impl Knots {
         for (m, v) in mults.iter().zip(values) {
             knots.extend(std::iter::repeat_n(*v, *m as usize));
         }
-        if knots.windows(2).any(|w| w[1] < w[0] || w[0].is_nan()) {
-            return None;
-        }
         Knots::checked(degree, knots)
     }
 
@@ -100,7 +97,7 @@ impl Knots {
         if degree == 0 || degree > MAX_DEGREE || knots.len() < 2 * (degree + 1) {
             return None;
         }
-        if knots.windows(2).any(|w| !(w[0] <= w[1])) {
+        if knots.iter().any(|k| k.is_nan()) || knots.windows(2).any(|w| w[1] < w[0]) {
             return None;
         }
         Some(Knots { degree, knots })

@@ -12,6 +12,11 @@
 //! instance number, never a silently missing face: a hole in the mesh would let the
 //! accessibility analysis see through the part.
 //!
+//! **Architecture Invariant:** a file costs in proportion to its size, whatever it
+//! holds: references are followed once each on a trail (`refs.rs`; a circle is
+//! `step_cycle`), nesting and counts are checked before they size anything, and the
+//! mesh stops at 2,000,000 triangles (`mesh_too_large`). The QIF reader keeps the same.
+//!
 //! **Decision: our own reader and tessellator, with spade for the triangulation.** The
 //! candidate stack (truck-stepio + truck-meshalgo) rejects the empty lists `()` most
 //! AP242 files hold (ruststep#256), fails on some faces and panics on small spheres;
