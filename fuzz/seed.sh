@@ -2,7 +2,7 @@
 # Seeds the fuzz corpora from the repository's own inputs (run from fuzz/).
 set -euo pipefail
 cd "$(dirname "$0")"
-mkdir -p corpus/spec corpus/check corpus/mesh corpus/dmis corpus/simulate
+mkdir -p corpus/spec corpus/check corpus/mesh corpus/dmis corpus/simulate corpus/step corpus/qif
 for f in ../examples/*.insp ../examples/parts/*.insp ../tests/cases/*/main.insp ../stdlib/*.insp; do
     n=$(echo "$f" | tr '/.' '__')
     cp "$f" "corpus/spec/$n"
@@ -34,4 +34,12 @@ part turn 2" "setup 1 move (0.5, 0)"; do
     total=$(( size + 64 + ${#dev} ))
     split=$(( (size * 255 + total - 1) / total ))
     { printf "\\$(printf '%03o' "$split")"; cat "$prog"; for _ in $(seq 64); do echo; done; printf '\n%s\n' "$dev"; } > "corpus/simulate/f2_$n"
+done
+# CAD parts: the suite's STEP and QIF files and the NIST parts beside the repository.
+for f in $(find ../tests ../examples -name '*.stp' -o -name '*.step') \
+    $(ls ../../shared/parts/*.stp ../../shared/parts/*/*.stp ../../shared/parts/*/*.step 2>/dev/null); do
+    cp "$f" "corpus/step/$(echo "$f" | tr '/.' '__')"
+done
+for f in $(find ../tests ../examples -name '*.qif') $(ls ../../shared/parts/*.qif 2>/dev/null); do
+    cp "$f" "corpus/qif/$(echo "$f" | tr '/.' '__')"
 done

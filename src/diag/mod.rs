@@ -25,14 +25,17 @@ pub trait Located {
 }
 
 /// Implements [`Located`] for an error enum whose every variant has a primary
-/// `span: Span` field: `located!(PlanError { UninspectableFace, NoConvergence, NoPlan })`.
-/// A variant added without a `span` does not compile, nor does one left out of the list.
+/// `span: Span` field: `located!(PlanError { UninspectableFace, NoConvergence, NoPlan })`;
+/// variants that wrap another located error (`Step(InFile<StepError>)`) are listed after
+/// `wrapping` and ask it. A variant added without a `span` does not compile, nor does
+/// one left out of the list.
 macro_rules! located {
-    ($ty:ty { $($variant:ident),* $(,)? }) => {
+    ($ty:ty { $($variant:ident),* $(,)? } $(wrapping { $($wrap:ident),* $(,)? })?) => {
         impl $crate::diag::Located for $ty {
             fn file(&self) -> $crate::source::FileId {
                 match self {
                     $(Self::$variant { span, .. } => $crate::diag::primary_file(span),)*
+                    $($(Self::$wrap(inner) => $crate::diag::Located::file(inner),)*)?
                 }
             }
         }

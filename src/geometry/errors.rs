@@ -1,5 +1,7 @@
 //! The geometry stage's diagnostics.
 
+use super::qif::error::QifError;
+use super::step::error::StepError;
 use crate::source::Span;
 
 /// A problem evaluating a part's geometry.
@@ -83,177 +85,14 @@ pub enum GeometryError {
         part: String,
         gap: String,
     },
-    #[error("STEP file `{path}` is not valid Part 21 text: line {line}: {message}")]
-    #[diagnostic(
-        code(insp::geometry::step_syntax),
-        help("the file is cut short or was edited by hand; re-export it from the CAD system")
-    )]
-    StepSyntax {
-        #[label("this STEP file")]
-        span: Span,
-        path: String,
-        line: usize,
-        message: String,
-    },
-    #[error("STEP file `{path}` holds no solid")]
-    #[diagnostic(
-        code(insp::geometry::step_no_solid),
-        help("export the part as a solid (MANIFOLD_SOLID_BREP); a file of PMI, wireframe or tessellated shapes only has no faces to inspect")
-    )]
-    StepNoSolid {
-        #[label("this STEP file")]
-        span: Span,
-        path: String,
-    },
-    #[error("STEP file `{path}` is incomplete: {reason}")]
-    #[diagnostic(
-        code(insp::geometry::step_missing_entity),
-        help("an instance the B-rep needs is not in the file: it was cut short or corrupted; re-export it")
-    )]
-    StepMissing {
-        #[label("this STEP file")]
-        span: Span,
-        path: String,
-        reason: String,
-    },
-    #[error("STEP file `{path}` has a malformed instance: {reason}")]
-    #[diagnostic(
-        code(insp::geometry::step_malformed),
-        help("the instance's parameters do not fit its type; re-export the file, or report the exporting CAD system")
-    )]
-    StepMalformed {
-        #[label("this STEP file")]
-        span: Span,
-        path: String,
-        reason: String,
-    },
-    #[error("STEP file `{path}`: {reason}")]
-    #[diagnostic(
-        code(insp::geometry::step_unsupported),
-        help("inspc evaluates planes, cylinders, cones, spheres, tori and B-spline surfaces, and lines, circles, ellipses, B-spline curves and polylines; export this geometry as B-splines")
-    )]
-    StepUnsupported {
-        #[label("this STEP file")]
-        span: Span,
-        path: String,
-        reason: String,
-    },
-    #[error("STEP file `{path}`: {reason}")]
-    #[diagnostic(
-        code(insp::geometry::step_unit),
-        help("inspc reads SI length units with their prefixes and conversion-based units such as the inch, assigned by the context of the solid's representation")
-    )]
-    StepUnit {
-        #[label("this STEP file")]
-        span: Span,
-        path: String,
-        reason: String,
-    },
-    #[error("face_{face} (#{id}) of STEP file `{path}` cannot be meshed: {reason}")]
-    #[diagnostic(
-        code(insp::geometry::step_face),
-        help("the face is kept out of nothing: a part with a hole in its mesh cannot be planned; repair the face in the CAD system (its bounds and surface must agree) and re-export")
-    )]
-    StepFace {
-        #[label("this STEP file")]
-        span: Span,
-        path: String,
-        face: usize,
-        id: u64,
-        reason: String,
-    },
-    #[error("QIF file `{path}` is not well-formed XML: line {line}: {message}")]
-    #[diagnostic(
-        code(insp::geometry::qif_syntax),
-        help(
-            "the file is cut short or was edited by hand; re-export it from the CAD or MBD system"
-        )
-    )]
-    QifSyntax {
-        #[label("this QIF file")]
-        span: Span,
-        path: String,
-        line: usize,
-        message: String,
-    },
-    #[error("QIF file `{path}` is not a QIF 3 document: {reason}")]
-    #[diagnostic(
-        code(insp::geometry::qif_version),
-        help("inspc reads QIF 3.x MBD documents (versionQIF=\"3.…\"); export the part as QIF 3, or as STEP AP242")
-    )]
-    QifVersion {
-        #[label("this QIF file")]
-        span: Span,
-        path: String,
-        reason: String,
-    },
-    #[error("QIF file `{path}` holds no solid")]
-    #[diagnostic(
-        code(insp::geometry::qif_no_solid),
-        help("export the part with its B-rep (Product/TopologySet with a SOLID body); a QIF file of characteristics or results only has no faces to inspect")
-    )]
-    QifNoSolid {
-        #[label("this QIF file")]
-        span: Span,
-        path: String,
-    },
-    #[error("QIF file `{path}` is incomplete: {reason}")]
-    #[diagnostic(
-        code(insp::geometry::qif_missing_entity),
-        help("an element the B-rep needs is not in the file: it was cut short or corrupted; re-export it")
-    )]
-    QifMissing {
-        #[label("this QIF file")]
-        span: Span,
-        path: String,
-        reason: String,
-    },
-    #[error("QIF file `{path}` has a malformed element: {reason}")]
-    #[diagnostic(
-        code(insp::geometry::qif_malformed),
-        help("the element's content does not fit its type; re-export the file, or report the exporting system")
-    )]
-    QifMalformed {
-        #[label("this QIF file")]
-        span: Span,
-        path: String,
-        reason: String,
-    },
-    #[error("QIF file `{path}`: {reason}")]
-    #[diagnostic(
-        code(insp::geometry::qif_unsupported),
-        help("inspc evaluates QIF planes, cylinders, cones, spheres and tori, and segments, circular arcs, NURBS, polylines and aggregates of them; export the part as STEP AP242 for other surfaces")
-    )]
-    QifUnsupported {
-        #[label("this QIF file")]
-        span: Span,
-        path: String,
-        reason: String,
-    },
-    #[error("QIF file `{path}`: {reason}")]
-    #[diagnostic(
-        code(insp::geometry::qif_unit),
-        help("inspc reads the primary linear unit of FileUnits: a conversion factor to metres, or mm, cm, m, inch or ft by name")
-    )]
-    QifUnit {
-        #[label("this QIF file")]
-        span: Span,
-        path: String,
-        reason: String,
-    },
-    #[error("face_{face} (id {id}) of QIF file `{path}` cannot be meshed: {reason}")]
-    #[diagnostic(
-        code(insp::geometry::qif_face),
-        help("the face is kept out of nothing: a part with a hole in its mesh cannot be planned; repair the face (its loops and surface must agree) and re-export")
-    )]
-    QifFace {
-        #[label("this QIF file")]
-        span: Span,
-        path: String,
-        face: usize,
-        id: u64,
-        reason: String,
-    },
+    /// A STEP file that cannot be read or meshed: its own diagnostic, located.
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    Step(InFile<StepError>),
+    /// A QIF file that cannot be read or meshed: its own diagnostic, located.
+    #[error(transparent)]
+    #[diagnostic(transparent)]
+    Qif(InFile<QifError>),
     #[error("mesh `{path}` is too large: {reason}")]
     #[diagnostic(
         code(insp::geometry::mesh_too_large),
@@ -338,21 +177,6 @@ crate::diag::located!(GeometryError {
     FixtureMissesPart,
     SeveralBodies,
     MeshTooLarge,
-    StepSyntax,
-    StepNoSolid,
-    StepMissing,
-    StepMalformed,
-    StepUnsupported,
-    StepUnit,
-    StepFace,
-    QifSyntax,
-    QifVersion,
-    QifNoSolid,
-    QifMissing,
-    QifMalformed,
-    QifUnsupported,
-    QifUnit,
-    QifFace,
     BooleanFailed,
     MissesPart,
     FaceGone,
@@ -360,7 +184,7 @@ crate::diag::located!(GeometryError {
     UnknownSegment,
     UnknownFileFace,
     NoMatch,
-});
+} wrapping { Step, Qif });
 
 /// A mesh-reading failure, located later at the spec's path.
 #[derive(Debug, Clone)]
@@ -381,76 +205,102 @@ pub enum MeshError {
 
 impl MeshError {
     /// The diagnostics, pointing at the spec's mesh path: one, or one per face of a
-    /// STEP file that could not be meshed.
+    /// CAD file that could not be meshed.
     pub fn at(self, span: Span, path: &std::path::Path) -> Vec<GeometryError> {
-        use super::qif::error::QifError as Q;
-        use super::step::error::StepError as S;
         let path = shown_path(path);
-        vec![match self {
-            MeshError::Unreadable(reason) => GeometryError::MeshUnreadable { span, path, reason },
-            MeshError::Corrupt(reason) => GeometryError::MeshCorrupt { span, path, reason },
-            MeshError::NotClosed(reason) => GeometryError::MeshNotClosed { span, path, reason },
-            MeshError::TooLarge(reason) => GeometryError::MeshTooLarge { span, path, reason },
-            MeshError::Step(S::Faces(list)) => {
-                return list
-                    .into_iter()
-                    .map(|(face, id, reason)| GeometryError::StepFace {
-                        span,
-                        path: path.clone(),
-                        face,
-                        id,
-                        reason,
-                    })
-                    .collect()
+        match self {
+            MeshError::Unreadable(reason) => {
+                vec![GeometryError::MeshUnreadable { span, path, reason }]
             }
-            MeshError::Step(e) => {
-                let reason = e.to_string();
-                match e {
-                    S::Syntax { line, message } => GeometryError::StepSyntax {
-                        span,
-                        path,
-                        line,
-                        message,
-                    },
-                    S::NoSolid => GeometryError::StepNoSolid { span, path },
-                    S::Missing { .. } => GeometryError::StepMissing { span, path, reason },
-                    S::Malformed { .. } => GeometryError::StepMalformed { span, path, reason },
-                    S::Unsupported { .. } => GeometryError::StepUnsupported { span, path, reason },
-                    S::Unit(_) => GeometryError::StepUnit { span, path, reason },
-                    S::Faces(_) => unreachable!("handled above"),
-                }
+            MeshError::Corrupt(reason) => vec![GeometryError::MeshCorrupt { span, path, reason }],
+            MeshError::NotClosed(reason) => {
+                vec![GeometryError::MeshNotClosed { span, path, reason }]
             }
-            MeshError::Qif(Q::Faces(list)) => {
-                return list
-                    .into_iter()
-                    .map(|(face, id, reason)| GeometryError::QifFace {
-                        span,
-                        path: path.clone(),
-                        face,
-                        id,
-                        reason,
-                    })
-                    .collect()
-            }
-            MeshError::Qif(e) => {
-                let reason = e.to_string();
-                match e {
-                    Q::Syntax { line, message } => GeometryError::QifSyntax {
-                        span,
-                        path,
-                        line,
-                        message,
-                    },
-                    Q::Version(_) => GeometryError::QifVersion { span, path, reason },
-                    Q::NoSolid => GeometryError::QifNoSolid { span, path },
-                    Q::Missing { .. } => GeometryError::QifMissing { span, path, reason },
-                    Q::Malformed { .. } => GeometryError::QifMalformed { span, path, reason },
-                    Q::Unsupported { .. } => GeometryError::QifUnsupported { span, path, reason },
-                    Q::Unit(_) => GeometryError::QifUnit { span, path, reason },
-                    Q::Faces(_) => unreachable!("handled above"),
-                }
-            }
-        }]
+            MeshError::TooLarge(reason) => vec![GeometryError::MeshTooLarge { span, path, reason }],
+            MeshError::Step(e) => e
+                .one_per_face()
+                .into_iter()
+                .map(|error| GeometryError::Step(InFile::new(span, &path, error)))
+                .collect(),
+            MeshError::Qif(e) => e
+                .one_per_face()
+                .into_iter()
+                .map(|error| GeometryError::Qif(InFile::new(span, &path, error)))
+                .collect(),
+        }
+    }
+}
+
+/// A CAD file's own error ([`StepError`], [`QifError`]) where a spec (or the command
+/// line) names the file: the message after the file's format and name, the code and
+/// help the inner error's, the label on the path.
+#[derive(Debug)]
+pub struct InFile<E> {
+    /// The path as the spec wrote it.
+    pub span: Span,
+    /// The file's name, as messages show it ([`shown_path`]).
+    pub path: String,
+    /// What is wrong with it.
+    pub error: E,
+}
+
+impl<E> InFile<E> {
+    fn new(span: Span, path: &str, error: E) -> Self {
+        InFile {
+            span,
+            path: path.to_string(),
+            error,
+        }
+    }
+}
+
+/// The exchange format of a CAD file error, as messages name it.
+pub trait CadFormat {
+    /// `STEP`, `QIF`.
+    const FORMAT: &'static str;
+}
+
+impl CadFormat for StepError {
+    const FORMAT: &'static str = "STEP";
+}
+
+impl CadFormat for QifError {
+    const FORMAT: &'static str = "QIF";
+}
+
+impl<E: CadFormat + std::fmt::Display> std::fmt::Display for InFile<E> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} file `{}`: {}", E::FORMAT, self.path, self.error)
+    }
+}
+
+impl<E: CadFormat + std::fmt::Debug + std::fmt::Display> std::error::Error for InFile<E> {}
+
+impl<E: CadFormat + miette::Diagnostic> miette::Diagnostic for InFile<E> {
+    fn code<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        self.error.code()
+    }
+    fn severity(&self) -> Option<miette::Severity> {
+        self.error.severity()
+    }
+    fn help<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        self.error.help()
+    }
+    fn url<'a>(&'a self) -> Option<Box<dyn std::fmt::Display + 'a>> {
+        self.error.url()
+    }
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
+        let label = miette::LabeledSpan::new_with_span(
+            Some(format!("this {} file", E::FORMAT)),
+            miette::SourceSpan::from(self.span),
+        );
+        Some(Box::new(std::iter::once(label)))
+    }
+}
+
+impl<E> crate::diag::Located for InFile<E> {
+    fn file(&self) -> crate::source::FileId {
+        crate::diag::primary_file(&self.span)
     }
 }
 

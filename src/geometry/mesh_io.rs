@@ -3,12 +3,9 @@
 //! merges vertices and checks for a (nearly) closed solid.
 
 use super::errors::MeshError;
-use super::weld::{weld, RawMesh};
+use super::weld::{weld, RawMesh, MAX_TRIANGLES};
 use crate::source::{FileKind, World};
 use std::path::Path;
-
-/// The most triangles a mesh may have.
-pub(crate) const MAX_TRIANGLES: usize = 2_000_000;
 
 /// Reads a mesh file through the world, scaling by `unit_mm`; a STEP or QIF part is
 /// meshed at the default resolution.

@@ -12,6 +12,9 @@ use super::errors::MeshError;
 use super::P3;
 use std::collections::HashMap;
 
+/// The most triangles a mesh may have, read (STL, OBJ) or made (STEP, QIF).
+pub(crate) const MAX_TRIANGLES: usize = 2_000_000;
+
 /// A mesh as read: welded vertices (mm), triangles, and each triangle's group.
 #[derive(Debug, Clone, Default)]
 pub struct RawMesh {

@@ -6,6 +6,7 @@ mod common;
 
 mod access;
 mod architecture;
+mod cad_hostile;
 mod cases;
 mod catalogue;
 mod cli;

@@ -10,7 +10,9 @@ use super::QifError;
 use crate::geometry::step::brep::{Bound, Brep, Edge, Face};
 use crate::geometry::step::geom::{BSplineCurve, Curve, Frame, Knots, Surf};
 use crate::geometry::{P3, V3};
+use std::cell::{Cell, RefCell};
 use std::collections::{HashMap, HashSet};
+use std::f64::consts::TAU;
 
 /// Lookups over the document.
 pub struct Doc<'a> {
@@ -21,7 +23,17 @@ pub struct Doc<'a> {
     pub unit: f64,
     /// Millimetres per file length unit, for stated values (tolerances, sizes).
     pub value_unit: f64,
+    /// How many more points the aggregates' sub-curves may be sampled at
+    /// ([`MAX_SAMPLES`] for the document).
+    pub samples: Cell<usize>,
+    /// Curves read, by id: every edge on one shares it.
+    pub curves: RefCell<HashMap<u64, (Curve, Option<P3>)>>,
 }
+
+/// How many points all the aggregate curves of a document may be sampled at together:
+/// an aggregate's sub-curves become one polyline, so its points are what the file
+/// costs to mesh (a million-triangle part has far fewer bound points).
+pub(crate) const MAX_SAMPLES: usize = 4_000_000;
 
 impl<'a> Doc<'a> {
     /// The element `id` refers to, from the element `from`.
@@ -56,7 +68,7 @@ impl<'a> Doc<'a> {
 pub(crate) fn malformed(n: &Node, message: &str) -> QifError {
     QifError::Malformed {
         id: n.id(),
-        element: n.name.clone(),
+        element: n.name.to_string(),
         line: n.line,
         message: message.to_string(),
     }
@@ -291,28 +303,23 @@ fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Option<P3>), Qi
                     })?,
                 None => vec![1.0; points.len()],
             };
-            let degree = order as usize;
-            if order.fract() != 0.0
-                || degree < 2
-                || degree - 1 > crate::geometry::step::geom::MAX_DEGREE
-                || knots.len() != points.len() + degree
-                || knots.windows(2).any(|w| w[1] < w[0])
-            {
-                return Err(malformed(
-                    c,
-                    "its order, knots and control points do not fit together",
-                ));
-            }
+            // The order is checked before it sizes anything: a whole number no
+            // higher than the highest degree read, plus one.
+            let max_order = (crate::geometry::step::geom::MAX_DEGREE + 1) as f64;
+            let fits = order.fract() == 0.0 && (2.0..=max_order).contains(&order);
+            let knots = Some(knots)
+                .filter(|k| fits && k.len() == points.len() + order as usize)
+                .and_then(|k| Knots::checked(order as usize - 1, k))
+                .ok_or_else(|| {
+                    malformed(c, "its order, knots and control points do not fit together")
+                })?;
             let curve = BSplineCurve {
-                knots: Knots {
-                    degree: degree - 1,
-                    knots,
-                },
+                knots,
                 points,
                 weights,
             };
             let start = curve.eval(curve.knots.range().0);
-            Ok((Curve::BSpline(curve), Some(start)))
+            Ok((Curve::BSpline(std::sync::Arc::new(curve)), Some(start)))
         }
         "Polyline13Core" => {
             let v = c
@@ -325,7 +332,7 @@ fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Option<P3>), Qi
                 .map(|p| P3::new(p[0], p[1], p[2]) * d.unit)
                 .collect();
             let start = pts[0];
-            Ok((Curve::Polyline(pts), Some(start)))
+            Ok((Curve::Polyline(pts.into()), Some(start)))
         }
         "Aggregate13Core" => {
             let mut pts: Vec<P3> = Vec::new();
@@ -352,7 +359,7 @@ fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Option<P3>), Qi
                 return Err(malformed(c, "its sub-curves are empty"));
             }
             let start = pts[0];
-            Ok((Curve::Polyline(pts), Some(start)))
+            Ok((Curve::Polyline(pts.into()), Some(start)))
         }
         _ => Err(unsupported()),
     }
@@ -361,13 +368,39 @@ fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Option<P3>), Qi
 /// A sub-curve of an aggregate as points along its domain, fine enough for any chord
 /// tolerance the tessellator is asked for (a 0.02 rad step on arcs, 32 points a span on
 /// B-splines).
+///
+/// Every point is charged to the document's [`Doc::samples`] before it is made: an
+/// arc's domain is at most a turn, and all aggregates together take at most
+/// [`MAX_SAMPLES`] points, so their cost follows the file's size.
 fn sample(curve: &Curve, c: &Node, d: &Doc) -> Result<Vec<P3>, QifError> {
-    Ok(match curve {
-        Curve::Line => vec![d.point(c, "StartPoint")?, d.point(c, "EndPoint")?],
-        Curve::Polyline(p) => p.clone(),
+    let count = match curve {
+        Curve::Line => 2,
+        Curve::Polyline(p) => p.len(),
         Curve::Circle(..) | Curve::Ellipse(..) => {
             let (a, b) = domain(c).ok_or_else(|| malformed(c, "it has no domain"))?;
-            let n = ((b - a).abs() / 0.02).ceil().clamp(1.0, 10_000.0) as usize;
+            let sweep = (b - a).abs();
+            if sweep.is_nan() || sweep > TAU + 1e-9 {
+                return Err(malformed(c, "its domain spans more than a full turn"));
+            }
+            ((b - a).abs() / 0.02).ceil().max(1.0) as usize + 1
+        }
+        Curve::BSpline(s) => 32 * s.knots.breaks().len() + 1,
+    };
+    match d.samples.get().checked_sub(count) {
+        Some(left) => d.samples.set(left),
+        None => {
+            return Err(malformed(
+                c,
+                &format!("the aggregate curves need more than {MAX_SAMPLES} points in all"),
+            ))
+        }
+    }
+    Ok(match curve {
+        Curve::Line => vec![d.point(c, "StartPoint")?, d.point(c, "EndPoint")?],
+        Curve::Polyline(p) => p.to_vec(),
+        Curve::Circle(..) | Curve::Ellipse(..) => {
+            let (a, b) = domain(c).ok_or_else(|| malformed(c, "it has no domain"))?;
+            let n = count - 1;
             (0..=n)
                 .map(|k| curve.eval(a + (b - a) * k as f64 / n as f64))
                 .collect()
@@ -516,8 +549,17 @@ fn edge(d: &Doc, e: &Node) -> Result<Edge, QifError> {
         d.point(p, "XYZ")
     };
     let (start, end) = (vertex("VertexBeg")?, vertex("VertexEnd")?);
-    let c = d.get(d.ref_id(e, "Curve")?, e)?;
-    let (curve, curve_start) = curve_core(d, core(c)?, c)?;
+    let cid = d.ref_id(e, "Curve")?;
+    let cached = d.curves.borrow().get(&cid).cloned();
+    let (curve, curve_start) = match cached {
+        Some(read) => read,
+        None => {
+            let c = d.get(cid, e)?;
+            let read = curve_core(d, core(c)?, c)?;
+            d.curves.borrow_mut().insert(cid, read.clone());
+            read
+        }
+    };
     let same_sense = match curve_start {
         Some(s) => (s - start).norm() <= (s - end).norm() + 1e-9,
         None => true,

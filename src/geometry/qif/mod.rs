@@ -41,6 +41,7 @@
 mod brep;
 pub(in crate::geometry) mod error;
 mod pmi;
+mod refs;
 mod xml;
 
 pub use error::QifError;
@@ -143,10 +144,17 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
         ids: xml::index(&root),
         unit: file_mm / scale,
         value_unit,
+        samples: std::cell::Cell::new(brep::MAX_SAMPLES),
+        curves: Default::default(),
     };
     let mut b = brep::read(&doc, &root).map_err(q)?;
     b.unit_name = unit_name.clone();
-    let shell = orient(&mut b, res).map_err(q)?;
+    // The PMI links faces and edges, not the mesh: it is read (and a circle of its
+    // features found) before the faces are meshed.
+    let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
+    let edge_faces: HashMap<u64, Vec<usize>> = step::edge_faces(&b);
+    let pmi = pmi::read(&doc, &root, &face_ids, &edge_faces).map_err(q)?;
+    let shell = orient(&mut b, res)?;
     let mesh_of = |b: &step::brep::Brep| {
         step::mesh_brep(b, res, crate::model::CadKind::Qif).map_err(|e| match e {
             MeshFailure::Faces(list) => q(QifError::Faces(list)),
@@ -157,9 +165,6 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
     if outward(&mut b, &mesh, &shell) {
         mesh = mesh_of(&b)?;
     }
-    let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
-    let edge_faces: HashMap<u64, Vec<usize>> = step::edge_faces(&b);
-    let pmi = pmi::read(&doc, &root, &face_ids, &edge_faces);
     Ok(CadPart {
         pmi,
         mesh,
@@ -180,9 +185,9 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
 /// are oriented, so one face's choice fixes its neighbours', across each connected shell.
 /// Returns each face's shell, for [`outward`] to turn a shell whose mesh comes out
 /// inside out.
-fn orient(b: &mut step::brep::Brep, res: Resolution) -> Result<Vec<usize>, QifError> {
+fn orient(b: &mut step::brep::Brep, res: Resolution) -> Result<Vec<usize>, MeshError> {
     use step::brep::Bound;
-    let edges = step::tess::edge_polylines(b, res);
+    let edges = step::tess::edge_polylines(b, res).map_err(MeshError::TooLarge)?;
     let natural: Vec<bool> = b
         .faces
         .iter()
@@ -215,6 +220,12 @@ fn orient(b: &mut step::brep::Brep, res: Resolution) -> Result<Vec<usize>, QifEr
             for bound in &b.faces[f].bounds {
                 let Bound::Edges(list) = bound else { continue };
                 for &(e, fwd) in list {
+                    // Only an edge of two faces (one of them maybe twice, along a seam)
+                    // fixes a neighbour's sense; one used more often says nothing, and
+                    // is not searched (a file may name an edge in every loop).
+                    if uses[e].len() > 3 {
+                        continue;
+                    }
                     let others: Vec<(usize, bool)> =
                         uses[e].iter().copied().filter(|(g, _)| *g != f).collect();
                     let [(g, gfwd)] = others.as_slice() else {
@@ -229,7 +240,7 @@ fn orient(b: &mut step::brep::Brep, res: Resolution) -> Result<Vec<usize>, QifEr
                             queue.push_back(*g);
                         }
                         Some(have) if have != want => {
-                            return Err(QifError::Faces(vec![(
+                            return Err(MeshError::Qif(QifError::Faces(vec![(
                                 g + 1,
                                 b.faces[*g].id,
                                 format!(
@@ -237,7 +248,7 @@ fn orient(b: &mut step::brep::Brep, res: Resolution) -> Result<Vec<usize>, QifEr
                                     f + 1,
                                     b.edges[e].id
                                 ),
-                            )]));
+                            )])));
                         }
                         Some(_) => {}
                     }

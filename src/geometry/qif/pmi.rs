@@ -8,9 +8,12 @@
 //! note.
 
 use super::brep::Doc;
+use super::refs;
 use super::xml::Node;
+use super::QifError;
 use crate::geometry::step::pmi::{Datum, DatumRef, DimKind, Dimension, GeoTolerance, Pmi, Target};
 use crate::model::{Material, TolKind};
+use std::cell::Cell;
 use std::collections::{BTreeSet, HashMap};
 
 /// Geometric characteristics by their QIF element, without `CharacteristicDefinition`.
@@ -64,16 +67,34 @@ struct Reader<'a> {
     /// Length unit name → millimetres.
     units: HashMap<String, f64>,
     notes: Vec<String>,
+    /// Feature nominal → its faces, once walked.
+    features: HashMap<u64, BTreeSet<usize>>,
+    /// How many more elements the feature walks may enter ([`refs::budget`]).
+    visits: Cell<usize>,
+    /// Whether a walk stopped at the budget.
+    out_of_budget: bool,
+    /// The first circle of features found: the document's error.
+    error: Option<QifError>,
 }
 
-/// Reads the PMI of a document whose faces (in numbering order) have the ids `faces`.
-pub fn read(d: &Doc, root: &Node, faces: &[u64], edge_faces: &HashMap<u64, Vec<usize>>) -> Pmi {
+/// Reads the PMI of a document whose faces (in numbering order) have the ids `faces`;
+/// features that name each other round a circle are a `qif_cycle` error.
+pub fn read(
+    d: &Doc,
+    root: &Node,
+    faces: &[u64],
+    edge_faces: &HashMap<u64, Vec<usize>>,
+) -> Result<Pmi, QifError> {
     let mut r = Reader {
         d,
         face_index: faces.iter().enumerate().map(|(i, id)| (*id, i)).collect(),
         edge_faces,
         units: length_units(root),
         notes: Vec::new(),
+        features: HashMap::new(),
+        visits: refs::budget(d.ids.len()),
+        out_of_budget: false,
+        error: None,
     };
     let mut pmi = Pmi::default();
     let letters = r.datums(root, &mut pmi.datums);
@@ -95,13 +116,21 @@ pub fn read(d: &Doc, root: &Node, faces: &[u64], edge_faces: &HashMap<u64, Vec<u
         .unwrap_or_default();
     let nominals = root
         .at(&["Characteristics", "CharacteristicNominals"])
-        .map(|n| n.children.as_slice())
+        .map(|n| &n.children[..])
         .unwrap_or_default();
     for nom in nominals {
         r.characteristic(nom, &defs, &frames, &mut pmi);
     }
+    if let Some(e) = r.error {
+        return Err(e);
+    }
+    if r.out_of_budget {
+        r.notes.push(
+            "the features name each other more often than the document has elements: the rest of their links are not followed".into(),
+        );
+    }
     pmi.notes = r.notes;
-    pmi
+    Ok(pmi)
 }
 
 /// A characteristic nominal being read: its id, name, node, definition and the feature
@@ -371,12 +400,18 @@ impl Reader<'_> {
         all.into_iter().collect()
     }
 
-    /// The faces of a feature nominal (through compound features), noting one that
-    /// names nothing on the part.
+    /// The faces of a feature nominal (through compound features, walked by
+    /// [`refs::reachable`] and remembered by id), noting one that names nothing on the
+    /// part. A circle of features is the document's error ([`Reader::error`]).
     fn feature_faces(&mut self, id: u64, who: &str) -> BTreeSet<usize> {
-        let mut out = BTreeSet::new();
-        let mut seen = BTreeSet::new();
-        self.collect(id, &mut out, &mut seen);
+        let out = match self.features.get(&id) {
+            Some(faces) => faces.clone(),
+            None => {
+                let faces = self.walk_feature(id);
+                self.features.insert(id, faces.clone());
+                faces
+            }
+        };
         if out.is_empty() {
             self.notes.push(format!(
                 "{who}: feature {id} is linked to no face of the part"
@@ -385,27 +420,39 @@ impl Reader<'_> {
         out
     }
 
-    fn collect(&self, id: u64, out: &mut BTreeSet<usize>, seen: &mut BTreeSet<u64>) {
-        if !seen.insert(id) {
-            return;
-        }
-        let Some(n) = self.d.ids.get(&id) else {
-            return;
+    fn walk_feature(&mut self, id: u64) -> BTreeSet<usize> {
+        let next = |n: u64| -> Vec<u64> {
+            if self.face_index.contains_key(&n) || self.edge_faces.contains_key(&n) {
+                return Vec::new();
+            }
+            let Some(node) = self.d.ids.get(&n) else {
+                return Vec::new();
+            };
+            let mut ids = Doc::id_list(node, "EntityInternalIds");
+            ids.extend(Doc::id_list(node, "FeatureNominalIds"));
+            ids
         };
-        if let Some(i) = self.face_index.get(&id) {
-            out.insert(*i);
-            return;
+        let line_of = |n: u64| self.d.ids.get(&n).map_or(0, |e| e.line);
+        let ids = match refs::reachable(id, next, line_of, &self.visits) {
+            Ok(Some(ids)) => ids,
+            Ok(None) => {
+                self.out_of_budget = true;
+                return BTreeSet::new();
+            }
+            Err(e) => {
+                self.error.get_or_insert(e);
+                return BTreeSet::new();
+            }
+        };
+        let mut out = BTreeSet::new();
+        for n in ids {
+            if let Some(i) = self.face_index.get(&n) {
+                out.insert(*i);
+            } else if let Some(fs) = self.edge_faces.get(&n) {
+                out.extend(fs.iter().copied());
+            }
         }
-        if let Some(fs) = self.edge_faces.get(&id) {
-            out.extend(fs.iter().copied());
-            return;
-        }
-        for e in Doc::id_list(n, "EntityInternalIds") {
-            self.collect(e, out, seen);
-        }
-        for f in Doc::id_list(n, "FeatureNominalIds") {
-            self.collect(f, out, seen);
-        }
+        out
     }
 
     /// A length value in millimetres, through its `linearUnit` attribute (else the

@@ -1,22 +1,30 @@
 //! A small element tree over quick-xml: names without their namespace prefix,
 //! attributes, text and the line each element starts on. QIF files are a few MB; the
 //! whole tree is kept, and elements are found by their `id` attribute.
+//!
+//! **Decision: a compact tree, bounded elements.** A file may be as large as the input
+//! limit, so an element costs a small constant: names are interned (one allocation per
+//! distinct name), attributes, children and text are boxed slices sized exactly. An
+//! element has at most [`MAX_ATTRIBUTES`] attributes (a QIF element has a handful) and
+//! duplicates are found by sorting (XML 1.0 §3.1 forbids them), not by comparing every
+//! pair; elements nest at most [`MAX_DEPTH`] deep.
 
+use crate::geometry::step::Name;
 use quick_xml::events::Event;
 use quick_xml::Reader;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// An element.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct Node {
     /// Local name (`Face`, not `q:Face`).
-    pub name: String,
+    pub name: Name,
     /// Attributes by local name, in file order.
-    pub attrs: Vec<(String, String)>,
+    pub attrs: Box<[(Name, Box<str>)]>,
     /// Child elements.
-    pub children: Vec<Node>,
+    pub children: Box<[Node]>,
     /// The text directly inside it, trimmed.
-    pub text: String,
+    pub text: Box<str>,
     /// 1-based line of its start tag.
     pub line: usize,
 }
@@ -26,8 +34,8 @@ impl Node {
     pub(crate) fn attr(&self, name: &str) -> Option<&str> {
         self.attrs
             .iter()
-            .find(|(k, _)| k == name)
-            .map(|(_, v)| v.as_str())
+            .find(|(k, _)| *k == name)
+            .map(|(_, v)| &**v)
     }
 
     /// The first child of this name.
@@ -47,7 +55,7 @@ impl Node {
 
     /// The text of the child at `path`.
     pub(crate) fn text_at(&self, path: &[&str]) -> Option<&str> {
-        self.at(path).map(|n| n.text.as_str())
+        self.at(path).map(|n| &*n.text)
     }
 
     /// Its `id` attribute as a number.
@@ -85,21 +93,63 @@ pub(crate) struct XmlError {
 /// cannot exhaust the stack.
 const MAX_DEPTH: usize = 200;
 
+/// Most attributes an element may have: a QIF element has a handful (the root a few
+/// namespace declarations more).
+pub(crate) const MAX_ATTRIBUTES: usize = 64;
+
+/// An element being read: its children and text grow until its end tag.
+struct Open {
+    name: Name,
+    attrs: Box<[(Name, Box<str>)]>,
+    children: Vec<Node>,
+    text: String,
+    line: usize,
+}
+
+impl Open {
+    fn close(self) -> Node {
+        Node {
+            name: self.name,
+            attrs: self.attrs,
+            children: self.children.into_boxed_slice(),
+            text: self.text.trim().into(),
+            line: self.line,
+        }
+    }
+}
+
+/// The names of a document, each stored once.
+#[derive(Default)]
+struct Names(HashSet<Name>);
+
+impl Names {
+    /// The local name of a qualified one (`q:Face` → `Face`).
+    fn local(&mut self, q: &[u8]) -> Name {
+        let s = String::from_utf8_lossy(q);
+        let local = s.rsplit(':').next().unwrap_or_default();
+        if let Some(n) = self.0.get(local) {
+            return n.clone();
+        }
+        let n = Name::new(local);
+        self.0.insert(n.clone());
+        n
+    }
+}
+
 /// Parses a document into its root element.
 pub fn parse(bytes: &[u8]) -> Result<Node, XmlError> {
-    let line_starts: Vec<usize> = std::iter::once(0)
-        .chain(
-            bytes
-                .iter()
-                .enumerate()
-                .filter(|(_, b)| **b == b'\n')
-                .map(|(i, _)| i + 1),
-        )
-        .collect();
+    let line_starts: Vec<usize> = std::iter::once(0).chain(line_breaks(bytes)).collect();
     let line_of = |pos: u64| line_starts.partition_point(|s| *s as u64 <= pos).max(1);
     let mut reader = Reader::from_reader(bytes);
     reader.config_mut().trim_text(false);
-    let mut stack: Vec<Node> = vec![Node::default()];
+    let mut names = Names::default();
+    let mut stack: Vec<Open> = vec![Open {
+        name: names.local(b""),
+        attrs: Box::new([]),
+        children: Vec::new(),
+        text: String::new(),
+        line: 1,
+    }];
     let mut buf = Vec::new();
     let err = |reader: &Reader<&[u8]>, message: String| XmlError {
         line: line_of(
@@ -119,20 +169,22 @@ pub fn parse(bytes: &[u8]) -> Result<Node, XmlError> {
                 if stack.len() > MAX_DEPTH {
                     return Err(err(&reader, "elements nest too deep".into()));
                 }
-                stack.push(element(&e, line_of(start)).map_err(|m| err(&reader, m))?);
+                let open = element(&e, line_of(start), &mut names).map_err(|m| err(&reader, m))?;
+                stack.push(open);
             }
             Event::Empty(e) => {
-                let node = element(&e, line_of(start)).map_err(|m| err(&reader, m))?;
+                let node = element(&e, line_of(start), &mut names).map_err(|m| err(&reader, m))?;
                 if let Some(top) = stack.last_mut() {
-                    top.children.push(node);
+                    top.children.push(node.close());
                 }
             }
             Event::End(_) => {
-                let mut node = stack.pop().unwrap_or_default();
-                node.text = node.text.trim().to_string();
-                match stack.last_mut() {
-                    Some(top) => top.children.push(node),
-                    None => return Err(err(&reader, "an end tag closes nothing".into())),
+                let node = match stack.pop() {
+                    Some(n) if !stack.is_empty() => n.close(),
+                    _ => return Err(err(&reader, "an end tag closes nothing".into())),
+                };
+                if let Some(top) = stack.last_mut() {
+                    top.children.push(node);
                 }
             }
             Event::Text(t) => {
@@ -170,40 +222,62 @@ pub fn parse(bytes: &[u8]) -> Result<Node, XmlError> {
         buf.clear();
     }
     if stack.len() > 1 {
-        let open = stack.last().map(|n| n.name.clone()).unwrap_or_default();
+        let open = stack.last().map(|n| n.name.to_string()).unwrap_or_default();
         return Err(XmlError {
             line: line_starts.len(),
             message: format!("the file ends inside <{open}>: it is cut short"),
         });
     }
-    let mut doc = stack.pop().unwrap_or_default();
-    match doc.children.len() {
-        1 => Ok(doc.children.remove(0)),
+    let mut roots = stack.pop().map(|d| d.children).unwrap_or_default();
+    match roots.len() {
+        1 => Ok(roots.remove(0)),
         0 => Err(XmlError {
             line: 1,
             message: "it holds no element".into(),
         }),
         _ => Err(XmlError {
-            line: doc.children[1].line,
+            line: roots[1].line,
             message: "it has more than one root element".into(),
         }),
     }
 }
 
-fn element(e: &quick_xml::events::BytesStart, line: usize) -> Result<Node, String> {
-    let local = |q: &[u8]| {
-        let s = String::from_utf8_lossy(q);
-        s.rsplit(':').next().unwrap_or_default().to_string()
-    };
+/// The offsets where lines after the first start.
+fn line_breaks(bytes: &[u8]) -> impl Iterator<Item = usize> + '_ {
+    bytes
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| **b == b'\n')
+        .map(|(i, _)| i + 1)
+}
+
+/// An element's start tag read: its local name and attributes, at most
+/// [`MAX_ATTRIBUTES`] of them and none twice.
+fn element(
+    e: &quick_xml::events::BytesStart,
+    line: usize,
+    names: &mut Names,
+) -> Result<Open, String> {
     let mut attrs = Vec::new();
-    for a in e.attributes() {
+    // quick-xml's own duplicate check compares each attribute with every earlier one.
+    for a in e.attributes().with_checks(false) {
+        if attrs.len() == MAX_ATTRIBUTES {
+            return Err(format!(
+                "an element has more than {MAX_ATTRIBUTES} attributes"
+            ));
+        }
         let a = a.map_err(|e| e.to_string())?;
         let v = a.unescape_value().map_err(|e| e.to_string())?;
-        attrs.push((local(a.key.as_ref()), v.into_owned()));
+        attrs.push((names.local(a.key.as_ref()), Box::<str>::from(v.as_ref())));
     }
-    Ok(Node {
-        name: local(e.name().as_ref()),
-        attrs,
+    let mut keys: Vec<&str> = attrs.iter().map(|(k, _)| k.as_str()).collect();
+    keys.sort_unstable();
+    if let Some(w) = keys.windows(2).find(|w| w[0] == w[1]) {
+        return Err(format!("an element has the attribute `{}` twice", w[0]));
+    }
+    Ok(Open {
+        name: names.local(e.name().as_ref()),
+        attrs: attrs.into_boxed_slice(),
         children: Vec::new(),
         text: String::new(),
         line,
@@ -234,7 +308,7 @@ mod tests {
         assert_eq!(d.name, "A");
         assert_eq!(d.attr("v"), Some("3"));
         let b = d.child("B").unwrap();
-        assert_eq!((b.text.as_str(), b.line, b.id()), ("1 2 & 3", 3, Some(7)));
+        assert_eq!((&*b.text, b.line, b.id()), ("1 2 & 3", 3, Some(7)));
         assert!(d.child("C").is_some());
     }
 

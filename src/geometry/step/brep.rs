@@ -2,12 +2,20 @@
 //! solids (and sheet bodies) in shell order, each with its exact surface, sense and
 //! bounds; edges with their curves; lengths in millimetres and angles in radians
 //! through the units of the representation that holds the solid.
+//!
+//! References whose depth the file decides (a shell wrapping a shell, a curve wrapping
+//! a curve) are followed through `refs::Trail` (circles are `step_cycle` errors);
+//! curves and surfaces are read once each and shared by every edge and face on them,
+//! and a face a shell lists twice is one face, so that the B-rep grows with the file,
+//! not with how often the file names an instance.
 
 use super::geom::{BSplineCurve, BSplineSurface, Curve, Frame, Knots, Surf};
 use super::p21::{Instance, Param, Record, P21};
+use super::refs::{Memo, Trail};
 use super::StepError;
 use crate::geometry::{P3, V3};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
 
 /// An edge: its end vertices, its curve, and whether it runs along the curve's sense.
 #[derive(Debug, Clone)]
@@ -68,6 +76,11 @@ struct Reader<'a> {
     angle: f64,
     edges: Vec<Edge>,
     edge_index: HashMap<u64, usize>,
+    /// Faces already read: a shell listing one again adds nothing.
+    seen_faces: HashSet<u64>,
+    trail: Trail,
+    curves: Memo<Curve>,
+    surfaces: Memo<Surf>,
 }
 
 /// Reads the B-rep of a parsed file.
@@ -92,6 +105,10 @@ pub fn read(f: &P21) -> Result<Brep, StepError> {
         angle,
         edges: Vec::new(),
         edge_index: HashMap::new(),
+        seen_faces: HashSet::new(),
+        trail: Trail::default(),
+        curves: Memo::default(),
+        surfaces: Memo::default(),
     };
     let mut faces = Vec::new();
     for &s in &solids {
@@ -379,11 +396,16 @@ impl<'a> Reader<'a> {
         let rec = &inst.records[0];
         if rec.name == "ORIENTED_CLOSED_SHELL" || rec.name == "ORIENTED_OPEN_SHELL" {
             let inner = self.reference(sh, rec, 2)?;
-            return self.shell(inner, sh, faces);
+            self.trail.enter(sh, inst.line)?;
+            let out = self.shell(inner, sh, faces);
+            self.trail.leave();
+            return out;
         }
         for fp in self.list(sh, rec, 1)? {
             let fid = self.ref_of(sh, fp)?;
-            faces.push(self.face(fid, sh)?);
+            if self.seen_faces.insert(fid) {
+                faces.push(self.face(fid, sh)?);
+            }
         }
         Ok(())
     }
@@ -476,7 +498,12 @@ impl<'a> Reader<'a> {
         Ok(self.edges.len() - 1)
     }
 
+    /// The curve `id`, read once ([`Reader::read_curve`]).
     fn curve(&self, id: u64, from: u64) -> Result<Curve, StepError> {
+        self.curves.get_or(id, || self.read_curve(id, from))
+    }
+
+    fn read_curve(&self, id: u64, from: u64) -> Result<Curve, StepError> {
         let inst = self.inst(id, Some(from))?;
         if inst.is("LINE") {
             return Ok(Curve::Line);
@@ -494,7 +521,9 @@ impl<'a> Reader<'a> {
             ));
         }
         if inst.is("B_SPLINE_CURVE_WITH_KNOTS") {
-            return self.bspline_curve(id, inst).map(Curve::BSpline);
+            return self
+                .bspline_curve(id, inst)
+                .map(|c| Curve::BSpline(Arc::new(c)));
         }
         for wrapper in [
             "TRIMMED_CURVE",
@@ -503,7 +532,8 @@ impl<'a> Reader<'a> {
             "INTERSECTION_CURVE",
         ] {
             if let Some(r) = inst.record(wrapper) {
-                return self.curve(self.reference(id, r, 1)?, id);
+                let inner = self.reference(id, r, 1)?;
+                return self.trail.follow(id, inst.line, || self.curve(inner, id));
             }
         }
         if let Some(r) = inst.record("POLYLINE") {
@@ -512,7 +542,7 @@ impl<'a> Reader<'a> {
                 .iter()
                 .map(|p| self.point(self.ref_of(id, p)?, id))
                 .collect::<Result<Vec<_>, _>>()?;
-            return Ok(Curve::Polyline(pts));
+            return Ok(Curve::Polyline(pts.into()));
         }
         Err(StepError::Unsupported {
             id,
@@ -615,7 +645,12 @@ impl<'a> Reader<'a> {
         })
     }
 
+    /// The surface `id`, read once ([`Reader::read_surface`]).
     fn surface(&self, id: u64, from: u64) -> Result<Surf, StepError> {
+        self.surfaces.get_or(id, || self.read_surface(id, from))
+    }
+
+    fn read_surface(&self, id: u64, from: u64) -> Result<Surf, StepError> {
         let inst = self.inst(id, Some(from))?;
         let frame = |r: &Record| self.frame(self.reference(id, r, 1)?, id);
         if let Some(r) = inst.record("PLANE") {
@@ -647,7 +682,7 @@ impl<'a> Reader<'a> {
         if inst.is("B_SPLINE_SURFACE_WITH_KNOTS") {
             return self
                 .bspline_surface(id, inst)
-                .map(|s| Surf::BSpline(Box::new(s)));
+                .map(|s| Surf::BSpline(Arc::new(s)));
         }
         Err(StepError::Unsupported {
             id,

@@ -7,6 +7,7 @@
 
 use crate::geometry::{P3, V3};
 use std::f64::consts::{FRAC_PI_2, TAU};
+use std::sync::Arc;
 
 /// A right-handed orthonormal frame (STEP's `AXIS2_PLACEMENT_3D`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,18 +64,40 @@ pub(crate) struct Knots {
 impl Knots {
     /// The knot vector from STEP's distinct knots and multiplicities; `None` when it
     /// does not fit `n` control points of this degree.
+    ///
+    /// The multiplicities are summed and checked against the `n + degree + 1` knots
+    /// the control points already read call for before anything is allocated from
+    /// them: a file's counts never size memory by themselves (a multiplicity of 10¹²
+    /// is refused, not expanded).
     pub fn new(degree: usize, mults: &[i64], values: &[f64], n: usize) -> Option<Knots> {
         if mults.len() != values.len() || degree == 0 || degree > MAX_DEGREE {
             return None;
         }
-        let mut knots = Vec::new();
+        let want = n.checked_add(degree + 1)?;
+        let mut total = 0usize;
+        for m in mults {
+            let m = usize::try_from(*m).ok().filter(|m| *m >= 1)?;
+            total = total.checked_add(m).filter(|t| *t <= want)?;
+        }
+        if total != want {
+            return None;
+        }
+        let mut knots = Vec::with_capacity(want);
         for (m, v) in mults.iter().zip(values) {
-            if *m < 1 {
-                return None;
-            }
             knots.extend(std::iter::repeat_n(*v, *m as usize));
         }
-        if knots.len() != n + degree + 1 || knots.windows(2).any(|w| w[1] < w[0]) {
+        Knots::checked(degree, knots)
+    }
+
+    /// A knot vector given in full (QIF writes it so): `None` unless it is
+    /// non-decreasing (no NaN), of a degree inspc evaluates, and long enough for the
+    /// `degree + 1` control points the degree needs at least (the caller checks it
+    /// against its own points).
+    pub fn checked(degree: usize, knots: Vec<f64>) -> Option<Knots> {
+        if degree == 0 || degree > MAX_DEGREE || knots.len() < 2 * (degree + 1) {
+            return None;
+        }
+        if knots.iter().any(|k| k.is_nan()) || knots.windows(2).any(|w| w[1] < w[0]) {
             return None;
         }
         Some(Knots { degree, knots })
@@ -222,10 +245,10 @@ pub(crate) enum Curve {
     Circle(Frame, f64),
     /// An ellipse: semi-axes along x and y.
     Ellipse(Frame, f64, f64),
-    /// A B-spline curve.
-    BSpline(BSplineCurve),
-    /// A polyline through these points.
-    Polyline(Vec<P3>),
+    /// A B-spline curve (shared: every edge on it holds the one read).
+    BSpline(Arc<BSplineCurve>),
+    /// A polyline through these points (shared likewise).
+    Polyline(Arc<[P3]>),
 }
 
 impl Curve {
@@ -298,8 +321,8 @@ pub enum Surf {
     Sphere(Frame, f64),
     /// A torus about z: major and minor radius.
     Torus(Frame, f64, f64),
-    /// A B-spline surface.
-    BSpline(Box<BSplineSurface>),
+    /// A B-spline surface (shared: every face on it holds the one read).
+    BSpline(Arc<BSplineSurface>),
 }
 
 impl Surf {
@@ -573,7 +596,7 @@ mod tests {
             let p = c.eval(i as f64 / 10.0);
             assert!((p.coords.norm() - 2.0).abs() < 1e-12);
         }
-        let t = Curve::BSpline(c.clone()).param(&c.eval(0.37));
+        let t = Curve::BSpline(Arc::new(c.clone())).param(&c.eval(0.37));
         assert!((t - 0.37).abs() < 1e-7);
     }
 }

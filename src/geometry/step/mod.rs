@@ -12,6 +12,11 @@
 //! instance number, never a silently missing face: a hole in the mesh would let the
 //! accessibility analysis see through the part.
 //!
+//! **Architecture Invariant:** a file costs in proportion to its size, whatever it
+//! holds: references are followed once each on a trail (`refs.rs`; a circle is
+//! `step_cycle`), nesting and counts are checked before they size anything, and the
+//! mesh stops at 2,000,000 triangles (`mesh_too_large`). The QIF reader keeps the same.
+//!
 //! **Decision: our own reader and tessellator, with spade for the triangulation.** The
 //! candidate stack (truck-stepio + truck-meshalgo) rejects the empty lists `()` most
 //! AP242 files hold (ruststep#256), fails on some faces and panics on small spheres;
@@ -36,9 +41,11 @@ pub(in crate::geometry) mod error;
 pub(super) mod geom;
 mod p21;
 pub mod pmi;
+mod refs;
 pub(super) mod tess;
 
 pub use error::StepError;
+pub(crate) use p21::Name;
 pub use tess::Resolution;
 
 use super::weld::{weld, RawMesh};
@@ -96,12 +103,14 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
     } else {
         0
     };
+    // The PMI links faces and edges, not the mesh: it is read (and a circle of its
+    // references found) before the faces are meshed.
+    let mut pmi = pmi::read(&file, &face_ids, &pmi_edges, b.unit_mm).map_err(MeshError::Step)?;
     b.faces.truncate(b.faces.len() - sheet_faces);
     let mesh = mesh_brep(&b, res, crate::model::CadKind::Step).map_err(|e| match e {
         MeshFailure::Faces(list) => MeshError::Step(StepError::Faces(list)),
         MeshFailure::Mesh(e) => e,
     })?;
-    let mut pmi = pmi::read(&file, &face_ids, &pmi_edges, b.unit_mm);
     locate_targets(&mut pmi, &mesh);
     Ok(CadPart {
         pmi,
@@ -127,7 +136,8 @@ pub(super) fn mesh_brep(
     res: Resolution,
     kind: crate::model::CadKind,
 ) -> Result<RawMesh, MeshFailure> {
-    let (soup, failures) = tess::tessellate(b, res);
+    let (soup, failures) =
+        tess::tessellate(b, res).map_err(|e| MeshFailure::Mesh(MeshError::TooLarge(e)))?;
     if !failures.is_empty() {
         return Err(MeshFailure::Faces(
             failures

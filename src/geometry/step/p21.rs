@@ -7,7 +7,8 @@
 
 use std::collections::HashMap;
 
-/// One parameter of an entity instance.
+/// One parameter of an entity instance. Kept small (24 bytes): a file's memory is
+/// mostly its parameters, so strings and lists are boxed slices and names interned.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Param {
     /// `$`: not given.
@@ -19,17 +20,74 @@ pub enum Param {
     /// A real.
     Real(f64),
     /// A string, with `''` and `\X\..` escapes left as written.
-    Str(String),
+    Str(Box<str>),
     /// An enumeration or boolean, `.T.` → `T`.
-    Enum(String),
+    Enum(Name),
     /// A reference `#id`.
     Ref(u64),
     /// A list `( ... )`.
-    List(Vec<Param>),
+    List(Box<[Param]>),
     /// A typed value such as `LENGTH_MEASURE(2.5)`.
-    Typed(String, Vec<Param>),
+    Typed(Box<Typed>),
     /// A binary `"..."`.
     Binary,
+}
+
+/// A typed parameter `NAME(params)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Typed {
+    /// The type, upper case.
+    pub name: Name,
+    /// Its parameters.
+    pub params: Box<[Param]>,
+}
+
+/// An upper-case name (entity type, enumeration value), interned per file: the same
+/// name costs one allocation however often the file writes it.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct Name(std::sync::Arc<str>);
+
+impl Name {
+    /// A name not interned (one of a kind).
+    pub(crate) fn new(text: &str) -> Name {
+        Name(text.into())
+    }
+
+    /// The name's text.
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+}
+
+impl std::ops::Deref for Name {
+    type Target = str;
+    fn deref(&self) -> &str {
+        &self.0
+    }
+}
+
+impl std::borrow::Borrow<str> for Name {
+    fn borrow(&self) -> &str {
+        &self.0
+    }
+}
+
+impl PartialEq<str> for Name {
+    fn eq(&self, other: &str) -> bool {
+        &*self.0 == other
+    }
+}
+
+impl PartialEq<&str> for Name {
+    fn eq(&self, other: &&str) -> bool {
+        &*self.0 == *other
+    }
+}
+
+impl std::fmt::Display for Name {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
 }
 
 impl Param {
@@ -38,7 +96,7 @@ impl Param {
         match self {
             Param::Real(x) => Some(*x),
             Param::Int(i) => Some(*i as f64),
-            Param::Typed(_, v) if v.len() == 1 => v[0].real(),
+            Param::Typed(t) if t.params.len() == 1 => t.params[0].real(),
             _ => None,
         }
     }
@@ -62,8 +120,8 @@ impl Param {
     /// A boolean or logical: `.T.` is true, `.F.` false.
     pub(crate) fn boolean(&self) -> Option<bool> {
         match self {
-            Param::Enum(e) if e == "T" => Some(true),
-            Param::Enum(e) if e == "F" => Some(false),
+            Param::Enum(e) if *e == "T" => Some(true),
+            Param::Enum(e) if *e == "F" => Some(false),
             _ => None,
         }
     }
@@ -89,16 +147,16 @@ impl Param {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Record {
     /// The entity type, upper case.
-    pub name: String,
+    pub name: Name,
     /// Its parameters.
-    pub params: Vec<Param>,
+    pub params: Box<[Param]>,
 }
 
 /// An entity instance: one record, or the several records of a complex instance.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Instance {
     /// The records; one for a simple instance.
-    pub records: Vec<Record>,
+    pub records: Box<[Record]>,
     /// The line its `#id` stands on (1-based).
     pub line: usize,
 }
@@ -117,7 +175,7 @@ impl Instance {
     /// The first record's type (for messages).
     pub(crate) fn type_name(&self) -> String {
         if self.records.len() == 1 {
-            self.records[0].name.clone()
+            self.records[0].name.to_string()
         } else {
             let names: Vec<&str> = self.records.iter().map(|r| r.name.as_str()).collect();
             format!("({})", names.join(" "))
@@ -145,10 +203,19 @@ pub struct SyntaxError {
     pub message: String,
 }
 
+/// How deep parameter lists may nest: deeper than any schema's aggregates (a B-spline
+/// surface's weights are two deep), shallow enough that the recursive descent below
+/// and the drop of the tree cannot exhaust the stack.
+pub(crate) const MAX_NESTING: usize = 32;
+
 struct Lexer<'a> {
     s: &'a [u8],
     i: usize,
     line: usize,
+    /// How many lists the parser is inside.
+    depth: usize,
+    /// The names read so far, each stored once.
+    names: std::collections::HashSet<Name>,
 }
 
 type Res<T> = Result<T, SyntaxError>;
@@ -215,7 +282,7 @@ impl<'a> Lexer<'a> {
         }
     }
 
-    fn keyword(&mut self) -> Res<String> {
+    fn keyword(&mut self) -> Res<Name> {
         self.skip()?;
         let start = self.i;
         while let Some(c) = self.s.get(self.i) {
@@ -231,7 +298,15 @@ impl<'a> Lexer<'a> {
                 None => self.err("expected a name, found the end of the file (is it truncated?)"),
             };
         }
-        Ok(String::from_utf8_lossy(&self.s[start..self.i]).to_ascii_uppercase())
+        // Only ASCII letters, digits, `_` and `-`: the bytes are UTF-8.
+        let text = std::str::from_utf8(&self.s[start..self.i]).unwrap_or_default();
+        let upper = text.to_ascii_uppercase();
+        if let Some(n) = self.names.get(upper.as_str()) {
+            return Ok(n.clone());
+        }
+        let n = Name(upper.into());
+        self.names.insert(n.clone());
+        Ok(n)
     }
 
     fn integer(&mut self) -> Res<u64> {
@@ -284,7 +359,7 @@ impl<'a> Lexer<'a> {
         }
     }
 
-    fn string(&mut self) -> Res<String> {
+    fn string(&mut self) -> Res<Box<str>> {
         let start_line = self.line;
         self.i += 1;
         let mut out = Vec::new();
@@ -311,7 +386,7 @@ impl<'a> Lexer<'a> {
                 }
             }
         }
-        Ok(String::from_utf8_lossy(&out).into_owned())
+        Ok(String::from_utf8_lossy(&out).into())
     }
 
     fn param(&mut self) -> Res<Param> {
@@ -347,15 +422,28 @@ impl<'a> Lexer<'a> {
             Some(c) if c.is_ascii_digit() || c == b'-' || c == b'+' => self.number(),
             Some(c) if c.is_ascii_alphabetic() || c == b'_' => {
                 let name = self.keyword()?;
-                Ok(Param::Typed(name, self.list()?))
+                let params = self.list()?;
+                Ok(Param::Typed(Box::new(Typed { name, params })))
             }
             Some(c) => self.err(format!("unexpected `{}` in a parameter list", c as char)),
             None => self.err("the file ends inside a parameter list (is it truncated?)"),
         }
     }
 
-    fn list(&mut self) -> Res<Vec<Param>> {
+    /// A parenthesised list, at most [`MAX_NESTING`] deep.
+    fn list(&mut self) -> Res<Box<[Param]>> {
         self.expect(b'(')?;
+        if self.depth >= MAX_NESTING {
+            return self.err(format!("parameter lists nest deeper than {MAX_NESTING}"));
+        }
+        self.depth += 1;
+        let items = self.items();
+        self.depth -= 1;
+        Ok(items?.into_boxed_slice())
+    }
+
+    /// A list's items after its `(`, up to and with its `)`.
+    fn items(&mut self) -> Res<Vec<Param>> {
         let mut items = Vec::new();
         if self.peek()? == Some(b')') {
             self.i += 1;
@@ -399,6 +487,8 @@ pub fn parse(bytes: &[u8]) -> Result<P21, SyntaxError> {
         s: bytes,
         i: 0,
         line: 1,
+        depth: 0,
+        names: std::collections::HashSet::new(),
     };
     if !lx.at_keyword("ISO-10303-21")? {
         return lx.err("not a STEP file: it does not start with `ISO-10303-21;`");
@@ -466,9 +556,9 @@ fn read_data(lx: &mut Lexer, out: &mut P21) -> Res<()> {
                         rs.push(lx.record()?);
                     }
                     lx.i += 1;
-                    rs
+                    rs.into_boxed_slice()
                 } else {
-                    vec![lx.record()?]
+                    Box::new([lx.record()?])
                 };
                 lx.expect(b';')?;
                 if out
@@ -520,7 +610,7 @@ mod tests {
         );
         let x = &f.instances[&3].records[0].params;
         assert_eq!(x[0].string(), Some("it's"));
-        assert_eq!(x[1], Param::List(vec![]));
+        assert_eq!(x[1], Param::List(Box::new([])));
         assert_eq!(x[2], Param::Null);
         assert_eq!(x[4].real(), Some(2.5));
     }

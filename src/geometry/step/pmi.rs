@@ -25,7 +25,10 @@
 
 use super::brep::unit_factor;
 use super::p21::{Instance, Param, P21};
+use super::refs::{Memo, Trail};
+use super::StepError;
 use crate::model::{Material, TolKind};
+use std::cell::Cell;
 use std::collections::{BTreeSet, HashMap};
 
 /// The PMI of a STEP file.
@@ -190,12 +193,25 @@ struct Links<'a> {
     limits_of: HashMap<u64, u64>,
     /// File length unit, mm (for a measure whose unit cannot be read).
     unit_mm: f64,
+    /// Datum references being read (a common datum lists others).
+    trail: Trail,
+    /// Datum reference compartments read.
+    compartments: Memo<Option<DatumRef>>,
+    /// How many more aspects the links may pass through ([`link_budget`]).
+    visits: Cell<usize>,
 }
 
 /// Reads the PMI of a parsed file whose faces (in numbering order) are `faces`; an
 /// aspect named by an edge is the edge's curved faces, or all its faces when none is
 /// curved (`edge_faces`).
-pub fn read(f: &P21, faces: &[u64], edge_faces: &HashMap<u64, Vec<usize>>, unit_mm: f64) -> Pmi {
+///
+/// A datum reference that lists itself (round any circle) is a `step_cycle` error.
+pub fn read(
+    f: &P21,
+    faces: &[u64],
+    edge_faces: &HashMap<u64, Vec<usize>>,
+    unit_mm: f64,
+) -> Result<Pmi, StepError> {
     let mut l = Links {
         f,
         face_index: faces.iter().enumerate().map(|(i, id)| (*id, i)).collect(),
@@ -209,6 +225,9 @@ pub fn read(f: &P21, faces: &[u64], edge_faces: &HashMap<u64, Vec<usize>>, unit_
         nominal_of: HashMap::new(),
         limits_of: HashMap::new(),
         unit_mm,
+        trail: Trail::default(),
+        compartments: Memo::default(),
+        visits: Cell::new(link_budget(f)),
     };
     let mut subject_of: HashMap<u64, u64> = HashMap::new();
     let mut shape_reps: Vec<(u64, u64)> = Vec::new();
@@ -295,21 +314,35 @@ pub fn read(f: &P21, faces: &[u64], edge_faces: &HashMap<u64, Vec<usize>>, unit_
         if inst.is("DATUM") {
             pmi.datums.push(l.datum(*id, &mut pmi.notes));
         } else if inst.is("GEOMETRIC_TOLERANCE") || KINDS.iter().any(|(n, _)| inst.is(n)) {
-            if let Some(t) = l.tolerance(*id, inst, &mut pmi.notes) {
+            if let Some(t) = l.tolerance(*id, inst, &mut pmi.notes)? {
                 pmi.tolerances.push(t);
             }
         } else if let Some(d) = l.dimension(*id, inst, &mut pmi.notes) {
             pmi.dimensions.push(d);
         }
     }
-    pmi
+    if l.visits.get() == 0 {
+        pmi.notes.push(format!(
+            "the PMI's links run through more than {} aspects in all: the rest are not followed, and what they link is missing",
+            link_budget(f)
+        ));
+    }
+    Ok(pmi)
+}
+
+/// How many aspects the links may pass through in all: a few times the file's
+/// instances, so that reading the PMI takes time in proportion to the file however
+/// its aspects name each other.
+fn link_budget(f: &P21) -> usize {
+    4 * f.order.len() + 10_000
 }
 
 /// The references in a usage's identified item: one, a list, or a typed set.
 fn collect_refs(p: &Param, out: &mut Vec<u64>) {
     match p {
         Param::Ref(r) => out.push(*r),
-        Param::List(v) | Param::Typed(_, v) => v.iter().for_each(|q| collect_refs(q, out)),
+        Param::List(v) => v.iter().for_each(|q| collect_refs(q, out)),
+        Param::Typed(t) => t.params.iter().for_each(|q| collect_refs(q, out)),
         _ => {}
     }
 }
@@ -322,8 +355,12 @@ impl Links<'_> {
         let mut out = BTreeSet::new();
         let mut stack = vec![aspect];
         while let Some(a) = stack.pop() {
-            if !seen.insert(a) || seen.len() > 10_000 {
+            if !seen.insert(a) {
                 continue;
+            }
+            match self.visits.get() {
+                0 => break,
+                n => self.visits.set(n - 1),
             }
             for item in self.usage.get(&a).into_iter().flatten() {
                 if let Some(i) = self.face_index.get(item) {
@@ -532,13 +569,21 @@ impl Links<'_> {
         Some((o, z, x))
     }
 
-    fn tolerance(&self, id: u64, inst: &Instance, notes: &mut Vec<String>) -> Option<GeoTolerance> {
+    fn tolerance(
+        &self,
+        id: u64,
+        inst: &Instance,
+        notes: &mut Vec<String>,
+    ) -> Result<Option<GeoTolerance>, StepError> {
         let kind = KINDS.iter().find(|(n, _)| inst.is(n)).map(|(_, k)| *k);
         // The common attributes: the GEOMETRIC_TOLERANCE record of a complex instance,
         // else the one record of a simple subtype.
-        let base = inst
+        let Some(base) = inst
             .record("GEOMETRIC_TOLERANCE")
-            .or_else(|| inst.records.first())?;
+            .or_else(|| inst.records.first())
+        else {
+            return Ok(None);
+        };
         let name = base
             .params
             .first()
@@ -555,7 +600,7 @@ impl Links<'_> {
             notes.push(format!(
                 "tolerance `{name}` (#{id}) has no value that can be read"
             ));
-            return None;
+            return Ok(None);
         };
         let faces = self.faces_at(&base.params, 3);
         let mut systems = Vec::new();
@@ -571,7 +616,7 @@ impl Links<'_> {
                 .into_iter()
                 .for_each(|p| collect_refs(p, &mut systems));
         }
-        let datums = self.datum_frame(&systems);
+        let datums = self.datum_frame(&systems)?;
         let mut material = None;
         let mut other = Vec::new();
         if let Some(r) = inst.record("GEOMETRIC_TOLERANCE_WITH_MODIFIERS") {
@@ -597,7 +642,7 @@ impl Links<'_> {
                 "tolerance `{name}` (#{id}) states no type (a bare GEOMETRIC_TOLERANCE)"
             ));
         }
-        Some(GeoTolerance {
+        Ok(Some(GeoTolerance {
             id,
             name,
             kind,
@@ -610,12 +655,12 @@ impl Links<'_> {
             faces,
             composite_of: self.composite.get(&id).copied(),
             unequal_mm,
-        })
+        }))
     }
 
     /// The compartments of the datum systems (or old-style datum references) a
     /// tolerance names, primary first.
-    fn datum_frame(&self, systems: &[u64]) -> Vec<DatumRef> {
+    fn datum_frame(&self, systems: &[u64]) -> Result<Vec<DatumRef>, StepError> {
         let mut out = Vec::new();
         let mut precedence = Vec::new();
         for &s in systems {
@@ -624,10 +669,8 @@ impl Links<'_> {
             };
             if let Some(r) = inst.record("DATUM_SYSTEM") {
                 for c in r.params.get(4).and_then(Param::list).unwrap_or(&[]) {
-                    if let Some(c) = c.reference().and_then(|c| self.f.instances.get(&c)) {
-                        if let Some(d) = self.compartment(c) {
-                            out.push(d);
-                        }
+                    if let Some(d) = c.reference().map(|c| self.compartment(c)).transpose()? {
+                        out.extend(d);
                     }
                 }
             } else if let Some(r) = inst.record("DATUM_REFERENCE") {
@@ -648,22 +691,37 @@ impl Links<'_> {
                         },
                     ));
                 }
-            } else if let Some(d) = self.compartment(inst) {
-                out.push(d);
+            } else {
+                out.extend(self.compartment(s)?);
             }
         }
         precedence.sort_by_key(|(p, _)| *p);
         out.extend(precedence.into_iter().map(|(_, d)| d));
-        out
+        Ok(out)
     }
 
-    /// A datum reference compartment (or element): its datum or common datums and
-    /// modifiers.
-    fn compartment(&self, inst: &Instance) -> Option<DatumRef> {
-        let r = inst
+    /// A datum reference compartment (or element) `id`: its datum or common datums
+    /// and modifiers, read once; `None` when it is none or names no datum. A common
+    /// datum lists further elements: followed on the trail, so one that lists itself
+    /// is a `step_cycle` error.
+    fn compartment(&self, id: u64) -> Result<Option<DatumRef>, StepError> {
+        let Some(inst) = self.f.instances.get(&id) else {
+            return Ok(None);
+        };
+        self.compartments.get_or(id, || {
+            self.trail
+                .follow(id, inst.line, || self.read_compartment(inst))
+        })
+    }
+
+    fn read_compartment(&self, inst: &Instance) -> Result<Option<DatumRef>, StepError> {
+        let Some(r) = inst
             .record("DATUM_REFERENCE_COMPARTMENT")
             .or_else(|| inst.record("DATUM_REFERENCE_ELEMENT"))
-            .or_else(|| inst.record("GENERAL_DATUM_REFERENCE"))?;
+            .or_else(|| inst.record("GENERAL_DATUM_REFERENCE"))
+        else {
+            return Ok(None);
+        };
         let mut d = DatumRef {
             letters: Vec::new(),
             material: None,
@@ -676,7 +734,7 @@ impl Links<'_> {
                 let mut elements = Vec::new();
                 collect_refs(p, &mut elements);
                 for e in elements {
-                    if let Some(sub) = self.f.instances.get(&e).and_then(|e| self.compartment(e)) {
+                    if let Some(sub) = self.compartment(e)? {
                         d.letters.extend(sub.letters);
                         d.material = d.material.or(sub.material);
                         d.other.extend(sub.other);
@@ -690,7 +748,11 @@ impl Links<'_> {
             collect_enums(p, &mut modifiers);
         }
         sort_modifiers(&modifiers, &mut d.material, &mut d.other);
-        (!d.letters.is_empty()).then_some(d)
+        // An element named twice is one datum: the lists stay as long as the file's
+        // distinct letters, however the elements share each other.
+        first_of_each(&mut d.letters);
+        first_of_each(&mut d.other);
+        Ok((!d.letters.is_empty()).then_some(d))
     }
 
     fn letter(&self, datum: u64) -> Option<String> {
@@ -810,7 +872,7 @@ impl Links<'_> {
         })?;
         let value = r.params[0].real()?;
         let kind = match &r.params[0] {
-            Param::Typed(k, _) => k.as_str(),
+            Param::Typed(t) => t.name.as_str(),
             _ => "",
         };
         let unit = r.params[1]
@@ -844,10 +906,17 @@ fn sort_modifiers(modifiers: &[String], material: &mut Option<Material>, other: 
 /// The enumerations in a modifier list (`SIMPLE_DATUM_REFERENCE_MODIFIER(.X.)`).
 fn collect_enums(p: &Param, out: &mut Vec<String>) {
     match p {
-        Param::Enum(e) => out.push(e.clone()),
-        Param::List(v) | Param::Typed(_, v) => v.iter().for_each(|q| collect_enums(q, out)),
+        Param::Enum(e) => out.push(e.to_string()),
+        Param::List(v) => v.iter().for_each(|q| collect_enums(q, out)),
+        Param::Typed(t) => t.params.iter().for_each(|q| collect_enums(q, out)),
         _ => {}
     }
+}
+
+/// Keeps the first of each repeated string, in order.
+fn first_of_each(v: &mut Vec<String>) {
+    let mut seen = std::collections::HashSet::new();
+    v.retain(|s| seen.insert(s.clone()));
 }
 
 /// A converted value rounded to 1e-9 of its unit, so that 0.015 in reads 0.381 mm.

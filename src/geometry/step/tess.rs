@@ -27,6 +27,7 @@
 
 use super::brep::{Bound, Brep, Edge, Face};
 use super::geom::{unwrap_near, Curve, Surf};
+use crate::geometry::weld::MAX_TRIANGLES;
 use crate::geometry::{P3, V3};
 use rayon::prelude::*;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation};
@@ -67,36 +68,59 @@ pub(crate) struct FaceFailure {
     pub reason: String,
 }
 
-/// Tessellates every face; the failures are every face that could not be meshed.
-pub(crate) fn tessellate(b: &Brep, res: Resolution) -> (Soup, Vec<FaceFailure>) {
-    let edges = edge_polylines(b, res);
+/// How many faces or edges are meshed side by side before the totals are checked: the
+/// check falls at the same place for any thread count.
+const BATCH: usize = 64;
+
+/// The most points one face's bounds may have, and the most it may gain inside.
+const MAX_FACE_POINTS: usize = 200_000;
+
+/// Tessellates every face; the failures are every face that could not be meshed. An
+/// error, before the work grows past it, when the part needs more than
+/// [`MAX_TRIANGLES`] triangles (or its edges more points): the mesh of a file is
+/// bounded whatever its curves and faces ask for.
+pub(crate) fn tessellate(b: &Brep, res: Resolution) -> Result<(Soup, Vec<FaceFailure>), String> {
+    let edges = edge_polylines(b, res)?;
     let mut soup = Soup::default();
     let mut failures = Vec::new();
-    // Faces are meshed in parallel and gathered in their order: the soup is the same for
-    // any thread count.
-    let meshes: Vec<_> = b
-        .faces
-        .par_iter()
-        .map(|face| face_mesh(face, &edges, res))
-        .collect();
-    for ((index, face), mesh) in b.faces.iter().enumerate().zip(meshes) {
-        match mesh {
-            Ok(tris) => {
-                for t in tris {
-                    let base = soup.positions.len();
-                    soup.positions.extend(t.iter().map(|p| [p.x, p.y, p.z]));
-                    soup.triangles.push([base, base + 1, base + 2]);
-                    soup.tri_face.push(index as u32);
+    // Faces are meshed in parallel batches and gathered in their order: the soup is the
+    // same for any thread count.
+    for (k, batch) in b.faces.chunks(BATCH).enumerate() {
+        let meshes: Vec<_> = batch
+            .par_iter()
+            .map(|face| face_mesh(face, &edges, res))
+            .collect();
+        for (j, (face, mesh)) in batch.iter().zip(meshes).enumerate() {
+            let index = k * BATCH + j;
+            match mesh {
+                Ok(tris) => {
+                    for t in tris {
+                        let base = soup.positions.len();
+                        soup.positions.extend(t.iter().map(|p| [p.x, p.y, p.z]));
+                        soup.triangles.push([base, base + 1, base + 2]);
+                        soup.tri_face.push(index as u32);
+                    }
                 }
+                Err(reason) => failures.push(FaceFailure {
+                    index,
+                    id: face.id,
+                    reason,
+                }),
             }
-            Err(reason) => failures.push(FaceFailure {
-                index,
-                id: face.id,
-                reason,
-            }),
+        }
+        if soup.triangles.len() > MAX_TRIANGLES {
+            return Err(too_large(res));
         }
     }
-    (soup, failures)
+    Ok((soup, failures))
+}
+
+/// Why a part is not meshed: it needs too many triangles at this resolution.
+fn too_large(res: Resolution) -> String {
+    format!(
+        "meshing it to a {} mm chord takes more than {MAX_TRIANGLES} triangles",
+        res.chord_mm
+    )
 }
 
 /// The segment count for an arc of `sweep` radians on radius `r`.
@@ -116,7 +140,7 @@ fn edge_points(e: &Edge, res: Resolution) -> Vec<P3> {
     let mut pts = match &e.curve {
         Curve::Line => vec![e.start, e.end],
         Curve::Polyline(p) => {
-            let mut p = p.clone();
+            let mut p = p.to_vec();
             if !e.same_sense {
                 p.reverse();
             }
@@ -264,13 +288,23 @@ struct Loop {
     wraps: [i64; 2],
 }
 
-/// A face's bounds in its surface's parameter plane, unwrapped along each loop.
-fn face_loops(face: &Face, edges: &[Vec<P3>]) -> Vec<Loop> {
+/// A face's bounds in its surface's parameter plane, unwrapped along each loop; an
+/// error past [`MAX_FACE_POINTS`] points (a loop may name one edge many times).
+fn face_loops(face: &Face, edges: &[Vec<P3>]) -> Result<Vec<Loop>, String> {
     let s = &face.surface;
     let periods = [s.u_period(), s.v_period()];
     let mut loops = Vec::new();
     let mut hint = None;
+    let mut points = 0usize;
     for bound in &face.bounds {
+        if let Bound::Edges(list) = bound {
+            points += list.iter().map(|(e, _)| edges[*e].len()).sum::<usize>();
+            if points > MAX_FACE_POINTS {
+                return Err(format!(
+                    "its bounds have more than {MAX_FACE_POINTS} points"
+                ));
+            }
+        }
         let pts3: Vec<P3> = match bound {
             Bound::Vertex => continue,
             Bound::Edges(list) => {
@@ -296,12 +330,23 @@ fn face_loops(face: &Face, edges: &[Vec<P3>]) -> Vec<Loop> {
         }
         loops.push(param_loop(s, &pts3, periods, &mut hint));
     }
-    loops
+    Ok(loops)
 }
 
-/// Edges cut into polylines as [`tessellate`] cuts them.
-pub(crate) fn edge_polylines(b: &Brep, res: Resolution) -> Vec<Vec<P3>> {
-    b.edges.par_iter().map(|e| edge_points(e, res)).collect()
+/// Edges cut into polylines as [`tessellate`] cuts them; an error when they take more
+/// than [`MAX_TRIANGLES`] points in all (more than the largest mesh has triangles).
+pub(crate) fn edge_polylines(b: &Brep, res: Resolution) -> Result<Vec<Vec<P3>>, String> {
+    let mut out: Vec<Vec<P3>> = Vec::with_capacity(b.edges.len());
+    let mut points = 0usize;
+    for batch in b.edges.chunks(BATCH) {
+        let cut: Vec<Vec<P3>> = batch.par_iter().map(|e| edge_points(e, res)).collect();
+        points += cut.iter().map(Vec::len).sum::<usize>();
+        if points > MAX_TRIANGLES {
+            return Err(too_large(res));
+        }
+        out.extend(cut);
+    }
+    Ok(out)
 }
 
 /// Whether a face lies along its surface's natural normal, told from its bounds alone
@@ -311,7 +356,7 @@ pub(crate) fn edge_polylines(b: &Brep, res: Resolution) -> Vec<Vec<P3>> {
 pub(crate) fn bound_sense(face: &Face, edges: &[Vec<P3>]) -> Option<bool> {
     let s = &face.surface;
     let periods = [s.u_period(), s.v_period()];
-    let loops = face_loops(face, edges);
+    let loops = face_loops(face, edges).ok()?;
     let mut wraps = [0i64; 2];
     let mut area = 0.0;
     for l in &loops {
@@ -343,7 +388,7 @@ pub(crate) fn bound_sense(face: &Face, edges: &[Vec<P3>]) -> Option<bool> {
 fn face_mesh(face: &Face, edges: &[Vec<P3>], res: Resolution) -> Result<Vec<[P3; 3]>, String> {
     let s = &face.surface;
     let periods = [s.u_period(), s.v_period()];
-    let loops = face_loops(face, edges);
+    let loops = face_loops(face, edges)?;
     if loops.is_empty() {
         return Err("it has no bound with edges".into());
     }
@@ -430,7 +475,7 @@ fn bounds_triangulation(polygons: &[Vec<Pt>], scale: &ParamScale) -> Result<Cdt,
 /// from the surface or turns too much ([`refinement_points`]), until none does, after
 /// 24 rounds, or with an error past 200,000 points.
 fn refine(cdt: &mut Cdt, s: &Surf, scale: &ParamScale, res: Resolution) -> Result<(), String> {
-    let mut budget = 200_000usize;
+    let mut budget = MAX_FACE_POINTS;
     // Triangles (by their corners) already found close enough: a later round
     // leaves most of them as they are.
     let mut good: std::collections::HashSet<[usize; 3]> = std::collections::HashSet::new();
@@ -441,8 +486,7 @@ fn refine(cdt: &mut Cdt, s: &Surf, scale: &ParamScale, res: Resolution) -> Resul
         }
         if add.len() > budget {
             return Err(format!(
-                "it needs more than {} points inside to meet the chord tolerance",
-                200_000
+                "it needs more than {MAX_FACE_POINTS} points inside to meet the chord tolerance"
             ));
         }
         budget -= add.len();
@@ -772,33 +816,42 @@ fn along_pole(out: &mut Vec<Pt>, u0: f64, u1: f64, v: f64, xyz: P3) {
 }
 
 /// Drops repeated points and spikes (a segment walked out and straight back, as a seam
-/// edge used twice next to a pole).
+/// edge used twice next to a pole), in one pass: each point is pushed on a stack that
+/// drops a repeat of its top and folds a spike back to its base; the ends are then
+/// joined round the loop the same way.
 fn dedup(pts: &mut Vec<Pt>) {
     let same =
         |a: &Pt, b: &Pt| (a.uv[0] - b.uv[0]).abs() < 1e-12 && (a.uv[1] - b.uv[1]).abs() < 1e-12;
-    let mut changed = true;
-    while changed && pts.len() > 2 {
-        changed = false;
-        let n = pts.len();
-        for i in 0..n {
-            let (a, b) = (&pts[i], &pts[(i + 1) % n]);
-            if same(a, b) {
-                pts.remove((i + 1) % n);
-                changed = true;
-                break;
-            }
-            let c = &pts[(i + 2) % n];
-            if n > 3 && same(a, c) {
-                // a → b → a: drop b and the second a.
-                let (j, k) = ((i + 1) % n, (i + 2) % n);
-                let (hi, lo) = (j.max(k), j.min(k));
-                pts.remove(hi);
-                pts.remove(lo);
-                changed = true;
-                break;
-            }
+    let mut out: Vec<Pt> = Vec::with_capacity(pts.len());
+    for p in pts.drain(..) {
+        if out.last().is_some_and(|l| same(l, &p)) {
+            continue;
+        }
+        if out.len() >= 2 && same(&out[out.len() - 2], &p) {
+            // a → b → a: drop b; the a on the stack stands for both.
+            out.pop();
+            continue;
+        }
+        out.push(p);
+    }
+    // Round the join: the last point repeating the first, or a spike across it.
+    loop {
+        let n = out.len();
+        if n <= 2 {
+            break;
+        }
+        if same(&out[n - 1], &out[0]) {
+            out.pop();
+        } else if n > 3 && same(&out[n - 2], &out[0]) {
+            out.truncate(n - 2);
+        } else if n > 3 && same(&out[n - 1], &out[1]) {
+            out.pop();
+            out.remove(0);
+        } else {
+            break;
         }
     }
+    *pts = out;
 }
 
 /// Turns the face's loops into closed polygons of the parameter plane: ordinary loops
@@ -1000,7 +1053,7 @@ mod sense_tests {
             };
             let f = super::super::p21::parse(&bytes).unwrap();
             let b = super::super::brep::read(&f).unwrap();
-            let edges = edge_polylines(&b, super::super::RESOLUTION);
+            let edges = edge_polylines(&b, super::super::RESOLUTION).unwrap();
             let mut told = 0;
             for (i, face) in b.faces.iter().enumerate() {
                 if let Some(s) = bound_sense(face, &edges) {
