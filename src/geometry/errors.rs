@@ -104,6 +104,18 @@ pub enum GeometryError {
         path: String,
         reason: String,
     },
+    #[error("the part in `{path}` spans {metres} m: no CMM measures a part over 10 m")]
+    #[diagnostic(
+        code(insp::geometry::part_too_large),
+        help("a part this size is a wrong length unit in the file (it says `{unit}`), or coordinates off by powers of ten; re-export the part in millimetres or inches")
+    )]
+    PartTooLarge {
+        #[label("this CAD file")]
+        span: Span,
+        path: String,
+        metres: String,
+        unit: String,
+    },
     #[error("the boolean operations of part `{part}` failed: {reason}")]
     #[diagnostic(code(insp::geometry::boolean_failed), help("check that every operation overlaps the stock and that no two operations touch in a single edge or point"))]
     BooleanFailed {
@@ -177,6 +189,7 @@ crate::diag::located!(GeometryError {
     FixtureMissesPart,
     SeveralBodies,
     MeshTooLarge,
+    PartTooLarge,
     BooleanFailed,
     MissesPart,
     FaceGone,
@@ -197,6 +210,13 @@ pub enum MeshError {
     NotClosed(String),
     /// Over the size limit.
     TooLarge(String),
+    /// A CAD part larger than any CMM measures.
+    Extent {
+        /// The diagonal of its box (mm).
+        span_mm: f64,
+        /// The file's length unit, as named.
+        unit: String,
+    },
     /// A STEP file that cannot be read or meshed.
     Step(super::step::error::StepError),
     /// A QIF file that cannot be read or meshed.
@@ -217,6 +237,12 @@ impl MeshError {
                 vec![GeometryError::MeshNotClosed { span, path, reason }]
             }
             MeshError::TooLarge(reason) => vec![GeometryError::MeshTooLarge { span, path, reason }],
+            MeshError::Extent { span_mm, unit } => vec![GeometryError::PartTooLarge {
+                span,
+                path,
+                metres: crate::model::fmt_num((span_mm / 1000.0 * 10.0).round() / 10.0),
+                unit,
+            }],
             MeshError::Step(e) => e
                 .one_per_face()
                 .into_iter()

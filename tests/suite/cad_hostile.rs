@@ -18,6 +18,7 @@ fn outcome(r: Result<step::CadPart, MeshError>) -> String {
         Err(MeshError::Qif(e)) => e.code().map(|c| c.to_string()).unwrap_or_default(),
         Err(MeshError::TooLarge(_)) => "insp::geometry::mesh_too_large".into(),
         Err(MeshError::NotClosed(_)) => "insp::geometry::mesh_not_closed".into(),
+        Err(MeshError::Extent { .. }) => "insp::geometry::part_too_large".into(),
         Err(e) => format!("{e:?}"),
     }
 }
@@ -256,4 +257,41 @@ fn qif_elements_and_counts_are_bounded() {
     assert_eq!(qif_code(twice.as_bytes()), "insp::geometry::qif_syntax");
     let nesting = format!("{}{}", "<a>".repeat(100_000), "</a>".repeat(100_000));
     assert_eq!(qif_code(nesting.as_bytes()), "insp::geometry::qif_syntax");
+}
+
+/// A part larger than any CMM measures is refused before it is meshed (meshing to an
+/// absolute chord costs more the larger the part): the NIST parts with their length
+/// unit scaled up by a prefix, and a circle of radius 1 in hectometres. The same files
+/// in their own unit read.
+#[test]
+fn parts_larger_than_a_cmm_are_refused_before_meshing() {
+    let hecto = step_edge_curve("#20=CIRCLE('',#8,1.);\n");
+    let hecto = String::from_utf8(hecto)
+        .unwrap()
+        .replace(".MILLI.", ".HECTO.");
+    assert_eq!(
+        step_code(hecto.as_bytes()),
+        "insp::geometry::part_too_large"
+    );
+    let ctc = std::fs::read_to_string("../shared/parts/nist_ctc_01_asme1_ap242-e1.stp")
+        .expect("the NIST parts beside the repository");
+    for prefix in [".KILO.", ".HECTO.", ".DECA."] {
+        let big = ctc.replace(
+            "SI_UNIT(.MILLI.,.METRE.)",
+            &format!("SI_UNIT({prefix},.METRE.)"),
+        );
+        assert_eq!(
+            step_code(big.as_bytes()),
+            "insp::geometry::part_too_large",
+            "{prefix}"
+        );
+    }
+    let qif = std::fs::read_to_string("../shared/parts/nist_ctc_01_asme1_ap242.qif").unwrap();
+    let km = qif.replacen(
+        "<UnitName>mm</UnitName>\n        <UnitConversion>\n          <Factor>0.001</Factor>",
+        "<UnitName>km</UnitName>\n        <UnitConversion>\n          <Factor>1000</Factor>",
+        1,
+    );
+    assert_ne!(km, qif, "the QIF file's linear unit was found");
+    assert_eq!(qif_code(km.as_bytes()), "insp::geometry::part_too_large");
 }

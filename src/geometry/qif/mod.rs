@@ -154,6 +154,7 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
     let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
     let edge_faces: HashMap<u64, Vec<usize>> = step::edge_faces(&b);
     let pmi = pmi::read(&doc, &root, &face_ids, &edge_faces).map_err(q)?;
+    step::check_extent(&b)?;
     let shell = orient(&mut b, res)?;
     let mesh_of = |b: &step::brep::Brep| {
         step::mesh_brep(b, res, crate::model::CadKind::Qif).map_err(|e| match e {

@@ -49,7 +49,7 @@ pub(crate) use p21::Name;
 pub use tess::Resolution;
 
 use super::weld::{weld, RawMesh};
-use super::{Surface, P3};
+use super::{Surface, P3, V3};
 use crate::geometry::errors::MeshError;
 use std::collections::{BTreeSet, HashMap};
 
@@ -94,6 +94,7 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
         })
     })?;
     let mut b = brep::read(&file).map_err(MeshError::Step)?;
+    check_extent(&b)?;
     // The PMI may name sheet faces: it is read against every face, the mesh made of the
     // solid's.
     let face_ids: Vec<u64> = b.faces.iter().map(|f| f.id).collect();
@@ -119,6 +120,65 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
         unit: (b.unit_name, b.unit_mm),
         sheet_faces,
     })
+}
+
+/// Refuses a B-rep larger than any CMM measures ([`crate::model::MAX_LENGTH_MM`], the
+/// bound the spec's own lengths have) before anything is meshed: meshing works to an
+/// absolute chord, so its cost grows with the part's size, and a part 100 km across is a
+/// file whose length unit is wrong (a prefix off by 10⁵), not a part to inspect.
+pub(super) fn check_extent(b: &brep::Brep) -> Result<(), MeshError> {
+    let span_mm = extent(b);
+    if span_mm > crate::model::MAX_LENGTH_MM {
+        return Err(MeshError::Extent {
+            span_mm,
+            unit: b.unit_name.clone(),
+        });
+    }
+    Ok(())
+}
+
+/// The diagonal of a box holding every edge of the B-rep (its vertices, a circle's or
+/// ellipse's whole round, a B-spline's control points, a polyline's points) and every
+/// sphere or torus a face lies on (mm); infinite when a coordinate is not finite, 0 for
+/// a B-rep without edges.
+fn extent(b: &brep::Brep) -> f64 {
+    let (mut lo, mut hi) = (
+        P3::from(V3::repeat(f64::INFINITY)),
+        P3::from(V3::repeat(f64::NEG_INFINITY)),
+    );
+    let mut add = |p: &P3, r: f64| {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k] - r);
+            hi[k] = hi[k].max(p[k] + r);
+        }
+    };
+    for e in &b.edges {
+        add(&e.start, 0.0);
+        add(&e.end, 0.0);
+        match &e.curve {
+            geom::Curve::Circle(f, r) => add(&f.o, r.abs()),
+            geom::Curve::Ellipse(f, a, c) => add(&f.o, a.abs().max(c.abs())),
+            geom::Curve::BSpline(c) => c.points.iter().for_each(|p| add(p, 0.0)),
+            geom::Curve::Polyline(pts) => pts.iter().for_each(|p| add(p, 0.0)),
+            geom::Curve::Line => {}
+        }
+    }
+    for f in &b.faces {
+        match &f.surface {
+            geom::Surf::Sphere(fr, r) => add(&fr.o, r.abs()),
+            geom::Surf::Torus(fr, big, small) => add(&fr.o, big.abs() + small.abs()),
+            _ => {}
+        }
+    }
+    let d = hi - lo;
+    if d.iter().any(|x| x.is_nan()) {
+        return f64::INFINITY;
+    }
+    // Nothing added (a face without edges): no extent to speak of.
+    if d.iter().any(|&x| x < 0.0) {
+        return 0.0;
+    }
+    d.norm()
 }
 
 /// Why a B-rep could not be meshed.
