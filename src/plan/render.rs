@@ -94,7 +94,16 @@ impl<'a> Names<'a> {
         face: &dyn Fn(FaceId) -> String,
     ) -> String {
         use crate::model::FixtureKind;
-        let faces = |fs: &[FaceId]| fs.iter().map(|f| face(*f)).collect::<Vec<_>>().join(", ");
+        // Each name once: faces named by what holds them (a datum, a side) can share one.
+        let faces = |fs: &[FaceId]| {
+            let mut words: Vec<String> = Vec::new();
+            for w in fs.iter().map(|f| face(*f)) {
+                if !words.contains(&w) {
+                    words.push(w);
+                }
+            }
+            words.join(", ")
+        };
         match h {
             super::poses::Holder::Table { faces: fs } => format!("the table on {}", faces(fs)),
             super::poses::Holder::Fixture {

@@ -12,11 +12,33 @@
 //! page exactly as a desktop one, and the parts (up to about 12 k triangles) draw in
 //! milliseconds. A touch's cone is `access::approach_cone` (no D2) at N = 32, sampled
 //! on 600 directions of a Fibonacci sphere: a fraction of a second on a real part
-//! beside its build. Each setup opens from the side that shows most of the part (four
-//! yaws tried by drawing at 160 × 120: an angle plate hides the part from one side);
-//! page and image agree.
+//! beside its build.
+//!
+//! **Decisions a user sees** (issue 50; page and image agree):
+//! - *Camera.* Each setup opens from the side its measured faces face: the mean outward
+//!   normal of its touched points, turned 30° (to the side showing more of the part)
+//!   for a three-quarter view, 20° to 60° above the table; where the normals cancel,
+//!   the side that shows most of the part. Dragging keeps the camera 5° to 90° above
+//!   the table; the wheel zooms from 0.5 to 16 times the fitted view.
+//! - *Depth.* Paths and points are depth-tested against the part and fixture (the
+//!   page keeps a software depth buffer beside its painter's order; a point on a face
+//!   turned away is behind the solid); what is hidden is drawn at a quarter of its
+//!   colour (points as rings), so it stays findable.
+//! - *Colours.* Features take light colours ([`FEATURE_COLORS`], CIE L* above 60),
+//!   probes dark saturated ones ([`PROBE_COLORS`], L* under 40): they never meet.
+//! - *Hold text.* Faces are named as the spec names them (`datum A`, `feature top`,
+//!   `stock.bottom`; a face an import only numbered by the side it faces), each once,
+//!   wrapped, never cut off.
+//! - *Images.* Each PNG has a caption (plan, setup, which way up, how held, probes)
+//!   and a legend of its colours, in a built-in 5 × 7 font (`font.rs`).
+//!
+//! `window.__inspc` holds what the page drew (camera, colours, each point, hidden or
+//! not), for `tests/suite/view.rs`.
 
+mod caption;
+mod font;
 mod raster;
+mod words;
 
 pub use raster::png;
 
@@ -96,8 +118,10 @@ pub struct PointInfo {
 /// One setup.
 #[derive(Debug, Clone, Serialize)]
 pub struct SetupInfo {
-    /// What holds the part.
+    /// What holds the part, its faces named as the spec names them.
     pub held_by: String,
+    /// Which way up the part stands (`part +z up`).
+    pub up: String,
     /// Part frame → machine frame (rows).
     pub rotation: [[f32; 3]; 3],
     /// The table's height along the setup's up direction (part frame, mm).
@@ -106,8 +130,11 @@ pub struct SetupInfo {
     pub fixture: Mesh,
     /// Its (probe, orientation) groups in order.
     pub groups: Vec<GroupInfo>,
-    /// The camera's turn about the vertical that shows most of the part (degrees).
+    /// The default camera's turn about the vertical (degrees): from the side the
+    /// setup's measured faces face.
     pub yaw: f32,
+    /// The default camera's elevation above the table (degrees).
+    pub pitch: f32,
 }
 
 /// A triangle mesh.
@@ -137,16 +164,21 @@ pub struct GroupInfo {
     pub touches: Vec<(usize, String)>,
 }
 
-/// Feature colours: distinct, readable on white and grey (Tableau 10 and a second row).
-const PALETTE: &[&str] = &[
-    "#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7",
-    "#9c755f", "#17becf", "#8c564b", "#bcbd22", "#1f77b4", "#d62728", "#2ca02c", "#9467bd",
+/// Feature colours: light and soft (ColorBrewer's qualitative Set3 without its grey,
+/// which is the faces no feature names), so no feature can take a probe's colour.
+pub(crate) const FEATURE_COLORS: &[&str] = &[
+    "#8dd3c7", "#ffffb3", "#bebada", "#fb8072", "#80b1d3", "#fdb462", "#b3de69", "#fccde5",
+    "#bc80bd", "#ccebc5", "#ffed6f",
 ];
 
-/// Probe colours (darker, so paths stand out on the faces).
-const PROBE_COLORS: &[&str] = &[
-    "#d62728", "#1f3a93", "#2e7d32", "#6a1b9a", "#e65100", "#00695c",
+/// Probe colours: dark and saturated (CIE L* under 40, every feature colour's above
+/// 60), so a path or point reads against any face and never as a feature.
+pub(crate) const PROBE_COLORS: &[&str] = &[
+    "#1a1a1a", "#08519c", "#7a0177", "#006d2c", "#8c2d04", "#4a1486",
 ];
+
+/// The faces no feature names.
+pub(crate) const OTHER_FACES: &str = "#afb2b6";
 
 /// How many directions a cone is sampled at.
 const SPHERE: usize = 600;
@@ -173,7 +205,7 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
         .enumerate()
         .map(|(k, f)| Named {
             name: f.name.clone(),
-            color: PALETTE[k % PALETTE.len()].to_string(),
+            color: FEATURE_COLORS[k % FEATURE_COLORS.len()].to_string(),
         })
         .collect();
     let cmm = &model.cmms[plan.cmm.0];
@@ -209,7 +241,8 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
             .map(|gp| group_info(hlip, gp, &shapes[gp.probe.0], &cones))
             .collect();
         setups.push(SetupInfo {
-            held_by: names.holder(&s.holder, &s.up),
+            held_by: words::held_by(&names, &face_feature, s),
+            up: words::up_words(&s.up),
             rotation: s
                 .rotation
                 .map(|r| r.map(|x| ((x * 1e6).round() / 1e6) as f32)),
@@ -217,6 +250,7 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
             fixture: fixture_mesh(s),
             groups,
             yaw: 0.0,
+            pitch: 0.0,
         });
     }
     let mut scene = Scene {
@@ -240,9 +274,59 @@ pub fn scene(model: &crate::model::Model, data: &PartData, built: &Built) -> Sce
         sphere,
     };
     for k in 0..scene.setups.len() {
-        scene.setups[k].yaw = raster::best_yaw(&scene, k);
+        let (yaw, pitch) = default_camera(&scene, k);
+        scene.setups[k].yaw = yaw;
+        scene.setups[k].pitch = pitch;
     }
     scene
+}
+
+/// The default camera's elevation bounds (degrees): above the table, never straight
+/// down, where a part's sides vanish.
+const PITCH_MIN_DEG: f32 = 20.0;
+const PITCH_MAX_DEG: f32 = 60.0;
+
+/// The default camera's turn off the measured faces' mean direction (degrees): a
+/// three-quarter view, which shows depth where a head-on one shows a flat face.
+const YAW_OFFSET_DEG: f32 = 30.0;
+
+/// Setup `k`'s default camera (yaw, pitch in degrees): from the side its measured faces
+/// face — the mean outward normal of its touched points in the machine frame, turned
+/// [`YAW_OFFSET_DEG`] to whichever side shows more of the part, its elevation kept
+/// within [`PITCH_MIN_DEG`]..[`PITCH_MAX_DEG`]. Where the normals cancel or all point
+/// up, the side that shows most of the part ([`raster::best_yaw`]) at 30° (or the
+/// mean's elevation).
+fn default_camera(scene: &Scene, k: usize) -> (f32, f32) {
+    let s = &scene.setups[k];
+    let mut m = [0f32; 3];
+    let mut n = 0usize;
+    for g in &s.groups {
+        for (p, _) in &g.touches {
+            let v = raster::rotate(&s.rotation, &scene.points[*p].n);
+            (0..3).for_each(|i| m[i] += v[i]);
+            n += 1;
+        }
+    }
+    let m = m.map(|x| x / n.max(1) as f32);
+    let (h, len) = (
+        m[0].hypot(m[1]),
+        (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt(),
+    );
+    if len < 0.15 {
+        return (raster::best_yaw(scene, k, 30.0, &raster::YAWS), 30.0);
+    }
+    let pitch = m[2]
+        .atan2(h)
+        .to_degrees()
+        .clamp(PITCH_MIN_DEG, PITCH_MAX_DEG);
+    if h < 0.15 * len {
+        return (raster::best_yaw(scene, k, pitch, &raster::YAWS), pitch);
+    }
+    // The viewer sits at (-sin yaw, -cos yaw) across the table (raster::view).
+    let yaw = (-m[0]).atan2(-m[1]).to_degrees();
+    let turn = |d: f32| ((yaw + d + 540.0).rem_euclid(360.0) - 180.0).round();
+    let tries = [turn(-YAW_OFFSET_DEG), turn(YAW_OFFSET_DEG)];
+    (raster::best_yaw(scene, k, pitch, &tries), pitch)
 }
 
 /// Per face, the first feature (in the part's order) that names it.
@@ -442,4 +526,47 @@ fn script_json(json: &str) -> String {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// CIE L* of an sRGB colour.
+    fn lightness(hex: &str) -> f64 {
+        let [r, g, b] = caption::rgb8(hex).map(|v| {
+            let v = v as f64 / 255.0;
+            if v <= 0.04045 {
+                v / 12.92
+            } else {
+                ((v + 0.055) / 1.055).powf(2.4)
+            }
+        });
+        let y = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+        116.0
+            * if y > 0.008856 {
+                y.cbrt()
+            } else {
+                7.787 * y + 16.0 / 116.0
+            }
+            - 16.0
+    }
+
+    #[test]
+    fn probes_and_features_never_share_a_colour() {
+        for f in FEATURE_COLORS.iter().chain([&OTHER_FACES]) {
+            assert!(
+                lightness(f) > 60.0,
+                "feature colour {f}: L* {}",
+                lightness(f)
+            );
+        }
+        for p in PROBE_COLORS {
+            assert!(lightness(p) < 40.0, "probe colour {p}: L* {}", lightness(p));
+        }
+        let mut all: Vec<&str> = FEATURE_COLORS.iter().chain(PROBE_COLORS).copied().collect();
+        all.sort_unstable();
+        all.dedup();
+        assert_eq!(all.len(), FEATURE_COLORS.len() + PROBE_COLORS.len());
+    }
 }

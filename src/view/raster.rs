@@ -1,19 +1,31 @@
 //! Still images of a scene (`inspc view --png`): the page's default view of one setup,
 //! drawn in software — a z-buffer, flat shading, the table, the fixture, the path and the
-//! points — and written as PNG.
+//! points, depth-tested against the part with what it hides drawn faintly — under a
+//! caption and over a legend (`caption.rs`), and written as PNG.
 
+use super::caption;
+use super::font::Image;
 use super::Scene;
 
-/// The camera: turned about the vertical by the setup's yaw ([`best_yaw`]), looking
-/// 30° down.
-pub(crate) const PITCH_DEG: f32 = 30.0;
+/// The yaws tried for a setup whose measured faces face no one side (degrees): from
+/// the front-left, and round the part.
+pub(crate) const YAWS: [f32; 4] = [-35.0, 55.0, 145.0, -125.0];
 
-/// The yaws tried for each setup (degrees): from the front-left, and round the part.
-const YAWS: [f32; 4] = [-35.0, 55.0, 145.0, -125.0];
+/// How much of its colour a path or point hidden behind the part keeps.
+const HIDDEN_ALPHA: f32 = 0.25;
 
 type V = [f32; 3];
 
-fn mul(r: &[[f32; 3]; 3], p: &V) -> V {
+/// Where the camera looks from: its turn about the vertical and its elevation above the
+/// table (degrees).
+#[derive(Debug, Clone, Copy)]
+struct Camera {
+    yaw: f32,
+    pitch: f32,
+}
+
+/// A part-frame vector in the machine frame (`r`'s rows).
+pub(crate) fn rotate(r: &[[f32; 3]; 3], p: &V) -> V {
     [
         r[0][0] * p[0] + r[0][1] * p[1] + r[0][2] * p[2],
         r[1][0] * p[0] + r[1][1] * p[1] + r[1][2] * p[2],
@@ -34,20 +46,15 @@ fn cross(a: &V, b: &V) -> V {
 }
 
 fn hex(c: &str) -> [f32; 3] {
-    let v = u32::from_str_radix(c.trim_start_matches('#'), 16).unwrap_or(0x888888);
-    [
-        ((v >> 16) & 255) as f32,
-        ((v >> 8) & 255) as f32,
-        (v & 255) as f32,
-    ]
+    caption::rgb8(c).map(f32::from)
 }
 
 /// Machine frame → view: turned by the yaw about z, then seen from the front and above
-/// at the pitch; x right and y up on the screen, z towards the viewer. The page's
-/// `view` is the same.
-fn view(p: &V, yaw: f32) -> V {
-    let (sy, cy) = yaw.to_radians().sin_cos();
-    let (sp, cp) = PITCH_DEG.to_radians().sin_cos();
+/// at the pitch; x right and y up on the screen, z towards the viewer (who sits at
+/// (-sin yaw, -cos yaw) across the table). The page's `view` is the same.
+fn view(p: &V, cam: Camera) -> V {
+    let (sy, cy) = cam.yaw.to_radians().sin_cos();
+    let (sp, cp) = cam.pitch.to_radians().sin_cos();
     let x = cy * p[0] - sy * p[1];
     let y = sy * p[0] + cy * p[1];
     [x, sp * y + cp * p[2], -cp * y + sp * p[2]]
@@ -102,7 +109,24 @@ impl Canvas {
         }
     }
 
-    /// A line drawn over everything nearer than `lift` behind it.
+    /// A pixel of a path or point: where the part (or anything drawn) is nearer than
+    /// `depth`, blended faintly over it without taking its depth.
+    fn overlay(&mut self, x: i32, y: i32, depth: f32, c: [f32; 3]) {
+        if x < 0 || y < 0 || x as usize >= self.w || y as usize >= self.h {
+            return;
+        }
+        let k = y as usize * self.w + x as usize;
+        if depth >= self.z[k] {
+            self.plot(x, y, depth, c);
+            return;
+        }
+        for (i, v) in c.iter().enumerate() {
+            let old = self.rgb[3 * k + i] as f32;
+            self.rgb[3 * k + i] = (old + (v - old) * HIDDEN_ALPHA).clamp(0.0, 255.0) as u8;
+        }
+    }
+
+    /// A line drawn over everything nearer than `lift` behind it, faintly where hidden.
     fn line(&mut self, a: V, b: V, color: [f32; 3], lift: f32) {
         let steps = ((b[0] - a[0]).abs().max((b[1] - a[1]).abs()).ceil() as usize).max(1);
         for k in 0..=steps {
@@ -112,34 +136,76 @@ impl Canvas {
                 a[1] + (b[1] - a[1]) * t,
                 a[2] + (b[2] - a[2]) * t + lift,
             ];
-            self.plot(p[0].round() as i32, p[1].round() as i32, p[2], color);
+            self.overlay(p[0].round() as i32, p[1].round() as i32, p[2], color);
+        }
+    }
+
+    /// A touched point: a 5 × 5 square in the probe's colour ringed in white, depth-
+    /// tested like a line; `facing` is its normal's view z: a point on a face turned
+    /// away is behind the solid whatever the depth test says near an edge.
+    fn marker(&mut self, p: V, facing: f32, color: [f32; 3], lift: f32) {
+        let lift = if facing < 0.0 {
+            f32::NEG_INFINITY
+        } else {
+            lift
+        };
+        let (x, y) = (p[0] as i32, p[1] as i32);
+        for dx in -3..=3i32 {
+            for dy in -3..=3i32 {
+                let c = if dx.abs() == 3 || dy.abs() == 3 {
+                    [255.0; 3]
+                } else {
+                    color
+                };
+                self.overlay(x + dx, y + dy, p[2] + lift, c);
+            }
         }
     }
 }
 
-/// The PNG of setup `setup` (from 0) at `width` × `height` pixels, from the setup's
-/// yaw; `None` when the scene has no such setup.
+/// The PNG of setup `setup` (from 0) at `width` × `height` pixels: its caption on top,
+/// the view from the setup's default camera, its legend below; `None` when the scene
+/// has no such setup.
 pub fn png(scene: &Scene, setup: usize, width: u32, height: u32) -> Option<Vec<u8>> {
-    let yaw = scene.setups.get(setup)?.yaw;
-    let c = draw(scene, setup, width as usize, height as usize, yaw)?;
+    let s = scene.setups.get(setup)?;
+    let cam = Camera {
+        yaw: s.yaw,
+        pitch: s.pitch,
+    };
+    let (w, h) = (width as usize, height as usize);
+    let mut rgb = vec![248u8; w * h * 3];
+    let mut image = Image {
+        w,
+        h,
+        rgb: &mut rgb,
+    };
+    let top = caption::caption(&mut image, scene, setup);
+    let bottom = caption::legend(&mut image, scene, setup);
+    // The view keeps at least half the image, whatever the caption and legend hold.
+    let view_h = (h.saturating_sub(top + bottom)).max(h / 2);
+    let top = top.min(h - view_h);
+    let c = draw(scene, setup, w, view_h, cam)?;
+    rgb[3 * w * top..3 * w * (top + view_h)].copy_from_slice(&c.rgb);
     let mut out = Vec::new();
     {
         let mut enc = png::Encoder::new(&mut out, width, height);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
         let mut writer = enc.write_header().ok()?;
-        writer.write_image_data(&c.rgb).ok()?;
+        writer.write_image_data(&rgb).ok()?;
     }
     Some(out)
 }
 
-/// The yaw (degrees) from which most of the part shows in setup `setup`: a fixture
-/// beside the part (an angle plate) hides it from one side.
-pub(crate) fn best_yaw(scene: &Scene, setup: usize) -> f32 {
-    let mut best = (0, YAWS[0]);
-    for yaw in YAWS {
+/// The yaw of `yaws` (degrees) from which, at `pitch`, most of the part shows in setup
+/// `setup`: a fixture beside the part (an angle plate) hides it from one side. The
+/// first of equals.
+pub(crate) fn best_yaw(scene: &Scene, setup: usize, pitch: f32, yaws: &[f32]) -> f32 {
+    let mut best = (0, yaws.first().copied().unwrap_or(0.0));
+    for &yaw in yaws {
+        let cam = Camera { yaw, pitch };
         let shown =
-            draw(scene, setup, 160, 120, yaw).map_or(0, |c| c.part.iter().filter(|p| **p).count());
+            draw(scene, setup, 160, 120, cam).map_or(0, |c| c.part.iter().filter(|p| **p).count());
         if shown > best.0 {
             best = (shown, yaw);
         }
@@ -147,20 +213,20 @@ pub(crate) fn best_yaw(scene: &Scene, setup: usize) -> f32 {
     best.1
 }
 
-/// Draws setup `setup` from `yaw`.
-fn draw(scene: &Scene, setup: usize, w: usize, h: usize, yaw: f32) -> Option<Canvas> {
+/// Draws setup `setup` from `cam`.
+fn draw(scene: &Scene, setup: usize, w: usize, h: usize, cam: Camera) -> Option<Canvas> {
     let s = scene.setups.get(setup)?;
-    let view = |p: &V| view(p, yaw);
+    let view = |p: &V| view(p, cam);
     let r = &s.rotation;
-    let part: Vec<V> = scene.vertices.iter().map(|p| view(&mul(r, p))).collect();
+    let part: Vec<V> = scene.vertices.iter().map(|p| view(&rotate(r, p))).collect();
     let fixture: Vec<V> = s
         .fixture
         .vertices
         .iter()
-        .map(|p| view(&mul(r, p)))
+        .map(|p| view(&rotate(r, p)))
         .collect();
     // The table: a square under the part at the table's height, a third wider.
-    let m: Vec<V> = scene.vertices.iter().map(|p| mul(r, p)).collect();
+    let m: Vec<V> = scene.vertices.iter().map(|p| rotate(r, p)).collect();
     let lo = |k: usize| m.iter().map(|p| p[k]).fold(f32::INFINITY, f32::min);
     let hi = |k: usize| m.iter().map(|p| p[k]).fold(f32::NEG_INFINITY, f32::max);
     let (cx, cy) = ((lo(0) + hi(0)) / 2.0, (lo(1) + hi(1)) / 2.0);
@@ -212,7 +278,7 @@ fn draw(scene: &Scene, setup: usize, w: usize, h: usize, yaw: f32) -> Option<Can
     for t in &s.fixture.triangles {
         tri(&mut c, &fixture, t, [150.0, 140.0, 125.0]);
     }
-    let grey = [175.0, 178.0, 182.0];
+    let grey = hex(super::OTHER_FACES);
     c.drawing_part = true;
     for (k, t) in scene.triangles.iter().enumerate() {
         let face = scene.tri_face[k] as usize;
@@ -226,22 +292,18 @@ fn draw(scene: &Scene, setup: usize, w: usize, h: usize, yaw: f32) -> Option<Can
     let lift = 2.0 * scale;
     for g in &s.groups {
         let color = hex(&scene.probes[g.probe].color);
-        let path: Vec<V> = g.path.iter().map(|p| screen(&view(&mul(r, p)))).collect();
+        let path: Vec<V> = g
+            .path
+            .iter()
+            .map(|p| screen(&view(&rotate(r, p))))
+            .collect();
         for pair in path.windows(2) {
             c.line(pair[0], pair[1], color, lift);
         }
         for (k, _) in &g.touches {
-            let p = screen(&view(&mul(r, &scene.points[*k].p)));
-            for dx in -2..=2 {
-                for dy in -2..=2 {
-                    c.plot(
-                        p[0] as i32 + dx,
-                        p[1] as i32 + dy,
-                        p[2] + lift,
-                        [20.0, 20.0, 20.0],
-                    );
-                }
-            }
+            let point = &scene.points[*k];
+            let p = screen(&view(&rotate(r, &point.p)));
+            c.marker(p, view(&rotate(r, &point.n))[2], color, lift);
         }
     }
     Some(c)
