@@ -36,6 +36,8 @@ mod planner;
 mod rename;
 mod requests;
 mod rpc;
+#[cfg(test)]
+mod session_tests;
 mod stdlib;
 mod symbols;
 mod text;

@@ -168,6 +168,7 @@ fn renamed(
     for (file, mut here) in by_file {
         let f = checked.sources.get(file);
         here.sort_by_key(|s| std::cmp::Reverse(s.start));
+        here.dedup();
         let mut text = f.text.clone();
         for s in here {
             text.replace_range(s.range(), new_name);
