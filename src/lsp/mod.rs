@@ -31,7 +31,9 @@
 
 mod complete;
 mod diagnostics;
+mod documents;
 mod hover;
+mod lifecycle;
 mod planner;
 mod rename;
 mod requests;
@@ -49,8 +51,7 @@ use crate::source::{FileKind, FsWorld, World, WorldError};
 use crate::Checked;
 use crossbeam_channel::{select, Receiver, Sender};
 use lsp_types as lt;
-use planner::{PlanOutput, PlanRun};
-use rpc::{Code, Incoming};
+use planner::PlanRun;
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::io::{BufRead, Write};
@@ -89,7 +90,7 @@ where
     std::thread::spawn(move || transport::pump(input, &frames_tx));
     let mut server = Server::new(work);
     let events = server.events.clone();
-    let mut phase = Phase::Starting;
+    let mut phase = lifecycle::Phase::Starting;
     let outcome = loop {
         let end = select! {
             recv(frames) -> frame => server.frame(frame.unwrap_or(Frame::End), &mut phase),
@@ -111,42 +112,6 @@ where
     // Dropping the server kills its planners and removes its stdlib copy.
     drop(server);
     outcome
-}
-
-/// Where the server is in LSP's lifecycle.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Phase {
-    Starting,
-    Running,
-    ShuttingDown,
-}
-
-fn capabilities() -> lt::ServerCapabilities {
-    lt::ServerCapabilities {
-        text_document_sync: Some(lt::TextDocumentSyncCapability::Options(
-            lt::TextDocumentSyncOptions {
-                open_close: Some(true),
-                change: Some(lt::TextDocumentSyncKind::FULL),
-                save: Some(lt::TextDocumentSyncSaveOptions::SaveOptions(
-                    lt::SaveOptions {
-                        include_text: Some(false),
-                    },
-                )),
-                ..Default::default()
-            },
-        )),
-        hover_provider: Some(lt::HoverProviderCapability::Simple(true)),
-        definition_provider: Some(lt::OneOf::Left(true)),
-        references_provider: Some(lt::OneOf::Left(true)),
-        document_symbol_provider: Some(lt::OneOf::Left(true)),
-        rename_provider: Some(lt::OneOf::Left(true)),
-        document_formatting_provider: Some(lt::OneOf::Left(true)),
-        completion_provider: Some(lt::CompletionOptions {
-            trigger_characters: Some(vec![":".into(), " ".into()]),
-            ..Default::default()
-        }),
-        ..Default::default()
-    }
 }
 
 /// An open document.
@@ -315,82 +280,6 @@ impl Server {
         }
     }
 
-    /// Handles what the reader found; `Some` ends the server.
-    fn frame(&mut self, frame: Frame, phase: &mut Phase) -> Option<Result<(), String>> {
-        match frame {
-            Frame::Body(body) => self.message(rpc::classify(&body), phase),
-            Frame::TooLarge(len) => {
-                let why = format!(
-                    "a message of {len} bytes is over the {} MiB inspc reads; it was skipped unread",
-                    transport::BODY_LIMIT >> 20
-                );
-                eprintln!("inspc lsp: {why}");
-                // Its id was never read: JSON-RPC answers such a message with id null.
-                let answer = rpc::error(Value::Null, Code::InvalidRequest, why);
-                self.outbox.push(answer);
-                None
-            }
-            Frame::End if *phase == Phase::ShuttingDown => Some(Ok(())),
-            Frame::End => Some(Err(
-                "the client closed the stream without `shutdown` and `exit`".into(),
-            )),
-            Frame::Broken(transport::Broken(why)) => Some(Err(format!(
-                "{why}: the stream cannot be resynchronised, so the server stops"
-            ))),
-        }
-    }
-
-    /// Handles one message as LSP's lifecycle allows; `Some` ends the server.
-    fn message(&mut self, message: Incoming, phase: &mut Phase) -> Option<Result<(), String>> {
-        match message {
-            Incoming::Invalid(answer) => self.outbox.push(answer),
-            Incoming::Response => self.log("inspc: a response came, to no request".into()),
-            Incoming::Notification { method, .. } if method == "exit" => {
-                return Some(match phase {
-                    Phase::ShuttingDown => Ok(()),
-                    _ => Err("the client sent `exit` without `shutdown`".into()),
-                });
-            }
-            // Before `initialize` and after `shutdown`, notifications are dropped.
-            Incoming::Notification { method, params } if *phase == Phase::Running => {
-                if let Err(why) = self.notification(&method, params) {
-                    self.log(format!("inspc: ignored `{method}`: {why}"));
-                }
-            }
-            Incoming::Notification { .. } => {}
-            Incoming::Request { id, method, params } => {
-                let answer = match (*phase, method.as_str()) {
-                    (Phase::Starting, "initialize") => {
-                        *phase = Phase::Running;
-                        initialize_result()
-                    }
-                    (Phase::Starting, _) => Err((
-                        Code::ServerNotInitialized,
-                        "the server has not been initialized".into(),
-                    )),
-                    (Phase::Running, "initialize") => Err((
-                        Code::InvalidRequest,
-                        "`initialize` was already received".into(),
-                    )),
-                    (Phase::Running, "shutdown") => {
-                        *phase = Phase::ShuttingDown;
-                        Ok(Value::Null)
-                    }
-                    (Phase::Running, _) => self.answer(&method, params),
-                    (Phase::ShuttingDown, _) => Err((
-                        Code::InvalidRequest,
-                        "the server is shutting down: only `exit` is expected".into(),
-                    )),
-                };
-                self.outbox.push(match answer {
-                    Ok(v) => rpc::result(id, v),
-                    Err((code, why)) => rpc::error(id, code, why),
-                });
-            }
-        }
-        None
-    }
-
     fn overlay(&self) -> Overlay {
         Overlay {
             docs: Arc::new(
@@ -421,190 +310,4 @@ impl Server {
             .map(|p| canonical_path(self.work, &p))
             .ok_or_else(|| format!("`{}` is not a `file://` URI", uri.as_str()))
     }
-
-    /// Handles a notification; `Err` says why it was not acted on.
-    fn notification(&mut self, method: &str, params: Value) -> Result<(), String> {
-        use lt::notification::*;
-        match method {
-            DidOpenTextDocument::METHOD => {
-                let p: lt::DidOpenTextDocumentParams = parse(params)?;
-                let path = self.canonical(&p.text_document.uri)?;
-                let doc = Doc {
-                    uri: p.text_document.uri,
-                    text: LineIndex::new(p.text_document.text),
-                    version: p.text_document.version,
-                };
-                self.docs.insert(path.clone(), doc);
-                self.changed(&path);
-            }
-            DidChangeTextDocument::METHOD => {
-                let p: lt::DidChangeTextDocumentParams = parse(params)?;
-                let path = self.canonical(&p.text_document.uri)?;
-                let doc = self.docs.get_mut(&path).ok_or("the document is not open")?;
-                // Full sync: the last change is the whole text.
-                if let Some(c) = p.content_changes.into_iter().last() {
-                    doc.text = LineIndex::new(c.text);
-                }
-                doc.version = p.text_document.version;
-                self.changed(&path);
-            }
-            DidSaveTextDocument::METHOD => {
-                let p: lt::DidSaveTextDocumentParams = parse(params)?;
-                let path = self.canonical(&p.text_document.uri)?;
-                self.plan(&path)?;
-            }
-            DidCloseTextDocument::METHOD => {
-                let p: lt::DidCloseTextDocumentParams = parse(params)?;
-                let path = self.canonical(&p.text_document.uri)?;
-                self.docs.remove(&path);
-                self.analyses.remove(&path);
-                self.planning.remove(&path);
-                self.publish();
-            }
-            "initialized" => {}
-            // LSP 3.17: `$/` notifications may be ignored.
-            m if m.starts_with("$/") => {}
-            _ => return Err("inspc lsp does not handle it".into()),
-        }
-        Ok(())
-    }
-
-    /// A document's text changed: the front end now, the graphs in the background.
-    fn changed(&mut self, path: &Path) {
-        let world = self.overlay();
-        let front = Arc::new(crate::check(&world, &[path.to_path_buf()]));
-        let version = self.docs[path].version;
-        let root_parsed = !front
-            .diagnostics
-            .iter()
-            .any(|d| d.code().starts_with("insp::syntax::") && front.roots.contains(&d.file));
-        let a = self
-            .analyses
-            .entry(path.to_path_buf())
-            .or_insert_with(|| Analysis {
-                front: front.clone(),
-                parsed: None,
-                deep: None,
-                plan: None,
-            });
-        if root_parsed {
-            a.parsed = Some(front.clone());
-        }
-        a.front = front;
-        self.publish();
-        if let Some(graphs) = &self.graphs {
-            let _ = graphs.send(GraphJob {
-                root: path.to_path_buf(),
-                version,
-                world,
-            });
-        }
-    }
-
-    /// Starts planning a saved spec in a child process, stopping the one before.
-    fn plan(&mut self, path: &Path) -> Result<(), String> {
-        self.planning.remove(path);
-        let a = self.analyses.get(path).ok_or("the document is not open")?;
-        if a.front.has_errors() || a.front.model.plans.is_empty() || self.work != Work::Full {
-            return Ok(()); // nothing to plan
-        }
-        self.plan_runs += 1;
-        let text = self.docs[path].text.text().to_string();
-        let run = planner::start(path, text, self.plan_runs, self.events_tx.clone())
-            .map_err(|e| format!("could not start the planner: {e}"))?;
-        self.planning.insert(path.to_path_buf(), run);
-        Ok(())
-    }
-
-    fn event(&mut self, ev: Event) {
-        match ev {
-            Event::Graphed { root, deep } => {
-                let Some(a) = self.analyses.get_mut(&root) else {
-                    return;
-                };
-                if a.deep.as_ref().is_some_and(|d| d.version > deep.version) {
-                    return;
-                }
-                a.deep = Some(*deep);
-                self.publish();
-            }
-            Event::Planned {
-                root,
-                id,
-                text,
-                output,
-                seconds,
-            } => {
-                if self.planning.get(&root).map(|r| r.id) != Some(id) {
-                    return; // a newer save started another plan
-                }
-                self.planning.remove(&root);
-                let parsed = output.and_then(|o| {
-                    serde_json::from_str::<PlanOutput>(&o).map_err(|e| e.to_string())
-                });
-                self.planned(&root, text, parsed, seconds);
-            }
-        }
-    }
-
-    /// A plan's answer: logged, kept for hovers, its diagnostics published.
-    fn planned(
-        &mut self,
-        root: &Path,
-        text: String,
-        out: Result<PlanOutput, String>,
-        seconds: f64,
-    ) {
-        let name = root
-            .file_name()
-            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
-        let out = match out {
-            Ok(out) => out,
-            Err(e) => return self.log(format!("inspc: planning {name} failed: {e}")),
-        };
-        let measured: Vec<String> = out
-            .plans
-            .iter()
-            .map(|p| {
-                format!(
-                    "{}: {}/{} tolerances measured",
-                    p["plan"].as_str().unwrap_or("?"),
-                    p["summary"]["tolerances_measured"],
-                    p["summary"]["tolerances"]
-                )
-            })
-            .collect();
-        let measured = match measured.is_empty() {
-            true => "no plan".to_string(),
-            false => measured.join(", "),
-        };
-        self.log(format!(
-            "inspc: planned {name} in {seconds:.2} s; {measured}"
-        ));
-        if let Some(a) = self.analyses.get_mut(root) {
-            a.plan = Some(PlanResult {
-                text,
-                diagnostics: out.diagnostics,
-                plans: out.plans,
-            });
-        }
-        self.publish();
-    }
-}
-
-/// Notification parameters as their type.
-fn parse<P: serde::de::DeserializeOwned>(params: Value) -> Result<P, String> {
-    serde_json::from_value(params).map_err(|e| format!("invalid params: {e}"))
-}
-
-/// The answer to `initialize`: what the server can do, and who it is.
-fn initialize_result() -> Result<Value, rpc::Failure> {
-    let result = lt::InitializeResult {
-        capabilities: capabilities(),
-        server_info: Some(lt::ServerInfo {
-            name: "inspc".into(),
-            version: Some(env!("CARGO_PKG_VERSION").into()),
-        }),
-    };
-    serde_json::to_value(result).map_err(|e| (Code::InternalError, e.to_string()))
 }

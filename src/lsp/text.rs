@@ -8,7 +8,7 @@
 //! UTF-16 with a running sum of the difference, so either way is two binary searches
 //! and no walk over the text — a file with 100,000 diagnostics, even on one line, is
 //! converted in linear time (rust-analyzer's `line-index` crate works the same way).
-//! An open document keeps its index for its version ([`super::Doc`]); a file read
+//! An open document keeps its index for its version (`Doc`); a file read
 //! through the source map gets one per request or publication ([`FileLines`]).
 
 use crate::source::{FileId, SourceMap, Span};
