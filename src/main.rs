@@ -271,7 +271,8 @@ enum Command {
     /// hover, go to definition, references, symbols, completion, rename, formatting.
     Lsp {
         /// Plan FILE and print the result for the server (what the server runs on save,
-        /// in a child process it can stop).
+        /// in a child process it can stop); ends (code 3) when standard input ends, the
+        /// server's pipe, so it never outlives the server.
         #[arg(long, hide = true)]
         plan: Option<PathBuf>,
     },

@@ -12,6 +12,7 @@ pub mod io;
 mod world;
 
 pub(crate) use world::normalize as normalize_path;
+pub(crate) use world::too_large;
 pub use world::{FileKind, FsWorld, MemoryWorld, World, WorldError};
 
 use std::path::{Path, PathBuf};

@@ -21,7 +21,7 @@ pub enum FileKind {
 impl FileKind {
     /// The largest file of this kind inspc reads (bytes). Real specs are kilobytes, real
     /// meshes of the NIST parts a few megabytes, real programs well under a megabyte.
-    pub fn limit(self) -> u64 {
+    pub const fn limit(self) -> u64 {
         match self {
             FileKind::Spec => 8 << 20,
             FileKind::Mesh => 256 << 20,
@@ -130,7 +130,7 @@ impl World for MemoryWorld {
 }
 
 /// The error for a file over its kind's limit.
-fn too_large(len: u64, kind: FileKind) -> Result<(), WorldError> {
+pub(crate) fn too_large(len: u64, kind: FileKind) -> Result<(), WorldError> {
     if len > kind.limit() {
         return Err(WorldError(format!(
             "it is larger than the {} MiB inspc reads for a {} file",

@@ -8,6 +8,8 @@ use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
+mod hostile;
+
 /// How long any one answer may take before the test calls the server hung (not a timing
 /// assertion: the real figures are printed).
 const HUNG: Duration = Duration::from_secs(60);
@@ -24,13 +26,20 @@ struct Client {
 
 impl Client {
     fn start() -> Client {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_inspc"))
+        Client::start_with(|_| {})
+    }
+
+    /// A client of a server whose command `configure` adjusts (its environment, its
+    /// stderr), initialized.
+    fn start_with(configure: impl FnOnce(&mut Command)) -> Client {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_inspc"));
+        command
             .arg("lsp")
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .expect("start inspc lsp");
+            .stderr(Stdio::inherit());
+        configure(&mut command);
+        let mut child = command.spawn().expect("start inspc lsp");
         let stdin = child.stdin.take().unwrap();
         let stdout = child.stdout.take().unwrap();
         let (tx, messages) = std::sync::mpsc::channel();
@@ -72,9 +81,24 @@ impl Client {
     }
 
     fn send(&mut self, v: Value) {
-        let body = v.to_string();
+        self.send_body(&v.to_string());
+    }
+
+    /// Sends any text as one message's body.
+    fn send_body(&mut self, body: &str) {
         write!(self.stdin, "Content-Length: {}\r\n\r\n{body}", body.len()).unwrap();
         self.stdin.flush().unwrap();
+    }
+
+    /// The next response, whatever its id (notifications meanwhile are kept).
+    fn response(&mut self) -> Value {
+        loop {
+            let m = self.messages.recv_timeout(HUNG).expect("a response");
+            if m.get("method").is_none() {
+                return m;
+            }
+            self.seen.push(m);
+        }
     }
 
     fn notify(&mut self, method: &str, params: Value) {
