@@ -87,7 +87,7 @@ where
 {
     // One frame at a time: a fast client waits for the server, not its memory.
     let (frames_tx, frames) = crossbeam_channel::bounded(1);
-    std::thread::spawn(move || transport::pump(input, &frames_tx));
+    let reader = std::thread::spawn(move || transport::pump(input, &frames_tx));
     let mut server = Server::new(work);
     let events = server.events.clone();
     let mut phase = lifecycle::Phase::Starting;
@@ -111,6 +111,13 @@ where
     };
     // Dropping the server kills its planners and removes its stdlib copy.
     drop(server);
+    // The reader ends at its next frame once nobody receives. An in-memory stream's
+    // next frame comes at once, so it is joined and no thread outlives the call; a
+    // stdio server's may never come (stdin left open), so it is left to the process's end.
+    drop(frames);
+    if work == Work::FrontEnd || reader.is_finished() {
+        let _ = reader.join();
+    }
     outcome
 }
 
