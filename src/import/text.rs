@@ -31,44 +31,6 @@ pub(super) enum Place {
     Comment,
 }
 
-/// The words of the grammar's `kw_` rules and `block_kw` (a unit test reads them from
-/// `grammar/insp.pest`).
-const KEYWORDS: &[&str] = &[
-    "use",
-    "part",
-    "plan",
-    "hierarchy",
-    "required",
-    "units",
-    "stock",
-    "mesh",
-    "cut",
-    "add",
-    "face",
-    "feature",
-    "datum",
-    "frame",
-    "tolerance",
-    "group",
-    "segment",
-    "step_face",
-    "qif_face",
-    "select",
-    "prefer",
-    "forbid",
-    "sample",
-    "with",
-    "cmm",
-    "head",
-    "probe",
-    "stylus",
-    "body",
-    "extension",
-    "sampling",
-    "fixture",
-    "scanner",
-];
-
 /// `raw`, from a file, as source text at `place` (see the module's decision).
 pub(super) fn source(raw: &str, place: Place) -> String {
     match place {
@@ -92,7 +54,7 @@ fn identifier(raw: &str) -> String {
     if !id.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_') {
         id.insert_str(0, "x_");
     }
-    if KEYWORDS.contains(&id.as_str()) {
+    if crate::syntax::KEYWORDS.contains(&id.as_str()) {
         id.push('_');
     }
     id
@@ -204,26 +166,6 @@ impl DatumLetters {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The keyword list is the grammar's.
-    #[test]
-    fn keywords_are_the_grammars() {
-        let pest = include_str!("../../grammar/insp.pest");
-        let mut words = Vec::new();
-        for line in pest.lines() {
-            let Some((rule, body)) = line.split_once('=') else {
-                continue;
-            };
-            let rule = rule.trim();
-            if rule.starts_with("kw_") || rule == "block_kw" {
-                words.extend(body.split('"').skip(1).step_by(2).map(str::to_string));
-            }
-        }
-        let mut ours: Vec<String> = KEYWORDS.iter().map(|s| s.to_string()).collect();
-        words.sort();
-        ours.sort();
-        assert_eq!(ours, words);
-    }
 
     #[test]
     fn identifiers_are_valid_and_not_keywords() {

@@ -1,7 +1,7 @@
 //! Rename: the places a declared name is written, or why it must not be renamed.
 //!
 //! **Decision: a rename that would change meaning is refused, and the check is the
-//! resolver's own.** A new name must be a name (not a keyword: `symbols::RESERVED`),
+//! resolver's own.** A new name must be a name (not a keyword: `syntax::KEYWORDS`),
 //! else -32602 Invalid params. Then two checks, each answering -32803 RequestFailed
 //! (LSP 3.17: the request was valid, the server declines) with the declaration in the
 //! way named and placed:

@@ -208,64 +208,15 @@ pub(crate) fn is_name(name: &str) -> bool {
     let first_ok = chars
         .next()
         .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
-    first_ok && chars.all(|c| c.is_ascii_alphanumeric() || c == '_') && !RESERVED.contains(&name)
+    first_ok
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && !crate::syntax::KEYWORDS.contains(&name)
 }
-
-/// The grammar's keywords (`grammar/insp.pest`, the `kw_` rules and `block_kw`): a name
-/// spelt like one would read as the keyword where the keyword may stand.
-pub(crate) const RESERVED: &[&str] = &[
-    "use",
-    "part",
-    "plan",
-    "hierarchy",
-    "required",
-    "units",
-    "stock",
-    "mesh",
-    "cut",
-    "add",
-    "face",
-    "feature",
-    "datum",
-    "frame",
-    "tolerance",
-    "group",
-    "segment",
-    "step_face",
-    "qif_face",
-    "select",
-    "prefer",
-    "forbid",
-    "sample",
-    "with",
-    "cmm",
-    "head",
-    "probe",
-    "stylus",
-    "body",
-    "extension",
-    "sampling",
-    "fixture",
-    "scanner",
-];
 
 #[cfg(test)]
 mod tests {
-    /// RESERVED lists exactly the grammar's keywords.
     #[test]
-    fn reserved_words_are_the_grammars_keywords() {
-        let grammar = include_str!("../../grammar/insp.pest");
-        let mut words: Vec<&str> = Vec::new();
-        for line in grammar.lines() {
-            let line = line.trim_start();
-            if line.starts_with("kw_") || line.starts_with("block_kw") {
-                words.extend(line.split('"').skip(1).step_by(2));
-            }
-        }
-        let mut reserved = super::RESERVED.to_vec();
-        words.sort_unstable();
-        reserved.sort_unstable();
-        assert_eq!(words, reserved);
+    fn names_are_names_and_not_keywords() {
         assert!(super::is_name("wide_slot") && !super::is_name("feature"));
         assert!(!super::is_name("2a") && !super::is_name("a-b") && !super::is_name(""));
     }

@@ -8,6 +8,7 @@
 //! DMIS; it accepts any text and either returns a tree or one [`SyntaxError`].
 
 pub mod ast;
+mod keywords;
 mod lower;
 mod words;
 
@@ -20,6 +21,7 @@ mod grammar {
     pub(crate) struct InspParser;
 }
 pub(crate) use grammar::{InspParser, Rule};
+pub(crate) use keywords::KEYWORDS;
 
 /// A syntax error.
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
