@@ -1,7 +1,9 @@
 //! Completion: what may be written at the cursor, from the text before it (which need
 //! not parse while one types) and the names and keys of the last spec that did.
 
+use super::face_names;
 use super::symbols::{contains, decls, Decl, DeclKind};
+use super::Deep;
 use crate::source::FileId;
 use crate::syntax::ast;
 use crate::Checked;
@@ -42,8 +44,15 @@ const PART_KEYWORDS: &[&str] = &[
 const PLAN_KEYWORDS: &[&str] = &["prefer", "forbid", "sample"];
 
 /// The completions at byte `offset` of `text`, the current text of `file`; `checked` is
-/// the last front end of the spec that parsed (its names and keys).
-pub fn complete(checked: &Checked, file: FileId, text: &str, offset: usize) -> Vec<CompletionItem> {
+/// the last front end of the spec that parsed (its names and keys), `deep` the last
+/// geometry stage (the faces of a mesh).
+pub fn complete(
+    checked: &Checked,
+    deep: Option<&Deep>,
+    file: FileId,
+    text: &str,
+    offset: usize,
+) -> Vec<CompletionItem> {
     let before = &text[..offset.min(text.len())];
     let line = &before[before.rfind('\n').map_or(0, |i| i + 1)..];
     let head = &line[..word_start(line)];
@@ -73,6 +82,17 @@ pub fn complete(checked: &Checked, file: FileId, text: &str, offset: usize) -> V
         Some("part") => {
             if at_statement_start {
                 return keywords(PART_KEYWORDS);
+            }
+            if let Some(part) = face_names::part_at(&checked.model, file, offset) {
+                let offers = |o: Vec<face_names::Offer>, kind| {
+                    o.iter().map(|(l, d)| item(l, kind, d)).collect()
+                };
+                if let Some(roles) = face_names::roles_after_dot(part, head) {
+                    return offers(roles, CompletionItemKind::ENUM_MEMBER);
+                }
+                if let Some(faces) = face_names::groups(part, head, deep) {
+                    return offers(faces, CompletionItemKind::VALUE);
+                }
             }
             if trimmed.starts_with("tolerance") && trimmed.trim_end().ends_with('=') {
                 return crate::resolve::tolerance_keywords()

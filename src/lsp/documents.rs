@@ -71,6 +71,7 @@ impl Server {
             .entry(path.to_path_buf())
             .or_insert_with(|| Analysis {
                 front: front.clone(),
+                version,
                 parsed: None,
                 deep: None,
                 plan: None,
@@ -79,6 +80,7 @@ impl Server {
             a.parsed = Some(front.clone());
         }
         a.front = front;
+        a.version = version;
         self.publish();
         if let Some(graphs) = &self.graphs {
             let _ = graphs.send(GraphJob {

@@ -1,7 +1,7 @@
 //! What hovering a name shows: the item as the model summary prints it, and for the names
 //! inside a part what the geometry, the measurement graph and the last plan know of them.
 
-use super::symbols::{decls, target, within, Decl, DeclKind};
+use super::symbols::{contains, decls, target, within, Decl, DeclKind};
 use super::Analysis;
 use crate::model::{ItemRef, Model};
 use crate::resolve::{accepts, Datums};
@@ -13,7 +13,9 @@ use std::fmt::Write;
 /// The hover of the name at `offset` of `file`: the span hovered and markdown.
 pub fn hover(a: &Analysis, file: FileId, offset: usize) -> Option<(Span, String)> {
     let checked = &a.front;
-    let (at, decl) = target(checked, file, offset)?;
+    let Some((at, decl)) = target(checked, file, offset) else {
+        return face_ref(a, file, offset);
+    };
     let all = decls(checked);
     let mut d = all.iter().find(|d| d.name.span == decl)?;
     let model = &checked.model;
@@ -157,24 +159,62 @@ fn op_faces(a: &Analysis, part: usize, op: &str) -> String {
     format!("faces {}", names.join(", "))
 }
 
+/// A part's geometry in the analysis's geometry stage, found by the part's name (the
+/// stage may be of an earlier version of the text, whose parts sit elsewhere).
+struct Geo<'a> {
+    deep: &'a super::Deep,
+    /// The part's index in the geometry stage's model.
+    k: usize,
+    data: &'a crate::PartData,
+}
+
+/// The geometry of part `part` of the current text, or the sentence that says why there
+/// is none yet. "See the diagnostics" only where there are some: a stage of an earlier
+/// version is still being replaced.
+fn geometry_of(a: &Analysis, part: usize) -> Result<Geo<'_>, &'static str> {
+    let being_built = "_The geometry is being built._";
+    let deep = a.deep.as_ref().ok_or(being_built)?;
+    let name = &a.front.model.parts[part].name;
+    let found = deep
+        .checked
+        .model
+        .parts
+        .iter()
+        .position(|p| &p.name == name);
+    if let Some((k, Some(data))) = found.map(|k| (k, deep.parts.get(k).and_then(Option::as_ref))) {
+        return Ok(Geo { deep, k, data });
+    }
+    if deep.version != a.version {
+        Err(being_built)
+    } else if deep.checked.has_errors() {
+        Err("_No geometry while the spec has errors: see the diagnostics._")
+    } else {
+        Err("_No geometry: the part is not declared in this file and no plan here names it._")
+    }
+}
+
 /// A feature's faces: surface, area, points sampled, and how the last plan reached them.
 fn feature_faces(a: &Analysis, part: usize, feature: usize, o: &mut String) {
-    let Some(deep) = &a.deep else {
+    let geo = match geometry_of(a, part) {
+        Ok(geo) => geo,
+        Err(why) => {
+            let _ = writeln!(o, "\n{why}");
+            return;
+        }
+    };
+    let name = &a.front.model.parts[part].features[feature].name;
+    let model_part = &geo.deep.checked.model.parts[geo.k];
+    let Some(feature) = model_part.features.iter().position(|f| &f.name == name) else {
         let _ = writeln!(o, "\n_The geometry is being built._");
         return;
     };
-    let Some(data) = deep.parts.get(part).and_then(Option::as_ref) else {
-        let _ = writeln!(o, "\n_No geometry: see the diagnostics._");
-        return;
-    };
-    let graph = deep.graphs.iter().find(|g| g.part == part);
-    let part_name = &a.front.model.parts[part].name;
     let _ = writeln!(o);
     // On a machine with a scanner: the sensor chosen and why.
-    let sensors = deep
+    let sensors = geo
+        .deep
         .graphs
         .iter()
-        .filter(|g| g.part == part)
+        .filter(|g| g.part == geo.k)
         .flat_map(|g| g.graph.sensors.iter().map(move |s| (g, s)))
         .filter(|(_, s)| s.feature.0 == feature);
     for (g, s) in sensors {
@@ -182,24 +222,71 @@ fn feature_faces(a: &Analysis, part: usize, feature: usize, o: &mut String) {
         let word = s.sensor.word();
         let _ = writeln!(o, "sensor in plan `{plan}`: **{word}** ({})\n", s.why);
     }
-    for id in data.feature_faces.get(feature).into_iter().flatten() {
-        let f = &data.geometry.faces[id.0];
-        let points = graph.map_or(0, |g| {
-            g.graph.fpoints.iter().filter(|p| p.face == *id).count()
-        });
-        let surface = crate::geometry::describe(&f.surface);
-        let _ = writeln!(
-            o,
-            "- **{}**: {} {}, {} mm², {points} points",
-            f.name,
-            f.surface.kind().keyword(),
-            surface,
-            crate::model::fmt_num((f.area * 10.0).round() / 10.0)
-        );
-        if let Some(state) = face_state(a, part_name, &f.name) {
-            let _ = writeln!(o, "  - {state}");
+    for id in geo.data.feature_faces.get(feature).into_iter().flatten() {
+        face_line(a, &geo, *id, o);
+    }
+}
+
+/// One face of the geometry: its surface, area and points, and how the last plan
+/// reached it.
+fn face_line(a: &Analysis, geo: &Geo, id: crate::geometry::FaceId, o: &mut String) {
+    let f = &geo.data.geometry.faces[id.0];
+    let graph = geo.deep.graphs.iter().find(|g| g.part == geo.k);
+    let points = graph.map_or(0, |g| {
+        g.graph.fpoints.iter().filter(|p| p.face == id).count()
+    });
+    let surface = crate::geometry::describe(&f.surface);
+    let _ = writeln!(
+        o,
+        "- **{}**: {} {}, {} mm², {points} points",
+        f.name,
+        f.surface.kind().keyword(),
+        surface,
+        crate::model::fmt_num((f.area * 10.0).round() / 10.0)
+    );
+    let part_name = &geo.deep.checked.model.parts[geo.k].name;
+    if let Some(state) = face_state(a, part_name, &f.name) {
+        let _ = writeln!(o, "  - {state}");
+    }
+}
+
+/// The hover of a face reference (`stock.top`, `slot.walls`, `group "face_90"`) at
+/// `offset`: the faces of the geometry it names.
+fn face_ref(a: &Analysis, file: FileId, offset: usize) -> Option<(Span, String)> {
+    let model = &a.front.model;
+    let (k, r) = model.parts.iter().enumerate().find_map(|(k, p)| {
+        let refs = p.features.iter().flat_map(|f| &f.faces);
+        refs.filter(|r| contains(r.span(), file, offset))
+            .min_by_key(|r| r.span().end - r.span().start)
+            .map(|r| (k, r))
+    })?;
+    let part = &model.parts[k];
+    let mut o = format!("```\n{}\n```\n", r.text(part));
+    // The reference's ids (an operation's index) are the current text's: only a
+    // geometry stage of this version resolves it.
+    let geo = geometry_of(a, k).and_then(|g| match g.deep.version == a.version {
+        true => Ok(g),
+        false => Err("_The geometry is being built._"),
+    });
+    match geo {
+        Ok(geo) => {
+            let ids = crate::geometry::resolve_faces(
+                &geo.data.geometry,
+                r,
+                &mut crate::diag::Diagnostics::new(),
+            );
+            if ids.is_empty() {
+                let _ = writeln!(o, "\nNames no face of the geometry: see the diagnostics.");
+            }
+            for id in ids {
+                face_line(a, &geo, id, &mut o);
+            }
+        }
+        Err(why) => {
+            let _ = writeln!(o, "\n{why}");
         }
     }
+    Some((r.span(), o))
 }
 
 /// The plans of the last run that plan `part`.

@@ -32,6 +32,7 @@
 mod complete;
 mod diagnostics;
 mod documents;
+mod face_names;
 mod hover;
 mod lifecycle;
 mod planner;
@@ -133,6 +134,8 @@ struct Doc {
 pub(crate) struct Analysis {
     /// The front end of the current text.
     pub front: Arc<Checked>,
+    /// The document version `front` is of.
+    pub version: i32,
     /// The last front end whose root parsed: names and keys for completion while the
     /// text is broken.
     pub parsed: Option<Arc<Checked>>,
@@ -160,7 +163,7 @@ pub(crate) struct PlanResult {
     pub text: String,
     /// Per file, its diagnostics.
     pub diagnostics: BTreeMap<PathBuf, Vec<lt::Diagnostic>>,
-    /// Each plan as `inspc plan --format json` writes it.
+    /// Each plan as `inspc build --plan-json` writes it.
     pub plans: Vec<serde_json::Value>,
 }
 

@@ -77,8 +77,8 @@ pub(crate) fn start(
     })
 }
 
-/// What `inspc lsp --plan FILE` writes: every diagnostic of the plan run per file, and
-/// every plan as `inspc plan --format json` writes it.
+/// What `inspc lsp --plan FILE` writes: every diagnostic of the build per file, and
+/// every plan as `inspc build --plan-json` writes it.
 #[derive(serde::Serialize, serde::Deserialize)]
 pub(crate) struct PlanOutput {
     pub diagnostics: BTreeMap<PathBuf, Vec<lt::Diagnostic>>,
@@ -105,15 +105,11 @@ pub fn plan_file(file: &Path) -> String {
             }
         }
     });
+    // The whole build (plans, paths and the program, nothing written): the path
+    // stage's warnings (`insp::path::self_aligned`, tight stand-offs) are the plan's too.
     let opts = crate::plan::PlanOptions::default();
-    let (checked, parts, _, planned) = crate::plans(&FsWorld, &[file.to_path_buf()], &opts);
-    let plans = planned
-        .iter()
-        .filter_map(|p| {
-            let names = crate::plan_names(&checked, &parts, p.plan)?;
-            Some(crate::plan::json(p.hlip.as_ref()?, &names))
-        })
-        .collect();
+    let (checked, built, _) = crate::build(&FsWorld, &[file.to_path_buf()], &opts, &|_, _, _| {});
+    let plans = built.into_iter().map(|b| b.json).collect();
     let out = PlanOutput {
         diagnostics: lsp_diagnostics(&checked),
         plans,

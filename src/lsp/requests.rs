@@ -115,7 +115,7 @@ impl Server {
             .sources
             .find_path(&path)
             .unwrap_or(crate::source::FileId(u32::MAX));
-        let items = complete::complete(checked, file, doc.text.text(), offset);
+        let items = complete::complete(checked, a.deep.as_ref(), file, doc.text.text(), offset);
         Some(lt::CompletionResponse::Array(items))
     }
 

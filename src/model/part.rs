@@ -428,6 +428,19 @@ pub enum FaceRef {
     Select(Selector, Span),
 }
 
+impl FaceRef {
+    /// Where the reference is written.
+    pub fn span(&self) -> Span {
+        match self {
+            FaceRef::Role { span, .. }
+            | FaceRef::Group(_, span)
+            | FaceRef::Segment(_, span)
+            | FaceRef::FileFace(_, _, span)
+            | FaceRef::Select(_, span) => *span,
+        }
+    }
+}
+
 /// How a feature came to be.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Declared {

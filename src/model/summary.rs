@@ -613,6 +613,13 @@ impl Feature {
     }
 }
 
+impl FaceRef {
+    /// The reference as the spec writes it: `stock.top`, `group "face_90"`.
+    pub fn text(&self, p: &Part) -> String {
+        face_text(p, self)
+    }
+}
+
 impl Tolerance {
     /// The tolerance as the summary prints it: `tolerance name: kind(features) value | datums`.
     pub fn text(&self, p: &Part) -> String {

@@ -8,6 +8,7 @@ use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
+mod faces;
 mod hostile;
 
 /// How long any one answer may take before the test calls the server hung (not a timing
