@@ -209,6 +209,12 @@ fn feature_faces(a: &Analysis, part: usize, feature: usize, o: &mut String) {
         return;
     };
     let _ = writeln!(o);
+    if geo.deep.version != a.version {
+        let _ = writeln!(
+            o,
+            "_As of an earlier version of the text; the geometry of this one is being built._\n"
+        );
+    }
     // On a machine with a scanner: the sensor chosen and why.
     let sensors = geo
         .deep

@@ -121,7 +121,7 @@ fn capabilities() -> lt::ServerCapabilities {
         rename_provider: Some(lt::OneOf::Left(true)),
         document_formatting_provider: Some(lt::OneOf::Left(true)),
         completion_provider: Some(lt::CompletionOptions {
-            trigger_characters: Some(vec![":".into(), " ".into()]),
+            trigger_characters: Some(vec![":".into(), " ".into(), ".".into(), "\"".into()]),
             ..Default::default()
         }),
         ..Default::default()

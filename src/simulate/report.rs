@@ -117,12 +117,14 @@ impl Report {
     /// The report for people.
     pub fn text(&self) -> String {
         let mut out = format!(
-            "simulated program {} (plan {}, part {}): {} setups, {} touches{}, {} moves checked{}\n",
+            "simulated program {} (plan {}, part {}): {} setup{}, {} touch{}{}, {} moves checked{}\n",
             self.program,
             self.plan,
             self.part,
             self.setups,
+            if self.setups == 1 { "" } else { "s" },
             self.touches,
+            if self.touches == 1 { "" } else { "es" },
             if self.scanned > 0 {
                 format!(", {} points scanned", self.scanned)
             } else {
