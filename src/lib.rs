@@ -359,6 +359,16 @@ fn plan_each(
         if !plan::check_machine(model, &model.plans[k], &data.geometry, &mut diags) {
             continue;
         }
+        let part = &model.parts[g.part];
+        if part.tolerances.is_empty() {
+            // A program that judges nothing is no inspection: refused, not written.
+            diags.push(plan::PlanError::NoTolerance {
+                span: model.plans[k].span,
+                plan: name.clone(),
+                part: part.name.clone(),
+            });
+            continue;
+        }
         let input = plan::Input {
             model,
             plan: &model.plans[k],

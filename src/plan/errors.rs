@@ -157,6 +157,17 @@ pub enum PlanError {
         span: Span,
         part: String,
     },
+    #[error("plan `{plan}` has nothing to judge: part `{part}` has no tolerance")]
+    #[diagnostic(
+        code(insp::plan::no_tolerance),
+        help("give part `{part}` the drawing's tolerances (`tolerance t = flatness(top, 0.05 mm)`); for a CAD file without PMI, `inspc import` writes a default inspection to start from")
+    )]
+    NoTolerance {
+        #[label("a program of this plan would measure points and judge nothing")]
+        span: Span,
+        plan: String,
+        part: String,
+    },
 }
 
 crate::diag::located!(PlanError {
@@ -168,6 +179,7 @@ crate::diag::located!(PlanError {
     PlacementSensitive,
     DatumInOtherSetup,
     NoPlan,
+    NoTolerance,
     PartOffTable,
     ProbeTooLong,
 });

@@ -164,7 +164,10 @@ const RACK: &str = r#"
 use std::heads::PH10MQ
 use std::probes::TP20_D2_L20
 use std::scanners::{LC15Dx, LC60Dx}
-part p { units mm, stock box(50, 50, 20), feature top = stock.top }
+part p {
+    units mm, stock box(50, 50, 20), feature top = stock.top
+    tolerance flat = flatness(top, 1 mm)
+}
 cmm lab {
     table { z 0 mm, size (1000 mm, 700 mm) }
     ram { radius 35 mm, length 600 mm }
