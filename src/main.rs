@@ -211,6 +211,10 @@ enum Command {
         /// Where to write the spec (default: standard output).
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// Scale the file's geometry by this factor after its own unit (10 reads a
+        /// 10 mm model as a 100 mm part); the spec's `mesh` says it again.
+        #[arg(long, default_value_t = 1.0, value_parser = scale_arg)]
+        scale: f64,
     },
     /// Reads a DMIS program and checks it as a controller would: line lengths, labels,
     /// names defined before use, MEAS blocks.
@@ -417,7 +421,11 @@ fn main() -> ExitCode {
             None => ExitCode::from(2),
         },
         Command::Lsp { plan } => lsp(plan.as_deref()),
-        Command::Import { file, output } => import(&file, output),
+        Command::Import {
+            file,
+            output,
+            scale,
+        } => import(&file, output, scale),
         Command::Simulate {
             program,
             spec,
@@ -1225,8 +1233,17 @@ fn import_warnings(file: &std::path::Path, warnings: &[inspc::import::LeftOut]) 
     print_diagnostics(&sources, &diags.sorted());
 }
 
+/// `--scale`: a factor from 0.001 to 1000, as a spec's `mesh "…" { scale … }` takes.
+fn scale_arg(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(s) if (0.001..=1000.0).contains(&s) => Ok(s),
+        Ok(_) => Err("a scale runs from 0.001 to 1000".into()),
+        Err(_) => Err("a scale is a number: 10 reads a 10 mm model as a 100 mm part".into()),
+    }
+}
+
 /// `inspc import`: a spec from a STEP or QIF file, on stdout or written atomically.
-fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
+fn import(file: &std::path::Path, output: Option<PathBuf>, scale: f64) -> ExitCode {
     use inspc::source::{FileKind, World};
     let bytes = match FsWorld.read(file, FileKind::Mesh) {
         Ok(b) => b,
@@ -1247,6 +1264,7 @@ fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
     let opts = inspc::import::ImportOptions {
         cad_path: cli::outputs::relative_to(file, &spec_dir),
         part_name: inspc::import::identifier(&stem),
+        scale,
     };
     let inspc::import::Imported {
         text,
@@ -1255,6 +1273,7 @@ fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
         tolerances: (t, tw),
         dimensions: (s, sw),
         warnings,
+        defaults,
     } = match inspc::import::import(&bytes, &opts) {
         Ok(i) => i,
         Err(e) => {
@@ -1276,13 +1295,19 @@ fn import(file: &std::path::Path, output: Option<PathBuf>) -> ExitCode {
         }
         None => print!("{text}"),
     }
-    eprintln!(
-        "inspc: {faces} faces; datums {dw} of {d}, tolerances {tw} of {t}, sizes and locations {sw} of {s} written{}",
-        output
-            .as_ref()
-            .map(|p| format!(" to {}", p.display()))
-            .unwrap_or_default()
-    );
+    let to = output
+        .as_ref()
+        .map(|p| format!(" to {}", p.display()))
+        .unwrap_or_default();
+    if defaults > 0 {
+        eprintln!(
+            "inspc: {faces} faces; no PMI: a default inspection of {defaults} tolerances (general tolerances, not the drawing's) written{to}"
+        );
+    } else {
+        eprintln!(
+            "inspc: {faces} faces; datums {dw} of {d}, tolerances {tw} of {t}, sizes and locations {sw} of {s} written{to}"
+        );
+    }
     ExitCode::SUCCESS
 }
 

@@ -105,6 +105,49 @@ const SAME_SURFACE_DEG: f64 = 0.1;
 const SAME_SURFACE_MM: f64 = 0.02;
 
 impl Surface {
+    /// The surface scaled by `s` about the origin (a spec's `mesh "…" { scale s }`):
+    /// points and radii scale, directions and angles stay.
+    pub fn scaled(&self, s: f64) -> Surface {
+        match self.clone() {
+            Surface::Plane { origin, normal } => Surface::Plane {
+                origin: origin * s,
+                normal,
+            },
+            Surface::Cylinder {
+                origin,
+                axis,
+                radius,
+                convex,
+            } => Surface::Cylinder {
+                origin: origin * s,
+                axis,
+                radius: radius * s,
+                convex,
+            },
+            Surface::Cone {
+                apex,
+                axis,
+                half_angle,
+                convex,
+            } => Surface::Cone {
+                apex: apex * s,
+                axis,
+                half_angle,
+                convex,
+            },
+            Surface::Sphere {
+                center,
+                radius,
+                convex,
+            } => Surface::Sphere {
+                center: center * s,
+                radius: radius * s,
+                convex,
+            },
+            Surface::Freeform => Surface::Freeform,
+        }
+    }
+
     /// The surface under a rigid motion `m`.
     pub fn moved(&self, m: &nalgebra::Isometry3<f64>) -> Surface {
         match self.clone() {
@@ -460,13 +503,18 @@ pub fn build(
             path,
             unit_mm,
             chord_mm,
+            scale,
             span,
         } => {
+            // The chord is the part's: a model scaled up is meshed finer in its own unit.
             let res = step::Resolution {
-                chord_mm: chord_mm.unwrap_or(step::RESOLUTION.chord_mm),
+                chord_mm: chord_mm.unwrap_or(step::RESOLUTION.chord_mm) / scale,
                 ..step::RESOLUTION
             };
-            let raw = read_reported(world, path, *unit_mm, res, *span, diags)?;
+            let mut raw = read_reported(world, path, *unit_mm, res, *span, diags)?;
+            if *scale != 1.0 {
+                raw.scale(*scale);
+            }
             let uses_groups = part
                 .features
                 .iter()

@@ -37,6 +37,18 @@ pub struct RawMesh {
     pub cad: Option<super::CadFaces>,
 }
 
+impl RawMesh {
+    /// The mesh scaled by `s` about the origin, its exact surfaces with it.
+    pub fn scale(&mut self, s: f64) {
+        for v in &mut self.vertices {
+            *v *= s;
+        }
+        for e in &mut self.exact {
+            *e = e.scaled(s);
+        }
+    }
+}
+
 /// Merges coincident vertices (to 1e-6 mm), drops degenerate triangles and counts open
 /// and non-manifold edges; a mesh with more than a tenth of its edges defective is not
 /// a solid at all.

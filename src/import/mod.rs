@@ -18,6 +18,7 @@
 //! comment and a warning ([`LeftOut`]).
 
 mod errors;
+mod recognise;
 mod text;
 mod values;
 mod write;
@@ -35,6 +36,9 @@ pub struct ImportOptions {
     pub cad_path: String,
     /// The part's name (an identifier).
     pub part_name: String,
+    /// The factor the file's geometry is scaled by after its unit (1: as modelled);
+    /// the spec's `mesh` says it again, so the spec reads the part at this size.
+    pub scale: f64,
 }
 
 /// A spec written from a STEP file, and what went into it.
@@ -53,6 +57,9 @@ pub struct Imported {
     /// The items left out for a value the spec cannot hold, each also a comment in
     /// the spec: warnings for the caller to place on the file's path.
     pub warnings: Vec<LeftOut>,
+    /// For a file without PMI, the tolerances of the default inspection written
+    /// (general tolerances in place of the drawing's); 0 when the file has PMI.
+    pub defaults: usize,
 }
 
 /// A file stem as an identifier: letters, digits and `_`, lower case, starting with a
@@ -77,10 +84,27 @@ pub fn identifier(stem: &str) -> String {
 /// Reads a STEP or QIF file (by `opts.cad_path`'s extension) and writes a spec for it.
 pub fn import(bytes: &[u8], opts: &ImportOptions) -> Result<Imported, MeshError> {
     let qif = opts.cad_path.to_ascii_lowercase().ends_with(".qif");
-    let part = if qif {
-        crate::geometry::qif::read(bytes, step::RESOLUTION)?
-    } else {
-        step::read(bytes, step::RESOLUTION)?
+    // The chord is the part's: a model scaled up is meshed finer in its own unit.
+    let res = step::Resolution {
+        chord_mm: step::RESOLUTION.chord_mm / opts.scale,
+        ..step::RESOLUTION
     };
+    let mut part = if qif {
+        crate::geometry::qif::read(bytes, res)?
+    } else {
+        step::read(bytes, res)?
+    };
+    if opts.scale != 1.0 {
+        scale(&mut part, opts.scale);
+    }
     Ok(write_spec(&part, opts))
+}
+
+/// The part scaled by `s`: its geometry, and the nominal lengths of its dimensions
+/// (their limits are the drawing's deviations and stay).
+fn scale(part: &mut step::CadPart, s: f64) {
+    part.mesh.scale(s);
+    for d in part.pmi.dimensions.iter_mut().filter(|d| !d.angular) {
+        d.nominal = d.nominal.map(|n| n * s);
+    }
 }

@@ -251,14 +251,28 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
         &mut used_tol_names,
         &mut warnings,
     );
-    let (dim_lines, written_dims) =
+    let (mut dim_lines, written_dims) =
         dimension_lines(p, &mut feats, &mut used_tol_names, &mut warnings);
     let mut datum_lines = datums.lines;
     common_datum_lines(&frames, &mut feats, &mut datum_lines);
+    let mut notes = p.notes.clone();
+    let no_pmi = p.datums.is_empty() && p.tolerances.is_empty() && p.dimensions.is_empty();
+    let mut defaults = 0;
+    let mut header = PMI_HEADER;
+    if no_pmi {
+        if let Some(d) = super::recognise::default_inspection(part) {
+            header = DEFAULT_HEADER;
+            let (datums, tols) = default_lines(&d, &mut feats, &mut used_tol_names);
+            defaults = tols.len();
+            datum_lines = datums;
+            dim_lines = tols;
+            notes.extend(d.notes);
+        }
+    }
 
     let text = render(
         part,
-        &p.notes,
+        (header, &notes),
         opts,
         &feats,
         &datum_lines,
@@ -274,7 +288,49 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
         tolerances: (p.tolerances.len(), written_tols),
         dimensions: (p.dimensions.len(), written_dims),
         warnings,
+        defaults,
     }
+}
+
+/// The first line of the spec's account of its tolerances, by where they come from.
+const PMI_HEADER: &str = "The datums, tolerances and sizes are the file's semantic PMI; what the language cannot say is a comment.";
+const DEFAULT_HEADER: &str = "The file has no PMI: the datums and tolerances below are a DEFAULT INSPECTION of the features inspc recognised, with general tolerances (sizes and distances ISO 2768-1 m, flatness ISO 2768-2 K, positions Ø2t) in place of the drawing's. Replace them with the drawing's before the results count.";
+
+/// The default inspection as spec lines: its datums, and its tolerances.
+fn default_lines(
+    d: &super::recognise::DefaultInspection,
+    feats: &mut Features,
+    used: &mut BTreeSet<String>,
+) -> (Vec<String>, Vec<String>) {
+    let names: Vec<String> = d
+        .features
+        .iter()
+        .map(|(faces, name)| feats.name(faces, Some(name.clone())))
+        .collect();
+    let datums = d
+        .datums
+        .iter()
+        .map(|(letter, f)| format!("    datum {letter} = {}", names[*f]))
+        .collect();
+    let tols = d
+        .tolerances
+        .iter()
+        .map(|t| {
+            let targets: Vec<&str> = t.features.iter().map(|f| names[*f].as_str()).collect();
+            let prefix = match t.keyword {
+                "flatness" => "flat",
+                "position" => "pos",
+                "distance" => "dist",
+                _ => "size",
+            };
+            let name = unique(used, &format!("{prefix}_{}", targets[0]));
+            let mut args: Vec<String> = targets.iter().map(|s| s.to_string()).collect();
+            args.push(t.value.clone());
+            args.extend(t.datums.iter().map(char::to_string));
+            format!("    tolerance {name} = {}({})", t.keyword, args.join(", "))
+        })
+        .collect();
+    (datums, tols)
 }
 
 /// The datums of the PMI as the spec writes them.
@@ -709,7 +765,7 @@ fn part_name(asked: &str) -> String {
 #[allow(clippy::too_many_arguments)]
 fn render(
     part: &CadPart,
-    notes: &[String],
+    (header, notes): (&str, &[String]),
     opts: &ImportOptions,
     feats: &Features,
     datum_lines: &[String],
@@ -729,12 +785,16 @@ fn render(
     );
     let _ = writeln!(
         s,
-        "// {} faces (`face_<n>` in the file's shell order), {} × {} × {} mm; the file's unit is {}.",
+        "// {} faces (`face_<n>` in the file's shell order), {} × {} × {} mm; the file's unit is {}{}.",
         part.solid_faces(),
         size[0],
         size[1],
         size[2],
-        source(&part.unit.0, Place::Comment)
+        source(&part.unit.0, Place::Comment),
+        match opts.scale == 1.0 {
+            true => String::new(),
+            false => format!(", scaled × {}", fmt_num(opts.scale)),
+        }
     );
     if part.sheet_faces > 0 {
         let _ = writeln!(
@@ -745,12 +805,13 @@ fn render(
             if part.sheet_faces == 1 { "is" } else { "are" },
         );
     }
-    let _ = writeln!(
-        s,
-        "// The datums, tolerances and sizes are the file's semantic PMI; what the language cannot say is a comment."
-    );
+    let _ = writeln!(s, "// {header}");
     if !notes.is_empty() {
-        let _ = writeln!(s, "//\n// The PMI as read:");
+        let title = match header == DEFAULT_HEADER {
+            true => "Left out of the default inspection:",
+            false => "The PMI as read:",
+        };
+        let _ = writeln!(s, "//\n// {title}");
         for n in notes {
             let _ = writeln!(s, "//   - {}", source(n, Place::Comment));
         }
@@ -769,7 +830,15 @@ fn render(
         "    // Quantities below are in mm; the file's own unit applies to its geometry."
     );
     let _ = writeln!(s, "    units mm");
-    let _ = writeln!(s, "    mesh \"{}\"", source(&opts.cad_path, Place::Literal));
+    let scale = match opts.scale == 1.0 {
+        true => String::new(),
+        false => format!(" {{ scale {} }}", fmt_num(opts.scale)),
+    };
+    let _ = writeln!(
+        s,
+        "    mesh \"{}\"{scale}",
+        source(&opts.cad_path, Place::Literal)
+    );
     if !feats.order.is_empty() {
         s.push('\n');
     }

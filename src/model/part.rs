@@ -62,6 +62,9 @@ pub enum Geometry {
         /// For a STEP or QIF file, the chord tolerance it is meshed to (mm), when the
         /// spec gives one ([`DEFAULT_CHORD_MM`] when it does not).
         chord_mm: Option<f64>,
+        /// The factor the file's geometry is scaled by after its unit (`scale 10`: a
+        /// file modelled at a tenth of the part's size); 1 when the spec gives none.
+        scale: f64,
         /// Where the path was written.
         span: Span,
     },

@@ -481,18 +481,23 @@ fn geometry_text(geometry: &Geometry) -> String {
             path,
             unit_mm,
             chord_mm,
+            scale,
             ..
         } => {
             let name = path
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default();
-            match CadKind::of_path(path) {
+            let text = match CadKind::of_path(path) {
                 Some(_) => format!(
                     "CAD {name} (in the file's unit, chord {} mm)",
                     fmt_num(chord_mm.unwrap_or(super::DEFAULT_CHORD_MM))
                 ),
                 None => format!("mesh {name} (× {} mm)", fmt_num(*unit_mm)),
+            };
+            match *scale == 1.0 {
+                true => text,
+                false => format!("{text} scaled × {}", fmt_num(*scale)),
             }
         }
     }

@@ -371,15 +371,36 @@ fn mesh(
             .and_then(|u| length_unit(cx, &u))
             .unwrap_or(part_unit);
     }
+    // After the file's unit, a factor for a file modelled at another size (the MFCAD
+    // parts are 10-unit cubes of 100 mm blocks).
+    let scale = p.get("scale").and_then(|v| {
+        let s = cx.number(v)?;
+        if !(MIN_SCALE..=MAX_SCALE).contains(&s) {
+            cx.err(E::OutOfRange {
+                span: v.span,
+                what: "the scale".into(),
+                value: crate::model::fmt_num(s),
+                range: format!("{MIN_SCALE} to {MAX_SCALE}"),
+                help: "`scale` multiplies the file's geometry after its unit: 10 reads a 10 mm model as a 100 mm part".into(),
+            });
+            return None;
+        }
+        Some(s)
+    });
     p.finish(cx);
     let full = mesh_file(r, cx, path)?;
     Some(Geometry::Mesh {
         path: full,
         unit_mm,
         chord_mm,
+        scale: scale.unwrap_or(1.0),
         span: path.span,
     })
 }
+
+/// The least and greatest factor a mesh may be scaled by.
+const MIN_SCALE: f64 = 0.001;
+const MAX_SCALE: f64 = 1000.0;
 
 /// The finest and coarsest chord tolerance a CAD part may be meshed to (mm).
 const MIN_CHORD_MM: f64 = 0.01;

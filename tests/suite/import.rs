@@ -221,6 +221,7 @@ fn imported(part: &str) -> String {
     let opts = ImportOptions {
         cad_path: format!("../../{}", file(part, "stp")),
         part_name: identifier(&format!("nist_{part}_asme1_ap242-e1")),
+        scale: 1.0,
     };
     import(&bytes, &opts).unwrap().text
 }
@@ -268,6 +269,7 @@ fn import_checks_clean(dir: &std::path::Path, name: &str, bytes: &[u8]) -> inspc
     let opts = ImportOptions {
         cad_path: name.to_string(),
         part_name: identifier(name),
+        scale: 1.0,
     };
     let imported = import(bytes, &opts).unwrap();
     let spec = dir.join("spec.insp");

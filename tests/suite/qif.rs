@@ -177,6 +177,7 @@ fn imported(stem: &str) -> String {
     let opts = ImportOptions {
         cad_path: format!("../../{path}"),
         part_name: identifier(stem),
+        scale: 1.0,
     };
     import(&bytes, &opts).unwrap().text
 }
