@@ -320,10 +320,6 @@ fn plane_name(g: &PlaneGroup, k: usize) -> String {
     }
 }
 
-fn zone(x: f64) -> String {
-    format!("{} mm", fmt_num(x))
-}
-
 fn size(nominal: f64) -> String {
     let n = (nominal * 1e4).round() / 1e4;
     format!("{} mm ± {} mm", fmt_num(n), fmt_num(iso2768_m(n)))
@@ -335,205 +331,290 @@ pub(super) fn default_inspection(part: &CadPart) -> Option<DefaultInspection> {
     if faces.is_empty() || faces.iter().all(|f| matches!(f.surface, Surface::Freeform)) {
         return None;
     }
-    let extent = {
-        let (mut lo, mut hi) = (P3::from([f64::MAX; 3]), P3::from([f64::MIN; 3]));
-        for v in &part.mesh.vertices {
-            lo = lo.inf(v);
-            hi = hi.sup(v);
-        }
-        (hi - lo).norm().max(1e-3)
-    };
-    let tol = 1e-5 * extent + 1e-6;
+    let (mut lo, mut hi) = (P3::from([f64::MAX; 3]), P3::from([f64::MIN; 3]));
+    for v in &part.mesh.vertices {
+        lo = lo.inf(v);
+        hi = hi.sup(v);
+    }
+    let tol = 1e-5 * (hi - lo).norm().max(1e-3) + 1e-6;
     let mut planes = plane_groups(&faces, tol);
-    // Largest first, then by where they lie: the same order on any run.
+    // Largest first; a stable sort keeps the file's order among equals.
     planes.sort_by(|a, b| b.area.total_cmp(&a.area));
-    let cylinders = cylinder_groups(&faces, tol);
-    let mut out = DefaultInspection {
-        features: Vec::new(),
-        datums: Vec::new(),
-        tolerances: Vec::new(),
-        notes: Vec::new(),
-    };
-    let mut plane_feature: Vec<Option<usize>> = vec![None; planes.len()];
-    let mut feature_of = |out: &mut DefaultInspection, k: usize| -> usize {
-        *plane_feature[k].get_or_insert_with(|| {
-            out.features
-                .push((planes[k].faces.clone(), plane_name(&planes[k], k)));
-            out.features.len() - 1
-        })
-    };
-
-    // The frame: A, B ⟂ A, C ⟂ A and B.
-    let mut frame: Vec<usize> = Vec::new();
-    for k in 0..planes.len() {
-        let n = planes[k].normal;
-        if frame.len() < 3
-            && frame
-                .iter()
-                .all(|&j| planes[j].normal.dot(&n).abs() < PERPENDICULAR)
-        {
-            frame.push(k);
-        }
-    }
-    let letters = ['A', 'B', 'C'];
-    for (i, &k) in frame.iter().enumerate() {
-        let f = feature_of(&mut out, k);
-        out.datums.push((letters[i], f));
-    }
-    let frame_letters: Vec<char> = letters[..frame.len()].to_vec();
-
-    // Flatness of the large planes.
-    let largest = planes.first().map_or(0.0, |p| p.area);
-    for k in 0..planes.len() {
-        if planes[k].area >= largest / 10.0 {
-            let f = feature_of(&mut out, k);
-            let length = longest_side(&planes[k].vertices, &planes[k].normal);
-            out.tolerances.push(DefaultTol {
-                keyword: "flatness",
-                features: vec![f],
-                value: zone(iso2768_k_flatness(length)),
-                datums: Vec::new(),
-            });
-        }
-    }
-
-    // Widths: slots and pockets (facing planes), the part's outer sizes along each
-    // datum's normal (the outermost planes, facing apart).
-    let mut paired = vec![false; planes.len()];
-    let mut slots = 0;
-    for i in 0..planes.len() {
-        if paired[i] {
-            continue;
-        }
-        let n = planes[i].normal;
-        let partner = (0..planes.len())
-            .filter(|&j| j != i && !paired[j] && planes[j].normal.dot(&n) < -PARALLEL)
-            .filter(|&j| (planes[j].origin - planes[i].origin).dot(&n) > tol)
-            .filter(|&j| overlap(&planes[i], &planes[j], tol))
-            .min_by(|&a, &b| {
-                let d = |j: usize| (planes[j].origin - planes[i].origin).dot(&n);
-                d(a).total_cmp(&d(b))
-            });
-        if let Some(j) = partner {
-            paired[i] = true;
-            paired[j] = true;
-            let width = (planes[j].origin - planes[i].origin).dot(&n);
-            let mut faces = planes[i].faces.clone();
-            faces.extend(&planes[j].faces);
-            faces.sort_unstable();
-            slots += 1;
-            out.features.push((faces, format!("slot_{slots}")));
-            out.tolerances.push(DefaultTol {
-                keyword: "width",
-                features: vec![out.features.len() - 1],
-                value: size(width),
-                datums: Vec::new(),
-            });
-        }
-    }
-    for &d in &frame {
-        let n = planes[d].normal;
-        let along: Vec<usize> = (0..planes.len())
-            .filter(|&j| planes[j].normal.dot(&n).abs() > PARALLEL)
-            .collect();
-        let outer = |sign: f64| {
-            along
-                .iter()
-                .copied()
-                .filter(|&j| planes[j].normal.dot(&n) * sign > 0.0)
-                .max_by(|&a, &b| {
-                    (planes[a].offset(&n) * sign).total_cmp(&(planes[b].offset(&n) * sign))
-                })
-        };
-        if let (Some(hi), Some(lo)) = (outer(1.0), outer(-1.0)) {
-            let width = planes[hi].offset(&n) - planes[lo].offset(&n);
-            let (fh, fl) = (feature_of(&mut out, hi), feature_of(&mut out, lo));
-            out.tolerances.push(DefaultTol {
-                keyword: "distance",
-                features: vec![fl, fh],
-                value: size(width),
-                datums: Vec::new(),
-            });
-        }
-        // Steps and floors: the other planes parallel to this datum.
-        for &j in &along {
-            if j == d || Some(j) == outer(1.0) || Some(j) == outer(-1.0) || paired[j] {
-                continue;
-            }
-            let gap = (planes[j].offset(&n) - planes[d].offset(&n)).abs();
-            if gap <= tol {
-                continue;
-            }
-            let (fd, fj) = (feature_of(&mut out, d), feature_of(&mut out, j));
-            out.tolerances.push(DefaultTol {
-                keyword: "distance",
-                features: vec![fd, fj],
-                value: size(gap),
-                datums: Vec::new(),
-            });
-        }
-    }
-
-    // Holes and bosses.
-    let mut partial = 0;
-    let (mut holes, mut bosses) = (0, 0);
-    for g in &cylinders {
-        if coverage_deg(g) < 300 {
-            partial += g.faces.len();
-            continue;
-        }
-        let name = if g.convex {
-            bosses += 1;
-            format!("boss_{bosses}")
-        } else {
-            holes += 1;
-            format!("hole_{holes}")
-        };
-        out.features.push((g.faces.clone(), name));
-        let f = out.features.len() - 1;
-        out.tolerances.push(DefaultTol {
-            keyword: "diameter",
-            features: vec![f],
-            value: size(2.0 * g.radius),
+    let mut found = Found {
+        plane_feature: vec![None; planes.len()],
+        planes,
+        tol,
+        frame: Vec::new(),
+        paired: Vec::new(),
+        out: DefaultInspection {
+            features: Vec::new(),
             datums: Vec::new(),
-        });
-        if !frame_letters.is_empty() {
-            // The zone from the hole's larger distance to the datum planes B and C.
-            let reach = frame
-                .iter()
-                .skip(1)
-                .map(|&d| (g.origin - planes[d].origin).dot(&planes[d].normal).abs())
-                .fold(0.0, f64::max);
-            out.tolerances.push(DefaultTol {
-                keyword: "position",
-                features: vec![f],
-                value: format!("dia {}", zone(2.0 * iso2768_m(reach))),
-                datums: frame_letters.clone(),
-            });
-        }
-    }
+            tolerances: Vec::new(),
+            notes: Vec::new(),
+        },
+    };
+    found.frame();
+    found.flatness();
+    found.slots();
+    found.sizes_and_steps();
+    found.holes(&cylinder_groups(&faces, tol));
     let others = faces
         .iter()
         .filter(|f| !matches!(f.surface, Surface::Plane { .. } | Surface::Cylinder { .. }))
         .count();
-    if partial > 0 {
-        out.notes.push(format!(
-            "{partial} partial cylindrical face{} (fillets, rounded ends) not inspected",
-            if partial == 1 { "" } else { "s" }
-        ));
-    }
     if others > 0 {
-        out.notes.push(format!(
+        found.out.notes.push(format!(
             "{others} face{} neither plane nor cylinder not inspected",
             if others == 1 { "" } else { "s" }
         ));
     }
-    Some(out)
+    Some(found.out)
 }
+
+/// The recognition under way: the plane groups, largest first, and what is written.
+struct Found {
+    planes: Vec<PlaneGroup>,
+    /// Per plane group, its feature once one is written.
+    plane_feature: Vec<Option<usize>>,
+    tol: f64,
+    /// The planes of datums A, B, C.
+    frame: Vec<usize>,
+    /// Per plane group, whether it is a wall of a slot.
+    paired: Vec<bool>,
+    out: DefaultInspection,
+}
+
+impl Found {
+    /// The feature of plane group `k`, written the first time it is asked for.
+    fn feature_of(&mut self, k: usize) -> usize {
+        if let Some(f) = self.plane_feature[k] {
+            return f;
+        }
+        let name = plane_name(&self.planes[k], k);
+        self.out.features.push((self.planes[k].faces.clone(), name));
+        let f = self.out.features.len() - 1;
+        self.plane_feature[k] = Some(f);
+        f
+    }
+
+    fn push(
+        &mut self,
+        keyword: &'static str,
+        features: Vec<usize>,
+        value: String,
+        datums: &[char],
+    ) {
+        self.out.tolerances.push(DefaultTol {
+            keyword,
+            features,
+            value,
+            datums: datums.to_vec(),
+        });
+    }
+
+    /// The frame: A the largest plane, B the largest ⟂ A, C the largest ⟂ both.
+    fn frame(&mut self) {
+        for k in 0..self.planes.len() {
+            let n = self.planes[k].normal;
+            let square = self
+                .frame
+                .iter()
+                .all(|&j| self.planes[j].normal.dot(&n).abs() < PERPENDICULAR);
+            if self.frame.len() < 3 && square {
+                self.frame.push(k);
+            }
+        }
+        for (i, k) in self.frame.clone().into_iter().enumerate() {
+            let f = self.feature_of(k);
+            self.out.datums.push((LETTERS[i], f));
+        }
+    }
+
+    /// Flatness of every plane at least a tenth the area of the largest.
+    fn flatness(&mut self) {
+        let largest = self.planes.first().map_or(0.0, |p| p.area);
+        for k in 0..self.planes.len() {
+            let g = &self.planes[k];
+            if g.area >= largest / 10.0 {
+                let zone = iso2768_k_flatness(longest_side(&g.vertices, &g.normal));
+                let f = self.feature_of(k);
+                self.push("flatness", vec![f], format!("{} mm", fmt_num(zone)), &[]);
+            }
+        }
+    }
+
+    /// Slots and pockets: each plane with the nearest parallel plane that faces it and
+    /// overlaps it, as one feature with a width.
+    fn slots(&mut self) {
+        let planes = &self.planes;
+        let tol = self.tol;
+        let mut paired = vec![false; planes.len()];
+        let mut widths = Vec::new();
+        for i in 0..planes.len() {
+            if paired[i] {
+                continue;
+            }
+            let n = planes[i].normal;
+            let gap = |j: usize| (planes[j].origin - planes[i].origin).dot(&n);
+            let partner = (0..planes.len())
+                .filter(|&j| !paired[j] && planes[j].normal.dot(&n) < -PARALLEL)
+                .filter(|&j| gap(j) > tol && overlap(&planes[i], &planes[j], tol))
+                .min_by(|&a, &b| gap(a).total_cmp(&gap(b)));
+            if let Some(j) = partner {
+                paired[i] = true;
+                paired[j] = true;
+                let mut faces = planes[i].faces.clone();
+                faces.extend(&planes[j].faces);
+                faces.sort_unstable();
+                widths.push((faces, gap(j)));
+            }
+        }
+        for (k, (faces, width)) in widths.into_iter().enumerate() {
+            self.out.features.push((faces, format!("slot_{}", k + 1)));
+            let f = self.out.features.len() - 1;
+            self.push("width", vec![f], size(width), &[]);
+        }
+        self.paired = paired;
+    }
+
+    /// Along each datum's normal: the part's size between its outermost planes, and the
+    /// distance from the datum plane to every other plane parallel to it (steps, floors).
+    fn sizes_and_steps(&mut self) {
+        for d in self.frame.clone() {
+            let n = self.planes[d].normal;
+            let along: Vec<usize> = (0..self.planes.len())
+                .filter(|&j| self.planes[j].normal.dot(&n).abs() > PARALLEL)
+                .collect();
+            let outer = |sign: f64| {
+                let planes = &self.planes;
+                along
+                    .iter()
+                    .copied()
+                    .filter(|&j| planes[j].normal.dot(&n) * sign > 0.0)
+                    .max_by(|&a, &b| {
+                        (planes[a].offset(&n) * sign).total_cmp(&(planes[b].offset(&n) * sign))
+                    })
+            };
+            let (hi, lo) = (outer(1.0), outer(-1.0));
+            if let (Some(hi), Some(lo)) = (hi, lo) {
+                let width = self.planes[hi].offset(&n) - self.planes[lo].offset(&n);
+                let (fl, fh) = (self.feature_of(lo), self.feature_of(hi));
+                self.push("distance", vec![fl, fh], size(width), &[]);
+            }
+            for &j in &along {
+                let gap = (self.planes[j].offset(&n) - self.planes[d].offset(&n)).abs();
+                let outermost = Some(j) == hi || Some(j) == lo;
+                if j == d || outermost || self.paired[j] || gap <= self.tol {
+                    continue;
+                }
+                let (fd, fj) = (self.feature_of(d), self.feature_of(j));
+                self.push("distance", vec![fd, fj], size(gap), &[]);
+            }
+        }
+    }
+
+    /// Holes and bosses: the diameter, and the position to the frame with a zone from
+    /// the axis's larger distance to the datum planes B and C.
+    fn holes(&mut self, cylinders: &[CylGroup]) {
+        let letters: Vec<char> = LETTERS[..self.frame.len()].to_vec();
+        let (mut partial, mut holes, mut bosses) = (0, 0, 0);
+        for g in cylinders {
+            if coverage_deg(g) < 300 {
+                partial += g.faces.len();
+                continue;
+            }
+            let name = if g.convex {
+                bosses += 1;
+                format!("boss_{bosses}")
+            } else {
+                holes += 1;
+                format!("hole_{holes}")
+            };
+            self.out.features.push((g.faces.clone(), name));
+            let f = self.out.features.len() - 1;
+            self.push("diameter", vec![f], size(2.0 * g.radius), &[]);
+            if letters.is_empty() {
+                continue;
+            }
+            let reach = self
+                .frame
+                .iter()
+                .skip(1)
+                .map(|&d| {
+                    (g.origin - self.planes[d].origin)
+                        .dot(&self.planes[d].normal)
+                        .abs()
+                })
+                .fold(0.0, f64::max);
+            let zone = 2.0 * iso2768_m(reach);
+            self.push(
+                "position",
+                vec![f],
+                format!("dia {} mm", fmt_num(zone)),
+                &letters,
+            );
+        }
+        if partial > 0 {
+            self.out.notes.push(format!(
+                "{partial} partial cylindrical face{} (fillets, rounded ends) not inspected",
+                if partial == 1 { "" } else { "s" }
+            ));
+        }
+    }
+}
+
+/// The letters of the frame's datums, in order.
+const LETTERS: [char; 3] = ['A', 'B', 'C'];
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn read(path: &str) -> CadPart {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+        let bytes = std::fs::read(&path).expect("the shared parts beside the repository");
+        crate::geometry::step::read(&bytes, crate::geometry::step::RESOLUTION).unwrap()
+    }
+
+    /// NIST CTC 01 without its PMI: a plate with Ø35 bores made of two half-cylinder
+    /// faces each (faces 90/91 and 76/77), found as holes with a size and a position.
+    #[test]
+    fn half_cylinders_make_one_hole_with_a_size_and_a_position() {
+        let part = read("../shared/parts/nist_ctc_01_asme1_ap242-e1.stp");
+        let d = default_inspection(&part).unwrap();
+        let hole = |faces: &[usize]| d.features.iter().position(|(f, _)| f == faces);
+        let bore_1 = hole(&[89, 90]).expect("faces 90 and 91 as one hole");
+        assert!(d.features[bore_1].1.starts_with("hole_"));
+        assert!(hole(&[75, 76]).is_some());
+        let of = |k: &str| {
+            d.tolerances
+                .iter()
+                .find(|t| t.keyword == k && t.features == [bore_1])
+                .map(|t| t.value.clone())
+        };
+        assert_eq!(of("diameter").as_deref(), Some("35 mm ± 0.3 mm"));
+        assert!(of("position").is_some_and(|v| v.starts_with("dia ")));
+        let letters: Vec<char> = d.datums.iter().map(|x| x.0).collect();
+        assert_eq!(letters, ['A', 'B', 'C']);
+    }
+
+    /// An MFCAD block (planes only): the facing walls of its slots pair up as widths,
+    /// its outer faces give its size along each datum's normal.
+    #[test]
+    fn facing_walls_are_slots_and_outer_faces_the_size() {
+        let mut part = read("../shared/parts/mfcad/0-0-0-2-5-23.step");
+        part.mesh.scale(10.0);
+        let d = default_inspection(&part).unwrap();
+        let widths = d.tolerances.iter().filter(|t| t.keyword == "width").count();
+        assert_eq!(widths, 3);
+        let sizes: Vec<&str> = d
+            .tolerances
+            .iter()
+            .filter(|t| t.keyword == "distance" && t.value.starts_with("100 mm"))
+            .map(|t| t.value.as_str())
+            .collect();
+        assert_eq!(sizes, ["100 mm ± 0.3 mm"; 3]);
+    }
 
     /// ISO 2768-1 table 1, class m, and ISO 2768-2 table 1, class K.
     #[test]

@@ -892,3 +892,34 @@ fn view_images_into_a_path_that_cannot_be_a_folder() {
     assert_eq!(code, 1);
     assert!(!images.exists(), "no folder for a run that writes nothing");
 }
+
+/// Issue 45: an MFCAD block (a 10 mm model of a 100 mm part, no PMI) imported with
+/// `--scale 10` gets a default inspection that builds with every tolerance measured; a
+/// scale out of range is refused before anything is read.
+#[test]
+fn a_part_without_pmi_is_imported_scaled_with_a_default_inspection_and_builds() {
+    common::require_shared_parts();
+    let dir = std::env::temp_dir().join(format!("inspc-mfcad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = dir.join("block.insp");
+    let spec = spec.to_string_lossy();
+    let step = "../shared/parts/mfcad/0-0-0-2-5-23.step";
+    let (code, _, stderr) = inspc(&["import", step, "--scale", "10", "-o", &spec]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("no PMI: a default inspection of"), "{stderr}");
+    let text = std::fs::read_to_string(&*spec).unwrap();
+    assert!(text.contains("100 × 100 × 100 mm"), "{text}");
+    assert!(text.contains("{ scale 10 }"), "{text}");
+    assert!(text.contains("DEFAULT INSPECTION"), "{text}");
+    let dmi = dir.join("block.dmi");
+    let (code, stdout, stderr) = inspc(&["build", &spec, "-o", &dmi.to_string_lossy()]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    assert!(
+        stdout.contains("tolerances measured 23 of 23"),
+        "{stdout}{stderr}"
+    );
+    let (code, _, stderr) = inspc(&["import", step, "--scale", "0"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("a scale runs from 0.001 to 1000"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
