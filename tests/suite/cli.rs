@@ -906,7 +906,10 @@ fn a_part_without_pmi_is_imported_scaled_with_a_default_inspection_and_builds() 
     let step = "../shared/parts/mfcad/0-0-0-2-5-23.step";
     let (code, _, stderr) = inspc(&["import", step, "--scale", "10", "-o", &spec]);
     assert_eq!(code, 0, "{stderr}");
-    assert!(stderr.contains("no PMI: a default inspection of"), "{stderr}");
+    assert!(
+        stderr.contains("no PMI: a default inspection of"),
+        "{stderr}"
+    );
     let text = std::fs::read_to_string(&*spec).unwrap();
     assert!(text.contains("100 × 100 × 100 mm"), "{text}");
     assert!(text.contains("{ scale 10 }"), "{text}");
@@ -920,6 +923,9 @@ fn a_part_without_pmi_is_imported_scaled_with_a_default_inspection_and_builds() 
     );
     let (code, _, stderr) = inspc(&["import", step, "--scale", "0"]);
     assert_eq!(code, 2, "{stderr}");
-    assert!(stderr.contains("a scale runs from 0.001 to 1000"), "{stderr}");
+    assert!(
+        stderr.contains("a scale runs from 0.001 to 1000"),
+        "{stderr}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -435,6 +435,15 @@ impl ParamScale {
     }
 }
 
+/// A point of the scaled parameter plane as the triangulation takes it. spade refuses
+/// coordinates below 1.8e-43 in magnitude but not 0 (`InsertionError::TooSmall`); a
+/// parameter that small is rounding noise of a zero (MFCAD's files carry such values)
+/// and becomes 0.
+fn plane_point(q: [f64; 2]) -> Point2<f64> {
+    let flush = |x: f64| if x.abs() < 1e-30 { 0.0 } else { x };
+    Point2::new(flush(q[0]), flush(q[1]))
+}
+
 /// The constrained Delaunay triangulation of a face's bounds (`polygons`) in its
 /// scaled parameter plane, every bound segment a constraint; an error when a point
 /// cannot be inserted or bounds cross.
@@ -446,7 +455,7 @@ fn bounds_triangulation(polygons: &[Vec<Pt>], scale: &ParamScale) -> Result<Cdt,
             let q = scale.scaled(p.uv);
             let h = cdt
                 .insert(Vert {
-                    pos: Point2::new(q[0], q[1]),
+                    pos: plane_point(q),
                     xyz: p.xyz,
                 })
                 .map_err(|e| format!("a bound point cannot be triangulated ({e:?})"))?;
@@ -494,7 +503,7 @@ fn refine(cdt: &mut Cdt, s: &Surf, scale: &ParamScale, res: Resolution) -> Resul
             let uv = scale.unscale(c);
             let xyz = s.eval(uv[0], uv[1]);
             cdt.insert(Vert {
-                pos: Point2::new(c[0], c[1]),
+                pos: plane_point(c),
                 xyz,
             })
             .map_err(|e| format!("an inner point cannot be triangulated ({e:?})"))?;
