@@ -17,7 +17,10 @@ pub fn hover(a: &Analysis, file: FileId, offset: usize) -> Option<(Span, String)
         return face_ref(a, file, offset);
     };
     let all = decls(checked);
-    let mut d = all.iter().find(|d| d.name.span == decl)?;
+    // A name bound to no declaration of ours (`stock` in `stock.top`): the reference.
+    let Some(mut d) = all.iter().find(|d| d.name.span == decl) else {
+        return face_ref(a, file, offset);
+    };
     let model = &checked.model;
     let mut o = String::new();
     if d.kind == DeclKind::Label {

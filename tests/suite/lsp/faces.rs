@@ -63,6 +63,9 @@ fn a_stock_part_completes_roles_and_hovers_its_face_references() {
     assert!(top.contains("stock.top"), "{top}");
     assert!(top.contains("stock.top**: plane"), "{top}");
     assert!(top.contains("mm²") && top.contains("points"), "{top}");
+    // On `stock` itself, the same.
+    let on_stock = hover_text(&mut c, &uri, pos(&text, "stock.top", 0, 1));
+    assert_eq!(on_stock, top);
     let walls = hover_text(&mut c, &uri, pos(&text, "large.walls", 0, 1));
     assert!(
         walls.contains("large.left_wall") && walls.contains("large.right_wall"),
