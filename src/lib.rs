@@ -27,7 +27,8 @@
 //! **Decision: the path stage is one more test.** A touch the planner validated but no
 //! collision-free move reaches (the roadmap finds no way in, or no way up to the
 //! clearance plane) bans that configuration (point, probe, setup, probe direction), and
-//! the plan is made again with it failing validation, at most `REPLANS` (3) times
+//! the plan is made again with it failing validation (a point, probe and setup that fail
+//! a second time, in every direction: `plan::Ban::widen`), at most `REPLANS` (3) times
 //! (`paths_of`); the diagnostics of the last try are the ones reported. A re-plan
 //! reuses the first planning's pure results (`plan::Memo`: cones, D2 caps, depth maps,
 //! grid orientations, the scene), so it costs clustering and validation only: one
@@ -568,6 +569,7 @@ fn paths_of(
                 }
                 break;
             }
+            let bans = plan::Ban::widen(bans, &bans_all);
             bans_all.extend(bans);
             if attempt == REPLANS {
                 memo.give_up_turned();

@@ -282,6 +282,7 @@ fn no_path(input: &Input, b: &BlockPath, g: &GroupIn, why: NoWay, points: Vec<us
             probe: g.slot.0,
             up: g.up,
             dir: g.dir,
+            any_dir: false,
         })
         .collect();
     let error = Box::new(PathError::NoPath {

@@ -37,6 +37,9 @@ pub struct Ban {
     pub up: V3,
     /// The probe direction, tip to head.
     pub dir: V3,
+    /// Every direction of the probe at the point in this setup, not only `dir`: the
+    /// path stage failed there twice ([`Ban::widen`]).
+    pub any_dir: bool,
 }
 
 impl Ban {
@@ -47,7 +50,22 @@ impl Ban {
         self.point == point
             && self.probe == probe
             && (self.up - up).norm() < eps
-            && (self.dir - dir).norm() < eps
+            && (self.any_dir || (self.dir - dir).norm() < eps)
+    }
+
+    /// The bans of a path failure, given those of the failures before: a point, probe
+    /// and setup that failed before with another direction is banned in every
+    /// direction. A re-plan that only turns the head for the same touch tends to turn
+    /// it to a neighbour that fails the same way (a horizontal stylus in a narrow
+    /// vertical passage, at another azimuth); the second failure says the probe does
+    /// not get there in this setup, so the next re-plan takes another probe or setup.
+    pub fn widen(new: Vec<Ban>, before: &[Ban]) -> Vec<Ban> {
+        new.into_iter()
+            .map(|mut b| {
+                b.any_dir |= before.iter().any(|o| o.is(b.point, b.probe, &b.up, &o.dir));
+                b
+            })
+            .collect()
     }
 }
 
@@ -88,5 +106,37 @@ impl Input<'_> {
                 .position(|p| std::ptr::eq(p, self.plan))
                 .unwrap_or(0),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Ban, V3};
+
+    fn ban(point: usize, dir: V3) -> Ban {
+        Ban {
+            point,
+            probe: 0,
+            up: V3::z(),
+            dir,
+            any_dir: false,
+        }
+    }
+
+    /// A second failure of a point, probe and setup bans every direction there; a
+    /// first failure, or another point's, bans only its direction.
+    #[test]
+    fn a_second_failure_of_a_touch_bans_every_direction_of_its_probe() {
+        let first = Ban::widen(vec![ban(7, V3::x())], &[]);
+        assert!(!first[0].any_dir);
+        assert!(!first[0].is(7, 0, &V3::z(), &V3::y()));
+        let second = Ban::widen(vec![ban(7, V3::y()), ban(8, V3::y())], &first);
+        assert!(second[0].any_dir);
+        assert!(second[0].is(7, 0, &V3::z(), &-V3::x()));
+        assert!(
+            !second[0].is(7, 1, &V3::z(), &-V3::x()),
+            "another probe stays free"
+        );
+        assert!(!second[1].any_dir);
     }
 }

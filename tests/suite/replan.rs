@@ -18,6 +18,7 @@ fn configurations(h: &Hlip) -> Vec<Ban> {
                             probe: p.probe.0,
                             up: s.up,
                             dir: o.direction,
+                            any_dir: false,
                         });
                     }
                 }
