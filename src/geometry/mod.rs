@@ -108,52 +108,21 @@ impl Surface {
     /// The surface scaled by `s` about the origin (a spec's `mesh "…" { scale s }`):
     /// points and radii scale, directions and angles stay.
     pub fn scaled(&self, s: f64) -> Surface {
-        match self.clone() {
-            Surface::Plane { origin, normal } => Surface::Plane {
-                origin: origin * s,
-                normal,
-            },
-            Surface::Cylinder {
-                origin,
-                axis,
-                radius,
-                convex,
-            } => Surface::Cylinder {
-                origin: origin * s,
-                axis,
-                radius: radius * s,
-                convex,
-            },
-            Surface::Cone {
-                apex,
-                axis,
-                half_angle,
-                convex,
-            } => Surface::Cone {
-                apex: apex * s,
-                axis,
-                half_angle,
-                convex,
-            },
-            Surface::Sphere {
-                center,
-                radius,
-                convex,
-            } => Surface::Sphere {
-                center: center * s,
-                radius: radius * s,
-                convex,
-            },
-            Surface::Freeform => Surface::Freeform,
-        }
+        self.mapped(|p| p * s, |v| v, s)
     }
 
     /// The surface under a rigid motion `m`.
     pub fn moved(&self, m: &nalgebra::Isometry3<f64>) -> Surface {
+        self.mapped(|p| m * p, |v| m * v, 1.0)
+    }
+
+    /// The surface under a similarity: `point` maps its points, `dir` its directions,
+    /// and lengths (radii) are multiplied by `length`; angles and sense stay.
+    fn mapped(&self, point: impl Fn(P3) -> P3, dir: impl Fn(V3) -> V3, length: f64) -> Surface {
         match self.clone() {
             Surface::Plane { origin, normal } => Surface::Plane {
-                origin: m * origin,
-                normal: m * normal,
+                origin: point(origin),
+                normal: dir(normal),
             },
             Surface::Cylinder {
                 origin,
@@ -161,9 +130,9 @@ impl Surface {
                 radius,
                 convex,
             } => Surface::Cylinder {
-                origin: m * origin,
-                axis: m * axis,
-                radius,
+                origin: point(origin),
+                axis: dir(axis),
+                radius: radius * length,
                 convex,
             },
             Surface::Cone {
@@ -172,8 +141,8 @@ impl Surface {
                 half_angle,
                 convex,
             } => Surface::Cone {
-                apex: m * apex,
-                axis: m * axis,
+                apex: point(apex),
+                axis: dir(axis),
                 half_angle,
                 convex,
             },
@@ -182,8 +151,8 @@ impl Surface {
                 radius,
                 convex,
             } => Surface::Sphere {
-                center: m * center,
-                radius,
+                center: point(center),
+                radius: radius * length,
                 convex,
             },
             Surface::Freeform => Surface::Freeform,

@@ -85,12 +85,11 @@ pub(super) fn iso2768_k_flatness(length: f64) -> f64 {
         .map_or(0.8, |r| r.1)
 }
 
-/// One face of the solid: its exact surface, area, centroid and vertices.
+/// One face of the solid: its exact surface, area, centroid and triangles.
 struct FaceInfo {
     surface: Surface,
     area: f64,
     centroid: P3,
-    vertices: Vec<P3>,
     triangles: Vec<[P3; 3]>,
 }
 
@@ -102,7 +101,6 @@ fn faces_of(part: &CadPart) -> Vec<FaceInfo> {
             surface: m.exact[k].clone(),
             area: 0.0,
             centroid: P3::origin(),
-            vertices: Vec::new(),
             triangles: Vec::new(),
         })
         .collect();
@@ -115,7 +113,6 @@ fn faces_of(part: &CadPart) -> Vec<FaceInfo> {
         let a = (p[1] - p[0]).cross(&(p[2] - p[0])).norm() / 2.0;
         f.area += a;
         weighted[g as usize] += (p[0].coords + p[1].coords + p[2].coords) * (a / 3.0);
-        f.vertices.extend(p);
         f.triangles.push(p);
     }
     for (f, w) in out.iter_mut().zip(weighted) {
@@ -172,14 +169,14 @@ fn plane_groups(faces: &[FaceInfo], tol: f64) -> Vec<PlaneGroup> {
             Some(g) => {
                 g.faces.push(k);
                 g.area += f.area;
-                g.vertices.extend(&f.vertices);
+                g.vertices.extend(f.triangles.iter().flatten());
             }
             None => out.push(PlaneGroup {
                 faces: vec![k],
                 normal,
                 origin,
                 area: f.area,
-                vertices: f.vertices.clone(),
+                vertices: f.triangles.iter().flatten().copied().collect(),
             }),
         }
     }

@@ -162,6 +162,9 @@ fn op_faces(a: &Analysis, part: usize, op: &str) -> String {
     format!("faces {}", names.join(", "))
 }
 
+/// What a hover says while the geometry of the current text is on its way.
+const BEING_BUILT: &str = "_The geometry is being built._";
+
 /// A part's geometry in the analysis's geometry stage, found by the part's name (the
 /// stage may be of an earlier version of the text, whose parts sit elsewhere).
 struct Geo<'a> {
@@ -175,8 +178,7 @@ struct Geo<'a> {
 /// is none yet. "See the diagnostics" only where there are some: a stage of an earlier
 /// version is still being replaced.
 fn geometry_of(a: &Analysis, part: usize) -> Result<Geo<'_>, &'static str> {
-    let being_built = "_The geometry is being built._";
-    let deep = a.deep.as_ref().ok_or(being_built)?;
+    let deep = a.deep.as_ref().ok_or(BEING_BUILT)?;
     let name = &a.front.model.parts[part].name;
     let found = deep
         .checked
@@ -188,7 +190,7 @@ fn geometry_of(a: &Analysis, part: usize) -> Result<Geo<'_>, &'static str> {
         return Ok(Geo { deep, k, data });
     }
     if deep.version != a.version {
-        Err(being_built)
+        Err(BEING_BUILT)
     } else if deep.checked.has_errors() {
         Err("_No geometry while the spec has errors: see the diagnostics._")
     } else {
@@ -208,7 +210,7 @@ fn feature_faces(a: &Analysis, part: usize, feature: usize, o: &mut String) {
     let name = &a.front.model.parts[part].features[feature].name;
     let model_part = &geo.deep.checked.model.parts[geo.k];
     let Some(feature) = model_part.features.iter().position(|f| &f.name == name) else {
-        let _ = writeln!(o, "\n_The geometry is being built._");
+        let _ = writeln!(o, "\n{BEING_BUILT}");
         return;
     };
     let _ = writeln!(o);
@@ -275,7 +277,7 @@ fn face_ref(a: &Analysis, file: FileId, offset: usize) -> Option<(Span, String)>
     // geometry stage of this version resolves it.
     let geo = geometry_of(a, k).and_then(|g| match g.deep.version == a.version {
         true => Ok(g),
-        false => Err("_The geometry is being built._"),
+        false => Err(BEING_BUILT),
     });
     match geo {
         Ok(geo) => {
