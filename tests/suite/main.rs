@@ -7,6 +7,7 @@ mod common;
 mod access;
 mod architecture;
 mod cad_hostile;
+mod cad_kinds;
 mod cases;
 mod catalogue;
 mod cli;

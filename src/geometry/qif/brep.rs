@@ -259,7 +259,10 @@ fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Option<P3>), Qi
         what: format!("curve {}", c.name.trim_end_matches("Core")),
     };
     match c.name.as_str() {
-        "Segment13Core" => Ok((Curve::Line, Some(d.point(c, "StartPoint")?))),
+        "Segment13Core" => {
+            let (a, b) = (d.point(c, "StartPoint")?, d.point(c, "EndPoint")?);
+            Ok((Curve::Line(a, b - a), Some(a)))
+        }
         "ArcCircular13Core" => {
             let r = d.length(c, "Radius")?;
             positive(c, r, "its radius")?;
@@ -272,6 +275,11 @@ fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Option<P3>), Qi
             let t0 = domain(c).map_or(0.0, |dm| dm.0);
             let curve = Curve::Circle(f, r);
             let start = curve.eval(t0);
+            Ok((curve, Some(start)))
+        }
+        "ArcConic13Core" => {
+            let curve = conic(d, c)?;
+            let start = curve.eval(domain(c).map_or(0.0, |dm| dm.0));
             Ok((curve, Some(start)))
         }
         "Nurbs13Core" => {
@@ -365,6 +373,40 @@ fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Option<P3>), Qi
     }
 }
 
+/// A conic arc's curve. QIF 3's schema (Geometry.xsd, `ArcConic13CoreType`) names `A`
+/// and `B` the conic's "major" and "minor diameter", as its circles, cylinders and tori
+/// give diameters, and puts the conic in the plane of `Normal` starting along `DirBeg`;
+/// it gives no formula, so ISO 10303-42's parametrisations are taken with the
+/// semi-axes (for a parabola the focal distance) `A/2` and `B/2`. The edge's vertices
+/// must then lie on the curve ([`edge`] checks): a reading that disagrees with the
+/// file's own topology stops instead of meshing a wrong face.
+fn conic(d: &Doc, c: &Node) -> Result<Curve, QifError> {
+    let a = d.length(c, "A")? / 2.0;
+    positive(c, a, "its A")?;
+    let f = frame(
+        c,
+        d.point(c, "Center")?,
+        vec3(c, "Normal")?,
+        Some(vec3(c, "DirBeg")?),
+    )?;
+    match c.attr("form") {
+        Some("PARABOLA") => Ok(Curve::Parabola(f, a)),
+        Some(form @ ("ELLIPSE" | "HYPERBOLA")) => {
+            let b = d.length(c, "B")? / 2.0;
+            positive(c, b, "its B")?;
+            Ok(if form == "ELLIPSE" {
+                Curve::Ellipse(f, a, b)
+            } else {
+                Curve::Hyperbola(f, a, b)
+            })
+        }
+        _ => Err(malformed(
+            c,
+            "its form is not PARABOLA, ELLIPSE or HYPERBOLA",
+        )),
+    }
+}
+
 /// A sub-curve of an aggregate as points along its domain, fine enough for any chord
 /// tolerance the tessellator is asked for (a 0.02 rad step on arcs, 32 points a span on
 /// B-splines).
@@ -374,8 +416,9 @@ fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Option<P3>), Qi
 /// [`MAX_SAMPLES`] points, so their cost follows the file's size.
 fn sample(curve: &Curve, c: &Node, d: &Doc) -> Result<Vec<P3>, QifError> {
     let count = match curve {
-        Curve::Line => 2,
+        Curve::Line(..) => 2,
         Curve::Polyline(p) => p.len(),
+        Curve::Parabola(..) | Curve::Hyperbola(..) => 65,
         Curve::Circle(..) | Curve::Ellipse(..) => {
             let (a, b) = domain(c).ok_or_else(|| malformed(c, "it has no domain"))?;
             let sweep = (b - a).abs();
@@ -396,9 +439,9 @@ fn sample(curve: &Curve, c: &Node, d: &Doc) -> Result<Vec<P3>, QifError> {
         }
     }
     Ok(match curve {
-        Curve::Line => vec![d.point(c, "StartPoint")?, d.point(c, "EndPoint")?],
+        Curve::Line(a, d) => vec![*a, a + d],
         Curve::Polyline(p) => p.to_vec(),
-        Curve::Circle(..) | Curve::Ellipse(..) => {
+        Curve::Circle(..) | Curve::Ellipse(..) | Curve::Parabola(..) | Curve::Hyperbola(..) => {
             let (a, b) = domain(c).ok_or_else(|| malformed(c, "it has no domain"))?;
             let n = count - 1;
             (0..=n)
@@ -560,6 +603,17 @@ fn edge(d: &Doc, e: &Node) -> Result<Edge, QifError> {
             read
         }
     };
+    if let Curve::Ellipse(..) | Curve::Parabola(..) | Curve::Hyperbola(..) = curve {
+        for p in [start, end] {
+            let off = (curve.eval(curve.param(&p)) - p).norm();
+            if off > 1e-3 {
+                return Err(malformed(
+                    e,
+                    &format!("its vertex lies {off:.3} mm off its conic arc (semi-axes read as half of <A> and <B>)"),
+                ));
+            }
+        }
+    }
     let same_sense = match curve_start {
         Some(s) => (s - start).norm() <= (s - end).norm() + 1e-9,
         None => true,

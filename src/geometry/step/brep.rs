@@ -9,9 +9,11 @@
 //! and a face a shell lists twice is one face, so that the B-rep grows with the file,
 //! not with how often the file names an instance.
 
+use super::canon::{canonical, revolution_axis};
 use super::geom::{BSplineCurve, BSplineSurface, Curve, Frame, Knots, Surf};
 use super::p21::{Instance, Param, Record, P21};
 use super::refs::{Memo, Trail};
+use super::swept::{Extrusion, Offset, Revolution};
 use super::StepError;
 use crate::geometry::{P3, V3};
 use std::collections::{HashMap, HashSet};
@@ -365,6 +367,27 @@ impl<'a> Reader<'a> {
         Ok(V3::new(x, y, z))
     }
 
+    /// A `VECTOR`: its direction times its magnitude (a length).
+    fn vector(&self, id: u64, from: u64) -> Result<V3, StepError> {
+        let rec = self.rec(id, from, "VECTOR")?;
+        let d = self
+            .direction(self.reference(id, rec, 1)?, id)?
+            .try_normalize(1e-300)
+            .ok_or_else(|| self.bad(id, "a vector's direction is zero"))?;
+        Ok(d * self.length(id, rec, 2)?)
+    }
+
+    /// An `AXIS1_PLACEMENT`: a point and its axis (z when left out).
+    fn axis1(&self, id: u64, from: u64) -> Result<(P3, V3), StepError> {
+        let rec = self.rec(id, from, "AXIS1_PLACEMENT")?;
+        let o = self.point(self.reference(id, rec, 1)?, id)?;
+        let z = match self.param(id, rec, 2)? {
+            Param::Ref(d) => self.direction(*d, id)?,
+            _ => V3::z(),
+        };
+        Ok((o, z))
+    }
+
     fn frame(&self, id: u64, from: u64) -> Result<Frame, StepError> {
         let rec = self.rec(id, from, "AXIS2_PLACEMENT_3D")?;
         let o = self.point(self.reference(id, rec, 1)?, id)?;
@@ -435,12 +458,26 @@ impl<'a> Reader<'a> {
             let orientation = self.boolean(bid, brec, 2)?;
             bounds.push(self.bound(lid, bid, orientation)?);
         }
+        let (surface, flip) = canonical(&surface, &self.bound_points(&bounds));
         Ok(Face {
             id,
             surface,
-            same_sense,
+            same_sense: same_sense != flip,
             bounds,
         })
+    }
+
+    /// The vertices of a face's bounds, where its sense can be compared.
+    fn bound_points(&self, bounds: &[Bound]) -> Vec<P3> {
+        bounds
+            .iter()
+            .filter_map(|b| match b {
+                Bound::Edges(list) => Some(list),
+                Bound::Vertex => None,
+            })
+            .flatten()
+            .flat_map(|(e, _)| [self.edges[*e].start, self.edges[*e].end])
+            .collect()
     }
 
     fn bound(&mut self, lid: u64, from: u64, orientation: bool) -> Result<Bound, StepError> {
@@ -505,8 +542,9 @@ impl<'a> Reader<'a> {
 
     fn read_curve(&self, id: u64, from: u64) -> Result<Curve, StepError> {
         let inst = self.inst(id, Some(from))?;
-        if inst.is("LINE") {
-            return Ok(Curve::Line);
+        if let Some(r) = inst.record("LINE") {
+            let o = self.point(self.reference(id, r, 1)?, id)?;
+            return Ok(Curve::Line(o, self.vector(self.reference(id, r, 2)?, id)?));
         }
         if let Some(r) = inst.record("CIRCLE") {
             let f = self.frame(self.reference(id, r, 1)?, id)?;
@@ -515,6 +553,18 @@ impl<'a> Reader<'a> {
         if let Some(r) = inst.record("ELLIPSE") {
             let f = self.frame(self.reference(id, r, 1)?, id)?;
             return Ok(Curve::Ellipse(
+                f,
+                self.length(id, r, 2)?,
+                self.length(id, r, 3)?,
+            ));
+        }
+        if let Some(r) = inst.record("PARABOLA") {
+            let f = self.frame(self.reference(id, r, 1)?, id)?;
+            return Ok(Curve::Parabola(f, self.length(id, r, 2)?));
+        }
+        if let Some(r) = inst.record("HYPERBOLA") {
+            let f = self.frame(self.reference(id, r, 1)?, id)?;
+            return Ok(Curve::Hyperbola(
                 f,
                 self.length(id, r, 2)?,
                 self.length(id, r, 3)?,
@@ -549,6 +599,20 @@ impl<'a> Reader<'a> {
             line: inst.line,
             what: format!("curve {}", inst.type_name()),
         })
+    }
+
+    /// The curve a surface sweeps: any curve inspc evaluates but a polyline, whose
+    /// sweep has no exact inverse here.
+    fn swept_curve(&self, id: u64, line: usize, curve: u64) -> Result<Curve, StepError> {
+        let c = self.trail.follow(id, line, || self.curve(curve, id))?;
+        if matches!(c, Curve::Polyline(_)) {
+            return Err(StepError::Unsupported {
+                id,
+                line,
+                what: "surface swept from a polyline".into(),
+            });
+        }
+        Ok(c)
     }
 
     fn points(&self, id: u64, l: &[Param]) -> Result<Vec<P3>, StepError> {
@@ -683,6 +747,41 @@ impl<'a> Reader<'a> {
             return self
                 .bspline_surface(id, inst)
                 .map(|s| Surf::BSpline(Arc::new(s)));
+        }
+        if let Some(r) = inst.record("SURFACE_OF_LINEAR_EXTRUSION") {
+            let curve = self.swept_curve(id, inst.line, self.reference(id, r, 1)?)?;
+            let dir = self
+                .vector(self.reference(id, r, 2)?, id)?
+                .try_normalize(1e-300)
+                .ok_or_else(|| self.bad(id, "the extrusion's vector is zero"))?;
+            return Ok(Surf::Extrusion(Arc::new(Extrusion { curve, dir })));
+        }
+        if let Some(r) = inst.record("SURFACE_OF_REVOLUTION") {
+            let curve = self.swept_curve(id, inst.line, self.reference(id, r, 1)?)?;
+            let (o, z) = self.axis1(self.reference(id, r, 2)?, id)?;
+            let axis = revolution_axis(o, z, &curve).ok_or_else(|| {
+                self.bad(
+                    id,
+                    "the revolved curve lies on its axis, or the axis is zero",
+                )
+            })?;
+            return Ok(Surf::Revolution(Arc::new(Revolution { curve, axis })));
+        }
+        if let Some(r) = inst.record("OFFSET_SURFACE") {
+            let inner = self.reference(id, r, 1)?;
+            let base = self
+                .trail
+                .follow(id, inst.line, || self.surface(inner, id))?;
+            let distance = self.real(id, r, 2)? * self.unit;
+            if !distance.is_finite() {
+                return Err(self.bad(id, format!("an offset cannot be {distance} mm")));
+            }
+            return Ok(Surf::Offset(Arc::new(Offset { base, distance })));
+        }
+        if let Some(r) = inst.record("RECTANGULAR_TRIMMED_SURFACE") {
+            // The face's bounds trim it: the basis surface is the geometry.
+            let inner = self.reference(id, r, 1)?;
+            return self.trail.follow(id, inst.line, || self.surface(inner, id));
         }
         Err(StepError::Unsupported {
             id,

@@ -5,6 +5,7 @@
 //! (away from a cylinder's, cone's, sphere's or torus's axis or centre); angles are
 //! radians, lengths millimetres.
 
+use super::swept::{Extrusion, Offset, Revolution};
 use crate::geometry::{P3, V3};
 use std::f64::consts::{FRAC_PI_2, TAU};
 use std::sync::Arc;
@@ -38,12 +39,12 @@ impl Frame {
     }
 
     /// Local coordinates of `p`.
-    fn local(&self, p: &P3) -> V3 {
+    pub(crate) fn local(&self, p: &P3) -> V3 {
         let d = p - self.o;
         V3::new(d.dot(&self.x), d.dot(&self.y), d.dot(&self.z))
     }
 
-    fn at(&self, x: f64, y: f64, z: f64) -> P3 {
+    pub(crate) fn at(&self, x: f64, y: f64, z: f64) -> P3 {
         self.o + self.x * x + self.y * y + self.z * z
     }
 }
@@ -210,6 +211,23 @@ pub(crate) struct BSplineSurface {
 }
 
 impl BSplineSurface {
+    /// The ends of v where the surface closes to a point (a revolved profile that
+    /// reaches its axis, a sphere made a B-spline): u is undefined there.
+    pub(crate) fn poles(&self) -> Vec<f64> {
+        let (u0, u1) = self.u.range();
+        let (v0, v1) = self.v.range();
+        [v0, v1]
+            .into_iter()
+            .filter(|&v| {
+                let first = self.eval(u0, v);
+                (1..8).all(|k| {
+                    let u = u0 + (u1 - u0) * k as f64 / 8.0;
+                    (self.eval(u, v) - first).norm() < 1e-7
+                })
+            })
+            .collect()
+    }
+
     /// The point at `(u, v)`.
     pub fn eval(&self, u: f64, v: f64) -> P3 {
         let wrap = |t: f64, k: &Knots, closed: bool| {
@@ -236,15 +254,19 @@ impl BSplineSurface {
     }
 }
 
-/// An edge's curve.
+/// An edge's curve (ISO 10303-42 § 4.4 parametrisations).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Curve {
-    /// A straight line (the edge runs between its vertices).
-    Line,
+    /// A straight line: a point and the vector one unit of parameter moves along it.
+    Line(P3, V3),
     /// A circle in the frame's xy plane, parametrised by angle from x.
     Circle(Frame, f64),
     /// An ellipse: semi-axes along x and y.
     Ellipse(Frame, f64, f64),
+    /// A parabola with this focal distance: `C + f·(t²·x + 2t·y)`.
+    Parabola(Frame, f64),
+    /// One branch of a hyperbola with these semi-axes: `C + a·cosh t·x + b·sinh t·y`.
+    Hyperbola(Frame, f64, f64),
     /// A B-spline curve (shared: every edge on it holds the one read).
     BSpline(Arc<BSplineCurve>),
     /// A polyline through these points (shared likewise).
@@ -252,19 +274,23 @@ pub(crate) enum Curve {
 }
 
 impl Curve {
-    /// The point at parameter `t` (not for lines and polylines).
+    /// The point at parameter `t` (not for polylines).
     pub fn eval(&self, t: f64) -> P3 {
         match self {
+            Curve::Line(o, d) => o + d * t,
             Curve::Circle(f, r) => f.at(r * t.cos(), r * t.sin(), 0.0),
             Curve::Ellipse(f, a, b) => f.at(a * t.cos(), b * t.sin(), 0.0),
+            Curve::Parabola(f, focal) => f.at(focal * t * t, 2.0 * focal * t, 0.0),
+            Curve::Hyperbola(f, a, b) => f.at(a * t.cosh(), b * t.sinh(), 0.0),
             Curve::BSpline(c) => c.eval(t),
-            Curve::Line | Curve::Polyline(_) => P3::origin(),
+            Curve::Polyline(_) => P3::origin(),
         }
     }
 
     /// The parameter of (the point of the curve nearest) `p`.
     pub fn param(&self, p: &P3) -> f64 {
         match self {
+            Curve::Line(o, d) => (p - o).dot(d) / d.norm_squared().max(1e-300),
             Curve::Circle(f, _) => {
                 let l = f.local(p);
                 l.y.atan2(l.x)
@@ -273,39 +299,92 @@ impl Curve {
                 let l = f.local(p);
                 (l.y / b).atan2(l.x / a)
             }
+            Curve::Parabola(f, focal) => f.local(p).y / (2.0 * focal),
+            Curve::Hyperbola(f, _, b) => (f.local(p).y / b).asinh(),
             Curve::BSpline(c) => nearest_param(|t| c.eval(t), c.knots.range(), p),
-            Curve::Line | Curve::Polyline(_) => 0.0,
+            Curve::Polyline(_) => 0.0,
+        }
+    }
+
+    /// The span of parameters the curve is defined over: a B-spline's knots, one turn
+    /// of a closed conic, a bounded stretch of the open ones (searches stay in it).
+    pub fn range(&self) -> (f64, f64) {
+        match self {
+            Curve::BSpline(c) => c.knots.range(),
+            Curve::Circle(..) | Curve::Ellipse(..) => (-std::f64::consts::PI, std::f64::consts::PI),
+            Curve::Hyperbola(..) => (-30.0, 30.0),
+            Curve::Line(..) | Curve::Parabola(..) | Curve::Polyline(_) => (-1e6, 1e6),
+        }
+    }
+
+    /// The period of the parameter, for a curve that closes on itself.
+    pub fn period(&self) -> Option<f64> {
+        match self {
+            Curve::Circle(..) | Curve::Ellipse(..) => Some(TAU),
+            Curve::BSpline(c) => {
+                let (a, b) = c.knots.range();
+                let span = (c.eval(b) - c.eval(a)).norm();
+                (span < 1e-9 * (1.0 + c.eval(a).coords.norm())).then_some(b - a)
+            }
+            _ => None,
+        }
+    }
+
+    /// The frame whose xy plane holds a conic.
+    pub fn plane(&self) -> Option<&Frame> {
+        match self {
+            Curve::Circle(f, _)
+            | Curve::Ellipse(f, ..)
+            | Curve::Parabola(f, _)
+            | Curve::Hyperbola(f, ..) => Some(f),
+            _ => None,
         }
     }
 }
 
 /// The parameter in `range` whose point is nearest `p`: a dense scan, then golden-section
-/// refinement around the best sample.
+/// refinement around the best sample (and around the other end too when the best is an
+/// end: on a closed curve both ends are the same point, and the nearest parameter may
+/// lie just inside either).
 pub(crate) fn nearest_param(f: impl Fn(f64) -> P3, (a, b): (f64, f64), p: &P3) -> f64 {
     const N: usize = 64;
     let d = |t: f64| (f(t) - p).norm_squared();
     let step = (b - a) / N as f64;
-    let (mut best, mut bd) = (a, f64::INFINITY);
+    let (mut best, mut bd) = (0, f64::INFINITY);
     for i in 0..=N {
-        let t = a + step * i as f64;
-        let dt = d(t);
+        let dt = d(a + step * i as f64);
         if dt < bd {
             bd = dt;
-            best = t;
+            best = i;
         }
     }
-    let (mut lo, mut hi) = ((best - step).max(a), (best + step).min(b));
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    for _ in 0..60 {
-        let m1 = hi - g * (hi - lo);
-        let m2 = lo + g * (hi - lo);
-        if d(m1) < d(m2) {
-            hi = m2;
-        } else {
-            lo = m1;
+    let golden = |k: usize| {
+        let t = a + step * k as f64;
+        let (mut lo, mut hi) = ((t - step).max(a), (t + step).min(b));
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        for _ in 0..60 {
+            let m1 = hi - g * (hi - lo);
+            let m2 = lo + g * (hi - lo);
+            if d(m1) < d(m2) {
+                hi = m2;
+            } else {
+                lo = m1;
+            }
         }
+        0.5 * (lo + hi)
+    };
+    let t = golden(best);
+    let other = match best {
+        0 => N,
+        k if k == N => 0,
+        _ => return t,
+    };
+    let t2 = golden(other);
+    if d(t2) < d(t) {
+        t2
+    } else {
+        t
     }
-    0.5 * (lo + hi)
 }
 
 /// A face's surface.
@@ -323,6 +402,12 @@ pub enum Surf {
     Torus(Frame, f64, f64),
     /// A B-spline surface (shared: every face on it holds the one read).
     BSpline(Arc<BSplineSurface>),
+    /// A curve swept along a vector (one not read as a plane or cylinder).
+    Extrusion(Arc<Extrusion>),
+    /// A curve revolved about an axis (one not read as an analytic surface).
+    Revolution(Arc<Revolution>),
+    /// A surface grown along its normal (one not read as an analytic surface).
+    Offset(Arc<Offset>),
 }
 
 impl Surf {
@@ -341,6 +426,19 @@ impl Surf {
                 f.at(rr * u.cos(), rr * u.sin(), small * v.sin())
             }
             Surf::BSpline(s) => s.eval(u, v),
+            Surf::Extrusion(e) => e.eval(u, v),
+            Surf::Revolution(r) => r.eval(u, v),
+            Surf::Offset(o) => o.eval(u, v),
+        }
+    }
+
+    /// Whether the surface's inverse is a search that a nearby parameter pair speeds up
+    /// (tessellation passes each bound point's as the next one's hint).
+    pub(crate) fn takes_hint(&self) -> bool {
+        match self {
+            Surf::BSpline(_) | Surf::Extrusion(_) | Surf::Revolution(_) => true,
+            Surf::Offset(o) => o.base.takes_hint(),
+            _ => false,
         }
     }
 
@@ -367,6 +465,9 @@ impl Surf {
                 (l.y.atan2(l.x), l.z.atan2(rho - big))
             }
             Surf::BSpline(s) => bspline_param(s, p, hint),
+            Surf::Extrusion(e) => e.param(p, hint.map(|h| h.0)),
+            Surf::Revolution(r) => r.param(p, hint.map(|h| h.1)),
+            Surf::Offset(o) => o.base.param(p, hint),
         }
     }
 
@@ -391,9 +492,9 @@ impl Surf {
                 let rho = (l.x * l.x + l.y * l.y).sqrt();
                 ((rho - big).hypot(l.z) - small).abs()
             }
-            Surf::BSpline(s) => {
-                let (u, v) = bspline_param(s, p, Some(hint));
-                (s.eval(u, v) - p).norm()
+            Surf::BSpline(_) | Surf::Extrusion(_) | Surf::Revolution(_) | Surf::Offset(_) => {
+                let (u, v) = self.param(p, Some(hint));
+                (self.eval(u, v) - p).norm()
             }
         }
     }
@@ -403,6 +504,8 @@ impl Surf {
         match self {
             Surf::Plane(_) => None,
             Surf::BSpline(s) => s.closed[0].then(|| s.u.range().1 - s.u.range().0),
+            Surf::Extrusion(e) => e.curve.period(),
+            Surf::Offset(o) => o.base.u_period(),
             _ => Some(TAU),
         }
     }
@@ -412,6 +515,8 @@ impl Surf {
         match self {
             Surf::Torus(..) => Some(TAU),
             Surf::BSpline(s) => s.closed[1].then(|| s.v.range().1 - s.v.range().0),
+            Surf::Revolution(r) => r.curve.period(),
+            Surf::Offset(o) => o.base.v_period(),
             _ => None,
         }
     }
@@ -421,6 +526,9 @@ impl Surf {
         match self {
             Surf::Sphere(..) => vec![-FRAC_PI_2, FRAC_PI_2],
             Surf::Cone(_, r, a) => vec![-r / a.tan()],
+            Surf::BSpline(s) => s.poles(),
+            Surf::Revolution(r) => r.poles(),
+            Surf::Offset(o) => o.base.poles(),
             _ => vec![],
         }
     }
@@ -433,6 +541,16 @@ impl Surf {
                 let l = f.local(p);
                 (l.x * l.x + l.y * l.y).sqrt() < 1e-7
             }
+            Surf::Revolution(r) => r.radius(p) < 1e-7,
+            Surf::BSpline(s) => s.poles().iter().any(|&pv| {
+                (v - pv).abs() < 1e-9 * (1.0 + pv.abs())
+                    || (s.eval(s.u.range().0, pv) - p).norm() < 1e-7
+            }),
+            Surf::Offset(o) => o
+                .base
+                .poles()
+                .iter()
+                .any(|&pv| (v - pv).abs() < 1e-9 * (1.0 + pv.abs())),
             _ => false,
         }
     }
@@ -446,10 +564,10 @@ impl Surf {
             Surf::Cone(_, r, a) => ((r + v * a.tan()).abs().max(1e-3), 1.0 / a.cos()),
             Surf::Sphere(_, r) => ((r * v.cos()).abs().max(1e-3), *r),
             Surf::Torus(_, big, small) => ((big + small * v.cos()).abs().max(1e-3), *small),
-            Surf::BSpline(s) => {
+            Surf::BSpline(_) | Surf::Extrusion(_) | Surf::Revolution(_) | Surf::Offset(_) => {
                 let h = 1e-4;
-                let du = (s.eval(u + h, v) - s.eval(u - h, v)).norm() / (2.0 * h);
-                let dv = (s.eval(u, v + h) - s.eval(u, v - h)).norm() / (2.0 * h);
+                let du = (self.eval(u + h, v) - self.eval(u - h, v)).norm() / (2.0 * h);
+                let dv = (self.eval(u, v + h) - self.eval(u, v - h)).norm() / (2.0 * h);
                 (du.max(1e-3), dv.max(1e-3))
             }
         }
@@ -472,7 +590,7 @@ impl Surf {
                 let r = radial(f)?;
                 (p - (f.o + r * *big)).try_normalize(1e-9)
             }
-            Surf::BSpline(_) => {
+            Surf::BSpline(_) | Surf::Extrusion(_) | Surf::Revolution(_) | Surf::Offset(_) => {
                 let h = 1e-6;
                 let su = self.eval(u + h, v) - self.eval(u - h, v);
                 let sv = self.eval(u, v + h) - self.eval(u, v - h);
@@ -482,42 +600,62 @@ impl Surf {
     }
 }
 
-/// Projects `p` onto a B-spline surface: the best point of a grid (or the hint), then
-/// Gauss-Newton steps inside the parameter box.
+/// Projects `p` onto a B-spline surface: Gauss-Newton steps from the hint when given;
+/// where they do not settle (a hint from another bound, far across the face), from the
+/// best point of a grid.
 fn bspline_param(s: &BSplineSurface, p: &P3, hint: Option<(f64, f64)>) -> (f64, f64) {
+    if let Some(h) = hint {
+        let (uv, settled) = gauss_newton(s, p, h, 6);
+        if settled {
+            return uv;
+        }
+    }
     let (u0, u1) = s.u.range();
     let (v0, v1) = s.v.range();
     let d = |u: f64, v: f64| (s.eval(u, v) - p).norm_squared();
-    let (mut u, mut v) = match hint {
-        Some(h) => h,
-        None => {
-            const N: usize = 24;
-            let mut best = (u0, v0, f64::INFINITY);
-            for i in 0..=N {
-                for j in 0..=N {
-                    let uu = u0 + (u1 - u0) * i as f64 / N as f64;
-                    let vv = v0 + (v1 - v0) * j as f64 / N as f64;
-                    let dd = d(uu, vv);
-                    if dd < best.2 {
-                        best = (uu, vv, dd);
-                    }
-                }
+    const N: usize = 24;
+    let mut best = (u0, v0, f64::INFINITY);
+    for i in 0..=N {
+        for j in 0..=N {
+            let uu = u0 + (u1 - u0) * i as f64 / N as f64;
+            let vv = v0 + (v1 - v0) * j as f64 / N as f64;
+            let dd = d(uu, vv);
+            if dd < best.2 {
+                best = (uu, vv, dd);
             }
-            (best.0, best.1)
         }
+    }
+    gauss_newton(s, p, (best.0, best.1), 30).0
+}
+
+/// Up to `steps` Gauss-Newton steps toward the foot of `p` from `start`, inside the
+/// parameter box (wrapping along a closed direction); whether the last step moved the
+/// point by less than 10⁻⁷ mm.
+fn gauss_newton(s: &BSplineSurface, p: &P3, start: (f64, f64), steps: usize) -> ((f64, f64), bool) {
+    let (u0, u1) = s.u.range();
+    let (v0, v1) = s.v.range();
+    let (mut u, mut v) = start;
+    let h = 1e-7 * (1.0 + (u1 - u0).abs().max((v1 - v0).abs()));
+    // Central differences whose ends stay in the box (at an open end a step outside
+    // would read the clamped end and halve the derivative).
+    let diff = |lo: f64, hi: f64, at: &dyn Fn(f64) -> P3, t: f64, closed: bool| {
+        let (a, b) = if closed {
+            (t - h, t + h)
+        } else {
+            ((t - h).max(lo), (t + h).min(hi))
+        };
+        (at(b) - at(a)) / (b - a)
     };
-    let steps = if hint.is_some() { 4 } else { 30 };
     for _ in 0..steps {
-        let h = 1e-7 * (1.0 + (u1 - u0).abs().max((v1 - v0).abs()));
         let q = s.eval(u, v);
-        let su = (s.eval(u + h, v) - s.eval(u - h, v)) / (2.0 * h);
-        let sv = (s.eval(u, v + h) - s.eval(u, v - h)) / (2.0 * h);
+        let su = diff(u0, u1, &|t| s.eval(t, v), u, s.closed[0]);
+        let sv = diff(v0, v1, &|t| s.eval(u, t), v, s.closed[1]);
         let r = p - q;
         let (a, b, c) = (su.dot(&su), su.dot(&sv), sv.dot(&sv));
         let (e, f) = (su.dot(&r), sv.dot(&r));
         let det = a * c - b * b;
         if det.abs() < 1e-30 {
-            break;
+            return ((u, v), false);
         }
         let du = (c * e - b * f) / det;
         let dv = (a * f - b * e) / det;
@@ -531,14 +669,16 @@ fn bspline_param(s: &BSplineSurface, p: &P3, hint: Option<(f64, f64)>) -> (f64, 
         };
         let nu = keep(u + du, u0, u1, s.closed[0]);
         let nv = keep(v + dv, v0, v1, s.closed[1]);
-        let done = (nu - u).abs() < 1e-12 && (nv - v).abs() < 1e-12;
+        let moved = ((nu - u) * a.sqrt()).abs() + ((nv - v) * c.sqrt()).abs();
+        let wrapped = (nu - (u + du)).abs() > 1e-12 && s.closed[0]
+            || (nv - (v + dv)).abs() > 1e-12 && s.closed[1];
         u = nu;
         v = nv;
-        if done {
-            break;
+        if moved < 1e-7 && !wrapped {
+            return ((u, v), true);
         }
     }
-    (u, v)
+    ((u, v), false)
 }
 
 /// `a` shifted by whole periods to lie within half a period of `near`.

@@ -37,11 +37,13 @@
 //! 0.5 rad, the reference meshes' own.
 
 pub(super) mod brep;
+mod canon;
 pub(in crate::geometry) mod error;
 pub(super) mod geom;
 mod p21;
 pub mod pmi;
 mod refs;
+mod swept;
 pub(super) mod tess;
 
 pub use error::StepError;
@@ -160,7 +162,7 @@ fn extent(b: &brep::Brep) -> f64 {
             geom::Curve::Ellipse(f, a, c) => add(&f.o, a.abs().max(c.abs())),
             geom::Curve::BSpline(c) => c.points.iter().for_each(|p| add(p, 0.0)),
             geom::Curve::Polyline(pts) => pts.iter().for_each(|p| add(p, 0.0)),
-            geom::Curve::Line => {}
+            geom::Curve::Line(..) | geom::Curve::Parabola(..) | geom::Curve::Hyperbola(..) => {}
         }
     }
     for f in &b.faces {
@@ -345,6 +347,10 @@ fn exact_surface(face: &brep::Face) -> Surface {
             radius: *r,
             convex: out,
         },
-        Surf::Torus(..) | Surf::BSpline(_) => Surface::Freeform,
+        Surf::Torus(..)
+        | Surf::BSpline(_)
+        | Surf::Extrusion(_)
+        | Surf::Revolution(_)
+        | Surf::Offset(_) => Surface::Freeform,
     }
 }

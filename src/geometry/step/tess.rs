@@ -68,6 +68,10 @@ pub(crate) struct FaceFailure {
     pub reason: String,
 }
 
+/// The closest an inner point may come to a triangle's corner (mm): a hundred times
+/// the distance the weld merges points at.
+const MIN_SPACING_MM: f64 = 1e-4;
+
 /// How many faces or edges are meshed side by side before the totals are checked: the
 /// check falls at the same place for any thread count.
 const BATCH: usize = 64;
@@ -138,7 +142,7 @@ fn arc_segments(sweep: f64, r: f64, res: Resolution) -> usize {
 fn edge_points(e: &Edge, res: Resolution) -> Vec<P3> {
     let closed = (e.start - e.end).norm() < 1e-9;
     let mut pts = match &e.curve {
-        Curve::Line => vec![e.start, e.end],
+        Curve::Line(..) => vec![e.start, e.end],
         Curve::Polyline(p) => {
             let mut p = p.to_vec();
             if !e.same_sense {
@@ -172,6 +176,17 @@ fn edge_points(e: &Edge, res: Resolution) -> Vec<P3> {
             (0..=n)
                 .map(|k| e.curve.eval(t0 + (t1 - t0) * k as f64 / n as f64))
                 .collect()
+        }
+        Curve::Parabola(..) | Curve::Hyperbola(..) => {
+            let (ts, te) = (e.curve.param(&e.start), e.curve.param(&e.end));
+            let (lo, hi) = (ts.min(te), ts.max(te));
+            let mut params = vec![lo];
+            refine_curve(&|t| e.curve.eval(t), lo, hi, res, 0, &mut params);
+            let mut p: Vec<P3> = params.iter().map(|&t| e.curve.eval(t)).collect();
+            if ts > te {
+                p.reverse();
+            }
+            p
         }
         Curve::BSpline(c) => {
             let (a, b) = c.knots.range();
@@ -553,12 +568,22 @@ fn refinement_points(
                 .iter()
                 .max_by(|a, b| a.length_2().total_cmp(&b.length_2()))
                 .filter(|e| !e.is_constraint_edge());
-            match longest {
+            let at = match longest {
                 Some(e) => {
                     let [a, b] = e.positions();
-                    add.push([(a.x + b.x) / 2.0, (a.y + b.y) / 2.0]);
+                    [(a.x + b.x) / 2.0, (a.y + b.y) / 2.0]
                 }
-                None => add.push(c),
+                None => c,
+            };
+            // A point that lands on a corner in space (a sliver along a seam, where
+            // the parameter plane is wider than the surface) would be welded into it
+            // and fold the mesh: the triangle is as fine as it gets.
+            let uv = scale.unscale(at);
+            let p = s.eval(uv[0], uv[1]);
+            if x.iter().any(|corner| (corner - p).norm() < MIN_SPACING_MM) {
+                good.insert(key);
+            } else {
+                add.push(at);
             }
         }
     }
@@ -726,7 +751,7 @@ fn param_loop(
         .iter()
         .map(|p| {
             let uv = s.param(p, *hint);
-            if matches!(s, Surf::BSpline(_)) {
+            if s.takes_hint() {
                 *hint = Some(uv);
             }
             uv

@@ -1,0 +1,173 @@
+//! Swept and offset surfaces read as the analytic surfaces they are.
+//!
+//! Exporters write the same cylinder as a `CYLINDRICAL_SURFACE` (most), a circle swept
+//! along its normal (CATIA V5's `SURFACE_OF_LINEAR_EXTRUSION`) or a line revolved about
+//! a parallel axis; a part's features (a bore's diameter, a datum plane) must not
+//! depend on which. OpenCASCADE recognises the same cases when it reads such a surface
+//! (`GeomAdaptor_Surface` reports the basis's kind; `ShapeCustom`/`GeomConvert` turn
+//! them analytic); the rules here are the geometry of ISO 10303-42's definitions:
+//! - a line swept along any other direction is a plane; a circle swept along its own
+//!   normal is a cylinder;
+//! - a line revolved is a cylinder (parallel to the axis and in a plane with it), a
+//!   plane (square to the axis) or a cone (crossing or meeting the axis in a plane with
+//!   it); a circle in a plane through the axis revolved is a sphere (centred on the
+//!   axis) or a torus;
+//! - an offset plane, cylinder, cone, sphere or torus is one of the same kind.
+//!
+//! The analytic surface's natural normal may point the other way from the swept one's
+//! (a circle swept along −z gives the inward normal; a revolved half-circle's depends
+//! on its side of the axis), so the face's sense is compared at its own points and
+//! flipped where they disagree.
+
+use super::geom::{Curve, Frame, Surf};
+use super::swept::{Extrusion, Offset, Revolution};
+use crate::geometry::{P3, V3};
+
+/// How far from parallel, square or coplanar a direction may be and still count
+/// (radians, or millimetres per millimetre).
+const ANGLE_EPS: f64 = 1e-9;
+/// How far from the axis a point may be and still be on it (mm).
+const ON_AXIS_MM: f64 = 1e-7;
+
+/// The analytic surface `s` is, if it is one, and whether a face on it must flip its
+/// sense to keep its outward normal (judged at `points`, points of the face).
+pub(crate) fn canonical(s: &Surf, points: &[P3]) -> (Surf, bool) {
+    let analytic = match s {
+        Surf::Extrusion(e) => extrusion(e),
+        Surf::Revolution(r) => revolution(r),
+        Surf::Offset(o) => offset(o),
+        _ => None,
+    };
+    let Some(a) = analytic else {
+        return (s.clone(), false);
+    };
+    (a.clone(), flipped(s, &a, points))
+}
+
+/// Whether the natural normals of `swept` and `analytic` are opposite at the first of
+/// `points` where both are defined.
+fn flipped(swept: &Surf, analytic: &Surf, points: &[P3]) -> bool {
+    for p in points {
+        let (u, v) = swept.param(p, None);
+        let (a, b) = analytic.param(p, None);
+        if let (Some(n), Some(m)) = (
+            swept.normal(&swept.eval(u, v), u, v),
+            analytic.normal(p, a, b),
+        ) {
+            return n.dot(&m) < 0.0;
+        }
+    }
+    false
+}
+
+fn extrusion(e: &Extrusion) -> Option<Surf> {
+    let d = e.dir;
+    match &e.curve {
+        Curve::Line(o, t) => {
+            let n = t.cross(&d).try_normalize(ANGLE_EPS)?;
+            Some(Surf::Plane(Frame::new(*o, Some(n), Some(*t))?))
+        }
+        Curve::Circle(f, r) if f.z.cross(&d).norm() < ANGLE_EPS => Some(Surf::Cylinder(*f, *r)),
+        _ => None,
+    }
+}
+
+fn revolution(r: &Revolution) -> Option<Surf> {
+    let axis = &r.axis;
+    let foot = |p: &P3| axis.o + axis.z * (p - axis.o).dot(&axis.z);
+    match &r.curve {
+        Curve::Line(o, t) => {
+            let e = t.try_normalize(1e-300)?;
+            let q = foot(o);
+            let w = o - q;
+            // The line must lie in a plane with the axis (else a hyperboloid).
+            if w.norm() > ON_AXIS_MM && e.dot(&axis.z.cross(&w.normalize())).abs() > ANGLE_EPS {
+                return None;
+            }
+            let along = e.dot(&axis.z);
+            let radial = (e - axis.z * along).try_normalize(ANGLE_EPS);
+            match radial {
+                None => {
+                    let x = w.try_normalize(ON_AXIS_MM)?;
+                    Some(Surf::Cylinder(
+                        Frame::new(q, Some(axis.z), Some(x))?,
+                        w.norm(),
+                    ))
+                }
+                Some(x) if along.abs() < ANGLE_EPS => {
+                    Some(Surf::Plane(Frame::new(q, Some(axis.z), Some(x))?))
+                }
+                Some(x) => {
+                    // The radius grows along the axis the way the line leaves it.
+                    let out = e.dot(&x);
+                    let z = axis.z * along.signum();
+                    let mut rho = w.dot(&x);
+                    let mut q = q;
+                    if rho < 0.0 {
+                        // `o` lies on the other nappe: take the point of the line as
+                        // far beyond the apex, where the radius is positive.
+                        let beyond = o + e * (-2.0 * rho / out);
+                        q = foot(&beyond);
+                        rho = -rho;
+                    }
+                    let semi = (out / along.abs()).atan();
+                    Some(Surf::Cone(Frame::new(q, Some(z), Some(x))?, rho, semi))
+                }
+            }
+        }
+        Curve::Circle(f, radius) => {
+            // The circle's plane must hold the axis.
+            if f.z.dot(&axis.z).abs() > ANGLE_EPS || (f.o - axis.o).dot(&f.z).abs() > ON_AXIS_MM {
+                return None;
+            }
+            let q = foot(&f.o);
+            let w = f.o - q;
+            if w.norm() < ON_AXIS_MM {
+                Some(Surf::Sphere(
+                    Frame::new(q, Some(axis.z), Some(axis.x))?,
+                    *radius,
+                ))
+            } else {
+                let x = w.normalize();
+                Some(Surf::Torus(
+                    Frame::new(q, Some(axis.z), Some(x))?,
+                    w.norm(),
+                    *radius,
+                ))
+            }
+        }
+        _ => None,
+    }
+}
+
+fn offset(o: &Offset) -> Option<Surf> {
+    let d = o.distance;
+    let grown = |r: f64| (r + d > 0.0).then_some(r + d);
+    match &o.base {
+        Surf::Plane(f) => Some(Surf::Plane(Frame {
+            o: f.o + f.z * d,
+            ..*f
+        })),
+        Surf::Cylinder(f, r) => Some(Surf::Cylinder(*f, grown(*r)?)),
+        // The normal leans back by the semi-angle: the radius at the origin grows by
+        // d / cos(semi-angle).
+        Surf::Cone(f, r, a) => Some(Surf::Cone(*f, r + d / a.cos(), *a)),
+        Surf::Sphere(f, r) => Some(Surf::Sphere(*f, grown(*r)?)),
+        Surf::Torus(f, big, small) => Some(Surf::Torus(*f, *big, grown(*small)?)),
+        _ => None,
+    }
+}
+
+/// The frame of a revolution's axis with x pointing at the profile, so that the
+/// profile lies at angle 0.
+pub(crate) fn revolution_axis(origin: P3, axis: V3, curve: &Curve) -> Option<Frame> {
+    let (a, b) = curve.range();
+    let mid = 0.5 * (a.max(-1e3) + b.min(1e3));
+    let samples = [mid, a.max(-1e3), b.min(1e3), 0.0];
+    let z = axis.try_normalize(ANGLE_EPS)?;
+    let x = samples.iter().find_map(|&t| {
+        let d = curve.eval(t) - origin;
+        (d - z * d.dot(&z)).try_normalize(ON_AXIS_MM)
+    });
+    Frame::new(origin, Some(z), x)
+}

@@ -1,0 +1,305 @@
+"""Makes the STEP fixtures of `tests/suite/cad_kinds.rs` with OpenCASCADE (OCP).
+
+Not run by CI: the files it writes are checked in. Re-run it by hand after changing a
+part here (`pip install cadquery-ocp==7.7.2`, then `python3 tests/cad/make.py` from the
+repository root). Each part is one solid whose faces use one surface or curve kind that
+real exporters write; beside each `NAME.stp` goes `NAME.json`, OpenCASCADE's own reading
+of the solid (every face's surface type and area, the volume, the bounding box, in
+millimetres), which the test compares inspc's reading with.
+
+Some kinds OpenCASCADE never writes by itself (a cylinder face with no seam edge, a
+plane angle in degrees); those parts are written by OpenCASCADE and then edited as text,
+and the edit is described beside the part.
+"""
+
+import json
+import math
+import os
+import re
+
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+from OCP.BRepBndLib import BRepBndLib
+from OCP.BRepBuilderAPI import (
+    BRepBuilderAPI_MakeEdge,
+    BRepBuilderAPI_MakeFace,
+    BRepBuilderAPI_MakeWire,
+    BRepBuilderAPI_NurbsConvert,
+)
+from OCP.BRepGProp import BRepGProp
+from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeOffsetShape
+from OCP.BRepPrimAPI import (
+    BRepPrimAPI_MakeBox,
+    BRepPrimAPI_MakeCone,
+    BRepPrimAPI_MakeCylinder,
+    BRepPrimAPI_MakePrism,
+    BRepPrimAPI_MakeRevol,
+    BRepPrimAPI_MakeSphere,
+)
+from OCP.Bnd import Bnd_Box
+from OCP.GC import GC_MakeArcOfHyperbola, GC_MakeArcOfParabola, GC_MakeSegment
+from OCP.GeomAbs import GeomAbs_SurfaceType
+from OCP.GeomAPI import GeomAPI_Interpolate
+from OCP.GProp import GProp_GProps
+from OCP.Interface import Interface_Static
+from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+from OCP.TColgp import TColgp_HArray1OfPnt
+from OCP.TopAbs import TopAbs_FACE
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
+from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_Hypr, gp_Parab, gp_Pnt, gp_Vec
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+KIND = {
+    GeomAbs_SurfaceType.GeomAbs_Plane: "plane",
+    GeomAbs_SurfaceType.GeomAbs_Cylinder: "cylinder",
+    GeomAbs_SurfaceType.GeomAbs_Cone: "cone",
+    GeomAbs_SurfaceType.GeomAbs_Sphere: "sphere",
+    GeomAbs_SurfaceType.GeomAbs_Torus: "torus",
+    GeomAbs_SurfaceType.GeomAbs_BezierSurface: "freeform",
+    GeomAbs_SurfaceType.GeomAbs_BSplineSurface: "freeform",
+    GeomAbs_SurfaceType.GeomAbs_SurfaceOfRevolution: "freeform",
+    GeomAbs_SurfaceType.GeomAbs_SurfaceOfExtrusion: "freeform",
+    GeomAbs_SurfaceType.GeomAbs_OffsetSurface: "freeform",
+}
+
+
+def interpolate(points, periodic):
+    arr = TColgp_HArray1OfPnt(1, len(points))
+    for i, p in enumerate(points):
+        arr.SetValue(i + 1, gp_Pnt(*p))
+    it = GeomAPI_Interpolate(arr, periodic, 1e-6)
+    it.Perform()
+    return it.Curve()
+
+
+def wire(*edges):
+    w = BRepBuilderAPI_MakeWire()
+    for e in edges:
+        w.Add(e)
+    return w.Wire()
+
+
+def segment(a, b):
+    return BRepBuilderAPI_MakeEdge(GC_MakeSegment(gp_Pnt(*a), gp_Pnt(*b)).Value()).Edge()
+
+
+def profile_face(edges):
+    return BRepBuilderAPI_MakeFace(wire(*edges)).Face()
+
+
+def reading(shape, unit_mm):
+    """OpenCASCADE's reading of the solid, in millimetres."""
+    faces = []
+    ex = TopExp_Explorer(shape, TopAbs_FACE)
+    while ex.More():
+        f = TopoDS.Face_s(ex.Current())
+        props = GProp_GProps()
+        BRepGProp.SurfaceProperties_s(f, props)
+        kind = KIND[BRepAdaptor_Surface(f).GetType()]
+        faces.append({"kind": kind, "area": round(props.Mass() * unit_mm**2, 6)})
+        ex.Next()
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props)
+    box = Bnd_Box()
+    box.SetGap(0.0)
+    BRepBndLib.AddOptimal_s(shape, box, False, False)
+    lo, hi = box.CornerMin(), box.CornerMax()
+    return {
+        "faces": faces,
+        "volume": round(props.Mass() * unit_mm**3, 6),
+        "box": [
+            [round(c * unit_mm, 6) for c in (lo.X(), lo.Y(), lo.Z())],
+            [round(c * unit_mm, 6) for c in (hi.X(), hi.Y(), hi.Z())],
+        ],
+    }
+
+
+def write(name, shape, unit="MM", unit_mm=1.0, edit=None, what=""):
+    Interface_Static.SetCVal_s("write.step.unit", unit)
+    Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
+    path = os.path.join(HERE, name + ".stp")
+    w = STEPControl_Writer()
+    w.Transfer(shape, STEPControl_AsIs)
+    w.Write(path)
+    text = open(path).read()
+    # The header's time stamp would change the file at every run.
+    text = re.sub(r"FILE_NAME\('[^']*','[^']*'", f"FILE_NAME('{name}.stp','2026-11-27T00:00:00'", text)
+    if edit:
+        text = edit(text)
+    open(path, "w").write(text)
+    expected = reading(shape, unit_mm)
+    expected["what"] = what
+    with open(os.path.join(HERE, name + ".json"), "w") as f:
+        json.dump(expected, f, indent=1)
+        f.write("\n")
+
+
+def blob_prism():
+    c = interpolate([(30, 0, 0), (20, 18, 0), (0, 25, 0), (-22, 15, 0), (-28, -5, 0), (-10, -22, 0), (15, -20, 0)], True)
+    f = BRepBuilderAPI_MakeFace(wire(BRepBuilderAPI_MakeEdge(c).Edge())).Face()
+    return BRepPrimAPI_MakePrism(f, gp_Vec(0, 0, 20)).Shape()
+
+
+def oblique_prism():
+    """A circle swept along a slanted vector: an oblique cylinder, not a cylinder."""
+    from OCP.gp import gp_Circ
+
+    e = BRepBuilderAPI_MakeEdge(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 12)).Edge()
+    f = BRepBuilderAPI_MakeFace(wire(e)).Face()
+    return BRepPrimAPI_MakePrism(f, gp_Vec(8, 0, 25)).Shape()
+
+
+def ellipse_prism():
+    from OCP.gp import gp_Elips
+
+    e = BRepBuilderAPI_MakeEdge(gp_Elips(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 20, 11)).Edge()
+    f = BRepBuilderAPI_MakeFace(wire(e)).Face()
+    return BRepPrimAPI_MakePrism(f, gp_Vec(0, 0, 15)).Shape()
+
+
+def vase(angle=2 * math.pi):
+    """A ring whose outside is a B-spline revolved about z."""
+    c = interpolate([(20, 0, 0), (26, 0, 10), (22, 0, 22), (28, 0, 35)], False)
+    outer = BRepBuilderAPI_MakeEdge(c).Edge()
+    f = profile_face([segment((10, 0, 0), (20, 0, 0)), outer, segment((28, 0, 35), (10, 0, 35)), segment((10, 0, 35), (10, 0, 0))])
+    return BRepPrimAPI_MakeRevol(f, gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), angle).Shape()
+
+
+def dome():
+    """A B-spline revolved from the axis: the surface closes at a pole."""
+    c = interpolate([(0, 0, 30), (12, 0, 27), (22, 0, 15), (25, 0, 0)], False)
+    f = profile_face([BRepBuilderAPI_MakeEdge(c).Edge(), segment((25, 0, 0), (0, 0, 0)), segment((0, 0, 0), (0, 0, 30))])
+    return BRepPrimAPI_MakeRevol(f, gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2 * math.pi).Shape()
+
+
+def conics():
+    """A plate bounded by a parabola and a hyperbola arc, extruded."""
+    parab = gp_Parab(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1), gp_Dir(0, 1, 0)), 4.0)
+    # Points of y² = 4 f x with x along the parabola's axis (here +y): (t, t²/16).
+    p_arc = GC_MakeArcOfParabola(parab, gp_Pnt(-16, 16, 0), gp_Pnt(16, 16, 0), True).Value()
+    hyp = gp_Hypr(gp_Ax2(gp_Pnt(0, 60, 0), gp_Dir(0, 0, 1), gp_Dir(0, -1, 0)), 10.0, 12.0)
+    h_arc = GC_MakeArcOfHyperbola(hyp, -1.0, 1.0, True).Value()
+    a, b = h_arc.StartPoint(), h_arc.EndPoint()
+    pa, pb = p_arc.StartPoint(), p_arc.EndPoint()
+    e1 = BRepBuilderAPI_MakeEdge(p_arc).Edge()
+    e3 = BRepBuilderAPI_MakeEdge(h_arc).Edge()
+    # Join the ends: each hyperbola end to the nearer parabola end.
+    ends = sorted([(a.X(), a), (b.X(), b)], key=lambda t: t[0])
+    pends = sorted([(pa.X(), pa), (pb.X(), pb)], key=lambda t: t[0])
+    s_left = segment(xyz(pends[0][1]), xyz(ends[0][1]))
+    s_right = segment(xyz(pends[1][1]), xyz(ends[1][1]))
+    f = profile_face([e1, s_right, e3, s_left])
+    return BRepPrimAPI_MakePrism(f, gp_Vec(0, 0, 10)).Shape()
+
+
+def xyz(p):
+    return (p.X(), p.Y(), p.Z())
+
+
+def nurbs_cap():
+    """A box with a spherical pocket, every face converted to rational B-splines."""
+    box = BRepPrimAPI_MakeBox(60, 40, 20).Shape()
+    ball = BRepPrimAPI_MakeSphere(gp_Pnt(30, 20, 28), 15).Shape()
+    cut = BRepAlgoAPI_Cut(box, ball).Shape()
+    return BRepBuilderAPI_NurbsConvert(cut, True).Shape()
+
+
+def offset_vase():
+    """The vase grown 2 mm: its B-spline side becomes an offset surface."""
+    mk = BRepOffsetAPI_MakeOffsetShape()
+    mk.PerformByJoin(vase(), 2.0, 1e-6)
+    return mk.Shape()
+
+
+def cylinder_block():
+    box = BRepPrimAPI_MakeBox(50, 40, 20).Shape()
+    hole = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(25, 20, -1), gp_Dir(0, 0, 1)), 8, 22).Shape()
+    return BRepAlgoAPI_Cut(box, hole).Shape()
+
+
+def cone_block():
+    box = BRepPrimAPI_MakeBox(50, 40, 20).Shape()
+    cone = BRepPrimAPI_MakeCone(gp_Ax2(gp_Pnt(25, 20, -1), gp_Dir(0, 0, 1)), 12, 5, 22).Shape()
+    return BRepAlgoAPI_Cut(box, cone).Shape()
+
+
+def without_seam(text):
+    """The bore's cylinder face bounded by its two circles alone, with no seam edge
+    (a band that goes once round, as some exporters write full cylinders)."""
+    lines = text.split("\n")
+    ents = {}
+    for l in lines:
+        m = re.match(r"#(\d+) = (\w+)\((.*)\);$", l)
+        if m:
+            ents[int(m.group(1))] = (m.group(2), m.group(3))
+    seams = {i for i, (t, a) in ents.items() if t == "SEAM_CURVE"}
+    seam_edges = {i for i, (t, a) in ents.items() if t == "EDGE_CURVE" and int(re.findall(r"#(\d+)", a)[2]) in seams}
+    seam_oriented = {i for i, (t, a) in ents.items() if t == "ORIENTED_EDGE" and int(re.findall(r"#(\d+)", a)[0]) in seam_edges}
+    out = []
+    for l in lines:
+        m = re.match(r"#(\d+) = EDGE_LOOP\('',\((.*)\)\);$", l)
+        if m:
+            refs = [int(r) for r in re.findall(r"#(\d+)", m.group(2))]
+            if any(r in seam_oriented for r in refs):
+                keep = [r for r in refs if r not in seam_oriented]
+                # Each circle closes on its own vertex: one loop per circle.
+                first, rest = keep[0], keep[1:]
+                l = f"#{m.group(1)} = EDGE_LOOP('',(#{first}));"
+                for r in rest:
+                    nid = 900000 + r
+                    out.append(f"#{nid} = EDGE_LOOP('',(#{r}));")
+                    sense = next(a.split(",")[-1] for t, a in ents.values() if t in ("FACE_BOUND", "FACE_OUTER_BOUND") and re.findall(r"#(\d+)", a)[0] == m.group(1))
+                    out.append(f"#{nid + 50000} = FACE_BOUND('',#{nid},{sense});")
+                    extra_bounds.setdefault(int(m.group(1)), []).append(nid + 50000)
+        out.append(l)
+    text = "\n".join(out)
+    for loop, bounds in extra_bounds.items():
+        # The loop's own bound is listed by a face: add the new bounds beside it.
+        bound = next(i for i, (t, a) in ents.items() if t in ("FACE_BOUND", "FACE_OUTER_BOUND") and re.findall(r"#(\d+)", a)[0] == str(loop))
+        face = next(i for i, (t, a) in ents.items() if t == "ADVANCED_FACE" and f"#{bound}" in re.findall(r"#\d+", a.split(")")[0]))
+        text = re.sub(rf"(#{face} = ADVANCED_FACE\('',\()([^)]*)\)", lambda m: m.group(1) + m.group(2) + "," + ",".join(f"#{b}" for b in bounds) + ")", text)
+    return text
+
+
+extra_bounds = {}
+
+
+def degrees(text):
+    """The plane angle unit declared as a degree (a conversion-based unit), and the
+    cone's semi-angle written in it."""
+    text = re.sub(
+        r"#(\d+) = \( NAMED_UNIT\(\*\) PLANE_ANGLE_UNIT\(\) SI_UNIT\(\$,\.RADIAN\.\) \);",
+        lambda m: f"#{m.group(1)} = ( CONVERSION_BASED_UNIT('DEGREE',#990001) NAMED_UNIT(#990003) PLANE_ANGLE_UNIT() );\n"
+        "#990001 = PLANE_ANGLE_MEASURE_WITH_UNIT(PLANE_ANGLE_MEASURE(0.0174532925199433),#990002);\n"
+        "#990002 = ( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) );\n"
+        "#990003 = DIMENSIONAL_EXPONENTS(0.,0.,0.,0.,0.,0.,0.);",
+        text,
+    )
+
+    def cone(m):
+        return f"{m.group(1)}{float(m.group(2)) * 180 / math.pi!r}{m.group(3)}"
+
+    return re.sub(r"(CONICAL_SURFACE\('',#\d+,[-0-9.E+]+,)([-0-9.E+]+)(\))", cone, text)
+
+
+def main():
+    write("extrusion_bspline", blob_prism(), what="a closed B-spline swept along z (SURFACE_OF_LINEAR_EXTRUSION, seam)")
+    write("extrusion_ellipse", ellipse_prism(), what="an ellipse swept along its normal")
+    write("extrusion_oblique", oblique_prism(), what="a circle swept along a slanted vector")
+    write("revolution_bspline", vase(), what="a B-spline revolved once round (SURFACE_OF_REVOLUTION, seam)")
+    write("revolution_partial", vase(2 * math.pi / 3), what="a B-spline revolved through 120 degrees")
+    write("revolution_pole", dome(), what="a B-spline revolved from the axis: a pole")
+    write("conics", conics(), what="a plate bounded by a parabola and a hyperbola, extruded")
+    write("nurbs", nurbs_cap(), what="a block with a spherical pocket, every face a rational B-spline")
+    write("offset", offset_vase(), what="the revolved vase grown 2 mm (OFFSET_SURFACE)")
+    write("seamless_cylinder", cylinder_block(), edit=without_seam, what="a bore whose cylinder face has no seam edge")
+    write("unit_inch", cylinder_block(), unit="INCH", unit_mm=1.0, what="lengths in inches")
+    write("unit_metre", cylinder_block(), unit="M", unit_mm=1.0, what="lengths in metres")
+    write("unit_degree", cone_block(), edit=degrees, what="plane angles in degrees (a conversion-based unit)")
+
+
+if __name__ == "__main__":
+    main()
