@@ -18,7 +18,7 @@ import os
 import re
 
 from OCP.BRep import BRep_Tool
-from OCP.BRepAdaptor import BRepAdaptor_Surface
+from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepBuilderAPI import (
@@ -39,7 +39,7 @@ from OCP.BRepPrimAPI import (
 )
 from OCP.Bnd import Bnd_Box
 from OCP.GC import GC_MakeArcOfHyperbola, GC_MakeArcOfParabola, GC_MakeSegment
-from OCP.GeomAbs import GeomAbs_SurfaceType
+from OCP.GeomAbs import GeomAbs_CurveType, GeomAbs_SurfaceType
 from OCP.GeomAPI import GeomAPI_Interpolate
 from OCP.GProp import GProp_GProps
 from OCP.Interface import Interface_Static
@@ -127,6 +127,8 @@ def write(name, shape, unit="MM", unit_mm=1.0, edit=None, what=""):
     text = open(path).read()
     # The header's time stamp would change the file at every run.
     text = re.sub(r"FILE_NAME\('[^']*','[^']*'", f"FILE_NAME('{name}.stp','2026-11-27T00:00:00'", text)
+    # Nor would the writer's product counter.
+    text = re.sub(r"Open CASCADE STEP translator ([\d.]+) \d+", r"Open CASCADE STEP translator \1", text)
     if edit:
         text = edit(text)
     open(path, "w").write(text)
@@ -267,6 +269,149 @@ def without_seam(text):
 extra_bounds = {}
 
 
+def entities(text):
+    """Instance number → (type, parameter text) of every simple instance."""
+    out = {}
+    for m in re.finditer(r"^#(\d+) = (\w+)\((.*?)\);$", text, re.M | re.S):
+        out[int(m.group(1))] = (m.group(2), m.group(3))
+    return out
+
+
+def numbers(params):
+    return [float(x) for x in re.findall(r"[-+]?\d+\.?\d*(?:E[-+]?\d+)?", params)]
+
+
+def disguised(text):
+    """Every analytic surface written as the swept or offset surface it also is, the
+    way CATIA V5 and other exporters write them: a plane as a line swept along the
+    plane (every other one as an offset of a parallel plane), a cylinder as a circle
+    swept along its axis (every other one swept the other way, so that the face's
+    sense must flip), a cone as a line revolved, a sphere and a torus as a circle
+    revolved (ISO 10303-42 surface_of_linear_extrusion, surface_of_revolution,
+    offset_surface)."""
+    ents = entities(text)
+    new = []
+    next_id = [800000]
+
+    def add(s):
+        next_id[0] += 1
+        new.append(f"#{next_id[0]} = {s};")
+        return f"#{next_id[0]}"
+
+    def vec3(v):
+        return "(" + ",".join(repr(float(x)) for x in v) + ")"
+
+    def placement(ref):
+        _, a = ents[int(ref[1:])]
+        refs = re.findall(r"#\d+", a)
+        p = numbers(ents[int(refs[0][1:])][1])
+        z = numbers(ents[int(refs[1][1:])][1])
+        x = numbers(ents[int(refs[2][1:])][1])
+        y = [z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]]
+        return p, x, y, z
+
+    def point(v):
+        return add(f"CARTESIAN_POINT('',{vec3(v)})")
+
+    def direction(v):
+        return add(f"DIRECTION('',{vec3(v)})")
+
+    def at(p, *terms):
+        out = list(p)
+        for k, v in terms:
+            out = [o + k * c for o, c in zip(out, v)]
+        return out
+
+    count = {"PLANE": 0, "CYLINDRICAL_SURFACE": 0}
+    # Surfaces whose swept form's natural normal points the other way: their faces'
+    # sense flags flip with them, so that the solid stays the same.
+    flipped = set()
+
+    def replace(m):
+        sid, kind, params = m.group(1), m.group(2), m.group(3)
+        ref = re.findall(r"#\d+", params)[0]
+        p, x, y, z = placement(ref)
+        vals = numbers(params.split(ref, 1)[1])
+        if kind == "PLANE":
+            count[kind] += 1
+            if count[kind] % 2 == 0:
+                d = 3.0
+                frame = add(f"AXIS2_PLACEMENT_3D('',{point(at(p, (-d, z)))},{direction(z)},{direction(x)})")
+                base = add(f"PLANE('',{frame})")
+                return f"#{sid} = OFFSET_SURFACE('',{base},{d!r},.F.);"
+            along_x = add(f"VECTOR('',{direction(x)},1.)")
+            line = add(f"LINE('',{point(p)},{along_x})")
+            along_y = add(f"VECTOR('',{direction(y)},1.)")
+            return f"#{sid} = SURFACE_OF_LINEAR_EXTRUSION('',{line},{along_y});"
+        if kind == "CYLINDRICAL_SURFACE":
+            count[kind] += 1
+            sign = 1.0 if count[kind] % 2 else -1.0
+            if sign < 0:
+                flipped.add(sid)
+            circle = add(f"CIRCLE('',{ref},{vals[0]!r})")
+            along = add(f"VECTOR('',{direction([sign * c for c in z])},1.)")
+            return f"#{sid} = SURFACE_OF_LINEAR_EXTRUSION('',{circle},{along});"
+        axis = add(f"AXIS1_PLACEMENT('',{point(p)},{direction(z)})")
+        if kind == "CONICAL_SURFACE":
+            r, semi = vals[0], vals[1]
+            d = [math.sin(semi) * a + math.cos(semi) * b for a, b in zip(x, z)]
+            slope = add(f"VECTOR('',{direction(d)},1.)")
+            line = add(f"LINE('',{point(at(p, (r, x)))},{slope})")
+            return f"#{sid} = SURFACE_OF_REVOLUTION('',{line},{axis});"
+        if kind == "SPHERICAL_SURFACE":
+            # The circle turns against the revolution: S_u × S_v points out.
+            frame = add(f"AXIS2_PLACEMENT_3D('',{point(p)},{direction([-c for c in y])},{direction(x)})")
+            circle = add(f"CIRCLE('',{frame},{vals[0]!r})")
+            return f"#{sid} = SURFACE_OF_REVOLUTION('',{circle},{axis});"
+        if kind == "TOROIDAL_SURFACE":
+            big, small = vals[0], vals[1]
+            # The circle turns with the revolution: S_u × S_v points in.
+            flipped.add(sid)
+            frame = add(f"AXIS2_PLACEMENT_3D('',{point(at(p, (big, x)))},{direction(y)},{direction(x)})")
+            circle = add(f"CIRCLE('',{frame},{small!r})")
+            return f"#{sid} = SURFACE_OF_REVOLUTION('',{circle},{axis});"
+        return m.group(0)
+
+    text = re.sub(
+        r"^#(\d+) = (PLANE|CYLINDRICAL_SURFACE|CONICAL_SURFACE|SPHERICAL_SURFACE|TOROIDAL_SURFACE)\((.*?)\);$",
+        replace,
+        text,
+        flags=re.M | re.S,
+    )
+    def sense(m):
+        flip = {".T.": ".F.", ".F.": ".T."}
+        return m.group(1) + (flip[m.group(3)] if m.group(2) in flipped else m.group(3)) + ");"
+
+    text = re.sub(r"(ADVANCED_FACE\('',\([^)]*\),#(\d+),)(\.[TF]\.)\);", sense, text)
+    return text.replace("ENDSEC;\nEND-ISO", "\n".join(new) + "\nENDSEC;\nEND-ISO", 1)
+
+
+def analytic_block():
+    """A block with a bore, a countersink, a spherical pocket and a filleted boss."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
+    from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
+    from OCP.TopAbs import TopAbs_EDGE
+
+    box = BRepPrimAPI_MakeBox(80, 50, 30).Shape()
+    bore = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(20, 25, -1), gp_Dir(0, 0, 1)), 6, 32).Shape()
+    sink = BRepPrimAPI_MakeCone(gp_Ax2(gp_Pnt(20, 25, 24), gp_Dir(0, 0, 1)), 6, 12, 6.01).Shape()
+    ball = BRepPrimAPI_MakeSphere(gp_Pnt(55, 25, 38), 12).Shape()
+    boss = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(62, 12, 30), gp_Dir(0, 0, 1)), 7, 8).Shape()
+    body = BRepAlgoAPI_Cut(BRepAlgoAPI_Cut(BRepAlgoAPI_Cut(box, bore).Shape(), sink).Shape(), ball).Shape()
+    body = BRepAlgoAPI_Fuse(body, boss).Shape()
+    fillet = BRepFilletAPI_MakeFillet(body)
+    ex = TopExp_Explorer(body, TopAbs_EDGE)
+    while ex.More():
+        e = TopoDS.Edge_s(ex.Current())
+        c = BRepAdaptor_Curve(e)
+        if c.GetType() == GeomAbs_CurveType.GeomAbs_Circle:
+            circ = c.Circle()
+            if abs(circ.Radius() - 7) < 1e-6 and abs(circ.Location().Z() - 38) < 1e-6:
+                fillet.Add(2.0, e)
+        ex.Next()
+    return fillet.Shape()
+
+
 def degrees(text):
     """The plane angle unit declared as a degree (a conversion-based unit), and the
     cone's semi-angle written in it."""
@@ -296,6 +441,7 @@ def main():
     write("nurbs", nurbs_cap(), what="a block with a spherical pocket, every face a rational B-spline")
     write("offset", offset_vase(), what="the revolved vase grown 2 mm (OFFSET_SURFACE)")
     write("seamless_cylinder", cylinder_block(), edit=without_seam, what="a bore whose cylinder face has no seam edge")
+    write("disguised", analytic_block(), edit=disguised, what="planes, cylinders, a cone, a sphere and a torus written as swept and offset surfaces")
     write("unit_inch", cylinder_block(), unit="INCH", unit_mm=1.0, what="lengths in inches")
     write("unit_metre", cylinder_block(), unit="M", unit_mm=1.0, what="lengths in metres")
     write("unit_degree", cone_block(), edit=degrees, what="plane angles in degrees (a conversion-based unit)")

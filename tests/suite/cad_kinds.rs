@@ -186,3 +186,10 @@ fn lengths_in_metres() {
 fn angles_in_degrees() {
     check("unit_degree");
 }
+
+#[test]
+fn analytic_surfaces_written_as_swept_and_offset_ones() {
+    // Each kind must come out as the analytic surface it is (the fixture's
+    // OpenCASCADE reading names them), with every face's normal outward.
+    check("disguised");
+}
