@@ -10,6 +10,10 @@ millimetres), which the test compares inspc's reading with.
 Some kinds OpenCASCADE never writes by itself (a cylinder face with no seam edge, a
 plane angle in degrees); those parts are written by OpenCASCADE and then edited as text,
 and the edit is described beside the part.
+
+Every file comes out byte-identical from run to run but `offset.stp`, whose faces
+OpenCASCADE's offset algorithm orders differently each time (the same solid): keep the
+checked-in one unless the part changes.
 """
 
 import json
@@ -386,6 +390,82 @@ def disguised(text):
     return text.replace("ENDSEC;\nEND-ISO", "\n".join(new) + "\nENDSEC;\nEND-ISO", 1)
 
 
+def spline_prism(mults, knots):
+    """A plate whose curved side is a cubic B-spline with the given knots, extruded."""
+    from OCP.Geom import Geom_BSplineCurve
+    from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal
+    from OCP.TColgp import TColgp_Array1OfPnt
+
+    pts = [(0, 0), (10, 12), (25, 8), (40, 18), (55, 5), (70, 10), (80, 0)]
+    poles = TColgp_Array1OfPnt(1, len(pts))
+    for i, (x, y) in enumerate(pts):
+        poles.SetValue(i + 1, gp_Pnt(x, y + 20, 0))
+    k = TColStd_Array1OfReal(1, len(knots))
+    m = TColStd_Array1OfInteger(1, len(mults))
+    for i, (kv, mv) in enumerate(zip(knots, mults)):
+        k.SetValue(i + 1, kv)
+        m.SetValue(i + 1, mv)
+    curve = Geom_BSplineCurve(poles, k, m, 3)
+    a, b = curve.StartPoint(), curve.EndPoint()
+    edges = [
+        BRepBuilderAPI_MakeEdge(curve).Edge(),
+        segment(xyz(b), (xyz(b)[0], 0, 0)),
+        segment((xyz(b)[0], 0, 0), (xyz(a)[0], 0, 0)),
+        segment((xyz(a)[0], 0, 0), xyz(a)),
+    ]
+    return BRepPrimAPI_MakePrism(profile_face(edges), gp_Vec(0, 0, 12)).Shape()
+
+
+def implied_knots(kind):
+    """B-splines whose knots their subtype implies (ISO 10303-42 uniform_curve,
+    quasi_uniform_curve, bezier_curve, bezier_surface): every simple B-spline instance
+    whose knots are that pattern loses them and takes the subtype's name. A Bézier
+    piece's shape does not depend on its knots' spacing, so degree-1 lines and planes
+    of any length qualify; a quasi-uniform or uniform curve's knots must be 0, 1, 2, …
+    as the subtype implies."""
+
+    def edit(text):
+        def curve(m):
+            name, deg, pts, flags, mults, knots = m.groups()
+            mults = [int(x) for x in mults.split(",")]
+            knots = [float(x) for x in knots.split(",")]
+            d = int(deg)
+            steps = [b - a for a, b in zip(knots, knots[1:])]
+            unit = all(abs(x - 1.0) < 1e-12 for x in steps)
+            if kind == "BEZIER" and mults[0] == mults[-1] == d + 1 and all(x == d for x in mults[1:-1]):
+                new = "BEZIER_CURVE"
+            elif kind == "QUASI_UNIFORM" and unit and knots[0] == 0 and mults[0] == mults[-1] == d + 1 and all(x == 1 for x in mults[1:-1]):
+                new = "QUASI_UNIFORM_CURVE"
+            elif kind == "UNIFORM" and unit and knots[0] == -d and all(x == 1 for x in mults):
+                new = "UNIFORM_CURVE"
+            else:
+                return m.group(0)
+            return f"{new}({name},{deg},{pts},{flags});"
+
+        def surface(m):
+            name, du, dv, pts, flags, mu, mv, ku, kv = m.groups()
+            ok = all(
+                [int(x) for x in ms.split(",")] == [int(d) + 1, int(d) + 1]
+                for ms, d in ((mu, du), (mv, dv))
+            )
+            if kind != "BEZIER" or not ok:
+                return m.group(0)
+            return f"BEZIER_SURFACE({name},{du},{dv},{pts},{flags});"
+
+        text = re.sub(
+            r"B_SPLINE_CURVE_WITH_KNOTS\(('[^']*'),(\d+),(\([^)]*\)),(\.\w+\.,\.\w+\.,\.\w+\.),\s*\(([^)]*)\),\s*\(([^)]*)\),\s*\.\w+\.\);",
+            curve,
+            text,
+        )
+        return re.sub(
+            r"B_SPLINE_SURFACE_WITH_KNOTS\(('[^']*'),(\d+),(\d+),(\((?:\s*,?\s*\([^)]*\))*\s*\)),(\.\w+\.,\.\w+\.,\.\w+\.,\.\w+\.),\s*\(([^)]*)\),\s*\(([^)]*)\),\s*\(([^)]*)\),\s*\(([^)]*)\),\s*\.\w+\.\);",
+            surface,
+            text,
+        )
+
+    return edit
+
+
 def analytic_block():
     """A block with a bore, a countersink, a spherical pocket and a filleted boss."""
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
@@ -442,6 +522,9 @@ def main():
     write("offset", offset_vase(), what="the revolved vase grown 2 mm (OFFSET_SURFACE)")
     write("seamless_cylinder", cylinder_block(), edit=without_seam, what="a bore whose cylinder face has no seam edge")
     write("disguised", analytic_block(), edit=disguised, what="planes, cylinders, a cone, a sphere and a torus written as swept and offset surfaces")
+    write("bezier", nurbs_cap(), edit=implied_knots("BEZIER"), what="the NURBS block with its lines and planes as Bezier curves and surfaces")
+    write("quasi_uniform", spline_prism([4, 1, 1, 1, 4], [0, 1, 2, 3, 4]), edit=implied_knots("QUASI_UNIFORM"), what="a quasi-uniform cubic B-spline, knots implied")
+    write("uniform", spline_prism([1] * 11, [float(k) for k in range(-3, 8)]), edit=implied_knots("UNIFORM"), what="a uniform cubic B-spline, knots implied")
     write("unit_inch", cylinder_block(), unit="INCH", unit_mm=1.0, what="lengths in inches")
     write("unit_metre", cylinder_block(), unit="M", unit_mm=1.0, what="lengths in metres")
     write("unit_degree", cone_block(), edit=degrees, what="plane angles in degrees (a conversion-based unit)")

@@ -193,3 +193,18 @@ fn analytic_surfaces_written_as_swept_and_offset_ones() {
     // OpenCASCADE reading names them), with every face's normal outward.
     check("disguised");
 }
+
+#[test]
+fn bezier_curves_and_surfaces() {
+    check("bezier");
+}
+
+#[test]
+fn a_quasi_uniform_b_spline() {
+    check("quasi_uniform");
+}
+
+#[test]
+fn a_uniform_b_spline() {
+    check("uniform");
+}

@@ -570,7 +570,15 @@ impl<'a> Reader<'a> {
                 self.length(id, r, 3)?,
             ));
         }
-        if inst.is("B_SPLINE_CURVE_WITH_KNOTS") {
+        if [
+            "B_SPLINE_CURVE_WITH_KNOTS",
+            "UNIFORM_CURVE",
+            "QUASI_UNIFORM_CURVE",
+            "BEZIER_CURVE",
+        ]
+        .iter()
+        .any(|k| inst.is(k))
+        {
             return self
                 .bspline_curve(id, inst)
                 .map(|c| Curve::BSpline(Arc::new(c)));
@@ -679,8 +687,77 @@ impl<'a> Reader<'a> {
         }
     }
 
+    /// The knots of a B-spline whose subtype implies them (ISO 10303-42 § 4.4:
+    /// `uniform_curve`, `quasi_uniform_curve`, `bezier_curve` and their surface
+    /// forms), for `n` control points of this degree along one direction: the
+    /// multiplicities and the distinct values. `None` for `…_WITH_KNOTS`.
+    fn implied_knots(
+        inst: &Instance,
+        form: &str,
+        degree: usize,
+        n: usize,
+    ) -> Option<(Vec<i64>, Vec<f64>)> {
+        let d = degree as i64;
+        let k = n as i64 - 1;
+        if inst.is(&format!("UNIFORM_{form}")) {
+            // Single knots −d, −d+1, …, k+1.
+            let values: Vec<f64> = (-d..=k + 1).map(|v| v as f64).collect();
+            Some((vec![1; values.len()], values))
+        } else if inst.is(&format!("QUASI_UNIFORM_{form}")) {
+            // 0, 1, …, k−d+1, the ends d+1 times.
+            let last = (k - d + 1).max(1);
+            let values: Vec<f64> = (0..=last).map(|v| v as f64).collect();
+            let mut mults = vec![1; values.len()];
+            mults[0] = d + 1;
+            *mults.last_mut()? = d + 1;
+            Some((mults, values))
+        } else if inst.is(&format!("BEZIER_{form}")) {
+            // Piecewise Bézier: 0, 1, …, k/d, the ends d+1 times, the rest d times.
+            let last = (k / d).max(1);
+            let values: Vec<f64> = (0..=last).map(|v| v as f64).collect();
+            let mut mults = vec![d; values.len()];
+            mults[0] = d + 1;
+            *mults.last_mut()? = d + 1;
+            Some((mults, values))
+        } else {
+            None
+        }
+    }
+
+    /// A B-spline's degree-and-points parameters and its knot parameters (`None` when
+    /// its subtype implies the knots).
+    fn bspline_head<'r>(
+        &self,
+        id: u64,
+        inst: &'r Instance,
+        base: &str,
+        form: &str,
+        head: usize,
+        tail: usize,
+    ) -> Result<(&'r [Param], Option<&'r [Param]>), StepError> {
+        if inst.is(&format!("{base}_WITH_KNOTS")) {
+            let (h, k) = self.bspline_parts(id, inst, base, head, tail)?;
+            return Ok((h, Some(k)));
+        }
+        let too_few = || self.bad(id, format!("{base} has too few parameters"));
+        let h: &[Param] = match inst.record(base) {
+            Some(b) => &b.params,
+            None => {
+                let r = ["UNIFORM_", "QUASI_UNIFORM_", "BEZIER_"]
+                    .iter()
+                    .find_map(|p| inst.record(&format!("{p}{form}")))
+                    .ok_or_else(too_few)?;
+                r.params.get(1..).ok_or_else(too_few)?
+            }
+        };
+        if h.len() < head {
+            return Err(too_few());
+        }
+        Ok((h, None))
+    }
+
     fn bspline_curve(&self, id: u64, inst: &Instance) -> Result<BSplineCurve, StepError> {
-        let (head, knots) = self.bspline_parts(id, inst, "B_SPLINE_CURVE", 5, 3)?;
+        let (head, knots) = self.bspline_head(id, inst, "B_SPLINE_CURVE", "CURVE", 5, 3)?;
         let degree = self.degree(id, &head[0])?;
         let points = self.points(
             id,
@@ -688,8 +765,11 @@ impl<'a> Reader<'a> {
                 .list()
                 .ok_or_else(|| self.bad(id, "control points expected"))?,
         )?;
-        let mults = self.ints(id, &knots[0])?;
-        let values = self.reals(id, &knots[1])?;
+        let (mults, values) = match knots {
+            Some(k) => (self.ints(id, &k[0])?, self.reals(id, &k[1])?),
+            None => Self::implied_knots(inst, "CURVE", degree, points.len())
+                .ok_or_else(|| self.bad(id, "the B-spline's knots are not given"))?,
+        };
         let knots = Knots::new(degree, &mults, &values, points.len())
             .ok_or_else(|| self.bad(id, "the knots do not fit the control points and degree"))?;
         let weights = match inst.record("RATIONAL_B_SPLINE_CURVE") {
@@ -743,7 +823,15 @@ impl<'a> Reader<'a> {
                 self.length(id, r, 3)?,
             ));
         }
-        if inst.is("B_SPLINE_SURFACE_WITH_KNOTS") {
+        if [
+            "B_SPLINE_SURFACE_WITH_KNOTS",
+            "UNIFORM_SURFACE",
+            "QUASI_UNIFORM_SURFACE",
+            "BEZIER_SURFACE",
+        ]
+        .iter()
+        .any(|k| inst.is(k))
+        {
             return self
                 .bspline_surface(id, inst)
                 .map(|s| Surf::BSpline(Arc::new(s)));
@@ -791,7 +879,7 @@ impl<'a> Reader<'a> {
     }
 
     fn bspline_surface(&self, id: u64, inst: &Instance) -> Result<BSplineSurface, StepError> {
-        let (head, knots) = self.bspline_parts(id, inst, "B_SPLINE_SURFACE", 7, 5)?;
+        let (head, knots) = self.bspline_head(id, inst, "B_SPLINE_SURFACE", "SURFACE", 7, 5)?;
         let (du, dv) = (self.degree(id, &head[0])?, self.degree(id, &head[1])?);
         let rows = head[2]
             .list()
@@ -810,20 +898,23 @@ impl<'a> Reader<'a> {
         if points.is_empty() || points.iter().any(|r| r.len() != nv) {
             return Err(self.bad(id, "the control points are not a rectangular grid"));
         }
-        let u = Knots::new(
-            du,
-            &self.ints(id, &knots[0])?,
-            &self.reals(id, &knots[2])?,
-            points.len(),
-        )
-        .ok_or_else(|| self.bad(id, "the u knots do not fit the control points and degree"))?;
-        let v = Knots::new(
-            dv,
-            &self.ints(id, &knots[1])?,
-            &self.reals(id, &knots[3])?,
-            nv,
-        )
-        .ok_or_else(|| self.bad(id, "the v knots do not fit the control points and degree"))?;
+        let ((mu, ku), (mv, kv)) = match knots {
+            Some(k) => (
+                (self.ints(id, &k[0])?, self.reals(id, &k[2])?),
+                (self.ints(id, &k[1])?, self.reals(id, &k[3])?),
+            ),
+            None => {
+                let implied = |d, n| {
+                    Self::implied_knots(inst, "SURFACE", d, n)
+                        .ok_or_else(|| self.bad(id, "the B-spline's knots are not given"))
+                };
+                (implied(du, points.len())?, implied(dv, nv)?)
+            }
+        };
+        let u = Knots::new(du, &mu, &ku, points.len())
+            .ok_or_else(|| self.bad(id, "the u knots do not fit the control points and degree"))?;
+        let v = Knots::new(dv, &mv, &kv, nv)
+            .ok_or_else(|| self.bad(id, "the v knots do not fit the control points and degree"))?;
         let weights = match inst.record("RATIONAL_B_SPLINE_SURFACE") {
             Some(r) => self
                 .list(id, r, 0)?
