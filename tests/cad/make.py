@@ -121,7 +121,9 @@ def reading(shape, unit_mm):
     }
 
 
-def write(name, shape, unit="MM", unit_mm=1.0, edit=None, what=""):
+def write(name, shape, unit="MM", unit_mm=1.0, edit=None, what="", qif=None):
+    """Writes NAME.stp and NAME.json, and NAME.qif when `qif` says how (`"u"` or
+    `"v"`: which NURBS index runs fastest, `qif_writer.py`)."""
     Interface_Static.SetCVal_s("write.step.unit", unit)
     Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
     path = os.path.join(HERE, name + ".stp")
@@ -136,6 +138,11 @@ def write(name, shape, unit="MM", unit_mm=1.0, edit=None, what=""):
     if edit:
         text = edit(text)
     open(path, "w").write(text)
+    if qif:
+        from qif_writer import Writer
+
+        with open(os.path.join(HERE, name + ".qif"), "w") as f:
+            f.write(Writer(v_fastest=qif == "v").write(shape))
     expected = reading(shape, unit_mm)
     expected["what"] = what
     with open(os.path.join(HERE, name + ".json"), "w") as f:
@@ -511,15 +518,15 @@ def degrees(text):
 
 
 def main():
-    write("extrusion_bspline", blob_prism(), what="a closed B-spline swept along z (SURFACE_OF_LINEAR_EXTRUSION, seam)")
-    write("extrusion_ellipse", ellipse_prism(), what="an ellipse swept along its normal")
+    write("extrusion_bspline", blob_prism(), what="a closed B-spline swept along z (SURFACE_OF_LINEAR_EXTRUSION, seam)", qif="u")
+    write("extrusion_ellipse", ellipse_prism(), what="an ellipse swept along its normal", qif="u")
     write("extrusion_oblique", oblique_prism(), what="a circle swept along a slanted vector")
-    write("revolution_bspline", vase(), what="a B-spline revolved once round (SURFACE_OF_REVOLUTION, seam)")
+    write("revolution_bspline", vase(), what="a B-spline revolved once round (SURFACE_OF_REVOLUTION, seam)", qif="u")
     write("revolution_partial", vase(2 * math.pi / 3), what="a B-spline revolved through 120 degrees")
-    write("revolution_pole", dome(), what="a B-spline revolved from the axis: a pole")
-    write("conics", conics(), what="a plate bounded by a parabola and a hyperbola, extruded")
-    write("nurbs", nurbs_cap(), what="a block with a spherical pocket, every face a rational B-spline")
-    write("offset", offset_vase(), what="the revolved vase grown 2 mm (OFFSET_SURFACE)")
+    write("revolution_pole", dome(), what="a B-spline revolved from the axis: a pole", qif="u")
+    write("conics", conics(), what="a plate bounded by a parabola and a hyperbola, extruded", qif="u")
+    write("nurbs", nurbs_cap(), what="a block with a spherical pocket, every face a rational B-spline", qif="v")
+    write("offset", offset_vase(), what="the revolved vase grown 2 mm (OFFSET_SURFACE)", qif="u")
     write("seamless_cylinder", cylinder_block(), edit=without_seam, what="a bore whose cylinder face has no seam edge")
     write("disguised", analytic_block(), edit=disguised, what="planes, cylinders, a cone, a sphere and a torus written as swept and offset surfaces")
     write("bezier", nurbs_cap(), edit=implied_knots("BEZIER"), what="the NURBS block with its lines and planes as Bezier curves and surfaces")

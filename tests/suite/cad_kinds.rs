@@ -5,7 +5,7 @@
 //! (outward normals: a face meshed inside out subtracts its share) and fill the same box.
 
 use inspc::geometry::step::{read, Resolution, RESOLUTION};
-use inspc::geometry::RawMesh;
+use inspc::geometry::{qif, RawMesh};
 use inspc::model::SurfaceKind;
 use serde_json::Value;
 
@@ -40,13 +40,29 @@ fn kind_name(k: SurfaceKind) -> &'static str {
 }
 
 fn check(name: &str) {
+    check_file(name, "stp");
+}
+
+/// The same solid written as QIF 3 (`tests/cad/qif_writer.py`), a document valid
+/// against the QIF 3 schemas (where `xmllint` is installed, as in CI).
+fn check_qif(name: &str) {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/cad/").to_string() + name + ".qif";
+    crate::qif_results::validate(name, &std::fs::read_to_string(path).unwrap());
+    check_file(name, "qif");
+}
+
+fn check_file(name: &str, ext: &str) {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/cad/");
-    let bytes = std::fs::read(format!("{dir}{name}.stp")).unwrap();
+    let bytes = std::fs::read(format!("{dir}{name}.{ext}")).unwrap();
+    let read = |res| match ext {
+        "qif" => qif::read(&bytes, res),
+        _ => read(&bytes, res),
+    };
     let want: Value =
         serde_json::from_str(&std::fs::read_to_string(format!("{dir}{name}.json")).unwrap())
             .unwrap();
     // At the resolution parts are planned at, the mesh closes too.
-    let coarse = read(&bytes, RESOLUTION).unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    let coarse = read(RESOLUTION).unwrap_or_else(|e| panic!("{name}: {e:?}"));
     assert_eq!(
         coarse.mesh.open_edges, 0,
         "{name}: closed at the planning resolution"
@@ -55,7 +71,7 @@ fn check(name: &str) {
         coarse.mesh.nonmanifold_edges, 0,
         "{name}: manifold at the planning resolution"
     );
-    let part = read(&bytes, FINE).unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    let part = read(FINE).unwrap_or_else(|e| panic!("{name}: {e:?}"));
     let m = &part.mesh;
     assert_eq!(m.open_edges, 0, "{name}: the solid's mesh is closed");
     assert_eq!(m.nonmanifold_edges, 0, "{name}: no edge of three triangles");
@@ -207,4 +223,39 @@ fn a_quasi_uniform_b_spline() {
 #[test]
 fn a_uniform_b_spline() {
     check("uniform");
+}
+
+#[test]
+fn qif_extrude23_of_a_nurbs_curve() {
+    check_qif("extrusion_bspline");
+}
+
+#[test]
+fn qif_extrude23_of_an_elliptic_arc() {
+    check_qif("extrusion_ellipse");
+}
+
+#[test]
+fn qif_revolution23() {
+    check_qif("revolution_bspline");
+}
+
+#[test]
+fn qif_revolution23_to_a_pole() {
+    check_qif("revolution_pole");
+}
+
+#[test]
+fn qif_parabolic_and_hyperbolic_arcs() {
+    check_qif("conics");
+}
+
+#[test]
+fn qif_nurbs23_with_the_control_points_v_fastest() {
+    check_qif("nurbs");
+}
+
+#[test]
+fn qif_offset23() {
+    check_qif("offset");
 }

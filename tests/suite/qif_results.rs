@@ -16,7 +16,7 @@ const SCHEMA: &str = "../shared/qif3-schema/QIFDocument.xsd";
 
 /// Validates `doc` against the QIF 3 schemas; false when `xmllint` is missing and not
 /// required.
-fn validate(name: &str, doc: &str) -> bool {
+pub(crate) fn validate(name: &str, doc: &str) -> bool {
     let found = Command::new("xmllint")
         .arg("--version")
         .output()

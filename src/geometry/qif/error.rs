@@ -101,7 +101,7 @@ pub enum QifError {
     #[error("{}", faces(_0))]
     #[diagnostic(
         code(insp::geometry::qif_face),
-        help("the face is kept out of nothing: a part with a hole in its mesh cannot be planned; repair the face (its loops and surface must agree) and re-export")
+        help("inspc meshes each face in its surface's parameters, and this face's loops could not be laid out there for the reason given; it is reported rather than dropped, since a hole in the mesh would let probes see through the part")
     )]
     Faces(Vec<(usize, u64, String)>),
 }

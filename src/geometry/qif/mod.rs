@@ -35,13 +35,17 @@
 //! feature nominals or their targets' feature nominals; composite frames' second
 //! segments become lower segments; the angle of a two-plane feature is the angle
 //! between its planes, as STEP files state it. Surfaces: plane, cylinder, cone, sphere,
-//! torus; curves: segment, circular arc, NURBS, polyline and aggregates of them; NURBS
-//! surfaces and meshed faces are `qif_unsupported`.
+//! torus, NURBS, extrusion, revolution, offset (`surfaces.rs`); curves: segment,
+//! circular and conic arc, NURBS, polyline and aggregates of them; meshed faces are
+//! `qif_unsupported`.
 
 mod brep;
+mod curves;
+mod doc;
 pub(in crate::geometry) mod error;
 mod pmi;
 mod refs;
+mod surfaces;
 mod xml;
 
 pub use error::QifError;
@@ -140,11 +144,11 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
         })?,
         None => file_mm,
     };
-    let doc = brep::Doc {
+    let doc = doc::Doc {
         ids: xml::index(&root),
         unit: file_mm / scale,
         value_unit,
-        samples: std::cell::Cell::new(brep::MAX_SAMPLES),
+        samples: std::cell::Cell::new(doc::MAX_SAMPLES),
         curves: Default::default(),
     };
     let mut b = brep::read(&doc, &root).map_err(q)?;

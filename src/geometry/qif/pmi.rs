@@ -7,7 +7,7 @@
 //! curved faces, as in the STEP reader). Reading never fails; what cannot be linked is a
 //! note.
 
-use super::brep::Doc;
+use super::doc::Doc;
 use super::refs;
 use super::xml::Node;
 use super::QifError;

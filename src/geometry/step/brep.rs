@@ -10,10 +10,11 @@
 //! not with how often the file names an instance.
 
 use super::canon::{canonical, revolution_axis};
-use super::geom::{BSplineCurve, BSplineSurface, Curve, Frame, Knots, Surf};
+use super::curve::{BSplineCurve, Curve, Frame, Knots};
+use super::geom::{BSplineSurface, Offset, Surf};
 use super::p21::{Instance, Param, Record, P21};
 use super::refs::{Memo, Trail};
-use super::swept::{Extrusion, Offset, Revolution};
+use super::swept::{Extrusion, Revolution};
 use super::StepError;
 use crate::geometry::{P3, V3};
 use std::collections::{HashMap, HashSet};

@@ -19,8 +19,9 @@
 //! on its side of the axis), so the face's sense is compared at its own points and
 //! flipped where they disagree.
 
-use super::geom::{Curve, Frame, Surf};
-use super::swept::{Extrusion, Offset, Revolution};
+use super::curve::{Curve, Frame};
+use super::geom::{Offset, Surf};
+use super::swept::{Extrusion, Revolution};
 use crate::geometry::{P3, V3};
 
 /// How far from parallel, square or coplanar a direction may be and still count

@@ -67,7 +67,7 @@ pub enum StepError {
     #[error("#{id} (line {line}) is a {what}, which inspc does not evaluate")]
     #[diagnostic(
         code(insp::geometry::step_unsupported),
-        help("inspc evaluates planes, cylinders, cones, spheres, tori and B-spline surfaces, and lines, circles, ellipses, B-spline curves and polylines; export this geometry as B-splines")
+        help("inspc evaluates planes, cylinders, cones, spheres, tori, B-spline, extruded, revolved and offset surfaces, and lines, conics, B-spline curves and polylines (README, \"CAD files\"); export this geometry as B-splines")
     )]
     Unsupported {
         /// The instance.
@@ -88,7 +88,7 @@ pub enum StepError {
     #[error("{}", faces(_0))]
     #[diagnostic(
         code(insp::geometry::step_face),
-        help("the face is kept out of nothing: a part with a hole in its mesh cannot be planned; repair the face in the CAD system (its bounds and surface must agree) and re-export")
+        help("inspc meshes each face in its surface's parameters, and this face's bounds could not be laid out there for the reason given; it is reported rather than dropped, since a hole in the mesh would let probes see through the part")
     )]
     Faces(Vec<(usize, u64, String)>),
 }

@@ -32,18 +32,21 @@
 //! faces, so PMI links to them are recognised and reported, but they are not meshed —
 //! no probe touches them and no move avoids them. Sheet bodies alone are the part.
 //! Surfaces: plane, cylinder, cone, sphere, torus (also degenerate), B-spline
-//! (rational, closed); curves: line, circle, ellipse, B-spline, polyline, and the
+//! (rational, closed; knots given or implied), linear extrusion, revolution, offset
+//! (`swept.rs`; read analytic where they are one, `canon.rs`), rectangular trimmed;
+//! curves: line, circle, ellipse, parabola, hyperbola, B-spline, polyline, and the
 //! trimmed, surface and seam wrappers. Resolution ([`RESOLUTION`]): 0.1 mm chord and
 //! 0.5 rad, the reference meshes' own.
 
 pub(super) mod brep;
-mod canon;
+pub(super) mod canon;
+pub(super) mod curve;
 pub(in crate::geometry) mod error;
 pub(super) mod geom;
 mod p21;
 pub mod pmi;
 mod refs;
-mod swept;
+pub(super) mod swept;
 pub(super) mod tess;
 
 pub use error::StepError;
@@ -158,11 +161,11 @@ fn extent(b: &brep::Brep) -> f64 {
         add(&e.start, 0.0);
         add(&e.end, 0.0);
         match &e.curve {
-            geom::Curve::Circle(f, r) => add(&f.o, r.abs()),
-            geom::Curve::Ellipse(f, a, c) => add(&f.o, a.abs().max(c.abs())),
-            geom::Curve::BSpline(c) => c.points.iter().for_each(|p| add(p, 0.0)),
-            geom::Curve::Polyline(pts) => pts.iter().for_each(|p| add(p, 0.0)),
-            geom::Curve::Line(..) | geom::Curve::Parabola(..) | geom::Curve::Hyperbola(..) => {}
+            curve::Curve::Circle(f, r) => add(&f.o, r.abs()),
+            curve::Curve::Ellipse(f, a, c) => add(&f.o, a.abs().max(c.abs())),
+            curve::Curve::BSpline(c) => c.points.iter().for_each(|p| add(p, 0.0)),
+            curve::Curve::Polyline(pts) => pts.iter().for_each(|p| add(p, 0.0)),
+            curve::Curve::Line(..) | curve::Curve::Parabola(..) | curve::Curve::Hyperbola(..) => {}
         }
     }
     for f in &b.faces {

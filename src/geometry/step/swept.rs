@@ -1,6 +1,7 @@
-//! Surfaces made from a curve or another surface: a curve swept along a vector
+//! Surfaces made from a curve: a curve swept along a vector
 //! (`SURFACE_OF_LINEAR_EXTRUSION`), a curve revolved about an axis
-//! (`SURFACE_OF_REVOLUTION`), a surface grown along its normal (`OFFSET_SURFACE`).
+//! (`SURFACE_OF_REVOLUTION`); and, in `geom.rs` beside the surfaces it grows, a surface
+//! grown along its normal (`OFFSET_SURFACE`).
 //!
 //! The parametrisations are ISO 10303-42's (§ 4.4.x `surface_of_linear_extrusion`,
 //! `surface_of_revolution`, `offset_surface`), so that `S_u × S_v` points along the
@@ -17,7 +18,7 @@
 //! half-plane (revolution), or taking the basis's (offset: a point's foot on the offset
 //! surface and on its basis share their parameters).
 
-use super::geom::{nearest_param, Curve, Frame, Surf};
+use super::curve::{nearest_param, Curve, Frame};
 use crate::geometry::{P3, V3};
 use std::f64::consts::TAU;
 
@@ -38,15 +39,6 @@ pub struct Revolution {
     /// The axis: origin and z; x points from the axis toward the curve, so that the
     /// curve lies at u = 0.
     pub(crate) axis: Frame,
-}
-
-/// A surface grown along its natural normal.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Offset {
-    /// The basis surface.
-    pub(crate) base: Surf,
-    /// The distance along the basis's natural normal (mm, may be negative).
-    pub(crate) distance: f64,
 }
 
 impl Extrusion {
@@ -114,16 +106,6 @@ impl Revolution {
     pub(crate) fn radius(&self, p: &P3) -> f64 {
         let l = self.axis.local(p);
         l.x.hypot(l.y)
-    }
-}
-
-impl Offset {
-    pub(crate) fn eval(&self, u: f64, v: f64) -> P3 {
-        let p = self.base.eval(u, v);
-        match self.base.normal(&p, u, v) {
-            Some(n) => p + n * self.distance,
-            None => p,
-        }
     }
 }
 

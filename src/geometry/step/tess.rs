@@ -26,7 +26,8 @@
 //! straight lines.
 
 use super::brep::{Bound, Brep, Edge, Face};
-use super::geom::{unwrap_near, Curve, Surf};
+use super::curve::{unwrap_near, Curve};
+use super::geom::Surf;
 use crate::geometry::weld::MAX_TRIANGLES;
 use crate::geometry::{P3, V3};
 use rayon::prelude::*;
