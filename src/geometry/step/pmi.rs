@@ -864,30 +864,44 @@ impl Links<'_> {
     }
 
     /// A measure's value in mm (lengths) or degrees (plane angles), and whether it is
-    /// an angle.
+    /// an angle ([`measure_value`]).
     fn measure(&self, id: u64) -> Option<(f64, bool)> {
-        let inst = self.f.instances.get(&id)?;
-        let r = inst.records.iter().find(|r| {
-            r.params.len() >= 2 && r.params[0].real().is_some() && r.params[1].reference().is_some()
-        })?;
-        let value = r.params[0].real()?;
-        let kind = match &r.params[0] {
-            Param::Typed(t) => t.name.as_str(),
-            _ => "",
+        measure_value(self.f, id, self.unit_mm)
+    }
+}
+
+/// A measure's value in mm (lengths) or degrees (plane angles), and whether it is an
+/// angle: `…_MEASURE_WITH_UNIT(value, unit)` or `MEASURE_REPRESENTATION_ITEM(name,
+/// value, unit)`, simple or in a complex instance.
+///
+/// **Decision: the unit says what a value measures.** ISO 10303-41 types a measure's
+/// value (`LENGTH_MEASURE(…)`, `PLANE_ANGLE_MEASURE(…)`) and names its unit; the two
+/// should agree, and where an exporter writes them apart (a size limit typed as a plane
+/// angle with the inch as its unit) the unit wins: a number in inches is a length
+/// whatever its type says, and taking it raw read a limit 25.4 times too tight. Only a
+/// value whose unit cannot be read falls back on its type, in the file's length unit or
+/// in degrees.
+fn measure_value(f: &P21, id: u64, unit_mm: f64) -> Option<(f64, bool)> {
+    let inst = f.instances.get(&id)?;
+    let (value, kind, unit) = inst.records.iter().find_map(|r| {
+        let at = |i: usize| -> Option<(f64, &str, u64)> {
+            let v = r.params.get(i)?;
+            let kind = match v {
+                Param::Typed(t) => t.name.as_str(),
+                _ => "",
+            };
+            Some((v.real()?, kind, r.params.get(i + 1)?.reference()?))
         };
-        let unit = r.params[1]
-            .reference()
-            .and_then(|u| self.f.instances.get(&u));
-        if kind.contains("ANGLE") {
-            let rad = unit
-                .and_then(|u| unit_factor(self.f, u, "RADIAN", 1.0, 0).ok())
-                .map_or(std::f64::consts::PI / 180.0, |(k, _)| k);
-            return Some((tidy(value * rad.to_degrees()), true));
-        }
-        let mm = unit
-            .and_then(|u| unit_factor(self.f, u, "METRE", 1000.0, 0).ok())
-            .map_or(self.unit_mm, |(k, _)| k);
-        Some((tidy(value * mm), false))
+        at(0).or_else(|| at(1))
+    })?;
+    let unit = f.instances.get(&unit);
+    let length = unit.and_then(|u| unit_factor(f, u, "METRE", 1000.0, 0).ok());
+    let angle = unit.and_then(|u| unit_factor(f, u, "RADIAN", 1.0, 0).ok());
+    match (length, angle) {
+        (Some((mm, _)), _) => Some((tidy(value * mm), false)),
+        (None, Some((rad, _))) => Some((tidy((value * rad).to_degrees()), true)),
+        _ if kind.contains("ANGLE") => Some((tidy(value), true)),
+        _ => Some((tidy(value * unit_mm), false)),
     }
 }
 
@@ -922,4 +936,55 @@ fn first_of_each(v: &mut Vec<String>) {
 /// A converted value rounded to 1e-9 of its unit, so that 0.015 in reads 0.381 mm.
 fn tidy(x: f64) -> f64 {
     (x * 1e9).round() / 1e9
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One measure per case exporters write, against a millimetre and an inch unit,
+    /// a radian and a degree.
+    const MEASURES: &str = "ISO-10303-21;
+HEADER;
+FILE_SCHEMA(('AP242_MANAGED_MODEL_BASED_3D_ENGINEERING_MIM_LF'));
+ENDSEC;
+DATA;
+#1=(LENGTH_UNIT()NAMED_UNIT(*)SI_UNIT(.MILLI.,.METRE.));
+#2=(NAMED_UNIT(*)PLANE_ANGLE_UNIT()SI_UNIT($,.RADIAN.));
+#3=DIMENSIONAL_EXPONENTS(1.,0.,0.,0.,0.,0.,0.);
+#4=LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.4),#1);
+#5=(CONVERSION_BASED_UNIT('INCH',#4)LENGTH_UNIT()NAMED_UNIT(#3));
+#6=DIMENSIONAL_EXPONENTS(0.,0.,0.,0.,0.,0.,0.);
+#7=PLANE_ANGLE_MEASURE_WITH_UNIT(PLANE_ANGLE_MEASURE(0.0174532925199433),#2);
+#8=(CONVERSION_BASED_UNIT('DEGREE',#7)NAMED_UNIT(#6)PLANE_ANGLE_UNIT());
+#10=LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(0.5),#1);
+#11=LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(0.015),#5);
+#12=(MEASURE_REPRESENTATION_ITEM()MEASURE_WITH_UNIT(PLANE_ANGLE_MEASURE(0.015),#5)REPRESENTATION_ITEM('upper limit'));
+#13=PLANE_ANGLE_MEASURE_WITH_UNIT(PLANE_ANGLE_MEASURE(30.),#8);
+#14=PLANE_ANGLE_MEASURE_WITH_UNIT(PLANE_ANGLE_MEASURE(0.5235987755982988),#2);
+#15=MEASURE_REPRESENTATION_ITEM('angle',LENGTH_MEASURE(45.),#8);
+#16=MEASURE_REPRESENTATION_ITEM('size',POSITIVE_LENGTH_MEASURE(2.),#99);
+#17=MEASURE_REPRESENTATION_ITEM('angle',PLANE_ANGLE_MEASURE(10.),#99);
+ENDSEC;
+END-ISO-10303-21;
+";
+
+    #[test]
+    fn measures_take_the_dimension_of_their_unit() {
+        let f = super::super::p21::parse(MEASURES.as_bytes()).unwrap();
+        let at = |id| measure_value(&f, id, 25.4).unwrap();
+        // Millimetres and inches.
+        assert_eq!(at(10), (0.5, false));
+        assert_eq!(at(11), (0.381, false));
+        // Typed as a plane angle with the inch as its unit: a length in inches.
+        assert_eq!(at(12), (0.381, false));
+        // Degrees and radians.
+        assert_eq!(at(13), (30.0, true));
+        assert_eq!(at(14), (30.0, true));
+        // Typed as a length with the degree as its unit: an angle.
+        assert_eq!(at(15), (45.0, true));
+        // A unit that cannot be read: the type says, in the file's length unit.
+        assert_eq!(at(16), (50.8, false));
+        assert_eq!(at(17), (10.0, true));
+    }
 }
