@@ -18,6 +18,7 @@
 //! comment and a warning ([`LeftOut`]).
 
 mod errors;
+mod fits;
 mod recognise;
 mod text;
 mod values;

@@ -642,10 +642,16 @@ fn dimension_line(
     used_names: &mut BTreeSet<String>,
 ) -> Result<String, String> {
     let unit = if d.angular { "deg" } else { "mm" };
-    let (Some(nominal), Some(upper), Some(lower)) = (d.nominal, d.upper, d.lower) else {
-        return Err(if let Some(fit) = &d.fit {
-            format!("its limits are a fit ({fit}), which inspc does not read")
-        } else if d.nominal.is_none() {
+    // A fit (`Ø25 G6`) is its ISO 286 limits.
+    let (mut upper, mut lower, mut note) = (d.upper, d.lower, String::new());
+    if let (Some(fit), Some(nominal), None) = (&d.fit, d.nominal, d.upper) {
+        let (u, l) = super::fits::deviations(fit, nominal)
+            .map_err(|why| format!("its limits are the fit {fit}, but {why}"))?;
+        (upper, lower) = (Some(u), Some(l));
+        note = format!(" // fit {fit}: ISO 286 limits");
+    }
+    let (Some(nominal), Some(upper), Some(lower)) = (d.nominal, upper, lower) else {
+        return Err(if d.nominal.is_none() {
             "the file gives it no value".to_string()
         } else {
             format!(
@@ -688,7 +694,7 @@ fn dimension_line(
         ),
     );
     Ok(format!(
-        "    tolerance {name} = {keyword}({}, {})",
+        "    tolerance {name} = {keyword}({}, {}){note}",
         targets.join(", "),
         limits(nominal, upper, lower, unit)
     ))

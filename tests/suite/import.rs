@@ -426,3 +426,31 @@ fn hostile_qif_labels_and_values_write_a_spec_that_checks_clean() {
         import_checks_clean(&dir, "odd\\\"name.qif", out.as_bytes());
     }
 }
+
+/// A diameter toleranced by a fit (ISO 10303-45 `limits_and_fits`: the zone's letter
+/// and grade) gets ISO 286's limits: CTC 01's first plus-minus range made `H7`.
+#[test]
+fn a_fit_reads_as_its_iso_286_limits() {
+    require_shared_parts();
+    let text = std::fs::read_to_string(file("ctc_01", "stp")).unwrap();
+    let patched = text.replace(
+        "#58=TOLERANCE_VALUE(#72,#71);",
+        "#58=LIMITS_AND_FITS('','H','7','ISO 286');",
+    );
+    assert_ne!(
+        patched, text,
+        "CTC 01's first tolerance value is where it was"
+    );
+    let opts = ImportOptions {
+        cad_path: "part.stp".into(),
+        part_name: "part".into(),
+        scale: 1.0,
+    };
+    let spec = import(patched.as_bytes(), &opts).unwrap().text;
+    let line = spec
+        .lines()
+        .find(|l| l.contains("// fit H7"))
+        .unwrap_or_else(|| panic!("no size written from the fit:\n{spec}"));
+    // Ø35 H7: IT7 over 30 up to 50 mm is 25 µm, H's lower deviation 0.
+    assert!(line.contains("35 mm +0.025 mm -0 mm"), "{line}");
+}
