@@ -413,7 +413,15 @@ fn tolerance_lines(
     let mut count = 0;
     for t in &p.tolerances {
         let label = format!("`{}` (#{})", t.name, t.id);
-        if let Err(why) = written(t.value_mm, Sign::Positive, "a zone", "mm") {
+        // A zone of 0 is legal at MMC or LMC (ASME Y14.5 zero tolerance at MMC).
+        let zero_at_material =
+            t.value_mm == 0.0 && matches!(t.material, Some(Material::Mmc | Material::Lmc));
+        let sign = if zero_at_material {
+            Sign::Any
+        } else {
+            Sign::Positive
+        };
+        if let Err(why) = written(t.value_mm, sign, "a zone", "mm") {
             warnings.push(LeftOut {
                 item: source(&format!("tolerance {label}"), Place::Comment),
                 value: why.clone(),

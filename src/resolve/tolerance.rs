@@ -130,12 +130,13 @@ pub(super) fn lower(
     let rule = rule_of(cx, call)?;
     let mut args = Args::read(cx, pc, rule, call)?;
     args.check_arity(cx, rule, call);
-    let Some((value, _)) = args.value.take() else {
+    let Some((value, value_span)) = args.value.take() else {
         if args.ok {
             missing_value(cx, rule, call);
         }
         return None;
     };
+    args.check_zero_zone(cx, rule, value_span);
     args.check_datums_allowed(cx, rule, call);
     args.check_basic_angle(cx, rule, call);
     check_unique_datums(cx, &pc.part, &args.datums);
@@ -182,6 +183,8 @@ struct Args {
     modifier: Option<(Material, Span)>,
     datums: Vec<(DatumRef, Span)>,
     basic_angle: Option<f64>,
+    /// A zone written as 0 (described), legal only at MMC or LMC.
+    zero: Option<String>,
     ok: bool,
     /// Whether the value has been written (valid or not): targets come before it,
     /// modifiers and datums after.
@@ -199,6 +202,7 @@ impl Args {
             modifier: None,
             datums: Vec::new(),
             basic_angle: None,
+            zero: None,
             ok: true,
             past_value: false,
             target_failed: false,
@@ -226,6 +230,9 @@ impl Args {
                 }
                 match zone(cx, v, rule.name) {
                     Some(w) => {
+                        if w == 0.0 {
+                            self.zero = Some(describe(v));
+                        }
                         let zone = TolValue::Zone {
                             width: w,
                             diameter: true,
@@ -316,14 +323,39 @@ impl Args {
         let val = if let Some(dim) = rule.size {
             size_limits(cx, v, dim)
         } else {
-            zone(cx, v, rule.name).map(|w| TolValue::Zone {
-                width: w,
-                diameter: false,
+            zone(cx, v, rule.name).map(|w| {
+                if w == 0.0 {
+                    self.zero = Some(describe(v));
+                }
+                TolValue::Zone {
+                    width: w,
+                    diameter: false,
+                }
             })
         };
         match val {
             Some(val) => self.value = Some((val, v.span)),
             None => self.ok = false,
+        }
+    }
+
+    /// A zone of width 0 reads only at MMC or LMC, where the feature's departure from
+    /// that size is the whole tolerance (ASME Y14.5-2018 § 10.3.4, zero tolerance at
+    /// MMC); elsewhere no part could pass it.
+    fn check_zero_zone(&mut self, cx: &mut Cx, rule: &Rule, span: Span) {
+        let at_material = matches!(self.modifier, Some((Material::Mmc | Material::Lmc, _)));
+        if let Some(value) = self.zero.take().filter(|_| !at_material) {
+            cx.err(E::NonPositive {
+                span,
+                what: format!("the {} tolerance", rule.name),
+                value,
+                help: if rule.material {
+                    "a zone of 0 reads only at MMC or LMC, where the size's departure from that condition is the tolerance (ASME Y14.5 zero tolerance at MMC); add `MMC` or give the zone a width".into()
+                } else {
+                    "a tolerance zone has a positive width".into()
+                },
+            });
+            self.ok = false;
         }
     }
 
@@ -497,7 +529,8 @@ fn zone(cx: &mut Cx, v: &ast::Value, what: &str) -> Option<f64> {
     match &v.kind {
         ValueKind::Quantity(_) => {
             let w = cx.length(v)?;
-            if w <= 0.0 {
+            // A zone of 0 is checked against the modifier once it is read.
+            if w < 0.0 {
                 cx.err(E::NonPositive {
                     span: v.span,
                     what: format!("the {what} tolerance"),

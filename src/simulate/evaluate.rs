@@ -166,9 +166,15 @@ impl TolDef {
     /// `TOL/POS,2D,tolzon,…`) by its width and a size (`TOL/DIAM,lotol,uptol`) by its
     /// lower and upper deviation; ASME Y14.5-2018 and ISO 1101 define a zone by a
     /// positive width `t`. Judging a part against an empty zone would fail every part
-    /// for the program's sake, not the part's.
+    /// for the program's sake, not the part's. The exception is a zone of 0 at MMC or
+    /// LMC (ASME Y14.5-2018 § 10.3.4, zero tolerance at MMC): the feature's departure
+    /// from that size is its whole zone.
     pub(crate) fn empty_zone(&self) -> Option<(String, &'static str)> {
-        if let Some(z) = self.zone.filter(|z| *z <= 0.0) {
+        let at_material = matches!(self.material.as_deref(), Some("MMC" | "LMC"));
+        if let Some(z) = self
+            .zone
+            .filter(|z| *z < 0.0 || (*z == 0.0 && !at_material))
+        {
             return Some((
                 format!(
                     "TOL/{} with a zone of {z} mm, which holds nothing",
@@ -386,20 +392,26 @@ fn profile(targets: &[Target], drf: &Drf, float: &(Vec<V3>, Vec<V3>), width: f64
 }
 
 /// A location (position, concentricity, coaxiality, symmetry) of `moved`, the first
-/// target in its datums' frame; a position at MMC gains its bonus from the feature's
-/// size tolerance.
+/// target in its datums' frame; a position at MMC or LMC gains its bonus from the
+/// feature's departure from that size (ASME Y14.5-2018 § 10.3.4, § 10.3.5): MMC is a
+/// boss's largest size and a hole's smallest, LMC the other way round.
 fn position(def: &TolDef, first: &Target, drf: &Drf, moved: &Measured, width: f64) -> Outcome {
     let mut out = location(drf, moved, first.nominal, width);
-    if def.word == "POS" && def.material.as_deref() == Some("MMC") {
+    let material = def
+        .material
+        .as_deref()
+        .filter(|m| matches!(*m, "MMC" | "LMC"));
+    if let (true, Some(m)) = (def.word == "POS", material) {
         match (first.size, first.measured.shape.size()) {
             (Some((nom, lo, hi)), Some(actual)) => {
-                let mmc = if first.convex { nom + hi } else { nom + lo };
-                out.limits.1 += (actual - mmc).abs();
+                let largest = first.convex == (m == "MMC");
+                let limit = if largest { nom + hi } else { nom + lo };
+                out.limits.1 += (actual - limit).abs();
             }
             _ => {
-                out.note = Some(
-                    "MMC read as RFS: the program outputs no size tolerance of this feature".into(),
-                );
+                out.note = Some(format!(
+                    "{m} read as RFS: the program outputs no size tolerance of this feature"
+                ));
             }
         }
     }

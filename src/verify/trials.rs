@@ -18,7 +18,8 @@
 //! `t` is the zone as the program judges it on the nominal part: with a material
 //! modifier, the zone plus the bonus the nominal size gives (ch. 10), read from the
 //! nominal run. Circularity and cylindricity need lobed or tapered surfaces, which the
-//! virtual part does not model: they are listed as not tried.
+//! virtual part does not model, and a zone of 0 at MMC on a feature whose nominal size
+//! is its MMC has no `t` to scale: they are listed as not tried.
 //!
 //! A datum frame's free turn and moves are not tried (`Frame`): a position to datum A
 //! alone does not locate a bore across A.
