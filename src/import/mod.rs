@@ -17,6 +17,7 @@
 //! or open an item, and an item whose value the spec cannot hold is left out with a
 //! comment and a warning ([`LeftOut`]).
 
+mod angles;
 mod errors;
 mod fits;
 mod recognise;

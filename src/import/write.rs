@@ -246,6 +246,7 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
     let mut used_tol_names = BTreeSet::new();
     let (tol_lines, written_tols) = tolerance_lines(
         p,
+        &part.mesh.exact,
         &mut feats,
         &mut frames,
         &mut used_tol_names,
@@ -404,6 +405,7 @@ fn common_datum_lines(frames: &Frames, feats: &mut Features, lines: &mut Vec<Str
 /// written.
 fn tolerance_lines(
     p: &pmi::Pmi,
+    exact: &[crate::geometry::Surface],
     feats: &mut Features,
     frames: &mut Frames,
     used_names: &mut BTreeSet<String>,
@@ -429,7 +431,9 @@ fn tolerance_lines(
             left_out(&mut lines, label, &why);
             continue;
         }
-        match tolerance_line(t, feats, frames, used_names) {
+        let basic =
+            (t.kind == Some(TolKind::Angularity)).then(|| super::angles::basic_angle(t, p, exact));
+        match tolerance_line(t, basic, feats, frames, used_names) {
             Ok(line) => {
                 lines.push(line);
                 count += 1;
@@ -445,6 +449,7 @@ fn tolerance_lines(
 /// are made even when it is left out.
 fn tolerance_line(
     t: &pmi::GeoTolerance,
+    basic: Option<Result<f64, String>>,
     feats: &mut Features,
     frames: &mut Frames,
     used_names: &mut BTreeSet<String>,
@@ -469,11 +474,18 @@ fn tolerance_line(
             Err(e) => why_not = Some(e),
         }
     }
-    if let Some(why) = why_not_written(t, kind, rule, &datums, frames, why_not) {
+    if let Some(Err(why)) = &basic {
+        why_not = Some(why.clone());
+    }
+    if let Some(why) = why_not_written(t, rule, &datums, frames, why_not) {
         return Err(why);
     }
     let feature = feats.name(&t.faces, None);
-    let (args, lost) = tolerance_args(t, rule, &feature, &datums);
+    let (mut args, lost) = tolerance_args(t, rule, &feature, &datums);
+    if let Some(Ok(angle)) = basic {
+        // The basic angle the model gives (`angles.rs`).
+        args.push(format!("basic {} deg", fmt_num(angle)));
+    }
     let name = unique(used_names, &format!("{}_{feature}", prefix(kind)));
     let comment = if lost.is_empty() {
         String::new()
@@ -491,7 +503,6 @@ fn tolerance_line(
 /// cannot; `why_not` is what its frame said, and a later reason replaces an earlier one.
 fn why_not_written(
     t: &pmi::GeoTolerance,
-    kind: TolKind,
     rule: Accepts,
     datums: &[(String, String)],
     frames: &Frames,
@@ -512,9 +523,6 @@ fn why_not_written(
             ))
         }
         _ => {}
-    }
-    if kind == TolKind::Angularity {
-        why_not = Some("its basic angle is not in the PMI".to_string());
     }
     // A datum feature is not toleranced relative to its own datum.
     for (l, _) in datums {

@@ -454,3 +454,29 @@ fn a_fit_reads_as_its_iso_286_limits() {
     // Ø35 H7: IT7 over 30 up to 50 mm is 25 µm, H's lower deviation 0.
     assert!(line.contains("35 mm +0.025 mm -0 mm"), "{line}");
 }
+
+/// An angularity whose basic angle the file does not give takes it from the model:
+/// CTC 01's perpendicularity of f25 to A made an angularity reads `basic 90 deg`, the
+/// angle the two modelled faces make (the arithmetic is unit-tested in
+/// `import/angles.rs`).
+#[test]
+fn an_angularity_takes_its_basic_angle_from_the_model() {
+    require_shared_parts();
+    let text = std::fs::read_to_string(file("ctc_01", "stp")).unwrap();
+    let patched = text.replace(
+        "#56=PERPENDICULARITY_TOLERANCE('Perpendicularity.1'",
+        "#56=ANGULARITY_TOLERANCE('Perpendicularity.1'",
+    );
+    assert_ne!(patched, text, "CTC 01's perpendicularity is where it was");
+    let opts = ImportOptions {
+        cad_path: "part.stp".into(),
+        part_name: "part".into(),
+        scale: 1.0,
+    };
+    let spec = import(patched.as_bytes(), &opts).unwrap().text;
+    let line = spec
+        .lines()
+        .find(|l| l.contains("= angularity("))
+        .unwrap_or_else(|| panic!("no angularity written:\n{spec}"));
+    assert!(line.ends_with("basic 90 deg)"), "{line}");
+}
