@@ -480,3 +480,32 @@ fn an_angularity_takes_its_basic_angle_from_the_model() {
         .unwrap_or_else(|| panic!("no angularity written:\n{spec}"));
     assert!(line.ends_with("basic 90 deg)"), "{line}");
 }
+
+/// A directed location (ISO 10303-47 `directed_dimensional_location`: from its first
+/// feature to its second) is the same distance as an undirected one: FTC 06's first
+/// location written directed imports the same line.
+#[test]
+fn a_directed_location_is_read_as_its_distance() {
+    require_shared_parts();
+    let text = std::fs::read_to_string(file("ftc_06", "stp")).unwrap();
+    let patched = text.replace(
+        "#16436=DIMENSIONAL_LOCATION('linear distance'",
+        "#16436=DIRECTED_DIMENSIONAL_LOCATION('linear distance'",
+    );
+    assert_ne!(patched, text, "FTC 06's location is where it was");
+    let opts = ImportOptions {
+        cad_path: "part.stp".into(),
+        part_name: "part".into(),
+        scale: 1.0,
+    };
+    let distances = |t: &str| -> Vec<String> {
+        import(t.as_bytes(), &opts)
+            .unwrap()
+            .text
+            .lines()
+            .filter(|l| l.contains("= distance("))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(distances(&patched), distances(&text));
+}

@@ -777,6 +777,9 @@ impl Links<'_> {
         } else if let Some(r) = inst
             .record("DIMENSIONAL_LOCATION")
             .or_else(|| inst.record("ANGULAR_LOCATION"))
+            // ISO 10303-47: a location measured from its first feature to its second;
+            // the distance between them is the same dimension.
+            .or_else(|| inst.record("DIRECTED_DIMENSIONAL_LOCATION"))
         {
             let name = r
                 .params
