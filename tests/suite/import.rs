@@ -509,3 +509,48 @@ fn a_directed_location_is_read_as_its_distance() {
     };
     assert_eq!(distances(&patched), distances(&text));
 }
+
+/// A profile toleranced on the product definition shape itself applies all over the
+/// part: CTC 02's first profile moved onto its shape reads on every face.
+#[test]
+fn an_all_over_profile_reads_on_every_face() {
+    require_shared_parts();
+    let text = std::fs::read_to_string(file("ctc_02", "stp")).unwrap();
+    let patched = text.replace(
+        "'Geometric tolerance for feature',#182,#615);",
+        "'Geometric tolerance for feature',#182,#45643);",
+    );
+    assert_ne!(patched, text, "CTC 02's first profile is where it was");
+    let opts = ImportOptions {
+        cad_path: "part.stp".into(),
+        part_name: "part".into(),
+        scale: 1.0,
+    };
+    let imported = import(patched.as_bytes(), &opts).unwrap();
+    let spec = &imported.text;
+    let line = spec
+        .lines()
+        .find(|l| l.contains("= profile_surface(") && l.contains("0.1 mm"))
+        .unwrap_or_else(|| panic!("no all-over profile written:\n{spec}"));
+    let feature = line
+        .split('(')
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .trim();
+    // The feature's definition, however many lines it takes.
+    let start = spec
+        .find(&format!("feature {feature} "))
+        .unwrap_or_else(|| panic!("no feature {feature}"));
+    let rest = &spec[start..];
+    let end = rest[1..]
+        .find("\n    feature ")
+        .map_or(rest.len(), |e| e + 1);
+    let end = end.min(rest.find("\n\n").unwrap_or(rest.len()));
+    let faces = rest[..end].matches("group \"face_").count();
+    let part =
+        inspc::geometry::step::read(patched.as_bytes(), inspc::geometry::step::RESOLUTION).unwrap();
+    assert_eq!(faces, part.solid_faces(), "{line}");
+}

@@ -351,6 +351,19 @@ impl Links<'_> {
     /// The faces of a shape aspect: what usages name for it and its members, through
     /// composites, derived features, datum target features and dimensional sizes.
     fn faces(&self, aspect: u64) -> Vec<usize> {
+        // A tolerance on the product definition shape itself applies all over the
+        // part (a general profile "all over", ASME Y14.5-2018 § 11.3.1.4).
+        if self
+            .f
+            .instances
+            .get(&aspect)
+            .is_some_and(|i| i.is("PRODUCT_DEFINITION_SHAPE"))
+        {
+            let mut all: Vec<usize> = self.face_index.values().copied().collect();
+            all.sort_unstable();
+            all.dedup();
+            return all;
+        }
         let mut seen = BTreeSet::new();
         let mut out = BTreeSet::new();
         let mut stack = vec![aspect];
