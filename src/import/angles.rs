@@ -123,6 +123,7 @@ mod tests {
             faces: vec![1],
             composite_of: None,
             unequal_mm: None,
+            per_unit: None,
         };
         basic_angle(&t, &pmi, exact)
     }

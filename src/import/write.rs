@@ -415,6 +415,16 @@ fn tolerance_lines(
     let mut count = 0;
     for t in &p.tolerances {
         let label = format!("`{}` (#{})", t.name, t.id);
+        // A zone per unit length or area is not the same zone over the whole feature
+        // (that would reject parts the drawing accepts): said, not converted.
+        if let Some(per) = &t.per_unit {
+            left_out(
+                &mut lines,
+                label,
+                &format!("its zone applies {per}, which the language cannot say; a zone over the whole feature would reject parts the drawing accepts"),
+            );
+            continue;
+        }
         // A zone of 0 is legal at MMC or LMC (ASME Y14.5 zero tolerance at MMC).
         let zero_at_material =
             t.value_mm == 0.0 && matches!(t.material, Some(Material::Mmc | Material::Lmc));

@@ -554,3 +554,31 @@ fn an_all_over_profile_reads_on_every_face() {
         inspc::geometry::step::read(patched.as_bytes(), inspc::geometry::step::RESOLUTION).unwrap();
     assert_eq!(faces, part.solid_faces(), "{line}");
 }
+
+/// A flatness per unit area (ISO 10303-47 `geometric_tolerance_with_defined_area_unit`)
+/// is said, not converted into a flatness of the whole face: CTC 01's flatness made
+/// 0.2 mm per 25 × 25 mm square.
+#[test]
+fn a_flatness_per_unit_area_is_said_not_converted() {
+    require_shared_parts();
+    let text = std::fs::read_to_string(file("ctc_01", "stp")).unwrap();
+    let patched = text.replace(
+        "#57=FLATNESS_TOLERANCE('Flatness.1','',#82,#297);",
+        "#57=(FLATNESS_TOLERANCE()GEOMETRIC_TOLERANCE('Flatness.1','',#82,#297)\
+             GEOMETRIC_TOLERANCE_WITH_DEFINED_AREA_UNIT(.SQUARE.,$)\
+             GEOMETRIC_TOLERANCE_WITH_DEFINED_UNIT(#990001));\n\
+             #990001=LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.),#4360);",
+    );
+    assert_ne!(patched, text, "CTC 01's flatness is where it was");
+    let opts = ImportOptions {
+        cad_path: "part.stp".into(),
+        part_name: "part".into(),
+        scale: 1.0,
+    };
+    let spec = import(patched.as_bytes(), &opts).unwrap().text;
+    assert!(!spec.contains("= flatness("), "{spec}");
+    assert!(
+        spec.contains("per 25 × 25 mm square area"),
+        "no comment on the per-unit flatness:\n{spec}"
+    );
+}

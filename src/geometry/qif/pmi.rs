@@ -538,6 +538,7 @@ impl Reader<'_> {
         faces: Vec<usize>,
     ) -> GeoTolerance {
         let value = def.child("ToleranceValue").and_then(|v| self.length(v));
+        let per_unit = self.per_unit(def);
         if value.is_none() {
             self.notes
                 .push(format!("{name}: its tolerance value cannot be read"));
@@ -579,7 +580,37 @@ impl Reader<'_> {
             faces,
             composite_of: None,
             unequal_mm: None,
+            per_unit,
         }
+    }
+
+    /// A zone per unit length or area (`ToleranceZonePerUnitLength`, `…PerUnitArea`:
+    /// QIF 3 Characteristics.xsd), in words.
+    fn per_unit(&mut self, def: &Node) -> Option<String> {
+        let fmt = |v: Option<f64>| v.map_or("?".to_string(), crate::model::fmt_num);
+        if let Some(u) = def.child("ToleranceZonePerUnitLength") {
+            let l = u.child("UnitLength").and_then(|v| self.length(v));
+            return Some(format!("per {} mm length", fmt(l)));
+        }
+        let a = def.child("ToleranceZonePerUnitArea")?;
+        if let Some(r) = a.child("RectangularUnitArea") {
+            let length = r
+                .child("RectangularUnitAreaLength")
+                .and_then(|v| self.length(v));
+            let width = r
+                .child("RectangularUnitAreaWidth")
+                .and_then(|v| self.length(v));
+            return Some(format!(
+                "per {} × {} mm rectangular area",
+                fmt(length),
+                fmt(width)
+            ));
+        }
+        let d = a
+            .child("CircularUnitArea")
+            .and_then(|c| c.child("CircularUnitAreaDiameter"))
+            .and_then(|v| self.length(v));
+        Some(format!("per Ø{} mm circular area", fmt(d)))
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -114,6 +114,11 @@ pub struct GeoTolerance {
     pub composite_of: Option<u64>,
     /// An unequally disposed profile's displacement (mm).
     pub unequal_mm: Option<f64>,
+    /// A zone per unit length or area (ISO 10303-47
+    /// `geometric_tolerance_with_defined_unit`; QIF `ToleranceZonePerUnit…`), in words
+    /// (`per 25 mm length`, `per 25 × 25 mm square area`): the zone applies to every
+    /// such stretch of the feature, not to all of it at once.
+    pub per_unit: Option<String>,
 }
 
 /// What a dimension measures.
@@ -646,6 +651,7 @@ impl Links<'_> {
             .and_then(Param::reference)
             .and_then(|m| self.measure(m))
             .map(|(v, _)| v);
+        let per_unit = self.per_unit(inst);
         let zone = self.zones.get(&id).map(String::as_str);
         if faces.is_empty() {
             notes.push(format!("tolerance `{name}` (#{id}) is linked to no face"));
@@ -668,7 +674,37 @@ impl Links<'_> {
             faces,
             composite_of: self.composite.get(&id).copied(),
             unequal_mm,
+            per_unit,
         }))
+    }
+
+    /// A zone per unit length or area, in words.
+    fn per_unit(&self, inst: &Instance) -> Option<String> {
+        let unit = inst.record("GEOMETRIC_TOLERANCE_WITH_DEFINED_UNIT")?;
+        let size = |p: Option<&Param>| {
+            p.and_then(Param::reference)
+                .and_then(|m| self.measure(m))
+                .map(|(v, _)| crate::model::fmt_num(v))
+        };
+        let first = size(unit.params.first()).unwrap_or_else(|| "?".into());
+        Some(
+            match inst.record("GEOMETRIC_TOLERANCE_WITH_DEFINED_AREA_UNIT") {
+                Some(area) => {
+                    let shape = area
+                        .params
+                        .first()
+                        .and_then(Param::enumeration)
+                        .unwrap_or("SQUARE")
+                        .to_lowercase();
+                    match (shape.as_str(), size(area.params.get(1))) {
+                        ("circular", _) => format!("per Ø{first} mm circular area"),
+                        (_, Some(second)) => format!("per {first} × {second} mm {shape} area"),
+                        _ => format!("per {first} × {first} mm {shape} area"),
+                    }
+                }
+                None => format!("per {first} mm length"),
+            },
+        )
     }
 
     /// The compartments of the datum systems (or old-style datum references) a
