@@ -101,6 +101,19 @@ pub fn read(f: &P21) -> Result<Brep, StepError> {
     let Some(&first) = solids.first().or(sheets.first()) else {
         return Err(StepError::NoSolid);
     };
+    // An assembly places its parts' solids by transforms its B-reps do not carry:
+    // read as they stand, they would overlap (AP203/AP214 product structure).
+    let occurrences = f
+        .order
+        .iter()
+        .filter(|id| f.instances[id].is("NEXT_ASSEMBLY_USAGE_OCCURRENCE"))
+        .count();
+    if occurrences > 0 && solids.len() > 1 {
+        return Err(StepError::Assembly {
+            occurrences,
+            solids: solids.len(),
+        });
+    }
     let (unit, unit_name, angle) = units(f, first)?;
     let mut r = Reader {
         f,

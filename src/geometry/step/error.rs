@@ -25,6 +25,18 @@ pub enum StepError {
         help("export the part as a solid (MANIFOLD_SOLID_BREP); a file of PMI, wireframe or tessellated shapes only has no faces to inspect")
     )]
     NoSolid,
+    /// An assembly: several parts placed by an assembly structure.
+    #[error("it is an assembly: {occurrences} part occurrences of {solids} solids (NEXT_ASSEMBLY_USAGE_OCCURRENCE)")]
+    #[diagnostic(
+        code(insp::geometry::step_assembly),
+        help("inspc inspects one part, and an assembly's parts stand where its placements put them, which the part's own B-rep does not say; export the part to be inspected on its own")
+    )]
+    Assembly {
+        /// Part occurrences the assembly structure places.
+        occurrences: usize,
+        /// Solids the file holds.
+        solids: usize,
+    },
     /// A reference to an instance the file does not define.
     #[error("{}", missing(*id, *from))]
     #[diagnostic(
