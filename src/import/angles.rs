@@ -1,7 +1,7 @@
 //! An angularity's basic angle from the model. STEP and QIF carry an angularity's
 //! basic angle as a separate (often missing) dimension; the model itself fixes it: it
 //! is the angle between the toleranced feature and its primary datum feature as
-//! modelled (ASME Y14.5-2018 § 9.3.3: the zone is at the basic angle to the datum).
+//! modelled (ASME Y14.5-2018 ch. 9, angularity: the zone is at the basic angle to the datum).
 //!
 //! A feature's direction is its planes' common normal or its cylinders' and cones'
 //! common axis; the angle between a plane and a plane, or an axis and an axis, is that

@@ -171,7 +171,11 @@ pub(crate) fn deviations(fit: &str, nominal: f64) -> Result<(f64, f64), String> 
             }
             let delta = if range == 0 { 0.0 } else { t - it(grade - 1) };
             let es = match l {
+                // ISO 286-2 Table 3's special cases: M6 over 250 up to 315 mm.
+                "m" if grade == 6 && range == 10 => -9.0,
                 _ if delta_rule => -ei + delta,
+                // N above IT8: 0, but −4 µm up to 3 mm.
+                "n" if range == 0 => -4.0,
                 "k" | "n" => 0.0,
                 _ => -ei,
             };
@@ -215,6 +219,8 @@ mod tests {
             ("D10", 50.0, 180.0, 80.0),
             ("H11", 3.0, 60.0, 0.0),
             ("K7", 2.0, 0.0, -10.0),
+            ("N9", 2.0, -4.0, -29.0),
+            ("M6", 300.0, -9.0, -41.0),
         ];
         for &(fit, size, up, low) in cases {
             let (u, l) = deviations(fit, size).unwrap();

@@ -426,8 +426,9 @@ fn tolerance_lines(
             continue;
         }
         // A zone of 0 is legal at MMC or LMC (ASME Y14.5 zero tolerance at MMC).
-        let zero_at_material =
-            t.value_mm == 0.0 && matches!(t.material, Some(Material::Mmc | Material::Lmc));
+        let zero_at_material = t.value_mm == 0.0
+            && t.kind == Some(TolKind::Position)
+            && matches!(t.material, Some(Material::Mmc | Material::Lmc));
         let sign = if zero_at_material {
             Sign::Any
         } else {

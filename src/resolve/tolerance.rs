@@ -339,17 +339,20 @@ impl Args {
         }
     }
 
-    /// A zone of width 0 reads only at MMC or LMC, where the feature's departure from
-    /// that size is the whole tolerance (ASME Y14.5-2018 § 10.3.4, zero tolerance at
-    /// MMC); elsewhere no part could pass it.
+    /// A position zone of width 0 reads only at MMC or LMC, where the feature's
+    /// departure from that size is the whole tolerance (ASME Y14.5-2018 § 10.3.4, zero
+    /// tolerance at MMC); elsewhere no part could pass it.
     fn check_zero_zone(&mut self, cx: &mut Cx, rule: &Rule, span: Span) {
-        let at_material = matches!(self.modifier, Some((Material::Mmc | Material::Lmc, _)));
+        // Only a position gains the bonus that makes a zero zone hold a part (the
+        // simulator's and a CMM's evaluation of TOL/POS); elsewhere 0 holds nothing.
+        let at_material = rule.kind == K::Position
+            && matches!(self.modifier, Some((Material::Mmc | Material::Lmc, _)));
         if let Some(value) = self.zero.take().filter(|_| !at_material) {
             cx.err(E::NonPositive {
                 span,
                 what: format!("the {} tolerance", rule.name),
                 value,
-                help: if rule.material {
+                help: if rule.kind == K::Position {
                     "a zone of 0 reads only at MMC or LMC, where the size's departure from that condition is the tolerance (ASME Y14.5 zero tolerance at MMC); add `MMC` or give the zone a width".into()
                 } else {
                     "a tolerance zone has a positive width".into()

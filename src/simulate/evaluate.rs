@@ -170,7 +170,8 @@ impl TolDef {
     /// LMC (ASME Y14.5-2018 § 10.3.4, zero tolerance at MMC): the feature's departure
     /// from that size is its whole zone.
     pub(crate) fn empty_zone(&self) -> Option<(String, &'static str)> {
-        let at_material = matches!(self.material.as_deref(), Some("MMC" | "LMC"));
+        let at_material =
+            self.word == "POS" && matches!(self.material.as_deref(), Some("MMC" | "LMC"));
         if let Some(z) = self
             .zone
             .filter(|z| *z < 0.0 || (*z == 0.0 && !at_material))
@@ -393,8 +394,10 @@ fn profile(targets: &[Target], drf: &Drf, float: &(Vec<V3>, Vec<V3>), width: f64
 
 /// A location (position, concentricity, coaxiality, symmetry) of `moved`, the first
 /// target in its datums' frame; a position at MMC or LMC gains its bonus from the
-/// feature's departure from that size (ASME Y14.5-2018 § 10.3.4, § 10.3.5): MMC is a
-/// boss's largest size and a hole's smallest, LMC the other way round.
+/// feature's departure from that size toward the other limit (ASME Y14.5-2018
+/// § 10.3.4, § 10.3.5): MMC is a boss's largest size and a hole's smallest, LMC the
+/// other way round. The size is the least-squares fit's, not the actual mating
+/// envelope's: the simulator's simplification, as most CMM software reports it.
 fn position(def: &TolDef, first: &Target, drf: &Drf, moved: &Measured, width: f64) -> Outcome {
     let mut out = location(drf, moved, first.nominal, width);
     let material = def
@@ -404,9 +407,15 @@ fn position(def: &TolDef, first: &Target, drf: &Drf, moved: &Measured, width: f6
     if let (true, Some(m)) = (def.word == "POS", material) {
         match (first.size, first.measured.shape.size()) {
             (Some((nom, lo, hi)), Some(actual)) => {
+                // The bonus is the departure from the condition toward the other
+                // limit; a size beyond the condition earns none (its size fails).
                 let largest = first.convex == (m == "MMC");
-                let limit = if largest { nom + hi } else { nom + lo };
-                out.limits.1 += (actual - limit).abs();
+                let bonus = if largest {
+                    nom + hi - actual
+                } else {
+                    actual - (nom + lo)
+                };
+                out.limits.1 += bonus.max(0.0);
             }
             _ => {
                 out.note = Some(format!(

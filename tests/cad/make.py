@@ -220,6 +220,13 @@ def nurbs_cap():
     return BRepBuilderAPI_NurbsConvert(cut, True).Shape()
 
 
+def offset_ellipse_prism():
+    """The elliptic prism grown 3 mm: its side an offset of a swept ellipse."""
+    mk = BRepOffsetAPI_MakeOffsetShape()
+    mk.PerformByJoin(ellipse_prism(), 3.0, 1e-6)
+    return mk.Shape()
+
+
 def offset_vase():
     """The vase grown 2 mm: its B-spline side becomes an offset surface."""
     mk = BRepOffsetAPI_MakeOffsetShape()
@@ -292,7 +299,13 @@ def numbers(params):
     return [float(x) for x in re.findall(r"[-+]?\d+\.?\d*(?:E[-+]?\d+)?", params)]
 
 
-def disguised(text):
+def disguised_far(text):
+    """`disguised`, with the cone's line given by a point beyond its apex, on the other
+    nappe from the face (ISO 10303-42 lets the line's point lie anywhere on it)."""
+    return disguised(text, far_cone=True)
+
+
+def disguised(text, far_cone=False):
     """Every analytic surface written as the swept or offset surface it also is, the
     way CATIA V5 and other exporters write them: a plane as a line swept along the
     plane (every other one as an offset of a parallel plane), a cylinder as a circle
@@ -367,7 +380,11 @@ def disguised(text):
             r, semi = vals[0], vals[1]
             d = [math.sin(semi) * a + math.cos(semi) * b for a, b in zip(x, z)]
             slope = add(f"VECTOR('',{direction(d)},1.)")
-            line = add(f"LINE('',{point(at(p, (r, x)))},{slope})")
+            start = at(p, (r, x))
+            if far_cone:
+                apex = at(start, (-r / math.sin(semi), d))
+                start = [2 * a - s0 for a, s0 in zip(apex, start)]
+            line = add(f"LINE('',{point(start)},{slope})")
             return f"#{sid} = SURFACE_OF_REVOLUTION('',{line},{axis});"
         if kind == "SPHERICAL_SURFACE":
             # The circle turns against the revolution: S_u × S_v points out.
@@ -532,6 +549,8 @@ def main():
     write("bezier", nurbs_cap(), edit=implied_knots("BEZIER"), what="the NURBS block with its lines and planes as Bezier curves and surfaces")
     write("quasi_uniform", spline_prism([4, 1, 1, 1, 4], [0, 1, 2, 3, 4]), edit=implied_knots("QUASI_UNIFORM"), what="a quasi-uniform cubic B-spline, knots implied")
     write("uniform", spline_prism([1] * 11, [float(k) for k in range(-3, 8)]), edit=implied_knots("UNIFORM"), what="a uniform cubic B-spline, knots implied")
+    write("disguised_far", analytic_block(), edit=disguised_far, what="the disguised block with its cone's line given beyond the apex")
+    write("offset_ellipse", offset_ellipse_prism(), what="an offset of an extruded ellipse (OFFSET_SURFACE of SURFACE_OF_LINEAR_EXTRUSION)")
     write("unit_inch", cylinder_block(), unit="INCH", unit_mm=1.0, what="lengths in inches")
     write("unit_metre", cylinder_block(), unit="M", unit_mm=1.0, what="lengths in metres")
     write("unit_degree", cone_block(), edit=degrees, what="plane angles in degrees (a conversion-based unit)")

@@ -83,6 +83,10 @@ class Writer:
             g = get()
             ax = g.Position()
             ra, rb = radii(g)
+            if form == "PARABOLA":
+                # OpenCASCADE's parameter U is ISO 10303-42's t = U / 2f (the reader's).
+                first, last = first / (2 * ra), last / (2 * ra)
+                dom = f'domain="{fmt(first, last)}"'
             return (f'<ArcConic13Core {dom} form="{form}"><A>{fmt(2 * ra)}</A><B>{fmt(2 * rb)}</B><Center>{pnt(g.Location())}</Center>'
                     f"<DirBeg>{pnt(ax.XDirection())}</DirBeg><Normal>{pnt(ax.Direction())}</Normal></ArcConic13Core>", "ArcConic13")
         if t == GeomAbs_CurveType.GeomAbs_BSplineCurve:

@@ -259,3 +259,14 @@ fn qif_nurbs23_with_the_control_points_v_fastest() {
 fn qif_offset23() {
     check_qif("offset");
 }
+
+#[test]
+fn a_revolved_line_given_beyond_its_apex() {
+    // The cone's line passes the axis: the face is on the nappe its own points say.
+    check("disguised_far");
+}
+
+#[test]
+fn an_offset_of_an_extruded_ellipse() {
+    check("offset_ellipse");
+}

@@ -26,7 +26,7 @@ use crate::geometry::{P3, V3};
 
 /// How far from parallel, square or coplanar a direction may be and still count
 /// (radians, or millimetres per millimetre).
-const ANGLE_EPS: f64 = 1e-9;
+const ANGLE_EPS: f64 = 1e-7;
 /// How far from the axis a point may be and still be on it (mm).
 const ON_AXIS_MM: f64 = 1e-7;
 
@@ -35,7 +35,7 @@ const ON_AXIS_MM: f64 = 1e-7;
 pub(crate) fn canonical(s: &Surf, points: &[P3]) -> (Surf, bool) {
     let analytic = match s {
         Surf::Extrusion(e) => extrusion(e),
-        Surf::Revolution(r) => revolution(r),
+        Surf::Revolution(r) => revolution(r, points),
         Surf::Offset(o) => offset(o),
         _ => None,
     };
@@ -73,7 +73,7 @@ fn extrusion(e: &Extrusion) -> Option<Surf> {
     }
 }
 
-fn revolution(r: &Revolution) -> Option<Surf> {
+fn revolution(r: &Revolution, points: &[P3]) -> Option<Surf> {
     let axis = &r.axis;
     let foot = |p: &P3| axis.o + axis.z * (p - axis.o).dot(&axis.z);
     match &r.curve {
@@ -99,20 +99,18 @@ fn revolution(r: &Revolution) -> Option<Surf> {
                     Some(Surf::Plane(Frame::new(q, Some(axis.z), Some(x))?))
                 }
                 Some(x) => {
-                    // The radius grows along the axis the way the line leaves it.
-                    let out = e.dot(&x);
-                    let z = axis.z * along.signum();
-                    let mut rho = w.dot(&x);
-                    let mut q = q;
-                    if rho < 0.0 {
-                        // `o` lies on the other nappe: take the point of the line as
-                        // far beyond the apex, where the radius is positive.
-                        let beyond = o + e * (-2.0 * rho / out);
-                        q = foot(&beyond);
-                        rho = -rho;
-                    }
-                    let semi = (out / along.abs()).atan();
-                    Some(Surf::Cone(Frame::new(q, Some(z), Some(x))?, rho, semi))
+                    // A line crossing the axis sweeps two nappes about its apex; the
+                    // face lies on one, told by its own points (ISO 10303-42 lets the
+                    // line's point lie anywhere on it, either side of the apex).
+                    let apex = o + e * (-w.dot(&x) / e.dot(&x));
+                    let side = points
+                        .iter()
+                        .chain([o, &(o + e)])
+                        .map(|p| (p - apex).dot(&axis.z))
+                        .find(|h| h.abs() > ON_AXIS_MM)?;
+                    let z = axis.z * side.signum();
+                    let semi = (e.dot(&x).abs() / along.abs()).atan();
+                    Some(Surf::Cone(Frame::new(apex, Some(z), Some(x))?, 0.0, semi))
                 }
             }
         }
@@ -152,7 +150,24 @@ fn offset(o: &Offset) -> Option<Surf> {
         Surf::Cylinder(f, r) => Some(Surf::Cylinder(*f, grown(*r)?)),
         // The normal leans back by the semi-angle: the radius at the origin grows by
         // d / cos(semi-angle).
-        Surf::Cone(f, r, a) => Some(Surf::Cone(*f, r + d / a.cos(), *a)),
+        Surf::Cone(f, r, a) => {
+            // The radius at the frame's origin may come out negative: move the origin
+            // along the axis to the apex's side where it is 0 or more.
+            let r2 = r + d / a.cos();
+            if r2 >= 0.0 {
+                Some(Surf::Cone(*f, r2, *a))
+            } else {
+                let shift = -r2 / a.tan();
+                Some(Surf::Cone(
+                    Frame {
+                        o: f.o + f.z * shift,
+                        ..*f
+                    },
+                    0.0,
+                    *a,
+                ))
+            }
+        }
         Surf::Sphere(f, r) => Some(Surf::Sphere(*f, grown(*r)?)),
         Surf::Torus(f, big, small) => Some(Surf::Torus(*f, *big, grown(*small)?)),
         _ => None,

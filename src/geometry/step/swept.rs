@@ -50,13 +50,15 @@ impl Extrusion {
     pub(crate) fn param(&self, p: &P3, hint: Option<f64>) -> (f64, f64) {
         let d = self.dir;
         let u = match self.curve.plane() {
-            // A planar curve: p slid along the sweep into the curve's plane.
-            Some(f) if d.dot(&f.z).abs() > 1e-9 => {
+            // A planar curve swept square to its plane: p dropped into the plane is
+            // its foot's sweep line, inverted in closed form.
+            Some(f) if d.cross(&f.z).norm() < 1e-9 => {
                 let q = p - d * ((p - f.o).dot(&f.z) / d.dot(&f.z));
-                self.curve.param(&q)
+                curve_param(&self.curve, &q, hint, |t| self.curve.eval(t))
             }
             _ => {
-                // Seen along the sweep, the nearest point of the curve.
+                // Seen along the sweep, the nearest point of the curve (the foot of a
+                // point on the surface or off it: the normal is square to the sweep).
                 let flat = |q: P3| q - d * q.coords.dot(&d);
                 let target = flat(*p);
                 curve_param(&self.curve, &target, hint, |t| flat(self.curve.eval(t)))
@@ -74,14 +76,19 @@ impl Revolution {
         a.at(l.x * c - l.y * s, l.x * s + l.y * c, l.z)
     }
 
-    /// The angle of `p` about the axis and the profile parameter of `p` turned back
-    /// into the profile's half-plane.
+    /// The profile parameter whose circle about the axis passes nearest `p` (the
+    /// profile and `p` both turned into the half-plane at angle 0, so that a profile
+    /// outside the axis's planes is inverted too), and the angle that turns that
+    /// profile point onto `p`.
     pub(crate) fn param(&self, p: &P3, hint: Option<f64>) -> (f64, f64) {
         let a = &self.axis;
-        let l = a.local(p);
-        let u = l.y.atan2(l.x);
-        let back = a.at(l.x.hypot(l.y), 0.0, l.z);
-        let v = curve_param(&self.curve, &back, hint, |t| self.curve.eval(t));
+        let flat = |q: &P3| {
+            let l = a.local(q);
+            a.at(l.x.hypot(l.y), 0.0, l.z)
+        };
+        let v = curve_param(&self.curve, &flat(p), hint, |t| flat(&self.curve.eval(t)));
+        let (lp, lc) = (a.local(p), a.local(&self.curve.eval(v)));
+        let u = lp.y.atan2(lp.x) - lc.y.atan2(lc.x);
         (u, v)
     }
 
@@ -128,7 +135,10 @@ fn curve_param(curve: &Curve, target: &P3, hint: Option<f64>, at: impl Fn(f64) -
         | Curve::Line(..)
             if (at(0.0) - curve.eval(0.0)).norm() < 1e-12 =>
         {
-            curve.param(target)
+            // Exact for a point on the curve; a point off it (on an offset of the
+            // sweep) is then taken to its true foot.
+            let t = curve.param(target);
+            newton(&at, target, t, range, curve.period().is_some()).unwrap_or(t)
         }
         _ => nearest_param(&at, range, target),
     }
