@@ -65,13 +65,13 @@ impl Frames {
         if letters.len() == 1 {
             return Ok(letters[0].clone());
         }
-        let joined: String = letters.concat();
-        if joined.len() > 2 {
-            return Err(format!(
-                "the common datum {} has more letters than a datum name holds",
-                letters.join("-")
-            ));
-        }
+        // E-F is written EF (two letters hold it); E-F-G as E_F_G, a common datum's
+        // name in the language.
+        let joined: String = if letters.len() == 2 && letters.iter().all(|l| l.len() == 1) {
+            letters.concat()
+        } else {
+            letters.join("_")
+        };
         if self.datum_feature.contains_key(&joined) {
             return Err(format!(
                 "common datum {} clashes with datum {joined}",

@@ -3,7 +3,7 @@
 //! reference frame names each datum once.
 //!
 //! **Decision:** datums are capital letters other than I, O and Q, as ASME Y14.5 names
-//! them (a warning otherwise). A datum on a face expression rather than a named feature
+//! them, or a common datum's letters joined by `_` (`E_F_G`; a warning otherwise). A datum on a face expression rather than a named feature
 //! gets a feature of its own.
 
 use super::errors::ResolveError as E;
@@ -23,12 +23,15 @@ pub(super) fn datum(
     span: Span,
     is_mesh: bool,
 ) {
-    let letters_ok = !name.name.is_empty()
-        && name.name.len() <= 2
-        && name
-            .name
-            .chars()
-            .all(|c| c.is_ascii_uppercase() && !matches!(c, 'I' | 'O' | 'Q'));
+    // A datum letter (`A`, … `AA`), or a common datum's letters joined by `_`
+    // (`E_F_G` for ASME Y14.5's E-F-G, established by its features together).
+    let letters_ok = name.name.split('_').all(|part| {
+        !part.is_empty()
+            && part.len() <= 2
+            && part
+                .chars()
+                .all(|c| c.is_ascii_uppercase() && !matches!(c, 'I' | 'O' | 'Q'))
+    });
     if !letters_ok {
         cx.err(E::DatumLetter {
             span: name.span,
