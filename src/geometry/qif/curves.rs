@@ -38,6 +38,11 @@ pub(super) fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Opti
             let start = curve.eval(domain(c).map_or(0.0, |dm| dm.0));
             Ok((curve, Some(start)))
         }
+        "Nurbs13Core" if c.child("CPsBinary").is_some() => Err(QifError::Unsupported {
+            id: owner.id(),
+            line: c.line,
+            what: "NURBS curve with binary control points (CPsBinary)".into(),
+        }),
         "Nurbs13Core" => {
             let order = num(c, "Order")?;
             let knots = c
@@ -82,7 +87,9 @@ pub(super) fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Opti
                 points,
                 weights,
             };
-            let start = curve.eval(curve.knots.range().0);
+            // The curve starts where its domain does (the knots' range when it says none).
+            let t0 = domain(c).map_or(curve.knots.range().0, |d| d.0);
+            let start = curve.eval(t0);
             Ok((Curve::BSpline(std::sync::Arc::new(curve)), Some(start)))
         }
         "Polyline13Core" => {

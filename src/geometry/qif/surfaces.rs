@@ -95,6 +95,13 @@ fn revolution(d: &Doc, c: &Node) -> Result<Surf, QifError> {
 }
 
 fn nurbs(d: &Doc, c: &Node, vertices: &[P3]) -> Result<Surf, QifError> {
+    if c.child("CPsBinary").is_some() {
+        return Err(QifError::Unsupported {
+            id: c.id(),
+            line: c.line,
+            what: "NURBS surface with binary control points (CPsBinary)".into(),
+        });
+    }
     let order = |name: &str| -> Result<usize, QifError> {
         let o = num(c, name)?;
         if o.fract() != 0.0 || !(2.0..=(MAX_DEGREE + 1) as f64).contains(&o) {
