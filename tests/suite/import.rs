@@ -427,26 +427,36 @@ fn hostile_qif_labels_and_values_write_a_spec_that_checks_clean() {
     }
 }
 
-/// A diameter toleranced by a fit (ISO 10303-45 `limits_and_fits`: the zone's letter
-/// and grade) gets ISO 286's limits: CTC 01's first plus-minus range made `H7`.
-#[test]
-fn a_fit_reads_as_its_iso_286_limits() {
+/// A NIST part's STEP text with `from` replaced by `to` (which must be there), and the
+/// part's own text.
+fn patched(part: &str, from: &str, to: &str) -> (String, String) {
     require_shared_parts();
-    let text = std::fs::read_to_string(file("ctc_01", "stp")).unwrap();
-    let patched = text.replace(
-        "#58=TOLERANCE_VALUE(#72,#71);",
-        "#58=LIMITS_AND_FITS('','H','7','ISO 286');",
-    );
-    assert_ne!(
-        patched, text,
-        "CTC 01's first tolerance value is where it was"
-    );
+    let text = std::fs::read_to_string(file(part, "stp")).unwrap();
+    let patched = text.replace(from, to);
+    assert_ne!(patched, text, "{part}: `{from}` is not in the file");
+    (patched, text)
+}
+
+/// The spec `inspc import` writes from STEP text.
+fn spec_of(text: &str) -> String {
     let opts = ImportOptions {
         cad_path: "part.stp".into(),
         part_name: "part".into(),
         scale: 1.0,
     };
-    let spec = import(patched.as_bytes(), &opts).unwrap().text;
+    import(text.as_bytes(), &opts).unwrap().text
+}
+
+/// A diameter toleranced by a fit (ISO 10303-45 `limits_and_fits`: the zone's letter
+/// and grade) gets ISO 286's limits: CTC 01's first plus-minus range made `H7`.
+#[test]
+fn a_fit_reads_as_its_iso_286_limits() {
+    let (text, _) = patched(
+        "ctc_01",
+        "#58=TOLERANCE_VALUE(#72,#71);",
+        "#58=LIMITS_AND_FITS('','H','7','ISO 286');",
+    );
+    let spec = spec_of(&text);
     let line = spec
         .lines()
         .find(|l| l.contains("// fit H7"))
@@ -461,19 +471,12 @@ fn a_fit_reads_as_its_iso_286_limits() {
 /// `import/angles.rs`).
 #[test]
 fn an_angularity_takes_its_basic_angle_from_the_model() {
-    require_shared_parts();
-    let text = std::fs::read_to_string(file("ctc_01", "stp")).unwrap();
-    let patched = text.replace(
+    let (text, _) = patched(
+        "ctc_01",
         "#56=PERPENDICULARITY_TOLERANCE('Perpendicularity.1'",
         "#56=ANGULARITY_TOLERANCE('Perpendicularity.1'",
     );
-    assert_ne!(patched, text, "CTC 01's perpendicularity is where it was");
-    let opts = ImportOptions {
-        cad_path: "part.stp".into(),
-        part_name: "part".into(),
-        scale: 1.0,
-    };
-    let spec = import(patched.as_bytes(), &opts).unwrap().text;
+    let spec = spec_of(&text);
     let line = spec
         .lines()
         .find(|l| l.contains("= angularity("))
@@ -486,48 +489,31 @@ fn an_angularity_takes_its_basic_angle_from_the_model() {
 /// location written directed imports the same line.
 #[test]
 fn a_directed_location_is_read_as_its_distance() {
-    require_shared_parts();
-    let text = std::fs::read_to_string(file("ftc_06", "stp")).unwrap();
-    let patched = text.replace(
+    let (text, original) = patched(
+        "ftc_06",
         "#16436=DIMENSIONAL_LOCATION('linear distance'",
         "#16436=DIRECTED_DIMENSIONAL_LOCATION('linear distance'",
     );
-    assert_ne!(patched, text, "FTC 06's location is where it was");
-    let opts = ImportOptions {
-        cad_path: "part.stp".into(),
-        part_name: "part".into(),
-        scale: 1.0,
-    };
     let distances = |t: &str| -> Vec<String> {
-        import(t.as_bytes(), &opts)
-            .unwrap()
-            .text
+        spec_of(t)
             .lines()
             .filter(|l| l.contains("= distance("))
             .map(String::from)
             .collect()
     };
-    assert_eq!(distances(&patched), distances(&text));
+    assert_eq!(distances(&text), distances(&original));
 }
 
 /// A profile toleranced on the product definition shape itself applies all over the
 /// part: CTC 02's first profile moved onto its shape reads on every face.
 #[test]
 fn an_all_over_profile_reads_on_every_face() {
-    require_shared_parts();
-    let text = std::fs::read_to_string(file("ctc_02", "stp")).unwrap();
-    let patched = text.replace(
+    let (text, _) = patched(
+        "ctc_02",
         "'Geometric tolerance for feature',#182,#615);",
         "'Geometric tolerance for feature',#182,#45643);",
     );
-    assert_ne!(patched, text, "CTC 02's first profile is where it was");
-    let opts = ImportOptions {
-        cad_path: "part.stp".into(),
-        part_name: "part".into(),
-        scale: 1.0,
-    };
-    let imported = import(patched.as_bytes(), &opts).unwrap();
-    let spec = &imported.text;
+    let spec = spec_of(&text);
     let line = spec
         .lines()
         .find(|l| l.contains("= profile_surface(") && l.contains("0.1 mm"))
@@ -551,7 +537,7 @@ fn an_all_over_profile_reads_on_every_face() {
     let end = end.min(rest.find("\n\n").unwrap_or(rest.len()));
     let faces = rest[..end].matches("group \"face_").count();
     let part =
-        inspc::geometry::step::read(patched.as_bytes(), inspc::geometry::step::RESOLUTION).unwrap();
+        inspc::geometry::step::read(text.as_bytes(), inspc::geometry::step::RESOLUTION).unwrap();
     assert_eq!(faces, part.solid_faces(), "{line}");
 }
 
@@ -560,22 +546,15 @@ fn an_all_over_profile_reads_on_every_face() {
 /// 0.2 mm per 25 × 25 mm square.
 #[test]
 fn a_flatness_per_unit_area_is_said_not_converted() {
-    require_shared_parts();
-    let text = std::fs::read_to_string(file("ctc_01", "stp")).unwrap();
-    let patched = text.replace(
+    let (text, _) = patched(
+        "ctc_01",
         "#57=FLATNESS_TOLERANCE('Flatness.1','',#82,#297);",
         "#57=(FLATNESS_TOLERANCE()GEOMETRIC_TOLERANCE('Flatness.1','',#82,#297)\
-             GEOMETRIC_TOLERANCE_WITH_DEFINED_AREA_UNIT(.SQUARE.,$)\
-             GEOMETRIC_TOLERANCE_WITH_DEFINED_UNIT(#990001));\n\
-             #990001=LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.),#4360);",
+         GEOMETRIC_TOLERANCE_WITH_DEFINED_AREA_UNIT(.SQUARE.,$)\
+         GEOMETRIC_TOLERANCE_WITH_DEFINED_UNIT(#990001));\n\
+         #990001=LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.),#4360);",
     );
-    assert_ne!(patched, text, "CTC 01's flatness is where it was");
-    let opts = ImportOptions {
-        cad_path: "part.stp".into(),
-        part_name: "part".into(),
-        scale: 1.0,
-    };
-    let spec = import(patched.as_bytes(), &opts).unwrap().text;
+    let spec = spec_of(&text);
     assert!(!spec.contains("= flatness("), "{spec}");
     assert!(
         spec.contains("per 25 × 25 mm square area"),

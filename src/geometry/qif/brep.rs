@@ -161,11 +161,7 @@ pub fn read(d: &Doc, root: &Node) -> Result<Brep, QifError> {
 fn bound_vertices(bounds: &[Bound], edges: &[Edge]) -> Vec<P3> {
     bounds
         .iter()
-        .filter_map(|b| match b {
-            Bound::Edges(list) => Some(list),
-            Bound::Vertex => None,
-        })
-        .flatten()
+        .flat_map(Bound::edges)
         .flat_map(|(e, _)| edge_samples(&edges[*e]))
         .collect()
 }

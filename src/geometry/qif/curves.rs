@@ -3,7 +3,7 @@
 use super::doc::{domain, frame, malformed, num, positive, vec3, Doc, MAX_SAMPLES};
 use super::xml::Node;
 use super::QifError;
-use crate::geometry::step::curve::{BSplineCurve, Curve, Knots, MAX_DEGREE};
+use crate::geometry::step::curve::{BSplineCurve, Curve, Frame, Knots, MAX_DEGREE};
 use crate::geometry::P3;
 use std::f64::consts::TAU;
 
@@ -22,12 +22,7 @@ pub(super) fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Opti
         "ArcCircular13Core" => {
             let r = d.length(c, "Radius")?;
             positive(c, r, "its radius")?;
-            let f = frame(
-                c,
-                d.point(c, "Center")?,
-                vec3(c, "Normal")?,
-                Some(vec3(c, "DirBeg")?),
-            )?;
+            let f = arc_frame(d, c)?;
             let t0 = domain(c).map_or(0.0, |dm| dm.0);
             let curve = Curve::Circle(f, r);
             let start = curve.eval(t0);
@@ -136,6 +131,18 @@ pub(super) fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Opti
     }
 }
 
+/// The plane and start of a circular or conic arc: centred at `Center`, square to
+/// `Normal`, starting along `DirBeg` (Geometry.xsd, `ArcCircular13CoreType`,
+/// `ArcConic13CoreType`).
+fn arc_frame(d: &Doc, c: &Node) -> Result<Frame, QifError> {
+    frame(
+        c,
+        d.point(c, "Center")?,
+        vec3(c, "Normal")?,
+        Some(vec3(c, "DirBeg")?),
+    )
+}
+
 /// A conic arc's curve. QIF 3's schema (Geometry.xsd, `ArcConic13CoreType`) names `A`
 /// and `B` the conic's "major" and "minor diameter", as its circles, cylinders and tori
 /// give diameters, and puts the conic in the plane of `Normal` starting along `DirBeg`;
@@ -146,12 +153,7 @@ pub(super) fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Opti
 fn conic(d: &Doc, c: &Node) -> Result<Curve, QifError> {
     let a = d.length(c, "A")? / 2.0;
     positive(c, a, "its A")?;
-    let f = frame(
-        c,
-        d.point(c, "Center")?,
-        vec3(c, "Normal")?,
-        Some(vec3(c, "DirBeg")?),
-    )?;
+    let f = arc_frame(d, c)?;
     match c.attr("form") {
         Some("PARABOLA") => Ok(Curve::Parabola(f, a)),
         Some(form @ ("ELLIPSE" | "HYPERBOLA")) => {

@@ -45,6 +45,16 @@ pub(crate) enum Bound {
     Vertex,
 }
 
+impl Bound {
+    /// Its edges (none for a vertex loop).
+    pub(crate) fn edges(&self) -> &[(usize, bool)] {
+        match self {
+            Bound::Edges(list) => list,
+            Bound::Vertex => &[],
+        }
+    }
+}
+
 /// A face.
 #[derive(Debug, Clone)]
 pub struct Face {
@@ -485,11 +495,7 @@ impl<'a> Reader<'a> {
     fn bound_points(&self, bounds: &[Bound]) -> Vec<P3> {
         bounds
             .iter()
-            .filter_map(|b| match b {
-                Bound::Edges(list) => Some(list),
-                Bound::Vertex => None,
-            })
-            .flatten()
+            .flat_map(Bound::edges)
             .flat_map(|(e, _)| [self.edges[*e].start, self.edges[*e].end])
             .collect()
     }
