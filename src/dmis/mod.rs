@@ -9,10 +9,11 @@
 
 mod read;
 pub mod text;
+mod units;
 mod write;
 
 pub use read::{read, word, Command, DmisError, Program, Statement, Word};
-pub use write::tol_word;
+pub use write::{tol_word, tolerance_labels};
 
 use crate::geometry::PartGeometry;
 use crate::model::{Model, Plan};

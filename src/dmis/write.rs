@@ -283,6 +283,30 @@ impl Nominal {
     }
 }
 
+/// The `T` label of every tolerance of `part`, and of the unit zone of each that has
+/// one besides its whole-feature zone: what the writer declares and a results file
+/// reports them by.
+pub fn tolerance_labels(part: &crate::model::Part) -> Vec<(String, Option<String>)> {
+    let mut labels = Labels::default();
+    let whole: Vec<String> = part
+        .tolerances
+        .iter()
+        .map(|t| labels.fresh("T", &t.name))
+        .collect();
+    whole
+        .into_iter()
+        .zip(&part.tolerances)
+        .map(|(l, t)| {
+            let unit = t
+                .per_unit
+                .as_ref()
+                .filter(|p| p.overall)
+                .map(|_| labels.fresh("T", &format!("{}_unit", t.name)));
+            (l, unit)
+        })
+        .collect()
+}
+
 /// The DMIS word of a tolerance kind.
 pub fn tol_word(k: TolKind) -> &'static str {
     match k {
@@ -368,8 +392,20 @@ struct Surf {
 struct Round {
     /// The point features' labels, in program order; empty when one block measures it.
     partials: Vec<String>,
+    /// The unit stretches of its zones per unit, each constructed from its points.
+    windows: Vec<Window>,
     /// The block that completes it.
     last: BlockKey,
+}
+
+/// One unit stretch of a surface under a zone per unit ([`super::units`]).
+struct Window {
+    /// The tolerance whose unit zone it is checked against.
+    tol: ToleranceId,
+    /// Its feature's label.
+    label: String,
+    /// The labels of the point features it is constructed from.
+    members: Vec<String>,
 }
 
 /// A feature touched by hand to align: its label, its touches (point, normal) and
@@ -433,8 +469,15 @@ struct Writer<'a> {
     faces_of: BTreeMap<Option<FeatureId>, Vec<String>>,
     /// Tolerance statements written so far (each just before its first `OUTPUT`).
     defined_tols: std::collections::BTreeSet<usize>,
+    /// The unit zones' `TOL` written.
+    defined_units: std::collections::BTreeSet<usize>,
     /// Per tolerance, its `TOL` statement.
     tol_stmts: Vec<String>,
+    /// Per surface label, the unit stretches its latest round constructed.
+    windows_of: BTreeMap<String, Vec<(ToleranceId, String)>>,
+    /// Per tolerance with a unit zone besides its whole one, the unit zone's label and
+    /// `TOL` statement.
+    unit_tols: Vec<Option<(String, String)>>,
     /// Nominals by feature label.
     nominals: BTreeMap<String, Nominal>,
     /// Per datum, its label.
@@ -477,7 +520,10 @@ pub fn write(input: &Input) -> String {
         pending: Vec::new(),
         faces_of: BTreeMap::new(),
         defined_tols: std::collections::BTreeSet::new(),
+        defined_units: std::collections::BTreeSet::new(),
         tol_stmts: Vec::new(),
+        windows_of: BTreeMap::new(),
+        unit_tols: Vec::new(),
         nominals: BTreeMap::new(),
         datums: Vec::new(),
         tols: Vec::new(),
@@ -707,6 +753,7 @@ impl Writer<'_> {
             self.faces_of.entry(feature).or_default().push(label);
             rounds.push(Round {
                 partials: vec![],
+                windows: vec![],
                 last: *k,
             });
         }
@@ -736,13 +783,18 @@ impl Writer<'_> {
         self.o.stmt(&format!("F({full})=FEAT/{}", nominal.feat()));
         self.nominals.insert(full.clone(), nominal.clone());
         self.faces_of.entry(feature).or_default().push(full.clone());
+        // A surface under a zone per unit is measured as points, whatever its blocks:
+        // its unit stretches are constructed from them.
+        let units = self.unit_zones(feature);
         let mut rounds = Vec::new();
         let mut n = 0;
+        let mut w = 0;
         for (r, keys) in rounds_of.iter().enumerate() {
             let mut partials = Vec::new();
+            let mut touched: Vec<(String, P3)> = Vec::new();
             for k in keys {
                 self.feats.insert(*k, (full.clone(), id, r));
-                if keys.len() == 1 {
+                if keys.len() == 1 && units.is_empty() {
                     continue;
                 }
                 // A scanned block of a surface scanned from several views measures
@@ -766,11 +818,14 @@ impl Writer<'_> {
                         ijk(&p.normal)
                     ));
                     self.points.insert((*k, ti), label.clone());
+                    touched.push((label.clone(), p.position));
                     partials.push(label);
                 }
             }
+            let windows = self.unit_windows(&name, &nominal, &units, &touched, &mut w);
             rounds.push(Round {
                 partials,
+                windows,
                 last: *keys.last().expect("a round has a block"),
             });
         }
@@ -780,6 +835,64 @@ impl Writer<'_> {
             feature,
             on_table,
         });
+    }
+
+    /// The zones per unit of the tolerances on `feature`.
+    fn unit_zones(&self, feature: Option<FeatureId>) -> Vec<(ToleranceId, crate::model::UnitOf)> {
+        let part = self.names.part();
+        part.tolerances
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| feature.is_some_and(|f| t.targets.contains(&f)))
+            .filter_map(|(i, t)| t.per_unit.as_ref().map(|p| (ToleranceId(i), p.unit)))
+            .collect()
+    }
+
+    /// The unit stretches of one round of a surface (`touched`: its point features and
+    /// their nominal places), each declared as a feature of the surface's kind; where the
+    /// surface has no touches to build them from (a scanned face), the program says so.
+    fn unit_windows(
+        &mut self,
+        name: &str,
+        nominal: &Nominal,
+        units: &[(ToleranceId, crate::model::UnitOf)],
+        touched: &[(String, P3)],
+        n: &mut usize,
+    ) -> Vec<Window> {
+        let Nominal::Surface(surface, _) = nominal else {
+            return Vec::new();
+        };
+        let points: Vec<P3> = touched.iter().map(|t| t.1).collect();
+        let mut out = Vec::new();
+        for &(tol, unit) in units {
+            let sets = super::units::windows(surface, unit, &points);
+            if sets.is_empty() {
+                let t = &self.names.part().tolerances[tol.0];
+                self.o.comment(&format!(
+                    "{}: no unit stretch of {name} has touches enough to fit; its zone per {} is not checked",
+                    t.name,
+                    unit.text()
+                ));
+            }
+            for members in sets {
+                *n += 1;
+                let label = self.labels.fresh("F", &format!("{name}_U{n}"));
+                // Declared where its points are: the window's centre on the surface.
+                let centre = members
+                    .iter()
+                    .fold(V3::zeros(), |a, &i| a + points[i].coords)
+                    / members.len() as f64;
+                let nominal = Nominal::Surface(surface.clone(), P3::from(centre));
+                self.o.stmt(&format!("F({label})=FEAT/{}", nominal.feat()));
+                self.nominals.insert(label.clone(), nominal);
+                out.push(Window {
+                    tol,
+                    label,
+                    members: members.into_iter().map(|i| touched[i].0.clone()).collect(),
+                });
+            }
+        }
+        out
     }
 
     /// A datum feature of several parallel bores or pins (a pattern of holes) is one
@@ -889,8 +1002,14 @@ impl Writer<'_> {
             let label = self.labels.fresh("DAT", &d.name);
             self.datums.push(label);
         }
-        for t in &part.tolerances {
-            let label = self.labels.fresh("T", &t.name);
+        let labels = tolerance_labels(part);
+        for (t, (label, unit)) in part.tolerances.iter().zip(labels) {
+            let unit_stmt = unit.map(|l| {
+                let zone = t.per_unit.as_ref().map_or(0.0, |p| p.zone);
+                let stmt = format!("T({l})=TOL/{},{}", tol_word(t.kind), real(zone));
+                (l, stmt)
+            });
+            self.unit_tols.push(unit_stmt);
             let mut params = vec![tol_word(t.kind).to_string()];
             match &t.value {
                 TolValue::Zone { width, diameter } => {
@@ -1568,6 +1687,14 @@ impl Writer<'_> {
             let full = s.full.clone();
             self.o
                 .stmt(&format!("CONST/{meas},F({full}),BF,{}", fa.join(",")));
+            let mut built = Vec::new();
+            for w in &r.windows {
+                let fa: Vec<String> = w.members.iter().map(|l| format!("FA({l})")).collect();
+                self.o
+                    .stmt(&format!("CONST/{meas},F({}),BF,{}", w.label, fa.join(",")));
+                built.push((w.tol, w.label.clone()));
+            }
+            self.windows_of.insert(full.clone(), built);
             Some(full)
         } else {
             None
@@ -1788,6 +1915,7 @@ impl Writer<'_> {
         };
         let profile = matches!(t.kind, TolKind::ProfileLine | TolKind::ProfileSurface);
         let mut lines = Vec::new();
+        let mut unit_lines = Vec::new();
         if profile {
             // A profile of several surfaces is one zone over them all (Y14.5-2018
             // ch. 11): one `OUTPUT` naming every surface.
@@ -1816,21 +1944,57 @@ impl Writer<'_> {
                 lines.push(format!("OUTPUT/{},TA({tl})", fa.join(",")));
             }
         } else {
+            let whole = t.per_unit.as_ref().is_none_or(|p| p.overall);
             for &f in &t.targets {
                 for l in labels_of(f) {
-                    lines.push(format!("OUTPUT/FA({l}),TA({tl})"));
+                    if whole {
+                        lines.push(format!("OUTPUT/FA({l}),TA({tl})"));
+                    }
+                    self.unit_outputs(r, &l, &mut unit_lines);
                 }
             }
         }
         // A tolerance recorded in several groups reports the same features once.
         lines.retain(|l| !self.outputs.contains(l));
-        self.outputs.extend(lines.iter().cloned());
-        if !lines.is_empty() && self.defined_tols.insert(r.0) {
+        unit_lines.retain(|l| !self.outputs.contains(l));
+        self.outputs
+            .extend(lines.iter().chain(&unit_lines).cloned());
+        let own = lines.len()
+            + if t.per_unit.as_ref().is_some_and(|p| !p.overall) {
+                unit_lines.len()
+            } else {
+                0
+            };
+        if own > 0 && self.defined_tols.insert(r.0) {
             let stmt = self.tol_stmts[r.0].clone();
             self.o.stmt(&stmt);
         }
         for l in lines {
             self.o.stmt(&l);
+        }
+        if let (Some((_, stmt)), false) = (&self.unit_tols[r.0], unit_lines.is_empty()) {
+            if self.defined_units.insert(r.0) {
+                let stmt = stmt.clone();
+                self.o.stmt(&stmt);
+            }
+        }
+        for l in unit_lines {
+            self.o.stmt(&l);
+        }
+    }
+
+    /// The `OUTPUT`s of tolerance `r`'s unit zone on the unit stretches of surface
+    /// `label`: under the unit zone's own label where the tolerance also bounds the whole
+    /// feature, else under the tolerance's.
+    fn unit_outputs(&self, r: ToleranceId, label: &str, lines: &mut Vec<String>) {
+        let tl = match &self.unit_tols[r.0] {
+            Some((l, _)) => l,
+            None => &self.tols[r.0],
+        };
+        for (tol, w) in self.windows_of.get(label).into_iter().flatten() {
+            if *tol == r {
+                lines.push(format!("OUTPUT/FA({w}),TA({tl})"));
+            }
         }
     }
 

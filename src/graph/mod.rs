@@ -366,6 +366,46 @@ fn add_points(
 /// that has one and lists the face (`owners`, sorted), else the sampling's strategy for
 /// its surface type, raised to [`FORM_POINTS`] on a plane whose flatness is toleranced.
 fn strategy_for(input: &Input, face: FaceId, owners: &[FeatureId]) -> Strategy {
+    let s = declared_strategy(input, face, owners);
+    let kind = input.geometry.faces[face.0].surface.kind();
+    match per_unit_spacing(input, owners) {
+        Some(spacing)
+            if matches!(
+                kind,
+                SurfaceKind::Plane | SurfaceKind::Cylinder | SurfaceKind::Cone
+            ) =>
+        {
+            Strategy {
+                method: crate::model::SampleMethod::Spread,
+                spacing: Some(spacing),
+                ..s
+            }
+        }
+        _ => s,
+    }
+}
+
+/// The rows of a face under a zone per unit length or area are at most a third of the
+/// unit apart, whatever the sampling says: a bump as wide as the unit, wherever it
+/// stands, has a point within 0.24 of the unit from its top (the diagonal of a third),
+/// where it still stands out 78 % of its height — and every unit stretch the program
+/// checks ([`crate::dmis`]) holds at least 3 × 3 points.
+fn per_unit_spacing(input: &Input, owners: &[FeatureId]) -> Option<f64> {
+    input
+        .part
+        .tolerances
+        .iter()
+        .filter(|t| t.targets.iter().any(|f| owners.contains(f)))
+        .filter_map(|t| t.per_unit.as_ref())
+        .map(|p| p.unit.least() / PER_UNIT_ROWS)
+        .reduce(f64::min)
+}
+
+/// Rows of points per unit stretch under a zone per unit.
+pub(crate) const PER_UNIT_ROWS: f64 = 3.0;
+
+/// The strategy the spec declares for a face: see [`strategy_for`].
+fn declared_strategy(input: &Input, face: FaceId, owners: &[FeatureId]) -> Strategy {
     if let Some(s) = owners.iter().find_map(|f| {
         input
             .overrides

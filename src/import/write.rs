@@ -416,14 +416,17 @@ fn tolerance_lines(
     for t in &p.tolerances {
         let label = format!("`{}` (#{})", t.name, t.id);
         // A zone per unit length or area is not the same zone over the whole feature
-        // (that would reject parts the drawing accepts): said, not converted.
+        // (that would reject parts the drawing accepts): written as `per_unit`, or
+        // said where the language has no such zone.
         if let Some(per) = &t.per_unit {
-            left_out(
-                &mut lines,
-                label,
-                &format!("its zone applies {per}, which the language cannot say; a zone over the whole feature would reject parts the drawing accepts"),
-            );
-            continue;
+            if let Err(why) = per_unit_arg(t, per) {
+                left_out(
+                    &mut lines,
+                    label,
+                    &format!("its zone applies {}, {why}; a zone over the whole feature would reject parts the drawing accepts", per.text),
+                );
+                continue;
+            }
         }
         // A zone of 0 is legal at MMC or LMC (ASME Y14.5 zero tolerance at MMC).
         let zero_at_material = t.value_mm == 0.0
@@ -453,6 +456,36 @@ fn tolerance_lines(
         }
     }
     (lines, count)
+}
+
+/// A zone per unit as the language writes it: `per_unit(0.02 mm, 25 mm)`, a square's or
+/// rectangle's sides, a circle's `dia`; Err with why not (the language has per-unit
+/// zones for straightness along a length and flatness over an area, ASME Y14.5-2018
+/// § 5.4.1.4 and § 5.4.2.2).
+fn per_unit_arg(t: &pmi::GeoTolerance, p: &pmi::PerUnitZone) -> Result<String, String> {
+    use crate::model::UnitOf;
+    if p.zone_mm.is_some_and(|z| z >= t.value_mm) {
+        return Err("not tighter than the whole feature's zone, which it must be".into());
+    }
+    let zone = p.zone_mm.unwrap_or(t.value_mm);
+    let zone = written(zone, Sign::Positive, "the zone per unit", "mm")?.0;
+    let size = |x: f64| written(x, Sign::Positive, "the unit", "mm").map(|w| w.0);
+    let unit = match (t.kind, p.unit) {
+        (_, None) => return Err("whose size cannot be read".into()),
+        (Some(TolKind::Straightness), Some(UnitOf::Length(l))) => size(l)?,
+        (Some(TolKind::Flatness), Some(UnitOf::Rectangle(a, b))) if a == b => size(a)?,
+        (Some(TolKind::Flatness), Some(UnitOf::Rectangle(a, b))) => {
+            format!("{} mm, {}", size(a)?, size(b)?)
+        }
+        (Some(TolKind::Flatness), Some(UnitOf::Circle(d))) => format!("dia {}", size(d)?),
+        _ => {
+            return Err(
+                "which the language has only for straightness per length and flatness per area"
+                    .into(),
+            )
+        }
+    };
+    Ok(format!("per_unit({zone} mm, {unit} mm)"))
 }
 
 /// One tolerance as `tolerance name = kind(feature, value, datums)`, with a comment on
@@ -560,13 +593,21 @@ fn tolerance_args(
 ) -> (Vec<String>, Vec<String>) {
     let mut args = vec![feature.to_string()];
     let mut lost = Vec::new();
-    if t.diameter && rule.dia {
-        args.push(format!("dia {}", mm(t.value_mm)));
-    } else {
-        if t.diameter {
-            lost.push("Ø zone".to_string());
+    match t.per_unit.as_ref().map(|p| (p, per_unit_arg(t, p))) {
+        Some((p, Ok(unit))) => {
+            // The file's whole-feature value, where it gives one besides the unit's.
+            if p.zone_mm.is_some() {
+                args.push(mm(t.value_mm));
+            }
+            args.push(unit);
         }
-        args.push(mm(t.value_mm));
+        _ if t.diameter && rule.dia => args.push(format!("dia {}", mm(t.value_mm))),
+        _ => {
+            if t.diameter {
+                lost.push("Ø zone".to_string());
+            }
+            args.push(mm(t.value_mm));
+        }
     }
     match (t.material, rule.material) {
         (Some(Material::Mmc), true) => args.push("MMC".into()),

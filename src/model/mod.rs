@@ -512,6 +512,9 @@ pub struct Strategy {
     pub points: Option<u32>,
     /// Boundary inset (the method's own rule when `None`).
     pub inset: Option<Inset>,
+    /// The most distance between neighbouring rows of a `spread` (mm; its own rule
+    /// when `None`): a zone per unit area needs points in every unit stretch.
+    pub spacing: Option<f64>,
 }
 
 /// A set of strategies per surface type.
@@ -536,6 +539,7 @@ impl Sampling {
                 method: SampleMethod::Uniform,
                 points: Some(9),
                 inset: None,
+                spacing: None,
             })
     }
 }

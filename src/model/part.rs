@@ -641,6 +641,62 @@ pub struct Tolerance {
     pub datums: Vec<DatumRef>,
     /// Basic angle for angularity (degrees).
     pub basic_angle: Option<f64>,
+    /// A zone that applies to every unit length or area of the feature.
+    pub per_unit: Option<PerUnit>,
     /// Where it was declared.
     pub span: Span,
+}
+
+/// A form zone that applies to every stretch of the feature of one size: ASME
+/// Y14.5-2018 § 5.4.1.4 (straightness per unit length) and § 5.4.2.2 (flatness per unit
+/// area), ISO 1101 `0.02/25`, `0.02/25×25`. It keeps an abrupt change within a short
+/// stretch smaller than the feature's whole form may be.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PerUnit {
+    /// The zone (mm) every unit stretch keeps.
+    pub zone: f64,
+    /// The stretch.
+    pub unit: UnitOf,
+    /// Whether the tolerance's [`Tolerance::value`] also bounds the whole feature (a
+    /// frame of two lines); `false`: the unit zone alone, and `value` is that zone.
+    pub overall: bool,
+}
+
+/// The size of a per-unit stretch (mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum UnitOf {
+    /// A length along the feature (straightness).
+    Length(f64),
+    /// A rectangle on the surface, length × width (a square where they are equal).
+    Rectangle(f64, f64),
+    /// A circle of this diameter on the surface.
+    Circle(f64),
+}
+
+impl UnitOf {
+    /// As a drawing writes it after the slash: `25`, `25×50`, `Ø25`.
+    pub fn text(self) -> String {
+        use super::fmt_num;
+        match self {
+            UnitOf::Length(l) => fmt_num(l),
+            UnitOf::Rectangle(a, b) => format!("{}×{}", fmt_num(a), fmt_num(b)),
+            UnitOf::Circle(d) => format!("Ø{}", fmt_num(d)),
+        }
+    }
+
+    /// The longest extent of the stretch (mm).
+    pub fn span(self) -> f64 {
+        match self {
+            UnitOf::Length(l) | UnitOf::Circle(l) => l,
+            UnitOf::Rectangle(a, b) => a.max(b),
+        }
+    }
+
+    /// The shortest extent of the stretch (mm): the sampling density follows it.
+    pub fn least(self) -> f64 {
+        match self {
+            UnitOf::Length(l) | UnitOf::Circle(l) => l,
+            UnitOf::Rectangle(a, b) => a.min(b),
+        }
+    }
 }

@@ -703,6 +703,7 @@ pub(super) fn strategy(
         method,
         points,
         inset,
+        spacing: None,
     })
 }
 

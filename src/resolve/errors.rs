@@ -6,6 +6,15 @@ use crate::source::Span;
 #[derive(Debug, thiserror::Error, miette::Diagnostic)]
 #[allow(missing_docs)]
 pub(crate) enum ResolveError {
+    #[error("this zone per unit cannot be read: {problem}")]
+    #[diagnostic(code(insp::resolve::per_unit))]
+    PerUnit {
+        #[label("here")]
+        span: Span,
+        problem: String,
+        #[help]
+        help: String,
+    },
     #[error("unknown {what} `{name}`")]
     #[diagnostic(code(insp::resolve::unknown_name))]
     UnknownName {
@@ -437,6 +446,7 @@ pub(crate) enum ResolveError {
 }
 
 crate::diag::located!(ResolveError {
+    PerUnit,
     UnknownName,
     WrongKind,
     DuplicateName,

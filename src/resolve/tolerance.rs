@@ -130,6 +130,7 @@ pub(super) fn lower(
     let rule = rule_of(cx, call)?;
     let mut args = Args::read(cx, pc, rule, call)?;
     args.check_arity(cx, rule, call);
+    let per_unit = args.per_unit_zone(cx, rule);
     let Some((value, value_span)) = args.value.take() else {
         if args.ok {
             missing_value(cx, rule, call);
@@ -149,6 +150,7 @@ pub(super) fn lower(
         modifier: args.modifier.map(|m| m.0),
         datums: args.datums.into_iter().map(|d| d.0).collect(),
         basic_angle: args.basic_angle,
+        per_unit,
         span: name.span,
     })
 }
@@ -183,6 +185,8 @@ struct Args {
     modifier: Option<(Material, Span)>,
     datums: Vec<(DatumRef, Span)>,
     basic_angle: Option<f64>,
+    /// `per_unit(zone, stretch)`, read.
+    per_unit: Option<(f64, UnitOf, Span)>,
     /// A zone written as 0 (described), legal only at MMC or LMC.
     zero: Option<String>,
     ok: bool,
@@ -202,6 +206,7 @@ impl Args {
             modifier: None,
             datums: Vec::new(),
             basic_angle: None,
+            per_unit: None,
             zero: None,
             ok: true,
             past_value: false,
@@ -301,6 +306,13 @@ impl Args {
                     None => self.ok = false,
                 }
             }
+            ValueKind::Call(c) if c.callee.as_ident().is_some_and(|i| i.name == PER_UNIT) => {
+                self.past_value = true;
+                match per_unit(cx, rule, c) {
+                    Some(p) => self.per_unit = Some(p),
+                    None => self.ok = false,
+                }
+            }
             ValueKind::Path(_) | ValueKind::Call(_) => match datum_ref(cx, pc, v) {
                 Some(d) => self.datums.push(d),
                 None => self.ok = false,
@@ -337,6 +349,45 @@ impl Args {
             Some(val) => self.value = Some((val, v.span)),
             None => self.ok = false,
         }
+    }
+
+    /// The per-unit zone, checked against the tolerance's type and overall zone; where
+    /// it stands alone it is the tolerance's value too.
+    fn per_unit_zone(&mut self, cx: &mut Cx, rule: &Rule) -> Option<PerUnit> {
+        let (zone, unit, span) = self.per_unit.take()?;
+        let Some((overall, _)) = &self.value else {
+            self.value = Some((
+                TolValue::Zone {
+                    width: zone,
+                    diameter: false,
+                },
+                span,
+            ));
+            return Some(PerUnit {
+                zone,
+                unit,
+                overall: false,
+            });
+        };
+        if let TolValue::Zone { width, .. } = overall {
+            if zone >= *width {
+                cx.err(E::PerUnit {
+                    span,
+                    problem: format!(
+                        "its zone {} mm is not tighter than the {} mm over the whole feature",
+                        crate::model::fmt_num(zone),
+                        crate::model::fmt_num(*width)
+                    ),
+                    help: format!("a unit zone limits abrupt change within a short stretch and is the smaller of the two (ASME Y14.5-2018 § 5.4.2.2); write `{}(feature, 0.1 mm, per_unit(0.02 mm, 25 mm))`, or the unit zone alone", rule.name),
+                });
+                self.ok = false;
+            }
+        }
+        Some(PerUnit {
+            zone,
+            unit,
+            overall: true,
+        })
     }
 
     /// A position zone of width 0 reads only at MMC or LMC, where the feature's
@@ -526,6 +577,69 @@ fn target(cx: &mut Cx, pc: &PartCx, p: &ast::Path) -> Option<FeatureId> {
             None
         }
     }
+}
+
+/// The call that gives a zone per unit length or area.
+const PER_UNIT: &str = "per_unit";
+
+/// `per_unit(zone, length)` (straightness; flatness per square), `per_unit(zone,
+/// length, width)` or `per_unit(zone, dia d)` (flatness per rectangle or circle): the
+/// unit stretches ASME Y14.5-2018 § 5.4.1.4 and § 5.4.2.2 and ISO 1101 allow, for the
+/// two tolerances they allow them on.
+fn per_unit(cx: &mut Cx, rule: &Rule, c: &ast::Call) -> Option<(f64, UnitOf, Span)> {
+    let example = "`per_unit(0.02 mm, 25 mm)`";
+    if !matches!(rule.kind, K::Flatness | K::Straightness) {
+        cx.err(E::PerUnit {
+            span: c.callee.span,
+            problem: format!("{} takes no zone per unit", rule.name),
+            help: "a zone per unit length or area is a form control: straightness per unit length, flatness per unit area (ASME Y14.5-2018 § 5.4.1.4, § 5.4.2.2)".into(),
+        });
+        return None;
+    }
+    let area = rule.kind == K::Flatness;
+    let mut lengths = Vec::new();
+    let mut circle = None;
+    for a in &c.args {
+        match a {
+            ast::Arg::Positional(v) => lengths.push(cx.positive(v, Dim::Length, PER_UNIT)?),
+            ast::Arg::Named(k, v) if k.name == "dia" && area => {
+                circle = Some(cx.positive(v, Dim::Length, PER_UNIT)?)
+            }
+            ast::Arg::Named(k, _) => {
+                cx.err(E::UnknownProperty {
+                    span: k.span,
+                    key: k.name.clone(),
+                    item: PER_UNIT.into(),
+                    help: if area {
+                        "`dia 25 mm` gives a circular unit area".into()
+                    } else {
+                        format!("straightness per unit takes a length: {example}")
+                    },
+                });
+                return None;
+            }
+        }
+    }
+    let unit = match (lengths.as_slice(), circle, area) {
+        ([zone, l], None, false) => Some((*zone, UnitOf::Length(*l))),
+        ([zone, l], None, true) => Some((*zone, UnitOf::Rectangle(*l, *l))),
+        ([zone, l, w], None, true) => Some((*zone, UnitOf::Rectangle(*l, *w))),
+        ([zone], Some(d), true) => Some((*zone, UnitOf::Circle(d))),
+        _ => None,
+    };
+    let Some((zone, unit)) = unit else {
+        cx.err(E::PerUnit {
+            span: c.span,
+            problem: "it needs a zone and the unit's size".into(),
+            help: if area {
+                "flatness per unit area: `per_unit(0.02 mm, 25 mm)` (a 25 × 25 square), `per_unit(0.02 mm, 25 mm, 50 mm)` (a rectangle) or `per_unit(0.02 mm, dia 25 mm)` (a circle)".into()
+            } else {
+                format!("straightness per unit length: {example} (0.02 mm in any 25 mm)")
+            },
+        });
+        return None;
+    };
+    Some((zone, unit, c.span))
 }
 
 fn zone(cx: &mut Cx, v: &ast::Value, what: &str) -> Option<f64> {

@@ -139,10 +139,10 @@ impl<'a> Sampler<'a> {
                 place.fan_leu_round(strategy.points.map_or(4, |n| n.div_ceil(2).max(1)) as usize)
             }
             (SampleMethod::Spread, Surface::Plane { .. }) => {
-                place.spread_plane(strategy.points.map(|n| n as usize))
+                place.spread_plane(strategy.points.map(|n| n as usize), strategy.spacing)
             }
             (SampleMethod::Spread, Surface::Cylinder { .. } | Surface::Cone { .. }) => {
-                place.spread_round(strategy.points.map(|n| n as usize))
+                place.spread_round(strategy.points.map(|n| n as usize), strategy.spacing)
             }
             (SampleMethod::FanLeu | SampleMethod::Spread, _) => place.pool(
                 SampleMethod::Hammersley,
@@ -230,8 +230,9 @@ pub(crate) const SPREAD_MAX_ROWS: usize = 7;
 
 /// Rows of a `spread` grid over a usable `a` × `b` mm: one every [`SPREAD_SPACING`], at
 /// least 3 each way (2 on a strip under 4 mm: points in one row fix no plane), denser
-/// until there are `want` points.
-fn spread_rows(a: f64, b: f64, want: Option<usize>) -> (usize, usize) {
+/// until there are `want` points. A `spacing` the strategy asks for (a zone per unit
+/// area) is kept however many rows it takes.
+fn spread_rows(a: f64, b: f64, want: Option<usize>, spacing: Option<f64>) -> (usize, usize) {
     let least = |x: f64| {
         if x < 1e-6 {
             1
@@ -241,13 +242,15 @@ fn spread_rows(a: f64, b: f64, want: Option<usize>) -> (usize, usize) {
             3
         }
     };
-    let rows = |x: f64, s: f64| {
-        ((x / s).ceil() as usize + 1).clamp(least(x), SPREAD_MAX_ROWS.max(least(x)))
+    let most = |x: f64| match spacing {
+        Some(s) => ((x / s).ceil() as usize + 1).max(least(x)),
+        None => SPREAD_MAX_ROWS.max(least(x)),
     };
-    let mut s = SPREAD_SPACING;
+    let rows = |x: f64, s: f64| ((x / s).ceil() as usize + 1).clamp(least(x), most(x));
+    let mut s = spacing.map_or(SPREAD_SPACING, |w| w.min(SPREAD_SPACING));
     loop {
         let (na, nb) = (rows(a, s), rows(b, s));
-        let full = (na >= SPREAD_MAX_ROWS || a < 4.0) && (nb >= SPREAD_MAX_ROWS || b < 4.0);
+        let full = (na >= most(a) || a < 4.0) && (nb >= most(b) || b < 4.0);
         if want.is_none_or(|w| na * nb >= w) || full || s < 0.5 {
             return (na, nb);
         }
@@ -419,13 +422,13 @@ impl Place<'_, '_> {
     /// (2, then 1, on a narrower strip), at most [`SPREAD_MAX_ROWS`]; denser until the
     /// grid holds `want` points where the graph asks for more. Points that fall off the
     /// face (a hole, an L-shaped face) move inwards by Fan & Leu's search.
-    fn spread_plane(&self, want: Option<usize>) -> Vec<Fpoint> {
+    fn spread_plane(&self, want: Option<usize>, spacing: Option<f64>) -> Vec<Fpoint> {
         let c = self.chart;
         let (eu, ev) = c.extent_mm();
         let edge = self.margin + EDGE_CLEARANCE;
         let (iu, iv) = (edge.min(NARROW_SHARE * eu), edge.min(NARROW_SHARE * ev));
         let (uu, uv) = (eu - 2.0 * iu, ev - 2.0 * iv);
-        let (nu, nv) = spread_rows(uu, uv, want);
+        let (nu, nv) = spread_rows(uu, uv, want, spacing);
         let at = |i: usize, n: usize| {
             if n == 1 {
                 0.5
@@ -450,7 +453,7 @@ impl Place<'_, '_> {
     /// its length (the margin and [`Place::end_clearance`] in) and between, a circle every
     /// [`SPREAD_SPACING`] mm, at least 3 where the length allows; at least 4 points a
     /// circle, more on a large one.
-    fn spread_round(&self, want: Option<usize>) -> Vec<Fpoint> {
+    fn spread_round(&self, want: Option<usize>, spacing: Option<f64>) -> Vec<Fpoint> {
         let c = self.chart;
         let (eu, ev) = c.extent_mm();
         let (_, sv) = c.scale();
@@ -459,7 +462,7 @@ impl Place<'_, '_> {
         };
         let (first, last) = (end(c.v.0, -1.0), end(c.v.1, 1.0));
         let usable = ev - first - last;
-        let (around, heights) = spread_rows(eu, usable, want);
+        let (around, heights) = spread_rows(eu, usable, want, spacing);
         let around = around.max(4);
         let span = c.u.1 - c.u.0;
         let mut targets = Vec::new();

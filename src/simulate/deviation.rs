@@ -10,6 +10,10 @@
 //! face stock.top bow 0.1                 # a plane's centre stands out (flatness); a
 //!                                        # face by its geometry name or a feature's name
 //! face stock.top shift 0.1               # a plane moves along its outward normal
+//! face stock.top bump 0.04 at (50, 20, 30) across 25
+//!                                        # a plane stands out 0.04 at the point,
+//!                                        # nothing 12.5 mm from it (a local dent
+//!                                        # where negative: flatness per unit area)
 //! part move (5, 0)                       # the part lies off on the table (machine x, y)
 //! part turn 3                            # … and turned about the vertical (degrees)
 //! setup 2 move (1, 0)                    # the same, in one setup only
@@ -35,6 +39,9 @@ pub struct FaceChange {
     /// A plane's bow (mm): its centre stands this far out along its normal, falling
     /// off with the square of the distance to nothing at its farthest corner.
     pub bow: f64,
+    /// Local bumps on a plane (nominal part frame): each a bow of its own `reach`
+    /// about its `centre`, nothing beyond.
+    pub(crate) bumps: Vec<Bow>,
 }
 
 /// A planar face bowed: a paraboloid over the plane, in the nominal part frame.
@@ -55,6 +62,32 @@ impl Bow {
         let across = (d - normal * d.dot(normal)).norm();
         self.height * (1.0 - (across / self.reach).powi(2))
     }
+
+    /// The same, as a bump: nothing beyond its reach.
+    fn bump_at(&self, normal: &V3, x: &P3) -> f64 {
+        let d = x - self.centre;
+        let across = (d - normal * d.dot(normal)).norm();
+        if across >= self.reach {
+            0.0
+        } else {
+            self.at(normal, x)
+        }
+    }
+}
+
+/// How far a plane stands out of its moved nominal: its bow and its bumps.
+#[derive(Debug, Clone)]
+pub(crate) struct Lift {
+    bow: Option<Bow>,
+    bumps: Vec<Bow>,
+}
+
+impl Lift {
+    /// How far the plane of normal `normal` stands out at (the projection of) `x`.
+    pub fn at(&self, normal: &V3, x: &P3) -> f64 {
+        self.bow.map_or(0.0, |b| b.at(normal, x))
+            + self.bumps.iter().map(|b| b.bump_at(normal, x)).sum::<f64>()
+    }
 }
 
 impl Default for FaceChange {
@@ -63,6 +96,7 @@ impl Default for FaceChange {
             motion: Isometry3::identity(),
             grow: 0.0,
             bow: 0.0,
+            bumps: Vec::new(),
         }
     }
 }
@@ -140,8 +174,23 @@ impl Deviations {
             .collect()
     }
 
+    /// A planar face's bow and bumps, moved with it; `None` when it has neither.
+    pub(crate) fn lift_of(&self, g: &PartGeometry, f: FaceId) -> Option<Lift> {
+        let c = self.faces.get(f.0)?;
+        let bumps: Vec<Bow> = c
+            .bumps
+            .iter()
+            .map(|b| Bow {
+                centre: c.motion * b.centre,
+                ..*b
+            })
+            .collect();
+        let bow = self.bow_of(g, f);
+        (bow.is_some() || !bumps.is_empty()).then_some(Lift { bow, bumps })
+    }
+
     /// A planar face's bow, moved with it; `None` when it has none.
-    pub(crate) fn bow_of(&self, g: &PartGeometry, f: FaceId) -> Option<Bow> {
+    fn bow_of(&self, g: &PartGeometry, f: FaceId) -> Option<Bow> {
         let c = self.faces.get(f.0)?;
         if c.bow == 0.0 {
             return None;
@@ -611,6 +660,7 @@ fn face_line(
         cur.motion = ch.motion * cur.motion;
         cur.grow += ch.grow;
         cur.bow += ch.bow;
+        cur.bumps.extend(ch.bumps);
     }
     Ok(())
 }
@@ -694,6 +744,7 @@ fn face_change(
         Some("tilt") => tilt_change(c, faces, area_centroid(g, faces), bad),
         Some("shift") => shift_change(c, faces, g, verb_at, bad),
         Some("bow") => bow_change(c, faces, g, verb_at, bad),
+        Some("bump") => bump_change(c, faces, g, verb_at, bad),
         Some("grow") => {
             let Some(d) = c.num() else {
                 let (s, e) = c.span();
@@ -838,8 +889,7 @@ fn shift_change(
             *f,
             FaceChange {
                 motion: Isometry3::from_parts(Translation3::from(t), UnitQuaternion::identity()),
-                grow: 0.0,
-                bow: 0.0,
+                ..FaceChange::default()
             },
         ));
     }
@@ -888,6 +938,68 @@ fn bow_change(
     Ok(out)
 }
 
+/// `bump MM at (x, y, z) across MM`: every face, a plane, standing out by the height at
+/// the point (part frame, projected onto each plane), nothing half the width from it.
+fn bump_change(
+    c: &mut Cur,
+    faces: &[FaceId],
+    g: &PartGeometry,
+    (vs, ve): (usize, usize),
+    bad: &Bad,
+) -> Result<Vec<(FaceId, FaceChange)>, SimError> {
+    const HELP: &str = "`face stock.top bump 0.04 mm at (50, 20, 30) across 25 mm`: the plane stands out 0.04 mm at the point, nothing 12.5 mm from it";
+    let height = c.num();
+    c.unit(&["mm"]);
+    let at = (c.word().as_deref() == Some("at"))
+        .then(|| c.tuple(3))
+        .flatten();
+    c.unit(&["mm"]);
+    let across = (c.word().as_deref() == Some("across"))
+        .then(|| c.num())
+        .flatten()
+        .filter(|w| *w > 0.0);
+    c.unit(&["mm"]);
+    let (Some(height), Some(at), Some(across)) = (height, at, across) else {
+        let (s, e) = c.span();
+        return Err(bad(
+            s,
+            e,
+            "`bump` takes a height, a point and a width",
+            "expected `bump H at (x, y, z) across W`",
+            HELP,
+        ));
+    };
+    let mut out = Vec::new();
+    for f in faces {
+        let Surface::Plane { origin, normal } = g.faces[f.0].surface else {
+            return Err(bad(
+                vs,
+                ve,
+                &format!(
+                    "`bump` raises planes; `{}` is not a plane",
+                    g.faces[f.0].name
+                ),
+                "not a plane",
+                HELP,
+            ));
+        };
+        let p = P3::new(at[0], at[1], at[2]);
+        let centre = p - normal * (p - origin).dot(&normal);
+        out.push((
+            *f,
+            FaceChange {
+                bumps: vec![Bow {
+                    height,
+                    centre,
+                    reach: across / 2.0,
+                }],
+                ..FaceChange::default()
+            },
+        ));
+    }
+    Ok(out)
+}
+
 /// Every face moved by `m`.
 fn rigid(faces: &[FaceId], m: Isometry3<f64>) -> Vec<(FaceId, FaceChange)> {
     let change = FaceChange {
@@ -915,7 +1027,7 @@ fn grow(g: &PartGeometry, faces: &[FaceId], d: f64) -> Option<Vec<(FaceId, FaceC
                 FaceChange {
                     motion: Isometry3::identity(),
                     grow: d,
-                    bow: 0.0,
+                    ..FaceChange::default()
                 },
             )),
             Surface::Plane { origin, normal } => {
@@ -930,8 +1042,7 @@ fn grow(g: &PartGeometry, faces: &[FaceId], d: f64) -> Option<Vec<(FaceId, FaceC
                             Translation3::from(normal * s),
                             UnitQuaternion::identity(),
                         ),
-                        grow: 0.0,
-                        bow: 0.0,
+                        ..FaceChange::default()
                     },
                 ));
             }

@@ -1453,14 +1453,14 @@ impl Machine<'_> {
         let g = self.input.geometry;
         let dev: &Deviations = self.input.deviations;
         let surface = dev.surface(g, face);
-        let bow = dev.bow_of(g, face);
+        let bow = dev.lift_of(g, face);
         Ok(match Shape::of_surface(&surface) {
             Some((shape, convex)) => {
                 // The distance on the solid's free side, less any bow.
                 let k = if convex { 1.0 } else { -1.0 };
                 let gap = |t: f64| {
                     let x = c0 - n * t;
-                    let lift = match (bow, shape.direction()) {
+                    let lift = match (&bow, shape.direction()) {
                         (Some(b), Some(normal)) => b.at(&normal, &x),
                         _ => 0.0,
                     };

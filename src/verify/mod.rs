@@ -23,8 +23,7 @@ pub mod trials;
 
 pub use report::Verification;
 
-use crate::dmis::text::Labels;
-use crate::model::{Model, TolValue};
+use crate::model::TolValue;
 use crate::simulate::{self, Report};
 use rayon::prelude::*;
 use report::{Placed, TolResult, Tried};
@@ -68,7 +67,7 @@ const IN_AT: f64 = 0.5;
 pub fn verify(bench: &Bench, opts: &Options) -> Verification {
     let part = &bench.sim.model.parts[bench.part];
     let nominal = run(bench, &[]);
-    let labels = tolerance_labels(bench.sim.model, bench.part);
+    let labels = crate::dmis::tolerance_labels(part);
     // The placements.
     let placements: Vec<Vec<String>> = (0..opts.placements)
         .map(|i| placement(i as u64, opts))
@@ -84,12 +83,12 @@ pub fn verify(bench: &Bench, opts: &Options) -> Verification {
     let mut jobs: Vec<(usize, usize, f64, Vec<String>)> = Vec::new();
     let mut tols: Vec<TolResult> = Vec::new();
     for (ti, t) in part.tolerances.iter().enumerate() {
-        let label = labels[ti].clone();
+        let (label, unit_label) = labels[ti].clone();
         let rows: Vec<&simulate::Row> = nominal
             .report
             .iter()
             .flat_map(|r| r.rows.iter())
-            .filter(|r| r.tolerance == label)
+            .filter(|r| r.tolerance == label || unit_label.as_ref() == Some(&r.tolerance))
             .collect();
         let zone = match &t.value {
             TolValue::Zone { width, .. } => rows
@@ -99,7 +98,7 @@ pub fn verify(bench: &Bench, opts: &Options) -> Verification {
             // A size's variants carry their own deviation.
             TolValue::Size { .. } => 1.0,
         };
-        let mut result = TolResult::new(ti, label, t, zone, !rows.is_empty());
+        let mut result = TolResult::new(ti, (label, unit_label), t, zone, !rows.is_empty());
         // A zone of 0 at MMC on a feature made at MMC leaves nothing to scale: the
         // trials need a zone, so it is listed as not tried.
         if !rows.is_empty() && zone > 0.0 {
@@ -183,16 +182,6 @@ pub fn verify(bench: &Bench, opts: &Options) -> Verification {
         placed,
         tolerances: tols,
     }
-}
-
-/// The DMIS label of each tolerance of the part, as the writer gives them.
-fn tolerance_labels(model: &Model, part: usize) -> Vec<String> {
-    let mut labels = Labels::default();
-    model.parts[part]
-        .tolerances
-        .iter()
-        .map(|t| labels.fresh("T", &t.name))
-        .collect()
 }
 
 /// Placement `i`: a shift and a turn drawn from a seeded generator (SplitMix64).

@@ -129,6 +129,10 @@ pub struct TolResult {
     pub index: usize,
     /// Its DMIS label.
     pub label: String,
+    /// Its unit zone's label, where it has one besides the whole feature's.
+    pub unit_label: Option<String>,
+    /// Its zone per unit as a drawing writes it (`0.02/25×25`).
+    pub per_unit: Option<String>,
     /// Its type, as DMIS names it.
     pub kind: TolKind,
     /// Its value, as written.
@@ -146,10 +150,22 @@ pub struct TolResult {
 }
 
 impl TolResult {
-    pub fn new(index: usize, label: String, t: &Tolerance, zone: f64, output: bool) -> TolResult {
+    pub fn new(
+        index: usize,
+        (label, unit_label): (String, Option<String>),
+        t: &Tolerance,
+        zone: f64,
+        output: bool,
+    ) -> TolResult {
+        let per_unit = t
+            .per_unit
+            .as_ref()
+            .map(|p| format!("{}/{}", crate::model::fmt_num(p.zone), p.unit.text()));
         TolResult {
             index,
             label,
+            unit_label,
+            per_unit,
             kind: t.kind,
             value: t.value.text(),
             size: matches!(t.value, TolValue::Size { .. }),
@@ -162,7 +178,7 @@ impl TolResult {
 
     /// What this tolerance read in a run.
     pub(crate) fn reading(&self, tried: &Tried) -> Option<Reading> {
-        let rows: Vec<_> = tried.rows().filter(|r| r.tolerance == self.label).collect();
+        let rows: Vec<_> = tried.rows().filter(|r| self.reads(&r.tolerance)).collect();
         if rows.is_empty() {
             return None;
         }
@@ -178,6 +194,12 @@ impl TolResult {
             value,
             pass: rows.iter().all(|r| r.pass()),
         })
+    }
+
+    /// Whether a results row of label `tolerance` is this tolerance's: its own or its
+    /// unit zone's.
+    pub(crate) fn reads(&self, tolerance: &str) -> bool {
+        tolerance == self.label || self.unit_label.as_deref() == Some(tolerance)
     }
 
     /// Tried, and every trial as it should be.
@@ -396,6 +418,7 @@ impl Verification {
                 "label": t.label,
                 "type": crate::dmis::tol_word(t.kind),
                 "value": t.value,
+                "per_unit": t.per_unit,
                 "zone": t.zone,
                 "output": t.output,
                 "ok": t.ok(),
@@ -475,7 +498,12 @@ fn tolerance_row(t: &TolResult) -> [String; 8] {
         if t.size {
             t.value.clone()
         } else {
-            fmt_num(round(t.zone))
+            match (&t.per_unit, t.unit_label.is_some()) {
+                // The unit zone alone is the tolerance's zone.
+                (Some(unit), false) => unit.clone(),
+                (Some(unit), true) => format!("{}, {unit}", fmt_num(round(t.zone))),
+                (None, _) => fmt_num(round(t.zone)),
+            }
         },
         verdicts(&|v| v.in_ok(), ["in", "out"]),
         verdicts(&|v| v.out_ok(), ["out", "in"]),

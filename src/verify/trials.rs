@@ -8,6 +8,7 @@
 //! | tolerance | zone (Y14.5-2018) | deviation tried at `k` × the zone `t` |
 //! | --- | --- | --- |
 //! | flatness, straightness | two parallel planes `t` apart (ch. 8, form) | each plane of the feature bowed by `k·t` (its centre stands out `k·t`, its farthest corner not at all: true flatness `k·t`) |
+//! | the same per unit length or area | the zone `u` in every unit stretch (§ 5.4.1.4, § 5.4.2.2) | each plane bumped `k·u` as wide as the unit, near its middle (the whole-feature zone, where there is one, bowed as above) |
 //! | profile with datums | a uniform boundary `t` wide about the true profile, located by the datums (ch. 11, profile) | each plane shifted `k·t/2` out, each curved face grown `k·t` in diameter |
 //! | profile without datums | the same zone, free to float: form only (ch. 11) | each plane bowed `k·t` |
 //! | perpendicularity, parallelism, angularity | two planes (or a cylinder for Ø) `t` apart at the basic orientation (ch. 9, orientation) | the feature tilted so that its far ends differ by `k·t` across its extent, about each of the two axes across it |
@@ -60,7 +61,18 @@ pub(crate) fn forbidden(
         k,
     };
     match t.kind {
-        TolKind::Flatness | TolKind::Straightness => b.bow_variants(),
+        TolKind::Flatness | TolKind::Straightness => match &t.per_unit {
+            None => b.bow_variants(),
+            Some(p) => {
+                let mut v = if p.overall {
+                    b.bow_variants()
+                } else {
+                    Vec::new()
+                };
+                v.extend(b.bump_variants(p));
+                v
+            }
+        },
         TolKind::ProfileSurface | TolKind::ProfileLine => b.profile_variants(),
         TolKind::Perpendicularity | TolKind::Parallelism | TolKind::Angularity => {
             b.tilt_variants(&frame)
@@ -100,6 +112,22 @@ impl<'a> Breaking<'a> {
     /// Its features in order: their names and faces.
     fn features(&self) -> impl Iterator<Item = (&'a String, &'a [FaceId])> + '_ {
         (0..self.t.targets.len()).filter_map(|i| self.feature(i))
+    }
+
+    /// A zone per unit: each feature's planes bumped, as wide as the unit's least side.
+    fn bump_variants(&self, p: &crate::model::PerUnit) -> Vec<Variant> {
+        let mut out = Vec::new();
+        for (name, faces) in self.features() {
+            let lines = bumps(self.g, faces, self.k * p.zone, p.unit.least());
+            if !lines.is_empty() {
+                out.push(Variant {
+                    what: format!("bump per {} on {name}", p.unit.text()),
+                    lines,
+                    unit: p.zone,
+                });
+            }
+        }
+        out
     }
 
     /// Form (flatness, straightness): each feature's planes bowed.
@@ -347,6 +375,39 @@ fn bows(g: &PartGeometry, faces: &[FaceId], h: f64) -> Vec<String> {
         .iter()
         .filter(|f| matches!(g.faces[f.0].surface, Surface::Plane { .. }))
         .map(|f| format!("face {} bow {}", g.faces[f.0].name, num(h)))
+        .collect()
+}
+
+/// Every plane of `faces` bumped `h` high and `across` wide, at the centre of its
+/// triangle nearest its centroid (on the face, where the centroid of a ring is not).
+fn bumps(g: &PartGeometry, faces: &[FaceId], h: f64, across: f64) -> Vec<String> {
+    faces
+        .iter()
+        .filter(|f| matches!(g.faces[f.0].surface, Surface::Plane { .. }))
+        .filter_map(|f| {
+            let face = &g.faces[f.0];
+            let at = face
+                .triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = g.triangles[*t as usize].map(|i| g.vertices[i as usize]);
+                    P3::from((a.coords + b.coords + c.coords) / 3.0)
+                })
+                .min_by(|a, b| {
+                    (a - face.centroid)
+                        .norm()
+                        .total_cmp(&(b - face.centroid).norm())
+                })?;
+            Some(format!(
+                "face {} bump {} at ({}, {}, {}) across {}",
+                face.name,
+                num(h),
+                num(at.x),
+                num(at.y),
+                num(at.z),
+                num(across)
+            ))
+        })
         .collect()
 }
 

@@ -542,10 +542,11 @@ fn an_all_over_profile_reads_on_every_face() {
 }
 
 /// A flatness per unit area (ISO 10303-47 `geometric_tolerance_with_defined_area_unit`)
-/// is said, not converted into a flatness of the whole face: CTC 01's flatness made
-/// 0.2 mm per 25 × 25 mm square.
+/// is written as one, not converted into a flatness of the whole face: CTC 01's flatness
+/// made 0.2 mm per 25 × 25 mm square; a per-unit zone on a type the language has none
+/// for (perpendicularity) is said in a comment.
 #[test]
-fn a_flatness_per_unit_area_is_said_not_converted() {
+fn a_flatness_per_unit_area_is_written_as_one() {
     let (text, _) = patched(
         "ctc_01",
         "#57=FLATNESS_TOLERANCE('Flatness.1','',#82,#297);",
@@ -555,9 +556,34 @@ fn a_flatness_per_unit_area_is_said_not_converted() {
          #990001=LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.),#4360);",
     );
     let spec = spec_of(&text);
-    assert!(!spec.contains("= flatness("), "{spec}");
     assert!(
-        spec.contains("per 25 × 25 mm square area"),
-        "no comment on the per-unit flatness:\n{spec}"
+        spec.contains("= flatness(") && spec.contains(", per_unit(0.2 mm, 25 mm))"),
+        "no per-unit flatness:\n{spec}"
+    );
+    assert!(!spec.contains(", 0.2 mm, per_unit"), "{spec}");
+    let rect = text.replace(
+        "GEOMETRIC_TOLERANCE_WITH_DEFINED_AREA_UNIT(.SQUARE.,$)",
+        "GEOMETRIC_TOLERANCE_WITH_DEFINED_AREA_UNIT(.RECTANGULAR.,#990002)",
+    ) + "";
+    let rect = rect.replace(
+        "#990001=LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.),#4360);",
+        "#990001=LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.),#4360);\n\
+         #990002=LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(50.),#4360);",
+    );
+    let spec = spec_of(&rect);
+    assert!(spec.contains("per_unit(0.2 mm, 25 mm, 50 mm))"), "{spec}");
+    // The spec it writes resolves, the tolerance's zone per unit alone.
+    let dir = hostile_dir("per-unit");
+    import_checks_clean(&dir, "ctc_01_per_unit.stp", rect.as_bytes());
+    let perp = text.replace(
+        "#57=(FLATNESS_TOLERANCE()GEOMETRIC_TOLERANCE(",
+        "#57=(PERPENDICULARITY_TOLERANCE()GEOMETRIC_TOLERANCE(",
+    );
+    let spec = spec_of(&perp);
+    assert!(
+        spec.contains(
+            "which the language has only for straightness per length and flatness per area"
+        ),
+        "{spec}"
     );
 }

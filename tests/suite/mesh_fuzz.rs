@@ -33,6 +33,7 @@ fn segment_and_sample(raw: &RawMesh) {
                         method,
                         points: Some(5),
                         inset: None,
+                        spacing: None,
                     },
                 );
             }

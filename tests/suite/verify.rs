@@ -121,3 +121,60 @@ fn the_report_is_the_same_every_run() {
     let b: Vec<String> = verify(spec, 3).iter().map(|v| v.text()).collect();
     assert_eq!(a, b);
 }
+
+/// Zones per unit area (ASME Y14.5-2018 § 5.4.2.2): a bump as wide as the unit, twice
+/// the unit zone high, reads out though the whole face stays within its own zone; half
+/// as high reads in. The program checks each unit stretch as a feature of its own.
+#[test]
+fn a_bump_within_a_unit_area_is_seen() {
+    let dir = std::env::temp_dir().join(format!("inspc_per_unit_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = dir.join("plate.insp");
+    std::fs::write(&spec, PER_UNIT_PLATE).unwrap();
+    let v = verify(&spec, 2);
+    std::fs::remove_dir_all(&dir).ok();
+    let text = v[0].text();
+    assert_eq!(v[0].problems(), 0, "{text}");
+    let json = v[0].json().to_string();
+    for what in [
+        "bump per 25×25 on top",
+        "bump per 20×10 on front",
+        "bow on top",
+    ] {
+        assert!(json.contains(what), "no trial `{what}`: {json}");
+    }
+    // The unit zone alone is not a whole-face zone: no bow is tried on the front.
+    assert!(!json.contains("bow on front"), "{json}");
+    assert!(
+        text.contains("0.1, 0.02/25×25") && text.contains("0.03/20×10"),
+        "{text}"
+    );
+}
+
+const PER_UNIT_PLATE: &str = "use std::heads::PH10MQ
+use std::probes::TP20_D2_L20
+use std::hierarchies::efficient_accuracy
+
+part plate {
+    units mm
+    stock box(120, 80, 20)
+    cut hole bore_a { at (60, 40, 20), axis -z, diameter 16, depth 20 }
+    feature top = stock.top
+    feature front = stock.front
+    tolerance top_flat = flatness(top, 0.1 mm, per_unit(0.02 mm, 25 mm))
+    tolerance front_flat = flatness(front, per_unit(0.03 mm, 20 mm, 10 mm))
+}
+
+cmm lab {
+    table { z 0 mm, size (1000 mm, 700 mm) }
+    ram { radius 35 mm, length 600 mm }
+    head PH10MQ
+    probes [p1: TP20_D2_L20]
+}
+
+plan plate_plan {
+    part plate
+    cmm lab
+    hierarchy efficient_accuracy
+}
+";

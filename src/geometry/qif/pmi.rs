@@ -11,7 +11,9 @@ use super::doc::Doc;
 use super::refs;
 use super::xml::Node;
 use super::QifError;
-use crate::geometry::step::pmi::{Datum, DatumRef, DimKind, Dimension, GeoTolerance, Pmi, Target};
+use crate::geometry::step::pmi::{
+    Datum, DatumRef, DimKind, Dimension, GeoTolerance, PerUnitZone, Pmi, Target,
+};
 use crate::model::{Material, TolKind};
 use std::cell::Cell;
 use std::collections::{BTreeSet, HashMap};
@@ -537,9 +539,14 @@ impl Reader<'_> {
         frames: &HashMap<u64, Vec<DatumRef>>,
         faces: Vec<usize>,
     ) -> GeoTolerance {
-        let value = def.child("ToleranceValue").and_then(|v| self.length(v));
-        let per_unit = self.per_unit(def);
-        if value.is_none() {
+        let mut value = def.child("ToleranceValue").and_then(|v| self.length(v));
+        let mut per_unit = self.per_unit(def);
+        // A zone per unit alone: the tolerance's value is that zone (as in STEP).
+        if let (None, Some(p)) = (value, per_unit.as_mut()) {
+            value = p.zone_mm.take();
+        }
+        // A zone per unit alone (the schema's second choice) has no whole-feature value.
+        if value.is_none() && per_unit.is_none() {
             self.notes
                 .push(format!("{name}: its tolerance value cannot be read"));
         }
@@ -585,32 +592,55 @@ impl Reader<'_> {
     }
 
     /// A zone per unit length or area (`ToleranceZonePerUnitLength`, `…PerUnitArea`:
-    /// QIF 3 Characteristics.xsd), in words.
-    fn per_unit(&mut self, def: &Node) -> Option<String> {
+    /// QIF 3 IntermediatesPMI.xsd, its zone `ToleranceValuePerUnit`).
+    fn per_unit(&mut self, def: &Node) -> Option<PerUnitZone> {
+        use crate::model::UnitOf;
         let fmt = |v: Option<f64>| v.map_or("?".to_string(), crate::model::fmt_num);
-        if let Some(u) = def.child("ToleranceZonePerUnitLength") {
-            let l = u.child("UnitLength").and_then(|v| self.length(v));
-            return Some(format!("per {} mm length", fmt(l)));
-        }
-        let a = def.child("ToleranceZonePerUnitArea")?;
-        if let Some(r) = a.child("RectangularUnitArea") {
-            let length = r
-                .child("RectangularUnitAreaLength")
-                .and_then(|v| self.length(v));
-            let width = r
-                .child("RectangularUnitAreaWidth")
-                .and_then(|v| self.length(v));
-            return Some(format!(
-                "per {} × {} mm rectangular area",
-                fmt(length),
-                fmt(width)
-            ));
-        }
-        let d = a
-            .child("CircularUnitArea")
-            .and_then(|c| c.child("CircularUnitAreaDiameter"))
+        let positive = |v: Option<f64>| v.filter(|x| x.is_finite() && *x > 0.0);
+        let (node, unit, text) = if let Some(u) = def.child("ToleranceZonePerUnitLength") {
+            let l = positive(u.child("UnitLength").and_then(|v| self.length(v)));
+            (
+                u,
+                l.map(UnitOf::Length),
+                format!("per {} mm length", fmt(l)),
+            )
+        } else {
+            let a = def.child("ToleranceZonePerUnitArea")?;
+            if let Some(r) = a.child("RectangularUnitArea") {
+                let length = positive(
+                    r.child("RectangularUnitAreaLength")
+                        .and_then(|v| self.length(v)),
+                );
+                let width = positive(
+                    r.child("RectangularUnitAreaWidth")
+                        .and_then(|v| self.length(v)),
+                );
+                (
+                    a,
+                    length.zip(width).map(|(l, w)| UnitOf::Rectangle(l, w)),
+                    format!("per {} × {} mm rectangular area", fmt(length), fmt(width)),
+                )
+            } else {
+                let d = positive(
+                    a.child("CircularUnitArea")
+                        .and_then(|c| c.child("CircularUnitAreaDiameter"))
+                        .and_then(|v| self.length(v)),
+                );
+                (
+                    a,
+                    d.map(UnitOf::Circle),
+                    format!("per Ø{} mm circular area", fmt(d)),
+                )
+            }
+        };
+        let zone_mm = node
+            .child("ToleranceValuePerUnit")
             .and_then(|v| self.length(v));
-        Some(format!("per Ø{} mm circular area", fmt(d)))
+        Some(PerUnitZone {
+            zone_mm,
+            unit,
+            text,
+        })
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -115,10 +115,22 @@ pub struct GeoTolerance {
     /// An unequally disposed profile's displacement (mm).
     pub unequal_mm: Option<f64>,
     /// A zone per unit length or area (ISO 10303-47
-    /// `geometric_tolerance_with_defined_unit`; QIF `ToleranceZonePerUnit…`), in words
-    /// (`per 25 mm length`, `per 25 × 25 mm square area`): the zone applies to every
-    /// such stretch of the feature, not to all of it at once.
-    pub per_unit: Option<String>,
+    /// `geometric_tolerance_with_defined_unit`; QIF `ToleranceZonePerUnit…`): the zone
+    /// applies to every such stretch of the feature, not to all of it at once.
+    pub per_unit: Option<PerUnitZone>,
+}
+
+/// A zone per unit length or area as the file gives it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PerUnitZone {
+    /// The zone per unit (mm) where the file gives it apart from the tolerance's value
+    /// (QIF `ToleranceValuePerUnit`, the value then bounding the whole feature); `None`
+    /// where the tolerance's value is the zone per unit (STEP).
+    pub zone_mm: Option<f64>,
+    /// The stretch; `None` where its size cannot be read.
+    pub unit: Option<crate::model::UnitOf>,
+    /// In words: `per 25 mm length`, `per 25 × 25 mm square area`.
+    pub text: String,
 }
 
 /// What a dimension measures.
@@ -678,33 +690,53 @@ impl Links<'_> {
         }))
     }
 
-    /// A zone per unit length or area, in words.
-    fn per_unit(&self, inst: &Instance) -> Option<String> {
+    /// A zone per unit length or area (ISO 10303-47: `unit_size`, and for an area its
+    /// `area_type` and, for a rectangle, `second_unit_size`; a circle's `unit_size` is
+    /// its diameter).
+    fn per_unit(&self, inst: &Instance) -> Option<PerUnitZone> {
+        use crate::model::UnitOf;
         let unit = inst.record("GEOMETRIC_TOLERANCE_WITH_DEFINED_UNIT")?;
         let size = |p: Option<&Param>| {
             p.and_then(Param::reference)
                 .and_then(|m| self.measure(m))
-                .map(|(v, _)| crate::model::fmt_num(v))
+                .map(|(v, _)| v)
+                .filter(|v| v.is_finite() && *v > 0.0)
         };
-        let first = size(unit.params.first()).unwrap_or_else(|| "?".into());
-        Some(
-            match inst.record("GEOMETRIC_TOLERANCE_WITH_DEFINED_AREA_UNIT") {
-                Some(area) => {
-                    let shape = area
-                        .params
-                        .first()
-                        .and_then(Param::enumeration)
-                        .unwrap_or("SQUARE")
-                        .to_lowercase();
-                    match (shape.as_str(), size(area.params.get(1))) {
-                        ("circular", _) => format!("per Ø{first} mm circular area"),
-                        (_, Some(second)) => format!("per {first} × {second} mm {shape} area"),
-                        _ => format!("per {first} × {first} mm {shape} area"),
+        let text = |v: Option<f64>| v.map_or("?".to_string(), crate::model::fmt_num);
+        let first = size(unit.params.first());
+        let (unit, words) = match inst.record("GEOMETRIC_TOLERANCE_WITH_DEFINED_AREA_UNIT") {
+            Some(area) => {
+                let shape = area
+                    .params
+                    .first()
+                    .and_then(Param::enumeration)
+                    .unwrap_or("SQUARE")
+                    .to_lowercase();
+                let second = size(area.params.get(1));
+                match shape.as_str() {
+                    "circular" => (
+                        first.map(UnitOf::Circle),
+                        format!("per Ø{} mm circular area", text(first)),
+                    ),
+                    _ => {
+                        let second = second.or(first);
+                        (
+                            first.zip(second).map(|(a, b)| UnitOf::Rectangle(a, b)),
+                            format!("per {} × {} mm {shape} area", text(first), text(second)),
+                        )
                     }
                 }
-                None => format!("per {first} mm length"),
-            },
-        )
+            }
+            None => (
+                first.map(UnitOf::Length),
+                format!("per {} mm length", text(first)),
+            ),
+        };
+        Some(PerUnitZone {
+            zone_mm: None,
+            unit,
+            text: words,
+        })
     }
 
     /// The compartments of the datum systems (or old-style datum references) a

@@ -142,6 +142,7 @@ impl<'a> HandTouch<'a> {
                 method: SampleMethod::Uniform,
                 points: Some(25),
                 inset: None,
+                spacing: None,
             },
             samples: RefCell::new(BTreeMap::new()),
         }
