@@ -217,3 +217,43 @@ fn a_damaged_qif_file_is_an_error_never_a_panic() {
     }
     assert!(errors > 0, "some left-out line must break the part");
 }
+
+/// A QIF flatness with a whole-face value and a zone per unit area (QIF 3
+/// `ToleranceZonePerUnitArea`, its `ToleranceValuePerUnit`) is written as both; one with
+/// the zone per unit alone as that zone alone, never as a flatness of 0 mm.
+#[test]
+fn a_qif_flatness_per_unit_area_keeps_both_zones() {
+    require_shared_parts();
+    let path = "../shared/parts/nist_ctc_01_asme1_ap242.qif";
+    let text = std::fs::read_to_string(path).unwrap();
+    let whole = "<ToleranceValue linearUnit=\"mm\">0.2</ToleranceValue>\n      </FlatnessCharacteristicDefinition>";
+    assert!(text.contains(whole), "CTC 01's flatness changed");
+    let unit = "<ToleranceZonePerUnitArea><ToleranceValuePerUnit linearUnit=\"mm\">0.05</ToleranceValuePerUnit>\
+                <RectangularUnitArea><RectangularUnitAreaLength linearUnit=\"mm\">30</RectangularUnitAreaLength>\
+                <RectangularUnitAreaWidth linearUnit=\"mm\">20</RectangularUnitAreaWidth></RectangularUnitArea>\
+                </ToleranceZonePerUnitArea>";
+    let opts = ImportOptions {
+        cad_path: "part.qif".into(),
+        part_name: "part".into(),
+        scale: 1.0,
+    };
+    let both = text.replace(
+        whole,
+        &format!("<ToleranceValue linearUnit=\"mm\">0.2</ToleranceValue>{unit}\n      </FlatnessCharacteristicDefinition>"),
+    );
+    let spec = import(both.as_bytes(), &opts).unwrap().text;
+    assert!(
+        spec.contains(", 0.2 mm, per_unit(0.05 mm, 30 mm, 20 mm))"),
+        "{spec}"
+    );
+    let alone = text.replace(
+        whole,
+        &format!("{unit}\n      </FlatnessCharacteristicDefinition>"),
+    );
+    let spec = import(alone.as_bytes(), &opts).unwrap().text;
+    assert!(
+        spec.contains(", per_unit(0.05 mm, 30 mm, 20 mm))"),
+        "{spec}"
+    );
+    assert!(!spec.contains("0 mm, per_unit"), "{spec}");
+}
