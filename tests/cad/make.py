@@ -52,6 +52,8 @@ from OCP.TColgp import TColgp_HArray1OfPnt
 from OCP.TopAbs import TopAbs_FACE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
+from OCP.BRep import BRep_Tool
+from OCP.GeomLib import GeomLib_IsPlanarSurface
 from OCP.gp import gp_Ax1, gp_Ax2, gp_Dir, gp_Hypr, gp_Parab, gp_Pnt, gp_Vec
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -103,6 +105,10 @@ def reading(shape, unit_mm):
         props = GProp_GProps()
         BRepGProp.SurfaceProperties_s(f, props)
         kind = KIND[BRepAdaptor_Surface(f).GetType()]
+        # A B-spline whose poles lie on one plane is that plane (OpenCASCADE's own
+        # test, `GeomLib_IsPlanarSurface`, at inspc's 1e-6 mm).
+        if kind == "freeform" and GeomLib_IsPlanarSurface(BRep_Tool.Surface_s(f), 1e-6).IsPlanar():
+            kind = "plane"
         faces.append({"kind": kind, "area": round(props.Mass() * unit_mm**2, 6)})
         ex.Next()
     props = GProp_GProps()

@@ -12,7 +12,14 @@
 //!   plane (square to the axis) or a cone (crossing or meeting the axis in a plane with
 //!   it); a circle in a plane through the axis revolved is a sphere (centred on the
 //!   axis) or a torus;
-//! - an offset plane, cylinder, cone, sphere or torus is one of the same kind.
+//! - an offset plane, cylinder, cone, sphere or torus is one of the same kind;
+//! - a B-spline surface whose control points lie on one plane is that plane: a point of
+//!   a (rational, positive-weight) B-spline is a convex combination of its control
+//!   points (ISO 10303-42 `b_spline_surface`), so it never leaves their plane. This is
+//!   the test OpenCASCADE's `GeomLib_IsPlanarSurface` makes on the poles; files whose
+//!   every surface is a B-spline (a part put through a NURBS conversion, some
+//!   exporters' "NURBS only" option) keep their planes, and the datums and defaults that
+//!   need them.
 //!
 //! The analytic surface's natural normal may point the other way from the swept one's
 //! (a circle swept along −z gives the inward normal; a revolved half-circle's depends
@@ -20,7 +27,7 @@
 //! flipped where they disagree.
 
 use super::curve::{Curve, Frame};
-use super::geom::{Offset, Surf};
+use super::geom::{BSplineSurface, Offset, Surf};
 use super::swept::{Extrusion, Revolution};
 use crate::geometry::{P3, V3};
 
@@ -37,6 +44,7 @@ pub(crate) fn canonical(s: &Surf, points: &[P3]) -> (Surf, bool) {
         Surf::Extrusion(e) => extrusion(e),
         Surf::Revolution(r) => revolution(r, points),
         Surf::Offset(o) => offset(o),
+        Surf::BSpline(b) => planar(b),
         _ => None,
     };
     let Some(a) = analytic else {
@@ -172,6 +180,43 @@ fn offset(o: &Offset) -> Option<Surf> {
         Surf::Torus(f, big, small) => Some(Surf::Torus(*f, *big, grown(*small)?)),
         _ => None,
     }
+}
+
+/// How far a B-spline's control point may lie off the plane of the others (mm) and the
+/// surface still be that plane: far below any tolerance a part is drawn to, above the
+/// rounding of 15-digit coordinates on a part a few metres across.
+const ON_PLANE_MM: f64 = 1e-6;
+
+/// The plane a B-spline surface is, if its control points lie on one, its normal the
+/// surface's own (∂S/∂u × ∂S/∂v where that is defined), so no face on it flips.
+fn planar(b: &BSplineSurface) -> Option<Surf> {
+    let s = Surf::BSpline(std::sync::Arc::new(b.clone()));
+    let (u0, u1) = b.u.range();
+    let (v0, v1) = b.v.range();
+    // The natural normal at the first of a few parameters where it is defined (a
+    // degenerate edge has none).
+    let normal = [
+        (0.5, 0.5),
+        (0.25, 0.25),
+        (0.75, 0.75),
+        (0.25, 0.75),
+        (0.75, 0.25),
+    ]
+    .iter()
+    .find_map(|(a, c)| {
+        let (u, v) = (u0 + a * (u1 - u0), v0 + c * (v1 - v0));
+        s.normal(&s.eval(u, v), u, v)
+    })?;
+    let poles: Vec<&P3> = b.points.iter().flatten().collect();
+    let n = poles.len() as f64;
+    let centre = P3::from(poles.iter().fold(V3::zeros(), |a, p| a + p.coords) / n);
+    if poles
+        .iter()
+        .any(|p| (*p - centre).dot(&normal).abs() > ON_PLANE_MM)
+    {
+        return None;
+    }
+    Frame::new(centre, Some(normal), None).map(Surf::Plane)
 }
 
 /// The frame of a revolution's axis with x pointing at the profile, so that the
