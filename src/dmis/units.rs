@@ -9,14 +9,18 @@
 //! constructs one feature per window from the touches that fall in it
 //! (`CONST/PLANE,F(X_U3),BF,FA(X_P7),…`) and outputs the unit zone on each.
 //!
-//! **Decision: windows step by half a unit.** Along each direction the windows start
-//! at the points' least coordinate and step by half the unit's size, the last one flush
-//! with the greatest: a deviation no wider than half a unit lies wholly inside one
-//! window, and with the sampler's rows a third of a unit apart
-//! (`graph::PER_UNIT_ROWS`) a window on the face holds at least 3 × 3 points. A
-//! rectangle's length runs along the direction the points spread most; a circle's
-//! windows are centred on the same steps. A feature shorter than the unit is one window
-//! of all its points: the unit zone then holds over the whole feature.
+//! **Decision: a window at every point.** A window's points are those of the window
+//! whose edges run through its lowest points, so windows starting at every point's own
+//! coordinates (and one flush with the last) hold every set of points any window of that
+//! size holds, wherever it lies; of those, windows whose points another window holds
+//! too are dropped (the larger set's zone is never narrower). A rectangle is tried both
+//! ways round, the standard fixing no orientation; its long side first runs along the
+//! direction the points spread most. A circle's windows are centred on the same steps. A
+//! feature shorter than the unit is one window of all its points: the unit zone then
+//! holds over the whole feature. With the sampler's rows a third of a unit apart
+//! (`graph::PER_UNIT_ROWS`), a window on the face holds at least 3 × 3 points, and a
+//! deviation narrower than a third of the unit may fall between rows: the program sees
+//! abrupt change down to that width, as any sampled measurement sees down to its pitch.
 //!
 //! **Decision: a window needs enough points to fit.** A plane's window keeps at least
 //! 4 points not on one line, a line's (straightness along a plane) 3, a cylinder's or
@@ -36,66 +40,80 @@ pub(super) fn windows(surface: &Surface, unit: UnitOf, points: &[P3]) -> Vec<Vec
         return Vec::new();
     };
     let coords: Vec<(f64, f64)> = points.iter().map(|p| frame.coords(p)).collect();
-    let range = |f: &dyn Fn(&(f64, f64)) -> f64| {
-        coords
-            .iter()
-            .map(f)
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
-                (lo.min(x), hi.max(x))
-            })
+    // A rectangle lies either way round: the standard fixes no orientation.
+    let shapes: Vec<(f64, f64)> = match unit {
+        UnitOf::Length(l) => vec![(l, f64::INFINITY)],
+        UnitOf::Rectangle(a, b) if (a - b).abs() <= EPS => vec![(a, b)],
+        UnitOf::Rectangle(a, b) => vec![(a, b), (b, a)],
+        UnitOf::Circle(d) => vec![(d, d)],
     };
-    let (u_range, v_range) = (range(&|c| c.0), range(&|c| c.1));
-    let (su, sv) = match unit {
-        UnitOf::Length(l) => (l, f64::INFINITY),
-        UnitOf::Rectangle(a, b) => (a.max(b), a.min(b)),
-        UnitOf::Circle(d) => (d, d),
-    };
-    let mut out: Vec<Vec<usize>> = Vec::new();
-    for u0 in starts(u_range, su) {
-        for v0 in starts(v_range, sv) {
-            let inside = |c: &(f64, f64)| match unit {
-                UnitOf::Circle(d) => {
-                    let (cu, cv) = (u0 + d / 2.0, v0 + d / 2.0);
-                    (c.0 - cu).hypot(c.1 - cv) <= d / 2.0 + EPS
+    let mut sets: Vec<Vec<usize>> = Vec::new();
+    for (su, sv) in shapes {
+        for u0 in starts(coords.iter().map(|c| c.0), su) {
+            for v0 in starts(coords.iter().map(|c| c.1), sv) {
+                let inside = |c: &(f64, f64)| match unit {
+                    UnitOf::Circle(d) => {
+                        let (cu, cv) = (u0 + d / 2.0, v0 + d / 2.0);
+                        (c.0 - cu).hypot(c.1 - cv) <= d / 2.0 + EPS
+                    }
+                    _ => {
+                        c.0 >= u0 - EPS
+                            && c.0 <= u0 + su + EPS
+                            && c.1 >= v0 - EPS
+                            && c.1 <= v0 + sv + EPS
+                    }
+                };
+                let members: Vec<usize> =
+                    (0..points.len()).filter(|&i| inside(&coords[i])).collect();
+                if frame.fits(&members, &coords) {
+                    sets.push(members);
                 }
-                _ => {
-                    c.0 >= u0 - EPS
-                        && c.0 <= u0 + su + EPS
-                        && c.1 >= v0 - EPS
-                        && c.1 <= v0 + sv + EPS
-                }
-            };
-            let members: Vec<usize> = (0..points.len()).filter(|&i| inside(&coords[i])).collect();
-            if frame.fits(&members, &coords) && !out.contains(&members) {
-                out.push(members);
             }
         }
     }
-    out
+    largest(sets)
 }
 
 /// How far outside a window a point on its edge may lie (mm).
 const EPS: f64 = 1e-6;
 
-/// Where the windows of size `size` start along a direction whose points run over
-/// `(lo, hi)`: every half unit from `lo`, the last flush with `hi`; one at `lo` where the
-/// points run no longer than a unit (or the window is unbounded that way).
-fn starts((lo, hi): (f64, f64), size: f64) -> Vec<f64> {
-    if !size.is_finite() || hi - lo <= size + EPS {
-        return vec![if size.is_finite() {
-            lo.min(hi - size)
-        } else {
-            lo
-        }];
+/// Where the windows of size `size` start along a direction whose points lie at
+/// `values`: at each point's own coordinate (the window whose edge it is), and one more
+/// flush with the last point; one at the first point where the window is unbounded that
+/// way. A window anywhere holds no point the window started at its first point's
+/// coordinate does not.
+fn starts(values: impl Iterator<Item = f64>, size: f64) -> Vec<f64> {
+    let mut v: Vec<f64> = values.collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup_by(|a, b| (*a - *b).abs() <= EPS);
+    let (Some(&lo), Some(&hi)) = (v.first(), v.last()) else {
+        return Vec::new();
+    };
+    if !size.is_finite() {
+        return vec![lo];
     }
-    let step = size / 2.0;
-    let last = hi - size;
-    let mut out: Vec<f64> = (0..)
-        .map(|k| lo + k as f64 * step)
-        .take_while(|x| *x < last - EPS)
-        .collect();
-    out.push(last);
+    let mut out: Vec<f64> = v.into_iter().filter(|x| *x + size < hi + EPS).collect();
+    out.push(hi - size);
+    out.sort_by(f64::total_cmp);
+    out.dedup_by(|a, b| (*a - *b).abs() <= EPS);
     out
+}
+
+/// The sets none of the others contains, in their sorted order: a window whose points
+/// all lie in another window is judged there (the larger set's fit is never flatter: a
+/// minimum zone, ISO 12781-1, of a superset contains the subset's).
+fn largest(mut sets: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
+    sets.sort();
+    sets.dedup();
+    let contains = |a: &Vec<usize>, b: &Vec<usize>| b.iter().all(|x| a.binary_search(x).is_ok());
+    (0..sets.len())
+        .filter(|&i| {
+            !sets
+                .iter()
+                .any(|t| t.len() > sets[i].len() && contains(t, &sets[i]))
+        })
+        .map(|i| sets[i].clone())
+        .collect()
 }
 
 /// The coordinates windows are laid out in: on a plane, the direction the points
@@ -222,13 +240,36 @@ mod tests {
     }
 
     #[test]
-    fn a_square_unit_steps_by_half_over_a_plate() {
-        // 100 × 50 mm, rows 25/3 mm apart: 13 × 7 points.
+    fn a_square_unit_starts_at_every_row() {
+        // 100 × 50 mm, rows 25/3 mm apart: 13 × 7 points; a 25 mm window holds 4 × 4.
         let pts = grid(13, 7, 100.0 / 12.0);
         let w = windows(&plane(), UnitOf::Rectangle(25.0, 25.0), &pts);
-        // Starts along 100 mm: 0, 12.5, …, 62.5, 75 (7); along 50 mm: 0, 12.5, 25 (3).
-        assert_eq!(w.len(), 21);
-        assert!(w.iter().all(|m| m.len() >= 9), "{w:?}");
+        // Starts along 100 mm: the 9 rows before 75, and 75; along 50 mm: 3 and 25.
+        assert_eq!(w.len(), 40);
+        assert!(w.iter().all(|m| m.len() == 16), "{w:?}");
+    }
+
+    #[test]
+    fn a_rectangle_lies_both_ways_round() {
+        let pts = grid(13, 7, 100.0 / 12.0);
+        let one = windows(&plane(), UnitOf::Rectangle(25.0, 25.0), &pts).len();
+        let both = windows(&plane(), UnitOf::Rectangle(25.0, 40.0), &pts);
+        // 25 × 40: 4 × 5 points either way; none holds another's points.
+        assert!(both.len() > one / 2, "{}", both.len());
+        assert!(both.iter().all(|m| m.len() == 20));
+    }
+
+    #[test]
+    fn windows_inside_others_are_dropped() {
+        // A ragged edge: the short last column's windows lie in the full ones.
+        let mut pts = grid(4, 4, 5.0);
+        pts.push(P3::new(17.0, 2.0, 0.0));
+        let w = windows(&plane(), UnitOf::Rectangle(16.0, 16.0), &pts);
+        for (i, a) in w.iter().enumerate() {
+            for (j, b) in w.iter().enumerate() {
+                assert!(i == j || !b.iter().all(|x| a.contains(x)), "{w:?}");
+            }
+        }
     }
 
     #[test]
@@ -242,8 +283,8 @@ mod tests {
     fn a_length_takes_the_whole_width() {
         let pts = grid(13, 3, 100.0 / 12.0);
         let w = windows(&plane(), UnitOf::Length(25.0), &pts);
-        assert_eq!(w.len(), 7);
-        assert!(w.iter().all(|m| m.len() >= 9));
+        assert_eq!(w.len(), 10);
+        assert!(w.iter().all(|m| m.len() == 12));
     }
 
     #[test]
@@ -258,8 +299,9 @@ mod tests {
     }
 
     #[test]
-    fn starts_end_flush() {
-        assert_eq!(starts((0.0, 60.0), 25.0), vec![0.0, 12.5, 25.0, 35.0]);
-        assert_eq!(starts((0.0, 20.0), 25.0), vec![-5.0]);
+    fn starts_at_each_value_and_end_flush() {
+        let v = [0.0, 12.5, 25.0, 37.5, 50.0, 60.0];
+        assert_eq!(starts(v.into_iter(), 25.0), vec![0.0, 12.5, 25.0, 35.0]);
+        assert_eq!(starts([0.0, 20.0].into_iter(), 25.0), vec![-5.0]);
     }
 }

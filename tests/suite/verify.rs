@@ -132,6 +132,41 @@ fn a_bump_within_a_unit_area_is_seen() {
     let spec = dir.join("plate.insp");
     std::fs::write(&spec, PER_UNIT_PLATE).unwrap();
     let v = verify(&spec, 2);
+    // Off the windows' centres too (an independent review's case: a 0.037 mm bump 25 mm
+    // across whose top fell on the edge of every window of a half-unit step read 0.02),
+    // and a bump on the front as wide as its short side.
+    let (_, built, _) = inspc::build(
+        &FsWorld,
+        std::slice::from_ref(&spec),
+        &inspc::plan::PlanOptions::default(),
+        &|_, _, _| {},
+    );
+    let program = dir.join("plate.dmi");
+    std::fs::write(&program, &built[0].dmis).unwrap();
+    let (spec_s, program_s) = (spec.to_str().unwrap(), program.to_str().unwrap());
+    for (dev, target) in [
+        (
+            "face stock.top bump 0.037 at (32.7, 32.3, 20) across 25",
+            "TOP_FLAT_UNIT",
+        ),
+        (
+            "face stock.front bump 0.034 at (38, 0, 8.5) across 10",
+            "FRONT_FLAT",
+        ),
+    ] {
+        let opts = inspc::simulate::Options::default();
+        let r = crate::simulate::run(spec_s, program_s, Some(dev), opts).unwrap();
+        let out: Vec<&str> = r
+            .rows
+            .iter()
+            .filter(|x| !x.pass())
+            .map(|x| x.tolerance.as_str())
+            .collect();
+        assert!(
+            !out.is_empty() && out.iter().all(|t| *t == target),
+            "{dev}: {out:?}"
+        );
+    }
     std::fs::remove_dir_all(&dir).ok();
     let text = v[0].text();
     assert_eq!(v[0].problems(), 0, "{text}");
