@@ -127,14 +127,16 @@ def reading(shape, unit_mm):
     }
 
 
-def write(name, shape, unit="MM", unit_mm=1.0, edit=None, what="", qif=None):
+def write(name, shape, unit="MM", unit_mm=1.0, edit=None, what="", qif=None, step_shape=None):
     """Writes NAME.stp and NAME.json, and NAME.qif when `qif` says how (`"u"` or
-    `"v"`: which NURBS index runs fastest, `qif_writer.py`)."""
+    `"v"`: which NURBS index runs fastest, `qif_writer.py`). `step_shape`, when given,
+    is what OpenCASCADE writes for `edit` to make exact (a curve it cannot write,
+    approximated); the expectation is always `shape`'s."""
     Interface_Static.SetCVal_s("write.step.unit", unit)
     Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
     path = os.path.join(HERE, name + ".stp")
     w = STEPControl_Writer()
-    w.Transfer(shape, STEPControl_AsIs)
+    w.Transfer(shape if step_shape is None else step_shape, STEPControl_AsIs)
     w.Write(path)
     text = open(path).read()
     # The header's time stamp would change the file at every run.
@@ -540,7 +542,54 @@ def degrees(text):
     return re.sub(r"(CONICAL_SURFACE\('',#\d+,[-0-9.E+]+,)([-0-9.E+]+)(\))", cone, text)
 
 
+def d_plate():
+    """A plate with a round end and a bore: lines, a half circle, full circles."""
+    from OCP.GC import GC_MakeArcOfCircle
+
+    arc = GC_MakeArcOfCircle(gp_Pnt(40, 0, 0), gp_Pnt(55, 15, 0), gp_Pnt(40, 30, 0)).Value()
+    edges = [segment((0, 0, 0), (40, 0, 0)), BRepBuilderAPI_MakeEdge(arc).Edge(), segment((40, 30, 0), (0, 30, 0)), segment((0, 30, 0), (0, 0, 0))]
+    plate = BRepPrimAPI_MakePrism(profile_face(edges), gp_Vec(0, 0, 12)).Shape()
+    bore = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(18, 15, -1), gp_Dir(0, 0, 1)), 6, 14).Shape()
+    return BRepAlgoAPI_Cut(plate, bore).Shape()
+
+
+def offset_blob():
+    """The blob's B-spline (made not periodic) and its offset 3 mm inward, the way
+    STEP's OFFSET_CURVE_3D with distance 3 and reference +z puts it: OpenCASCADE's offset
+    by -3 along T x V is the standard's by 3 along V x T."""
+    from OCP.Geom import Geom_OffsetCurve
+
+    c = interpolate([(30, 0, 0), (20, 18, 0), (0, 25, 0), (-22, 15, 0), (-28, -5, 0), (-10, -22, 0), (15, -20, 0)], True)
+    c.SetNotPeriodic()
+    return c, Geom_OffsetCurve(c, -3.0, gp_Dir(0, 0, 1))
+
+
+def offset_prism(exact):
+    """The offset blob swept 20 mm along z: exactly, or (for the file OpenCASCADE can
+    write, whose curves the edit replaces) with the offset approximated."""
+    from OCP.GeomAbs import GeomAbs_Shape
+    from OCP.GeomConvert import GeomConvert_ApproxCurve
+
+    _, off = offset_blob()
+    curve = off if exact else GeomConvert_ApproxCurve(off, 1e-7, GeomAbs_Shape.GeomAbs_C2, 200, 9).Curve()
+    f = BRepBuilderAPI_MakeFace(wire(BRepBuilderAPI_MakeEdge(curve).Edge())).Face()
+    return BRepPrimAPI_MakePrism(f, gp_Vec(0, 0, 20)).Shape()
+
+
 def main():
+    import sys
+
+    from curves_edit import composite, offset_curves
+
+    only = set(sys.argv[1:])
+    if only:
+        # Only the named parts (the others' files stay as they are).
+        global write
+        all_write = write
+        write = lambda name, *a, **k: all_write(name, *a, **k) if name in only else None
+    basis, _ = offset_blob()
+    write("composite", d_plate(), edit=composite, what="every edge's curve a composite of two trimmed stretches (COMPOSITE_CURVE, TRIMMED_CURVE)")
+    write("offset_curve", offset_prism(True), edit=offset_curves(basis, 3.0, (0.0, 0.0, 1.0)), step_shape=offset_prism(False), what="a B-spline's offset swept along z (OFFSET_CURVE_3D)")
     write("extrusion_bspline", blob_prism(), what="a closed B-spline swept along z (SURFACE_OF_LINEAR_EXTRUSION, seam)", qif="u")
     write("extrusion_ellipse", ellipse_prism(), what="an ellipse swept along its normal", qif="u")
     write("extrusion_oblique", oblique_prism(), what="a circle swept along a slanted vector")

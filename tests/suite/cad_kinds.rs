@@ -270,3 +270,15 @@ fn a_revolved_line_given_beyond_its_apex() {
 fn an_offset_of_an_extruded_ellipse() {
     check("offset_ellipse");
 }
+
+#[test]
+fn composite_curves_of_trimmed_stretches() {
+    // Every edge's curve is two stretches of its line or circle, trimmed by parameter,
+    // by point, and against the basis's sense with the segment turned back.
+    check("composite");
+}
+
+#[test]
+fn an_offset_curve_swept() {
+    check("offset_curve");
+}

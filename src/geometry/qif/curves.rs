@@ -193,6 +193,7 @@ fn sample(curve: &Curve, c: &Node, d: &Doc) -> Result<Vec<P3>, QifError> {
             ((b - a).abs() / 0.02).ceil().max(1.0) as usize + 1
         }
         Curve::BSpline(s) => 32 * s.knots.breaks().len() + 1,
+        Curve::Composite(_) | Curve::Offset(_) => 32 * curve.breaks().len().max(2) + 1,
     };
     match d.samples.get().checked_sub(count) {
         Some(left) => d.samples.set(left),
@@ -222,6 +223,12 @@ fn sample(curve: &Curve, c: &Node, d: &Doc) -> Result<Vec<P3>, QifError> {
                 }
             }
             out
+        }
+        Curve::Composite(_) | Curve::Offset(_) => {
+            let (a, b) = curve.range();
+            (0..count)
+                .map(|k| curve.eval(a + (b - a) * k as f64 / (count - 1) as f64))
+                .collect()
         }
     })
 }

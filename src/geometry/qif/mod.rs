@@ -192,7 +192,7 @@ pub fn read(bytes: &[u8], res: Resolution) -> Result<CadPart, MeshError> {
 /// inside out.
 fn orient(b: &mut step::brep::Brep, res: Resolution) -> Result<Vec<usize>, MeshError> {
     use step::brep::Bound;
-    let edges = step::tess::edge_polylines(b, res).map_err(MeshError::TooLarge)?;
+    let edges = step::edges::edge_polylines(b, res).map_err(MeshError::TooLarge)?;
     let natural: Vec<bool> = b
         .faces
         .iter()

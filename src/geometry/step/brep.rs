@@ -83,15 +83,18 @@ pub(crate) struct Brep {
     pub sheet_faces: usize,
 }
 
-struct Reader<'a> {
-    f: &'a P21,
-    unit: f64,
-    angle: f64,
+/// The reader of one file's B-rep (its curves made of curves are `compound.rs`'s).
+pub(super) struct Reader<'a> {
+    pub(super) f: &'a P21,
+    /// Millimetres per file length unit.
+    pub(super) unit: f64,
+    /// Radians per file plane angle unit.
+    pub(super) angle: f64,
     edges: Vec<Edge>,
     edge_index: HashMap<u64, usize>,
     /// Faces already read: a shell listing one again adds nothing.
     seen_faces: HashSet<u64>,
-    trail: Trail,
+    pub(super) trail: Trail,
     curves: Memo<Curve>,
     surfaces: Memo<Surf>,
 }
@@ -309,14 +312,14 @@ pub(super) fn unit_factor(
 }
 
 impl<'a> Reader<'a> {
-    fn inst(&self, id: u64, from: Option<u64>) -> Result<&'a Instance, StepError> {
+    pub(super) fn inst(&self, id: u64, from: Option<u64>) -> Result<&'a Instance, StepError> {
         self.f
             .instances
             .get(&id)
             .ok_or(StepError::Missing { id, from })
     }
 
-    fn bad(&self, id: u64, message: impl Into<String>) -> StepError {
+    pub(super) fn bad(&self, id: u64, message: impl Into<String>) -> StepError {
         StepError::Malformed {
             id,
             line: self.f.instances.get(&id).map_or(0, |i| i.line),
@@ -324,42 +327,52 @@ impl<'a> Reader<'a> {
         }
     }
 
-    fn param<'r>(&self, id: u64, rec: &'r Record, i: usize) -> Result<&'r Param, StepError> {
+    pub(super) fn param<'r>(
+        &self,
+        id: u64,
+        rec: &'r Record,
+        i: usize,
+    ) -> Result<&'r Param, StepError> {
         rec.params
             .get(i)
             .ok_or_else(|| self.bad(id, format!("{} has too few parameters", rec.name)))
     }
 
-    fn reference(&self, id: u64, rec: &Record, i: usize) -> Result<u64, StepError> {
+    pub(super) fn reference(&self, id: u64, rec: &Record, i: usize) -> Result<u64, StepError> {
         let p = self.param(id, rec, i)?;
         self.ref_of(id, p)
     }
 
-    fn ref_of(&self, id: u64, p: &Param) -> Result<u64, StepError> {
+    pub(super) fn ref_of(&self, id: u64, p: &Param) -> Result<u64, StepError> {
         p.reference()
             .ok_or_else(|| self.bad(id, "a reference `#n` was expected"))
     }
 
-    fn list<'r>(&self, id: u64, rec: &'r Record, i: usize) -> Result<&'r [Param], StepError> {
+    pub(super) fn list<'r>(
+        &self,
+        id: u64,
+        rec: &'r Record,
+        i: usize,
+    ) -> Result<&'r [Param], StepError> {
         self.param(id, rec, i)?
             .list()
             .ok_or_else(|| self.bad(id, format!("{}: a list was expected", rec.name)))
     }
 
-    fn real(&self, id: u64, rec: &Record, i: usize) -> Result<f64, StepError> {
+    pub(super) fn real(&self, id: u64, rec: &Record, i: usize) -> Result<f64, StepError> {
         self.param(id, rec, i)?
             .real()
             .ok_or_else(|| self.bad(id, format!("{}: a number was expected", rec.name)))
     }
 
-    fn boolean(&self, id: u64, rec: &Record, i: usize) -> Result<bool, StepError> {
+    pub(super) fn boolean(&self, id: u64, rec: &Record, i: usize) -> Result<bool, StepError> {
         self.param(id, rec, i)?
             .boolean()
             .ok_or_else(|| self.bad(id, format!("{}: .T. or .F. was expected", rec.name)))
     }
 
     /// The record named `name` of instance `id`.
-    fn rec(&self, id: u64, from: u64, name: &str) -> Result<&'a Record, StepError> {
+    pub(super) fn rec(&self, id: u64, from: u64, name: &str) -> Result<&'a Record, StepError> {
         let inst = self.inst(id, Some(from))?;
         inst.record(name).ok_or_else(|| {
             self.bad(
@@ -379,13 +392,13 @@ impl<'a> Reader<'a> {
         }
     }
 
-    fn point(&self, id: u64, from: u64) -> Result<P3, StepError> {
+    pub(super) fn point(&self, id: u64, from: u64) -> Result<P3, StepError> {
         let rec = self.rec(id, from, "CARTESIAN_POINT")?;
         let [x, y, z] = self.triple(id, rec)?;
         Ok(P3::new(x, y, z) * self.unit)
     }
 
-    fn direction(&self, id: u64, from: u64) -> Result<V3, StepError> {
+    pub(super) fn direction(&self, id: u64, from: u64) -> Result<V3, StepError> {
         let rec = self.rec(id, from, "DIRECTION")?;
         let [x, y, z] = self.triple(id, rec)?;
         Ok(V3::new(x, y, z))
@@ -429,7 +442,7 @@ impl<'a> Reader<'a> {
         })
     }
 
-    fn length(&self, id: u64, rec: &Record, i: usize) -> Result<f64, StepError> {
+    pub(super) fn length(&self, id: u64, rec: &Record, i: usize) -> Result<f64, StepError> {
         let x = self.real(id, rec, i)? * self.unit;
         if !x.is_finite() || x < 0.0 {
             return Err(self.bad(id, format!("{}: a length cannot be {x}", rec.name)));
@@ -556,7 +569,7 @@ impl<'a> Reader<'a> {
     }
 
     /// The curve `id`, read once ([`Reader::read_curve`]).
-    fn curve(&self, id: u64, from: u64) -> Result<Curve, StepError> {
+    pub(super) fn curve(&self, id: u64, from: u64) -> Result<Curve, StepError> {
         self.curves.get_or(id, || self.read_curve(id, from))
     }
 
@@ -602,6 +615,9 @@ impl<'a> Reader<'a> {
             return self
                 .bspline_curve(id, inst)
                 .map(|c| Curve::BSpline(Arc::new(c)));
+        }
+        if let Some(c) = self.compound(id, inst) {
+            return c;
         }
         for wrapper in [
             "TRIMMED_CURVE",

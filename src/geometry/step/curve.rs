@@ -2,6 +2,7 @@
 //! surfaces share: evaluation, and the inverse from a point to its parameter (ISO
 //! 10303-42 § 4.4 parametrisations; angles are radians, lengths millimetres).
 
+use super::composite::{Composite, OffsetCurve};
 use crate::geometry::{P3, V3};
 use std::f64::consts::TAU;
 use std::sync::Arc;
@@ -206,12 +207,17 @@ pub(crate) enum Curve {
     Hyperbola(Frame, f64, f64),
     /// A B-spline curve (shared: every edge on it holds the one read).
     BSpline(Arc<BSplineCurve>),
-    /// A polyline through these points (shared likewise).
+    /// A polyline through these points (shared likewise), parametrised from 0 at the
+    /// first point by one per segment (ISO 10303-42 `polyline`).
     Polyline(Arc<[P3]>),
+    /// Stretches of other curves joined end to end (shared; `composite.rs`).
+    Composite(Arc<Composite>),
+    /// A curve at a constant distance from another (shared; `composite.rs`).
+    Offset(Arc<OffsetCurve>),
 }
 
 impl Curve {
-    /// The point at parameter `t` (not for polylines).
+    /// The point at parameter `t`.
     pub fn eval(&self, t: f64) -> P3 {
         match self {
             Curve::Line(o, d) => o + d * t,
@@ -220,7 +226,9 @@ impl Curve {
             Curve::Parabola(f, focal) => f.at(focal * t * t, 2.0 * focal * t, 0.0),
             Curve::Hyperbola(f, a, b) => f.at(a * t.cosh(), b * t.sinh(), 0.0),
             Curve::BSpline(c) => c.eval(t),
-            Curve::Polyline(_) => P3::origin(),
+            Curve::Polyline(p) => polyline_at(p, t),
+            Curve::Composite(c) => c.eval(t),
+            Curve::Offset(o) => o.eval(t),
         }
     }
 
@@ -239,7 +247,19 @@ impl Curve {
             Curve::Parabola(f, focal) => f.local(p).y / (2.0 * focal),
             Curve::Hyperbola(f, _, b) => (f.local(p).y / b).asinh(),
             Curve::BSpline(c) => nearest_param(|t| c.eval(t), c.knots.range(), p),
-            Curve::Polyline(_) => 0.0,
+            Curve::Polyline(pts) => polyline_param(pts, p),
+            // The nearest of each segment's nearest points.
+            Curve::Composite(c) => c
+                .spans()
+                .into_iter()
+                .map(|span| nearest_param(|t| c.eval(t), span, p))
+                .min_by(|a, b| {
+                    (c.eval(*a) - p)
+                        .norm_squared()
+                        .total_cmp(&(c.eval(*b) - p).norm_squared())
+                })
+                .unwrap_or(0.0),
+            Curve::Offset(o) => nearest_param(|t| o.eval(t), o.basis.range(), p),
         }
     }
 
@@ -250,7 +270,23 @@ impl Curve {
             Curve::BSpline(c) => c.knots.range(),
             Curve::Circle(..) | Curve::Ellipse(..) => (-std::f64::consts::PI, std::f64::consts::PI),
             Curve::Hyperbola(..) => (-30.0, 30.0),
-            Curve::Line(..) | Curve::Parabola(..) | Curve::Polyline(_) => (-1e6, 1e6),
+            Curve::Line(..) | Curve::Parabola(..) => (-1e6, 1e6),
+            Curve::Polyline(p) => (0.0, p.len().saturating_sub(1) as f64),
+            Curve::Composite(c) => c.range(),
+            Curve::Offset(o) => o.basis.range(),
+        }
+    }
+
+    /// The parameters inside the range where the curve may bend sharply (a B-spline's
+    /// knots, a polyline's corners, a composite's joints) with the range's ends; none
+    /// for a smooth curve.
+    pub(crate) fn breaks(&self) -> Vec<f64> {
+        match self {
+            Curve::BSpline(c) => c.knots.breaks(),
+            Curve::Polyline(p) => (0..p.len()).map(|k| k as f64).collect(),
+            Curve::Composite(c) => c.breaks(),
+            Curve::Offset(o) => o.basis.breaks(),
+            _ => vec![],
         }
     }
 
@@ -258,11 +294,13 @@ impl Curve {
     pub fn period(&self) -> Option<f64> {
         match self {
             Curve::Circle(..) | Curve::Ellipse(..) => Some(TAU),
-            Curve::BSpline(c) => {
-                let (a, b) = c.knots.range();
-                let span = (c.eval(b) - c.eval(a)).norm();
-                (span < 1e-9 * (1.0 + c.eval(a).coords.norm())).then_some(b - a)
+            Curve::Composite(c) => c.period(),
+            Curve::BSpline(_) => {
+                let (a, b) = self.range();
+                let span = (self.eval(b) - self.eval(a)).norm();
+                (span < 1e-9 * (1.0 + self.eval(a).coords.norm())).then_some(b - a)
             }
+            Curve::Offset(o) => o.period,
             _ => None,
         }
     }
@@ -277,6 +315,33 @@ impl Curve {
             _ => None,
         }
     }
+}
+
+/// A polyline's point at `t`: the `⌊t⌋`-th segment at `t − ⌊t⌋` (the ends clamp).
+fn polyline_at(p: &[P3], t: f64) -> P3 {
+    let Some(last) = p.len().checked_sub(1) else {
+        return P3::origin();
+    };
+    if last == 0 || t.is_nan() {
+        return p[0];
+    }
+    let t = t.clamp(0.0, last as f64);
+    let i = (t.floor() as usize).min(last - 1);
+    p[i] + (p[i + 1] - p[i]) * (t - i as f64)
+}
+
+/// The parameter of the point of a polyline nearest `q`.
+fn polyline_param(p: &[P3], q: &P3) -> f64 {
+    let mut best = (0.0, f64::INFINITY);
+    for (i, w) in p.windows(2).enumerate() {
+        let d = w[1] - w[0];
+        let s = ((q - w[0]).dot(&d) / d.norm_squared().max(1e-300)).clamp(0.0, 1.0);
+        let dist = (w[0] + d * s - q).norm_squared();
+        if dist < best.1 {
+            best = (i as f64 + s, dist);
+        }
+    }
+    best.0
 }
 
 /// The parameter in `range` whose point is nearest `p`: a dense scan, then golden-section

@@ -40,7 +40,10 @@
 
 pub(super) mod brep;
 pub(super) mod canon;
+pub(super) mod composite;
+mod compound;
 pub(super) mod curve;
+pub(super) mod edges;
 pub(in crate::geometry) mod error;
 pub(super) mod geom;
 mod p21;
@@ -49,9 +52,11 @@ mod refs;
 pub(super) mod swept;
 pub(super) mod tess;
 
+/// The curve type, for the files of this folder that `curve.rs` imports.
+pub(crate) use curve::Curve;
+pub use edges::Resolution;
 pub use error::StepError;
 pub(crate) use p21::Name;
-pub use tess::Resolution;
 
 use super::weld::{weld, RawMesh};
 use super::{Surface, P3, V3};
@@ -165,6 +170,10 @@ fn extent(b: &brep::Brep) -> f64 {
             curve::Curve::Ellipse(f, a, c) => add(&f.o, a.abs().max(c.abs())),
             curve::Curve::BSpline(c) => c.points.iter().for_each(|p| add(p, 0.0)),
             curve::Curve::Polyline(pts) => pts.iter().for_each(|p| add(p, 0.0)),
+            c @ (curve::Curve::Composite(_) | curve::Curve::Offset(_)) => {
+                let (a, z) = c.range();
+                (0..=64).for_each(|k| add(&c.eval(a + (z - a) * k as f64 / 64.0), 0.0));
+            }
             curve::Curve::Line(..) | curve::Curve::Parabola(..) | curve::Curve::Hyperbola(..) => {}
         }
     }

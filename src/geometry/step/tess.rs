@@ -25,23 +25,15 @@
 //! triangulated with v squeezed `RULED_STRETCH` (8) times, so triangles run along their
 //! straight lines.
 
-use super::brep::{Bound, Brep, Edge, Face};
-use super::curve::{unwrap_near, Curve};
+use super::brep::{Bound, Brep, Face};
+use super::curve::unwrap_near;
+use super::edges::{edge_polylines, refine_curve, too_large, Resolution, BATCH};
 use super::geom::Surf;
 use crate::geometry::weld::MAX_TRIANGLES;
 use crate::geometry::{P3, V3};
 use rayon::prelude::*;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation};
 use std::f64::consts::TAU;
-
-/// How fine the mesh is.
-#[derive(Debug, Clone, Copy)]
-pub struct Resolution {
-    /// Largest distance between a triangle and the surface (mm).
-    pub chord_mm: f64,
-    /// Largest turn of the normal across a triangle or an edge segment (radians).
-    pub angle_rad: f64,
-}
 
 /// How much longer than wide a triangle may come out along a cylinder's or cone's
 /// straight lines, where the surface does not curve.
@@ -72,10 +64,6 @@ pub(crate) struct FaceFailure {
 /// The closest an inner point may come to a triangle's corner (mm): a hundred times
 /// the distance the weld merges points at.
 const MIN_SPACING_MM: f64 = 1e-4;
-
-/// How many faces or edges are meshed side by side before the totals are checked: the
-/// check falls at the same place for any thread count.
-const BATCH: usize = 64;
 
 /// The most points one face's bounds may have, and the most it may gain inside.
 const MAX_FACE_POINTS: usize = 200_000;
@@ -118,175 +106,6 @@ pub(crate) fn tessellate(b: &Brep, res: Resolution) -> Result<(Soup, Vec<FaceFai
         }
     }
     Ok((soup, failures))
-}
-
-/// Why a part is not meshed: it needs too many triangles at this resolution.
-fn too_large(res: Resolution) -> String {
-    format!(
-        "meshing it to a {} mm chord takes more than {MAX_TRIANGLES} triangles",
-        res.chord_mm
-    )
-}
-
-/// The segment count for an arc of `sweep` radians on radius `r`.
-fn arc_segments(sweep: f64, r: f64, res: Resolution) -> usize {
-    let chord_step = if res.chord_mm < r {
-        2.0 * (1.0 - res.chord_mm / r).acos()
-    } else {
-        res.angle_rad
-    };
-    let step = chord_step.min(res.angle_rad).max(1e-3);
-    ((sweep.abs() / step).ceil() as usize).max(1)
-}
-
-/// An edge as a polyline from its start vertex to its end vertex.
-fn edge_points(e: &Edge, res: Resolution) -> Vec<P3> {
-    let closed = (e.start - e.end).norm() < 1e-9;
-    let mut pts = match &e.curve {
-        Curve::Line(..) => vec![e.start, e.end],
-        Curve::Polyline(p) => {
-            let mut p = p.to_vec();
-            if !e.same_sense {
-                p.reverse();
-            }
-            p
-        }
-        Curve::Circle(_, r) | Curve::Ellipse(_, r, _) => {
-            let r = match &e.curve {
-                Curve::Ellipse(_, a, b) => a.max(*b),
-                _ => *r,
-            };
-            let t0 = e.curve.param(&e.start);
-            let mut t1 = e.curve.param(&e.end);
-            if e.same_sense {
-                while t1 <= t0 + 1e-9 {
-                    t1 += TAU;
-                }
-                if !closed && t1 - t0 > TAU - 1e-9 {
-                    t1 -= TAU;
-                }
-            } else {
-                while t1 >= t0 - 1e-9 {
-                    t1 -= TAU;
-                }
-                if !closed && t0 - t1 > TAU - 1e-9 {
-                    t1 += TAU;
-                }
-            }
-            let n = arc_segments(t1 - t0, r, res);
-            (0..=n)
-                .map(|k| e.curve.eval(t0 + (t1 - t0) * k as f64 / n as f64))
-                .collect()
-        }
-        Curve::Parabola(..) | Curve::Hyperbola(..) => {
-            let (ts, te) = (e.curve.param(&e.start), e.curve.param(&e.end));
-            let (lo, hi) = (ts.min(te), ts.max(te));
-            let mut params = vec![lo];
-            refine_curve(&|t| e.curve.eval(t), lo, hi, res, 0, &mut params);
-            let mut p: Vec<P3> = params.iter().map(|&t| e.curve.eval(t)).collect();
-            if ts > te {
-                p.reverse();
-            }
-            p
-        }
-        Curve::BSpline(c) => {
-            let (a, b) = c.knots.range();
-            let near = |p: &P3, t: f64| (c.eval(t) - p).norm() < 1e-6;
-            let (ts, te) = if closed && near(&e.start, a) && near(&e.start, b) {
-                if e.same_sense {
-                    (a, b)
-                } else {
-                    (b, a)
-                }
-            } else {
-                let find = |p: &P3| {
-                    if near(p, a) {
-                        a
-                    } else if near(p, b) {
-                        b
-                    } else {
-                        e.curve.param(p)
-                    }
-                };
-                (find(&e.start), find(&e.end))
-            };
-            let (lo, hi) = (ts.min(te), ts.max(te));
-            let mut knots: Vec<f64> = c.knots.breaks();
-            knots.retain(|k| *k > lo && *k < hi);
-            let mut stops = vec![lo];
-            stops.extend(knots);
-            stops.push(hi);
-            let mut params = vec![lo];
-            for w in stops.windows(2) {
-                refine_curve(&|t| c.eval(t), w[0], w[1], res, 0, &mut params);
-            }
-            let mut p: Vec<P3> = params.iter().map(|&t| c.eval(t)).collect();
-            if ts > te {
-                p.reverse();
-            }
-            p
-        }
-    };
-    // The ends are the vertices exactly, so that edges meeting there share a point.
-    if let Some(first) = pts.first_mut() {
-        *first = e.start;
-    }
-    if let Some(last) = pts.last_mut() {
-        *last = e.end;
-    }
-    if pts.len() < 2 {
-        pts = vec![e.start, e.end];
-    }
-    pts
-}
-
-/// Appends the parameters after `a` up to `b`, splitting where the curve leaves the
-/// chord by more than the tolerance or turns by more than the angle limit.
-fn refine_curve(
-    f: &dyn Fn(f64) -> P3,
-    a: f64,
-    b: f64,
-    res: Resolution,
-    depth: usize,
-    out: &mut Vec<f64>,
-) {
-    split_curve(f, (a, f(a)), (b, f(b)), res, depth, out);
-}
-
-/// [`refine_curve`] with the ends' points known, so that each split evaluates the
-/// curve only at its new parameters.
-fn split_curve(
-    f: &dyn Fn(f64) -> P3,
-    (a, pa): (f64, P3),
-    (b, pb): (f64, P3),
-    res: Resolution,
-    depth: usize,
-    out: &mut Vec<f64>,
-) {
-    let m = 0.5 * (a + b);
-    let pm = f(m);
-    let chord = pb - pa;
-    // The curve's distance from the chord at a quarter, the middle and three quarters
-    // (a span of a B-spline can bend twice).
-    let from_chord = |p: P3| {
-        if chord.norm() > 1e-12 {
-            (p - pa).cross(&chord).norm() / chord.norm()
-        } else {
-            (p - pa).norm()
-        }
-    };
-    let off = [pm, f(a + (b - a) * 0.25), f(a + (b - a) * 0.75)]
-        .into_iter()
-        .map(from_chord)
-        .fold(0.0, f64::max);
-    let turn = (pm - pa).angle(&(pb - pm));
-    // Depth and count limits keep a corrupt curve from taking the memory.
-    if depth < 14 && out.len() < 100_000 && (off > res.chord_mm || turn > res.angle_rad) {
-        split_curve(f, (a, pa), (m, pm), res, depth + 1, out);
-        split_curve(f, (m, pm), (b, pb), res, depth + 1, out);
-    } else {
-        out.push(b);
-    }
 }
 
 /// A point of a face's parameter-plane polygon: scaled (u, v), and the 3D point when
@@ -347,22 +166,6 @@ fn face_loops(face: &Face, edges: &[Vec<P3>]) -> Result<Vec<Loop>, String> {
         loops.push(param_loop(s, &pts3, periods, &mut hint));
     }
     Ok(loops)
-}
-
-/// Edges cut into polylines as [`tessellate`] cuts them; an error when they take more
-/// than [`MAX_TRIANGLES`] points in all (more than the largest mesh has triangles).
-pub(crate) fn edge_polylines(b: &Brep, res: Resolution) -> Result<Vec<Vec<P3>>, String> {
-    let mut out: Vec<Vec<P3>> = Vec::with_capacity(b.edges.len());
-    let mut points = 0usize;
-    for batch in b.edges.chunks(BATCH) {
-        let cut: Vec<Vec<P3>> = batch.par_iter().map(|e| edge_points(e, res)).collect();
-        points += cut.iter().map(Vec::len).sum::<usize>();
-        if points > MAX_TRIANGLES {
-            return Err(too_large(res));
-        }
-        out.extend(cut);
-    }
-    Ok(out)
 }
 
 /// Whether a face lies along its surface's natural normal, told from its bounds alone
