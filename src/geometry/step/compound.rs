@@ -61,7 +61,7 @@ impl Reader<'_> {
         }
         for (k, w) in segments.windows(2).enumerate() {
             let gap = (w[0].curve.eval(w[0].to) - w[1].curve.eval(w[1].from)).norm();
-            if !(gap <= JOIN_MM) {
+            if gap.is_nan() || gap > JOIN_MM {
                 return Err(self.bad(
                     id,
                     format!(
