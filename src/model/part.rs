@@ -684,14 +684,6 @@ impl UnitOf {
         }
     }
 
-    /// The longest extent of the stretch (mm).
-    pub fn span(self) -> f64 {
-        match self {
-            UnitOf::Length(l) | UnitOf::Circle(l) => l,
-            UnitOf::Rectangle(a, b) => a.max(b),
-        }
-    }
-
     /// The shortest extent of the stretch (mm): the sampling density follows it.
     pub fn least(self) -> f64 {
         match self {

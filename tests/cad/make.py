@@ -21,6 +21,7 @@ import math
 import os
 import re
 
+from curves_edit import entities, numbers
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
@@ -293,18 +294,6 @@ def without_seam(text):
 
 
 extra_bounds = {}
-
-
-def entities(text):
-    """Instance number → (type, parameter text) of every simple instance."""
-    out = {}
-    for m in re.finditer(r"^#(\d+) = (\w+)\((.*?)\);$", text, re.M | re.S):
-        out[int(m.group(1))] = (m.group(2), m.group(3))
-    return out
-
-
-def numbers(params):
-    return [float(x) for x in re.findall(r"[-+]?\d+\.?\d*(?:E[-+]?\d+)?", params)]
 
 
 def disguised_far(text):
