@@ -128,9 +128,10 @@ def reading(shape, unit_mm):
     }
 
 
-def write(name, shape, unit="MM", unit_mm=1.0, edit=None, what="", qif=None, step_shape=None):
+def write(name, shape, unit="MM", unit_mm=1.0, edit=None, what="", qif=None, step_shape=None, qif_kinds=None):
     """Writes NAME.stp and NAME.json, and NAME.qif when `qif` says how (`"u"` or
-    `"v"`: which NURBS index runs fastest, `qif_writer.py`). `step_shape`, when given,
+    `"v"`: which NURBS index runs fastest, `qif_writer.py`; `qif_kinds` the writer's
+    other options). `step_shape`, when given,
     is what OpenCASCADE writes for `edit` to make exact (a curve it cannot write,
     approximated); the expectation is always `shape`'s."""
     Interface_Static.SetCVal_s("write.step.unit", unit)
@@ -151,7 +152,7 @@ def write(name, shape, unit="MM", unit_mm=1.0, edit=None, what="", qif=None, ste
         from qif_writer import Writer
 
         with open(os.path.join(HERE, name + ".qif"), "w") as f:
-            f.write(Writer(v_fastest=qif == "v").write(shape))
+            f.write(Writer(v_fastest=qif == "v", **(qif_kinds or {})).write(shape))
     expected = reading(shape, unit_mm)
     expected["what"] = what
     with open(os.path.join(HERE, name + ".json"), "w") as f:
@@ -565,6 +566,28 @@ def offset_prism(exact):
     return BRepPrimAPI_MakePrism(f, gp_Vec(0, 0, 20)).Shape()
 
 
+def ruled_loft():
+    """A solid ruled between the blob's B-spline at z = 0 and a copy of it shrunk to 0.6
+    and turned 20° at z = 25 (the same knots, so corresponding points share a parameter)."""
+    from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
+    from OCP.gp import gp_Trsf
+
+    c = interpolate([(30, 0, 0), (20, 18, 0), (0, 25, 0), (-22, 15, 0), (-28, -5, 0), (-10, -22, 0), (15, -20, 0)], True)
+    top = c.Copy()
+    t = gp_Trsf()
+    t.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), math.radians(20))
+    s = gp_Trsf()
+    s.SetScale(gp_Pnt(0, 0, 0), 0.6)
+    m = gp_Trsf()
+    m.SetTranslation(gp_Vec(0, 0, 25))
+    top.Transform(m.Multiplied(t.Multiplied(s)))
+    loft = BRepOffsetAPI_ThruSections(True, True)
+    loft.AddWire(wire(BRepBuilderAPI_MakeEdge(c).Edge()))
+    loft.AddWire(wire(BRepBuilderAPI_MakeEdge(top).Edge()))
+    loft.Build()
+    return loft.Shape()
+
+
 def main():
     import sys
 
@@ -578,6 +601,9 @@ def main():
         write = lambda name, *a, **k: all_write(name, *a, **k) if name in only else None
     basis, _ = offset_blob()
     write("composite", d_plate(), edit=composite, what="every edge's curve a composite of two trimmed stretches (COMPOSITE_CURVE, TRIMMED_CURVE)")
+    write("spline", BRepBuilderAPI_NurbsConvert(spline_prism([4, 1, 1, 1, 4], [0, 1, 2, 3, 4]), True).Shape(), qif="v", qif_kinds={"splines": True},
+          what="the quasi-uniform spline plate with every face and edge a B-spline, written to QIF as polynomial pieces (Spline13, Spline23)")
+    write("ruled", ruled_loft(), qif="u", qif_kinds={"ruled": True}, what="a loft ruled between a B-spline and its smaller copy (QIF Ruled23)")
     write("offset_curve", offset_prism(True), edit=offset_curves(basis, 3.0, (0.0, 0.0, 1.0)), step_shape=offset_prism(False), what="a B-spline's offset swept along z (OFFSET_CURVE_3D)")
     write("extrusion_bspline", blob_prism(), what="a closed B-spline swept along z (SURFACE_OF_LINEAR_EXTRUSION, seam)", qif="u")
     write("extrusion_ellipse", ellipse_prism(), what="an ellipse swept along its normal", qif="u")

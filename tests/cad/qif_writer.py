@@ -52,9 +52,14 @@ def pnt(p):
 
 
 class Writer:
-    def __init__(self, v_fastest=False):
+    def __init__(self, v_fastest=False, splines=False, ruled=False):
+        """`splines`: non-rational B-splines written as Spline13/Spline23 (`qif_splines.py`,
+        every other one normalised); `ruled`: a surface of degree 1 with two rows of poles
+        as Ruled23."""
         self.next = 0
         self.v_fastest = v_fastest
+        self.splines = splines
+        self.ruled = ruled
         self.points, self.curves, self.surfaces = [], [], []
         self.vertices, self.edges, self.loops, self.faces = [], [], [], []
 
@@ -95,6 +100,10 @@ class Writer:
                 # QIF's knot vector is the full one, poles + order long.
                 b = b.Copy()
                 b.SetNotPeriodic()
+            if self.splines and not b.IsRational():
+                from qif_splines import spline13_core
+
+                return spline13_core(b, first, last, normalized=self.next % 2 == 0)
             knots = []
             for i in range(1, b.NbKnots() + 1):
                 knots += [b.Knot(i)] * b.Multiplicity(i)
@@ -146,6 +155,16 @@ class Writer:
                     b.SetUNotPeriodic()
                 if b.IsVPeriodic():
                     b.SetVNotPeriodic()
+            if self.ruled:
+                from qif_splines import ruled_core
+
+                core = ruled_core(b, self.curve_core)
+                if core:
+                    return core
+            if self.splines and not (b.IsURational() or b.IsVRational()):
+                from qif_splines import spline23_core
+
+                return spline23_core(b, self.v_fastest, normalized=self.next % 2 == 1)
             nu, nv = b.NbUPoles(), b.NbVPoles()
 
             def knots(n, k, m):

@@ -282,3 +282,16 @@ fn composite_curves_of_trimmed_stretches() {
 fn an_offset_curve_swept() {
     check("offset_curve");
 }
+
+#[test]
+fn qif_spline13_and_spline23_polynomial_pieces() {
+    // Every edge a Spline13 and every face a Spline23, normalised or not in turn, the
+    // patches and their coefficients v-fastest (the STEP file has them as B-splines).
+    check_qif("spline");
+    check("spline");
+}
+
+#[test]
+fn qif_ruled23_between_two_b_splines() {
+    check_qif("ruled");
+}

@@ -24,7 +24,7 @@ fn surface(d: &Doc, n: &Node) -> Result<Option<Surf>, QifError> {
         "Plane23" | "Cylinder23" | "Cone23" | "Sphere23" | "Torus23" => {
             analytic_surface(d, core(n)?).map(Some)
         }
-        "Nurbs23" | "Extrude23" | "Revolution23" | "Offset23" => Ok(None),
+        "Nurbs23" | "Spline23" | "Extrude23" | "Revolution23" | "Ruled23" | "Offset23" => Ok(None),
         _ => Err(QifError::Unsupported {
             id: n.id(),
             line: n.line,

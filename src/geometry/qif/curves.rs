@@ -87,6 +87,7 @@ pub(super) fn curve_core(d: &Doc, c: &Node, owner: &Node) -> Result<(Curve, Opti
             let start = curve.eval(t0);
             Ok((Curve::BSpline(std::sync::Arc::new(curve)), Some(start)))
         }
+        "Spline13Core" => super::splines::spline13(d, c),
         "Polyline13Core" => {
             let v = c
                 .child("Points")

@@ -45,6 +45,7 @@ mod doc;
 pub(in crate::geometry) mod error;
 mod pmi;
 mod refs;
+mod splines;
 mod surfaces;
 mod xml;
 

@@ -1,7 +1,9 @@
 //! QIF 3's surfaces beyond the analytic ones (Geometry.xsd): `Nurbs23` (orders, knot
-//! vectors, control points and weights), `Extrude23` (a profile curve swept to a
-//! termination point), `Revolution23` (a generatrix turned about an axis) and
-//! `Offset23` (a surface moved along its normal), read into the STEP reader's surfaces
+//! vectors, control points and weights), `Spline23` (polynomial patches, `splines.rs`),
+//! `Extrude23` (a profile curve swept to a termination point), `Revolution23` (a
+//! generatrix turned about an axis), `Ruled23` (straight segments joining corresponding
+//! points of two curves) and `Offset23` (a surface moved along its normal), read into
+//! the STEP reader's surfaces
 //! so that one tessellator meshes both; a sweep or offset that is an analytic surface
 //! is read as that surface (`step/canon.rs`).
 //!
@@ -12,13 +14,13 @@
 //! vertices on is malformed, not guessed.
 
 use super::curves::curve_core;
-use super::doc::{core, frame, malformed, num, positive, vec3, Doc};
+use super::doc::{core, domain, frame, malformed, num, positive, vec3, Doc};
 use super::xml::Node;
 use super::QifError;
 use crate::geometry::step::canon::{canonical, revolution_axis};
 use crate::geometry::step::curve::{Curve, Knots, MAX_DEGREE};
 use crate::geometry::step::geom::{BSplineSurface, Offset, Surf};
-use crate::geometry::step::swept::{Extrusion, Revolution};
+use crate::geometry::step::swept::{Extrusion, Revolution, Ruled};
 use crate::geometry::{P3, V3};
 use std::sync::Arc;
 
@@ -35,6 +37,8 @@ pub(super) fn read(d: &Doc, n: &Node, vertices: &[P3]) -> Result<Surf, QifError>
 fn from_core(d: &Doc, c: &Node, vertices: &[P3]) -> Result<Surf, QifError> {
     match c.name.as_str() {
         "Nurbs23Core" => nurbs(d, c, vertices),
+        "Spline23Core" => super::splines::spline23(d, c, vertices, ON_SURFACE_MM),
+        "Ruled23Core" => ruled(d, c),
         "Extrude23Core" => extrude(d, c),
         "Revolution23Core" => revolution(d, c),
         "Offset23Core" => {
@@ -80,6 +84,39 @@ fn extrude(d: &Doc, c: &Node) -> Result<Surf, QifError> {
         .try_normalize(1e-12)
         .ok_or_else(|| malformed(c, "its termination point is its start"))?;
     Ok(Surf::Extrusion(Arc::new(Extrusion { curve, dir })))
+}
+
+/// A `Ruled23Core`: its two `<Curve>`s, each run over its own parameters (a segment's
+/// from start to end, a polyline's from its first point to its last, an arc's or a NURBS curve's over its domain, a NURBS curve's
+/// knots when it states none) as u runs from 0 to 1; the second backwards when
+/// `turnedSecondCurve` is set (Geometry.xsd `Ruled23CoreType`).
+fn ruled(d: &Doc, c: &Node) -> Result<Surf, QifError> {
+    let mut curves = Vec::new();
+    for holder in c.all("Curve") {
+        let inner = holder
+            .children
+            .iter()
+            .find(|k| k.name.ends_with("Core"))
+            .ok_or_else(|| malformed(holder, "it has no curve"))?;
+        let (curve, _) = curve_core(d, inner, c)?;
+        let span = match &curve {
+            // A segment and a polyline run over parameters of their own.
+            Curve::Line(..) => (0.0, 1.0),
+            Curve::Polyline(_) => curve.range(),
+            Curve::BSpline(_) => domain(inner).unwrap_or(curve.range()),
+            _ => domain(inner).ok_or_else(|| malformed(inner, "it has no domain"))?,
+        };
+        curves.push((curve, span.0, span.1));
+    }
+    let [a, mut b]: [(Curve, f64, f64); 2] = curves
+        .try_into()
+        .map_err(|_| malformed(c, "it does not have two <Curve>s"))?;
+    if matches!(c.attr("turnedSecondCurve"), Some("true" | "1")) {
+        b = (b.0, b.2, b.1);
+    }
+    let closes = |(k, t0, t1): &(Curve, f64, f64)| (k.eval(*t0) - k.eval(*t1)).norm() < 1e-9;
+    let closed = closes(&a) && closes(&b);
+    Ok(Surf::Ruled(Arc::new(Ruled { a, b, closed })))
 }
 
 fn revolution(d: &Doc, c: &Node) -> Result<Surf, QifError> {

@@ -4,12 +4,18 @@
 //! A line is its two vertices; a circle or ellipse is cut into equal angles; every other
 //! curve is cut between its vertices' parameters by halving where it strays from the
 //! chord or turns too much, first at its knots, corners or joints (a B-spline's knots,
-//! a composite's joints), where it may bend sharply.
+//! a composite's joints), where it may bend sharply. An edge of a ruled face (QIF's
+//! `Ruled23`) is cut further wherever that face's normal turns along it by more than
+//! the angle limit: a twisted ruled surface turns along its straight lines, and the
+//! face's triangles cannot split a bound segment (OpenCASCADE's mesher cuts every edge
+//! so; the other surfaces' edges are left as they were, which keeps the meshes of the
+//! parts already read).
 
-use super::brep::{Brep, Edge};
+use super::brep::{Bound, Brep, Edge};
 use super::curve::Curve;
+use super::geom::Surf;
 use crate::geometry::weld::MAX_TRIANGLES;
-use crate::geometry::P3;
+use crate::geometry::{P3, V3};
 use rayon::prelude::*;
 use std::f64::consts::TAU;
 
@@ -199,10 +205,31 @@ fn split_curve(
 /// Edges cut into polylines, as tessellation cuts them; an error when they take more
 /// than [`MAX_TRIANGLES`] points in all (more than the largest mesh has triangles).
 pub(crate) fn edge_polylines(b: &Brep, res: Resolution) -> Result<Vec<Vec<P3>>, String> {
+    // The ruled faces each edge bounds: their normals may turn along a straight edge.
+    let mut ruled: Vec<Vec<&Surf>> = vec![Vec::new(); b.edges.len()];
+    for f in b
+        .faces
+        .iter()
+        .filter(|f| matches!(f.surface, Surf::Ruled(_)))
+    {
+        for (e, _) in f.bounds.iter().flat_map(Bound::edges) {
+            ruled[*e].push(&f.surface);
+        }
+    }
     let mut out: Vec<Vec<P3>> = Vec::with_capacity(b.edges.len());
     let mut points = 0usize;
-    for batch in b.edges.chunks(BATCH) {
-        let cut: Vec<Vec<P3>> = batch.par_iter().map(|e| edge_points(e, res)).collect();
+    for (k, batch) in b.edges.chunks(BATCH).enumerate() {
+        let cut: Vec<Vec<P3>> = batch
+            .par_iter()
+            .enumerate()
+            .map(|(i, e)| {
+                let pts = edge_points(e, res);
+                match ruled[k * BATCH + i].as_slice() {
+                    [] => pts,
+                    faces => turned(e, pts, faces, res),
+                }
+            })
+            .collect();
         points += cut.iter().map(Vec::len).sum::<usize>();
         if points > MAX_TRIANGLES {
             return Err(too_large(res));
@@ -210,6 +237,57 @@ pub(crate) fn edge_polylines(b: &Brep, res: Resolution) -> Result<Vec<Vec<P3>>, 
         out.extend(cut);
     }
     Ok(out)
+}
+
+/// Each ruled face's normal at a point of an edge (`None` where it is undefined).
+type Normals = Vec<Option<V3>>;
+
+/// An edge's points with more between any two where the normal of a ruled face it
+/// bounds turns by more than the angle limit: a twisted ruled surface turns along its
+/// straight lines, and a bound segment is what the face's triangles cannot split.
+fn turned(e: &Edge, pts: Vec<P3>, faces: &[&Surf], res: Resolution) -> Vec<P3> {
+    let normals = |p: &P3| -> Normals {
+        faces
+            .iter()
+            .map(|s| {
+                let (u, v) = s.param(p, None);
+                s.normal(&s.eval(u, v), u, v)
+            })
+            .collect()
+    };
+    let turns = |a: &[Option<V3>], b: &[Option<V3>]| {
+        a.iter()
+            .zip(b)
+            .any(|(x, y)| matches!((x, y), (Some(x), Some(y)) if x.angle(y) > res.angle_rad))
+    };
+    fn split(
+        e: &Edge,
+        (a, na): (P3, &[Option<V3>]),
+        (b, nb): (P3, &[Option<V3>]),
+        depth: usize,
+        normals: &dyn Fn(&P3) -> Normals,
+        turns: &dyn Fn(&[Option<V3>], &[Option<V3>]) -> bool,
+        out: &mut Vec<P3>,
+    ) {
+        if depth < 10 && turns(na, nb) {
+            let m = P3::from((a.coords + b.coords) / 2.0);
+            let m = e.curve.eval(e.curve.param(&m));
+            let nm = normals(&m);
+            split(e, (a, na), (m, &nm), depth + 1, normals, turns, out);
+            split(e, (m, &nm), (b, nb), depth + 1, normals, turns, out);
+        } else {
+            out.push(b);
+        }
+    }
+    let mut out = vec![pts[0]];
+    let mut prev = normals(&pts[0]);
+    for &p in &pts[1..] {
+        let np = normals(&p);
+        let a = *out.last().unwrap_or(&p);
+        split(e, (a, &prev), (p, &np), 0, &normals, &turns, &mut out);
+        prev = np;
+    }
+    out
 }
 
 /// An edge on a curve known by evaluation only (a composite, an offset): from its

@@ -6,7 +6,7 @@
 //! radians, lengths millimetres.
 
 use super::curve::{Frame, Knots};
-use super::swept::{Extrusion, Revolution};
+use super::swept::{Extrusion, Revolution, Ruled};
 use crate::geometry::{P3, V3};
 use std::f64::consts::{FRAC_PI_2, TAU};
 use std::sync::Arc;
@@ -91,6 +91,8 @@ pub enum Surf {
     Revolution(Arc<Revolution>),
     /// A surface grown along its normal (one not read as an analytic surface).
     Offset(Arc<Offset>),
+    /// A surface ruled between two curves (QIF's `Ruled23`).
+    Ruled(Arc<Ruled>),
 }
 
 impl Surf {
@@ -112,6 +114,7 @@ impl Surf {
             Surf::Extrusion(e) => e.eval(u, v),
             Surf::Revolution(r) => r.eval(u, v),
             Surf::Offset(o) => o.eval(u, v),
+            Surf::Ruled(r) => r.eval(u, v),
         }
     }
 
@@ -119,7 +122,7 @@ impl Surf {
     /// (tessellation passes each bound point's as the next one's hint).
     pub(crate) fn takes_hint(&self) -> bool {
         match self {
-            Surf::BSpline(_) | Surf::Extrusion(_) | Surf::Revolution(_) => true,
+            Surf::BSpline(_) | Surf::Extrusion(_) | Surf::Revolution(_) | Surf::Ruled(_) => true,
             Surf::Offset(o) => o.base.takes_hint(),
             _ => false,
         }
@@ -151,6 +154,15 @@ impl Surf {
             Surf::Extrusion(e) => e.param(p, hint.map(|h| h.0)),
             Surf::Revolution(r) => r.param(p, hint.map(|h| h.1)),
             Surf::Offset(o) => o.base.param(p, hint),
+            Surf::Ruled(r) => {
+                let patch = Patch {
+                    eval: &|u, v| r.eval(u, v),
+                    u: (0.0, 1.0),
+                    v: (0.0, 1.0),
+                    closed: [r.closed, false],
+                };
+                patch_param(&patch, p, hint)
+            }
         }
     }
 
@@ -175,7 +187,11 @@ impl Surf {
                 let rho = (l.x * l.x + l.y * l.y).sqrt();
                 ((rho - big).hypot(l.z) - small).abs()
             }
-            Surf::BSpline(_) | Surf::Extrusion(_) | Surf::Revolution(_) | Surf::Offset(_) => {
+            Surf::BSpline(_)
+            | Surf::Extrusion(_)
+            | Surf::Revolution(_)
+            | Surf::Offset(_)
+            | Surf::Ruled(_) => {
                 let (u, v) = self.param(p, Some(hint));
                 (self.eval(u, v) - p).norm()
             }
@@ -189,6 +205,7 @@ impl Surf {
             Surf::BSpline(s) => s.closed[0].then(|| s.u.range().1 - s.u.range().0),
             Surf::Extrusion(e) => e.curve.period(),
             Surf::Offset(o) => o.base.u_period(),
+            Surf::Ruled(r) => r.closed.then_some(1.0),
             _ => Some(TAU),
         }
     }
@@ -247,7 +264,11 @@ impl Surf {
             Surf::Cone(_, r, a) => ((r + v * a.tan()).abs().max(1e-3), 1.0 / a.cos()),
             Surf::Sphere(_, r) => ((r * v.cos()).abs().max(1e-3), *r),
             Surf::Torus(_, big, small) => ((big + small * v.cos()).abs().max(1e-3), *small),
-            Surf::BSpline(_) | Surf::Extrusion(_) | Surf::Revolution(_) | Surf::Offset(_) => {
+            Surf::BSpline(_)
+            | Surf::Extrusion(_)
+            | Surf::Revolution(_)
+            | Surf::Offset(_)
+            | Surf::Ruled(_) => {
                 let h = 1e-4;
                 let du = (self.eval(u + h, v) - self.eval(u - h, v)).norm() / (2.0 * h);
                 let dv = (self.eval(u, v + h) - self.eval(u, v - h)).norm() / (2.0 * h);
@@ -273,7 +294,11 @@ impl Surf {
                 let r = radial(f)?;
                 (p - (f.o + r * *big)).try_normalize(1e-9)
             }
-            Surf::BSpline(_) | Surf::Extrusion(_) | Surf::Revolution(_) | Surf::Offset(_) => {
+            Surf::BSpline(_)
+            | Surf::Extrusion(_)
+            | Surf::Revolution(_)
+            | Surf::Offset(_)
+            | Surf::Ruled(_) => {
                 let h = 1e-6;
                 let su = self.eval(u + h, v) - self.eval(u - h, v);
                 let sv = self.eval(u, v + h) - self.eval(u, v - h);
@@ -302,19 +327,43 @@ impl Offset {
     }
 }
 
-/// Projects `p` onto a B-spline surface: Gauss-Newton steps from the hint when given;
-/// where they do not settle (a hint from another bound, far across the face), from the
-/// best point of a grid.
+/// A surface known by evaluation over a parameter box, closed or not along each
+/// direction: what [`patch_param`] projects onto.
+pub(crate) struct Patch<'a> {
+    /// The point at `(u, v)`.
+    pub eval: &'a dyn Fn(f64, f64) -> P3,
+    /// The range of u.
+    pub u: (f64, f64),
+    /// The range of v.
+    pub v: (f64, f64),
+    /// Whether it closes on itself along u and along v.
+    pub closed: [bool; 2],
+}
+
+/// Projects `p` onto a B-spline surface ([`patch_param`]).
 fn bspline_param(s: &BSplineSurface, p: &P3, hint: Option<(f64, f64)>) -> (f64, f64) {
+    let patch = Patch {
+        eval: &|u, v| s.eval(u, v),
+        u: s.u.range(),
+        v: s.v.range(),
+        closed: s.closed,
+    };
+    patch_param(&patch, p, hint)
+}
+
+/// Projects `p` onto a patch: Gauss-Newton steps from the hint when given; where they
+/// do not settle (a hint from another bound, far across the face), from the best point
+/// of a grid.
+pub(crate) fn patch_param(s: &Patch, p: &P3, hint: Option<(f64, f64)>) -> (f64, f64) {
     if let Some(h) = hint {
         let (uv, settled) = gauss_newton(s, p, h, 6);
         if settled {
             return uv;
         }
     }
-    let (u0, u1) = s.u.range();
-    let (v0, v1) = s.v.range();
-    let d = |u: f64, v: f64| (s.eval(u, v) - p).norm_squared();
+    let (u0, u1) = s.u;
+    let (v0, v1) = s.v;
+    let d = |u: f64, v: f64| ((s.eval)(u, v) - p).norm_squared();
     const N: usize = 24;
     let mut best = (u0, v0, f64::INFINITY);
     for i in 0..=N {
@@ -333,9 +382,9 @@ fn bspline_param(s: &BSplineSurface, p: &P3, hint: Option<(f64, f64)>) -> (f64, 
 /// Up to `steps` Gauss-Newton steps toward the foot of `p` from `start`, inside the
 /// parameter box (wrapping along a closed direction); whether the last step moved the
 /// point by less than 10⁻⁷ mm.
-fn gauss_newton(s: &BSplineSurface, p: &P3, start: (f64, f64), steps: usize) -> ((f64, f64), bool) {
-    let (u0, u1) = s.u.range();
-    let (v0, v1) = s.v.range();
+fn gauss_newton(s: &Patch, p: &P3, start: (f64, f64), steps: usize) -> ((f64, f64), bool) {
+    let (u0, u1) = s.u;
+    let (v0, v1) = s.v;
     let (mut u, mut v) = start;
     let h = 1e-7 * (1.0 + (u1 - u0).abs().max((v1 - v0).abs()));
     // Central differences whose ends stay in the box (at an open end a step outside
@@ -349,9 +398,9 @@ fn gauss_newton(s: &BSplineSurface, p: &P3, start: (f64, f64), steps: usize) -> 
         (at(b) - at(a)) / (b - a)
     };
     for _ in 0..steps {
-        let q = s.eval(u, v);
-        let su = diff(u0, u1, &|t| s.eval(t, v), u, s.closed[0]);
-        let sv = diff(v0, v1, &|t| s.eval(u, t), v, s.closed[1]);
+        let q = (s.eval)(u, v);
+        let su = diff(u0, u1, &|t| (s.eval)(t, v), u, s.closed[0]);
+        let sv = diff(v0, v1, &|t| (s.eval)(u, t), v, s.closed[1]);
         let r = p - q;
         let (a, b, c) = (su.dot(&su), su.dot(&sv), sv.dot(&sv));
         let (e, f) = (su.dot(&r), sv.dot(&r));

@@ -363,6 +363,7 @@ fn exact_surface(face: &brep::Face) -> Surface {
         | Surf::BSpline(_)
         | Surf::Extrusion(_)
         | Surf::Revolution(_)
-        | Surf::Offset(_) => Surface::Freeform,
+        | Surf::Offset(_)
+        | Surf::Ruled(_) => Surface::Freeform,
     }
 }

@@ -1,6 +1,7 @@
-//! Surfaces made from a curve: a curve swept along a vector
+//! Surfaces made from curves: a curve swept along a vector
 //! (`SURFACE_OF_LINEAR_EXTRUSION`), a curve revolved about an axis
-//! (`SURFACE_OF_REVOLUTION`); and, in `geom.rs` beside the surfaces it grows, a surface
+//! (`SURFACE_OF_REVOLUTION`), a surface ruled between two curves (QIF's `Ruled23`, whose
+//! inverse is `geom.rs`'s search over its parameter square); and, in `geom.rs` beside the surfaces it grows, a surface
 //! grown along its normal (`OFFSET_SURFACE`).
 //!
 //! The parametrisations are ISO 10303-42's (§ 4.4.x `surface_of_linear_extrusion`,
@@ -39,6 +40,27 @@ pub struct Revolution {
     /// The axis: origin and z; x points from the axis toward the curve, so that the
     /// curve lies at u = 0.
     pub(crate) axis: Frame,
+}
+
+/// A surface ruled between two curves: `S(u, v) = (1 − v)·A(a(u)) + v·B(b(u))` for u and
+/// v from 0 to 1, each curve's parameter running linearly over its span as u does (the
+/// straight segments join corresponding points; QIF 3 Geometry.xsd `Ruled23CoreType`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ruled {
+    /// The first curve and the parameters it runs from and to.
+    pub(crate) a: (Curve, f64, f64),
+    /// The second curve likewise.
+    pub(crate) b: (Curve, f64, f64),
+    /// Whether both curves close, so that u runs on round them.
+    pub(crate) closed: bool,
+}
+
+impl Ruled {
+    pub(crate) fn eval(&self, u: f64, v: f64) -> P3 {
+        let u = if self.closed { u.rem_euclid(1.0) } else { u };
+        let at = |(c, t0, t1): &(Curve, f64, f64)| c.eval(t0 + (t1 - t0) * u);
+        P3::from(at(&self.a).coords * (1.0 - v) + at(&self.b).coords * v)
+    }
 }
 
 impl Extrusion {
