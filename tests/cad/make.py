@@ -588,6 +588,15 @@ def ruled_loft():
     return loft.Shape()
 
 
+def thin_ring():
+    """A ring whose bore is 0.95 mm off its axis: its wall is 0.05 mm thin on one side,
+    less than the 0.1 mm chord parts are meshed to, so that the chords of its two sides
+    cross in the end faces' parameters (a sliver wall)."""
+    outer = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 21, 10).Shape()
+    bore = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0.95, -1), gp_Dir(0, 0, 1)), 20, 12).Shape()
+    return BRepAlgoAPI_Cut(outer, bore).Shape()
+
+
 def main():
     import sys
 
@@ -604,6 +613,7 @@ def main():
     write("spline", BRepBuilderAPI_NurbsConvert(spline_prism([4, 1, 1, 1, 4], [0, 1, 2, 3, 4]), True).Shape(), qif="v", qif_kinds={"splines": True},
           what="the quasi-uniform spline plate with every face and edge a B-spline, written to QIF as polynomial pieces (Spline13, Spline23)")
     write("ruled", ruled_loft(), qif="u", qif_kinds={"ruled": True}, what="a loft ruled between a B-spline and its smaller copy (QIF Ruled23)")
+    write("thin_wall", thin_ring(), what="a ring with a wall 0.05 mm thin: its end faces' bounds cross at the 0.1 mm chord")
     write("offset_curve", offset_prism(True), edit=offset_curves(basis, 3.0, (0.0, 0.0, 1.0)), step_shape=offset_prism(False), what="a B-spline's offset swept along z (OFFSET_CURVE_3D)")
     write("extrusion_bspline", blob_prism(), what="a closed B-spline swept along z (SURFACE_OF_LINEAR_EXTRUSION, seam)", qif="u")
     write("extrusion_ellipse", ellipse_prism(), what="an ellipse swept along its normal", qif="u")

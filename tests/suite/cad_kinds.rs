@@ -295,3 +295,44 @@ fn qif_spline13_and_spline23_polynomial_pieces() {
 fn qif_ruled23_between_two_b_splines() {
     check_qif("ruled");
 }
+
+#[test]
+fn a_wall_thinner_than_the_chord_meshes_by_the_fallback() {
+    // At the planning resolution the chords of the wall's two sides cross in the end
+    // faces' parameters and Delaunay refuses them (tess.rs's unit test); ear clipping
+    // meshes them, closed, with their area.
+    check("thin_wall");
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/cad/");
+    let part = read(
+        &std::fs::read(format!("{dir}thin_wall.stp")).unwrap(),
+        RESOLUTION,
+    )
+    .unwrap();
+    let want: Value =
+        serde_json::from_str(&std::fs::read_to_string(format!("{dir}thin_wall.json")).unwrap())
+            .unwrap();
+    let (areas, _) = areas_and_volume(&part.mesh);
+    let planes: Vec<f64> = part
+        .mesh
+        .exact
+        .iter()
+        .zip(&areas)
+        .filter(|(s, _)| s.kind() == SurfaceKind::Plane)
+        .map(|(_, a)| *a)
+        .collect();
+    let exact = want["faces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["kind"] == "plane")
+        .unwrap()["area"]
+        .as_f64()
+        .unwrap();
+    assert_eq!(planes.len(), 2);
+    for a in planes {
+        assert!(
+            (a - exact).abs() <= 0.01 * exact,
+            "an end face of {a} mm² against {exact} mm²"
+        );
+    }
+}

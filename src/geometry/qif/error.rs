@@ -80,7 +80,7 @@ pub enum QifError {
     #[error("{}", unsupported(*id, *line, what))]
     #[diagnostic(
         code(insp::geometry::qif_unsupported),
-        help("inspc evaluates QIF planes, cylinders, cones, spheres and tori, and segments, circular arcs, NURBS, polylines and aggregates of them; export the part as STEP AP242 for other surfaces")
+        help("inspc evaluates every QIF 3 curve and surface kind (README, \"CAD files\"), with control points given as text, and faces given by their surfaces; export the part with text control points and B-rep faces, or as STEP AP242")
     )]
     Unsupported {
         /// The element's id.

@@ -79,7 +79,7 @@ pub enum StepError {
     #[error("#{id} (line {line}) is a {what}, which inspc does not evaluate")]
     #[diagnostic(
         code(insp::geometry::step_unsupported),
-        help("inspc evaluates planes, cylinders, cones, spheres, tori, B-spline, extruded, revolved and offset surfaces, and lines, conics, B-spline curves and polylines (README, \"CAD files\"); export this geometry as B-splines")
+        help("inspc evaluates planes, cylinders, cones, spheres, tori, B-spline, extruded, revolved and offset surfaces, and lines, conics, B-spline curves, polylines, composite and offset curves (README, \"CAD files\"); export this geometry as B-splines")
     )]
     Unsupported {
         /// The instance.

@@ -45,6 +45,7 @@ mod compound;
 pub(super) mod curve;
 pub(super) mod edges;
 pub(in crate::geometry) mod error;
+mod fallback;
 pub(super) mod geom;
 mod p21;
 pub mod pmi;

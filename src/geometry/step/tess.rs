@@ -28,6 +28,7 @@
 use super::brep::{Bound, Brep, Face};
 use super::curve::unwrap_near;
 use super::edges::{edge_polylines, refine_curve, too_large, Resolution, BATCH};
+use super::fallback::{ear_mesh, uncross, Refiner};
 use super::geom::Surf;
 use crate::geometry::weld::MAX_TRIANGLES;
 use crate::geometry::{P3, V3};
@@ -214,11 +215,129 @@ fn face_mesh(face: &Face, edges: &[Vec<P3>], res: Resolution) -> Result<Vec<[P3;
     let sense = if face.same_sense { 1.0 } else { -1.0 };
     let polygons = close_loops(s, loops, periods, sense, res)?;
     let scale = ParamScale::of(s, &polygons);
-    let mut cdt = bounds_triangulation(&polygons, &scale)?;
-    if !matches!(s, Surf::Plane(_)) {
-        refine(&mut cdt, s, &scale, res)?;
+    delaunay(s, &polygons, &scale, sense, res).or_else(|why| {
+        apart(s, &polygons, &scale, sense, res)
+            .or_else(|_| ear_clipped(s, &polygons, &scale, sense, res))
+            .map_err(|e| format!("{why}; nor by the fallbacks ({e})"))
+    })
+}
+
+/// Delaunay again with the bound points whose segments cross moved apart in the plane
+/// (`fallback::uncross`): by half the chord, then up to four times farther. The bounds'
+/// chords of a wall thinner than the chord cross by less than that.
+fn apart(
+    s: &Surf,
+    polygons: &[Vec<Pt>],
+    scale: &ParamScale,
+    sense: f64,
+    res: Resolution,
+) -> Result<Vec<[P3; 3]>, String> {
+    let mut plane: Vec<Vec<[f64; 2]>> = polygons
+        .iter()
+        .map(|p| p.iter().map(|pt| scale.scaled(pt.uv)).collect())
+        .collect();
+    let mut delta = 0.5 * res.chord_mm;
+    let mut last = Err("its bounds do not cross".to_string());
+    for _ in 0..4 {
+        if uncross(&mut plane, delta) == 0 {
+            break;
+        }
+        let moved: Vec<Vec<Pt>> = polygons
+            .iter()
+            .zip(&plane)
+            .map(|(p, q)| {
+                p.iter()
+                    .zip(q)
+                    .map(|(pt, q)| Pt {
+                        uv: scale.unscale(*q),
+                        xyz: pt.xyz,
+                    })
+                    .collect()
+            })
+            .collect();
+        last = delaunay(s, &moved, scale, sense, res);
+        if last.is_ok() {
+            break;
+        }
+        delta *= 2.0;
+    }
+    last
+}
+
+/// The constrained Delaunay triangulation of a face's bounds, refined on a curved
+/// surface; where refining fails (too many points, a point spade refuses), refined
+/// again to ten times the chord, then not at all: coarser, but the face's.
+fn delaunay(
+    s: &Surf,
+    polygons: &[Vec<Pt>],
+    scale: &ParamScale,
+    sense: f64,
+    res: Resolution,
+) -> Result<Vec<[P3; 3]>, String> {
+    let mut cdt = bounds_triangulation(polygons, scale)?;
+    if !matches!(s, Surf::Plane(_)) && refine(&mut cdt, s, scale, res).is_err() {
+        let coarse = Resolution {
+            chord_mm: res.chord_mm * 10.0,
+            angle_rad: (res.angle_rad * 2.0).min(1.0),
+        };
+        cdt = bounds_triangulation(polygons, scale)?;
+        if refine(&mut cdt, s, scale, coarse).is_err() {
+            cdt = bounds_triangulation(polygons, scale)?;
+        }
     }
     inside_triangles(&cdt, sense)
+}
+
+/// The fallback when Delaunay fails (`fallback.rs`): the bounds ear-clipped in the
+/// scaled plane with every point kept, split inside where a triangle strays from a
+/// curved surface; counter-clockwise in the plane is along the natural normal.
+fn ear_clipped(
+    s: &Surf,
+    polygons: &[Vec<Pt>],
+    scale: &ParamScale,
+    sense: f64,
+    res: Resolution,
+) -> Result<Vec<[P3; 3]>, String> {
+    let plane: Vec<Vec<([f64; 2], P3)>> = polygons
+        .iter()
+        .map(|p| p.iter().map(|pt| (scale.scaled(pt.uv), pt.xyz)).collect())
+        .collect();
+    let eval = |q: [f64; 2]| {
+        let uv = scale.unscale(q);
+        s.eval(uv[0], uv[1])
+    };
+    let stray = |q: [[f64; 2]; 3], x: [P3; 3]| {
+        // Two corners on one pole: nothing to refine.
+        if (x[1] - x[0]).cross(&(x[2] - x[0])).norm() < 1e-12 {
+            return false;
+        }
+        let c = [
+            (q[0][0] + q[1][0] + q[2][0]) / 3.0,
+            (q[0][1] + q[1][1] + q[2][1]) / 3.0,
+        ];
+        strays(s, scale, res, (q, c), x)
+    };
+    let refiner = Refiner {
+        eval: &eval,
+        strays: &stray,
+        budget: MAX_FACE_POINTS,
+        spacing_mm: MIN_SPACING_MM,
+    };
+    let curved = !matches!(s, Surf::Plane(_));
+    // Bounds cross by less than the chord that cut them.
+    let flat = ear_mesh(&plane, res.chord_mm, curved.then_some(&refiner))?;
+    Ok(flat
+        .tris
+        .iter()
+        .map(|t| {
+            let x = t.map(|i| flat.xyz[i]);
+            if sense > 0.0 {
+                x
+            } else {
+                [x[0], x[2], x[1]]
+            }
+        })
+        .collect())
 }
 
 /// The triangulation of a face's parameter plane.
@@ -905,5 +1024,45 @@ mod sense_tests {
                 b.faces.len()
             );
         }
+    }
+
+    /// The end faces of a ring whose wall is thinner than the chord: their bounds'
+    /// chords cross, Delaunay refuses them, and the fallback meshes them with their
+    /// area (π (21² − 20²) mm²).
+    #[test]
+    fn crossing_bounds_fall_back_to_chords_moved_apart() {
+        let bytes = std::fs::read("tests/cad/thin_wall.stp").unwrap();
+        let f = super::super::p21::parse(&bytes).unwrap();
+        let b = super::super::brep::read(&f).unwrap();
+        let res = super::super::RESOLUTION;
+        let edges = edge_polylines(&b, res).unwrap();
+        let mut planes = 0;
+        for face in b
+            .faces
+            .iter()
+            .filter(|f| matches!(f.surface, Surf::Plane(_)))
+        {
+            let s = &face.surface;
+            let loops = face_loops(face, &edges).unwrap();
+            let sense = if face.same_sense { 1.0 } else { -1.0 };
+            let periods = [s.u_period(), s.v_period()];
+            let polygons = close_loops(s, loops, periods, sense, res).unwrap();
+            let scale = ParamScale::of(s, &polygons);
+            let why = delaunay(s, &polygons, &scale, sense, res).unwrap_err();
+            assert!(why.contains("cross"), "{why}");
+
+            let area: f64 = face_mesh(face, &edges, res)
+                .unwrap()
+                .iter()
+                .map(|t| 0.5 * (t[1] - t[0]).cross(&(t[2] - t[0])).norm())
+                .sum();
+            let exact = std::f64::consts::PI * (21.0f64.powi(2) - 20.0f64.powi(2));
+            assert!(
+                (area - exact).abs() < 0.01 * exact,
+                "{area} against {exact}"
+            );
+            planes += 1;
+        }
+        assert_eq!(planes, 2);
     }
 }
