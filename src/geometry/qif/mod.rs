@@ -34,10 +34,11 @@
 //! `EntityInternalIds` (faces, or edges as their curved faces); datums follow their
 //! feature nominals or their targets' feature nominals; composite frames' second
 //! segments become lower segments; the angle of a two-plane feature is the angle
-//! between its planes, as STEP files state it. Surfaces: plane, cylinder, cone, sphere,
-//! torus, NURBS, extrusion, revolution, offset (`surfaces.rs`); curves: segment,
-//! circular and conic arc, NURBS, polyline and aggregates of them; meshed faces are
-//! `qif_unsupported`.
+//! between its planes, as STEP files state it. Surfaces: every QIF 3 kind — plane,
+//! cylinder, cone, sphere, torus, NURBS, spline (`splines.rs`), extrusion, revolution,
+//! ruled, offset (`surfaces.rs`); curves: every kind — segment, circular and conic arc,
+//! NURBS, spline, polyline and aggregates of them; meshed faces and binary control
+//! points are `qif_unsupported`.
 
 mod brep;
 mod curves;

@@ -50,7 +50,7 @@ pub(super) fn spline13(d: &Doc, c: &Node) -> Result<(Curve, Option<P3>), QifErro
         let piece = bernstein(&a, degree);
         if let Some(last) = points.last() {
             let gap = (last - piece[0]).norm();
-            if !(gap <= JOIN_MM) {
+            if gap.is_nan() || gap > JOIN_MM {
                 return Err(malformed(
                     c,
                     &format!(
@@ -187,7 +187,11 @@ impl Grid<'_> {
                     let cell = &mut grid[i * self.p + ii][j * self.q + jj];
                     let b = P3::from(b);
                     match cell {
-                        Some(prev) if !((*prev - b).norm() <= JOIN_MM) => return None,
+                        Some(prev)
+                            if (*prev - b).norm().is_nan() || (*prev - b).norm() > JOIN_MM =>
+                        {
+                            return None
+                        }
                         _ => *cell = Some(b),
                     }
                 }
@@ -210,7 +214,7 @@ fn breakpoints(c: &Node, name: &str) -> Result<Vec<f64>, QifError> {
         .child(name)
         .and_then(|k| k.numbers())
         .ok_or_else(|| malformed(c, &format!("its <{name}> are not numbers")))?;
-    if k.len() < 2 || k.windows(2).any(|w| !(w[1] > w[0])) || k.iter().any(|x| !x.is_finite()) {
+    if k.len() < 2 || k.windows(2).any(|w| w[1] <= w[0]) || k.iter().any(|x| !x.is_finite()) {
         return Err(malformed(
             c,
             &format!("its <{name}> are not two or more ascending breakpoints"),

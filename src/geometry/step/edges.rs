@@ -242,52 +242,55 @@ pub(crate) fn edge_polylines(b: &Brep, res: Resolution) -> Result<Vec<Vec<P3>>, 
 /// Each ruled face's normal at a point of an edge (`None` where it is undefined).
 type Normals = Vec<Option<V3>>;
 
+fn normals_at(faces: &[&Surf], p: &P3) -> Normals {
+    faces
+        .iter()
+        .map(|s| {
+            let (u, v) = s.param(p, None);
+            s.normal(&s.eval(u, v), u, v)
+        })
+        .collect()
+}
+
 /// An edge's points with more between any two where the normal of a ruled face it
 /// bounds turns by more than the angle limit: a twisted ruled surface turns along its
 /// straight lines, and a bound segment is what the face's triangles cannot split.
 fn turned(e: &Edge, pts: Vec<P3>, faces: &[&Surf], res: Resolution) -> Vec<P3> {
-    let normals = |p: &P3| -> Normals {
-        faces
-            .iter()
-            .map(|s| {
-                let (u, v) = s.param(p, None);
-                s.normal(&s.eval(u, v), u, v)
-            })
-            .collect()
-    };
-    let turns = |a: &[Option<V3>], b: &[Option<V3>]| {
-        a.iter()
-            .zip(b)
-            .any(|(x, y)| matches!((x, y), (Some(x), Some(y)) if x.angle(y) > res.angle_rad))
-    };
-    fn split(
-        e: &Edge,
-        (a, na): (P3, &[Option<V3>]),
-        (b, nb): (P3, &[Option<V3>]),
-        depth: usize,
-        normals: &dyn Fn(&P3) -> Normals,
-        turns: &dyn Fn(&[Option<V3>], &[Option<V3>]) -> bool,
-        out: &mut Vec<P3>,
-    ) {
-        if depth < 10 && turns(na, nb) {
-            let m = P3::from((a.coords + b.coords) / 2.0);
-            let m = e.curve.eval(e.curve.param(&m));
-            let nm = normals(&m);
-            split(e, (a, na), (m, &nm), depth + 1, normals, turns, out);
-            split(e, (m, &nm), (b, nb), depth + 1, normals, turns, out);
-        } else {
-            out.push(b);
-        }
-    }
     let mut out = vec![pts[0]];
-    let mut prev = normals(&pts[0]);
+    let mut prev = normals_at(faces, &pts[0]);
     for &p in &pts[1..] {
-        let np = normals(&p);
+        let np = normals_at(faces, &p);
         let a = *out.last().unwrap_or(&p);
-        split(e, (a, &prev), (p, &np), 0, &normals, &turns, &mut out);
+        split_turn(e, faces, res, (a, &prev), (p, &np), 0, &mut out);
         prev = np;
     }
     out
+}
+
+/// Appends the points after `a` up to `b`, halving along the edge's curve while the
+/// faces' normals at the two ends differ by more than the angle limit.
+fn split_turn(
+    e: &Edge,
+    faces: &[&Surf],
+    res: Resolution,
+    (a, na): (P3, &[Option<V3>]),
+    (b, nb): (P3, &[Option<V3>]),
+    depth: usize,
+    out: &mut Vec<P3>,
+) {
+    let turns = na
+        .iter()
+        .zip(nb)
+        .any(|(x, y)| matches!((x, y), (Some(x), Some(y)) if x.angle(y) > res.angle_rad));
+    if depth < 10 && turns {
+        let m = P3::from((a.coords + b.coords) / 2.0);
+        let m = e.curve.eval(e.curve.param(&m));
+        let nm = normals_at(faces, &m);
+        split_turn(e, faces, res, (a, na), (m, &nm), depth + 1, out);
+        split_turn(e, faces, res, (m, &nm), (b, nb), depth + 1, out);
+    } else {
+        out.push(b);
+    }
 }
 
 /// An edge on a curve known by evaluation only (a composite, an offset): from its

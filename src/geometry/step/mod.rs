@@ -34,9 +34,12 @@
 //! Surfaces: plane, cylinder, cone, sphere, torus (also degenerate), B-spline
 //! (rational, closed; knots given or implied), linear extrusion, revolution, offset
 //! (`swept.rs`; read analytic where they are one, `canon.rs`), rectangular trimmed;
-//! curves: line, circle, ellipse, parabola, hyperbola, B-spline, polyline, and the
-//! trimmed, surface and seam wrappers. Resolution ([`RESOLUTION`]): 0.1 mm chord and
-//! 0.5 rad, the reference meshes' own.
+//! curves: line, circle, ellipse, parabola, hyperbola, B-spline, polyline, composite
+//! curves of trimmed or bounded segments and offset curves (`composite.rs`, read by
+//! `compound.rs`), and the trimmed, surface and seam wrappers. Edges are cut once each
+//! (`edges.rs`); a face whose triangulation fails falls back to a coarser one that keeps
+//! the mesh closed (`tess.rs`, `fallback.rs`). Resolution ([`RESOLUTION`]): 0.1 mm chord
+//! and 0.5 rad, the reference meshes' own.
 
 pub(super) mod brep;
 pub(super) mod canon;

@@ -1,7 +1,7 @@
 //! Tessellation of a B-rep to a chord tolerance, face by face.
 //!
-//! Every edge is cut into a polyline once (so the two faces that share it share its
-//! points and the mesh closes). A face's bounds are mapped into the surface's parameter
+//! Every edge is cut into a polyline once (`edges.rs`: the two faces that share it share
+//! its points and the mesh closes). A face's bounds are mapped into the surface's parameter
 //! plane, scaled to millimetres, and triangulated there with a constrained Delaunay
 //! triangulation (spade); triangles outside the bounds are dropped, and on a curved
 //! surface points are added inside until every triangle lies within the chord tolerance
@@ -24,6 +24,13 @@
 //! pole inside a loop becomes a run of points along the pole. Cylinders and cones are
 //! triangulated with v squeezed `RULED_STRETCH` (8) times, so triangles run along their
 //! straight lines.
+//!
+//! **Decision: a failing face falls back, coarser, rather than fail.** Where refining
+//! runs out of points it is redone to ten times the chord, then left out; where the
+//! bounds cross in the plane (a wall thinner than the chord), the crossing points are
+//! moved apart in the plane only and Delaunay runs again; last, the bounds are
+//! ear-clipped (`fallback.rs`). Each keeps every bound point, so the mesh stays closed;
+//! a face is an error only when all fail, with the first reason.
 
 use super::brep::{Bound, Brep, Face};
 use super::curve::unwrap_near;
