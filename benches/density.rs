@@ -5,9 +5,10 @@
 //! sampling is the first row of each part: the baseline in the same run.
 //!
 //! Each row runs in a child process (this binary again, `INSPC_DENSITY_ONE=spec:N`), so its
-//! peak memory (`VmHWM`) is its own. Sizes are `INSPC_DENSITY_SIZES` (default `12,24,48`;
-//! the series reaches 10,000 points on CTC 02 at about 460 a face). A build that
-//! fails prints its diagnostic codes in place of the counts.
+//! peak memory (`VmHWM`) is its own. Sizes are `INSPC_DENSITY_SIZES` (default
+//! `12,48,200,455`: 10,010 points on CTC 02's 22 sampled faces; FTC 06's 108 faces pass
+//! the 20,000-point limit at 455 and say so). A build that fails prints its diagnostic
+//! codes in place of the counts.
 //!
 //! Run with `cargo bench --bench density` (needs `../shared/parts`).
 
@@ -25,7 +26,7 @@ fn main() {
         return;
     }
     let sizes: Vec<usize> = std::env::var("INSPC_DENSITY_SIZES")
-        .unwrap_or_else(|_| "12,24,48".into())
+        .unwrap_or_else(|_| "12,48,200,455".into())
         .split(',')
         .filter_map(|s| s.trim().parse().ok())
         .collect();

@@ -49,7 +49,7 @@ use crate::geometry::{FaceId, PartGeometry, Surface};
 use crate::model::{Declared, FeatureId, Part, Sampling, Strategy, SurfaceKind, TolKind};
 use crate::sample::{Fpoint, Sampler};
 use petgraph::graph::{DiGraph, NodeIndex};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 /// A node of the measurement graph.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,12 +109,25 @@ pub struct MeasurementGraph {
     /// Per feature, its sensor and why, when the plan's machine carries a scanner
     /// ([`sensors::select`]); empty otherwise.
     pub sensors: Vec<sensors::SensorPick>,
+    /// Per face sampled with more than [`DENSE_FACE`] points, the same strategy's
+    /// [`REPRESENTATIVES`] points: what the planner decides the face's configurations
+    /// on (`plan::dense`). They are not measured.
+    pub representatives: BTreeMap<FaceId, Vec<Fpoint>>,
 }
 
+/// The most points a face has and is still planned point by point: the spread
+/// sampling gives a toleranced face at most 25.
+pub(crate) const DENSE_FACE: usize = 25;
+
+/// How many points of its own strategy a denser face is planned on (`plan::dense`): as
+/// many as a face of a typical real program, the same at every density.
+pub(crate) const REPRESENTATIVES: u32 = 12;
+
 /// The most measuring points one graph may hold. The path stage keeps a shortest-path
-/// tree per point of a group (points × roadmap nodes), so this bounds its memory to a
-/// few hundred megabytes and a build to seconds; real parts use far fewer (FTC 08: 737).
-pub(crate) const MAX_POINTS: usize = 5_000;
+/// tree per point of a group (points × roadmap nodes), so this bounds its memory: CTC 02
+/// at 10,000 points peaks at 1.1 GB. A body-in-white program runs 2,000 and more; dense
+/// faces cost the planner their representatives only (`plan::dense`).
+pub(crate) const MAX_POINTS: usize = 20_000;
 
 impl MeasurementGraph {
     /// The fpoints of a face, by index.
@@ -189,7 +202,7 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
     }
     let feature_nodes = add_features(part, &mut graph, root, &datums_of);
     let (face_nodes, owners_of) = add_faces(input, &mut graph, &feature_nodes, &datums_of);
-    let fpoints = add_points(input, &mut graph, &face_nodes, owners_of, diags);
+    let (fpoints, representatives) = add_points(input, &mut graph, &face_nodes, owners_of, diags);
     MeasurementGraph {
         plan: input.plan.map(str::to_owned),
         sampling: input.sampling.name.clone(),
@@ -198,6 +211,7 @@ pub fn build(input: &Input, diags: &mut Diagnostics) -> MeasurementGraph {
         fpoints,
         margin: input.margin,
         sensors: Vec::new(),
+        representatives,
     }
 }
 
@@ -316,14 +330,16 @@ type FacesAdded = (
 );
 
 /// Samples each face and adds its fpoints under it, up to [`MAX_POINTS`] in all;
-/// reports a face that gets none, and stops with an error past the limit.
+/// reports a face that gets none, and stops with an error past the limit. A face of
+/// more than [`DENSE_FACE`] points is also sampled at [`REPRESENTATIVES`] points.
 fn add_points(
     input: &Input,
     graph: &mut DiGraph<Node, Edge>,
     face_nodes: &[(FaceId, NodeIndex, FeatureId)],
     mut owners_of: HashMap<FaceId, Vec<FeatureId>>,
     diags: &mut Diagnostics,
-) -> Vec<Fpoint> {
+) -> (Vec<Fpoint>, BTreeMap<FaceId, Vec<Fpoint>>) {
+    let mut representatives = BTreeMap::new();
     let part = input.part;
     let g = input.geometry;
     let sampler = Sampler::new(g, input.margin);
@@ -353,13 +369,21 @@ fn add_points(
                 margin: crate::model::fmt_num(input.margin),
             });
         }
+        if points.len() > DENSE_FACE {
+            let few = Strategy {
+                points: Some(REPRESENTATIVES),
+                spacing: None,
+                ..strategy.clone()
+            };
+            representatives.insert(face, sampler.sample(face, &few));
+        }
         for p in points {
             let pn = graph.add_node(Node::Point(fpoints.len()));
             graph.add_edge(fnode, pn, Edge::Point);
             fpoints.push(p);
         }
     }
-    fpoints
+    (fpoints, representatives)
 }
 
 /// The strategy for a face: the override of the first feature (in declaration order)

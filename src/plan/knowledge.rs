@@ -168,31 +168,25 @@ impl<'a> Knowledge<'a> {
         up: V3,
         held: &Held,
     ) -> Result<(), Blocker> {
-        let probe = &machine.probes[p];
-        let point = &self.points[f];
         let contact = if f >= self.graph_points {
             Contact::Table
         } else {
             Contact::Part
         };
-        let travel = match contact {
-            Contact::Part => access::pose::backoff(
-                &self.scene,
-                &point.position,
-                &point.normal,
-                probe.tip_radius,
-                self.opts.retract,
-            ),
-            Contact::Table => self.opts.retract,
+        let touch = Touch {
+            point: &self.points[f],
+            contact,
+            probe: &machine.probes[p],
+            dir,
+            up,
         };
-        Pose::new(&self.scene, probe, dir, up, held.table)
-            .with_fixture(&held.solids)
-            .approach(
-                &point.tip_centre(probe.tip_radius),
-                &point.normal,
-                travel,
-                contact,
-            )
+        touch_check(
+            &self.scene,
+            self.opts.retract,
+            &touch,
+            held.table,
+            &held.solids,
+        )
     }
 
     /// The initial knowledge: half-line cones at every fpoint for every probe, table
@@ -844,6 +838,47 @@ impl<'a> Knowledge<'a> {
         }
         self.d1p.retain(|&(f, p, _), _| !done.contains(&(f, p)));
     }
+}
+
+/// One touch as validation poses it: a point, what it lies on, and the probe standing
+/// along `dir` in setup `up`.
+pub(crate) struct Touch<'p> {
+    pub point: &'p Fpoint,
+    pub contact: Contact,
+    pub probe: &'p ProbeShape,
+    pub dir: V3,
+    pub up: V3,
+}
+
+/// Validates one touch (a primitive inspection plan, seed ch. 4.1): the tip swept from
+/// the retract point `retract` mm out (less where the part is nearer behind a point on
+/// the part) to the contact, every component along the approach, against the part
+/// (`scene`), the table at height `table` and the fixture's `solids`.
+pub(crate) fn touch_check(
+    scene: &Scene,
+    retract: f64,
+    t: &Touch,
+    table: f64,
+    solids: &[crate::access::pose::Solid],
+) -> Result<(), Blocker> {
+    let travel = match t.contact {
+        Contact::Part => access::pose::backoff(
+            scene,
+            &t.point.position,
+            &t.point.normal,
+            t.probe.tip_radius,
+            retract,
+        ),
+        Contact::Table => retract,
+    };
+    Pose::new(scene, t.probe, t.dir, t.up, table)
+        .with_fixture(solids)
+        .approach(
+            &t.point.tip_centre(t.probe.tip_radius),
+            &t.point.normal,
+            travel,
+            t.contact,
+        )
 }
 
 /// Preferred directions: the axes, the plan's setups, the realisable setups, the table

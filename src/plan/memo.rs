@@ -51,9 +51,29 @@ pub struct Memo {
     /// A plan validated with the part turned was sought and not found: the re-plans of
     /// the same input (which only add bans) do not seek it again.
     pub(crate) unturnable: bool,
+    /// Points of a dense face the search plans besides its representatives, by index in
+    /// the full graph ([`super::dense`]): those no representative's configuration
+    /// reached, and those the path stage banned.
+    pub(super) promoted: std::collections::BTreeSet<usize>,
+    /// The full graph's indices of the points the knowledge above is numbered by, when
+    /// the search planned a thinned graph.
+    thinned: Option<Vec<usize>>,
 }
 
 impl Memo {
+    /// Numbers the per-point knowledge by the thinned graph of `full` (indices in the
+    /// full graph): what was kept for another numbering is forgotten.
+    pub(super) fn retarget(&mut self, full: &[usize]) {
+        if self.thinned.as_deref() == Some(full) {
+            return;
+        }
+        self.thinned = Some(full.to_vec());
+        self.initial = None;
+        self.cones.clear();
+        self.orientations.clear();
+        self.caps.clear();
+    }
+
     /// Later plannings of this input validate at the nominal pose only.
     pub fn give_up_turned(&mut self) {
         self.unturnable = true;

@@ -30,6 +30,7 @@
 mod account;
 mod axes;
 pub mod cluster;
+mod dense;
 mod errors;
 mod explain;
 mod fallback;

@@ -43,7 +43,7 @@ use super::machine::Machine;
 use super::memo::Memo;
 use super::solve::{self, Branch};
 use super::validate::{self, Pip};
-use super::{axes, placement, poses, remeasure, scan, Hlip, Input, PlanError, PlanOptions};
+use super::{axes, dense, placement, poses, remeasure, scan, Hlip, Input, PlanError, PlanOptions};
 use crate::diag::Diagnostics;
 use crate::geometry::{FaceId, V3};
 use crate::graph::Node;
@@ -72,7 +72,10 @@ pub fn plan_with(
     loop {
         let skip: BTreeSet<FaceId> = lasers.iter().flat_map(|l| l.faces.clone()).collect();
         let mut own = Diagnostics::new();
-        let Some(mut hlip) = plan_placed(input, opts, memo, &skip, &mut own) else {
+        let mut placed = |i: &Input, o: &PlanOptions, m: &mut Memo, d: &mut Diagnostics| {
+            plan_placed(i, o, m, &skip, d)
+        };
+        let Some(mut hlip) = dense::plan_dense(input, opts, memo, &mut own, &mut placed) else {
             diags.extend(own);
             return None;
         };

@@ -12,6 +12,7 @@ mod cases;
 mod catalogue;
 mod cli;
 mod cluster_props;
+mod density;
 mod diag_files;
 mod diagnostics;
 mod dmis_foreign;
