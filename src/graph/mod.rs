@@ -124,8 +124,8 @@ pub(crate) const DENSE_FACE: usize = 25;
 pub(crate) const REPRESENTATIVES: u32 = 12;
 
 /// The most measuring points one graph may hold. The path stage keeps a shortest-path
-/// tree per point of a group (points × roadmap nodes), so this bounds its memory: CTC 02
-/// at 10,000 points peaks at 1.1 GB. A body-in-white program runs 2,000 and more; dense
+/// tree per point of a group (points × roadmap nodes), so this bounds its memory: at
+/// 10,000 points CTC 02 peaks at 1.4 GB and FTC 06 at 2.1 GB. A body-in-white program runs 2,000 and more; dense
 /// faces cost the planner their representatives only (`plan::dense`).
 pub(crate) const MAX_POINTS: usize = 20_000;
 
