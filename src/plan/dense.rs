@@ -185,40 +185,13 @@ pub(super) fn renumber(hlip: &mut Hlip, t: &Thinned, g: &MeasurementGraph) -> us
 /// touch with them; the plan is counted again.
 pub(super) fn strip(hlip: &mut Hlip, cut: usize) {
     hlip.points.truncate(cut);
-    for s in &mut hlip.setups {
-        for p in &mut s.probes {
-            for o in &mut p.orients {
-                for i in &mut o.inspections {
-                    for v in &mut i.faces {
-                        v.points.retain(|&x| x < cut);
-                    }
-                    i.faces
-                        .retain(|v| !v.points.is_empty() || !v.passes.is_empty());
-                }
-                o.inspections.retain(|i| !i.faces.is_empty());
-            }
-            p.orients.retain(|o| !o.inspections.is_empty());
-        }
-        s.probes.retain(|p| !p.orients.is_empty());
+    for v in visits_mut(hlip) {
+        v.points.retain(|&x| x < cut);
     }
+    hlip.prune();
     hlip.setups.retain(|s| !s.probes.is_empty());
     let head = hlip.head;
     super::scan::recount(hlip, head);
-    let touched = || {
-        hlip.setups
-            .iter()
-            .flat_map(|s| &s.probes)
-            .flat_map(|p| &p.orients)
-            .flat_map(|o| &o.inspections)
-            .flat_map(|i| i.faces.iter().map(move |v| (i.feature, v)))
-            .filter(|(_, v)| v.passes.is_empty())
-    };
-    let features: BTreeSet<_> = touched().map(|(f, _)| f).collect();
-    let points: BTreeSet<usize> = touched()
-        .flat_map(|(_, v)| v.points.iter().copied())
-        .collect();
-    hlip.summary.features = features.len();
-    hlip.summary.points = points.len();
 }
 
 /// Where a visit is in the plan: setup, probe, orientation, inspection and visit.

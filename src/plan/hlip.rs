@@ -258,6 +258,22 @@ impl Hlip {
                                 && v.passes.is_empty())
                         });
                     }
+                }
+            }
+        }
+        self.prune();
+    }
+
+    /// Drops the visits with nothing to touch or scan, and the inspections, orientations
+    /// and probes left empty (setups stay); counts the touched features and points again.
+    pub(crate) fn prune(&mut self) {
+        for s in &mut self.setups {
+            for p in &mut s.probes {
+                for o in &mut p.orients {
+                    for i in &mut o.inspections {
+                        i.faces
+                            .retain(|v| !v.points.is_empty() || !v.passes.is_empty());
+                    }
                     o.inspections.retain(|i| !i.faces.is_empty());
                 }
                 p.orients.retain(|o| !o.inspections.is_empty());

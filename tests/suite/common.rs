@@ -308,3 +308,22 @@ pub fn nearest_faces(
         })
         .collect()
 }
+
+/// The plan of the first plan of the spec at `path`, planned with `opts`; fails the test
+/// on any error.
+pub fn first_plan(path: &std::path::Path, opts: &inspc::plan::PlanOptions) -> inspc::plan::Hlip {
+    let (checked, _, _, planned) =
+        inspc::plans(&inspc::source::FsWorld, &[path.to_path_buf()], opts);
+    let errors: Vec<String> = checked
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity() == miette::Severity::Error)
+        .map(|d| d.message())
+        .collect();
+    assert!(errors.is_empty(), "{}: {errors:?}", path.display());
+    planned
+        .into_iter()
+        .next()
+        .and_then(|p| p.hlip)
+        .expect("a plan")
+}

@@ -3,8 +3,8 @@
 //! probes and setup directions are the same at every density, every point sampled is
 //! either touched or counted as dropped, and no representative is left in the plan.
 
+use crate::common::first_plan;
 use inspc::plan::{Hlip, PlanOptions, PointRef};
-use inspc::source::FsWorld;
 use std::collections::BTreeSet;
 
 /// The spec with every surface kind sampled at `n` Hammersley points, planned.
@@ -28,28 +28,20 @@ fn plan_at(spec: &str, n: usize) -> Hlip {
         &text[..=open],
         &text[open + 1..]
     );
-    // Beside the spec, whose `use` paths are relative to its folder.
-    let path = std::path::Path::new(spec)
-        .with_file_name(format!(".density-{}-{n}.insp", std::process::id()));
+    // In a folder of its own (the examples' folder is read by other tests), with the
+    // part files its `use` paths name.
+    let dir = std::env::temp_dir().join(format!("inspc-density-{}-{n}", std::process::id()));
+    let parts = dir.join("parts");
+    std::fs::create_dir_all(&parts).unwrap();
+    for f in std::fs::read_dir("examples/parts").unwrap() {
+        let f = f.unwrap().path();
+        std::fs::copy(&f, parts.join(f.file_name().unwrap())).unwrap();
+    }
+    let path = dir.join("dense.insp");
     std::fs::write(&path, dense).unwrap();
-    let (checked, _, _, planned) = inspc::plans(
-        &FsWorld,
-        std::slice::from_ref(&path),
-        &PlanOptions::default(),
-    );
-    std::fs::remove_file(&path).ok();
-    let errors: Vec<String> = checked
-        .diagnostics
-        .iter()
-        .filter(|d| d.severity() == miette::Severity::Error)
-        .map(|d| d.message())
-        .collect();
-    assert!(errors.is_empty(), "{spec} at {n}: {errors:?}");
-    planned
-        .into_iter()
-        .next()
-        .and_then(|p| p.hlip)
-        .expect("a plan")
+    let plan = first_plan(&path, &PlanOptions::default());
+    std::fs::remove_dir_all(&dir).ok();
+    plan
 }
 
 /// Every point the plan touches.

@@ -2,8 +2,6 @@
 //! collision-free move reaches is banned, and the planner plans that touch elsewhere.
 
 use inspc::plan::{Ban, Hlip, PlanOptions};
-use inspc::source::FsWorld;
-use std::path::PathBuf;
 
 /// Every (point, probe, up, direction) the plan touches.
 fn configurations(h: &Hlip) -> Vec<Ban> {
@@ -29,19 +27,7 @@ fn configurations(h: &Hlip) -> Vec<Ban> {
 }
 
 fn plan(spec: &str, opts: &PlanOptions) -> Hlip {
-    let (checked, _, _, planned) = inspc::plans(&FsWorld, &[PathBuf::from(spec)], opts);
-    let errors: Vec<String> = checked
-        .diagnostics
-        .iter()
-        .filter(|d| d.severity() == miette::Severity::Error)
-        .map(|d| d.message())
-        .collect();
-    assert!(errors.is_empty(), "{spec}: {errors:?}");
-    planned
-        .into_iter()
-        .next()
-        .and_then(|p| p.hlip)
-        .expect("a plan")
+    crate::common::first_plan(std::path::Path::new(spec), opts)
 }
 
 fn same(a: &Ban, b: &Ban) -> bool {
