@@ -109,9 +109,9 @@ pub struct MeasurementGraph {
     /// Per feature, its sensor and why, when the plan's machine carries a scanner
     /// ([`sensors::select`]); empty otherwise.
     pub sensors: Vec<sensors::SensorPick>,
-    /// Per face sampled with more than [`DENSE_FACE`] points, the same strategy's
-    /// [`REPRESENTATIVES`] points: what the planner decides the face's configurations
-    /// on (`plan::dense`). They are not measured.
+    /// Per face sampled with more than [`DENSE_FACE`] points, the same strategy asked
+    /// for [`REPRESENTATIVES`] points, where that gives at most half as many: what the
+    /// planner decides the face's configurations on (`plan::dense`). Not measured.
     pub representatives: BTreeMap<FaceId, Vec<Fpoint>>,
 }
 
@@ -375,7 +375,12 @@ fn add_points(
                 spacing: None,
                 ..strategy.clone()
             };
-            representatives.insert(face, sampler.sample(face, &few));
+            let few = sampler.sample(face, &few);
+            // A strategy whose own rules keep the count up (a tight zone's spread) gives
+            // no fewer: the face is planned on its own points.
+            if few.len() * 2 <= points.len() {
+                representatives.insert(face, few);
+            }
         }
         for p in points {
             let pn = graph.add_node(Node::Point(fpoints.len()));

@@ -466,6 +466,10 @@ fn place(
             .copied()
             .collect();
         if !joined.is_empty() {
+            let mut joined = joined;
+            joined.extend(again(face, &near, &joined, &mut |c| {
+                *tried.entry(c).or_insert_with(|| check(c))
+            }));
             return Placed::Join(joined);
         }
     }
@@ -496,6 +500,47 @@ fn place(
         Some((_, c)) => Placed::Elsewhere(c, like),
         None => Placed::Nowhere,
     }
+}
+
+/// The visits, besides `joined`, of setups that measure the face again
+/// (`remeasure`: a datum measured where it is read): in a setup each of whose
+/// representatives is also touched in another setup, the point joins the visits of the
+/// nearest representative touched there whose configuration `check` passes, as the
+/// search measures there every point of the face the setup reaches.
+fn again(
+    face: &BTreeMap<usize, Vec<At>>,
+    near: &[(f64, usize)],
+    joined: &[At],
+    check: &mut dyn FnMut(Config) -> bool,
+) -> Vec<At> {
+    let setups_of = |r: usize| face[&r].iter().map(|at| at.0).collect::<BTreeSet<usize>>();
+    let mut all: BTreeSet<usize> = BTreeSet::new();
+    for &r in face.keys() {
+        all.extend(setups_of(r));
+    }
+    let done: BTreeSet<usize> = joined.iter().map(|at| at.0).collect();
+    let mut out = Vec::new();
+    for s in all.difference(&done) {
+        let measured_again = face
+            .keys()
+            .filter(|&&r| setups_of(r).contains(s))
+            .all(|&r| setups_of(r).len() > 1);
+        if !measured_again {
+            continue;
+        }
+        for &(_, r) in near.iter().filter(|(_, r)| setups_of(*r).contains(s)) {
+            let here: Vec<At> = face[&r]
+                .iter()
+                .filter(|at| at.0 == *s && check((at.0, at.1, at.2)))
+                .copied()
+                .collect();
+            if !here.is_empty() {
+                out.extend(here);
+                break;
+            }
+        }
+    }
+    out
 }
 
 /// What a touch of a dense face's point is validated against.
