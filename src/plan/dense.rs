@@ -307,7 +307,9 @@ fn repair(
     let check = |c: Config| v.config(&hlip.setups, q, f, c);
     match place(f.position, face, &hlip.points, &hlip.setups, &check) {
         Placed::Nowhere => {
-            let like = nearest_visit(f.position, face, &hlip.points);
+            let Some(like) = nearest_visit(f.position, face, &hlip.points) else {
+                return Placed::Nowhere;
+            };
             let clear = |setup: &SetupNode, slot: usize, dir: V3| v.clear(setup, q, f, slot, dir);
             match open_orientation(hlip, v.machine, f, like, &clear) {
                 Some(config) => Placed::Elsewhere(config, like),
@@ -319,13 +321,12 @@ fn repair(
 }
 
 /// The first visit of the representative of `face` nearest to `at`.
-fn nearest_visit(at: P3, face: &BTreeMap<usize, Vec<At>>, points: &[PlanPoint]) -> At {
+fn nearest_visit(at: P3, face: &BTreeMap<usize, Vec<At>>, points: &[PlanPoint]) -> Option<At> {
     let (_, r) = face
         .keys()
         .map(|&r| ((points[r].position - at).norm(), r))
-        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
-        .expect("a touched face has a representative");
-    face[&r][0]
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))?;
+    face[&r].first().copied()
 }
 
 /// A new orientation for point `f` in the setup of visit `like`, where no configuration
