@@ -227,6 +227,35 @@ pub fn sampling_margin(model: &model::Model, plan: Option<&model::Plan>) -> f64 
         .max(1e-3)
 }
 
+/// The plan's probes as the sampler sees them (none without a plan): stylus length,
+/// extensions and body, from the tip up.
+pub fn probe_shanks(model: &model::Model, plan: Option<&model::Plan>) -> Vec<sample::Shank> {
+    let Some(plan) = plan else { return Vec::new() };
+    model.cmms[plan.cmm.0]
+        .probes
+        .iter()
+        .map(|(_, p)| {
+            let probe = &model.probes[p.0];
+            let stylus = &model.styli[probe.stylus.0];
+            let body = &model.bodies[probe.body.0];
+            let extensions: Vec<(f64, f64)> = probe
+                .extensions
+                .iter()
+                .rev()
+                .map(|e| {
+                    let e = &model.extensions[e.0];
+                    (e.length, e.diameter / 2.0)
+                })
+                .collect();
+            sample::Shank::new(
+                stylus.length,
+                &extensions,
+                (body.length, body.diameter / 2.0),
+            )
+        })
+        .collect()
+}
+
 /// Runs [`check_geometry`], then builds the measurement graph of every plan in the root
 /// files, and of every root part no plan names. Sampling diagnostics join the others.
 pub fn measurement_graphs(
@@ -267,6 +296,7 @@ fn graphs_of(checked: &mut Checked, parts: &[Option<PartData>]) -> Vec<Graphed> 
             sampling,
             overrides: plan.map_or(&[][..], |p| &p.overrides),
             margin: sampling_margin(model, plan),
+            shanks: probe_shanks(model, plan),
             span: plan.map_or(model.parts[k].span, |p| p.span),
         };
         let mut built = graph::build(&input, &mut diags);

@@ -185,6 +185,9 @@ pub struct Input<'a> {
     pub overrides: &'a [(FeatureId, Strategy)],
     /// The distance points keep from face boundaries (mm).
     pub margin: f64,
+    /// The plan's probes as the sampler sees them: a recess floor's points keep clear of
+    /// its walls by the probe part standing beside them (`sample::recess_margins`).
+    pub shanks: Vec<crate::sample::Shank>,
     /// Where a problem of the whole graph is reported: the plan's name, or the part's.
     pub span: crate::source::Span,
 }
@@ -342,7 +345,7 @@ fn add_points(
     let mut representatives = BTreeMap::new();
     let part = input.part;
     let g = input.geometry;
-    let sampler = Sampler::new(g, input.margin);
+    let sampler = Sampler::new(g, input.margin).with_shanks(&input.shanks);
     let mut fpoints = Vec::new();
     for &(face, fnode, first_feature) in face_nodes {
         let mut owners = owners_of.remove(&face).unwrap_or_default();

@@ -796,7 +796,37 @@ fn rack(part: &CadPart, size: [f64; 3]) -> Vec<(&'static str, &'static str)> {
     if extent > 150.0 {
         rack.push(("p4", "TP20_D2_L20_X30"));
     }
+    if deepest_floor(part) > DEEP_FLOOR {
+        rack.push((if rack.len() == 3 { "p4" } else { "p5" }, "TP20_D3_L50_X50"));
+    }
     rack
+}
+
+/// A recess floor deeper than this (mm) is past the 50 mm stylus's reach with its head
+/// kept 5 mm above the opening: the rack gets the stylus on a 50 mm extension, as
+/// Renishaw's stylus guidance asks for a stylus "long enough to reach all features".
+const DEEP_FLOOR: f64 = 45.0;
+
+/// The depth (mm) of the part's deepest recess floor (`geometry::recess_depth`): the
+/// floor of a pocket or blind hole walled on every side.
+fn deepest_floor(part: &CadPart) -> f64 {
+    let m = &part.mesh;
+    let mut own: Vec<Vec<u32>> = vec![Vec::new(); m.exact.len()];
+    for (t, &g) in m.tri_group.iter().enumerate() {
+        if let Some(list) = own.get_mut(g as usize) {
+            list.push(t as u32);
+        }
+    }
+    m.exact
+        .iter()
+        .zip(&own)
+        .filter_map(|(s, tris)| match s {
+            Surface::Plane { normal, .. } if !tris.is_empty() => {
+                crate::geometry::recess_depth(&m.vertices, &m.triangles, tris, normal)
+            }
+            _ => None,
+        })
+        .fold(0.0, f64::max)
 }
 
 /// The part's extent along x, y and z (mm).
@@ -824,6 +854,7 @@ const SPEC_NAMES: &[&str] = &[
     "TP20_D1_L20",
     "TP20_D3_L50",
     "TP20_D2_L20_X30",
+    "TP20_D3_L50_X50",
 ];
 
 /// The part's name as an identifier that no other item of the spec has.

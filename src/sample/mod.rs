@@ -45,9 +45,11 @@
 //! its mid-line). Which probe fits there is the planner's question, not the sampler's.
 
 mod chart;
+mod recess;
 
 pub(crate) use chart::convex_hull;
 pub use chart::{perpendicular_basis, Chart};
+pub use recess::{recess_margins, Shank};
 
 use crate::geometry::{FaceId, FaceIndex, PartGeometry, Surface, P3, V3};
 use crate::model::{Inset, SampleMethod, Strategy};
@@ -78,6 +80,9 @@ pub struct Sampler<'a> {
     /// The distance points keep from a face's boundary (mm): the largest tip radius the
     /// plan's machine carries, so that every probe's tip fits; Fan & Leu's `r`.
     pub margin: f64,
+    /// Per face, a larger margin where it is the floor of a deep recess
+    /// ([`recess_margins`]); empty: `margin` everywhere.
+    floors: Vec<f64>,
 }
 
 /// How many search steps span a face in each parameter.
@@ -90,7 +95,21 @@ impl<'a> Sampler<'a> {
             g,
             index: FaceIndex::new(g),
             margin,
+            floors: Vec::new(),
         }
+    }
+
+    /// The sampler with a margin per face from the probes that reach it: a recess
+    /// floor's points keep clear of its walls by the radius of the probe part standing
+    /// beside them ([`recess_margins`]).
+    pub fn with_shanks(mut self, shanks: &[Shank]) -> Sampler<'a> {
+        self.floors = recess_margins(self.g, shanks, self.margin);
+        self
+    }
+
+    /// The margin face `face`'s points keep from its boundary.
+    pub fn margin_of(&self, face: FaceId) -> f64 {
+        self.floors.get(face.0).copied().unwrap_or(self.margin)
     }
 
     /// The measuring points of one face. The entry point of the sampling stage. A face
@@ -98,7 +117,7 @@ impl<'a> Sampler<'a> {
     /// sampled again with the margin halved, down to [`MIN_MARGIN_MM`]: its points gather
     /// on its mid-line, and the planner decides which probe fits there.
     pub fn sample(&self, face: FaceId, strategy: &Strategy) -> Vec<Fpoint> {
-        let mut margin = self.margin;
+        let mut margin = self.margin_of(face);
         loop {
             let pts = self.sample_with_margin(face, strategy, margin);
             if !pts.is_empty() || margin <= MIN_MARGIN_MM {

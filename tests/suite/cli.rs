@@ -929,3 +929,35 @@ fn a_part_without_pmi_is_imported_scaled_with_a_default_inspection_and_builds() 
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 45: the floor of a hexagonal pocket 57 mm deep and 17.3 mm across flats (MFCAD
+/// 8-8-11-12-12-23 as a 100 mm block) is past the 50 mm stylus: the import's rack adds
+/// the stylus on a 50 mm extension, the floor's points keep the extension clear of the
+/// pocket's walls, and the plan measures every default tolerance, the floor's distance
+/// from the back with the long probe.
+#[test]
+fn a_pocket_floor_deeper_than_the_longest_stylus_is_measured_on_an_extension() {
+    common::require_shared_parts();
+    let dir = std::env::temp_dir().join(format!("inspc-deep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = dir.join("deep.insp");
+    let spec = spec.to_string_lossy();
+    let step = "../shared/parts/mfcad/8-8-11-12-12-23.step";
+    let (code, _, stderr) = inspc(&["import", step, "--scale", "10", "-o", &spec]);
+    assert_eq!(code, 0, "{stderr}");
+    let text = std::fs::read_to_string(&*spec).unwrap();
+    assert!(text.contains("p4: TP20_D3_L50_X50"), "{text}");
+    let dmi = dir.join("deep.dmi");
+    let (code, stdout, stderr) = inspc(&["build", &spec, "-o", &dmi.to_string_lossy()]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    assert!(
+        stdout.contains("tolerances measured 28 of 28"),
+        "{stdout}{stderr}"
+    );
+    let program = std::fs::read_to_string(&dmi).unwrap();
+    assert!(
+        program.contains("SNSLCT/S(P4_"),
+        "the floor is touched with p4"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
