@@ -70,6 +70,19 @@ pub fn recess_depth(
         depth = Some(h);
         h += step;
     }
+    // The opening lies between the last walled height and the next: halve the gap.
+    if let Some(mut low) = depth {
+        let mut high = h.min(exit);
+        for _ in 0..5 {
+            let mid = (low + high) / 2.0;
+            if walled(mid) {
+                low = mid;
+            } else {
+                high = mid;
+            }
+        }
+        depth = Some(low);
+    }
     // A recess wider than it is deep lets the probe lean away from its walls.
     let width = 2.0 * (reach - 1.0);
     depth.filter(|&d| d >= width)
@@ -179,7 +192,7 @@ mod tests {
     fn a_pocket_floor_is_as_deep_as_the_pocket() {
         let (v, t, floor) = pocket(17.0, 57.0);
         let depth = recess_depth(&v, &t, &floor, &V3::z()).unwrap();
-        assert!((depth - 57.0).abs() <= STEP_MM, "{depth}");
+        assert!((depth - 57.0).abs() <= 0.1, "{depth}");
     }
 
     #[test]
