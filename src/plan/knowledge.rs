@@ -188,12 +188,13 @@ fn rescue_empty(
     let (n, pref) = (opts.n, &opts.preferred[..]);
     let redo: Vec<usize> = (0..items.len())
         .into_par_iter()
+        .filter(|&k| on_extension(items[k].1))
         .filter(|&k| cones[k].tip_fits && cones[k].approach.is_empty())
         .filter(|&k| {
             let (f, probe) = items[k];
             let sky = access::gac_halfline(scene, &f.tip_centre(probe.tip_radius), n, pref);
             let cells = 6 * (n as usize).pow(2) + sky.preferred_len();
-            on_extension(probe) && (sky.count() as f64) < NARROW_SKY * cells as f64
+            (sky.count() as f64) < NARROW_SKY * cells as f64
         })
         .collect();
     let again: Vec<access::PointCones> = redo
