@@ -37,7 +37,8 @@ pub fn recess_depth(
 ) -> Option<f64> {
     let n = normal.try_normalize(1e-12)?;
     let start = point_on(vertices, triangles, own)?;
-    let exit = box_exit(vertices, &start, &n)?;
+    let (lo, hi) = bounds(vertices)?;
+    let exit = box_exit(&lo, &hi, &start, &n)?;
     let hits = |o: &P3, d: &V3, reach: f64| {
         triangles.iter().any(|t| {
             let [a, b, c] = t.map(|i| vertices[i as usize]);
@@ -101,9 +102,8 @@ fn point_on(vertices: &[P3], triangles: &[[u32; 3]], own: &[u32]) -> Option<P3> 
         .min_by(|a, b| (a - mean).norm().total_cmp(&(b - mean).norm()))
 }
 
-/// How far from `p` along unit `d` the ray leaves the mesh's bounding box.
-fn box_exit(vertices: &[P3], p: &P3, d: &V3) -> Option<f64> {
-    let (lo, hi) = bounds(vertices)?;
+/// How far from `p` along unit `d` the ray leaves the box from `lo` to `hi`.
+pub(crate) fn box_exit(lo: &P3, hi: &P3, p: &P3, d: &V3) -> Option<f64> {
     (0..3)
         .filter(|&i| d[i].abs() > 1e-9)
         .map(|i| {

@@ -11,7 +11,7 @@
 //! stylus alone does not reach, which is what the rack offers; points the extension
 //! cannot reach are points the program could not touch.
 
-use crate::geometry::{recess_depth, PartGeometry, Surface};
+use crate::geometry::{box_exit, recess_depth, PartGeometry, Surface};
 
 /// The clearance (mm) kept between a recess wall and the probe part beside it: the
 /// default motion margin (1 mm, which the planner's moves keep) and half a millimetre.
@@ -85,13 +85,7 @@ pub fn recess_margins(g: &PartGeometry, shanks: &[Shank], margin: f64) -> Vec<f6
                 return margin;
             };
             // Cheap first: a recess is no deeper than the part's box above the face.
-            let room = (0..3)
-                .filter(|&i| normal[i].abs() > 1e-9)
-                .map(|i| {
-                    let wall = if normal[i] > 0.0 { hi[i] } else { lo[i] };
-                    (wall - f.centroid[i]) / normal[i]
-                })
-                .fold(f64::INFINITY, f64::min);
+            let room = box_exit(&lo, &hi, &f.centroid, &normal).unwrap_or(f64::INFINITY);
             if !shanks.iter().any(|s| s.widens_within(room + 1.0, margin)) {
                 return margin;
             }
