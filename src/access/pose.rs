@@ -122,6 +122,17 @@ pub fn room_to_touch(scene: &Scene, p: &P3, n: &V3, tip_radius: f64, travel: f64
     backoff(scene, p, n, tip_radius, travel) >= MIN_TRAVEL.min(travel) - 1e-9
 }
 
+/// Whether the tip of radius `r`, on its approach from the retract point `c + n · travel`
+/// to the contact's tip centre `c`, meets one of a fixture's `solids`: the tip's part of
+/// [`Pose::approach`]'s fixture test, which no orientation of the probe changes.
+pub fn tip_meets_fixture(solids: &[Solid], c: &P3, n: &V3, travel: f64, r: f64) -> bool {
+    let q = c + n * travel;
+    let mid = P3::from((c.coords + q.coords) / 2.0);
+    solids
+        .iter()
+        .any(|s| s.distance_at_least(&mid) <= travel / 2.0 + r && s.hits(&Capsule::new(*c, q, r)))
+}
+
 /// How far the tip backs off contact `p` (normal `n`) before and after a touch: `travel`,
 /// or half the free space in front of the point when that is less (a small bore: the
 /// tip waits on its axis rather than past the far wall). The planner validates a touch
@@ -340,6 +351,25 @@ impl Solid {
         }
     }
 
+    /// A lower bound of the distance from `p` (part frame) to this solid: exact for a
+    /// box, from the bounding sphere otherwise.
+    fn distance_at_least(&self, p: &P3) -> f64 {
+        match &self.shape {
+            SolidShape::Box(h) => {
+                let local = self.at.inverse_transform_point(p);
+                local
+                    .coords
+                    .abs()
+                    .zip_map(h, |x, h| (x - h).max(0.0))
+                    .norm()
+            }
+            _ => {
+                let (c, r) = self.bounding_sphere();
+                (p - c).norm() - r
+            }
+        }
+    }
+
     /// Whether a shape given in the part frame meets this solid.
     pub fn hits(&self, shape: &dyn Shape) -> bool {
         let id = Isometry::identity();
@@ -475,6 +505,11 @@ impl<'a> Pose<'a> {
         self.fixture = solids;
         self.spheres = solids.iter().map(Solid::bounding_sphere).collect();
         self
+    }
+
+    /// The part it poses the probe against.
+    pub fn scene(&self) -> &Scene {
+        self.scene
     }
 
     /// The ram direction.
@@ -723,4 +758,32 @@ impl Core {
 /// 1 nm, so a stand-off read back from a program finds its own key).
 fn spot(x: &P3) -> [i64; 3] {
     [x.x, x.y, x.z].map(|c| (c * 1e4).round() as i64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A plate 20 × 20 × 10 mm whose top lies at z = 0.
+    fn plate() -> Vec<Solid> {
+        vec![Solid::cuboid(
+            P3::new(0.0, 0.0, -5.0),
+            Rotation3::identity(),
+            V3::new(10.0, 10.0, 5.0),
+        )]
+    }
+
+    #[test]
+    fn a_tip_sweeping_along_the_plate_meets_it() {
+        let c = P3::new(0.0, 0.0, 0.5);
+        assert!(tip_meets_fixture(&plate(), &c, &V3::x(), 5.0, 1.0));
+    }
+
+    #[test]
+    fn a_tip_backing_off_the_plate_clears_it() {
+        let c = P3::new(0.0, 0.0, 1.5);
+        assert!(!tip_meets_fixture(&plate(), &c, &V3::z(), 5.0, 1.0));
+        let far = P3::new(50.0, 0.0, 0.5);
+        assert!(!tip_meets_fixture(&plate(), &far, &V3::x(), 5.0, 1.0));
+    }
 }

@@ -32,6 +32,8 @@
 //! grid comes from one depth map per setup (`access::SecondMap`), cached per (point,
 //! probe, setup), and keeps the probe off the table.
 
+mod fixture;
+
 use super::cluster::{Bits, Set};
 use super::machine::Machine;
 use super::memo::{Dom, Memo};
@@ -335,7 +337,7 @@ impl<'a> Knowledge<'a> {
                 dom
             }
         };
-        Knowledge {
+        let mut k = Knowledge {
             setups,
             held: BTreeMap::new(),
             opts,
@@ -354,7 +356,9 @@ impl<'a> Knowledge<'a> {
             grid_cells: BTreeMap::new(),
             pref_index: access::PreferredIndex::new(&empty),
             acquired: 0,
-        }
+        };
+        k.drop_tip_on_fixture(machine);
+        k
     }
 
     /// An empty cube map of the knowledge's shape.
