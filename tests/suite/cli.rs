@@ -930,6 +930,26 @@ fn a_part_without_pmi_is_imported_scaled_with_a_default_inspection_and_builds() 
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// An MFCAD part (`../shared/parts/mfcad/<name>.step`) imported as a 100 mm block and
+/// built: the spec's text, the build's summary and the program.
+fn import_and_build(name: &str) -> (String, String, String) {
+    common::require_shared_parts();
+    let dir = std::env::temp_dir().join(format!("inspc-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = dir.join("part.insp");
+    let spec = spec.to_string_lossy();
+    let step = format!("../shared/parts/mfcad/{name}.step");
+    let (code, _, stderr) = inspc(&["import", &step, "--scale", "10", "-o", &spec]);
+    assert_eq!(code, 0, "{stderr}");
+    let text = std::fs::read_to_string(&*spec).unwrap();
+    let dmi = dir.join("part.dmi");
+    let (code, stdout, stderr) = inspc(&["build", &spec, "-o", &dmi.to_string_lossy()]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let program = std::fs::read_to_string(&dmi).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    (text, stdout, program)
+}
+
 /// Issue 45: the floor of a hexagonal pocket 57 mm deep and 17.3 mm across flats (MFCAD
 /// 8-8-11-12-12-23 as a 100 mm block) is past the 50 mm stylus: the import's rack adds
 /// the stylus on a 50 mm extension, the floor's points keep the extension clear of the
@@ -937,27 +957,34 @@ fn a_part_without_pmi_is_imported_scaled_with_a_default_inspection_and_builds() 
 /// from the back with the long probe.
 #[test]
 fn a_pocket_floor_deeper_than_the_longest_stylus_is_measured_on_an_extension() {
-    common::require_shared_parts();
-    let dir = std::env::temp_dir().join(format!("inspc-deep-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let spec = dir.join("deep.insp");
-    let spec = spec.to_string_lossy();
-    let step = "../shared/parts/mfcad/8-8-11-12-12-23.step";
-    let (code, _, stderr) = inspc(&["import", step, "--scale", "10", "-o", &spec]);
-    assert_eq!(code, 0, "{stderr}");
-    let text = std::fs::read_to_string(&*spec).unwrap();
+    let (text, stdout, program) = import_and_build("8-8-11-12-12-23");
     assert!(text.contains("p4: TP20_D3_L50_X50"), "{text}");
-    let dmi = dir.join("deep.dmi");
-    let (code, stdout, stderr) = inspc(&["build", &spec, "-o", &dmi.to_string_lossy()]);
-    assert_eq!(code, 0, "{stdout}{stderr}");
-    assert!(
-        stdout.contains("tolerances measured 28 of 28"),
-        "{stdout}{stderr}"
-    );
-    let program = std::fs::read_to_string(&dmi).unwrap();
+    assert!(stdout.contains("tolerances measured 28 of 28"), "{stdout}");
     assert!(
         program.contains("SNSLCT/S(P4_"),
         "the floor is touched with p4"
     );
-    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 45: a block whose spec offers an angle and a sine plate (MFCAD 4-9-19). The
+/// face a plate clamps cannot be touched there, whatever the probe's orientation: the
+/// planner knows it before the first round, instead of learning it one plate angle a
+/// round and stopping at its limit with the top face unmeasured.
+#[test]
+fn a_face_clamped_on_a_plate_is_not_planned_there() {
+    let (_, stdout, _) = import_and_build("4-9-19");
+    assert!(stdout.contains("tolerances measured 12 of 12"), "{stdout}");
+}
+
+/// Issue 45: a triangular passage runs through the block (MFCAD 1-1-4-10-12-23); no
+/// point of its walls has a way straight up or up the probe's axis, and the probe
+/// leaves the part sideways before it rises.
+#[test]
+fn a_passage_wall_is_left_sideways() {
+    let (_, stdout, program) = import_and_build("1-1-4-10-12-23");
+    assert!(stdout.contains("tolerances measured 23 of 23"), "{stdout}");
+    assert!(
+        program.contains("MEAS/POINT,F(PLANE_13_P1)"),
+        "the passage's wall `face_6` is touched"
+    );
 }
