@@ -113,7 +113,8 @@ enum Command {
         allow_unmeasured: bool,
     },
     /// Plans every plan of a spec: setups, probes, orientations and what each inspects
-    /// (the high-level inspection plan).
+    /// (the high-level inspection plan), as the program is built from it — after the
+    /// path stage's re-plans.
     Plan {
         /// The `.insp` spec.
         file: PathBuf,
@@ -615,7 +616,16 @@ fn plan(
     explain: bool,
 ) -> ExitCode {
     let start = std::time::Instant::now();
-    let (checked, parts, _, planned) = inspc::plans(&FsWorld, &[file.to_path_buf()], opts);
+    // The plan `build` writes: a configuration the path stage cannot route is planned
+    // again there, so the plan before the paths can differ from the program's.
+    let run = inspc::run(
+        &FsWorld,
+        &[file.to_path_buf()],
+        opts,
+        inspc::Until::Build,
+        &|_, _, _| {},
+    );
+    let (checked, parts) = (&run.checked, &run.parts);
     if explain {
         let model = &checked.model;
         for plan in &model.plans {
@@ -631,14 +641,10 @@ fn plan(
     if checked.has_errors() {
         return ExitCode::from(1);
     }
-    let hlips: Vec<(&inspc::plan::Hlip, inspc::plan::Names)> = planned
+    let hlips: Vec<(&inspc::plan::Hlip, inspc::plan::Names)> = run
+        .built
         .iter()
-        .filter_map(|p| {
-            Some((
-                p.hlip.as_ref()?,
-                inspc::plan_names(&checked, &parts, p.plan)?,
-            ))
-        })
+        .filter_map(|b| Some((&b.hlip, inspc::plan_names(checked, parts, b.plan)?)))
         .collect();
     match format {
         TableFormat::Text => {

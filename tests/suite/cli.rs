@@ -930,9 +930,20 @@ fn a_part_without_pmi_is_imported_scaled_with_a_default_inspection_and_builds() 
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// An MFCAD part (`../shared/parts/mfcad/<name>.step`) imported as a 100 mm block and
-/// built: the spec's text, the build's summary and the program.
-fn import_and_build(name: &str) -> (String, String, String) {
+/// An MFCAD part (`../shared/parts/mfcad/<name>.step`) imported as a 100 mm block,
+/// built and planned.
+struct Imported {
+    /// The spec's text.
+    text: String,
+    /// `inspc build`'s summary.
+    built: String,
+    /// The program.
+    program: String,
+    /// `inspc plan`'s listing.
+    plan: String,
+}
+
+fn import_and_build(name: &str) -> Imported {
     common::require_shared_parts();
     let dir = std::env::temp_dir().join(format!("inspc-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -943,11 +954,18 @@ fn import_and_build(name: &str) -> (String, String, String) {
     assert_eq!(code, 0, "{stderr}");
     let text = std::fs::read_to_string(&*spec).unwrap();
     let dmi = dir.join("part.dmi");
-    let (code, stdout, stderr) = inspc(&["build", &spec, "-o", &dmi.to_string_lossy()]);
-    assert_eq!(code, 0, "{stdout}{stderr}");
+    let (code, built, stderr) = inspc(&["build", &spec, "-o", &dmi.to_string_lossy()]);
+    assert_eq!(code, 0, "{built}{stderr}");
     let program = std::fs::read_to_string(&dmi).unwrap();
+    let (code, plan, stderr) = inspc(&["plan", &spec]);
+    assert_eq!(code, 0, "{plan}{stderr}");
     let _ = std::fs::remove_dir_all(&dir);
-    (text, stdout, program)
+    Imported {
+        text,
+        built,
+        program,
+        plan,
+    }
 }
 
 /// Issue 45: the floor of a hexagonal pocket 57 mm deep and 17.3 mm across flats (MFCAD
@@ -957,11 +975,15 @@ fn import_and_build(name: &str) -> (String, String, String) {
 /// from the back with the long probe.
 #[test]
 fn a_pocket_floor_deeper_than_the_longest_stylus_is_measured_on_an_extension() {
-    let (text, stdout, program) = import_and_build("8-8-11-12-12-23");
-    assert!(text.contains("p4: TP20_D3_L50_X50"), "{text}");
-    assert!(stdout.contains("tolerances measured 28 of 28"), "{stdout}");
+    let part = import_and_build("8-8-11-12-12-23");
+    assert!(part.text.contains("p4: TP20_D3_L50_X50"), "{}", part.text);
     assert!(
-        program.contains("SNSLCT/S(P4_"),
+        part.built.contains("tolerances measured 28 of 28"),
+        "{}",
+        part.built
+    );
+    assert!(
+        part.program.contains("SNSLCT/S(P4_"),
         "the floor is touched with p4"
     );
 }
@@ -972,19 +994,35 @@ fn a_pocket_floor_deeper_than_the_longest_stylus_is_measured_on_an_extension() {
 /// round and stopping at its limit with the top face unmeasured.
 #[test]
 fn a_face_clamped_on_a_plate_is_not_planned_there() {
-    let (_, stdout, _) = import_and_build("4-9-19");
-    assert!(stdout.contains("tolerances measured 12 of 12"), "{stdout}");
+    let part = import_and_build("4-9-19");
+    assert!(
+        part.built.contains("tolerances measured 12 of 12"),
+        "{}",
+        part.built
+    );
 }
 
 /// Issue 45: a triangular passage runs through the block (MFCAD 1-1-4-10-12-23); no
 /// point of its walls has a way straight up or up the probe's axis, and the probe
-/// leaves the part sideways before it rises.
+/// leaves the part sideways before it rises. The path stage re-plans this part, and
+/// `inspc plan` lists the plan the program was built from.
 #[test]
 fn a_passage_wall_is_left_sideways() {
-    let (_, stdout, program) = import_and_build("1-1-4-10-12-23");
-    assert!(stdout.contains("tolerances measured 23 of 23"), "{stdout}");
+    let part = import_and_build("1-1-4-10-12-23");
     assert!(
-        program.contains("MEAS/POINT,F(PLANE_13_P1)"),
+        part.built.contains("tolerances measured 23 of 23"),
+        "{}",
+        part.built
+    );
+    assert!(
+        part.program.contains("MEAS/POINT,F(PLANE_13_P1)"),
         "the passage's wall `face_6` is touched"
+    );
+    let setups = part.plan.matches("change-setup").count();
+    assert!(
+        part.built.contains(&format!(", {setups} setups,")),
+        "{}{}",
+        part.plan,
+        part.built
     );
 }
