@@ -1,15 +1,15 @@
-//! Setups whose fixture holds a point's face: out of that point's domain from the start.
+//! Setups whose fixture covers a point: out of that point's domain from the start.
 //!
-//! The cones see the part alone, and a fixture failure was learnt one setup a round; on a
-//! sine plate tried every 5° under eight faces that is hundreds of rounds, and the
-//! search stopped at its limit with the clamped face still planned on the plate. The tip
-//! sweeps from the retract point to the contact along the point's normal whatever the
-//! probe's orientation ([`access::pose::Pose::approach`]), so where that sweep meets the
-//! fixture no orientation reaches the point: the setup is taken out of the point's
-//! domain for that probe before the first round, as the table takes out a face lying on
-//! it. A stylus or body meeting the fixture depends on the orientation and stays with
-//! validation (sweeping every candidate orientation against the fixture when D1′ is
-//! made, tried, made MFCAD builds several times slower).
+//! The cones see the part alone, so validation is what finds a fixture in the way, one
+//! setup a round; a sine plate tried every 5° under eight faces offers hundreds of
+//! setups, more than the search has rounds, and a face the plate clamps would stay
+//! planned on the plate. The tip sweeps from the retract point to the contact along the
+//! point's normal whatever the probe's orientation ([`access::pose::Pose::approach`]),
+//! so where that sweep meets the fixture no orientation reaches the point: the setup is
+//! taken out of the point's domain for that probe before the first round, as the table
+//! takes out a face lying on it. A stylus or body meeting the fixture depends on the
+//! orientation and stays with validation (sweeping every candidate orientation against
+//! the fixture when D1′ is made made MFCAD builds several times slower).
 
 use super::{Knowledge, Machine};
 use crate::access;
