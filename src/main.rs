@@ -618,13 +618,7 @@ fn plan(
     let start = std::time::Instant::now();
     // The plan `build` writes: a configuration the path stage cannot route is planned
     // again there, so the plan before the paths can differ from the program's.
-    let run = inspc::run(
-        &FsWorld,
-        &[file.to_path_buf()],
-        opts,
-        inspc::Until::Build,
-        &|_, _, _| {},
-    );
+    let run = whole_run(file, opts);
     let (checked, parts) = (&run.checked, &run.parts);
     if explain {
         let model = &checked.model;
@@ -828,6 +822,12 @@ fn beside(file: &std::path::Path) -> (&std::path::Path, String) {
     (dir, stem)
 }
 
+/// The whole pipeline on one spec, every stage's result kept, without a progress bar.
+fn whole_run(file: &std::path::Path, opts: &inspc::plan::PlanOptions) -> inspc::Run {
+    let roots = [file.to_path_buf()];
+    inspc::run(&FsWorld, &roots, opts, inspc::Until::Build, &|_, _, _| {})
+}
+
 /// `inspc view`: the pipeline, then the page (and images) of every plan, written
 /// atomically.
 fn view(
@@ -836,13 +836,7 @@ fn view(
     png: Option<PathBuf>,
     opts: &inspc::plan::PlanOptions,
 ) -> ExitCode {
-    let run = inspc::run(
-        &FsWorld,
-        &[file.to_path_buf()],
-        opts,
-        inspc::Until::Build,
-        &|_, _, _| {},
-    );
+    let run = whole_run(file, opts);
     let checked = &run.checked;
     let named = output
         .is_some()

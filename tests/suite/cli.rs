@@ -943,6 +943,14 @@ struct Imported {
     plan: String,
 }
 
+impl Imported {
+    /// Asserts the build measured all `n` tolerances of the spec.
+    fn measures_all(&self, n: usize) {
+        let all = format!("tolerances measured {n} of {n}");
+        assert!(self.built.contains(&all), "{}", self.built);
+    }
+}
+
 fn import_and_build(name: &str) -> Imported {
     common::require_shared_parts();
     let dir = std::env::temp_dir().join(format!("inspc-{name}-{}", std::process::id()));
@@ -977,11 +985,7 @@ fn import_and_build(name: &str) -> Imported {
 fn a_pocket_floor_deeper_than_the_longest_stylus_is_measured_on_an_extension() {
     let part = import_and_build("8-8-11-12-12-23");
     assert!(part.text.contains("p4: TP20_D3_L50_X50"), "{}", part.text);
-    assert!(
-        part.built.contains("tolerances measured 28 of 28"),
-        "{}",
-        part.built
-    );
+    part.measures_all(28);
     assert!(
         part.program.contains("SNSLCT/S(P4_"),
         "the floor is touched with p4"
@@ -995,11 +999,7 @@ fn a_pocket_floor_deeper_than_the_longest_stylus_is_measured_on_an_extension() {
 #[test]
 fn a_face_clamped_on_a_plate_is_not_planned_there() {
     let part = import_and_build("4-9-19");
-    assert!(
-        part.built.contains("tolerances measured 12 of 12"),
-        "{}",
-        part.built
-    );
+    part.measures_all(12);
 }
 
 /// Issue 45: a triangular passage runs through the block (MFCAD 1-1-4-10-12-23); no
@@ -1009,11 +1009,7 @@ fn a_face_clamped_on_a_plate_is_not_planned_there() {
 #[test]
 fn a_passage_wall_is_left_sideways() {
     let part = import_and_build("1-1-4-10-12-23");
-    assert!(
-        part.built.contains("tolerances measured 23 of 23"),
-        "{}",
-        part.built
-    );
+    part.measures_all(23);
     assert!(
         part.program.contains("MEAS/POINT,F(PLANE_13_P1)"),
         "the passage's wall `face_6` is touched"
