@@ -155,30 +155,16 @@ mod tests {
         ]);
         // The pocket's four walls and the cube's bottom; the top ring is left out (a ray
         // up the floor's normal leaves through the opening either way).
-        quad([
-            P3::new(a, a, z),
-            P3::new(b, a, z),
-            P3::new(b, a, 100.0),
-            P3::new(a, a, 100.0),
-        ]);
-        quad([
-            P3::new(b, a, z),
-            P3::new(b, b, z),
-            P3::new(b, b, 100.0),
-            P3::new(b, a, 100.0),
-        ]);
-        quad([
-            P3::new(b, b, z),
-            P3::new(a, b, z),
-            P3::new(a, b, 100.0),
-            P3::new(b, b, 100.0),
-        ]);
-        quad([
-            P3::new(a, b, z),
-            P3::new(a, a, z),
-            P3::new(a, a, 100.0),
-            P3::new(a, b, 100.0),
-        ]);
+        let corners = [(a, a), (b, a), (b, b), (a, b)];
+        for k in 0..4 {
+            let ((x0, y0), (x1, y1)) = (corners[k], corners[(k + 1) % 4]);
+            quad([
+                P3::new(x0, y0, z),
+                P3::new(x1, y1, z),
+                P3::new(x1, y1, 100.0),
+                P3::new(x0, y0, 100.0),
+            ]);
+        }
         quad([
             P3::new(0.0, 0.0, 0.0),
             P3::new(100.0, 0.0, 0.0),
