@@ -829,6 +829,19 @@ fn deepest_floor(part: &CadPart) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The fixture that tilts the part: the 6 × 12 in sine plate, or the large tilting table
+/// for a part the plate takes in no pose (more than half as large again as its top even
+/// lying on its smallest side).
+fn tilting_fixture(extent: [f64; 3]) -> &'static str {
+    let mut e = extent;
+    e.sort_by(f64::total_cmp);
+    if e[0] > 1.5 * 150.0 || e[1] > 1.5 * 300.0 {
+        "TILT_TABLE_60"
+    } else {
+        "SINE_PLATE_60"
+    }
+}
+
 /// The part's extent along x, y and z (mm).
 fn size(part: &CadPart) -> [f64; 3] {
     let mut lo = [f64::INFINITY; 3];
@@ -926,7 +939,8 @@ fn render(
     let probes: Vec<&str> = rack.iter().map(|(_, p)| *p).collect();
     let _ = writeln!(s, "use std::probes::{{{}}}", probes.join(", "));
     let _ = writeln!(s, "use std::hierarchies::efficient_accuracy");
-    let _ = writeln!(s, "use std::fixtures::{{ANGLE_PLATE, SINE_PLATE_60}}");
+    let tilter = tilting_fixture(extent);
+    let _ = writeln!(s, "use std::fixtures::{{ANGLE_PLATE, RISERS_25, {tilter}}}");
 
     let name = part_name(&opts.part_name);
     let _ = writeln!(s, "\npart {name} {{");
@@ -1000,15 +1014,21 @@ fn render(
     let _ = writeln!(s, "    head PH10MQ");
     let rack_text: Vec<String> = rack.iter().map(|(l, p)| format!("{l}: {p}")).collect();
     let _ = writeln!(s, "    probes [{}]", rack_text.join(", "));
-    let _ = writeln!(s, "    fixtures [angle: ANGLE_PLATE, sine: SINE_PLATE_60]");
+    let _ = writeln!(
+        s,
+        "    fixtures [risers: RISERS_25, angle: ANGLE_PLATE, sine: {tilter}]"
+    );
     let _ = writeln!(s, "}}");
     let _ = writeln!(s, "\nplan {name}_plan {{");
     let _ = writeln!(s, "    part {name}");
     let _ = writeln!(s, "    cmm lab");
     let _ = writeln!(s, "    hierarchy efficient_accuracy");
     let _ = writeln!(s, "    prefer setup +z weight 1.0");
-    let _ = writeln!(s, "    // Plates for faces the table alone cannot present.");
-    let _ = writeln!(s, "    fixtures [angle, sine]");
+    let _ = writeln!(
+        s,
+        "    // Risers where the table hides a face, plates for faces no pose on it presents."
+    );
+    let _ = writeln!(s, "    fixtures [risers, angle, sine]");
     let _ = writeln!(s, "    output {{ dmis \"{name}.dmi\" }}");
     let _ = writeln!(s, "}}");
     s

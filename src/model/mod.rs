@@ -237,11 +237,21 @@ pub enum FixtureKind {
         /// The diameters it holds.
         diameter: [f64; 2],
     },
+    /// Three risers (a three-point support): the part stands in one of its stable
+    /// poses on three pads `height` above the table, so faces and holes at its bottom
+    /// are free of the table.
+    Risers {
+        /// The pads' diameter.
+        pads: f64,
+    },
     /// A sine plate (an angle plate at 90°): the part clamped on one of its flat faces to
     /// a plate tilted by an angle within `tilt` about a horizontal axis.
     SinePlate {
         /// The tilt range (degrees).
         tilt: [f64; 2],
+        /// The plate's top (width, length), where the spec gives it: a part wider or longer
+        /// than half as much again does not go on it.
+        plate: Option<[f64; 2]>,
     },
     /// A fixture made for one part, from its mesh in the part's frame (a nest, a wedge,
     /// a cradle): it stands on the table with `up` pointing up and holds the part on
@@ -265,6 +275,7 @@ impl FixtureKind {
             FixtureKind::Vise { .. } => "vise",
             FixtureKind::Chuck { .. } => "chuck",
             FixtureKind::VBlock { .. } => "vblock",
+            FixtureKind::Risers { .. } => "risers",
             FixtureKind::SinePlate { .. } => "sine_plate",
             FixtureKind::Mesh { .. } => "mesh",
         }

@@ -405,7 +405,16 @@ fn fixture_summary(o: &mut String, f: &Fixture) {
             fmt_num(*body)
         ),
         FixtureKind::VBlock { diameter } => format!("diameter {}", r(diameter, "mm")),
-        FixtureKind::SinePlate { tilt } => format!("tilt {}", r(tilt, "deg")),
+        FixtureKind::Risers { pads } => format!("pads Ø{} mm", fmt_num(*pads)),
+        FixtureKind::SinePlate { tilt, plate } => format!(
+            "tilt {}{}",
+            r(tilt, "deg"),
+            plate.map_or(String::new(), |p| format!(
+                ", plate {} × {} mm",
+                fmt_num(p[0]),
+                fmt_num(p[1])
+            ))
+        ),
         FixtureKind::Mesh {
             path, unit_mm, up, ..
         } => format!(

@@ -393,7 +393,7 @@ fn blocked(probe: &str, blocker: &Blocker) -> String {
 fn unblock(blocker: &Blocker) -> &'static str {
     match blocker {
         Blocker::Tip => "the tip meets the part on its way in or out: shorten `motion { retract }` and `prehit`, or use a smaller tip",
-        Blocker::TipOnTable | Blocker::ComponentOnTable(_) => "the probe comes down to the table here: a setup or fixture that lifts this face off the table (`fixtures [..]`), or a probe with a longer stylus",
+        Blocker::TipOnTable | Blocker::ComponentOnTable(_) => "the probe comes down to the table here: risers that lift the part (`fixture` of `kind risers`, std::fixtures::RISERS_25, named in the plan's `fixtures [..]`), another setup, or a probe with a longer stylus",
         Blocker::Component(_) => "a longer or thinner stylus, an extension, or another setup (`prefer setup`) gives the probe room",
         Blocker::Fixture(_) => "another fixture, or a setup on the table, leaves this face free; `inspc plan --explain-setups` lists them",
         Blocker::Path => "a longer stylus, another orientation or a larger `motion { clearance }` may open a way to it",

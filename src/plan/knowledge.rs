@@ -256,8 +256,7 @@ impl<'a> Knowledge<'a> {
             geometry,
             machine,
             &table_dirs,
-            &empty,
-            &real,
+            (&empty, &real, &setups),
             &mut points,
         );
         let graph_points = fpoints.len();
@@ -946,14 +945,14 @@ fn preferred_directions(
 
 /// The table alternatives of datum faces that can rest on the table (ch. 3.6.2): each
 /// face's table points join `points`, and the alternative is alive only where the pose
-/// stands (`real`).
+/// stands on the table itself (`real`, and no riser under it: the table points lie in
+/// the face's plane).
 fn table_alternatives(
     scene: &Scene,
     geometry: &crate::geometry::PartGeometry,
     machine: &Machine,
     table_dirs: &[(FaceId, V3)],
-    empty: &CubeMap,
-    real: &CubeMap,
+    (empty, real, setups): (&CubeMap, &CubeMap, &super::poses::Setups),
     points: &mut Vec<Fpoint>,
 ) -> Vec<TableAlt> {
     let mut tables = Vec::new();
@@ -971,7 +970,11 @@ fn table_alternatives(
             face,
             cell: empty.index(cell),
             points: (first..points.len()).collect(),
-            alive: real.get(cell),
+            alive: real.get(cell)
+                && matches!(
+                    setups.holder(&empty.direction(cell)),
+                    Some(super::poses::Holder::Table { .. })
+                ),
         });
     }
     tables

@@ -44,9 +44,11 @@ mod placement;
 pub mod poses;
 mod remeasure;
 mod render;
+mod risers;
 mod scan;
 mod search;
 mod solve;
+mod support;
 mod validate;
 
 pub use errors::PlanError;

@@ -19,7 +19,8 @@
 //! fixture's pose; Spitz's "any direction, a fixture exists" is what a plan says by
 //! naming a fixture (the swiss sphere's plans name a chuck). Ten degrees to tip
 //! excludes a disc on its rim, a shaft on its end and a thin plate on its edge. The
-//! table alone comes first, then the plan's fixtures in the order it names them: a vise
+//! table alone comes first (on the plan's risers where the table hides a face, see
+//! [`super::risers`]), then the plan's fixtures in the order it names them: a vise
 //! clamps two opposite bounding faces, the part on a flat face square to them; a chuck
 //! holds an outer cylinder at the part's end, axis vertical, or a sphere in any
 //! direction; V-blocks hold an outer cylinder at the part's bottom, axis horizontal,
@@ -41,8 +42,11 @@
 //! no operator does. The plan says how the part lies ("tilted 60°, its longest edge
 //! along the hinge"). A tilted plate's solid runs up its own plane from the table (its
 //! hinge the fixture's `height` under the part) to 30 mm past the part's top, so the
-//! table lies where the real one does.
+//! table lies where the real one does. A plate with a `plate` size holds only a part at
+//! most [`PLATE_OVERHANG`] times its top each way (an 800 mm part does not go on a 6 ×
+//! 12 in sine plate); inspc does not know the part's material, so no load limit.
 
+use super::support::{polygon_area, tip};
 use crate::access::pose::Solid;
 use crate::geometry::{FaceId, FixtureMesh, PartGeometry, Surface, P3, V3};
 use crate::model::{Fixture, FixtureKind, Model, Plan};
@@ -122,7 +126,7 @@ pub enum Holder {
         faces: Vec<FaceId>,
         /// How the part lies on a tilted plate, for the operator: where the clamped
         /// face's longest edge goes against the plate's hinge.
-        placement: Option<&'static str>,
+        placement: Option<String>,
     },
 }
 
@@ -145,6 +149,9 @@ const PLATE_STEP_DEG: f64 = 5.0;
 const PLATE_RESTS: usize = 8;
 /// The least support a face clamped on a plate has, as a share of the largest face's.
 const PLATE_MIN_SHARE: f64 = 0.25;
+/// How far a part may be larger than a plate's top it is clamped on, as a factor on
+/// each side's length: a quarter overhanging at either end.
+const PLATE_OVERHANG: f64 = 1.5;
 
 /// The setups a plan may use and what holds the part in each: the stable rest poses
 /// first, then the plan's fixtures in the order it names them.
@@ -165,6 +172,9 @@ pub struct Setups<'a> {
     com: P3,
     /// The plan's mesh fixtures placed with the part, by slot, each as a solid.
     meshes: Vec<(usize, &'a FixtureMesh, Solid)>,
+    /// The plan's first risers (slot) and, per rest pose, the pads' centres where the
+    /// part stands on them in that pose (see [`super::risers`]).
+    risers: Option<(usize, Vec<Option<[P3; 3]>>)>,
 }
 
 impl<'a> Setups<'a> {
@@ -205,16 +215,29 @@ impl<'a> Setups<'a> {
         {
             clamps = clamp_pairs(geometry, &hull);
         }
+        let extremes = Extremes::new(&hull);
+        let com = centre_of_mass(geometry);
+        let risers = fixtures.iter().find_map(|&(slot, f)| match f.kind {
+            FixtureKind::Risers { pads } => Some((
+                slot,
+                rests
+                    .iter()
+                    .map(|r| riser_pads(geometry, r, extremes.lowest(&r.up), &com, pads))
+                    .collect(),
+            )),
+            _ => None,
+        });
         Setups {
             geometry,
             rests,
             fixtures,
             clamps,
-            extremes: Extremes::new(&hull),
+            extremes,
             hull,
             size: (hi - lo).norm(),
-            com: centre_of_mass(geometry),
+            com,
             meshes,
+            risers,
         }
     }
 
@@ -247,8 +270,8 @@ impl<'a> Setups<'a> {
                     }
                 }
                 FixtureKind::Mesh { up, .. } => out.push(V3::from(up).normalize()),
-                FixtureKind::SinePlate { tilt } => {
-                    for r in self.plate_rests() {
+                FixtureKind::SinePlate { tilt, plate } => {
+                    for r in self.plate_rests(plate) {
                         for deg in plate_tilts(tilt) {
                             let t = deg.to_radians();
                             for z in r.azimuths() {
@@ -267,9 +290,14 @@ impl<'a> Setups<'a> {
     /// up, and how the part lies on it: the part clamped with its face's longest edge
     /// against the plate's rail, square to it or at 45°, the plate tilting it towards
     /// one of the face's [`RestPose::azimuths`].
-    fn on_plate(&self, tilt: [f64; 2], up: &V3) -> Option<(&RestPose, Option<&'static str>)> {
+    fn on_plate(
+        &self,
+        tilt: [f64; 2],
+        plate: Option<[f64; 2]>,
+        up: &V3,
+    ) -> Option<(&RestPose, Option<&'static str>)> {
         let (lo, hi) = (tilt[0].to_radians(), tilt[1].to_radians());
-        self.plate_rests().find_map(|r| {
+        self.plate_rests(plate).find_map(|r| {
             let a = r.up.dot(up).clamp(-1.0, 1.0).acos();
             if a < lo - 1e-9 || a > hi + 1e-9 {
                 return None;
@@ -295,8 +323,9 @@ impl<'a> Setups<'a> {
 
     /// The flat faces a sine plate may clamp: the largest [`PLATE_RESTS`] of those with
     /// at least [`PLATE_MIN_SHARE`] of the largest one's support — a plate holds a part
-    /// by a broad face, not cantilevered from an end or a chamfer.
-    fn plate_rests(&self) -> impl Iterator<Item = &RestPose> {
+    /// by a broad face, not cantilevered from an end or a chamfer — where the part lying
+    /// on that face fits the plate's top (`plate`, see [`Setups::fits_plate`]).
+    fn plate_rests(&self, plate: Option<[f64; 2]>) -> impl Iterator<Item = &RestPose> {
         let largest = self
             .rests
             .iter()
@@ -305,8 +334,38 @@ impl<'a> Setups<'a> {
             .fold(0.0, f64::max);
         self.rests
             .iter()
-            .filter(move |r| r.flat && r.area >= PLATE_MIN_SHARE * largest)
+            .filter(move |r| {
+                r.flat
+                    && r.area >= PLATE_MIN_SHARE * largest
+                    && plate.is_none_or(|p| self.fits_plate(r, p))
+            })
             .take(PLATE_RESTS)
+    }
+
+    /// Whether the part lying on rest `r` fits a plate whose top is `plate` (width,
+    /// length), either way round: its extents along the face's longest edge and across
+    /// it at most [`PLATE_OVERHANG`] times the plate's.
+    fn fits_plate(&self, r: &RestPose, plate: [f64; 2]) -> bool {
+        let across = r.up.cross(&r.edge).normalize();
+        let extent = |d: &V3| {
+            let (lo, hi) = self
+                .hull
+                .iter()
+                .map(|v| v.coords.dot(d))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                    (a.min(x), b.max(x))
+                });
+            hi - lo
+        };
+        let (a, b) = (extent(&r.edge), extent(&across));
+        let k = PLATE_OVERHANG;
+        (a <= k * plate[0] && b <= k * plate[1]) || (a <= k * plate[1] && b <= k * plate[0])
+    }
+
+    /// The risers' slot and pads under rest pose `k`, where it stands on them.
+    fn pads(&self, k: usize) -> Option<(usize, &[P3; 3])> {
+        let (slot, pads) = self.risers.as_ref()?;
+        pads[k].as_ref().map(|p| (*slot, p))
     }
 
     /// The placed mesh of the fixture in `slot` and its solid, if it is a mesh fixture.
@@ -346,7 +405,19 @@ impl<'a> Setups<'a> {
     /// when that pose is stable, else the first of the plan's fixtures that can.
     pub fn holder(&self, up: &V3) -> Option<Holder> {
         let same = |a: &V3| (a - up).norm() < 1e-6;
-        if let Some(r) = self.rests.iter().find(|r| r.stable() && same(&r.up)) {
+        if let Some((k, r)) = self
+            .rests
+            .iter()
+            .enumerate()
+            .find(|(_, r)| r.stable() && same(&r.up))
+        {
+            if let Some((slot, pads)) = self.pads(k) {
+                return Some(Holder::Fixture {
+                    slot,
+                    faces: r.faces.clone(),
+                    placement: Some(super::risers::words(pads)),
+                });
+            }
             return Some(Holder::Table {
                 faces: r.faces.clone(),
             });
@@ -365,18 +436,13 @@ impl<'a> Setups<'a> {
 
     /// The faces fixture `f` (in `slot`) holds with `up` pointing up, if it can hold the
     /// part so, and on a plate how the part lies (see [`Holder::Fixture`]).
-    fn holds(
-        &self,
-        slot: usize,
-        f: &Fixture,
-        up: &V3,
-    ) -> Option<(Vec<FaceId>, Option<&'static str>)> {
-        if let FixtureKind::SinePlate { tilt } = f.kind {
+    fn holds(&self, slot: usize, f: &Fixture, up: &V3) -> Option<(Vec<FaceId>, Option<String>)> {
+        if let FixtureKind::SinePlate { tilt, plate } = f.kind {
             // The part clamped with an edge against the plate's rail: the plate tilts it
             // towards one of the face's azimuths, by an angle in its range.
             return self
-                .on_plate(tilt, up)
-                .map(|(r, placement)| (r.faces.clone(), placement));
+                .on_plate(tilt, plate, up)
+                .map(|(r, placement)| (r.faces.clone(), placement.map(str::to_string)));
         }
         self.grips(slot, f, up).map(|faces| (faces, None))
     }
@@ -391,6 +457,7 @@ impl<'a> Setups<'a> {
                 same(&V3::from(its_up).normalize()).then(|| m.locating.clone())
             }
             FixtureKind::SinePlate { .. } => None, // `holds` answers for plates
+            FixtureKind::Risers { .. } => None,    // `holder` answers for risers
             FixtureKind::Vise { opening, .. } => {
                 let base = self.rests.iter().find(|r| r.flat && same(&r.up))?;
                 self.clamps
@@ -501,6 +568,14 @@ impl<'a> Setups<'a> {
                 .mesh_of(*slot)
                 .map(|(_, solid)| vec![solid.clone()])
                 .unwrap_or_default(),
+            FixtureKind::Risers { pads } => {
+                let same = |a: &V3| (a - up).norm() < 1e-6;
+                (0..self.rests.len())
+                    .find(|&k| same(&self.rests[k].up))
+                    .and_then(|k| self.pads(k))
+                    .map(|(_, c)| super::risers::solids(c, up, f.height, pads))
+                    .unwrap_or_default()
+            }
             FixtureKind::Chuck { jaws, body, .. } => {
                 let Some(face) = faces.first() else {
                     return vec![];
@@ -759,12 +834,37 @@ impl<'a> Setups<'a> {
                         .count();
                     format!("holds one of {n} outer cylinders of Ø{}..{} mm with its axis horizontal, turned in {VBLOCK_STEP_DEG}° steps", diameter[0], diameter[1])
                 }
-                FixtureKind::SinePlate { tilt } => {
-                    let n = self.plate_rests().count();
-                    format!(
-                        "clamps the part on one of its {n} largest flat faces, the face's longest edge along the plate's rail or square to it, tilted {}°..{}° in {PLATE_STEP_DEG}° steps",
-                        tilt[0], tilt[1]
-                    )
+                FixtureKind::Risers { pads } => {
+                    let lifted: Vec<String> = (0..self.rests.len())
+                        .filter(|&k| self.pads(k).is_some())
+                        .map(|k| dir(&self.rests[k].up))
+                        .collect();
+                    if lifted.is_empty() {
+                        "lifts no pose: where the part stands, the table hides none of its faces"
+                            .into()
+                    } else {
+                        format!(
+                            "lifts the part {} mm on three Ø{pads} mm pads where the table would hide a face: up {}",
+                            f.height,
+                            lifted.join(", ")
+                        )
+                    }
+                }
+                FixtureKind::SinePlate { tilt, plate } => {
+                    let n = self.plate_rests(plate).count();
+                    let top = plate.map_or(String::new(), |p| {
+                        format!(" that fit its {} × {} mm top", p[0], p[1])
+                    });
+                    match (n, plate) {
+                        (0, Some(p)) => format!(
+                            "holds the part on none of its faces: it is more than {PLATE_OVERHANG} times the plate's {} × {} mm top",
+                            p[0], p[1]
+                        ),
+                        _ => format!(
+                            "clamps the part on one of its {n} largest flat faces{top}, the face's longest edge along the plate's rail or square to it, tilted {}°..{}° in {PLATE_STEP_DEG}° steps",
+                            tilt[0], tilt[1]
+                        ),
+                    }
                 }
             };
             let _ = writeln!(out, "  fixture {label} ({}): {what}", f.kind.word());
@@ -1069,6 +1169,15 @@ fn rest_poses(g: &PartGeometry, hv: &[P3], hi_tris: &[[u32; 3]]) -> Vec<RestPose
     out
 }
 
+/// The pads under rest pose `r` where the part stands on risers of pad diameter `pad`
+/// in it: a stable pose in which the table hides a face and the pads hold the part.
+fn riser_pads(g: &PartGeometry, r: &RestPose, low: f64, com: &P3, pad: f64) -> Option<[P3; 3]> {
+    if !r.stable() || !super::risers::needs_lift(g, &r.up, low, &r.faces) {
+        return None;
+    }
+    super::risers::pads(g, &r.up, low, &r.faces, com, pad, MIN_TIP_DEG)
+}
+
 /// The edges where two faces meet, each the vertices of one connected chain of mesh
 /// edges between the same two faces (a circle where a chamfer meets a side, the line
 /// where two planes meet). An edge lying wholly in a resting plane is a contact even
@@ -1162,35 +1271,6 @@ fn longest_edge(poly: &[(f64, f64)], e1: &V3, e2: &V3) -> V3 {
         }
     }
     best.1
-}
-
-/// The tipping angle (degrees) of a convex counter-clockwise polygon about its nearest
-/// edge with the centre of mass over `c` at height `h`; negative when `c` is outside.
-fn tip(poly: &[(f64, f64)], c: (f64, f64), h: f64) -> f64 {
-    if poly.len() < 3 {
-        return -90.0;
-    }
-    let mut d = f64::INFINITY;
-    for k in 0..poly.len() {
-        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
-        let (ex, ey) = (b.0 - a.0, b.1 - a.1);
-        let len = (ex * ex + ey * ey).sqrt();
-        if len < 1e-12 {
-            continue;
-        }
-        // Left of a counter-clockwise edge is inside.
-        d = d.min((ex * (c.1 - a.1) - ey * (c.0 - a.0)) / len);
-    }
-    d.atan2(h.max(1e-9)).to_degrees()
-}
-
-fn polygon_area(poly: &[(f64, f64)]) -> f64 {
-    let mut s = 0.0;
-    for k in 0..poly.len() {
-        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
-        s += a.0 * b.1 - b.0 * a.1;
-    }
-    s.abs() / 2.0
 }
 
 #[cfg(test)]

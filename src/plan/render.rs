@@ -142,10 +142,20 @@ impl<'a> Names<'a> {
                             "{name} under {}, tilted {}°{}",
                             faces(fs),
                             fmt_num((tilt * 10.0).round() / 10.0),
-                            placement.map_or(String::new(), |p| format!(", {p}"))
+                            placement
+                                .as_ref()
+                                .map_or(String::new(), |p| format!(", {p}"))
                         )
                     }
                     FixtureKind::Mesh { .. } => format!("{name} located on {}", faces(fs)),
+                    FixtureKind::Risers { .. } => format!(
+                        "{name}: standing on {} on three {} mm risers{}",
+                        faces(fs),
+                        fmt_num(fixture.height),
+                        placement
+                            .as_ref()
+                            .map_or(String::new(), |p| format!(", {p}"))
+                    ),
                     _ => format!("{name} on {}", faces(fs)),
                 }
             }

@@ -1,4 +1,4 @@
-//! Fixtures beside a CMM: vises, chucks, V-blocks, sine plates and mesh nests, with the
+//! Fixtures beside a CMM: vises, chucks, V-blocks, risers, sine plates and mesh nests, with the
 //! sizes that say what each can hold and how high it holds the part.
 
 use super::errors::ResolveError as E;
@@ -37,12 +37,28 @@ pub(super) fn fixture(
                 .unwrap_or([1.0, 100.0]);
             FixtureKind::VBlock { diameter }
         }
+        Some("risers") => FixtureKind::Risers {
+            pads: length_or(cx, p, "pads", "20 mm", 20.0),
+        },
         Some("sine_plate") => {
             let tilt = p
                 .req(cx, "tilt", "0 deg .. 60 deg")
                 .and_then(|v| tilt_range(cx, v))
                 .unwrap_or([0.0, 0.0]);
-            FixtureKind::SinePlate { tilt }
+            let plate = p.get("plate").and_then(|v| {
+                let size = cx.lengths::<2>(v)?;
+                if size.iter().any(|x| *x <= 0.0) {
+                    cx.err(E::NonPositive {
+                        span: v.span,
+                        what: "the plate's size".into(),
+                        value: describe(v),
+                        help: "give the plate's top as (width, length)".into(),
+                    });
+                    return None;
+                }
+                Some(size)
+            });
+            FixtureKind::SinePlate { tilt, plate }
         }
         Some("mesh") => mesh_nest(r, cx, p),
         Some(other) => {
@@ -50,7 +66,7 @@ pub(super) fn fixture(
                 let help = suggest::help_for_unknown(
                     "fixture kind",
                     other,
-                    ["vise", "chuck", "vblock", "sine_plate", "mesh"],
+                    ["vise", "chuck", "vblock", "risers", "sine_plate", "mesh"],
                 );
                 cx.err(E::UnknownName {
                     span: *s,
@@ -59,9 +75,15 @@ pub(super) fn fixture(
                     help,
                 });
             }
-            FixtureKind::SinePlate { tilt: [0.0, 0.0] }
+            FixtureKind::SinePlate {
+                tilt: [0.0, 0.0],
+                plate: None,
+            }
         }
-        None => FixtureKind::SinePlate { tilt: [0.0, 0.0] },
+        None => FixtureKind::SinePlate {
+            tilt: [0.0, 0.0],
+            plate: None,
+        },
     };
     describe_only(cx, p);
     Fixture {
@@ -138,7 +160,10 @@ fn mesh_nest(r: &Resolver, cx: &mut Cx, p: &mut Props) -> FixtureKind {
             up,
             span,
         },
-        None => FixtureKind::SinePlate { tilt: [0.0, 0.0] },
+        None => FixtureKind::SinePlate {
+            tilt: [0.0, 0.0],
+            plate: None,
+        },
     }
 }
 

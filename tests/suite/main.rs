@@ -37,3 +37,4 @@ mod tours;
 mod verify;
 mod view;
 mod vscode;
+mod workholding;
