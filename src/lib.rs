@@ -28,7 +28,7 @@
 //! collision-free move reaches (the roadmap finds no way in, or no way up to the
 //! clearance plane) bans that configuration (point, probe, setup, probe direction), and
 //! the plan is made again with it failing validation (a point, probe and setup that fail
-//! a second time, in every direction: `plan::Ban::widen`), at most `REPLANS` (3) times
+//! a second time, in every direction: `plan::Ban::widen`), at most `REPLANS` (16) times
 //! (`paths_of`); the diagnostics of the last try are the ones reported. A re-plan
 //! reuses the first planning's pure results (`plan::Memo`: cones, D2 caps, depth maps,
 //! grid orientations, the scene), so it costs clustering and validation only: one
@@ -536,7 +536,10 @@ pub fn run(
 }
 
 /// How many times a plan whose touches the path stage cannot reach is planned again.
-const REPLANS: usize = 3;
+/// Each re-plan bans what the last could not route; a block with a through passage or
+/// a tunnel (MFCAD parts) takes up to a dozen before every touch has a way in and up,
+/// and a part that routes at once never pays for the budget.
+const REPLANS: usize = 16;
 
 /// The plan, part and moves of each plan whose paths were planned.
 type Pathed = Vec<(usize, usize, plan::Hlip, path::Llip)>;

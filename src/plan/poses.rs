@@ -415,7 +415,7 @@ impl<'a> Setups<'a> {
                 return Some(Holder::Fixture {
                     slot,
                     faces: r.faces.clone(),
-                    placement: Some(super::risers::words(pads)),
+                    placement: Some(super::risers::words(pads, &self.geometry.bounds().0, &r.up)),
                 });
             }
             return Some(Holder::Table {

@@ -240,16 +240,27 @@ pub(crate) fn solids(centres: &[P3; 3], up: &V3, height: f64, pad: f64) -> Vec<S
         .collect()
 }
 
-/// Where the pads go, for the operator: `pads at (10, 15, 0), (90, 15, 0) and (50, 85,
-/// 0) mm in part coordinates` (to the nearest millimetre; no apostrophe, which a DMIS
-/// text cannot hold).
-pub(crate) fn words(pads: &[P3; 3]) -> String {
+/// Where the pads go, for the operator, measured from the corner of the part's
+/// bounding box at its least x, y and z (`corner`), to the nearest millimetre: `pads at
+/// x 28 y 10, x 68 y 30 and x 28 y 50 mm from the part's corner at its least x, y and z`.
+/// The coordinate along `up` is left out where `up` is a part axis (it is the base's).
+/// No apostrophe: a DMIS text cannot hold one.
+pub(crate) fn words(pads: &[P3; 3], corner: &P3, up: &V3) -> String {
+    let axes: Vec<(usize, &str)> = [(0, "x"), (1, "y"), (2, "z")]
+        .into_iter()
+        .filter(|&(k, _)| up[k].abs() < 1.0 - 1e-9)
+        .collect();
     let at = |p: &P3| {
-        let r = |x: f64| crate::model::fmt_num(x.round() + 0.0);
-        format!("({}, {}, {})", r(p.x), r(p.y), r(p.z))
+        axes.iter()
+            .map(|&(k, name)| {
+                let d = (p[k] - corner[k]).round() + 0.0;
+                format!("{name} {}", crate::model::fmt_num(d))
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
     };
     format!(
-        "pads at {}, {} and {} mm in part coordinates",
+        "pads at {}, {} and {} mm from the corner of the part at its least x, y and z",
         at(&pads[0]),
         at(&pads[1]),
         at(&pads[2])

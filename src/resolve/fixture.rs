@@ -46,17 +46,12 @@ pub(super) fn fixture(
                 .and_then(|v| tilt_range(cx, v))
                 .unwrap_or([0.0, 0.0]);
             let plate = p.get("plate").and_then(|v| {
-                let size = cx.lengths::<2>(v)?;
-                if size.iter().any(|x| *x <= 0.0) {
-                    cx.err(E::NonPositive {
-                        span: v.span,
-                        what: "the plate's size".into(),
-                        value: describe(v),
-                        help: "give the plate's top as (width, length)".into(),
-                    });
-                    return None;
-                }
-                Some(size)
+                positive_pair(
+                    cx,
+                    v,
+                    "the plate's size",
+                    "give the plate's top as (width, length)",
+                )
             });
             FixtureKind::SinePlate { tilt, plate }
         }
@@ -106,21 +101,24 @@ fn vise(cx: &mut Cx, p: &mut Props) -> FixtureKind {
     let opening = length_or(cx, p, "opening", "160 mm", 100.0);
     let jaw = p
         .req(cx, "jaw", "(150 mm, 40 mm)")
-        .and_then(|v| {
-            let j = cx.lengths::<2>(v)?;
-            if j.iter().any(|x| *x <= 0.0) {
-                cx.err(E::NonPositive {
-                    span: v.span,
-                    what: "the jaw size".into(),
-                    value: describe(v),
-                    help: "give the jaws' width and height".into(),
-                });
-                return None;
-            }
-            Some(j)
-        })
+        .and_then(|v| positive_pair(cx, v, "the jaw size", "give the jaws' width and height"))
         .unwrap_or([100.0, 30.0]);
     FixtureKind::Vise { opening, jaw }
+}
+
+/// Two positive lengths, `(150 mm, 40 mm)`; `what` and `help` word the error otherwise.
+fn positive_pair(cx: &mut Cx, v: &ast::Value, what: &str, help: &str) -> Option<[f64; 2]> {
+    let pair = cx.lengths::<2>(v)?;
+    if pair.iter().any(|x| *x <= 0.0) {
+        cx.err(E::NonPositive {
+            span: v.span,
+            what: what.into(),
+            value: describe(v),
+            help: help.into(),
+        });
+        return None;
+    }
+    Some(pair)
 }
 
 /// `kind chuck`: the `diameter` range it grips, its `jaws` and `body`.

@@ -8,18 +8,18 @@ use std::path::Path;
 
 const REBATE: &str = "tests/cases/setup_risers_for_a_base_rebate/main.insp";
 
-/// The pads' centres from a riser setup's words: `pads at (x, y, z), …`.
-fn pads(placement: &str) -> Vec<[f64; 3]> {
-    placement
-        .split('(')
-        .skip(1)
-        .map(|p| {
-            let inner = &p[..p.find(')').expect("a closing bracket")];
-            let v: Vec<f64> = inner
-                .split(',')
-                .map(|x| x.trim().parse().unwrap())
-                .collect();
-            [v[0], v[1], v[2]]
+/// The pads' centres (x, y) from a riser setup's words: `pads at x 28 y 10, x 68 y 30
+/// and x 28 y 50 mm from the corner …`.
+fn pads(placement: &str) -> Vec<[f64; 2]> {
+    let list = &placement[placement.find("pads at ").expect("pads") + 8..];
+    let list = &list[..list.find(" mm from").expect("mm from")];
+    list.split([',', ' '])
+        .filter(|w| !w.is_empty() && *w != "and")
+        .collect::<Vec<_>>()
+        .chunks(4)
+        .map(|c| {
+            assert_eq!((c[0], c[2]), ("x", "y"), "{placement}");
+            [c[1].parse().unwrap(), c[3].parse().unwrap()]
         })
         .collect()
 }
@@ -38,16 +38,16 @@ fn risers_lift_the_block_whose_base_rebate_the_table_hides() {
     };
     let at = pads(words);
     assert_eq!(at.len(), 3, "{words}");
-    // Ø20 mm pads wholly under the base: x 10..80 (the rebate takes 0..10), y 0..60.
-    for [x, y, z] in &at {
+    // Ø20 mm pads wholly under the base: x 10..80 (the rebate takes 0..10), y 0..60,
+    // measured from the part's corner (0, 0, 0).
+    for [x, y] in &at {
         assert!((20.0 - 1.0..=70.0 + 1.0).contains(x), "{words}");
         assert!((10.0 - 1.0..=50.0 + 1.0).contains(y), "{words}");
-        assert_eq!(*z, 0.0, "{words}");
     }
     // The centre of mass (about (40.4, 30)) inside the pads' triangle.
     let c = (40.4, 30.0);
     let side =
-        |a: &[f64; 3], b: &[f64; 3]| (b[0] - a[0]) * (c.1 - a[1]) - (b[1] - a[1]) * (c.0 - a[0]);
+        |a: &[f64; 2], b: &[f64; 2]| (b[0] - a[0]) * (c.1 - a[1]) - (b[1] - a[1]) * (c.0 - a[0]);
     let s3 = [
         side(&at[0], &at[1]),
         side(&at[1], &at[2]),
