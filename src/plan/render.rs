@@ -1,7 +1,7 @@
 //! The HLIP as text (the seed's operator listing: change-setup, change-probe,
 //! change-orient, inspect, record) and as JSON (the tree plus a summary).
 
-use super::{Hlip, Summary};
+use super::{Hlip, SetupNode, Summary};
 use crate::access::pose::{Contact, Head};
 use crate::geometry::{FaceId, PartGeometry, V3};
 use crate::model::{fmt_num, DatumId, FeatureId, Model, Part, Plan, PlanId, SlotId, ToleranceId};
@@ -196,6 +196,64 @@ fn dir_text(v: &V3) -> String {
     }
 }
 
+/// Why setup `si` is in the plan, in words: the features measured in it and in no other
+/// setup, then those it shares, with the setups it shares them with —
+/// `datum_a, f12 and 3 more: measured in no other setup; part of f7 (with s1)`.
+fn setup_reason(h: &Hlip, si: usize, names: &Names) -> String {
+    let features_of = |s: &SetupNode| {
+        let mut out: Vec<Option<FeatureId>> = Vec::new();
+        for i in s
+            .probes
+            .iter()
+            .flat_map(|p| &p.orients)
+            .flat_map(|o| &o.inspections)
+        {
+            if !out.contains(&i.feature) {
+                out.push(i.feature);
+            }
+        }
+        out
+    };
+    let all: Vec<Vec<Option<FeatureId>>> = h.setups.iter().map(features_of).collect();
+    let (mut own, mut shared) = (Vec::new(), Vec::new());
+    for f in &all[si] {
+        let others: Vec<String> = (0..all.len())
+            .filter(|&k| k != si && all[k].contains(f))
+            .map(|k| format!("s{}", k + 1))
+            .collect();
+        if others.is_empty() {
+            own.push(names.feature(*f));
+        } else {
+            shared.push(format!(
+                "{} (with {})",
+                names.feature(*f),
+                others.join(", ")
+            ));
+        }
+    }
+    let list = |items: Vec<String>| {
+        const MOST: usize = 6;
+        let n = items.len();
+        let mut words: Vec<String> = items.into_iter().take(MOST).collect();
+        if n > MOST {
+            words.push(format!("{} more", n - MOST));
+        }
+        match words.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+            Some((last, _)) => last.clone(),
+            None => String::new(),
+        }
+    };
+    let own = list(own.into_iter().map(str::to_string).collect());
+    let shared = list(shared);
+    match (own.is_empty(), shared.is_empty()) {
+        (false, true) => format!("{own}: measured in no other setup"),
+        (false, false) => format!("{own}: measured in no other setup; part of {shared}"),
+        (true, false) => format!("part of {shared}"),
+        (true, true) => "nothing".to_string(),
+    }
+}
+
 /// The plan as an indented operator listing with a summary.
 pub fn text(h: &Hlip, names: &Names) -> String {
     let (model, plan) = (names.model, names.plan);
@@ -212,6 +270,7 @@ pub fn text(h: &Hlip, names: &Names) -> String {
     for (si, s) in h.setups.iter().enumerate() {
         let _ = writeln!(out, "change-setup s{} up {}", si + 1, dir_text(&s.up));
         let _ = writeln!(out, "  held by {}", names.holder(&s.holder, &s.up));
+        let _ = writeln!(out, "  for {}", setup_reason(h, si, names));
         for t in &s.on_table {
             let _ = writeln!(out, "  rest {} on the table", names.face(*t));
         }
@@ -372,12 +431,14 @@ pub fn json(h: &Hlip, names: &Names) -> Value {
     let setups: Vec<Value> = h
         .setups
         .iter()
-        .map(|s| {
+        .enumerate()
+        .map(|(si, s)| {
             j!({
                 "up": arr(&s.up),
                 "rotation": s.rotation,
                 "on_table": s.on_table.iter().map(|f| names.face(*f)).collect::<Vec<_>>(),
                 "held_by": names.holder(&s.holder, &s.up),
+                "for": setup_reason(h, si, names),
                 "probes": s.probes.iter().map(|p| j!({
                     "probe": names.probe(p.probe),
                     "orientations": p.orients.iter().map(|o| j!({
