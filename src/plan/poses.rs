@@ -175,6 +175,9 @@ pub struct Setups<'a> {
     /// The plan's first risers (slot) and, per rest pose, the pads' centres where the
     /// part stands on them in that pose (see [`super::risers`]).
     risers: Option<(usize, Vec<Option<[P3; 3]>>)>,
+    /// Per rest pose, the part's extents along its support's longest edge and across
+    /// it: what a plate's top must take ([`fits_plate`]).
+    spans: Vec<[f64; 2]>,
 }
 
 impl<'a> Setups<'a> {
@@ -227,11 +230,13 @@ impl<'a> Setups<'a> {
             )),
             _ => None,
         });
+        let spans = rests.iter().map(|r| spans(&hull, r)).collect();
         Setups {
             geometry,
             rests,
             fixtures,
             clamps,
+            spans,
             extremes,
             hull,
             size: (hi - lo).norm(),
@@ -324,7 +329,7 @@ impl<'a> Setups<'a> {
     /// The flat faces a sine plate may clamp: the largest [`PLATE_RESTS`] of those with
     /// at least [`PLATE_MIN_SHARE`] of the largest one's support — a plate holds a part
     /// by a broad face, not cantilevered from an end or a chamfer — where the part lying
-    /// on that face fits the plate's top (`plate`, see [`Setups::fits_plate`]).
+    /// on that face fits the plate's top (`plate`, see [`fits_plate`]).
     fn plate_rests(&self, plate: Option<[f64; 2]>) -> impl Iterator<Item = &RestPose> {
         let largest = self
             .rests
@@ -334,32 +339,14 @@ impl<'a> Setups<'a> {
             .fold(0.0, f64::max);
         self.rests
             .iter()
-            .filter(move |r| {
+            .zip(&self.spans)
+            .filter(move |(r, span)| {
                 r.flat
                     && r.area >= PLATE_MIN_SHARE * largest
-                    && plate.is_none_or(|p| self.fits_plate(r, p))
+                    && plate.is_none_or(|p| fits_plate(span, p))
             })
+            .map(|(r, _)| r)
             .take(PLATE_RESTS)
-    }
-
-    /// Whether the part lying on rest `r` fits a plate whose top is `plate` (width,
-    /// length), either way round: its extents along the face's longest edge and across
-    /// it at most [`PLATE_OVERHANG`] times the plate's.
-    fn fits_plate(&self, r: &RestPose, plate: [f64; 2]) -> bool {
-        let across = r.up.cross(&r.edge).normalize();
-        let extent = |d: &V3| {
-            let (lo, hi) = self
-                .hull
-                .iter()
-                .map(|v| v.coords.dot(d))
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-                    (a.min(x), b.max(x))
-                });
-            hi - lo
-        };
-        let (a, b) = (extent(&r.edge), extent(&across));
-        let k = PLATE_OVERHANG;
-        (a <= k * plate[0] && b <= k * plate[1]) || (a <= k * plate[1] && b <= k * plate[0])
     }
 
     /// The risers' slot and pads under rest pose `k`, where it stands on them.
@@ -1167,6 +1154,29 @@ fn rest_poses(g: &PartGeometry, hv: &[P3], hi_tris: &[[u32; 3]]) -> Vec<RestPose
             .then(a.up.x.total_cmp(&b.up.x))
     });
     out
+}
+
+/// The part's extents (its convex `hull`'s) along rest `r`'s longest support edge and
+/// across it.
+fn spans(hull: &[P3], r: &RestPose) -> [f64; 2] {
+    let across = r.up.cross(&r.edge).normalize();
+    [r.edge, across].map(|d| {
+        let (lo, hi) = hull
+            .iter()
+            .map(|v| v.coords.dot(&d))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x), b.max(x))
+            });
+        hi - lo
+    })
+}
+
+/// Whether a part of extents `span` fits a plate whose top is `plate` (width, length),
+/// either way round: each at most [`PLATE_OVERHANG`] times the plate's.
+fn fits_plate(span: &[f64; 2], plate: [f64; 2]) -> bool {
+    let k = PLATE_OVERHANG;
+    let [a, b] = *span;
+    (a <= k * plate[0] && b <= k * plate[1]) || (a <= k * plate[1] && b <= k * plate[0])
 }
 
 /// The pads under rest pose `r` where the part stands on risers of pad diameter `pad`

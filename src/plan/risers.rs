@@ -69,7 +69,7 @@ pub(crate) fn pads(
 ) -> Option<[P3; 3]> {
     let (e1, e2) = perpendicular_basis(up);
     let flat = |x: &V3| (x.dot(&e1), x.dot(&e2));
-    let tris: Vec<[(f64, f64); 3]> = g
+    let tris: Vec<Triangle> = g
         .triangles
         .iter()
         .enumerate()
@@ -95,11 +95,7 @@ pub(crate) fn pads(
 
 /// Grid points over the triangles `tris` that lie on one of them and at least
 /// `clearance` from every edge of `edges` (the contact's outline).
-fn on_material(
-    tris: &[[(f64, f64); 3]],
-    edges: &[[(f64, f64); 2]],
-    clearance: f64,
-) -> Vec<(f64, f64)> {
+fn on_material(tris: &[Triangle], edges: &[[(f64, f64); 2]], clearance: f64) -> Vec<(f64, f64)> {
     let (mut lo, mut hi) = ((f64::MAX, f64::MAX), (f64::MIN, f64::MIN));
     for p in tris.iter().flatten() {
         lo = (lo.0.min(p.0), lo.1.min(p.1));
@@ -145,7 +141,7 @@ fn boundary(
         .collect()
 }
 
-fn in_triangle(t: &[(f64, f64); 3], q: (f64, f64)) -> bool {
+fn in_triangle(t: &Triangle, q: (f64, f64)) -> bool {
     let side = |a: (f64, f64), b: (f64, f64)| (b.0 - a.0) * (q.1 - a.1) - (b.1 - a.1) * (q.0 - a.0);
     let s = [side(t[0], t[1]), side(t[1], t[2]), side(t[2], t[0])];
     s.iter().all(|&x| x >= -1e-9) || s.iter().all(|&x| x <= 1e-9)
