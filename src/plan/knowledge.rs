@@ -944,9 +944,10 @@ fn preferred_directions(
 }
 
 /// The table alternatives of datum faces that can rest on the table (ch. 3.6.2): each
-/// face's table points join `points`, and the alternative is alive only where the pose
-/// stands on the table itself (`real`, and no riser under it: the table points lie in
-/// the face's plane).
+/// face's table points join `points`. A face has one only where its pose stands on the
+/// table itself (`real`, and no riser under it: the table points lie in the face's
+/// plane); elsewhere the table is not there to stand in for it, and nothing (the
+/// planner, the re-measurement of datums) may touch it.
 fn table_alternatives(
     scene: &Scene,
     geometry: &crate::geometry::PartGeometry,
@@ -957,6 +958,15 @@ fn table_alternatives(
 ) -> Vec<TableAlt> {
     let mut tables = Vec::new();
     for &(face, up) in table_dirs {
+        let cell = empty.cell_of(&up);
+        let on_table = real.get(cell)
+            && matches!(
+                setups.holder(&empty.direction(cell)),
+                Some(super::poses::Holder::Table { .. })
+            );
+        if !on_table {
+            continue;
+        }
         let pts = table_points(scene, geometry, face, &up, machine);
         let first = points.len();
         points.extend(pts.iter().map(|&position| Fpoint {
@@ -964,17 +974,11 @@ fn table_alternatives(
             position,
             normal: up,
         }));
-        // A datum face can rest on the table only in a pose that stands.
-        let cell = empty.cell_of(&up);
         tables.push(TableAlt {
             face,
             cell: empty.index(cell),
             points: (first..points.len()).collect(),
-            alive: real.get(cell)
-                && matches!(
-                    setups.holder(&empty.direction(cell)),
-                    Some(super::poses::Holder::Table { .. })
-                ),
+            alive: true,
         });
     }
     tables
