@@ -1187,8 +1187,10 @@ impl Machine<'_> {
     }
 
     /// Under `MODE/PROG`, the touch's approach to the contact `found` swept with the
-    /// probe: from the nominal tip centre `nominal` or, where the actual surface stands
-    /// proud of it, from the contact.
+    /// probe: from the approach point, `SNSET/APPRCH` out from the nominal tip centre
+    /// `nominal` along the touch's vector (ANSI/DMIS 105.2 `SNSET/APPRCH`: the distance
+    /// from the nominal point at which the approach starts), to the nominal tip centre
+    /// or, where the actual surface stands proud of it, to the contact.
     fn check_touch_approach(
         &self,
         ctx: &SetupCtx,
@@ -1212,13 +1214,17 @@ impl Machine<'_> {
         // (tilted, or the frame off), the ball is nearer its nominal triangles than
         // a tip is allowed to be, and no material is there. The check starts where
         // the ball clears them.
-        if let Some((face, d)) = self.nearest_face(&outer) {
-            if Some(face) == touched && d < r {
-                outer += np * (r - d);
+        // The nearest facet need not lie along the touch's vector (a small bore's facets
+        // stand across it): a few steps out until the ball clears them.
+        for _ in 0..4 {
+            match self.nearest_face(&outer) {
+                Some((face, d)) if Some(face) == touched && d < r - 1e-6 => outer += np * (r - d),
+                _ => break,
             }
         }
+        let travel = (self.apprch - (outer - nominal).dot(np)).max(0.0);
         let pose = self.pose(ctx, s);
-        if let Err(b) = pose.approach(&outer, np, self.apprch, contact) {
+        if let Err(b) = pose.approach(&outer, np, travel, contact) {
             return Err(self.collision(at, b, "on the touch's approach"));
         }
         Ok(())
