@@ -1884,6 +1884,7 @@ impl Writer<'_> {
                 | TolKind::ProfileLine
                 | TolKind::ProfileSurface
         );
+        let sized = matches!(t.kind, TolKind::Diameter | TolKind::Radius);
         let labels_of = |f: FeatureId| -> Vec<String> {
             if let Some((pair, walls)) = self.pairs.get(&f) {
                 return if per_wall {
@@ -1911,6 +1912,13 @@ impl Writer<'_> {
             }
             // The table stands in for a datum; the tolerance is the part's surface's.
             labels.retain(|l| !self.is_table(l));
+            // A size is a circle's, cylinder's, cone's or sphere's: a free-form face
+            // (`GSURF`) reports none (the graph stage warns, `size_on_freeform`).
+            if sized {
+                labels.retain(|l| {
+                    !matches!(self.nominals.get(l), Some(Nominal::Surface(Surface::Freeform, _)))
+                });
+            }
             labels
         };
         let profile = matches!(t.kind, TolKind::ProfileLine | TolKind::ProfileSurface);

@@ -33,6 +33,23 @@ pub(crate) enum GraphError {
         found: String,
         help: String,
     },
+    #[error("{tolerance} `{name}` is read on {read} of the {total} faces of `{feature}`: {faces} {is} free-form, and a free-form face has no size")]
+    #[diagnostic(
+        code(insp::graph::size_on_freeform),
+        severity(Warning),
+        help("a free-form face (a torus blend, a spline patch) is measured as a DMIS `GSURF`: points on a surface, with no diameter or radius for `TOL/DIAM` or `TOL/RAD` to judge; a profile tolerance controls its shape, or leave it out of the feature")
+    )]
+    SizeOnFreeform {
+        #[label("this tolerance")]
+        span: Span,
+        tolerance: String,
+        name: String,
+        feature: String,
+        read: String,
+        total: usize,
+        faces: String,
+        is: &'static str,
+    },
     #[error("{what} samples more than {limit} measuring points on its {faces} faces", limit = super::MAX_POINTS)]
     #[diagnostic(
         code(insp::graph::too_many_points),
@@ -50,4 +67,5 @@ crate::diag::located!(GraphError {
     TooManyPoints,
     NoPoints,
     WrongSurface,
+    SizeOnFreeform,
 });

@@ -552,7 +552,12 @@ pub fn check_surfaces(
                     k != SurfaceKind::Freeform && !allowed.contains(&k)
                 })
         });
-        let Some((f, face)) = wrong else { continue };
+        let Some((f, face)) = wrong else {
+            if matches!(t.kind, TolKind::Diameter | TolKind::Radius) {
+                size_on_freeform(t, part, g, feature_faces, diags);
+            }
+            continue;
+        };
         let names: Vec<&str> = allowed.iter().map(|k| k.keyword()).collect();
         let needs = match names.as_slice() {
             [one] => one.to_string(),
@@ -567,6 +572,46 @@ pub fn check_surfaces(
             feature: part.features[f.0].name.clone(),
             found: format!("a {}", g.faces[face.0].surface.kind().keyword()),
             help: "check the feature's faces (`inspc faces` lists their types), or choose a tolerance that fits them".into(),
+        });
+    }
+}
+
+/// Warns where a diameter or radius names free-form faces among its features' faces:
+/// the program reads the size on the others only (see [`GraphError::SizeOnFreeform`]).
+fn size_on_freeform(
+    t: &crate::model::Tolerance,
+    part: &Part,
+    g: &PartGeometry,
+    feature_faces: &[Vec<FaceId>],
+    diags: &mut Diagnostics,
+) {
+    for f in &t.targets {
+        let faces = &feature_faces[f.0];
+        let free: Vec<&str> = faces
+            .iter()
+            .filter(|face| g.faces[face.0].surface.kind() == SurfaceKind::Freeform)
+            .map(|face| g.faces[face.0].name.as_str())
+            .collect();
+        if free.is_empty() {
+            continue;
+        }
+        let shown = match free.len() {
+            1 => format!("`{}`", free[0]),
+            2 => format!("`{}` and `{}`", free[0], free[1]),
+            n => format!("`{}`, `{}` and {} more", free[0], free[1], n - 2),
+        };
+        diags.push(GraphError::SizeOnFreeform {
+            span: t.span,
+            tolerance: t.kind.keyword().to_string(),
+            name: t.name.clone(),
+            feature: part.features[f.0].name.clone(),
+            read: match faces.len() - free.len() {
+                0 => "none".to_string(),
+                n => n.to_string(),
+            },
+            total: faces.len(),
+            faces: shown,
+            is: if free.len() == 1 { "is" } else { "are" },
         });
     }
 }
