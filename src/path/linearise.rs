@@ -97,9 +97,12 @@ fn setup_groups<'a>(
             // plane, where the longest probe in any orientation swings clear.
             let lift = reach_max - probe.reach() * dir.dot(&up);
             let (mut blocks, records) = orient_blocks(input, hlip, scene, probe, o, datum_of);
-            let pose = Pose::new(scene, probe, dir, up, table).with_fixture(&s.fixture);
+            let poses: Vec<Pose> = placed_dirs(dir, up, s.square_within)
+                .into_iter()
+                .map(|d| Pose::new(scene, probe, d, up, table).with_fixture(&s.fixture))
+                .collect();
             for b in &mut blocks {
-                outlast(input, hlip, (scene, probe, &pose), b, standoff);
+                outlast(input, hlip, (scene, probe, &poses), b, standoff);
             }
             let has_datum = blocks.iter().any(|b| b.datum.is_some());
             setup_groups.push(GroupIn {
@@ -273,12 +276,13 @@ fn excursion(input: &Input, feature: FeatureId) -> f64 {
 /// ([`excursion`]): the approach then starts the motion margin beyond that (DMIS
 /// `SNSET/APPRCH`; PC-DMIS's prehit distance is set the same way, larger than the
 /// deviation expected). Where the longer approach (validated as the planner validated
-/// the standard one, [`Pose::approach`]) or the free space in front of a point does not
+/// the standard one, [`Pose::approach`], in each of `poses`: the probe's direction and
+/// turned as the part may be placed) or the free space in front of a point does not
 /// allow it, the block keeps the stand-off it had.
 fn outlast(
     input: &Input,
     hlip: &Hlip,
-    (scene, probe, pose): (&Scene, &ProbeShape, &Pose),
+    (scene, probe, poses): (&Scene, &ProbeShape, &[Pose]),
     b: &mut BlockPath,
     standoff: f64,
 ) {
@@ -298,11 +302,30 @@ fn outlast(
     let clear = points.iter().all(|&k| {
         let p = &hlip.points[k];
         let c = p.position + p.normal * probe.tip_radius;
-        pose.approach(&c, &p.normal, longer, Contact::Part).is_ok()
+        poses
+            .iter()
+            .all(|pose| pose.approach(&c, &p.normal, longer, Contact::Part).is_ok())
     });
     if clear {
         b.standoff = longer;
     }
+}
+
+/// The probe's directions (part frame) a setup's touches must stay clear in: `dir`,
+/// and turned either way about `up` by the turn the setup tolerates (its prompt's
+/// `square_within`, else [`crate::plan::PLACEMENT_TURN`]): the part set off square,
+/// found by the alignment, sees the indexed stylus turned (as the planner validated
+/// every touch, `plan::validate`).
+fn placed_dirs(dir: V3, up: V3, square_within: Option<f64>) -> Vec<V3> {
+    let turn = square_within.unwrap_or(crate::plan::PLACEMENT_TURN);
+    if turn <= 0.0 || dir.cross(&up).norm() < 1e-9 {
+        return vec![dir];
+    }
+    let axis = nalgebra::Unit::new_normalize(up);
+    [0.0, turn, -turn]
+        .into_iter()
+        .map(|t| nalgebra::Rotation3::from_axis_angle(&axis, t.to_radians()) * dir)
+        .collect()
 }
 
 /// A block's stand-off: `standoff`, or half the free space in front of its points when

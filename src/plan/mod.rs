@@ -54,6 +54,7 @@ mod validate;
 pub use errors::PlanError;
 pub use explain::explain_setups;
 pub(crate) use hlip::STEPS_PER_MM;
+pub(crate) use validate::PLACEMENT_TURN;
 pub use hlip::{
     FaceVisit, Hlip, Inspection, OrientNode, PlanPoint, PointRef, ProbeNode, SetupNode, Summary,
 };
