@@ -1916,7 +1916,10 @@ impl Writer<'_> {
             // (`GSURF`) reports none (the graph stage warns, `size_on_freeform`).
             if sized {
                 labels.retain(|l| {
-                    !matches!(self.nominals.get(l), Some(Nominal::Surface(Surface::Freeform, _)))
+                    !matches!(
+                        self.nominals.get(l),
+                        Some(Nominal::Surface(Surface::Freeform, _))
+                    )
                 });
             }
             labels

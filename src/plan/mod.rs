@@ -54,7 +54,6 @@ mod validate;
 pub use errors::PlanError;
 pub use explain::explain_setups;
 pub(crate) use hlip::STEPS_PER_MM;
-pub(crate) use validate::PLACEMENT_TURN;
 pub use hlip::{
     FaceVisit, Hlip, Inspection, OrientNode, PlanPoint, PointRef, ProbeNode, SetupNode, Summary,
 };
@@ -63,6 +62,7 @@ pub use machine::check_machine;
 pub use memo::Memo;
 pub use render::{json, text, Names};
 pub use search::plan_with;
+pub(crate) use validate::PLACEMENT_TURN;
 
 use crate::diag::Diagnostics;
 
