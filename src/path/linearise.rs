@@ -318,13 +318,8 @@ fn outlast(
 /// every touch, `plan::validate`).
 fn placed_dirs(dir: V3, up: V3, square_within: Option<f64>) -> Vec<V3> {
     let turn = square_within.unwrap_or(crate::plan::PLACEMENT_TURN);
-    if turn <= 0.0 || dir.cross(&up).norm() < 1e-9 {
-        return vec![dir];
-    }
-    let axis = nalgebra::Unit::new_normalize(up);
-    [0.0, turn, -turn]
-        .into_iter()
-        .map(|t| nalgebra::Rotation3::from_axis_angle(&axis, t.to_radians()) * dir)
+    std::iter::once(dir)
+        .chain(crate::plan::turned_dirs(dir, &up, turn))
         .collect()
 }
 

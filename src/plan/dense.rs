@@ -45,7 +45,6 @@ use crate::diag::Diagnostics;
 use crate::geometry::{FaceId, P3, V3};
 use crate::graph::{Edge, MeasurementGraph, Node};
 use crate::sample::Fpoint;
-use nalgebra::{Rotation3, Unit};
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -599,13 +598,9 @@ impl Validator<'_> {
             None if self.turned => PLACEMENT_TURN,
             None => 0.0,
         };
-        if turn <= 0.0 || dir.cross(&up).norm() < 1e-9 {
-            return true;
-        }
-        let axis = Unit::new_normalize(up);
-        [1.0, -1.0]
+        super::validate::turned_dirs(dir, &up, turn)
             .into_iter()
-            .all(|sign| ok(Rotation3::from_axis_angle(&axis, sign * turn.to_radians()) * dir))
+            .all(ok)
     }
 }
 

@@ -62,7 +62,7 @@ pub use machine::check_machine;
 pub use memo::Memo;
 pub use render::{json, text, Names};
 pub use search::plan_with;
-pub(crate) use validate::PLACEMENT_TURN;
+pub(crate) use validate::{turned_dirs, PLACEMENT_TURN};
 
 use crate::diag::Diagnostics;
 

@@ -72,16 +72,24 @@ pub(crate) fn clear_turned(
     held: &Held,
     turn: f64,
 ) -> Result<(), Blocker> {
-    let dir = probe_dir(m, pip, up);
-    if turn <= 0.0 || dir.cross(up).norm() < 1e-9 {
-        return Ok(());
-    }
-    let axis = Unit::new_normalize(*up);
-    for sign in [1.0, -1.0] {
-        let turned = Rotation3::from_axis_angle(&axis, sign * turn.to_radians()) * dir;
+    for turned in turned_dirs(probe_dir(m, pip, up), up, turn) {
         k.pose_check(m, pip.point, pip.probe, turned, *up, held)?;
     }
     Ok(())
+}
+
+/// A probe direction `dir` turned `turn` degrees either way about `up` (the part set
+/// off square under an indexed stylus); none where there is no turn or the probe
+/// stands along `up` (it turns into itself).
+pub(crate) fn turned_dirs(dir: V3, up: &V3, turn: f64) -> Vec<V3> {
+    if turn <= 0.0 || dir.cross(up).norm() < 1e-9 {
+        return Vec::new();
+    }
+    let axis = Unit::new_normalize(*up);
+    [1.0, -1.0]
+        .into_iter()
+        .map(|sign| Rotation3::from_axis_angle(&axis, sign * turn.to_radians()) * dir)
+        .collect()
 }
 
 /// The largest of the turns tried (degrees: `turn`, then 2, 1, 0.5, 0.25 and 0.1 where
