@@ -31,8 +31,9 @@
 //! a second time, in every direction: `plan::Ban::widen`), at most `REPLANS` (16) times
 //! (`paths_of`); the diagnostics of the last try are the ones reported. A re-plan
 //! reuses the first planning's pure results (`plan::Memo`: cones, D2 caps, depth maps,
-//! grid orientations, the scene), so it costs clustering and validation only: one
-//! unreachable touch costs a re-plan, not the program.
+//! grid orientations, the scene), so it costs clustering and validation only, and from
+//! the round where the new ban first matters (`plan::journal`: the rounds before it are
+//! the last search's): one unreachable touch costs a re-plan, not the program.
 #![warn(missing_docs)]
 
 pub mod access;

@@ -201,6 +201,11 @@ impl Diagnostics {
         self.items.push(d);
     }
 
+    /// Whether nothing was filed.
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
     /// Whether any error (not just warnings) was filed.
     pub fn has_errors(&self) -> bool {
         self.items.iter().any(|d| d.severity() == Severity::Error)

@@ -26,6 +26,7 @@ use std::collections::{BTreeMap, BTreeSet};
 const TRIES_PER_POINT: usize = 240;
 
 /// A round's plan and the touches in it that failed validation.
+#[derive(Clone)]
 pub(super) struct Fallback {
     /// The round's best branches.
     pub branches: Vec<Branch>,

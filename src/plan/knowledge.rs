@@ -37,7 +37,7 @@ mod rescue;
 
 use super::cluster::{Bits, Set};
 use super::machine::Machine;
-use super::memo::{Dom, Memo};
+use super::memo::{Dom, DomRow, Memo};
 use crate::access::pose::{above_table, frame, table_height, Blocker, Contact, Pose};
 use crate::access::{self, tip_fits, Cell, ConeOptions, CubeMap, ProbeShape, Scene, SecondMap};
 use crate::geometry::{FaceId, Surface, P3, V3};
@@ -47,6 +47,7 @@ use crate::sample::Fpoint;
 use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::Arc;
 
 /// Putting a planar datum face on the table (ch. 3.6.2).
 #[derive(Debug, Clone)]
@@ -59,6 +60,19 @@ pub(crate) struct TableAlt {
     pub points: Vec<usize>,
     /// False once validation found the table points unreachable.
     pub alive: bool,
+}
+
+/// The part of the knowledge a search's rounds change (the rest is fixed by the input
+/// or a cache of pure results): what [`super::journal`] keeps to resume from.
+#[derive(Clone)]
+pub(crate) struct Learnt {
+    dom: Vec<DomRow>,
+    d1p: BTreeMap<(usize, usize, usize), Bits>,
+    /// The setup cells whose holding was asked for: `reject` reads a fixture from it.
+    held: BTreeSet<usize>,
+    /// Per table alternative, whether it is alive.
+    alive: Vec<bool>,
+    acquired: usize,
 }
 
 /// The planner's knowledge base.
@@ -78,8 +92,9 @@ pub(crate) struct Knowledge<'a> {
     pub graph_points: usize,
     /// The margin the plan's moves keep (`motion { margin }`, mm).
     pub motion_margin: f64,
-    /// Per point and probe.
-    pub dom: Vec<Vec<Dom>>,
+    /// Per point and probe; a point's row is shared with the journal's states until
+    /// learning changes it ([`super::journal`]).
+    pub dom: Vec<DomRow>,
     /// Setups the plan forbids.
     pub forbidden: CubeMap,
     /// Setups an operator can realise: the part's stable poses and its fixtures'
@@ -260,10 +275,13 @@ impl<'a> Knowledge<'a> {
             &mut points,
         );
         let graph_points = fpoints.len();
-        let dom: Vec<Vec<Dom>> = match &memo.initial {
+        let dom: Vec<DomRow> = match &memo.initial {
             Some(dom) => dom.clone(),
             None => {
-                let dom = initial_domains(&scene, fpoints, machine, &opts);
+                let dom: Vec<DomRow> = initial_domains(&scene, fpoints, machine, &opts)
+                    .into_iter()
+                    .map(Arc::new)
+                    .collect();
                 memo.initial = Some(dom.clone());
                 dom
             }
@@ -313,6 +331,44 @@ impl<'a> Knowledge<'a> {
             self.held.insert(s, h);
         }
         &self.held[&s]
+    }
+
+    /// What the search has learnt so far, to resume from ([`super::journal`]).
+    pub(crate) fn learnt(&self) -> Learnt {
+        Learnt {
+            dom: self.dom.clone(),
+            d1p: self.d1p.clone(),
+            held: self.held.keys().copied().collect(),
+            alive: self.tables.iter().map(|t| t.alive).collect(),
+            acquired: self.acquired,
+        }
+    }
+
+    /// About what a copy of every point's domains takes (bytes): per point and probe,
+    /// two cube maps of `6 n²` bits.
+    pub(crate) fn domain_bytes(&self) -> usize {
+        let n = self.opts.n as usize;
+        let probes = self.dom.first().map_or(0, |row| row.len());
+        self.dom.len() * probes * 2 * (6 * n * n / 8)
+    }
+
+    /// Takes up what a search had learnt ([`Knowledge::learnt`] of the same input).
+    pub(crate) fn resume(&mut self, l: Learnt) {
+        self.dom = l.dom;
+        self.d1p = l.d1p;
+        self.held.retain(|s, _| l.held.contains(s));
+        for &s in &l.held {
+            self.held(s);
+        }
+        for (t, &alive) in self.tables.iter_mut().zip(&l.alive) {
+            t.alive = alive;
+        }
+        self.acquired = l.acquired;
+    }
+
+    /// The memo the knowledge reads and fills.
+    pub(super) fn memo(&mut self) -> &mut Memo {
+        self.memo
     }
 
     /// [`Knowledge::held`], uncached.
@@ -712,7 +768,7 @@ impl<'a> Knowledge<'a> {
                 return;
             }
         }
-        let dom = &mut self.dom[f][p];
+        let dom = &mut Arc::make_mut(&mut self.dom[f])[p];
         let cell = dom.setup.cell(s);
         if machine.head.indexable() {
             // No orientation works in this setup: nor, most likely, in setups close by.
@@ -831,7 +887,7 @@ impl<'a> Knowledge<'a> {
             for j in exact {
                 cones.approach.set(Cell::Preferred(j), true);
             }
-            let dom = &mut self.dom[f][p];
+            let dom = &mut Arc::make_mut(&mut self.dom[f])[p];
             dom.full = true;
             dom.tip &= cones.tip_fits;
             match (&mut dom.d1, cones.d2, cap) {

@@ -9,7 +9,11 @@ use super::cluster::Bits;
 use crate::access::scan::{FaceCones, FaceCoverage};
 use crate::access::{self, CubeMap, Scene, SecondMap};
 use crate::geometry::{FaceId, V3};
-use std::collections::BTreeMap;
+use std::any::Any;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// What is known about one fpoint, per probe: shared until learning changes it.
+pub(crate) type DomRow = std::sync::Arc<Vec<Dom>>;
 
 /// How much is known about one (fpoint, probe).
 #[derive(Debug, Clone)]
@@ -33,7 +37,7 @@ pub(crate) struct Dom {
 #[derive(Default)]
 pub struct Memo {
     /// The initial knowledge of every (graph point, probe).
-    pub(super) initial: Option<Vec<Vec<Dom>>>,
+    pub(super) initial: Option<Vec<DomRow>>,
     /// The whole probe's cones per (point, probe).
     pub(super) cones: BTreeMap<(usize, usize), access::PointCones>,
     /// The second component's depth map per setup cell.
@@ -55,6 +59,10 @@ pub struct Memo {
     /// the full graph ([`super::dense`]): those no representative's configuration
     /// reached, and those the path stage banned.
     pub(super) promoted: std::collections::BTreeSet<usize>,
+    /// Per search of the input (the turn's bits, the faces left to a scanner), the
+    /// states its rounds started from: a [`super::journal::Journal`], as the search
+    /// hands it over.
+    pub(super) journals: BTreeMap<(u64, BTreeSet<FaceId>), Box<dyn Any + Send + Sync>>,
     /// The full graph's indices of the points the knowledge above is numbered by, when
     /// the search planned a thinned graph.
     thinned: Option<Vec<usize>>,
@@ -72,6 +80,7 @@ impl Memo {
         self.cones.clear();
         self.orientations.clear();
         self.caps.clear();
+        self.journals.clear();
     }
 
     /// Later plannings of this input validate at the nominal pose only.

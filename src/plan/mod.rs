@@ -37,6 +37,7 @@ mod fallback;
 mod filter;
 mod hlip;
 mod input;
+mod journal;
 mod knowledge;
 mod machine;
 mod memo;

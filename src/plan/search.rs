@@ -38,6 +38,7 @@ use super::explain::{face_name, report_face};
 use super::fallback::Fallback;
 use super::filter::filter;
 use super::hlip::{assemble, Round};
+use super::journal::Journal;
 use super::knowledge::{self, Knowledge};
 use super::machine::Machine;
 use super::memo::Memo;
@@ -173,6 +174,12 @@ fn plan_touch(
 ) -> Option<Hlip> {
     let (model, plan) = (input.model, input.plan);
     let machine = Machine::new(model, plan);
+    let key = (turn.to_bits(), skip.clone());
+    let old: Option<SearchJournal> = memo
+        .journals
+        .remove(&key)
+        .and_then(|j| j.downcast().ok())
+        .map(|j| *j);
     let mut k = initial_knowledge(input, opts, &machine, memo);
     let mut search = Search {
         input,
@@ -186,13 +193,41 @@ fn plan_touch(
         fallback: None,
         skipped: skip.clone(),
         read_axes: axes::axis_faces(input.graph, &model.parts[plan.part.0]),
+        checked: Vec::new(),
     };
-    for iteration in 1..=opts.max_iterations {
-        if let ControlFlow::Break(hlip) = search.round(&mut k, iteration, diags) {
-            return hlip;
+    let (mut first, mut validating) = (1, false);
+    let banned =
+        |(pip, up): &(Pip, V3), bans: &[super::Ban]| validate::banned(&machine, pip, up, bans);
+    let mut journal = match old.and_then(|j| j.resume(&opts.bans, banned)) {
+        Some((iteration, (learnt, rounds), kept)) => {
+            k.resume(learnt);
+            search.take_up(rounds);
+            (first, validating) = (iteration, true);
+            kept
+        }
+        None => Journal::new(&opts.bans, k.domain_bytes()),
+    };
+    let mut own = Diagnostics::new();
+    let mut out = None;
+    for iteration in first..=opts.max_iterations {
+        let before = validating.then(|| (k.learnt(), search.rounds()));
+        let reported = !own.is_empty();
+        let next = search.round(&mut k, iteration, &mut own);
+        let checked = std::mem::take(&mut search.checked);
+        validating = !checked.is_empty();
+        journal.record(iteration, before, checked, reported);
+        if let ControlFlow::Break(hlip) = next {
+            out = Some(hlip);
+            break;
         }
     }
-    search.give_up(&mut k, diags)
+    let hlip = match out {
+        Some(hlip) => hlip,
+        None => search.give_up(&mut k, &mut own),
+    };
+    k.memo().journals.insert(key, Box::new(journal));
+    diags.extend(own);
+    hlip
 }
 
 /// The knowledge base the search starts from: the plan's setups, the datum faces that
@@ -274,6 +309,23 @@ struct Search<'a> {
     skipped: BTreeSet<FaceId>,
     /// Faces whose axis a tolerance reads ([`axes::axis_faces`]).
     read_axes: BTreeSet<FaceId>,
+    /// The touches the round validated, for the journal.
+    checked: Vec<(Pip, V3)>,
+}
+
+/// A search's journal: per round, what the knowledge learnt and the rounds' own state
+/// at its start, and the touches (in their setups) it validated.
+type SearchJournal = Journal<(knowledge::Learnt, Rounds), (Pip, V3)>;
+
+/// What a search's rounds change of their own state: what the journal keeps beside the
+/// knowledge's to resume a search from.
+#[derive(Clone)]
+struct Rounds {
+    validated: BTreeSet<Pip>,
+    turned_fails: BTreeMap<usize, usize>,
+    last: LastRound,
+    fallback: Option<Fallback>,
+    skipped: BTreeSet<FaceId>,
 }
 
 /// The touches of a round's plan that failed validation, sorted for what follows.
@@ -290,6 +342,26 @@ struct Failures {
 }
 
 impl Search<'_> {
+    /// The state the rounds so far left ([`Rounds`]).
+    fn rounds(&self) -> Rounds {
+        Rounds {
+            validated: self.validated.clone(),
+            turned_fails: self.turned_fails.clone(),
+            last: self.last.clone(),
+            fallback: self.fallback.clone(),
+            skipped: self.skipped.clone(),
+        }
+    }
+
+    /// Takes up the state of an earlier search's rounds.
+    fn take_up(&mut self, r: Rounds) {
+        self.validated = r.validated;
+        self.turned_fails = r.turned_fails;
+        self.last = r.last;
+        self.fallback = r.fallback;
+        self.skipped = r.skipped;
+    }
+
     /// One round of generate and test.
     fn round(&mut self, k: &mut Knowledge, iteration: usize, diags: &mut Diagnostics) -> Next {
         let (input, machine) = (self.input, self.machine);
@@ -456,6 +528,7 @@ impl Search<'_> {
         pips.sort_by_key(|(p, _)| *p);
         pips.dedup_by_key(|(p, _)| *p);
         pips.retain(|(p, _)| !self.validated.contains(p));
+        self.checked.clone_from(&pips);
         let held: BTreeMap<usize, knowledge::Held> = pips
             .iter()
             .map(|(p, _)| (p.setup, k.held(p.setup).clone()))

@@ -44,11 +44,16 @@ pub(crate) fn check(
     held: &Held,
     bans: &[super::Ban],
 ) -> Result<(), Blocker> {
-    let dir = probe_dir(m, pip, up);
-    if bans.iter().any(|b| b.is(pip.point, pip.probe, up, &dir)) {
+    if banned(m, pip, up, bans) {
         return Err(Blocker::Path);
     }
-    k.pose_check(m, pip.point, pip.probe, dir, *up, held)
+    k.pose_check(m, pip.point, pip.probe, probe_dir(m, pip, up), *up, held)
+}
+
+/// Whether one of `bans` (the path stage's) covers a PIP in setup `up`.
+pub(crate) fn banned(m: &Machine, pip: &Pip, up: &V3, bans: &[super::Ban]) -> bool {
+    let dir = probe_dir(m, pip, up);
+    bans.iter().any(|b| b.is(pip.point, pip.probe, up, &dir))
 }
 
 /// The probe's direction (tip to head, part frame) of a PIP in setup `up`.

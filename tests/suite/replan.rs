@@ -62,3 +62,47 @@ fn a_banned_configuration_is_planned_elsewhere() {
         assert_eq!(again.summary.tolerances, first.summary.tolerances, "{spec}");
     }
 }
+
+/// A re-plan takes up the search where a new ban first matters (`plan::journal`): its
+/// plan is the one a search from the first round gives, for a ban on the first touch
+/// (validated early) and on the last (validated late).
+#[test]
+fn a_replan_that_resumes_plans_as_a_search_from_the_start() {
+    use inspc::plan::{plan_with, Input, Memo};
+    for spec in ["examples/f3_indexed.insp", "examples/f2.insp"] {
+        let (checked, parts, graphs, planned) = inspc::plans(
+            &inspc::source::FsWorld,
+            &[spec.into()],
+            &PlanOptions::default(),
+        );
+        let model = &checked.model;
+        let p = &planned[0];
+        let plan = &model.plans[p.plan];
+        let g = graphs
+            .iter()
+            .find(|g| g.graph.plan.as_deref() == Some(&plan.name))
+            .expect("the plan's graph");
+        let data = parts[g.part].as_ref().expect("the part");
+        let input = Input {
+            model,
+            plan,
+            geometry: &data.geometry,
+            fixtures: &data.fixtures,
+            graph: &g.graph,
+        };
+        let touched = configurations(p.hlip.as_ref().expect("a plan"));
+        for ban in [&touched[0], touched.last().expect("a touch")] {
+            let mut memo = Memo::default();
+            let mut diags = inspc::diag::Diagnostics::new();
+            plan_with(&input, &PlanOptions::default(), &mut memo, &mut diags);
+            let banned = PlanOptions {
+                bans: vec![ban.clone()],
+                ..PlanOptions::default()
+            };
+            let resumed = plan_with(&input, &banned, &mut memo, &mut diags);
+            let fresh = plan_with(&input, &banned, &mut Memo::default(), &mut diags);
+            assert!(fresh.is_some(), "{spec}: no plan with {ban:?}");
+            assert_eq!(resumed, fresh, "{spec}: banned {ban:?}");
+        }
+    }
+}

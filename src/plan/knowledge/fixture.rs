@@ -64,7 +64,7 @@ impl Knowledge<'_> {
             .collect();
         for (f, pairs) in blocked.into_iter().enumerate() {
             for (p, s) in pairs {
-                let setup = &mut self.dom[f][p].setup;
+                let setup = &mut std::sync::Arc::make_mut(&mut self.dom[f])[p].setup;
                 let cell = setup.cell(s);
                 setup.set(cell, false);
             }
