@@ -3,8 +3,8 @@
 //! The path stage sends a plan back with configurations banned ([`Ban`]) and the planner
 //! searches the same input again. Generate-and-test is deterministic: until a round
 //! validates a touch that a new ban covers, every round of the new search computes what
-//! the last search's did — the same knowledge, clustering and validation results — so its
-//! rounds up to there are the old ones. The journal keeps, per search, the state at the
+//! the last search's did (the same knowledge, clustering and validation results), so
+//! its rounds up to there are the old ones. The journal keeps, per search, the state at the
 //! start of each round that validated touches, with those touches; a re-plan takes up the
 //! state of the first round whose touches a new ban covers (the last round's where none
 //! does: then only what the search does after it settles changes) and searches on from
@@ -18,9 +18,9 @@
 //! whole-probe cones, and a state held across them would copy every domain they change.
 //! The touches of a round without a state count with the state before it.
 //!
-//! **Decision: what a state is.** The knowledge's learnt part (`knowledge::Learnt`: the domains,
-//! whose rows the states share until learning changes one, D1′, the setups whose
-//! holding was asked, the table alternatives' life) and the search's own
+//! **Decision: what a state is.** The knowledge's learnt part (`knowledge::Learnt`:
+//! the domains, whose rows the states share until learning changes one, D1′, the setups
+//! whose holding was asked, the table alternatives' life) and the search's own
 //! ([`super::search`]: touches validated, fragile counts, faces skipped, the fallback,
 //! why the last round failed). Pure results (cones, depth maps, orientations) are in the
 //! memo already. A state is kept only while the search has reported nothing: a round that
@@ -28,11 +28,11 @@
 //! later state.
 //!
 //! **Decision: which searches.** One journal per search of an input: keyed by the turn
-//! the touches are validated at and the faces left to a scanner, kept in the [`super::Memo`]
-//! (which forgets them when a dense graph is renumbered), and taken up only where the
-//! bans it was written under begin the new search's bans. The journal knows neither
-//! the state nor the touches it keeps (`S`, `C`): the memo sits below the search and
-//! holds it as the search hands it over.
+//! the touches are validated at and the faces left to a scanner, kept in the
+//! [`super::Memo`] (which forgets them when a dense graph is renumbered), taken up only
+//! where the bans it was written under begin the new search's bans. The journal knows
+//! neither the state nor the touches it keeps (`S`, `C`): the memo sits below the search
+//! and holds it as the search hands it over.
 
 use super::Ban;
 
