@@ -439,27 +439,22 @@ impl<'a> Roadmap<'a> {
         (lo - m, hi + m)
     }
 
-    /// Dijkstra from goal `s` until `stop` says the search may end (given the node just
-    /// settled and how many goals are settled): every node's distance, and per node the
-    /// predecessor and the index of the edge from it. The nodes settle in one order
-    /// whatever `stop` is (by distance, ties by index), so a search stopped early agrees
-    /// with the whole one on every node it settled.
-    fn dijkstra(&self, s: usize, stop: impl Fn(usize, usize) -> bool) -> Tree {
+    /// Dijkstra from goal `s` until node `to` settles: per node the predecessor and the
+    /// index of the edge from it. The nodes settle in one
+    /// order (by distance, ties by index), so a search stopped early agrees with the
+    /// whole one on every node it settled.
+    fn dijkstra(&self, s: usize, to: usize) -> Vec<(u32, u32)> {
         let n = self.nodes.len();
         let mut dist = vec![f64::INFINITY; n];
         let mut prev = vec![NO_EDGE; n];
         let mut heap = BinaryHeap::new();
-        let mut settled_goals = 0;
         dist[s] = 0.0;
         heap.push(Item(0.0, s));
         while let Some(Item(d, u)) = heap.pop() {
             if d > dist[u] {
                 continue;
             }
-            if u < self.goals {
-                settled_goals += 1;
-            }
-            if stop(u, settled_goals) {
+            if u == to {
                 break;
             }
             for (k, e) in self.adj[u].iter().enumerate() {
@@ -471,37 +466,85 @@ impl<'a> Roadmap<'a> {
                 }
             }
         }
-        Tree { dist, prev }
+        prev
     }
 
-    /// The shortest-path distances between goals (each search ends when every goal is
-    /// settled). The paths themselves are found again when asked for
-    /// ([`Paths::path`]): a group visits each goal once, so it asks for about as many
-    /// paths as it has goals, and keeping every goal's tree (goals × nodes entries)
-    /// took 1.7 GB on NIST FTC 06 at 10,000 points.
+    /// The shortest-path distances between goals. The paths themselves are found again
+    /// when asked for ([`Paths::path`]): a group visits each goal once, so it asks for
+    /// about as many paths as it has goals, and a tree per goal is goals × nodes
+    /// entries.
     pub(crate) fn shortest_paths(&self) -> Paths {
-        let goals = self.goals;
-        let dist: Vec<Vec<f64>> = (0..goals)
+        let dist: Vec<Vec<f64>> = (0..self.goals)
             .into_par_iter()
-            .map(|g| {
-                let mut d = self.dijkstra(g, |_, settled| settled == goals).dist;
-                d.truncate(goals);
-                d
-            })
+            .map_init(
+                || Scratch::new(self.nodes.len()),
+                |scratch, g| self.goal_distances(g, scratch),
+            )
             .collect();
         Paths { dist }
+    }
+
+    /// Dijkstra from goal `s` to every goal, as [`Roadmap::dijkstra`] settles them, until
+    /// the last goal settles; on a scratch whose distances are reset where this search
+    /// set them (a search per goal over tens of thousands of nodes, each a fresh array,
+    /// was mostly page faults).
+    fn goal_distances(&self, s: usize, scratch: &mut Scratch) -> Vec<f64> {
+        let Scratch { dist, heap, set } = scratch;
+        let mut settled_goals = 0;
+        dist[s] = 0.0;
+        set.push(s);
+        heap.push(Item(0.0, s));
+        while let Some(Item(d, u)) = heap.pop() {
+            if d > dist[u] {
+                continue;
+            }
+            if u < self.goals {
+                settled_goals += 1;
+                if settled_goals == self.goals {
+                    break;
+                }
+            }
+            for e in &self.adj[u] {
+                let nd = d + e.length;
+                if nd < dist[e.to] - 1e-12 {
+                    if dist[e.to] == f64::INFINITY {
+                        set.push(e.to);
+                    }
+                    dist[e.to] = nd;
+                    heap.push(Item(nd, e.to));
+                }
+            }
+        }
+        let out = dist[..self.goals].to_vec();
+        for &k in set.iter() {
+            dist[k] = f64::INFINITY;
+        }
+        set.clear();
+        heap.clear();
+        out
+    }
+}
+
+/// What one thread's searches reuse: distances (infinite but where the search under
+/// way set them), the heap, and the nodes whose distance is set.
+struct Scratch {
+    dist: Vec<f64>,
+    heap: BinaryHeap<Item>,
+    set: Vec<usize>,
+}
+
+impl Scratch {
+    fn new(n: usize) -> Scratch {
+        Scratch {
+            dist: vec![f64::INFINITY; n],
+            heap: BinaryHeap::new(),
+            set: Vec::new(),
+        }
     }
 }
 
 /// No predecessor.
 const NO_EDGE: (u32, u32) = (u32::MAX, u32::MAX);
-
-/// Dijkstra's result from one node: per node its distance and its predecessor with the
-/// index of the edge from it.
-struct Tree {
-    dist: Vec<f64>,
-    prev: Vec<(u32, u32)>,
-}
 
 /// Shortest-path distances between the goals of a roadmap.
 pub(crate) struct Paths {
@@ -519,7 +562,7 @@ impl Paths {
     pub fn path(&self, map: &Roadmap, a: usize, b: usize) -> Vec<P3> {
         // Walk back from b to a in a's tree; each edge's route runs from its
         // predecessor towards the node.
-        let prev = map.dijkstra(a, |u, _| u == b).prev;
+        let prev = map.dijkstra(a, b);
         let mut chain = Vec::new();
         let mut at = b;
         while at != a {
