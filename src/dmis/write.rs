@@ -2163,7 +2163,22 @@ fn nominal_of(input: &Input, b: &BlockPath) -> Option<Nominal> {
         return None;
     }
     let face = input.geometry.faces.get(b.face.0)?;
-    Some(Nominal::Surface(face.surface.clone(), face.centroid))
+    let mut surface = face.surface.clone();
+    // A round surface a size tolerance controls takes the drawing's size.
+    if let (Some(f), Surface::Cylinder { radius, .. } | Surface::Sphere { radius, .. }) =
+        (b.feature, &mut surface)
+    {
+        let part = &input.model.parts[input.plan.part.0];
+        let drawing = part
+            .tolerances
+            .iter()
+            .filter(|t| t.targets.contains(&f))
+            .find_map(|t| t.drawing_diameter(2.0 * *radius));
+        if let Some(d) = drawing {
+            *radius = d / 2.0;
+        }
+    }
+    Some(Nominal::Surface(surface, face.centroid))
 }
 
 /// A surface's blocks in rounds: a block that touches a point again (a datum measured

@@ -647,6 +647,35 @@ pub struct Tolerance {
     pub span: Span,
 }
 
+impl Tolerance {
+    /// The drawing's nominal diameter for a round surface of the toleranced feature whose
+    /// CAD diameter is `cad`: the size tolerance's nominal (twice it for a radius) where
+    /// `cad` lies within the tolerance's limits, so that the surface is the one the
+    /// dimension controls; `None` for other tolerances and other surfaces. The drawing
+    /// governs (ASME Y14.5-2018 §1.4: dimensions define the part; a CAD model is
+    /// modelled at some size within the limits, NIST FTC 08's Ø6.0452 +0.127/−0.0254
+    /// holes at Ø6.0325). A DMIS `TOL/DIAM` gives its limits as deviations from the
+    /// `FEAT`'s nominal (ANSI/DMIS 105.2 `TOL/DIAM,lotol,uptol`), so the program's
+    /// `FEAT` and the verification's size trials both start from this nominal.
+    pub fn drawing_diameter(&self, cad: f64) -> Option<f64> {
+        let scale = match self.kind {
+            TolKind::Diameter => 1.0,
+            TolKind::Radius => 2.0,
+            _ => return None,
+        };
+        let TolValue::Size {
+            nominal,
+            lower,
+            upper,
+        } = self.value
+        else {
+            return None;
+        };
+        let within = (lower * scale - 1e-9..=upper * scale + 1e-9).contains(&cad);
+        within.then_some(nominal * scale)
+    }
+}
+
 /// A form zone that applies to every stretch of the feature of one size: ASME
 /// Y14.5-2018 § 5.4.1.4 (straightness per unit length) and § 5.4.2.2 (flatness per unit
 /// area), ISO 1101 `0.02/25`, `0.02/25×25`. It keeps an abrupt change within a short

@@ -238,7 +238,10 @@ pub(crate) fn solids(centres: &[P3; 3], up: &V3, height: f64, pad: f64) -> Vec<S
 
 /// Where the pads go, for the operator, measured from the corner of the part's
 /// bounding box at its least x, y and z (`corner`), to the nearest millimetre: `pads at
-/// x 28 y 10, x 68 y 30 and x 28 y 50 mm from the part's corner at its least x, y and z`.
+/// x 28 y 10, x 68 y 30 and x 28 y 50 mm from the corner of the part at its least x, y and
+/// z, along the axes of the part drawing`. The axes are said: a part turned over stands
+/// with its y against the machine's, and pads read in machine axes land elsewhere (an
+/// independent review of NIST FTC 08's program put one 9.8 mm from a touch on datum D).
 /// The coordinate along `up` is left out where `up` is a part axis (it is the base's).
 /// No apostrophe: a DMIS text cannot hold one.
 pub(crate) fn words(pads: &[P3; 3], corner: &P3, up: &V3) -> String {
@@ -256,7 +259,8 @@ pub(crate) fn words(pads: &[P3; 3], corner: &P3, up: &V3) -> String {
             .join(" ")
     };
     format!(
-        "pads at {}, {} and {} mm from the corner of the part at its least x, y and z",
+        "pads at {}, {} and {} mm from the corner of the part at its least x, y and z, \
+         along the axes of the part drawing",
         at(&pads[0]),
         at(&pads[1]),
         at(&pads[2])

@@ -133,10 +133,13 @@ pub fn verify(bench: &Bench, opts: &Options) -> Verification {
                 };
                 for f in &t.targets {
                     let name = &part.features[f.0].name;
+                    let faces = &bench.sim.feature_faces[f.0];
+                    let off = trials::off_drawing(bench.sim.geometry, faces, t);
                     for (side, dev) in trials::size_sides(&t.value) {
+                        let grow = trials::num(off + dev * scale);
                         result.limits.push((
                             format!("{name} at its {side}"),
-                            vec![format!("feature {name} grow {}", trials::num(dev * scale))],
+                            vec![format!("feature {name} grow {grow}")],
                             None,
                         ));
                     }

@@ -217,16 +217,20 @@ impl<'a> Breaking<'a> {
         out
     }
 
-    /// A size: each feature grown by `k` × each limit's deviation (a radius's twice).
+    /// A size: each feature grown to its drawing size plus `k` × each limit's deviation
+    /// (a radius's twice): a CAD model modelled off the drawing's nominal
+    /// ([`Tolerance::drawing_diameter`]) is grown by the difference too.
     fn size_variants(&self) -> Vec<Variant> {
         let t = self.t;
         let scale = if t.kind == TolKind::Radius { 2.0 } else { 1.0 };
         let mut out = Vec::new();
-        for (name, _) in self.features() {
+        for (name, faces) in self.features() {
+            let off_drawing = off_drawing(self.g, faces, t);
             for (side, dev) in size_sides(&t.value) {
+                let grow = off_drawing + self.k * dev * scale;
                 out.push(Variant {
                     what: format!("{name} {side}"),
-                    lines: vec![format!("feature {name} grow {}", num(self.k * dev * scale))],
+                    lines: vec![format!("feature {name} grow {}", num(grow))],
                     unit: dev,
                 });
             }
@@ -346,6 +350,21 @@ impl Frame {
     fn fixes_move(&self, dir: &V3) -> bool {
         self.none || self.held.iter().map(|h| h.dot(dir).powi(2)).sum::<f64>() > 1.0 - 1e-3
     }
+}
+
+/// How much a feature's CAD diameter must grow to the size tolerance `t`'s nominal:
+/// that of its first round face the tolerance controls ([`Tolerance::drawing_diameter`]);
+/// 0 where the model is at the drawing's size.
+pub(crate) fn off_drawing(g: &PartGeometry, faces: &[FaceId], t: &Tolerance) -> f64 {
+    faces
+        .iter()
+        .find_map(|f| match g.faces[f.0].surface {
+            Surface::Cylinder { radius, .. } | Surface::Sphere { radius, .. } => {
+                t.drawing_diameter(2.0 * radius).map(|d| d - 2.0 * radius)
+            }
+            _ => None,
+        })
+        .unwrap_or(0.0)
 }
 
 /// The size changes that take a size to its limits: `("upper limit", +0.1)`,
