@@ -721,3 +721,42 @@ impl UnitOf {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::source::{FileId, Span};
+
+    fn size(kind: TolKind, nominal: f64, lower: f64, upper: f64) -> Tolerance {
+        Tolerance {
+            name: "size".into(),
+            kind,
+            targets: vec![],
+            value: TolValue::Size {
+                nominal,
+                lower,
+                upper,
+            },
+            modifier: None,
+            datums: vec![],
+            basic_angle: None,
+            per_unit: None,
+            span: Span::new(FileId(0), 0, 0),
+        }
+    }
+
+    #[test]
+    fn a_cad_size_within_the_limits_takes_the_drawings_nominal() {
+        // NIST FTC 08's datum holes: Ø6.0452 +0.127/−0.0254 on the drawing, Ø6.0325 in CAD.
+        let hole = size(TolKind::Diameter, 6.0452, 6.0198, 6.1722);
+        assert_eq!(hole.drawing_diameter(6.0325), Some(6.0452));
+        // A counterbore of the same feature, another size: not the dimensioned surface.
+        assert_eq!(hole.drawing_diameter(10.0), None);
+        // A radius gives a diameter.
+        let fillet = size(TolKind::Radius, 3.175, 2.667, 3.683);
+        assert_eq!(fillet.drawing_diameter(6.3), Some(6.35));
+        // Not a size.
+        let width = size(TolKind::Width, 10.0, 9.9, 10.1);
+        assert_eq!(width.drawing_diameter(10.0), None);
+    }
+}
