@@ -440,9 +440,9 @@ impl<'a> Roadmap<'a> {
     }
 
     /// Dijkstra from goal `s` until node `to` settles: per node the predecessor and the
-    /// index of the edge from it. The nodes settle in one
-    /// order (by distance, ties by index), so a search stopped early agrees with the
-    /// whole one on every node it settled.
+    /// index of the edge from it. The nodes settle in one order (by distance, ties by
+    /// index), so a search stopped early agrees with the whole one on every node it
+    /// settled.
     fn dijkstra(&self, s: usize, to: usize) -> Vec<(u32, u32)> {
         let n = self.nodes.len();
         let mut dist = vec![f64::INFINITY; n];
