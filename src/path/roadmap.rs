@@ -13,7 +13,7 @@
 use crate::access::pose::{Blocker, Pose};
 use crate::geometry::{P3, V3};
 use rayon::prelude::*;
-use std::cmp::Ordering;
+use std::cmp::{Ordering, Reverse};
 use std::collections::BinaryHeap;
 
 /// Neighbours each new node is connected to.
@@ -439,34 +439,44 @@ impl<'a> Roadmap<'a> {
         (lo - m, hi + m)
     }
 
-    /// Dijkstra from goal `s` until node `to` settles: per node the predecessor and the
-    /// index of the edge from it. The nodes settle in one order (by distance, ties by
-    /// index), so a search stopped early agrees with the whole one on every node it
-    /// settled.
-    fn dijkstra(&self, s: usize, to: usize) -> Vec<(u32, u32)> {
-        let n = self.nodes.len();
-        let mut dist = vec![f64::INFINITY; n];
-        let mut prev = vec![NO_EDGE; n];
-        let mut heap = BinaryHeap::new();
+    /// Dijkstra from goal `s` on `scratch` until `stop` says the search may end (given
+    /// the node just settled and how many goals are settled), leaving each reached
+    /// node's distance and predecessor (with the index of the edge from it) there. The
+    /// nodes settle in one order (by distance, ties by index), so a search stopped early
+    /// agrees with the whole one on every node it settled.
+    fn search(&self, s: usize, scratch: &mut Scratch, stop: impl Fn(usize, usize) -> bool) {
+        let Scratch {
+            dist,
+            prev,
+            heap,
+            set,
+        } = scratch;
+        let mut settled_goals = 0;
         dist[s] = 0.0;
-        heap.push(Item(0.0, s));
-        while let Some(Item(d, u)) = heap.pop() {
+        set.push(s);
+        heap.push(Reverse(Near(0.0, s, 0)));
+        while let Some(Reverse(Near(d, u, _))) = heap.pop() {
             if d > dist[u] {
                 continue;
             }
-            if u == to {
+            if u < self.goals {
+                settled_goals += 1;
+            }
+            if stop(u, settled_goals) {
                 break;
             }
             for (k, e) in self.adj[u].iter().enumerate() {
                 let nd = d + e.length;
                 if nd < dist[e.to] - 1e-12 {
+                    if dist[e.to] == f64::INFINITY {
+                        set.push(e.to);
+                    }
                     dist[e.to] = nd;
                     prev[e.to] = (u as u32, k as u32);
-                    heap.push(Item(nd, e.to));
+                    heap.push(Reverse(Near(nd, e.to, 0)));
                 }
             }
         }
-        prev
     }
 
     /// The shortest-path distances between goals. The paths themselves are found again
@@ -474,62 +484,33 @@ impl<'a> Roadmap<'a> {
     /// about as many paths as it has goals, and a tree per goal is goals × nodes
     /// entries.
     pub(crate) fn shortest_paths(&self) -> Paths {
-        let dist: Vec<Vec<f64>> = (0..self.goals)
+        let goals = self.goals;
+        let dist: Vec<Vec<f64>> = (0..goals)
             .into_par_iter()
             .map_init(
                 || Scratch::new(self.nodes.len()),
-                |scratch, g| self.goal_distances(g, scratch),
+                |scratch, g| {
+                    self.search(g, scratch, |_, settled| settled == goals);
+                    let d = scratch.dist[..goals].to_vec();
+                    scratch.reset();
+                    d
+                },
             )
             .collect();
-        Paths { dist }
-    }
-
-    /// Dijkstra from goal `s` to every goal, as [`Roadmap::dijkstra`] settles them, until
-    /// the last goal settles; on a scratch whose distances are reset where this search
-    /// set them (a search per goal over tens of thousands of nodes, each a fresh array,
-    /// was mostly page faults).
-    fn goal_distances(&self, s: usize, scratch: &mut Scratch) -> Vec<f64> {
-        let Scratch { dist, heap, set } = scratch;
-        let mut settled_goals = 0;
-        dist[s] = 0.0;
-        set.push(s);
-        heap.push(Item(0.0, s));
-        while let Some(Item(d, u)) = heap.pop() {
-            if d > dist[u] {
-                continue;
-            }
-            if u < self.goals {
-                settled_goals += 1;
-                if settled_goals == self.goals {
-                    break;
-                }
-            }
-            for e in &self.adj[u] {
-                let nd = d + e.length;
-                if nd < dist[e.to] - 1e-12 {
-                    if dist[e.to] == f64::INFINITY {
-                        set.push(e.to);
-                    }
-                    dist[e.to] = nd;
-                    heap.push(Item(nd, e.to));
-                }
-            }
+        Paths {
+            dist,
+            scratch: std::sync::Mutex::new(Scratch::new(self.nodes.len())),
         }
-        let out = dist[..self.goals].to_vec();
-        for &k in set.iter() {
-            dist[k] = f64::INFINITY;
-        }
-        set.clear();
-        heap.clear();
-        out
     }
 }
 
-/// What one thread's searches reuse: distances (infinite but where the search under
-/// way set them), the heap, and the nodes whose distance is set.
+/// What searches reuse: distances and predecessors (unset but where the search under
+/// way set them), the heap, and the nodes set. A search per goal over tens of thousands
+/// of nodes, each on fresh arrays, was mostly page faults.
 struct Scratch {
     dist: Vec<f64>,
-    heap: BinaryHeap<Item>,
+    prev: Vec<(u32, u32)>,
+    heap: BinaryHeap<Reverse<Near>>,
     set: Vec<usize>,
 }
 
@@ -537,18 +518,31 @@ impl Scratch {
     fn new(n: usize) -> Scratch {
         Scratch {
             dist: vec![f64::INFINITY; n],
+            prev: vec![NO_EDGE; n],
             heap: BinaryHeap::new(),
             set: Vec::new(),
         }
+    }
+
+    /// Unsets what the last search set.
+    fn reset(&mut self) {
+        for &k in &self.set {
+            self.dist[k] = f64::INFINITY;
+            self.prev[k] = NO_EDGE;
+        }
+        self.set.clear();
+        self.heap.clear();
     }
 }
 
 /// No predecessor.
 const NO_EDGE: (u32, u32) = (u32::MAX, u32::MAX);
 
-/// Shortest-path distances between the goals of a roadmap.
+/// Shortest-path distances between the goals of a roadmap, and a scratch to find a path
+/// on (taken one path at a time).
 pub(crate) struct Paths {
     dist: Vec<Vec<f64>>,
+    scratch: std::sync::Mutex<Scratch>,
 }
 
 impl Paths {
@@ -562,11 +556,12 @@ impl Paths {
     pub fn path(&self, map: &Roadmap, a: usize, b: usize) -> Vec<P3> {
         // Walk back from b to a in a's tree; each edge's route runs from its
         // predecessor towards the node.
-        let prev = map.dijkstra(a, b);
+        let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
+        map.search(a, &mut scratch, |u, _| u == b);
         let mut chain = Vec::new();
         let mut at = b;
         while at != a {
-            let (p, k) = prev[at];
+            let (p, k) = scratch.prev[at];
             if (p, k) == NO_EDGE {
                 break;
             }
@@ -574,6 +569,8 @@ impl Paths {
             chain.push((p, at, map.adj[p][k].route));
             at = p;
         }
+        scratch.reset();
+        drop(scratch);
         chain.reverse();
         let mut out = Vec::new();
         for (p, q, route) in chain {
@@ -650,26 +647,6 @@ impl Ord for Near {
         self.0
             .total_cmp(&o.0)
             .then((self.1, self.2).cmp(&(o.1, o.2)))
-    }
-}
-
-/// A heap entry ordered by smallest distance, then smallest node.
-struct Item(f64, usize);
-
-impl PartialEq for Item {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
-    }
-}
-impl Eq for Item {}
-impl PartialOrd for Item {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Item {
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.0.total_cmp(&self.0).then(o.1.cmp(&self.1))
     }
 }
 
