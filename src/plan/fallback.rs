@@ -9,14 +9,19 @@
 //! has (its own configurations first, then any probe and orientation); the rest are
 //! left out with a warning per face (`insp::plan::points_left_out`). Only a search in
 //! which no round got as far as validation ends in `insp::plan::no_convergence`.
+//!
+//! **Decision: a fallback is finished as a settled round is.** Its branches go back to
+//! the search, which measures the datums again where they are read and asks each setup
+//! as square as its touches need (`Search::finish`): a fallback plan validated at the
+//! nominal pose alone once wrote no squareness in its prompts, and NIST CTC 02
+//! imported stopped on a stylus collision at 2.5° in `inspc verify` with no warning.
 
 use super::cluster::Strategy;
-use super::hlip::{assemble, Round};
 use super::knowledge::Knowledge;
 use super::machine::Machine;
 use super::solve::{self, Branch};
 use super::validate::{self, Pip};
-use super::{explain, Hlip, Input, PlanOptions};
+use super::{explain, Input, PlanOptions};
 use crate::access::pose::Blocker;
 use crate::diag::Diagnostics;
 use crate::geometry::FaceId;
@@ -32,6 +37,8 @@ pub(super) struct Fallback {
     pub branches: Vec<Branch>,
     /// Its touches that failed validation.
     pub left: BTreeSet<Pip>,
+    /// Those of them that collided only with the part turned.
+    pub turned_only: BTreeSet<Pip>,
     /// Per face: touches that failed, the probe of the first and what it hit.
     pub causes: BTreeMap<FaceId, (usize, usize, Blocker)>,
     /// The clustering strategy that made the branches.
@@ -40,23 +47,43 @@ pub(super) struct Fallback {
     pub dropped: usize,
 }
 
+/// A fallback's branches once its failed touches moved or left out.
+pub(super) struct Relocated {
+    /// The branches less their failed touches, and a branch per configuration they
+    /// moved to.
+    pub branches: Vec<Branch>,
+    /// The clustering strategy that made the branches.
+    pub strategy: Strategy,
+    /// Fpoints the round's filter dropped and the touches left out.
+    pub dropped: usize,
+    /// Touches moved, touches left out.
+    pub unsettled: (usize, usize),
+}
+
 impl Fallback {
-    /// The plan: the branches less their failed touches, each failed touch moved to the
-    /// first configuration that validates, the rest left out and reported. `None` when
-    /// nothing of the plan is left.
+    /// The branches less their failed touches, each failed touch moved to the first
+    /// configuration that validates, the rest left out and reported. `None` when
+    /// nothing of the plan is left. The search makes the plan of them as of a round
+    /// that settled (datums measured again, the setups' squareness). With
+    /// `keep_turned_only`, a touch clear at the nominal pose that collided only with the
+    /// part turned stays where it is.
     pub(crate) fn settle(
         self,
         input: &Input,
         k: &mut Knowledge,
         m: &Machine,
         opts: &PlanOptions,
+        keep_turned_only: bool,
         diags: &mut Diagnostics,
-    ) -> Option<Hlip> {
+    ) -> Option<Relocated> {
         let mut branches: Vec<Branch> = Vec::new();
         // Per failed touch, its branch: the tree it came from.
         let mut origin: Vec<(Pip, usize)> = Vec::new();
         for (i, b) in self.branches.iter().enumerate() {
-            let failed = |point: usize| self.left.contains(&b.pip(point));
+            let failed = |point: usize| {
+                let pip = b.pip(point);
+                self.left.contains(&pip) && !(keep_turned_only && self.turned_only.contains(&pip))
+            };
             if let Some(tree) = solve::prune(&b.tree, &failed) {
                 branches.push(Branch { tree, ..b.clone() });
             }
@@ -81,6 +108,7 @@ impl Fallback {
         let mut still: BTreeMap<(FaceId, bool), (BTreeSet<usize>, usize, Blocker)> =
             BTreeMap::new();
         let mut left = 0;
+        let failing = origin.len();
         for (pip, from) in origin {
             match relocate(k, m, &pip, &setups, &used, &opts.bans) {
                 Some((s, p, o)) => moved.entry((from, s, p, o)).or_default().push(pip.point),
@@ -130,17 +158,12 @@ impl Fallback {
                 diags,
             );
         }
-        let moved_touches = self.left.len() - left;
-        let round = Round {
-            branches: &branches,
-            iterations: opts.max_iterations,
+        Some(Relocated {
+            branches,
+            strategy: self.strategy,
             dropped: self.dropped + left,
-            strategy: Some(self.strategy),
-            exact_budget: opts.exact_budget,
-        };
-        let mut hlip = assemble(input, k, m, &round);
-        hlip.summary.unsettled = Some((moved_touches, left));
-        Some(hlip)
+            unsettled: (failing - left, left),
+        })
     }
 }
 

@@ -24,12 +24,17 @@
 //! frame, and a stylus deep in a bore with little room beside its stem touches the
 //! wall. Every touch is validated also with the part turned `validate::PLACEMENT_TURN`
 //! (3°, a part set by eye) either way; a point whose configurations collide only turned
-//! takes one clear at the nominal pose after `FRAGILE_AFTER` (6) tries, and where no
-//! turned plan settles (or none the path stage routes after its re-plans,
-//! `Memo::give_up_turned`) the plan is made at the nominal pose. A setup with touches
-//! clear only nearer square says by how much in its prompt and warns
-//! `insp::plan::placement_sensitive` (`placement`). The turned validation triples the
-//! pose checks, and a part no turned plan settles for is planned twice.
+//! takes one clear at the nominal pose after `FRAGILE_AFTER` (6) tries. Where no turned
+//! round settles within the rounds, the best round's touches that collided only turned
+//! stay where they are (clear at the nominal pose) and the others move as the fallback
+//! moves them (`give_up_turned`): on NIST CTC 02 imported the turned search was two
+//! touches short at round 40 and the part was planned again from nothing at the
+//! nominal pose. Only where that would leave touches out (or the path stage routes no
+//! turned plan after its re-plans, `Memo::give_up_turned`) is the plan made at the
+//! nominal pose. A setup with touches clear only nearer square says by how much in its
+//! prompt and warns `insp::plan::placement_sensitive` (`placement`) — whichever way
+//! the plan was reached, the fallback's included (`finish`). The turned validation
+//! triples the pose checks.
 
 use super::account::account;
 use super::cluster::{self, Strategy};
@@ -334,6 +339,8 @@ struct Failures {
     invalid: Vec<(usize, usize, usize, Option<usize>)>,
     /// The touches that failed.
     left: BTreeSet<Pip>,
+    /// Those of them clear at the nominal pose that collided only with the part turned.
+    turned_only: BTreeSet<Pip>,
     /// Per face name, the touches that failed and the first cause (probe, what it hit),
     /// for the diagnostic.
     failed: BTreeMap<String, (usize, usize, crate::access::pose::Blocker)>,
@@ -406,6 +413,7 @@ impl Search<'_> {
             self.fallback = Some(Fallback {
                 branches: best.1.clone(),
                 left: failures.left,
+                turned_only: failures.turned_only,
                 causes: failures.causes,
                 strategy: best.0,
                 dropped: dropped.len(),
@@ -555,12 +563,14 @@ impl Search<'_> {
         let mut failures = Failures {
             invalid: Vec::new(),
             left: BTreeSet::new(),
+            turned_only: BTreeSet::new(),
             failed: BTreeMap::new(),
             causes: BTreeMap::new(),
         };
         for (p, what, turned_only) in checked {
             if turned_only {
                 *self.turned_fails.entry(p.point).or_default() += 1;
+                failures.turned_only.insert(p);
             }
             match what {
                 Ok(()) => {
@@ -590,6 +600,26 @@ impl Search<'_> {
         failures
     }
 
+    /// [`Self::give_up`] with a turn: the fallback's touches that failed only turned
+    /// kept, the others moved; each of them then validated at the nominal pose only.
+    fn give_up_turned(mut self, k: &mut Knowledge, diags: &mut Diagnostics) -> Option<Hlip> {
+        let f = self.fallback.take()?;
+        let failed: Vec<usize> = f.left.iter().map(|p| p.point).collect();
+        let mut own = Diagnostics::new();
+        let r = f.settle(self.input, k, self.machine, self.opts, true, &mut own)?;
+        if r.unsettled.1 > 0 {
+            return None;
+        }
+        for point in failed {
+            self.turned_fails.insert(point, FRAGILE_AFTER);
+        }
+        let iterations = self.opts.max_iterations;
+        let mut hlip = self.finish(k, r.branches, r.strategy, iterations, r.dropped, &mut own);
+        hlip.summary.unsettled = Some(r.unsettled);
+        diags.extend(own);
+        Some(hlip)
+    }
+
     /// The plan of a round whose touches all validated: the datums measured again where
     /// they are read, the setups' squareness, and why it needs more setups than the
     /// minimum.
@@ -602,28 +632,13 @@ impl Search<'_> {
         dropped: usize,
         diags: &mut Diagnostics,
     ) -> Hlip {
-        let (input, machine, opts, turn) = (self.input, self.machine, self.opts, self.turn);
         debug_assert!(
-            audit(k, machine, &best.1).is_empty(),
+            audit(k, self.machine, &best.1).is_empty(),
             "{:?}",
-            audit(k, machine, &best.1)
+            audit(k, self.machine, &best.1)
         );
-        // Datums measured again where the tolerances read against them are.
-        let again =
-            remeasure::datums_where_read(input, k, machine, &best.1, turn, &opts.bans, diags);
-        let branches: Vec<Branch> = best.1.iter().cloned().chain(again).collect();
-        let round = Round {
-            branches: &branches,
-            iterations: iteration,
-            dropped,
-            strategy: Some(best.0),
-            exact_budget: opts.exact_budget,
-        };
-        let mut hlip = assemble(input, k, machine, &round);
-        // Touches validated turned are clear turned; the others are measured.
-        let turned_fails = &self.turned_fails;
-        let fragile = |p: &Pip| turn == 0.0 || turned_fails.get(&p.point) >= Some(&FRAGILE_AFTER);
-        placement::square_within(input, k, machine, &branches, &fragile, &mut hlip, diags);
+        let mut hlip = self.finish(k, best.1.clone(), best.0, iteration, dropped, diags);
+        let machine = self.machine;
         if hlip.summary.setups > hlip.summary.min_setups.0 {
             let forcing = forcing_levels(root, k, machine, self.hierarchy, &best.1);
             hlip.summary.more_setups = Some(forcing.unwrap_or_else(|| {
@@ -633,14 +648,50 @@ impl Search<'_> {
         hlip
     }
 
-    /// No round settled: with a turn, no plan (the caller plans again without); else the
-    /// best plan found, or the diagnostic saying why the last round failed.
-    fn give_up(self, k: &mut Knowledge, diags: &mut Diagnostics) -> Option<Hlip> {
+    /// The plan of branches whose touches all validated: the datums measured again
+    /// where the tolerances read against them are, and how square each setup must be
+    /// set (the touches not validated turned are tried turned).
+    fn finish(
+        &self,
+        k: &mut Knowledge,
+        branches: Vec<Branch>,
+        strategy: Strategy,
+        iterations: usize,
+        dropped: usize,
+        diags: &mut Diagnostics,
+    ) -> Hlip {
+        let (input, machine, opts, turn) = (self.input, self.machine, self.opts, self.turn);
+        let again =
+            remeasure::datums_where_read(input, k, machine, &branches, turn, &opts.bans, diags);
+        let branches: Vec<Branch> = branches.into_iter().chain(again).collect();
+        let round = Round {
+            branches: &branches,
+            iterations,
+            dropped,
+            strategy: Some(strategy),
+            exact_budget: opts.exact_budget,
+        };
+        let mut hlip = assemble(input, k, machine, &round);
+        let turned_fails = &self.turned_fails;
+        let fragile = |p: &Pip| turn == 0.0 || turned_fails.get(&p.point) >= Some(&FRAGILE_AFTER);
+        placement::square_within(input, k, machine, &branches, &fragile, &mut hlip, diags);
+        hlip
+    }
+
+    /// No round settled: the best plan found — the fallback's, finished as a settled
+    /// round's — or the diagnostic saying why the last round failed. With a turn, the
+    /// fallback's touches that collided only turned stay (the setups then say how
+    /// square to set the part), and a fallback that would leave touches out is no plan:
+    /// the caller plans again at the nominal pose, where more configurations validate.
+    fn give_up(mut self, k: &mut Knowledge, diags: &mut Diagnostics) -> Option<Hlip> {
         if self.turn > 0.0 {
-            return None;
+            return self.give_up_turned(k, diags);
         }
-        if let Some(f) = self.fallback {
-            if let Some(hlip) = f.settle(self.input, k, self.machine, self.opts, diags) {
+        if let Some(f) = self.fallback.take() {
+            if let Some(r) = f.settle(self.input, k, self.machine, self.opts, false, diags) {
+                let iterations = self.opts.max_iterations;
+                let mut hlip = self.finish(k, r.branches, r.strategy, iterations, r.dropped, diags);
+                hlip.summary.unsettled = Some(r.unsettled);
                 return Some(hlip);
             }
         }
