@@ -679,13 +679,21 @@ impl Search<'_> {
     }
 
     /// No round settled: the best plan found — the fallback's, finished as a settled
-    /// round's — or the diagnostic saying why the last round failed. With a turn, the
-    /// fallback's touches that collided only turned stay (the setups then say how
-    /// square to set the part), and a fallback that would leave touches out is no plan:
-    /// the caller plans again at the nominal pose, where more configurations validate.
+    /// round's — or the diagnostic saying why the last round failed. With a turn, in
+    /// the first planning the fallback's touches that collided only turned stay (the
+    /// setups then say how square to set the part), and a fallback that would leave
+    /// touches out is no plan: the caller plans again at the nominal pose, where more
+    /// configurations validate. A re-plan after the path stage's bans whose turned
+    /// search does not settle is no plan either: a turned plan the rounds could not
+    /// settle and the path stage could not route is not worth routing again (on MFCAD
+    /// 1-1-5-8-13-23 sixteen such re-plans left the nominal one so many bans that it
+    /// found no path).
     fn give_up(mut self, k: &mut Knowledge, diags: &mut Diagnostics) -> Option<Hlip> {
-        if self.turn > 0.0 {
+        if self.turn > 0.0 && self.opts.bans.is_empty() {
             return self.give_up_turned(k, diags);
+        }
+        if self.turn > 0.0 {
+            return None;
         }
         if let Some(f) = self.fallback.take() {
             if let Some(r) = f.settle(self.input, k, self.machine, self.opts, false, diags) {
