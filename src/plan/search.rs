@@ -27,11 +27,12 @@
 //! takes one clear at the nominal pose after `FRAGILE_AFTER` (6) tries. Where no turned
 //! round settles within the rounds, the best round's touches that collided only turned
 //! stay where they are (clear at the nominal pose) and the others move as the fallback
-//! moves them (`give_up_turned`): on NIST CTC 02 imported the turned search was two
+//! moves them (`finish_fallback`): on NIST CTC 02 imported the turned search was two
 //! touches short at round 40 and the part was planned again from nothing at the
-//! nominal pose. Only where that would leave touches out (or the path stage routes no
-//! turned plan after its re-plans, `Memo::give_up_turned`) is the plan made at the
-//! nominal pose. A setup with touches clear only nearer square says by how much in its
+//! nominal pose. That holds for the first planning only: where it would leave touches
+//! out, where a re-plan after the path stage's bans does not settle turned, or where
+//! the path stage routes no turned plan after its re-plans (`Memo::give_up_turned`),
+//! the plan is made at the nominal pose. A setup with touches clear only nearer square says by how much in its
 //! prompt and warns `insp::plan::placement_sensitive` (`placement`) — whichever way
 //! the plan was reached, the fallback's included (`finish`). The turned validation
 //! triples the pose checks.
@@ -600,14 +601,20 @@ impl Search<'_> {
         failures
     }
 
-    /// [`Self::give_up`] with a turn: the fallback's touches that failed only turned
-    /// kept, the others moved; each of them then validated at the nominal pose only.
-    fn give_up_turned(mut self, k: &mut Knowledge, diags: &mut Diagnostics) -> Option<Hlip> {
+    /// The fallback's plan: its failed touches moved (with `turned`, those that failed
+    /// only turned kept, and none may be left out), each of them then taken as
+    /// validated at the nominal pose only, finished as a settled round's.
+    fn finish_fallback(
+        &mut self,
+        k: &mut Knowledge,
+        turned: bool,
+        diags: &mut Diagnostics,
+    ) -> Option<Hlip> {
         let f = self.fallback.take()?;
         let failed: Vec<usize> = f.left.iter().map(|p| p.point).collect();
         let mut own = Diagnostics::new();
-        let r = f.settle(self.input, k, self.machine, self.opts, true, &mut own)?;
-        if r.unsettled.1 > 0 {
+        let r = f.settle(self.input, k, self.machine, self.opts, turned, &mut own)?;
+        if turned && r.unsettled.1 > 0 {
             return None;
         }
         for point in failed {
@@ -689,19 +696,14 @@ impl Search<'_> {
     /// 1-1-5-8-13-23 sixteen such re-plans left the nominal one so many bans that it
     /// found no path).
     fn give_up(mut self, k: &mut Knowledge, diags: &mut Diagnostics) -> Option<Hlip> {
-        if self.turn > 0.0 && self.opts.bans.is_empty() {
-            return self.give_up_turned(k, diags);
-        }
         if self.turn > 0.0 {
-            return None;
+            let first = self.opts.bans.is_empty();
+            return first
+                .then(|| self.finish_fallback(k, true, diags))
+                .flatten();
         }
-        if let Some(f) = self.fallback.take() {
-            if let Some(r) = f.settle(self.input, k, self.machine, self.opts, false, diags) {
-                let iterations = self.opts.max_iterations;
-                let mut hlip = self.finish(k, r.branches, r.strategy, iterations, r.dropped, diags);
-                hlip.summary.unsettled = Some(r.unsettled);
-                return Some(hlip);
-            }
+        if let Some(hlip) = self.finish_fallback(k, false, diags) {
+            return Some(hlip);
         }
         let plan = self.input.plan;
         diags.push(PlanError::NoConvergence {
