@@ -114,6 +114,7 @@ use crate::access::pose::{Contact, Head};
 use crate::geometry::{FaceId, Surface, P3, V3};
 use crate::model::{FeatureId, Material, SlotId, TolKind, TolValue, ToleranceId};
 use crate::path::{BlockPath, GroupPath, SetupPath};
+use crate::plan::poses::Holder;
 use crate::plan::Names;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -1124,18 +1125,7 @@ impl Writer<'_> {
             .holder_naming(&setup.holder, &setup.up, &|f| self.face_words(f));
         self.o
             .oper(&format!("HOLD IT BY {}", holder.to_uppercase()));
-        // How it is turned about the vertical: where a part axis across `up` points.
-        let across = if setup.up.x.abs() < 0.9 {
-            V3::x()
-        } else {
-            V3::y()
-        };
-        let name = if across == V3::x() { "X" } else { "Y" };
-        let m = r * across;
-        self.o.oper(&format!(
-            "TURN IT SO THAT ITS +{name} DIRECTION POINTS ALONG MACHINE {}",
-            direction_words(&V3::new(round3(m.x), round3(m.y), round3(m.z)))
-        ));
+        self.turn_about_vertical(&setup.holder, &setup.up, &r);
         for f in &setup.on_table {
             let face = self.face_words(*f);
             self.o.oper(&format!("REST {face} ON THE TABLE"));
@@ -1158,6 +1148,61 @@ impl Writer<'_> {
             ));
         }
         self.o.stmt("PAUSE");
+    }
+
+    /// How the part is turned about the vertical: on a tilted plate, where the plate's
+    /// hinge runs and which way its raised end points (the part's lie on the plate is
+    /// in the holder's words); else where a part axis across `up` points.
+    fn turn_about_vertical(&mut self, holder: &Holder, up: &V3, r: &nalgebra::Matrix3<f64>) {
+        if let Some((hinge, rising)) = self.plate_lie(holder, up) {
+            let horizontal = |v: V3| {
+                let h = V3::new(v.x, v.y, 0.0).normalize();
+                direction_words(&V3::new(round3(h.x), round3(h.y), 0.0))
+            };
+            // The plate's face (the clamped face's inward normal, `rising × hinge`)
+            // leans away from its raised end; an angle plate's looks level.
+            let face = r * rising.cross(&hinge);
+            let hinge = r * hinge;
+            let sense = if hinge.x.abs() > 1e-6 {
+                hinge.x
+            } else {
+                hinge.y
+            };
+            self.o.oper(&format!(
+                "TURN THE PLATE SO THAT ITS HINGE RUNS ALONG MACHINE {} AND ITS FACE LOOKS TOWARDS MACHINE {}",
+                horizontal(hinge * sense.signum()).trim_start_matches('+'),
+                horizontal(face)
+            ));
+            return;
+        }
+        let across = if up.x.abs() < 0.9 { V3::x() } else { V3::y() };
+        let name = if across == V3::x() { "X" } else { "Y" };
+        let m = r * across;
+        self.o.oper(&format!(
+            "TURN IT SO THAT ITS +{name} DIRECTION POINTS ALONG MACHINE {}",
+            direction_words(&V3::new(round3(m.x), round3(m.y), round3(m.z)))
+        ));
+    }
+
+    /// The part directions along the hinge and up the slope of the tilted plate that
+    /// holds it, if a tilted plate does ([`crate::plan::poses::plate_lie`]).
+    fn plate_lie(&self, holder: &Holder, up: &V3) -> Option<(V3, V3)> {
+        let Holder::Fixture { slot, faces, .. } = holder else {
+            return None;
+        };
+        let (_, id) = &self.input.model.cmms[self.input.plan.cmm.0].fixtures[*slot];
+        if !matches!(
+            self.input.model.fixtures[id.0].kind,
+            crate::model::FixtureKind::SinePlate { .. }
+        ) {
+            return None;
+        }
+        let Surface::Plane { normal, .. } =
+            self.input.geometry.faces.get(faces.first()?.0)?.surface
+        else {
+            return None;
+        };
+        crate::plan::poses::plate_lie(&normal, up)
     }
 
     /// The setup's alignment by hand (`MODE/MAN`), feature by feature: the `DATSET`
@@ -2247,7 +2292,8 @@ mod tests {
             at: None,
         };
         let msg = "hold it by fixture sine (sine_plate) under datum G (face_22), face_27, \
-                   tilted 53.4°, its longest edge at 45° to the hinge, Ø8 ± 0.1";
+                   tilted 53.4°, its (0.707, -0.707, 0) direction along the hinge, its +x side \
+                   rising, Ø8 ± 0.1";
         o.oper(msg);
         let said: Vec<String> = o
             .text

@@ -39,8 +39,10 @@
 //! range; the planner tries those poses exactly (the range's ends and every 5°). Any
 //! cube-map direction at an allowed angle from any flat face is not a pose: it would
 //! let plans clamp a plate by a chamfer or tilt a part about an arbitrary axis, which
-//! no operator does. The plan says how the part lies ("tilted 60°, its longest edge
-//! along the hinge"). A tilted plate's solid runs up its own plane from the table (its
+//! no operator does. The plan says how the part lies in the drawing's axes ("tilted
+//! 60°, its y axis along the hinge, its +x side rising", see [`plate_words`]): an
+//! independent review read "its longest edge square to the hinge" as the part's longest
+//! edge where the support polygon's was meant, a 90° error on a 680 × 860 mm part. A tilted plate's solid runs up its own plane from the table (its
 //! hinge the fixture's `height` under the part) to 30 mm past the part's top, so the
 //! table lies where the real one does. A plate with a `plate` size holds only a part at
 //! most [`PLATE_OVERHANG`] times its top each way (an 800 mm part does not go on a 6 ×
@@ -124,8 +126,8 @@ pub enum Holder {
         slot: usize,
         /// The faces the fixture grips or the part rests on in it.
         faces: Vec<FaceId>,
-        /// How the part lies on a tilted plate, for the operator: where the clamped
-        /// face's longest edge goes against the plate's hinge.
+        /// How the part lies on a tilted plate, for the operator: which part direction
+        /// runs along the plate's hinge and which side rises (see [`plate_words`]).
         placement: Option<String>,
     },
 }
@@ -300,7 +302,7 @@ impl<'a> Setups<'a> {
         tilt: [f64; 2],
         plate: Option<[f64; 2]>,
         up: &V3,
-    ) -> Option<(&RestPose, Option<&'static str>)> {
+    ) -> Option<(&RestPose, Option<String>)> {
         let (lo, hi) = (tilt[0].to_radians(), tilt[1].to_radians());
         self.plate_rests(plate).find_map(|r| {
             let a = r.up.dot(up).clamp(-1.0, 1.0).acos();
@@ -313,16 +315,11 @@ impl<'a> Setups<'a> {
             // Within 1e-5 on the sphere (0.0006°): a program's ROTATEs give the
             // simulator the setup to about that.
             let (c, s) = (a.cos(), a.sin());
-            let k = r
+            let z = r
                 .azimuths()
-                .iter()
-                .position(|z| (r.up * c + z * s - up).norm() < 1e-5)?;
-            let placement = match k {
-                0 | 1 => "its longest edge square to the hinge",
-                2 | 3 => "its longest edge along the hinge",
-                _ => "its longest edge at 45° to the hinge",
-            };
-            Some((r, Some(placement)))
+                .into_iter()
+                .find(|z| (r.up * c + z * s - up).norm() < 1e-5)?;
+            Some((r, Some(plate_words(&r.up.cross(&z), &z))))
         })
     }
 
@@ -429,7 +426,7 @@ impl<'a> Setups<'a> {
             // towards one of the face's azimuths, by an angle in its range.
             return self
                 .on_plate(tilt, plate, up)
-                .map(|(r, placement)| (r.faces.clone(), placement.map(str::to_string)));
+                .map(|(r, placement)| (r.faces.clone(), placement));
         }
         self.grips(slot, f, up).map(|faces| (faces, None))
     }
@@ -1283,6 +1280,52 @@ fn longest_edge(poly: &[(f64, f64)], e1: &V3, e2: &V3) -> V3 {
     best.1
 }
 
+/// The part directions along a tilted plate's hinge and up its slope: from the clamped
+/// face's outward `normal` and the part's `up` direction (both in part axes); `None`
+/// where the plate lies flat.
+pub(crate) fn plate_lie(normal: &V3, up: &V3) -> Option<(V3, V3)> {
+    let plate = -normal;
+    let slope = up - plate * plate.dot(up);
+    if slope.norm() < 1e-6 {
+        return None;
+    }
+    let rising = slope.normalize();
+    Some((plate.cross(&rising).normalize(), rising))
+}
+
+/// How a part lies on a tilted plate, in the drawing's axes: the direction along the
+/// `hinge` (either sense: an axis by its name) and the side that `rising` lifts.
+pub(crate) fn plate_words(hinge: &V3, rising: &V3) -> String {
+    let along = match axis_name(hinge) {
+        Some(a) => format!("its {} axis", &a[1..]),
+        None => format!("its {} direction", rounded(&(hinge * first_sign(hinge)))),
+    };
+    let side = axis_name(rising)
+        .map(str::to_string)
+        .unwrap_or_else(|| rounded(rising));
+    format!("{along} along the hinge, its {side} side rising")
+}
+
+/// An axis direction's name ("+x"), if `v` is one.
+fn axis_name(v: &V3) -> Option<&'static str> {
+    let names = [["+x", "+y", "+z"], ["-x", "-y", "-z"]];
+    (0..3)
+        .find(|&k| v[k].abs() > 1.0 - 1e-6)
+        .map(|k| names[usize::from(v[k] < 0.0)][k])
+}
+
+/// The sign that makes a direction's first non-zero component positive.
+fn first_sign(v: &V3) -> f64 {
+    let c = v.iter().find(|c| c.abs() > 1e-6).copied().unwrap_or(1.0);
+    c.signum()
+}
+
+/// A direction to three decimals, "(0.707, -0.707, 0)".
+fn rounded(v: &V3) -> String {
+    let n = |x: f64| crate::model::fmt_num((x * 1e3).round() / 1e3 + 0.0);
+    format!("({}, {}, {})", n(v.x), n(v.y), n(v.z))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1314,6 +1357,28 @@ mod tests {
             assert_eq!(e.lowest(&d).to_bits(), scan.to_bits(), "{d:?}");
         }
         assert_eq!(Extremes::new(&[]).lowest(&V3::z()), f64::INFINITY);
+    }
+
+    #[test]
+    fn a_tilted_plate_names_the_part_axis_along_its_hinge() {
+        // The top face (+z) clamped on a plate tilted 55° with the part's +x end up:
+        // the part's up is -z turned 55° towards +x.
+        let a = 55f64.to_radians();
+        let up = V3::new(a.sin(), 0.0, -a.cos());
+        let (hinge, rising) = plate_lie(&V3::z(), &up).unwrap();
+        assert!((hinge.y.abs() - 1.0).abs() < 1e-9, "{hinge:?}");
+        assert!((rising - V3::x()).norm() < 1e-9, "{rising:?}");
+        assert_eq!(
+            plate_words(&hinge, &rising),
+            "its y axis along the hinge, its +x side rising"
+        );
+        // At 45° to the part's axes, and a flat plate.
+        let d = V3::new(-1.0, 1.0, 0.0).normalize();
+        assert_eq!(
+            plate_words(&d, &V3::new(-1.0, -1.0, 0.0).normalize()),
+            "its (0.707, -0.707, 0) direction along the hinge, its (-0.707, -0.707, 0) side rising"
+        );
+        assert!(plate_lie(&V3::z(), &-V3::z()).is_none());
     }
 
     #[test]
