@@ -49,7 +49,9 @@
 //! what it reads in place to 10 µm (`a_part_placed_off_is_found_by_the_alignment` in
 //! `tests/suite/simulate.rs`); a second pass would touch every alignment feature again
 //! for a change below that. The DCC realignment keeps the manual features of faces
-//! touched by hand only. A setup whose features leave rotations or origins free says so
+//! touched by hand only, and takes a slot's or tab's centre plane where the setup
+//! measured both its walls (the datum a width establishes; one wall would move the
+//! frame by half the width's error). A setup whose features leave rotations or origins free says so
 //! to the operator (`TEXT/OPER`: place the part at its nominal position).
 //!
 //! **Decision: one DMIS feature per surface.** A feature's faces that lie on one
@@ -455,6 +457,8 @@ struct Writer<'a> {
     outputs: std::collections::BTreeSet<String>,
     /// Per feature of two opposed planes, its constructed `PARPLN` and the two surfaces.
     pairs: BTreeMap<FeatureId, (String, [usize; 2])>,
+    /// Per constructed `PARPLN`, its nominal centre and direction (the first wall's).
+    centres: BTreeMap<String, (P3, V3)>,
     /// Per datum feature of parallel bores or pins (a pattern), its `PATERN` and the
     /// members' surfaces.
     patterns: BTreeMap<FeatureId, (String, Vec<usize>)>,
@@ -512,6 +516,7 @@ pub fn write(input: &Input) -> String {
         surfs: Vec::new(),
         points: BTreeMap::new(),
         pairs: BTreeMap::new(),
+        centres: BTreeMap::new(),
         depths: BTreeMap::new(),
         patterns: BTreeMap::new(),
         done_in: BTreeMap::new(),
@@ -991,6 +996,7 @@ impl Writer<'_> {
                 ijk(&na),
                 real(width)
             ));
+            self.centres.insert(label.clone(), (mid, na));
             self.pairs.insert(f, (label, [a, b]));
         }
     }
@@ -1804,11 +1810,74 @@ impl Writer<'_> {
             if r.setup == si && r.labels.iter().all(|l| r.measured.contains(l)) {
                 self.o
                     .comment("alignment again, on the features as the program measured them");
-                self.datset(&format!("SETUP{}_DCC", si + 1), &r.fa, &r.shifts);
+                let (fa, shifts) = self.on_centre_planes(si, &r);
+                self.datset(&format!("SETUP{}_DCC", si + 1), &fa, &shifts);
             } else {
                 self.realign = Some(r);
             }
         }
+    }
+
+    /// The DCC alignment's `DATSET` parameters and `TRANS` shifts with each wall of a
+    /// slot or tab whose other wall the setup measured too replaced by their centre
+    /// plane: a width is a feature of size and the datum it establishes is its centre
+    /// plane (ASME Y14.5-2018 ch. 7, datum features of size; ISO 5459:2011, the median
+    /// plane as a width's situation feature), so a part whose width runs to a limit keeps
+    /// its frame where the drawing puts it, not half the change off with one wall —
+    /// the frame every later move is written in (NIST FTC 06's datum B, a 304.8 mm
+    /// width, moved the frame into a stand-off 0.09 mm from a counterbore's wall).
+    fn on_centre_planes(&self, si: usize, r: &Realign) -> (Vec<String>, Vec<String>) {
+        let mut fa = r.fa.clone();
+        let mut shifts = r.shifts.clone();
+        for entry in &mut fa {
+            let Some((wall, rest)) = entry.strip_prefix("FA(").and_then(|e| e.split_once(')'))
+            else {
+                continue;
+            };
+            let Some((centre, mid, flip)) = self.centre_plane_of(si, r, wall) else {
+                continue;
+            };
+            let mut words = Vec::new();
+            for w in rest.split(',').filter(|w| !w.is_empty()) {
+                if let Some(axis) = w.strip_suffix("ORIG") {
+                    let k = usize::from(axis.as_bytes()[0].saturating_sub(b'X')).min(2);
+                    let shift = format!("{axis}ORIG,{}", real(-mid[k]));
+                    match shifts
+                        .iter_mut()
+                        .find(|s| s.starts_with(&format!("{axis}ORIG,")))
+                    {
+                        Some(s) => *s = shift,
+                        None => shifts.push(shift),
+                    }
+                }
+                words.push(match (w.ends_with("DIR") && flip, w.strip_prefix('-')) {
+                    (false, _) => w.to_string(),
+                    (true, Some(plain)) => plain.to_string(),
+                    (true, None) => format!("-{w}"),
+                });
+            }
+            *entry = format!("FA({centre}),{}", words.join(","));
+        }
+        (fa, shifts)
+    }
+
+    /// The centre plane of the slot or tab `wall` belongs to, where setup `si` measured
+    /// both its walls under the program: its label, nominal centre, and whether its
+    /// direction runs against the wall's.
+    fn centre_plane_of(&self, si: usize, r: &Realign, wall: &str) -> Option<(&str, P3, bool)> {
+        let (centre, walls) = self
+            .pairs
+            .values()
+            .find(|(_, ws)| ws.iter().any(|&w| self.surfs[w].full == wall))?;
+        let both = walls.iter().all(|&w| {
+            self.done_in.get(&w) == Some(&si) && r.measured.contains(&self.surfs[w].full)
+        });
+        let Some(Nominal::Surface(Surface::Plane { normal, .. }, _)) = self.nominals.get(wall)
+        else {
+            return None;
+        };
+        let &(mid, dir) = self.centres.get(centre)?;
+        both.then_some((centre.as_str(), mid, normal.dot(&dir) < 0.0))
     }
 
     /// The group's tolerances, and those pending from before, output where ready: once
