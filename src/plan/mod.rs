@@ -46,6 +46,7 @@ pub mod poses;
 mod remeasure;
 mod render;
 mod risers;
+mod roomy;
 mod scan;
 mod search;
 mod solve;

@@ -50,7 +50,9 @@ use super::machine::Machine;
 use super::memo::Memo;
 use super::solve::{self, Branch};
 use super::validate::{self, Pip};
-use super::{axes, dense, placement, poses, remeasure, scan, Hlip, Input, PlanError, PlanOptions};
+use super::{
+    axes, dense, placement, poses, remeasure, roomy, scan, Hlip, Input, PlanError, PlanOptions,
+};
 use crate::diag::Diagnostics;
 use crate::geometry::{FaceId, V3};
 use crate::graph::Node;
@@ -668,6 +670,7 @@ impl Search<'_> {
         diags: &mut Diagnostics,
     ) -> Hlip {
         let (input, machine, opts, turn) = (self.input, self.machine, self.opts, self.turn);
+        let branches = roomy::roomier(k, machine, branches, turn, &opts.bans);
         let again =
             remeasure::datums_where_read(input, k, machine, &branches, turn, &opts.bans, diags);
         let branches: Vec<Branch> = branches.into_iter().chain(again).collect();

@@ -29,6 +29,7 @@ mod no_panic;
 mod qif;
 mod qif_results;
 mod replan;
+mod room;
 mod sampling;
 mod scan;
 mod simulate;
