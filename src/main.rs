@@ -308,8 +308,10 @@ struct Search {
     /// Cube-map resolution of the accessibility cones.
     #[arg(short = 'n', long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(8..=256))]
     resolution: u32,
-    /// Generate-and-test rounds; when none settles, the plan is the best one found less
-    /// the touches that never validated, each face's left-out points named.
+    /// Generate-and-test rounds (in the search that validates each touch with the part
+    /// turned, those before the first that validates do not count, up to as many
+    /// again); when none settles, the plan is the best one found less the touches that
+    /// never validated, each face's left-out points named.
     #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u32).range(1..=1000))]
     rounds: u32,
     /// Which backend computes the accessibility cones. The GPU's cones err on the blocked

@@ -72,7 +72,7 @@ impl Fallback {
         input: &Input,
         k: &mut Knowledge,
         m: &Machine,
-        opts: &PlanOptions,
+        (opts, rounds): (&PlanOptions, usize),
         keep_turned_only: bool,
         diags: &mut Diagnostics,
     ) -> Option<Relocated> {
@@ -153,7 +153,7 @@ impl Fallback {
                 input,
                 (face, on_table),
                 (points.len(), total),
-                opts.max_iterations,
+                rounds,
                 (&m.probes[*probe].name, blocker),
                 diags,
             );

@@ -35,7 +35,8 @@
 //! the plan is made at the nominal pose. A setup with touches clear only nearer square says by how much in its
 //! prompt and warns `insp::plan::placement_sensitive` (`placement`) — whichever way
 //! the plan was reached, the fallback's included (`finish`). The turned validation
-//! triples the pose checks.
+//! triples the pose checks; the turned search's rounds before its first that validates
+//! do not count against `--rounds`, up to as many again (`plan_touch`).
 
 use super::account::account;
 use super::cluster::{self, Strategy};
@@ -202,6 +203,7 @@ fn plan_touch(
         skipped: skip.clone(),
         read_axes: axes::axis_faces(input.graph, &model.parts[plan.part.0]),
         checked: Vec::new(),
+        ran: 0,
     };
     let (mut first, mut validating) = (1, false);
     let banned =
@@ -217,17 +219,33 @@ fn plan_touch(
     };
     let mut own = Diagnostics::new();
     let mut out = None;
-    for iteration in first..=opts.max_iterations {
+    // In the turned search, the rounds before the first that validates (the clustering
+    // still learning which orientations reach) do not count against `--rounds`, up to
+    // as many again: NIST CTC 02 imported learns for 26 rounds before its first plan
+    // to validate and settles, every touch clear at 3°, by round 56 — where at 40 its
+    // fallback asked the operator to square the part and 8 of 20 placements crashed.
+    // Not in the nominal search: there the longer run replaced a fallback that kept
+    // every face measured by one that left points out (MFCAD 4-5-8-10-13-23).
+    let mut last = opts.max_iterations;
+    let mut iteration = first;
+    let mut validated = validating;
+    while iteration <= last {
         let before = validating.then(|| (k.learnt(), search.rounds()));
         let reported = !own.is_empty();
+        search.ran = iteration;
         let next = search.round(&mut k, iteration, &mut own);
         let checked = std::mem::take(&mut search.checked);
         validating = !checked.is_empty();
+        validated |= validating;
+        if turn > 0.0 && !validated && matches!(next, ControlFlow::Continue(())) {
+            last = (last + 1).min(2 * opts.max_iterations);
+        }
         journal.record(iteration, before, checked, reported);
         if let ControlFlow::Break(hlip) = next {
             out = Some(hlip);
             break;
         }
+        iteration += 1;
     }
     let hlip = match out {
         Some(hlip) => hlip,
@@ -319,6 +337,8 @@ struct Search<'a> {
     read_axes: BTreeSet<FaceId>,
     /// The touches the round validated, for the journal.
     checked: Vec<(Pip, V3)>,
+    /// The rounds run so far.
+    ran: usize,
 }
 
 /// A search's journal: per round, what the knowledge learnt and the rounds' own state
@@ -615,14 +635,21 @@ impl Search<'_> {
         let f = self.fallback.take()?;
         let failed: Vec<usize> = f.left.iter().map(|p| p.point).collect();
         let mut own = Diagnostics::new();
-        let r = f.settle(self.input, k, self.machine, self.opts, turned, &mut own)?;
+        let r = f.settle(
+            self.input,
+            k,
+            self.machine,
+            (self.opts, self.ran),
+            turned,
+            &mut own,
+        )?;
         if turned && r.unsettled.1 > 0 {
             return None;
         }
         for point in failed {
             self.turned_fails.insert(point, FRAGILE_AFTER);
         }
-        let iterations = self.opts.max_iterations;
+        let iterations = self.ran;
         let mut hlip = self.finish(k, r.branches, r.strategy, iterations, r.dropped, &mut own);
         hlip.summary.unsettled = Some(r.unsettled);
         diags.extend(own);
@@ -712,7 +739,7 @@ impl Search<'_> {
         diags.push(PlanError::NoConvergence {
             span: plan.span,
             plan: plan.name.clone(),
-            iterations: self.opts.max_iterations,
+            iterations: self.ran,
             last: self.last,
         });
         None
