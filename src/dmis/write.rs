@@ -436,6 +436,10 @@ struct Realign {
     measured: std::collections::BTreeSet<String>,
 }
 
+/// A slot's or tab's constructed `PARPLN`: its label, its walls' surfaces, and its
+/// nominal centre and direction.
+type Pair = (String, [usize; 2], (P3, V3));
+
 /// The writer's state: the program so far and the labels handed out.
 struct Writer<'a> {
     input: &'a Input<'a>,
@@ -455,10 +459,9 @@ struct Writer<'a> {
     realign: Option<Realign>,
     /// The `OUTPUT` statements written.
     outputs: std::collections::BTreeSet<String>,
-    /// Per feature of two opposed planes, its constructed `PARPLN` and the two surfaces.
-    pairs: BTreeMap<FeatureId, (String, [usize; 2])>,
-    /// Per constructed `PARPLN`, its nominal centre and direction (the first wall's).
-    centres: BTreeMap<String, (P3, V3)>,
+    /// Per feature of two opposed planes, its constructed `PARPLN`, the two surfaces,
+    /// and the plane's nominal centre and direction (the first wall's).
+    pairs: BTreeMap<FeatureId, Pair>,
     /// Per datum feature of parallel bores or pins (a pattern), its `PATERN` and the
     /// members' surfaces.
     patterns: BTreeMap<FeatureId, (String, Vec<usize>)>,
@@ -516,7 +519,6 @@ pub fn write(input: &Input) -> String {
         surfs: Vec::new(),
         points: BTreeMap::new(),
         pairs: BTreeMap::new(),
-        centres: BTreeMap::new(),
         depths: BTreeMap::new(),
         patterns: BTreeMap::new(),
         done_in: BTreeMap::new(),
@@ -996,8 +998,7 @@ impl Writer<'_> {
                 ijk(&na),
                 real(width)
             ));
-            self.centres.insert(label.clone(), (mid, na));
-            self.pairs.insert(f, (label, [a, b]));
+            self.pairs.insert(f, (label, [a, b], (mid, na)));
         }
     }
 
@@ -1770,7 +1771,7 @@ impl Writer<'_> {
             r.measured.insert(done.clone());
         }
         // The second wall of a slot or tab makes the pair.
-        if let Some((pair, walls)) = b.feature.and_then(|f| self.pairs.get(&f)).cloned() {
+        if let Some((pair, walls, _)) = b.feature.and_then(|f| self.pairs.get(&f)).cloned() {
             if !walls.iter().all(|w| self.done.contains(w)) {
                 return None;
             }
@@ -1865,10 +1866,10 @@ impl Writer<'_> {
     /// both its walls under the program: its label, nominal centre, and whether its
     /// direction runs against the wall's.
     fn centre_plane_of(&self, si: usize, r: &Realign, wall: &str) -> Option<(&str, P3, bool)> {
-        let (centre, walls) = self
+        let (centre, walls, (mid, dir)) = self
             .pairs
             .values()
-            .find(|(_, ws)| ws.iter().any(|&w| self.surfs[w].full == wall))?;
+            .find(|(_, ws, _)| ws.iter().any(|&w| self.surfs[w].full == wall))?;
         let both = walls.iter().all(|&w| {
             self.done_in.get(&w) == Some(&si) && r.measured.contains(&self.surfs[w].full)
         });
@@ -1876,8 +1877,7 @@ impl Writer<'_> {
         else {
             return None;
         };
-        let &(mid, dir) = self.centres.get(centre)?;
-        both.then_some((centre.as_str(), mid, normal.dot(&dir) < 0.0))
+        both.then_some((centre.as_str(), *mid, normal.dot(dir) < 0.0))
     }
 
     /// The group's tolerances, and those pending from before, output where ready: once
@@ -2000,7 +2000,7 @@ impl Writer<'_> {
         );
         let sized = matches!(t.kind, TolKind::Diameter | TolKind::Radius);
         let labels_of = |f: FeatureId| -> Vec<String> {
-            if let Some((pair, walls)) = self.pairs.get(&f) {
+            if let Some((pair, walls, _)) = self.pairs.get(&f) {
                 return if per_wall {
                     walls.iter().map(|w| self.surfs[*w].full.clone()).collect()
                 } else {
