@@ -1296,7 +1296,6 @@ pub(crate) fn plate_lie(normal: &V3, up: &V3) -> Option<(V3, V3)> {
 /// How a part lies on a tilted plate, in the drawing's axes: the direction along the
 /// `hinge` (either sense: an axis by its name) and the side that `rising` lifts.
 pub(crate) fn plate_words(hinge: &V3, rising: &V3) -> String {
-    let axis_name = |v: &V3| super::render::axis(&[v.x, v.y, v.z]);
     let along = match axis_name(hinge) {
         Some(a) => format!("its {} axis", &a[1..]),
         None => format!("its {} direction", rounded(&(hinge * first_sign(hinge)))),
@@ -1305,6 +1304,15 @@ pub(crate) fn plate_words(hinge: &V3, rising: &V3) -> String {
         .map(str::to_string)
         .unwrap_or_else(|| rounded(rising));
     format!("{along} along the hinge, its {side} side rising")
+}
+
+/// An axis direction's name ("+x"), if `v` is one (`render` names plan directions the
+/// same way; `render` imports this module, so not from there).
+fn axis_name(v: &V3) -> Option<&'static str> {
+    let names = [["+x", "+y", "+z"], ["-x", "-y", "-z"]];
+    (0..3)
+        .find(|&k| v[k].abs() > 1.0 - 1e-6)
+        .map(|k| names[usize::from(v[k] < 0.0)][k])
 }
 
 /// The sign that makes a direction's first non-zero component positive.

@@ -173,7 +173,7 @@ fn arr(v: &V3) -> [f64; 3] {
 }
 
 /// A direction's name when it is an axis.
-pub(super) fn axis(v: &[f64; 3]) -> Option<&'static str> {
+fn axis(v: &[f64; 3]) -> Option<&'static str> {
     let names = [
         ([1.0, 0.0, 0.0], "+x"),
         ([-1.0, 0.0, 0.0], "-x"),
