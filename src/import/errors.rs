@@ -12,17 +12,21 @@ use thiserror::Error;
 pub struct LeftOut {
     /// The item as the spec's comment names it: ``tolerance `Position (3)` (#128)``.
     pub item: String,
-    /// What is wrong with its value: `a zone of inf mm`.
+    /// What is wrong with its value (`a zone of inf mm`), or for a general tolerance,
+    /// what it applies to.
     pub value: String,
+    /// A general tolerance (one on the whole part), not a value the spec cannot hold.
+    pub general: bool,
 }
 
 impl LeftOut {
     /// The diagnostic, labelled on `span`: the file's path as the command line named it.
     pub fn at(&self, span: Span) -> ImportError {
-        ImportError::ValueLeftOut {
-            span,
-            item: self.item.clone(),
-            value: self.value.clone(),
+        let (item, value) = (self.item.clone(), self.value.clone());
+        if self.general {
+            ImportError::GeneralTolerance { span, item, value }
+        } else {
+            ImportError::ValueLeftOut { span, item, value }
         }
     }
 }
@@ -43,6 +47,22 @@ pub enum ImportError {
         item: String,
         value: String,
     },
+
+    #[error("{item} is a general tolerance ({value}): the spec keeps it as a comment")]
+    #[diagnostic(
+        code(insp::import::general_tolerance),
+        severity(Warning),
+        help("a tolerance on the whole part is the drawing's \"unless otherwise specified\" note: the program inspects the features toleranced one by one; to check it on chosen surfaces, write a `profile_surface` on a feature of those faces")
+    )]
+    GeneralTolerance {
+        #[label("read from this file")]
+        span: Span,
+        item: String,
+        value: String,
+    },
 }
 
-crate::diag::located!(ImportError { ValueLeftOut });
+crate::diag::located!(ImportError {
+    ValueLeftOut,
+    GeneralTolerance
+});

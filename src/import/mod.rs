@@ -20,8 +20,10 @@
 mod angles;
 mod errors;
 mod fits;
+mod reach;
 mod recognise;
 mod text;
+mod touch;
 mod values;
 mod write;
 

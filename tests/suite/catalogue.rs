@@ -45,6 +45,7 @@ const NO_SPEC_EXAMPLE: &[(&str, &str)] = &[
     ("insp::simulate::bad_statement", "a program run on the virtual CMM: tests/suite/simulate.rs"),
     ("insp::simulate::bad_deviation", "a deviations file: tests/suite/simulate.rs"),
     ("insp::import::value_left_out", "an imported STEP or QIF file, not a spec: tests/suite/import.rs"),
+    ("insp::import::general_tolerance", "an imported STEP or QIF file, not a spec: tests/suite/import.rs"),
     ("insp::io::unreadable", "a file named on the command line: tests/suite/cli.rs"),
     ("insp::io::unwritable", "an output of the command line: tests/suite/cli.rs"),
     ("insp::io::not_a_file", "an output of the command line: tests/suite/cli.rs"),

@@ -505,40 +505,48 @@ fn a_directed_location_is_read_as_its_distance() {
 }
 
 /// A profile toleranced on the product definition shape itself applies all over the
-/// part: CTC 02's first profile moved onto its shape reads on every face.
+/// part (the reader links it to every face), and the spec keeps it as a comment with a
+/// warning: a general tolerance is not inspected face by face. CTC 02's first profile
+/// moved onto its shape.
 #[test]
-fn an_all_over_profile_reads_on_every_face() {
+fn an_all_over_profile_is_read_on_every_face_and_kept_as_a_comment() {
     let (text, _) = patched(
         "ctc_02",
         "'Geometric tolerance for feature',#182,#615);",
         "'Geometric tolerance for feature',#182,#45643);",
     );
-    let spec = spec_of(&text);
-    let line = spec
-        .lines()
-        .find(|l| l.contains("= profile_surface(") && l.contains("0.1 mm"))
-        .unwrap_or_else(|| panic!("no all-over profile written:\n{spec}"));
-    let feature = line
-        .split('(')
-        .nth(1)
-        .unwrap()
-        .split(',')
-        .next()
-        .unwrap()
-        .trim();
-    // The feature's definition, however many lines it takes.
-    let start = spec
-        .find(&format!("feature {feature} "))
-        .unwrap_or_else(|| panic!("no feature {feature}"));
-    let rest = &spec[start..];
-    let end = rest[1..]
-        .find("\n    feature ")
-        .map_or(rest.len(), |e| e + 1);
-    let end = end.min(rest.find("\n\n").unwrap_or(rest.len()));
-    let faces = rest[..end].matches("group \"face_").count();
     let part =
         inspc::geometry::step::read(text.as_bytes(), inspc::geometry::step::RESOLUTION).unwrap();
-    assert_eq!(faces, part.solid_faces(), "{line}");
+    let all_over = part
+        .pmi
+        .tolerances
+        .iter()
+        .find(|t| t.faces.len() >= part.solid_faces())
+        .expect("no tolerance read on every face");
+    assert!((all_over.value_mm - 0.1).abs() < 1e-9);
+    let opts = ImportOptions {
+        cad_path: "part.stp".into(),
+        part_name: "part".into(),
+        scale: 1.0,
+    };
+    let imported = import(text.as_bytes(), &opts).unwrap();
+    let spec = &imported.text;
+    assert!(
+        !spec
+            .lines()
+            .any(|l| l.contains("= profile_surface(") && l.contains("0.1 mm")),
+        "the general profile is written as a tolerance:\n{spec}"
+    );
+    let comment = format!(
+        "a general tolerance, profile_surface 0.1 mm on all {} faces",
+        part.solid_faces()
+    );
+    assert!(spec.contains(&comment), "no comment `{comment}`:\n{spec}");
+    assert!(
+        imported.warnings.iter().any(|w| w.general),
+        "{:?}",
+        imported.warnings
+    );
 }
 
 /// A flatness per unit area (ISO 10303-47 `geometric_tolerance_with_defined_area_unit`)
