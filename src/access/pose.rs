@@ -253,6 +253,19 @@ impl Solid {
         }
     }
 
+    /// The same solid `by` wider across: a cylinder's radius, a box's half extents
+    /// across its local y (a mesh as it is).
+    pub fn widen(&mut self, by: f64) {
+        match &mut self.shape {
+            SolidShape::Cylinder { radius, .. } => *radius += by,
+            SolidShape::Box(half) => {
+                half.x += by;
+                half.z += by;
+            }
+            SolidShape::Mesh(_) => {}
+        }
+    }
+
     /// A cylinder around the axis from `base` along unit `axis` over `height`.
     pub fn cylinder(base: P3, axis: V3, height: f64, radius: f64) -> Solid {
         let rot = Rotation3::rotation_between(&V3::y(), &axis).unwrap_or_else(|| {

@@ -377,7 +377,7 @@ impl<'a> Knowledge<'a> {
         let setups = &self.setups;
         match setups.holder(&up) {
             Some(holder) => {
-                let solids = setups.solids(&holder, &up);
+                let solids = setups.keep_out(&holder, &up);
                 Held {
                     table: setups.table(&holder, &up, &solids),
                     solids,

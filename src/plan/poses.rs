@@ -58,6 +58,13 @@ use crate::sample::{convex_hull, perpendicular_basis};
 /// tips at 6°, a disc on its rim at 3°; a cube on a face at 45°.
 pub const MIN_TIP_DEG: f64 = 10.0;
 
+/// How far (mm) the part may stand off the place the prompt gives it on supports set by
+/// eye: three risers are put down where the prompt's distances say and the part set on
+/// them, each to within what `inspc verify` tries (5 mm), so the planner keeps touches
+/// and moves that far clear of the pads ([`Setups::keep_out`]); the virtual CMM puts the
+/// pads where they are.
+pub(crate) const PLACEMENT_SHIFT: f64 = 5.0;
+
 /// Directions closer than this are one pose (degrees).
 const SAME_PLANE_DEG: f64 = 0.5;
 
@@ -533,6 +540,21 @@ impl<'a> Setups<'a> {
             .find(|(k, _)| *k == slot)
             .map(|(_, f)| *f)
             .expect("holders name the plan's fixtures")
+    }
+
+    /// What the planner keeps clear of: the fixture's solids, riser pads widened by
+    /// [`PLACEMENT_SHIFT`] (pads are set by eye; a part 5 mm off them
+    /// brings a touch under it 5 mm nearer one).
+    pub fn keep_out(&self, holder: &Holder, up: &V3) -> Vec<Solid> {
+        let mut solids = self.solids(holder, up);
+        if let Holder::Fixture { slot, .. } = holder {
+            if matches!(self.fixture(*slot).kind, FixtureKind::Risers { .. }) {
+                for s in &mut solids {
+                    s.widen(PLACEMENT_SHIFT);
+                }
+            }
+        }
+        solids
     }
 
     /// The fixture's solids in the part frame with `up` pointing up: obstacles to the
