@@ -669,6 +669,43 @@ impl Writer<'_> {
         }
     }
 
+    /// Whether a plane of `feature` touched in `blocks` is measured as points on a
+    /// surface (`GSURF`) rather than a `PLANE`: its touches cannot fix a plane (fewer
+    /// than three, or in a row: NIST STC 08's two 3 × 3 mm lands, one point each), and
+    /// only profiles read it, which judge each point against its nominal (ASME
+    /// Y14.5-2018 § 11.3: the zone is about the true profile, no fitted plane), never a
+    /// datum or a tolerance that needs the plane.
+    fn points_only(&self, feature: Option<FeatureId>, blocks: &[BlockKey]) -> bool {
+        let Some(f) = feature else {
+            return false;
+        };
+        let llip = self.input.llip;
+        let block = |k: &BlockKey| &llip.setups[k.0].groups[k.1].blocks[k.2];
+        // A scan's cloud fixes its plane.
+        if blocks.iter().any(|k| !block(k).passes.is_empty()) {
+            return false;
+        }
+        let pts: Vec<usize> = blocks
+            .iter()
+            .flat_map(|k| &block(k).touches)
+            .map(|t| t.point)
+            .collect();
+        let positions: Vec<&P3> = pts
+            .iter()
+            .map(|&k| &self.input.hlip.points[k].position)
+            .collect();
+        if pts.len() >= 3 && crate::plan::spans_area(&positions) {
+            return false;
+        }
+        let part = self.names.part();
+        let profiles = part.tolerances.iter().filter(|t| t.targets.contains(&f));
+        !part.datums.iter().any(|d| d.feature == f)
+            && profiles.clone().count() > 0
+            && profiles
+                .into_iter()
+                .all(|t| matches!(t.kind, TolKind::ProfileSurface | TolKind::ProfileLine))
+    }
+
     /// One nominal per (feature, face, table) measured, in order of first use.
     /// One `FEAT` per surface of a feature (faces on one surface are one feature), and
     /// one per partial where the program measures a surface in several blocks.
@@ -698,6 +735,14 @@ impl Writer<'_> {
             } else {
                 name
             };
+            let nominal = match nominal {
+                Nominal::Surface(Surface::Plane { .. }, centre)
+                    if self.points_only(feature, &blocks) =>
+                {
+                    Nominal::Surface(Surface::Freeform, centre)
+                }
+                n => n,
+            };
             let surface = SurfaceOf {
                 name,
                 nominal,
@@ -710,7 +755,19 @@ impl Writer<'_> {
                 self.freeform_nominals(surface, &blocks);
                 continue;
             }
-            let rounds = measuring_rounds(llip, &blocks, surface.nominal.least_touches());
+            let plane = matches!(
+                surface.nominal,
+                Nominal::Surface(Surface::Plane { .. }, _) | Nominal::Table(..)
+            );
+            let points = &self.input.hlip.points;
+            // A plane's touches fix it only spread across an area (never a row).
+            let fixes = |pts: &[usize]| {
+                !plane
+                    || crate::plan::spans_area(
+                        &pts.iter().map(|&k| &points[k].position).collect::<Vec<_>>(),
+                    )
+            };
+            let rounds = measuring_rounds(llip, &blocks, surface.nominal.least_touches(), &fixes);
             self.surface_nominals(surface, &rounds);
         }
         self.centre_planes();
@@ -2297,12 +2354,15 @@ fn nominal_of(input: &Input, b: &BlockPath) -> Option<Nominal> {
 
 /// A surface's blocks in rounds: a block that touches a point again (a datum measured
 /// anew with another probe) starts a new round, which measures the surface anew. A
-/// round of fewer touches than the surface needs (`least`) fits nothing (one touch is
-/// no plane): it joins the round before it, or after it for the first.
+/// round of fewer touches than the surface needs (`least`), or whose touched points
+/// do not fix it (`fixes`: a plane's three points in a row, NIST CTC 03's datum D
+/// touched again along one edge), fits nothing: it joins the round before it, or after
+/// it for the first.
 fn measuring_rounds(
     llip: &crate::path::Llip,
     blocks: &[BlockKey],
     least: usize,
+    fixes: &dyn Fn(&[usize]) -> bool,
 ) -> Vec<Vec<BlockKey>> {
     let block = |k: &BlockKey| &llip.setups[k.0].groups[k.1].blocks[k.2];
     let mut rounds_of: Vec<Vec<BlockKey>> = Vec::new();
@@ -2321,9 +2381,17 @@ fn measuring_rounds(
             .map(|k| block(k).touches.len().max(block(k).passes.len() * least))
             .sum()
     };
+    let fits = |keys: &[BlockKey]| {
+        let scanned = keys.iter().any(|k| !block(k).passes.is_empty());
+        let pts: Vec<usize> = keys
+            .iter()
+            .flat_map(|k| block(k).touches.iter().map(|t| t.point))
+            .collect();
+        touches(keys) >= least && (scanned || fixes(&pts))
+    };
     let mut r = 0;
     while rounds_of.len() > 1 && r < rounds_of.len() {
-        if touches(&rounds_of[r]) >= least {
+        if fits(&rounds_of[r]) {
             r += 1;
             continue;
         }

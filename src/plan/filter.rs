@@ -35,7 +35,7 @@ pub(crate) fn min_points(kind: SurfaceKind) -> usize {
 
 /// Whether points spread across an area, not along a line: a plane fitted to them is
 /// determined. The second principal spread must be at least [`LEAST_SPREAD`].
-pub(super) fn spans_area(points: &[&crate::geometry::P3]) -> bool {
+pub(crate) fn spans_area(points: &[&crate::geometry::P3]) -> bool {
     if points.len() < 3 {
         return false;
     }

@@ -55,6 +55,7 @@ mod validate;
 
 pub use errors::PlanError;
 pub use explain::explain_setups;
+pub(crate) use filter::spans_area;
 pub(crate) use hlip::STEPS_PER_MM;
 pub use hlip::{
     FaceVisit, Hlip, Inspection, OrientNode, PlanPoint, PointRef, ProbeNode, SetupNode, Summary,
