@@ -78,7 +78,8 @@
 //! `SNSDEF/PROBE,INDEX,POL,A,B,VEC,i,j,k,L,D` (L tip centre to head, D tip diameter,
 //! the vector tip to head in machine axes); `DATSET` direction words `XDIR`… with a
 //! leading `-` for a negative normal; a datum on the table is `<FEATURE>_T` (the table
-//! plane); free-form faces are `GSURF`. Probe changes happen on the clearance plane;
+//! plane); free-form faces are `GSURF`, and so is a plane only profiles read whose
+//! touches fix no plane (`points_only`). Probe changes happen on the clearance plane;
 //! the rack is not modelled.
 //!
 //! **Decision: stand-offs.** A block whose stand-off differs from the program's

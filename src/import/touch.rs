@@ -125,7 +125,7 @@ mod tests {
     /// `rho`, swept 10 mm along z: group 0 the floor, 1 the wall, 2 the fillet.
     fn corner(rho: f64) -> RawMesh {
         let mut m = RawMesh::default();
-        let mut quad = |m: &mut RawMesh, p: [P3; 4], g: u32| {
+        let quad = |m: &mut RawMesh, p: [P3; 4], g: u32| {
             let base = m.vertices.len() as u32;
             m.vertices.extend(p);
             m.triangles.push([base, base + 1, base + 2]);
