@@ -39,6 +39,7 @@ pub use errors::{GeometryError, MeshError};
 pub use fixture::{place_fixture, FixtureMesh};
 pub use mesh_io::read_mesh;
 pub use query::{edge_triangles, line_triangle, FaceIndex};
+pub(crate) use recess::across;
 pub(crate) use recess::box_exit;
 pub use recess::recess_depth;
 pub use report::{describe, faces_json, faces_table};

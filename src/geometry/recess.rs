@@ -123,7 +123,7 @@ fn bounds(vertices: &[P3]) -> Option<(P3, P3)> {
 }
 
 /// Two unit vectors square to `n` and to each other.
-fn across(n: &V3) -> (V3, V3) {
+pub(crate) fn across(n: &V3) -> (V3, V3) {
     let seed = if n.x.abs() < 0.9 { V3::x() } else { V3::y() };
     let u = n.cross(&seed).normalize();
     (u, n.cross(&u))

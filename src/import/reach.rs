@@ -10,7 +10,7 @@
 //! where eight rays across the axis all run the body's radius (with a margin) without
 //! meeting the part.
 
-use crate::geometry::{RawMesh, Surface, P3, V3};
+use crate::geometry::{across, RawMesh, Surface, P3, V3};
 use parry3d_f64::math::{Point, Vector};
 use parry3d_f64::query::{Ray, RayCast};
 use parry3d_f64::shape::TriMesh;
@@ -151,13 +151,6 @@ fn hole_reach(mesh: &TriMesh, deep: &P3, dir: &V3, length: f64) -> Option<f64> {
         h += STEP;
     }
     None
-}
-
-/// Two unit vectors square to `n` and to each other.
-fn across(n: &V3) -> (V3, V3) {
-    let t = if n.x.abs() < 0.9 { V3::x() } else { V3::y() };
-    let u = n.cross(&t).normalize();
-    (u, n.cross(&u))
 }
 
 #[cfg(test)]
