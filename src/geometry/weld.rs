@@ -38,6 +38,17 @@ pub struct RawMesh {
 }
 
 impl RawMesh {
+    /// Per group with an exact surface (`exact`'s order), the indices of its triangles.
+    pub fn triangles_of_groups(&self) -> Vec<Vec<u32>> {
+        let mut own: Vec<Vec<u32>> = vec![Vec::new(); self.exact.len()];
+        for (t, &g) in self.tri_group.iter().enumerate() {
+            if let Some(list) = own.get_mut(g as usize) {
+                list.push(t as u32);
+            }
+        }
+        own
+    }
+
     /// The mesh scaled by `s` about the origin, its exact surfaces with it.
     pub fn scale(&mut self, s: f64) {
         for v in &mut self.vertices {

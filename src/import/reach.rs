@@ -39,12 +39,7 @@ pub(super) fn small_hole_reach(mesh: &RawMesh) -> f64 {
     let Ok(trimesh) = TriMesh::new(mesh.vertices.clone(), mesh.triangles.clone()) else {
         return 0.0;
     };
-    let mut own: Vec<Vec<u32>> = vec![Vec::new(); mesh.exact.len()];
-    for (t, &g) in mesh.tri_group.iter().enumerate() {
-        if let Some(list) = own.get_mut(g as usize) {
-            list.push(t as u32);
-        }
-    }
+    let own = mesh.triangles_of_groups();
     // The small concave cylinders, the halves of one hole together.
     let mut holes: Vec<(P3, V3, Vec<usize>)> = Vec::new();
     for (k, surface) in mesh.exact.iter().enumerate() {

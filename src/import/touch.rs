@@ -49,28 +49,28 @@ pub(super) fn untouchable(mesh: &RawMesh, faces: &BTreeSet<usize>, r: f64) -> BT
             };
         }
     }
-    // The triangles of each face asked, those off its boundary where it has some.
-    let mut own: Vec<Vec<usize>> = vec![Vec::new(); mesh.exact.len().max(1)];
-    let mut inner: Vec<Vec<usize>> = vec![Vec::new(); mesh.exact.len().max(1)];
-    for (t, &g) in mesh.tri_group.iter().enumerate() {
-        let g = g as usize;
-        if faces.contains(&g) && g < own.len() {
-            own[g].push(t);
-            if mesh.triangles[t]
-                .iter()
-                .all(|&i| face_of[i as usize] == Some(g))
-            {
-                inner[g].push(t);
-            }
-        }
-    }
+    // The triangles of each face, those off its boundary where it has some.
+    let own = mesh.triangles_of_groups();
+    let inner = |f: usize, tris: &[u32]| -> Vec<u32> {
+        tris.iter()
+            .copied()
+            .filter(|&t| {
+                mesh.triangles[t as usize]
+                    .iter()
+                    .all(|&i| face_of[i as usize] == Some(f))
+            })
+            .collect()
+    };
     faces
         .iter()
         .copied()
         .filter(|&f| {
-            let tris = match inner.get(f) {
-                Some(t) if !t.is_empty() => t.as_slice(),
-                _ => own.get(f).map_or(&[][..], Vec::as_slice),
+            let all = own.get(f).map_or(&[][..], Vec::as_slice);
+            let off_edges = inner(f, all);
+            let tris = if off_edges.is_empty() {
+                all
+            } else {
+                &off_edges[..]
             };
             let tighter = match mesh.exact.get(f) {
                 Some(
@@ -94,13 +94,13 @@ pub(super) fn untouchable(mesh: &RawMesh, faces: &BTreeSet<usize>, r: f64) -> BT
 
 /// The share of up to [`SAMPLES`] of `tris` (spread evenly by index) at whose centroid
 /// the ball of radius `r` stands clear of the mesh.
-fn fit_share(mesh: &RawMesh, trimesh: &TriMesh, tris: &[usize], r: f64) -> f64 {
+fn fit_share(mesh: &RawMesh, trimesh: &TriMesh, tris: &[u32], r: f64) -> f64 {
     let step = tris.len().div_ceil(SAMPLES).max(1);
-    let picked: Vec<usize> = tris.iter().copied().step_by(step).collect();
+    let picked: Vec<u32> = tris.iter().copied().step_by(step).collect();
     let fits = picked
         .iter()
         .filter(|&&t| {
-            let [a, b, c] = mesh.triangles[t].map(|i| mesh.vertices[i as usize]);
+            let [a, b, c] = mesh.triangles[t as usize].map(|i| mesh.vertices[i as usize]);
             let Some(n) = (b - a).cross(&(c - a)).try_normalize(1e-12) else {
                 return false;
             };

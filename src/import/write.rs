@@ -204,7 +204,7 @@ fn touchable_pmi(part: &CadPart, mut p: pmi::Pmi) -> (pmi::Pmi, BTreeMap<u64, St
     let asked: BTreeSet<usize> = p
         .tolerances
         .iter()
-        .filter(|t| t.faces.len() < solid)
+        .filter(|t| !general(t, solid))
         .flat_map(|t| t.faces.iter().copied())
         .chain(
             p.dimensions
@@ -237,7 +237,7 @@ fn touchable_pmi(part: &CadPart, mut p: pmi::Pmi) -> (pmi::Pmi, BTreeMap<u64, St
             notes.push(format!("{what}: left out {}", why(&lost)));
         }
     };
-    for t in p.tolerances.iter_mut().filter(|t| t.faces.len() < solid) {
+    for t in p.tolerances.iter_mut().filter(|t| !general(t, solid)) {
         drop(&mut t.faces, t.id, format!("`{}`", t.name));
     }
     let mut sizes_gone = Vec::new();
@@ -497,7 +497,7 @@ fn tolerance_lines(
     let mut count = 0;
     for t in &p.tolerances {
         let label = format!("`{}` (#{})", t.name, t.id);
-        if solid > 1 && t.faces.len() >= solid {
+        if general(t, solid) {
             let what = general_words(t);
             warnings.push(LeftOut {
                 item: source(&format!("tolerance {label}"), Place::Comment),
@@ -557,6 +557,11 @@ fn tolerance_lines(
         }
     }
     (lines, count)
+}
+
+/// Whether a tolerance is a general one: on every one of the part's `solid` faces.
+fn general(t: &pmi::GeoTolerance, solid: usize) -> bool {
+    solid > 1 && t.faces.len() >= solid
 }
 
 /// A general tolerance in words: `a profile of 1.524 mm to A|B|C on all 304 faces`.
@@ -927,12 +932,7 @@ const DEEP_FLOOR: f64 = 45.0;
 /// floor of a pocket or blind hole walled on every side.
 fn deepest_floor(part: &CadPart) -> f64 {
     let m = &part.mesh;
-    let mut own: Vec<Vec<u32>> = vec![Vec::new(); m.exact.len()];
-    for (t, &g) in m.tri_group.iter().enumerate() {
-        if let Some(list) = own.get_mut(g as usize) {
-            list.push(t as u32);
-        }
-    }
+    let own = m.triangles_of_groups();
     m.exact
         .iter()
         .zip(&own)
