@@ -5,11 +5,16 @@ use super::{FaceId, PartGeometry, P3, V3};
 use std::collections::HashMap;
 
 /// Per face, what point queries need: its boundary edges (where it meets another face or
-/// the mesh is open). Built once per geometry.
+/// the mesh is open), and which of them are walls. Built once per geometry.
 #[derive(Debug, Clone)]
 pub struct FaceIndex {
     /// Per face, boundary segments as vertex index pairs, in a stable order.
     pub boundary: Vec<Vec<[u32; 2]>>,
+    /// Per face, parallel to `boundary`: whether the face beyond the segment rises on
+    /// the face's outward side (a concave edge: a wall, a fillet up to one), where a
+    /// tip beside the edge meets material; else the edge is open (an outer edge, a
+    /// hole's mouth), where material falls away.
+    pub wall: Vec<Vec<bool>>,
 }
 
 impl FaceIndex {
@@ -17,6 +22,7 @@ impl FaceIndex {
     pub fn new(g: &PartGeometry) -> FaceIndex {
         let edges = edge_triangles(&g.triangles);
         let mut boundary = vec![Vec::new(); g.faces.len()];
+        let mut wall = vec![Vec::new(); g.faces.len()];
         for (t, tri) in g.triangles.iter().enumerate() {
             let f = g.tri_face[t];
             for k in 0..3 {
@@ -25,10 +31,23 @@ impl FaceIndex {
                 let inner = users.len() == 2 && users.iter().all(|&u| g.tri_face[u as usize] == f);
                 if !inner {
                     boundary[f as usize].push([a, b]);
+                    wall[f as usize].push(rises_beyond(g, t, [a, b], users));
                 }
             }
         }
-        FaceIndex { boundary }
+        FaceIndex { boundary, wall }
+    }
+
+    /// Distances from `p` to a face's open edges and to its walls (mm; infinite where
+    /// it has none), as [`FaceIndex::wall`] tells them apart.
+    pub fn edge_distances(&self, g: &PartGeometry, face: FaceId, p: &P3) -> (f64, f64) {
+        let (mut open, mut wall) = (f64::INFINITY, f64::INFINITY);
+        for (&[a, b], &is_wall) in self.boundary[face.0].iter().zip(&self.wall[face.0]) {
+            let d = segment_distance(p, &g.vertices[a as usize], &g.vertices[b as usize]);
+            let slot = if is_wall { &mut wall } else { &mut open };
+            *slot = slot.min(d);
+        }
+        (open, wall)
     }
 
     /// Distance from `p` to the boundary of a face (mm); infinite for a closed face.
@@ -38,6 +57,28 @@ impl FaceIndex {
             .map(|&[a, b]| segment_distance(p, &g.vertices[a as usize], &g.vertices[b as usize]))
             .fold(f64::INFINITY, f64::min)
     }
+}
+
+/// Whether the other triangle on edge `ab` of triangle `t` rises on `t`'s outward side
+/// (its far corner above `t`'s plane by more than a micrometre): the edge is concave.
+/// An edge of the open mesh, or one shared by more than two triangles, is not.
+fn rises_beyond(g: &PartGeometry, t: usize, [a, b]: [u32; 2], users: &[u32]) -> bool {
+    let mut others = users.iter().filter(|&&u| u as usize != t);
+    let (Some(&u), None) = (others.next(), others.next()) else {
+        return false;
+    };
+    let tri = g.triangles[t].map(|i| g.vertices[i as usize]);
+    let Some(n) = (tri[1] - tri[0])
+        .cross(&(tri[2] - tri[0]))
+        .try_normalize(0.0)
+    else {
+        return false;
+    };
+    let far = g.triangles[u as usize]
+        .into_iter()
+        .find(|&i| i != a && i != b)
+        .map(|i| g.vertices[i as usize]);
+    far.is_some_and(|w| (w - g.vertices[a as usize]).dot(&n) > 1e-3)
 }
 
 /// Each undirected edge (smaller vertex index first) → the triangles using it, in order.

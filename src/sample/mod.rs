@@ -43,6 +43,17 @@
 //! keeps its points towards its mid-line; a face no point of which keeps the margin is
 //! sampled again with the margin halved, down to [`MIN_MARGIN_MM`] (a 1 mm ring gets
 //! its mid-line). Which probe fits there is the planner's question, not the sampler's.
+//!
+//! **Decision: a narrow plane's points keep clear of its walls.** With the margin
+//! halved, a plane's points first keep [`WALL_CLEARANCE`] more from its walls (edges
+//! where the next face rises on the outward side: [`FaceIndex::wall`]) than from its
+//! open edges (a hole's mouth, an outer edge), and only where no point does so the
+//! margin alone. A counterbore floor between a hole and its wall is where this matters:
+//! Fan & Leu's corners of the inset square put FTC 06's floor points (a ring 2.7 mm
+//! wide) 0.2 mm from the wall for a Ø2 tip at its stand-off, and an alignment 0.5 mm
+//! off (a datum plane at twice its tolerance) drove the tip into the wall. The plan's
+//! moves keep `motion { margin }` (1 mm by default) from the part, and a stand-off
+//! should as well. Toward the hole's mouth the ball only overhangs empty space.
 
 mod chart;
 mod recess;
@@ -118,16 +129,30 @@ impl<'a> Sampler<'a> {
     /// on its mid-line, and the planner decides which probe fits there.
     pub fn sample(&self, face: FaceId, strategy: &Strategy) -> Vec<Fpoint> {
         let mut margin = self.margin_of(face);
+        let plane = matches!(self.g.faces[face.0].surface, Surface::Plane { .. });
         loop {
-            let pts = self.sample_with_margin(face, strategy, margin);
+            let pts = self.sample_with_margin(face, strategy, margin, margin);
             if !pts.is_empty() || margin <= MIN_MARGIN_MM {
                 return pts;
             }
             margin = (margin / 2.0).max(MIN_MARGIN_MM);
+            if plane {
+                let pts = self.sample_with_margin(face, strategy, margin, margin + WALL_CLEARANCE);
+                if !pts.is_empty() {
+                    return pts;
+                }
+            }
         }
     }
 
-    fn sample_with_margin(&self, face: FaceId, strategy: &Strategy, margin: f64) -> Vec<Fpoint> {
+    /// Points keeping `margin` from the face's open edges and `wall` from its walls.
+    fn sample_with_margin(
+        &self,
+        face: FaceId,
+        strategy: &Strategy,
+        margin: f64,
+        wall: f64,
+    ) -> Vec<Fpoint> {
         let f = &self.g.faces[face.0];
         if f.area <= 0.0 {
             return Vec::new();
@@ -145,6 +170,7 @@ impl<'a> Sampler<'a> {
             chart: &chart,
             face,
             margin,
+            wall: wall.max(margin),
         };
         match (strategy.method, &f.surface) {
             (SampleMethod::FanLeu, Surface::Plane { .. }) => {
@@ -277,6 +303,11 @@ fn spread_rows(a: f64, b: f64, want: Option<usize>, spacing: Option<f64>) -> (us
     }
 }
 
+/// How much farther than the margin a narrow plane's points keep from its walls (mm):
+/// the default `motion { margin }`, so that a tip the margin's size, standing off the
+/// point before its touch, keeps the plan's clearance from the wall beside it.
+pub(crate) const WALL_CLEARANCE: f64 = 1.0;
+
 /// The least margin a face is sampled with (mm), however narrow it is.
 pub(crate) const MIN_MARGIN_MM: f64 = 0.1;
 
@@ -289,7 +320,11 @@ struct Place<'s, 'a> {
     s: &'s Sampler<'a>,
     chart: &'s Chart,
     face: FaceId,
+    /// The distance points keep from the face's open edges.
     margin: f64,
+    /// The distance points keep from its walls ([`FaceIndex::wall`]): the margin, or more
+    /// on a narrow face ([`WALL_CLEARANCE`]).
+    wall: f64,
 }
 
 impl Place<'_, '_> {
@@ -307,7 +342,8 @@ impl Place<'_, '_> {
         if !g.face_covers(self.face, &position, &normal, self.chart.cover_tolerance()) {
             return None;
         }
-        if self.s.index.boundary_distance(g, self.face, &position) < self.margin {
+        let (open, wall) = self.s.index.edge_distances(g, self.face, &position);
+        if open < self.margin || wall < self.wall {
             return None;
         }
         Some(Fpoint {

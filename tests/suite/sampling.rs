@@ -1,15 +1,28 @@
 //! The sampling rules on faces where the answer is known: Fan & Leu's insets, the
 //! slender-face shift, the zig-zag search around a hole, the cylinder circles, point
-//! counts of uniform and Hammersley sampling, and per-feature overrides.
+//! counts of uniform and Hammersley sampling, per-feature overrides, and a narrow floor's
+//! points kept clear of its wall.
 
 use inspc::source::MemoryWorld;
 
 /// The fpoints of every face of a one-part spec, as (face name, x, y, z) rounded to µm.
 fn points(part_body: &str, plan_extra: &str) -> Vec<(String, [f64; 3])> {
+    points_on(&["TP20_D2_L20"], part_body, plan_extra)
+}
+
+/// [`points`] with a rack of the given stdlib probes (`p1`, `p2`, … in order).
+fn points_on(probes: &[&str], part_body: &str, plan_extra: &str) -> Vec<(String, [f64; 3])> {
+    let rack: Vec<String> = probes
+        .iter()
+        .enumerate()
+        .map(|(i, p)| format!("p{}: {p}", i + 1))
+        .collect();
     let src = format!(
-        "use std::heads::PH6\nuse std::probes::TP20_D2_L20\npart p {{\n units mm\n{part_body}\n}}\n\
-         cmm lab {{ table {{ z 0 mm }}, ram {{ radius 35 mm, length 600 mm }}, head PH6, probes [p1: TP20_D2_L20] }}\n\
-         plan q {{ part p, cmm lab\n{plan_extra}\n}}\n"
+        "use std::heads::PH6\nuse std::probes::{{{}}}\npart p {{\n units mm\n{part_body}\n}}\n\
+         cmm lab {{ table {{ z 0 mm }}, ram {{ radius 35 mm, length 600 mm }}, head PH6, probes [{}] }}\n\
+         plan q {{ part p, cmm lab\n{plan_extra}\n}}\n",
+        probes.join(", "),
+        rack.join(", ")
     );
     let mut world = MemoryWorld::new();
     world.insert("main.insp", src.into_bytes());
@@ -143,5 +156,30 @@ fn uniform_and_hammersley_give_the_requested_counts_and_overrides_win() {
             ((q[0] - 50.0).powi(2) + (q[1] - 25.0).powi(2)).sqrt() > 10.0,
             "{q:?}"
         );
+    }
+}
+
+#[test]
+fn a_counterbore_floor_narrower_than_the_widest_tip_keeps_its_points_clear_of_the_wall() {
+    // A Ø22 × 4 counterbore over a Ø12 through hole: its floor is a ring 5 mm wide, under
+    // the 6 mm the rack's widest tip (Ø6, margin 3) needs. Fan & Leu's points sit at the
+    // corners of the inset square, r = 9.33, where a Ø2 tip standing off the floor keeps
+    // 0.67 mm from the wall. With the margin halved the points keep 1.5 mm from the hole's
+    // mouth (r ≥ 7.5) and 1.5 + 1 mm from the wall (r ≤ 8.5): the Ø2 tip keeps 1.5 mm.
+    let p = points_on(
+        &["TP20_D2_L20", "TP20_D6_L20"],
+        " stock box(100, 50, 20)\n cut hole cb { at (50, 25, 20), axis -z, diameter 22, depth 4 }\n \
+         cut hole h { at (50, 25, 20), axis -z, diameter 12, depth through }\n feature floor = cb.bottom",
+        "",
+    );
+    let floor = on(&p, "cb.bottom");
+    assert_eq!(floor.len(), 4, "{floor:?}");
+    for q in &floor {
+        let r = ((q[0] - 50.0).powi(2) + (q[1] - 25.0).powi(2)).sqrt();
+        assert!(
+            (7.5 - 1e-6..=8.5 + 1e-6).contains(&r),
+            "{q:?} is {r} mm from the axis"
+        );
+        assert!((q[2] - 16.0).abs() < 1e-6, "{q:?}");
     }
 }
