@@ -210,11 +210,12 @@ pub enum Unreachable {
 /// What stops a probe at a face's first point it cannot reach.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Stop {
-    /// The tip does not fit with room to back off, at any point.
+    /// The tip does not fit with room to back off at enough points: `fits` of `points`.
     TipDoesNotFit {
         probe: String,
         diameter: f64,
         points: usize,
+        fits: usize,
         travel: f64,
     },
     /// Every straight line from the tip centre meets the part.
@@ -259,9 +260,15 @@ impl fmt::Display for Unreachable {
 impl fmt::Display for Stop {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Stop::TipDoesNotFit { probe, diameter, points, travel } => write!(
+            Stop::TipDoesNotFit { probe, diameter, points, fits: 0, travel } => write!(
                 f,
                 "probe {probe}'s Ø{} mm tip does not fit at any of its {points} points with {} mm to back off the surface",
+                fmt_num(*diameter),
+                fmt_num(*travel)
+            ),
+            Stop::TipDoesNotFit { probe, diameter, points, fits, travel } => write!(
+                f,
+                "probe {probe}'s Ø{} mm tip fits at only {fits} of its {points} points with {} mm to back off the surface",
                 fmt_num(*diameter),
                 fmt_num(*travel)
             ),
@@ -450,12 +457,30 @@ mod tests {
                 probe: "P1".into(),
                 diameter: 2.0,
                 points: 3,
+                fits: 0,
                 travel: 0.5,
             },
         };
         assert_eq!(
             few.to_string(),
             "probe P1 reaches 0 of its 3 points (it needs 3); probe P1's Ø2 mm tip does not fit at any of its 3 points with 0.5 mm to back off the surface"
+        );
+        let some = Unreachable::TooFew {
+            probe: "P1".into(),
+            reach: 1,
+            points: 9,
+            need: 3,
+            stop: Stop::TipDoesNotFit {
+                probe: "P1".into(),
+                diameter: 1.0,
+                points: 9,
+                fits: 2,
+                travel: 0.5,
+            },
+        };
+        assert_eq!(
+            some.to_string(),
+            "probe P1 reaches 1 of its 9 points (it needs 3); probe P1's Ø1 mm tip fits at only 2 of its 9 points with 0.5 mm to back off the surface"
         );
         assert_eq!(
             Shortfall::FewTouches(1).to_string(),

@@ -67,16 +67,19 @@ pub(super) fn report_face(
             .iter()
             .filter(|&&f| k.dom[f][p].tip && !k.dom[f][p].setup.and(&usable).is_empty())
             .count();
+        // Where the tip fits at too few points, that is the cause, whatever blocks the
+        // probe at the points where it fits.
+        let fits = pts.iter().filter(|&&f| k.dom[f][p].tip).count();
+        let no_fit = || Stop::TipDoesNotFit {
+            probe: probe.name.clone(),
+            diameter: 2.0 * probe.tip_radius,
+            points: pts.len(),
+            fits,
+            travel: crate::access::pose::MIN_TRAVEL,
+        };
         let (depth, stop) = match pts.iter().copied().find(|&f| k.dom[f][p].tip) {
-            None => (
-                0,
-                Stop::TipDoesNotFit {
-                    probe: probe.name.clone(),
-                    diameter: 2.0 * probe.tip_radius,
-                    points: pts.len(),
-                    travel: crate::access::pose::MIN_TRAVEL,
-                },
-            ),
+            None => (0, no_fit()),
+            Some(f) if fits < need => (blocking(k, m, p, f).0, no_fit()),
             Some(f) => blocking(k, m, p, f),
         };
         if best
