@@ -177,7 +177,7 @@ impl<'a> Breaking<'a> {
         let (g, zone, k) = (self.g, self.zone, self.k);
         let mut out = Vec::new();
         for (name, faces) in self.features() {
-            for (axis, across, length) in tilts(g, faces) {
+            for (axis, across, length) in tilts(g, faces, frame.free_turn) {
                 if !frame.fixes_turn(&axis) {
                     continue;
                 }
@@ -499,14 +499,31 @@ fn extent(g: &PartGeometry, faces: &[FaceId], dir: &V3) -> f64 {
 /// A feature's tilts: (axis of the turn, the direction across which its far ends part,
 /// the feature's extent that way). A plane turns about each of two axes in it; an axis
 /// about each of two directions across it, over its length.
-fn tilts(g: &PartGeometry, faces: &[FaceId]) -> Vec<(V3, V3, f64)> {
+///
+/// Where one datum direction `free` orients the zone alone (a lone primary plane or
+/// axis), the zone may turn about `free` (ASME Y14.5-2018 § 7.11, the degrees of freedom
+/// a primary datum arrests; § 9.5, an orientation zone is basic to the datums given): a
+/// turn changes the feature's angle to `free` only by its share about `n × free`, so
+/// the feature tilts about that one axis. CTC 03's datum E, at 45° to A, tilted about
+/// the other axis in its plane (one that keeps its angle to A) read 0.008 of a 1.016
+/// angularity zone, as the standard says it should.
+fn tilts(g: &PartGeometry, faces: &[FaceId], free: Option<V3>) -> Vec<(V3, V3, f64)> {
     let Some((n, plane)) = orientation(g, faces) else {
         return Vec::new();
     };
     let [u, v] = across_of(&n);
+    let tilted = free.and_then(|d| n.cross(&d).try_normalize(1e-6));
+    // Turning about `v` lifts the ends along `u` apart; a turn about `tilted` as one of
+    // those two where it lies along one.
+    let pairs = match tilted {
+        None => vec![(v, u), (u, v)],
+        Some(t) => vec![[(v, u), (u, v)]
+            .into_iter()
+            .find(|(axis, _)| axis.cross(&t).norm() < 1e-9)
+            .unwrap_or((t, n.cross(&t)))],
+    };
     if plane {
-        // Turning about `v` lifts the ends along `u` apart.
-        [(v, u), (u, v)]
+        pairs
             .into_iter()
             .map(|(axis, along)| (axis, along, extent(g, faces, &along)))
             .filter(|x| x.2 > 1e-6)
@@ -516,7 +533,10 @@ fn tilts(g: &PartGeometry, faces: &[FaceId]) -> Vec<(V3, V3, f64)> {
         if length < 1e-6 {
             return Vec::new();
         }
-        vec![(v, u, length), (u, v, length)]
+        pairs
+            .into_iter()
+            .map(|(axis, along)| (axis, along, length))
+            .collect()
     }
 }
 

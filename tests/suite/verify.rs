@@ -1,6 +1,6 @@
 //! `inspc verify` where the answer is known: a clean program, a program that cannot see
 //! a tilt (the feature sets its own frame), the sampling that decides whether a bow is
-//! seen, and the same report on every run.
+//! seen, the one tilt an angle to a lone datum forbids, and the same report on every run.
 
 use inspc::source::FsWorld;
 use inspc::verify::{Options, Verification};
@@ -213,3 +213,44 @@ plan plate_plan {
     hierarchy efficient_accuracy
 }
 ";
+
+/// A 100 × 50 × 60 block whose top-right edge is cut at 45° (the chamfer's normal is
+/// (0.707, 0, 0.707)), faces grouped by name; its bottom is datum A.
+const CHAMFERED_BLOCK: &str = "v 0 0 0\nv 100 0 0\nv 100 0 30\nv 70 0 60\nv 0 0 60\n\
+    v 0 50 0\nv 100 50 0\nv 100 50 30\nv 70 50 60\nv 0 50 60\n\
+    g bottom\nf 1 7 2\nf 1 6 7\ng right\nf 2 8 3\nf 2 7 8\ng chamfer\nf 3 9 4\nf 3 8 9\n\
+    g top\nf 4 10 5\nf 4 9 10\ng left\nf 5 6 1\nf 5 10 6\n\
+    g front\nf 1 2 3\nf 1 3 4\nf 1 4 5\ng back\nf 6 8 7\nf 6 9 8\nf 6 10 9\n";
+
+/// Angularity to a lone primary plane (ASME Y14.5-2018 § 7.11: the plane leaves the
+/// zone free to turn about its normal): only a tilt that changes the chamfer's 45° to A
+/// is forbidden. A tilt about the chamfer's other in-plane axis keeps the angle (to the
+/// first order) and reads in, as it should; the battery tries the one tilt that
+/// matters, which reads out at twice the zone and in at half.
+#[test]
+fn an_angle_to_a_lone_datum_is_broken_by_the_tilt_that_changes_it() {
+    let dir = std::env::temp_dir().join(format!("inspc_angle_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("block.obj"), CHAMFERED_BLOCK).unwrap();
+    let spec = dir.join("block.insp");
+    std::fs::write(
+        &spec,
+        "use std::heads::PH10MQ\nuse std::probes::TP20_D2_L20\n\
+         part block {\n    units mm\n    mesh \"block.obj\"\n    \
+         feature base = group \"bottom\"\n    feature slope = group \"chamfer\"\n    \
+         datum A = base\n    tolerance ang = angularity(slope, 0.1 mm, A, basic 45 deg)\n}\n\
+         cmm lab {\n    table { z 0 mm, size (1000 mm, 700 mm) }\n    ram { radius 35 mm, length 600 mm }\n    \
+         head PH10MQ\n    probes [p1: TP20_D2_L20]\n}\n\
+         plan block_plan {\n    part block\n    cmm lab\n}\n",
+    )
+    .unwrap();
+    let v = verify(&spec, 1);
+    std::fs::remove_dir_all(&dir).ok();
+    let text = v[0].text();
+    assert_eq!(v[0].problems(), 0, "{text}");
+    let ang = text
+        .lines()
+        .find(|l| l.starts_with("ANG "))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(ang.contains(" in ") && ang.contains(" out "), "{ang}");
+}
