@@ -20,6 +20,7 @@
 mod angles;
 mod errors;
 mod fits;
+mod levels;
 mod reach;
 mod recognise;
 mod text;

@@ -322,8 +322,14 @@ pub(super) fn write_spec(part: &CadPart, opts: &ImportOptions) -> Imported {
         &mut used_tol_names,
         &mut warnings,
     );
-    let (mut dim_lines, written_dims) =
-        dimension_lines(p, &gone, &mut feats, &mut used_tol_names, &mut warnings);
+    let (mut dim_lines, written_dims) = dimension_lines(
+        p,
+        &part.mesh.exact,
+        &gone,
+        &mut feats,
+        &mut used_tol_names,
+        &mut warnings,
+    );
     let mut datum_lines = datums.lines;
     common_datum_lines(&frames, &mut feats, &mut datum_lines);
     let mut notes = p.notes.clone();
@@ -765,6 +771,7 @@ fn tolerance_args(
 /// and how many were written.
 fn dimension_lines(
     p: &pmi::Pmi,
+    exact: &[Surface],
     gone: &BTreeMap<u64, String>,
     feats: &mut Features,
     used_names: &mut BTreeSet<String>,
@@ -790,7 +797,7 @@ fn dimension_lines(
             left_out(&mut lines, label, &why);
             continue;
         }
-        match dimension_line(d, feats, used_names) {
+        match dimension_line(d, exact, feats, used_names) {
             Ok(line) => {
                 lines.push(line);
                 count += 1;
@@ -831,9 +838,11 @@ fn dimension_values(d: &pmi::Dimension) -> Result<(), String> {
 }
 
 /// One dimension as `tolerance name = diameter|radius|width|distance|angle(…, limits)`;
-/// Err with why the language cannot say it.
+/// Err with why the language cannot say it. A width between planes that all face one
+/// way, at two levels, is the distance between the levels ([`super::levels`]).
 fn dimension_line(
     d: &pmi::Dimension,
+    exact: &[Surface],
     feats: &mut Features,
     used_names: &mut BTreeSet<String>,
 ) -> Result<String, String> {
@@ -867,7 +876,18 @@ fn dimension_line(
                 "thickness" | "width" | "length" => "width",
                 _ => return Err("inspc has no such size".into()),
             };
-            (keyword, vec![feats.name(&d.faces, None)])
+            match super::levels::step_levels(exact, &d.faces).filter(|_| keyword == "width") {
+                Some((upper, lower)) => {
+                    note = format!(
+                        "{note} // a {what} between faces that all face one way: the distance between their levels"
+                    );
+                    (
+                        "distance",
+                        vec![feats.name(&upper, None), feats.name(&lower, None)],
+                    )
+                }
+                None => (keyword, vec![feats.name(&d.faces, None)]),
+            }
         }
         pmi::DimKind::Location(_) => {
             if d.to_faces.is_empty() {
