@@ -164,13 +164,15 @@ impl<'a> Sampler<'a> {
         let (eu, ev) = chart.extent_mm();
         // A face narrower than the tip keeps as much of the margin as it can: its points
         // gather towards the mid-line (a 1 mm ring gets a row on its middle, not none).
+        // Walls keep what they keep beyond it.
+        let beyond = (wall - margin).max(0.0);
         let margin = margin.min(NARROW_SHARE * eu.min(ev));
         let place = Place {
             s: self,
             chart: &chart,
             face,
             margin,
-            wall: wall.max(margin),
+            wall: margin + beyond,
         };
         match (strategy.method, &f.surface) {
             (SampleMethod::FanLeu, Surface::Plane { .. }) => {
