@@ -52,10 +52,8 @@ impl FaceIndex {
 
     /// Distance from `p` to the boundary of a face (mm); infinite for a closed face.
     pub fn boundary_distance(&self, g: &PartGeometry, face: FaceId, p: &P3) -> f64 {
-        self.boundary[face.0]
-            .iter()
-            .map(|&[a, b]| segment_distance(p, &g.vertices[a as usize], &g.vertices[b as usize]))
-            .fold(f64::INFINITY, f64::min)
+        let (open, wall) = self.edge_distances(g, face, p);
+        open.min(wall)
     }
 }
 
