@@ -493,6 +493,33 @@ impl<'a> Pose<'a> {
         }
     }
 
+    /// The same pose with the indexed probe's components also standing along each of
+    /// `turned` (the part set off square turns the stylus about the tip, in the part's
+    /// frame, while the ram stays along `up`): every test then holds for them all. A
+    /// fixed head's probe stands along `up` and turns into itself.
+    pub fn with_turned(mut self, probe: &ProbeShape, turned: &[V3]) -> Pose<'a> {
+        if probe.head != Head::Indexable {
+            return self;
+        }
+        for t in turned {
+            for comp in &probe.first {
+                self.parts.push(Posed {
+                    comp: comp.clone(),
+                    dir: *t,
+                    offset: V3::zeros(),
+                });
+            }
+            for comp in &probe.second {
+                self.parts.push(Posed {
+                    comp: comp.clone(),
+                    dir: self.up,
+                    offset: t * probe.reach(),
+                });
+            }
+        }
+        self
+    }
+
     /// The same pose with moves keeping `margin` (mm) from part, fixture and table.
     pub fn with_margin(mut self, margin: f64) -> Pose<'a> {
         self.margin = margin.max(0.0);
@@ -790,6 +817,48 @@ mod tests {
     fn a_tip_sweeping_along_the_plate_meets_it() {
         let c = P3::new(0.0, 0.0, 0.5);
         assert!(tip_meets_fixture(&plate(), &c, &V3::x(), 5.0, 1.0));
+    }
+
+    /// A wall in the plane y = 0, x from 0 to 100, z from -50 to 50, as two triangles.
+    fn wall() -> Scene {
+        let (a, b) = (P3::new(0.0, 0.0, -50.0), P3::new(100.0, 0.0, -50.0));
+        let (c, d) = (P3::new(100.0, 0.0, 50.0), P3::new(0.0, 0.0, 50.0));
+        Scene::of_triangles(&[[a, b, c], [a, c, d]])
+    }
+
+    /// A Ø1 stylus 50 mm long on an indexable head (no head or ram components).
+    fn horizontal_stylus() -> ProbeShape {
+        ProbeShape {
+            name: "p".into(),
+            tip_radius: 1.0,
+            first: vec![Component {
+                name: "stylus".into(),
+                a: 0.0,
+                b: 50.0,
+                radius: 0.5,
+                end: End::Round,
+            }],
+            second: vec![],
+            head: Head::Indexable,
+        }
+    }
+
+    #[test]
+    fn a_stylus_beside_a_wall_meets_it_once_the_part_is_turned() {
+        // The stylus lies along +x, 2.5 mm from the wall: a move along it clears by 1
+        // mm. The part set 3° off square turns the stylus about the tip in the part's
+        // frame, and its far end swings 50 · sin 3° = 2.6 mm towards the wall.
+        let scene = wall();
+        let probe = horizontal_stylus();
+        let (dir, up) = (V3::x(), V3::z());
+        let (p, q) = (P3::new(10.0, 2.5, 0.0), P3::new(20.0, 2.5, 0.0));
+        let plain = Pose::new(&scene, &probe, dir, up, -1000.0);
+        assert!(plain.segment_with(&p, &q, 0.5).is_ok());
+        let turned = crate::plan::turned_dirs(dir, &up, 3.0);
+        let posed = Pose::new(&scene, &probe, dir, up, -1000.0).with_turned(&probe, &turned);
+        assert!(posed.segment_with(&p, &q, 0.5).is_err());
+        // A probe standing along the vertical turns into itself: there is nothing to add.
+        assert!(crate::plan::turned_dirs(up, &up, 3.0).is_empty());
     }
 
     #[test]

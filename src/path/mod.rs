@@ -26,7 +26,10 @@
 //! the tip as an exact capsule, stylus and extensions as the exact union of two rounded
 //! triangles, body, head and ram as the convex hull of their two end positions (a
 //! support map, `access::swept`, never a built hull); the table by the components'
-//! lowest points at the ends. A scanner's group (`plan_scan_group`) runs its passes in
+//! lowest points at the ends. A group of an indexed probe first keeps its moves clear
+//! with the stylus also turned as far as the setup lets the part be set off square
+//! (`Pose::with_turned`, as the planner validated its touches); only where that leaves
+//! goals apart are its moves those clear at the nominal pose. A scanner's group (`plan_scan_group`) runs its passes in
 //! order, each from its nearer end, joined straight, over the passes lifted along the
 //! scanner's direction, or by the clearance plane.
 //!

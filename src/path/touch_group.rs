@@ -19,7 +19,7 @@ use super::roadmap::{Disconnected, Paths, Roadmap};
 use super::{no_path, polyline, tour, BlockPath, NoWay, Touch, Unreached};
 use crate::access::pose::{Contact, Pose};
 use crate::access::Scene;
-use crate::geometry::{PartGeometry, P3};
+use crate::geometry::{PartGeometry, P3, V3};
 use crate::plan::{Hlip, Input};
 use rayon::prelude::*;
 
@@ -35,7 +35,14 @@ pub(super) struct GroupOut {
 /// The shares of the plan's margin a stand-off tries, largest first.
 const MARGIN_STEPS: [f64; 5] = [1.0, 0.5, 0.25, 0.125, 0.0];
 
-/// Plans one group: roadmap, tour, entry and exit.
+/// Plans one group: roadmap, tour, entry and exit. Its moves first stay clear with the
+/// part turned as far as the setup lets the operator set it (its prompt's
+/// `square_within`, else [`crate::plan::PLACEMENT_TURN`]), as its touches were
+/// validated: the alignment follows the part, an indexed stylus keeps its machine
+/// direction, and a move that skims a rib with the stylus tilted meets it once the part
+/// stands 2° off square (NIST FTC 06 imported from QIF, `inspc verify`). Where the
+/// group has no such way, its moves are those clear at the nominal pose, as before:
+/// the touches decide what a setup tolerates, and the prompt says it.
 pub(super) fn plan_group(
     input: &Input,
     hlip: &Hlip,
@@ -43,8 +50,29 @@ pub(super) fn plan_group(
     g: &GroupIn,
     standoff: f64,
 ) -> Result<GroupOut, Unreached> {
+    let turn = hlip.setups[g.setup]
+        .square_within
+        .unwrap_or(crate::plan::PLACEMENT_TURN);
+    let turned = crate::plan::turned_dirs(g.dir, &g.up, turn);
+    if turned.is_empty() {
+        return plan_group_posed(input, hlip, scene, g, standoff, &[]);
+    }
+    plan_group_posed(input, hlip, scene, g, standoff, &turned)
+        .or_else(|_| plan_group_posed(input, hlip, scene, g, standoff, &[]))
+}
+
+/// [`plan_group`] with the probe also standing along each of `turned`.
+fn plan_group_posed(
+    input: &Input,
+    hlip: &Hlip,
+    scene: &Scene,
+    g: &GroupIn,
+    standoff: f64,
+    turned: &[V3],
+) -> Result<GroupOut, Unreached> {
     let full = input.plan.motion.margin;
     let mut pose = Pose::new(scene, g.probe, g.dir, g.up, g.table)
+        .with_turned(g.probe, turned)
         .with_fixture(g.fixture)
         .with_margin(full);
     let (goals, owner) = standoffs(hlip, g);
