@@ -826,30 +826,13 @@ mod tests {
         Scene::of_triangles(&[[a, b, c], [a, c, d]])
     }
 
-    /// A Ø1 stylus 50 mm long on an indexable head (no head or ram components).
-    fn horizontal_stylus() -> ProbeShape {
-        ProbeShape {
-            name: "p".into(),
-            tip_radius: 1.0,
-            first: vec![Component {
-                name: "stylus".into(),
-                a: 0.0,
-                b: 50.0,
-                radius: 0.5,
-                end: End::Round,
-            }],
-            second: vec![],
-            head: Head::Indexable,
-        }
-    }
-
     #[test]
     fn a_stylus_beside_a_wall_meets_it_once_the_part_is_turned() {
         // The stylus lies along +x, 2.5 mm from the wall: a move along it clears by 1
         // mm. The part set 3° off square turns the stylus about the tip in the part's
         // frame, and its far end swings 50 · sin 3° = 2.6 mm towards the wall.
         let scene = wall();
-        let probe = horizontal_stylus();
+        let probe = ProbeShape::bare_stylus(50.0, Head::Indexable);
         let (dir, up) = (V3::x(), V3::z());
         let (p, q) = (P3::new(10.0, 2.5, 0.0), P3::new(20.0, 2.5, 0.0));
         let plain = Pose::new(&scene, &probe, dir, up, -1000.0);

@@ -167,6 +167,25 @@ impl ProbeShape {
         self.first.last().map_or(0.0, |c| c.b)
     }
 
+    /// A bare stylus of `length` mm (Ø1 stem, Ø2 tip) on a head of `head`'s kind, with
+    /// no body, head or ram: the probe the unit tests pose.
+    #[cfg(test)]
+    pub(crate) fn bare_stylus(length: f64, head: Head) -> ProbeShape {
+        ProbeShape {
+            name: "p".into(),
+            tip_radius: 1.0,
+            first: vec![Component {
+                name: "stylus".into(),
+                a: 0.0,
+                b: length,
+                radius: 0.5,
+                end: End::Round,
+            }],
+            second: vec![],
+            head,
+        }
+    }
+
     /// Every component of a straight probe (fixed head), from the tip up.
     pub fn straight(&self) -> Vec<Component> {
         self.first.iter().chain(&self.second).cloned().collect()

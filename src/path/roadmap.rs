@@ -653,7 +653,7 @@ impl Ord for Near {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::access::{Component, End, ProbeShape, Scene};
+    use crate::access::{ProbeShape, Scene};
 
     /// The 12 triangles of a box, outward.
     fn cuboid(lo: P3, hi: P3) -> Vec<[P3; 3]> {
@@ -671,28 +671,12 @@ mod tests {
             .collect()
     }
 
-    fn stylus() -> ProbeShape {
-        ProbeShape {
-            name: "p".into(),
-            tip_radius: 1.0,
-            first: vec![Component {
-                name: "stylus".into(),
-                a: 0.0,
-                b: 30.0,
-                radius: 0.5,
-                end: End::Round,
-            }],
-            second: vec![],
-            head: crate::access::Head::Fixed,
-        }
-    }
-
     #[test]
     fn a_goal_sealed_in_a_box_is_reported() {
         let tris = cuboid(P3::new(-10.0, -10.0, -10.0), P3::new(10.0, 10.0, 10.0));
         let verts: Vec<P3> = tris.iter().flatten().copied().collect();
         let scene = Scene::of_triangles(&tris);
-        let probe = stylus();
+        let probe = ProbeShape::bare_stylus(30.0, crate::access::Head::Fixed);
         let pose = Pose::new(&scene, &probe, V3::z(), V3::z(), -100.0);
         let goals = vec![
             P3::origin(),
@@ -723,7 +707,7 @@ mod tests {
         let tris = cuboid(P3::new(-1.0, -20.0, 0.0), P3::new(1.0, 20.0, 20.0));
         let verts: Vec<P3> = tris.iter().flatten().copied().collect();
         let scene = Scene::of_triangles(&tris);
-        let probe = stylus();
+        let probe = ProbeShape::bare_stylus(30.0, crate::access::Head::Fixed);
         let pose = Pose::new(&scene, &probe, V3::z(), V3::z(), -100.0);
         let (a, b) = (P3::new(-5.0, 0.0, 5.0), P3::new(5.0, 0.0, 5.0));
         assert_eq!(pose.segment(&a, &b), Err(Blocker::Tip));
