@@ -29,9 +29,10 @@
 //! lowest points at the ends. A group of an indexed probe first keeps its moves clear
 //! with the stylus also turned as far as the setup lets the part be set off square
 //! (`Pose::with_turned`, as the planner validated its touches); only where that leaves
-//! goals apart are its moves those clear at the nominal pose. A scanner's group (`plan_scan_group`) runs its passes in
-//! order, each from its nearer end, joined straight, over the passes lifted along the
-//! scanner's direction, or by the clearance plane.
+//! goals apart are its moves those clear at the nominal pose. A scanner's group
+//! (`plan_scan_group`) runs its passes in order, each from its nearer end, joined
+//! straight, over the passes lifted along the scanner's direction, or by the clearance
+//! plane.
 //!
 //! **Decision: an unreachable touch is one more failed test.** A touch the roadmap
 //! cannot reach is returned, not given up on: the driver bans its configuration and
